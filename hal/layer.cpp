@@ -1,0 +1,1 @@
+// placeholder so the hal library has a translation unit until its first source lands

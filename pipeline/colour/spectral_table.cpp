@@ -1,0 +1,163 @@
+// Spectral CSV parsing with file:line error messages.
+#include <pipeline/colour/spectral_table.h>
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace replica::pipeline::colour {
+namespace {
+
+std::vector<std::string> splitCsvLine(const std::string& line)
+{
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream in(line);
+    while (std::getline(in, cell, ',')) {
+        while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '\t')) {
+            cell.pop_back();
+        }
+        std::size_t start = 0;
+        while (start < cell.size() && (cell[start] == ' ' || cell[start] == '\t')) {
+            ++start;
+        }
+        cells.push_back(cell.substr(start));
+    }
+    if (!line.empty() && line.back() == ',') {
+        cells.emplace_back();
+    }
+    return cells;
+}
+
+bool parseDouble(const std::string& cell, double& out)
+{
+    if (cell.empty()) {
+        return false;
+    }
+    const char* first = cell.data();
+    const char* last = cell.data() + cell.size();
+    if (*first == '+') {
+        ++first;
+    }
+    auto [ptr, ec] = std::from_chars(first, last, out);
+    return ec == std::errc() && ptr == last && std::isfinite(out);
+}
+
+} // namespace
+
+Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::string& source)
+{
+    SpectralTable table;
+    table.source = source;
+    std::istringstream in(text);
+    std::string line;
+    int lineNo = 0;
+    bool haveHeader = false;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') {
+            line.pop_back();
+        }
+        if (line.empty() || line[0] == '#') {
+            continue;
+        }
+        auto cells = splitCsvLine(line);
+        if (!haveHeader) {
+            if (cells.size() < 2 || cells[0] != "wavelength_nm") {
+                return makeError(ErrorCode::InvalidArgument,
+                        fmt::format("{}:{}: header must be 'wavelength_nm,<name>,...'", source,
+                                lineNo));
+            }
+            for (std::size_t c = 1; c < cells.size(); ++c) {
+                if (cells[c].empty()) {
+                    return makeError(ErrorCode::InvalidArgument,
+                            fmt::format("{}:{}: column {} has an empty name", source, lineNo, c + 1));
+                }
+            }
+            table.columns.assign(cells.begin() + 1, cells.end());
+            haveHeader = true;
+            continue;
+        }
+        if (cells.size() != table.columns.size() + 1) {
+            return makeError(ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: {} cells, expected {} (wavelength_nm and {} columns)", source,
+                            lineNo, cells.size(), table.columns.size() + 1, table.columns.size()));
+        }
+        double wl = 0.0;
+        if (!parseDouble(cells[0], wl)) {
+            return makeError(ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: wavelength '{}' is not a number", source, lineNo, cells[0]));
+        }
+        if (!table.wavelengthNm.empty() && !(wl > table.wavelengthNm.back())) {
+            return makeError(ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: wavelength {} nm does not increase (previous {} nm)", source,
+                            lineNo, wl, table.wavelengthNm.back()));
+        }
+        std::vector<double> row(table.columns.size());
+        for (std::size_t c = 0; c < row.size(); ++c) {
+            if (!parseDouble(cells[c + 1], row[c])) {
+                return makeError(ErrorCode::InvalidArgument,
+                        fmt::format("{}:{}: column '{}' value '{}' is not a finite number", source,
+                                lineNo, table.columns[c], cells[c + 1]));
+            }
+        }
+        table.wavelengthNm.push_back(wl);
+        table.rows.push_back(std::move(row));
+    }
+    if (!haveHeader) {
+        return makeError(ErrorCode::InvalidArgument,
+                fmt::format("{}: no header line 'wavelength_nm,...' found", source));
+    }
+    if (table.rows.size() < 2) {
+        return makeError(ErrorCode::InvalidArgument,
+                fmt::format("{}: needs at least two data rows, found {}", source, table.rows.size()));
+    }
+    return table;
+}
+
+Expected<SpectralTable> loadSpectralCsv(const std::filesystem::path& path)
+{
+    std::ifstream file(path, std::ios::binary);
+    if (!file) {
+        return makeError(ErrorCode::NotFound,
+                fmt::format("{}: cannot open spectral table (does the file exist?)", path.string()));
+    }
+    std::ostringstream text;
+    text << file.rdbuf();
+    return parseSpectralCsv(text.str(), path.string());
+}
+
+Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
+{
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+        if (columns[c] != column) {
+            continue;
+        }
+        SampledSpectrum s;
+        s.wavelengthNm = wavelengthNm;
+        s.value.reserve(rows.size());
+        for (const auto& row : rows) {
+            s.value.push_back(row[c]);
+        }
+        return resampleToWorkingGrid(s, fmt::format("{}: column '{}'", source, column));
+    }
+    return makeError(ErrorCode::NotFound, fmt::format("{}: no column named '{}'", source, column));
+}
+
+Expected<std::vector<Spectrum>> SpectralTable::allSpectra() const
+{
+    std::vector<Spectrum> out;
+    for (const auto& name : columns) {
+        auto s = spectrum(name);
+        if (!s) {
+            return tl::unexpected(s.error());
+        }
+        out.push_back(*s);
+    }
+    return out;
+}
+
+} // namespace replica::pipeline::colour

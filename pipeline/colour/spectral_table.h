@@ -1,0 +1,29 @@
+// Reading spectral CSV tables: '#' comment lines, a header 'wavelength_nm,<name>,...', numeric rows.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/colour/spectrum.h>
+
+namespace replica::pipeline::colour {
+
+struct SpectralTable {
+    std::string source;                    // file name, for messages
+    std::vector<std::string> columns;      // value column names, header order
+    std::vector<double> wavelengthNm;      // strictly increasing
+    std::vector<std::vector<double>> rows; // rows[i][c]: value of column c at wavelengthNm[i]
+
+    // The named column resampled to the working grid, or an error naming the file and column.
+    Expected<Spectrum> spectrum(const std::string& column) const;
+    // Every column resampled to the working grid, in header order.
+    Expected<std::vector<Spectrum>> allSpectra() const;
+};
+
+// Parses CSV text. 'source' names the file in messages ("file:line: problem").
+Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::string& source);
+Expected<SpectralTable> loadSpectralCsv(const std::filesystem::path& path);
+
+} // namespace replica::pipeline::colour

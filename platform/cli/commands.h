@@ -1,0 +1,17 @@
+// Registration of each 'replica' subcommand; each sets exitCode when it runs.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace replica::platform {
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitLossy = 3;
+
+void registerRunCommand(CLI::App& app, int& exitCode);
+void registerReplayCommand(CLI::App& app, int& exitCode);
+void registerInspectCommand(CLI::App& app, int& exitCode);
+
+} // namespace replica::platform

@@ -1,0 +1,1 @@
+// placeholder so the recordings library has a translation unit until its first source lands
