@@ -1,12 +1,12 @@
 // Spectral CSV parsing with file:line error messages.
-#include <pipeline/colour/spectral_table.h>
-
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
+
+#include <pipeline/colour/spectral_table.h>
 
 namespace replica::pipeline::colour {
 namespace {
@@ -17,7 +17,8 @@ std::vector<std::string> splitCsvLine(const std::string& line)
     std::string cell;
     std::istringstream in(line);
     while (std::getline(in, cell, ',')) {
-        while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '\t')) {
+        while (!cell.empty() &&
+               (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '\t')) {
             cell.pop_back();
         }
         std::size_t start = 0;
@@ -68,52 +69,60 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
         if (!haveHeader) {
             if (cells.size() < 2 || cells[0] != "wavelength_nm") {
                 return makeError(ErrorCode::InvalidArgument,
-                        fmt::format("{}:{}: header must be 'wavelength_nm,<name>,...'", source,
-                                lineNo));
+                                 fmt::format("{}:{}: header must be 'wavelength_nm,<name>,...'",
+                                             source, lineNo));
             }
             for (std::size_t c = 1; c < cells.size(); ++c) {
                 if (cells[c].empty()) {
                     return makeError(ErrorCode::InvalidArgument,
-                            fmt::format("{}:{}: column {} has an empty name", source, lineNo, c + 1));
+                                     fmt::format("{}:{}: column {} has an empty name", source,
+                                                 lineNo, c + 1));
                 }
             }
             table.columns.assign(cells.begin() + 1, cells.end());
+            table.headerLine = lineNo;
             haveHeader = true;
             continue;
         }
         if (cells.size() != table.columns.size() + 1) {
-            return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}:{}: {} cells, expected {} (wavelength_nm and {} columns)", source,
-                            lineNo, cells.size(), table.columns.size() + 1, table.columns.size()));
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: {} cells, expected {} (wavelength_nm and {} columns)",
+                                source, lineNo, cells.size(), table.columns.size() + 1,
+                                table.columns.size()));
         }
         double wl = 0.0;
         if (!parseDouble(cells[0], wl)) {
             return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}:{}: wavelength '{}' is not a number", source, lineNo, cells[0]));
+                             fmt::format("{}:{}: wavelength '{}' is not a number", source, lineNo,
+                                         cells[0]));
         }
         if (!table.wavelengthNm.empty() && !(wl > table.wavelengthNm.back())) {
-            return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}:{}: wavelength {} nm does not increase (previous {} nm)", source,
-                            lineNo, wl, table.wavelengthNm.back()));
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: wavelength {} nm does not increase (previous {} nm)",
+                                source, lineNo, wl, table.wavelengthNm.back()));
         }
         std::vector<double> row(table.columns.size());
         for (std::size_t c = 0; c < row.size(); ++c) {
             if (!parseDouble(cells[c + 1], row[c])) {
                 return makeError(ErrorCode::InvalidArgument,
-                        fmt::format("{}:{}: column '{}' value '{}' is not a finite number", source,
-                                lineNo, table.columns[c], cells[c + 1]));
+                                 fmt::format("{}:{}: column '{}' value '{}' is not a finite number",
+                                             source, lineNo, table.columns[c], cells[c + 1]));
             }
         }
         table.wavelengthNm.push_back(wl);
         table.rows.push_back(std::move(row));
+        table.rowLines.push_back(lineNo);
     }
     if (!haveHeader) {
         return makeError(ErrorCode::InvalidArgument,
-                fmt::format("{}: no header line 'wavelength_nm,...' found", source));
+                         fmt::format("{}: no header line 'wavelength_nm,...' found", source));
     }
     if (table.rows.size() < 2) {
         return makeError(ErrorCode::InvalidArgument,
-                fmt::format("{}: needs at least two data rows, found {}", source, table.rows.size()));
+                         fmt::format("{}: needs at least two data rows, found {}", source,
+                                     table.rows.size()));
     }
     return table;
 }
@@ -123,7 +132,8 @@ Expected<SpectralTable> loadSpectralCsv(const std::filesystem::path& path)
     std::ifstream file(path, std::ios::binary);
     if (!file) {
         return makeError(ErrorCode::NotFound,
-                fmt::format("{}: cannot open spectral table (does the file exist?)", path.string()));
+                         fmt::format("{}: cannot open spectral table (does the file exist?)",
+                                     path.string()));
     }
     std::ostringstream text;
     text << file.rdbuf();
@@ -136,6 +146,19 @@ Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
         if (columns[c] != column) {
             continue;
         }
+        // Name the offending line when the data stop short of the working grid.
+        if (!wavelengthNm.empty() && wavelengthNm.front() > kFirstNm) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}:{}: data start at {} nm but must cover {}-{} nm",
+                                         source, rowLines.empty() ? 0 : rowLines.front(),
+                                         wavelengthNm.front(), kFirstNm, kLastNm));
+        }
+        if (!wavelengthNm.empty() && wavelengthNm.back() < kLastNm) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}:{}: data end at {} nm but must cover {}-{} nm", source,
+                                         rowLines.empty() ? 0 : rowLines.back(),
+                                         wavelengthNm.back(), kFirstNm, kLastNm));
+        }
         SampledSpectrum s;
         s.wavelengthNm = wavelengthNm;
         s.value.reserve(rows.size());
@@ -144,7 +167,8 @@ Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
         }
         return resampleToWorkingGrid(s, fmt::format("{}: column '{}'", source, column));
     }
-    return makeError(ErrorCode::NotFound, fmt::format("{}: no column named '{}'", source, column));
+    return makeError(ErrorCode::NotFound, fmt::format("{}:{}: no column named '{}' in the header",
+                                                      source, headerLine, column));
 }
 
 Expected<std::vector<Spectrum>> SpectralTable::allSpectra() const
@@ -158,6 +182,43 @@ Expected<std::vector<Spectrum>> SpectralTable::allSpectra() const
         out.push_back(*s);
     }
     return out;
+}
+
+Expected<void> checkWorkingGrid(const SpectralTable& table)
+{
+    if (table.wavelengthNm.size() != kBands) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("{}: has {} wavelength rows, expected the {} of the working grid "
+                            "({}-{} nm every {} nm)",
+                            table.source, table.wavelengthNm.size(), kBands, kFirstNm, kLastNm,
+                            kStepNm));
+    }
+    for (std::size_t i = 0; i < kBands; ++i) {
+        if (table.wavelengthNm[i] != bandCentreNm(i)) {
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}: wavelength row {} is {} nm, expected {} nm (the working grid)",
+                                table.source, i + 1, table.wavelengthNm[i], bandCentreNm(i)));
+        }
+    }
+    return {};
+}
+
+Expected<Spectrum> workingGridColumn(const SpectralTable& table, const std::string& column)
+{
+    for (std::size_t c = 0; c < table.columns.size(); ++c) {
+        if (table.columns[c] != column) {
+            continue;
+        }
+        Spectrum s;
+        for (std::size_t i = 0; i < kBands && i < table.rows.size(); ++i) {
+            s[i] = table.rows[i][c];
+        }
+        return s;
+    }
+    return makeError(ErrorCode::InvalidArgument,
+                     fmt::format("{}: no column named '{}'", table.source, column));
 }
 
 } // namespace replica::pipeline::colour
