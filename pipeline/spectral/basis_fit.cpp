@@ -64,9 +64,24 @@ Expected<colour::ChannelBasis> fitChannelBasis(const Observer& obs,
     for (const auto& f : fitLights) {
         g.push_back(f.h * f.a);
     }
+    if (fitLights.size() != lights.size()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "channel fit: a training light has no luminance");
+    }
+    if (!options.lightWeights.empty() && options.lightWeights.size() != g.size()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("channel fit: {} light weights for {} lights",
+                                     options.lightWeights.size(), g.size()));
+    }
     DenseMatrix gtg(kBands, kBands);
-    for (const auto& gj : g) {
-        gtg = gtg + gj.transposed() * gj;
+    for (std::size_t j = 0; j < g.size(); ++j) {
+        const double weight = options.lightWeights.empty() ? 1.0 : options.lightWeights[j];
+        const DenseMatrix gj = g[j].transposed() * g[j];
+        for (std::size_t a = 0; a < kBands; ++a) {
+            for (std::size_t b = 0; b < kBands; ++b) {
+                gtg(a, b) += weight * gj(a, b);
+            }
+        }
     }
     const SymmetricEigen eig = symmetricEigen(l->transposed() * gtg * *l);
     DenseMatrix q(kBands, kChannels);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <pipeline/base/expected.h>
 #include <pipeline/colour/channel_basis.h>
@@ -21,6 +22,10 @@ struct BasisFitOptions {
     // Tikhonov term added to the reflectance second moment, relative to its mean diagonal: keeps
     // the projection smooth where the training set has no energy.
     double ridge = 1e-4;
+    // Weight of each training light in the sum over lights (empty: all 1). With K = 6 channels at
+    // most two lights can be exact at once; weighting the booth's own lamps well above the others
+    // makes them nearly exact while keeping the rest usable (docs/accuracy.md).
+    std::vector<double> lightWeights;
 };
 
 // With C the weighted second moment of the training reflectances (plus the ridge) and G the stacked

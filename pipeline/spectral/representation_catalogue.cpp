@@ -8,7 +8,7 @@ namespace replica::pipeline::spectral {
 
 std::vector<std::string> representationNames()
 {
-    return {"rgb3", "paper6", "replica_k6", "spectral36", "pca6", "box6"};
+    return {"rgb3", "paper6", "replica_k6", "spectral36", "general_k6", "pca6", "box6"};
 }
 
 Expected<std::unique_ptr<Representation>> makeRepresentation(const std::filesystem::path& dataDir,
@@ -33,7 +33,7 @@ Expected<std::unique_ptr<Representation>> makeRepresentation(const std::filesyst
         }
         return makeSixChannelRepresentation(obs, std::move(*model));
     }
-    if (name == "replica_k6" || name == "pca6") {
+    if (name == "replica_k6" || name == "general_k6" || name == "pca6") {
         auto basis = colour::loadChannelBasis(channels / (name + ".csv"));
         if (!basis) {
             return tl::unexpected(basis.error());

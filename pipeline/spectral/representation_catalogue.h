@@ -13,7 +13,8 @@
 namespace replica::pipeline::spectral {
 
 // "rgb3" (1), "paper6" (2), "replica_k6" (3, the appliance's default), "spectral36" (4), and for
-// comparison "pca6" (principal components, light-independent) and "box6" (six box bands).
+// comparison "general_k6" (light-aware, all training lights equal), "pca6" (principal components,
+// light-independent) and "box6" (six box bands).
 std::vector<std::string> representationNames();
 constexpr const char* kDefaultRepresentation = "replica_k6";
 

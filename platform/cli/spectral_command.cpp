@@ -1,10 +1,12 @@
 // 'replica spectral eval' (representation accuracy on a light and a reflectance set) and 'replica
 // spectral fit' (derive the channel data the appliance ships).
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -116,6 +118,8 @@ int runEval(const EvalOptions& o)
 struct FitOptions {
     std::string reflectances = "ces99";
     std::string lights;
+    std::string boothLights = "A,F8,F7";
+    double boothWeight = 10.0;
     std::string out;
     int rounds = 1000;
 };
@@ -185,10 +189,31 @@ int runFit(const FitOptions& o)
                         "380-730 nm at 10 nm; see docs/accuracy.md",
                         training.size(), o.reflectances, lights.size(), fmt::join(lightNames, " "));
 
-    spectral::BasisFitOptions lightAware;
-    auto k6 = spectral::fitChannelBasis(*obs, *d65, training, lights, lightAware, "replica_k6");
+    // replica_k6: every training light, the booth's own lamps weighted up; general_k6: all equal.
+    spectral::BasisFitOptions boothOptions;
+    const auto booth = splitList(o.boothLights);
+    for (const auto& name : booth) {
+        if (std::find(lightNames.begin(), lightNames.end(), name) == lightNames.end()) {
+            lights.names.push_back(name);
+            auto l = spectral::loadCieIlluminant(data, name);
+            if (!l) {
+                return fail(l.error().message);
+            }
+            lights.spectra.push_back(*l);
+        }
+    }
+    for (const auto& name : lights.names) {
+        const bool isBooth = std::find(booth.begin(), booth.end(), name) != booth.end();
+        boothOptions.lightWeights.push_back(isBooth ? o.boothWeight : 1.0);
+    }
+    auto k6 = spectral::fitChannelBasis(*obs, *d65, training, lights, boothOptions, "replica_k6");
     if (!k6) {
         return fail(k6.error().message);
+    }
+    auto general = spectral::fitChannelBasis(*obs, *d65, training, lights,
+                                             spectral::BasisFitOptions{}, "general_k6");
+    if (!general) {
+        return fail(general.error().message);
     }
     spectral::BasisFitOptions pca;
     pca.lightAware = false;
@@ -202,9 +227,14 @@ int runFit(const FitOptions& o)
     if (!paper6) {
         return fail(paper6.error().message);
     }
-    for (const auto& [basis, file] :
-         {std::pair{&*k6, "replica_k6.csv"}, std::pair{&*pca6, "pca6.csv"}}) {
-        auto saved = colour::saveChannelBasis(*basis, outDir / file, provenance);
+    const std::string boothNote =
+            fmt::format("; booth lamps {} weighted {}", o.boothLights, o.boothWeight);
+    const std::tuple<const colour::ChannelBasis*, const char*, std::string> outputs[] = {
+            {&*k6, "replica_k6.csv", boothNote},
+            {&*general, "general_k6.csv", ""},
+            {&*pca6, "pca6.csv", "; principal components, lights unused"}};
+    for (const auto& [basis, file, note] : outputs) {
+        auto saved = colour::saveChannelBasis(*basis, outDir / file, provenance + note);
         if (!saved) {
             return fail(saved.error().message);
         }
@@ -254,15 +284,23 @@ void registerSpectralCommand(CLI::App& app, int& exitCode)
     e->callback([eval, &exitCode] { exitCode = runEval(*eval); });
 
     auto fit = std::make_shared<FitOptions>();
-    auto* f = spectralCmd->add_subcommand("fit", "derive the channel data the appliance ships "
-                                                 "(replica_k6.csv, pca6.csv, paper6.csv) from "
-                                                 "named training sets");
+    auto* f = spectralCmd->add_subcommand(
+            "fit", "derive the channel data the appliance ships "
+                   "(replica_k6.csv, general_k6.csv, pca6.csv, paper6.csv) from "
+                   "named training sets");
     f->add_option("--reflectances", fit->reflectances,
                   "training reflectances: comma-separated set names (ces99, tcs14) or CSV paths")
             ->capture_default_str();
     f->add_option("--lights", fit->lights,
                   fmt::format("training lights: comma-separated CIE illuminant names (default: {})",
                               fmt::join(spectral::evaluationLightNames(), ",")));
+    f->add_option("--booth-lights", fit->boothLights,
+                  "the booth's own lamps (CIE names), weighted up in replica_k6")
+            ->capture_default_str();
+    f->add_option("--booth-weight", fit->boothWeight,
+                  "weight of each booth lamp against 1 for the others")
+            ->capture_default_str()
+            ->check(CLI::Range(0.0, 1e6));
     f->add_option("--out", fit->out, "output folder (default: the data folder's channels/)");
     f->add_option("--rounds", fit->rounds, "alternating least-squares rounds for paper6")
             ->capture_default_str()
