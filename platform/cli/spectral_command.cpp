@@ -17,6 +17,7 @@
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/spectral/accuracy.h>
 #include <pipeline/spectral/basis_fit.h>
+#include <pipeline/spectral/metamers.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/spectral/six_channel_model.h>
 #include <platform/cli/commands.h>
@@ -255,6 +256,63 @@ int runFit(const FitOptions& o)
     return kExitOk;
 }
 
+struct MetamerOptions {
+    std::string matchLight = "A";
+    std::string mismatchLight = "D65";
+    std::string seeds = "ces99";
+    std::string out;
+    std::size_t count = 6;
+    double minMismatch = 3.0;
+    double targetMismatch = 8.0;
+};
+
+int runMetamers(const MetamerOptions& o)
+{
+    auto fail = [](const std::string& msg) {
+        std::fprintf(stderr, "replica spectral metamers: %s\n", msg.c_str());
+        return kExitFailure;
+    };
+    const auto data = dataDir();
+    auto obs = colour::loadCie1931(data);
+    auto basis = colour::loadDefaultChannelBasis(data);
+    auto match = spectral::loadCieIlluminant(data, o.matchLight);
+    auto mismatch = spectral::loadCieIlluminant(data, o.mismatchLight);
+    auto seeds = spectral::loadReflectanceSet(data, o.seeds);
+    for (const Error* e : {obs ? nullptr : &obs.error(), basis ? nullptr : &basis.error(),
+                           match ? nullptr : &match.error(), mismatch ? nullptr : &mismatch.error(),
+                           seeds ? nullptr : &seeds.error()}) {
+        if (e != nullptr) {
+            return fail(e->message);
+        }
+    }
+    const auto pairs = spectral::findMetamerPairs(*obs, *basis, *match, *mismatch, *seeds, o.count,
+                                                  o.minMismatch, o.targetMismatch);
+    if (pairs.empty()) {
+        return fail(fmt::format("no seed in '{}' gives a pair with CIEDE2000 >= {} under {}",
+                                o.seeds, o.minMismatch, o.mismatchLight));
+    }
+    const std::filesystem::path out =
+            o.out.empty() ? data / "scenes" / "metamers" /
+                                    fmt::format("metamers_{}_{}.csv", o.matchLight, o.mismatchLight)
+                          : std::filesystem::path(o.out);
+    auto saved = spectral::saveMetamerPairs(pairs, out,
+                                            fmt::format("written by 'replica spectral metamers' in "
+                                                        "the span of {} from {} seeds; same XYZ "
+                                                        "under {}, different under {}",
+                                                        basis->name, o.seeds, o.matchLight,
+                                                        o.mismatchLight));
+    if (!saved) {
+        return fail(saved.error().message);
+    }
+    for (const auto& p : pairs) {
+        std::cout << fmt::format("{} (from {}): de00 {:.4f} under {}, {:.2f} under {}\n", p.name,
+                                 p.seed, p.de00Match, o.matchLight, p.de00Mismatch,
+                                 o.mismatchLight);
+    }
+    std::cout << "wrote " << out.string() << "\n";
+    return kExitOk;
+}
+
 } // namespace
 
 void registerSpectralCommand(CLI::App& app, int& exitCode)
@@ -306,6 +364,30 @@ void registerSpectralCommand(CLI::App& app, int& exitCode)
             ->capture_default_str()
             ->check(CLI::Range(1, 100000));
     f->callback([fit, &exitCode] { exitCode = runFit(*fit); });
+
+    auto met = std::make_shared<MetamerOptions>();
+    auto* m = spectralCmd->add_subcommand(
+            "metamers",
+            "write metameric reflectance pairs (same XYZ under one light, different under another) "
+            "inside the default channel basis, as a scene target");
+    m->add_option("--match-light", met->matchLight, "CIE illuminant of the match")
+            ->capture_default_str();
+    m->add_option("--mismatch-light", met->mismatchLight, "CIE illuminant of the mismatch")
+            ->capture_default_str();
+    m->add_option("--seeds", met->seeds, "reflectance set the pairs grow from")
+            ->capture_default_str();
+    m->add_option("--count", met->count, "number of pairs")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 50));
+    m->add_option("--min-mismatch", met->minMismatch, "smallest CIEDE2000 under the mismatch light")
+            ->capture_default_str();
+    m->add_option("--target-mismatch", met->targetMismatch,
+                  "CIEDE2000 the pairs are eased back to under the mismatch light (0: as large as "
+                  "possible)")
+            ->capture_default_str();
+    m->add_option("--out", met->out,
+                  "output CSV (default: data/scenes/metamers/metamers_<match>_<mismatch>.csv)");
+    m->callback([met, &exitCode] { exitCode = runMetamers(*met); });
 }
 
 } // namespace replica::platform
