@@ -1,4 +1,5 @@
 // Nearest-shape light classification with accept/release thresholds and a confirmation count.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -9,33 +10,48 @@
 namespace replica::pipeline::spectral {
 namespace {
 
-constexpr double kSqrt2 = 1.4142135623730951;
-
-double norm(const Spectrum& s)
+std::vector<StoredLight> nameLamps(std::vector<colour::Spectrum> lamps)
 {
-    double n = 0.0;
-    for (double v : s.v) {
-        n += v * v;
+    std::vector<StoredLight> out;
+    for (std::size_t i = 0; i < lamps.size(); ++i) {
+        out.push_back({fmt::format("lamp{}", i), lamps[i]});
     }
-    return std::sqrt(n);
+    return out;
+}
+
+double positiveSum(const Spectrum& s)
+{
+    double sum = 0.0;
+    for (double v : s.v) {
+        sum += std::max(v, 0.0);
+    }
+    return sum;
 }
 
 } // namespace
 
 double spectralShapeDistance(const Spectrum& a, const Spectrum& b)
 {
-    const double na = norm(a);
-    const double nb = norm(b);
-    if (!(na > 0.0) || !(nb > 0.0) || !std::isfinite(na) || !std::isfinite(nb)) {
-        return kSqrt2;
+    // Sensor noise can make dark bands slightly negative; negative power is not a shape feature.
+    const double sa = positiveSum(a);
+    const double sb = positiveSum(b);
+    if (!(sa > 0.0) || !(sb > 0.0) || !std::isfinite(sa) || !std::isfinite(sb)) {
+        return std::numeric_limits<double>::infinity();
     }
-    double d = 0.0;
+    const double n = static_cast<double>(colour::kBands);
+    double sq = 0.0;
     for (std::size_t i = 0; i < colour::kBands; ++i) {
-        const double diff = a[i] / na - b[i] / nb;
-        d += diff * diff;
+        const double d = std::max(a[i], 0.0) * n / sa - std::max(b[i], 0.0) * n / sb;
+        sq += d * d;
     }
-    return std::sqrt(d);
+    return std::sqrt(sq / n);
 }
+
+LightClassifier::LightClassifier(std::vector<colour::Spectrum> lamps,
+                                 double unknownAbove,
+                                 double switchMargin)
+    : lights_(nameLamps(std::move(lamps))), params_{unknownAbove, unknownAbove, switchMargin, 1}
+{}
 
 Expected<LightClassifier> LightClassifier::create(std::vector<StoredLight> lights,
                                                   const LightClassifierParams& params)
@@ -44,7 +60,7 @@ Expected<LightClassifier> LightClassifier::create(std::vector<StoredLight> light
         return makeError(ErrorCode::InvalidArgument, "light classifier: no stored lights");
     }
     for (const auto& l : lights) {
-        if (!(norm(l.spd) > 0.0) || l.spd.max() <= 0.0) {
+        if (!(positiveSum(l.spd) > 0.0)) {
             return makeError(
                     ErrorCode::InvalidArgument,
                     fmt::format("light classifier: stored light '{}' has no energy", l.name));

@@ -1,4 +1,4 @@
-// Classifier mode of the paper: which stored booth light is the sensed spectrum, or "unknown" (then
+// Classifier mode of the paper: which stored booth lamp is the sensed spectrum, or "unknown" (then
 // the renderer uses the sensed spectrum itself: direct-sensor mode). Hysteresis keeps sensor noise
 // from making the answer flicker.
 #pragma once
@@ -13,10 +13,10 @@ namespace replica::pipeline::spectral {
 
 using colour::Spectrum;
 
-// Shape difference of two spectra, blind to their scale (a dimmer or a longer integration does not
-// change it): the Euclidean distance between the spectra each divided by its own Euclidean norm,
-// over the 36 bands. 0 for proportional spectra, sqrt(2) for spectra with no band in common. A
-// spectrum with no positive energy is at distance sqrt(2) from everything.
+// Shape difference of two SPDs, blind to their scale (a dimmer or a longer integration does not
+// change it): negative bands (sensor noise) are clamped to 0, each spectrum is scaled to unit mean
+// over the 36 bands, and the result is the RMS difference. 0 for proportional spectra; infinity
+// when either has no positive energy.
 double spectralShapeDistance(const Spectrum& a, const Spectrum& b);
 
 struct StoredLight {
@@ -25,35 +25,53 @@ struct StoredLight {
 };
 
 struct LightClassifierParams {
-    // A light is recognised when the sensed shape is within acceptDistance of it...
-    double acceptDistance = 0.03;
-    // ...and, once recognised, kept while it stays within releaseDistance (> acceptDistance) and no
-    // other stored light is closer by more than switchMargin.
-    double releaseDistance = 0.05;
-    double switchMargin = 0.01;
-    // A different answer must win this many consecutive samples before it replaces the current one.
+    // A lamp is recognised when the sensed shape is within acceptDistance of it...
+    double acceptDistance = 0.05;
+    // ...and, once recognised, kept while it stays within releaseDistance (>= acceptDistance) and
+    // no other lamp is closer by more than switchMargin.
+    double releaseDistance = 0.08;
+    double switchMargin = 0.02;
+    // A different answer must win this many consecutive samples before it replaces the current one
+    // (1: at once).
     int confirmSamples = 3;
 };
 
 struct Classification {
-    int index = -1;               // into the stored lights; -1 = unknown
-    std::string name = "unknown"; // the stored light's name, or "unknown"
-    double distance = 0.0;        // shape distance to that light (to the nearest one when unknown)
+    int index = -1;               // into the stored lamps; -1 = unknown
+    std::string name = "unknown"; // the stored lamp's name, or "unknown"
+    double distance = 0.0;        // shape distance to that lamp (to the nearest one when unknown)
 };
 
 class LightClassifier
 {
 public:
-    // Fails for an empty list, a stored light without energy, or thresholds out of order.
+    // The appliance's original form: lamps named "lamp0", "lamp1", ...; one threshold for accepting
+    // and keeping (releaseDistance = acceptDistance = unknownAbove) and an answer that changes at
+    // once (confirmSamples = 1). With no lamps every answer is unknown.
+    explicit LightClassifier(std::vector<colour::Spectrum> lamps,
+                             double unknownAbove = 0.10,
+                             double switchMargin = 0.02);
+
+    // The full form. Fails for an empty list, a lamp without energy, or thresholds out of order.
     static Expected<LightClassifier> create(std::vector<StoredLight> lights,
                                             const LightClassifierParams& params = {});
 
-    // The nearest stored light, without memory: what a single sample says.
+    static double shapeDistance(const colour::Spectrum& a, const colour::Spectrum& b)
+    {
+        return spectralShapeDistance(a, b);
+    }
+
+    // The nearest stored lamp, without memory: what a single sample says.
     Classification nearest(const Spectrum& sensed) const;
     // Feeds one sensed spectrum through the hysteresis and returns the current answer.
     Classification update(const Spectrum& sensed);
-    const Classification& current() const { return current_; }
+    // update(), returning the lamp index or -1 for unknown.
+    int classify(const colour::Spectrum& sensed) { return update(sensed).index; }
+
+    int current() const { return current_.index; }
+    const Classification& currentClassification() const { return current_; }
     const std::vector<StoredLight>& lights() const { return lights_; }
+    const LightClassifierParams& params() const { return params_; }
     void reset();
 
 private:

@@ -23,7 +23,9 @@ int runCli(int argc, char** argv)
             ->capture_default_str();
 
     int exitCode = 0;
-    // (subcommands are registered here as they land)
+    registerRunCommand(app, exitCode);
+    registerReplayCommand(app, exitCode);
+    registerInspectCommand(app, exitCode);
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
 

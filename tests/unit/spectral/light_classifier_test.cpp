@@ -25,16 +25,22 @@ std::vector<StoredLight> boothLights()
 
 TEST(SpectralShapeDistance, ClosedForms)
 {
+    // Unit mean over n = 36 bands, then RMS difference.
+    const double n = static_cast<double>(colour::kBands);
     Spectrum a;
     Spectrum b;
     a[3] = 2.0;
     b[10] = 5.0;
-    EXPECT_NEAR(spectralShapeDistance(a, b), std::sqrt(2.0), 1e-15); // nothing in common
-    EXPECT_NEAR(spectralShapeDistance(a, a * 7.0), 0.0, 1e-15);      // scale does not matter
+    // a -> n at band 3, b -> n at band 10: RMS of two differences of n is sqrt(2 n).
+    EXPECT_NEAR(spectralShapeDistance(a, b), std::sqrt(2.0 * n), 1e-12);
+    EXPECT_NEAR(spectralShapeDistance(a, a * 7.0), 0.0, 1e-15); // scale does not matter
     Spectrum c = a;
-    c[10] = 2.0; // (1, 1)/sqrt2 against (1, 0): distance sqrt(2 - sqrt 2)
-    EXPECT_NEAR(spectralShapeDistance(a, c), std::sqrt(2.0 - std::sqrt(2.0)), 1e-15);
-    EXPECT_NEAR(spectralShapeDistance(a, Spectrum{}), std::sqrt(2.0), 1e-15);
+    c[10] = 2.0; // c -> n/2 at bands 3 and 10: differences n/2 twice, RMS sqrt(n / 2)
+    EXPECT_NEAR(spectralShapeDistance(a, c), std::sqrt(n / 2.0), 1e-12);
+    Spectrum noisy = a;
+    noisy[20] = -0.3; // negative (noise) bands carry no shape
+    EXPECT_NEAR(spectralShapeDistance(a, noisy), 0.0, 1e-15);
+    EXPECT_TRUE(std::isinf(spectralShapeDistance(a, Spectrum{})));
 }
 
 TEST(LightClassifier, RejectsBadSetups)
@@ -66,7 +72,7 @@ TEST(LightClassifier, OtherLightsAreUnknown)
         ASSERT_TRUE(l);
         EXPECT_EQ(c->nearest(*l).name, "unknown") << other;
     }
-    // About a 100 K step from A (2856 K) is the edge: 2900 K is still A, 3000 K is not.
+    // About a 125 K step from A (2856 K) is the edge: 2900 K is still A, 3000 K is not.
     EXPECT_EQ(c->nearest(colour::planckianSpectrum(2900.0)).name, "A");
     EXPECT_EQ(c->nearest(colour::planckianSpectrum(3000.0)).name, "unknown");
 }
@@ -83,9 +89,9 @@ TEST(LightClassifier, HysteresisNeedsConfirmationAndHoldsNearTheEdge)
         EXPECT_EQ(c->update(a).name, "unknown");
     }
     EXPECT_EQ(c->update(a).name, "A");
-    // A Planckian at about 2960 K lies between accept (0.03) and release (0.05): alone it would be
+    // A Planckian at 3030 K lies between accept (0.05) and release (0.08): alone it would be
     // unknown, but once A is recognised it is kept, however long it lasts.
-    const Spectrum edge = colour::planckianSpectrum(2960.0);
+    const Spectrum edge = colour::planckianSpectrum(3030.0);
     const double d = spectralShapeDistance(edge, a);
     ASSERT_GT(d, p.acceptDistance);
     ASSERT_LT(d, p.releaseDistance);
@@ -102,7 +108,8 @@ TEST(LightClassifier, HysteresisNeedsConfirmationAndHoldsNearTheEdge)
     }
     EXPECT_EQ(c->update(f7).name, "F7");
     c->reset();
-    EXPECT_EQ(c->current().name, "unknown");
+    EXPECT_EQ(c->currentClassification().name, "unknown");
+    EXPECT_EQ(c->current(), -1);
 }
 
 TEST(LightClassifier, NoFlickerAtTenTimesTheDataSheetNoise)
@@ -114,7 +121,7 @@ TEST(LightClassifier, NoFlickerAtTenTimesTheDataSheetNoise)
         EXPECT_EQ(classifierFlicker(lights, {}, noise, l.spd, 400, 21), 0) << l.name;
     }
     // A light sitting right at the accept threshold, where single samples fall either side.
-    const Spectrum edge = colour::planckianSpectrum(2952.0);
+    const Spectrum edge = colour::planckianSpectrum(2985.0);
     EXPECT_LE(classifierFlicker(lights, {}, noise, edge, 400, 22), 1);
 }
 
