@@ -9,7 +9,9 @@
 #include <fmt/format.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/colour/cct.h>
 #include <pipeline/spectral/accuracy.h>
+#include <pipeline/spectral/classifier_study.h>
 #include <pipeline/spectral/representation_catalogue.h>
 
 namespace {
@@ -63,6 +65,90 @@ void printAccuracyTable()
             }
             std::printf("\n");
         }
+    }
+    std::printf("\n");
+}
+
+void printClassifierStudy()
+{
+    std::vector<StoredLight> booth;
+    for (const char* n : {"A", "F8", "F7"}) {
+        auto l = loadCieIlluminant(dataDir(), n);
+        if (!l) {
+            return;
+        }
+        booth.push_back({n, *l});
+    }
+    const LightClassifierParams params;
+    std::printf("light classifier (accept %.3f, release %.3f, margin %.3f, confirm %d)\n\n",
+                params.acceptDistance, params.releaseDistance, params.switchMargin,
+                params.confirmSamples);
+    for (double scale : {1.0, 10.0, 30.0, 40.0}) {
+        BandNoiseParams noise;
+        noise.noiseScale = scale;
+        const auto m = classifierConfusion(booth, params, noise, 1000, 17);
+        std::printf("noise x%g (1000 single samples per lamp), rows true, columns answer:\n\n| |",
+                    scale);
+        for (const auto& l : m.labels) {
+            std::printf(" %s |", l.c_str());
+        }
+        std::printf(" flicker/1000 |\n|---|");
+        for (std::size_t i = 0; i <= m.labels.size(); ++i) {
+            std::printf("---|");
+        }
+        std::printf("\n");
+        for (std::size_t t = 0; t < booth.size(); ++t) {
+            std::printf("| %s |", booth[t].name.c_str());
+            for (int c : m.counts[t]) {
+                std::printf(" %d |", c);
+            }
+            std::printf(" %d |\n", classifierFlicker(booth, params, noise, booth[t].spd, 1000, 23));
+        }
+        std::printf(
+                "\nnoise floor (p99.9 shape distance of a reading from its lamp): A %.4f, F8 %.4f, "
+                "F7 %.4f\n\n",
+                noiseFloorDistance(booth[0].spd, noise, 2000, 0.999, 5),
+                noiseFloorDistance(booth[1].spd, noise, 2000, 0.999, 5),
+                noiseFloorDistance(booth[2].spd, noise, 2000, 0.999, 5));
+    }
+    auto all = loadAllCieIlluminants(dataDir());
+    if (all) {
+        std::vector<StoredLight> cie;
+        for (std::size_t i = 0; i < all->size(); ++i) {
+            cie.push_back({all->names[i], all->spectra[i]});
+        }
+        const auto m = classifierConfusion(cie, params, BandNoiseParams{}, 200, 19);
+        int correct = 0;
+        int unknown = 0;
+        int wrong = 0;
+        for (std::size_t t = 0; t < cie.size(); ++t) {
+            for (std::size_t c = 0; c <= cie.size(); ++c) {
+                (c == t ? correct : (c == cie.size() ? unknown : wrong)) += m.counts[t][c];
+            }
+        }
+        std::printf(
+                "all %zu CIE illuminants stored, data-sheet noise, 200 samples each: %d correct, "
+                "%d unknown, %d wrong\n\n",
+                cie.size(), correct, unknown, wrong);
+    }
+    std::printf("smallest mixture (1 - a) L + a M no longer taken for L (<= 1 %% of samples), "
+                "data-sheet noise:\n\n| L | M | a | shape distance |\n|---|---|---|---|\n");
+    for (std::size_t i = 0; i < booth.size(); ++i) {
+        for (std::size_t j = 0; j < booth.size(); ++j) {
+            if (i == j) {
+                continue;
+            }
+            const auto s = minimumSeparableDifference(booth, params, BandNoiseParams{}, i,
+                                                      booth[j].spd, 400, 29);
+            std::printf("| %s | %s | %.4f | %.4f |\n", booth[i].name.c_str(), booth[j].name.c_str(),
+                        s.mixFraction, s.shapeDistance);
+        }
+    }
+    for (double t : {2900.0, 2950.0, 3000.0, 3050.0}) {
+        const Spectrum p = pipeline::colour::planckianSpectrum(t);
+        auto c = LightClassifier::create(booth, params);
+        std::printf("Planckian %.0f K: distance from A %.4f, classified %s\n", t,
+                    spectralShapeDistance(p, booth[0].spd), c->nearest(p).name.c_str());
     }
     std::printf("\n");
 }
@@ -135,6 +221,7 @@ BENCHMARK_CAPTURE(lightVectors, spectral36, "spectral36");
 int main(int argc, char** argv)
 {
     printAccuracyTable();
+    printClassifierStudy();
     benchmark::Initialize(&argc, argv);
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
