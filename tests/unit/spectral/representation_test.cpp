@@ -8,6 +8,7 @@
 #include <pipeline/spectral/basis_fit.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/spectral/six_channel_model.h>
+#include <platform/appliance.h>
 
 #include <gtest/gtest.h>
 
@@ -213,6 +214,18 @@ TEST_F(Spectral, ShippedPaperModelLoadsAndIsComparableToThePaper)
     // Same family as the paper's: within a factor of two of its Table 1 means.
     EXPECT_LT(stats(**paper, "D65", cc_).mean, 0.8);
     EXPECT_LT(stats(**paper, "A", cc_).mean, 1.6);
+}
+
+// The appliance renders with the fitted default basis (docs/accuracy.md), not the box bands.
+TEST(DefaultBasis, ApplianceConfigNamesTheShippedFittedBasis)
+{
+    const platform::RunConfig config;
+    EXPECT_EQ(config.basis, kDefaultRepresentation);
+    auto basis = colour::loadChannelBasis(dataDir() / "channels" / (config.basis + ".csv"));
+    ASSERT_TRUE(basis) << basis.error().message;
+    auto def = colour::loadDefaultChannelBasis(dataDir());
+    ASSERT_TRUE(def);
+    EXPECT_EQ(basis->project[0].v, def->project[0].v);
 }
 
 } // namespace
