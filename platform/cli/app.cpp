@@ -26,6 +26,8 @@ int runCli(int argc, char** argv)
     registerRunCommand(app, exitCode);
     registerReplayCommand(app, exitCode);
     registerInspectCommand(app, exitCode);
+    registerColorCommand(app, exitCode);
+    registerSpectralCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {
