@@ -228,5 +228,36 @@ TEST(DefaultBasis, ApplianceConfigNamesTheShippedFittedBasis)
     EXPECT_EQ(basis->project[0].v, def->project[0].v);
 }
 
+// rendering-notes.md hard case 10: a light with energy in one band only, and a sensed spectrum with
+// noisy negative bands, must give finite per-light vectors in every representation.
+TEST_F(Spectral, NarrowBandAndNegativeNoisyLightsStayFinite)
+{
+    Spectrum laser;
+    laser[17] = 5.0; // 550 nm only
+    Spectrum noisy = light("F11");
+    for (std::size_t i = 0; i < colour::kBands; i += 3) {
+        noisy[i] -= 0.5 * noisy.max(); // some bands well below zero
+    }
+    Spectrum negative = Spectrum::constant(-1.0);
+    for (const auto& name : representationNames()) {
+        auto rep = makeRepresentation(dataDir(), obs_, d65_, name);
+        ASSERT_TRUE(rep) << name;
+        for (const Spectrum* l : {&laser, &noisy, &negative}) {
+            for (const Xyz& m : (*rep)->lightVectors(*l)) {
+                EXPECT_TRUE(std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.z)) << name;
+            }
+        }
+        // The perfect white under a single-band light is finite in every representation.
+        const Xyz w = shade((*rep)->encode(Spectrum::constant(1.0)), (*rep)->lightVectors(laser));
+        EXPECT_TRUE(std::isfinite(w.y)) << name;
+    }
+    // A light without positive luminance gives zero vectors rather than a division by zero.
+    auto k6 = makeRepresentation(dataDir(), obs_, d65_, kDefaultRepresentation);
+    ASSERT_TRUE(k6);
+    for (const Xyz& m : (*k6)->lightVectors(negative)) {
+        EXPECT_EQ(m.y, 0.0);
+    }
+}
+
 } // namespace
 } // namespace replica::pipeline::spectral
