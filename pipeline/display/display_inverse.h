@@ -62,6 +62,9 @@ public:
     static DisplayLut3d build(const DisplayInverse& inverse, int size = 33);
     glm::dvec3 counts(const glm::dvec3& xyz) const;
     int size() const { return size_; }
+    // Node (i, j, k) at index (k * size + j) * size + i, counts; and the per-axis 1 / white XYZ.
+    const std::vector<glm::dvec3>& nodes() const { return nodes_; }
+    const glm::dvec3& scale() const { return scale_; }
 
 private:
     int size_ = 0;
