@@ -95,7 +95,7 @@ colorCheckerStudy(const DisplayInverse& inverse,
                          fmt::format("{}: no column '{}'", chart->source, kWhitePatch));
     }
     const auto whiteIndex = static_cast<std::size_t>(whiteIt - chart->columns.begin());
-    const colour::ChannelBasis basis = colour::boxBasis();
+    const colour::ChannelBasis& basis = options.basis;
     const DisplayModel& model = inverse.model();
     const double maxCount = model.maxCount();
     const double e = options.illuminanceLux;
@@ -166,6 +166,13 @@ colorCheckerStudy(const DisplayInverse& inverse,
             const glm::dvec3 rel = wY > 0.0 ? v[i] / wY * ref : glm::dvec3(0.0);
             return colour::xyzToLab(colour::cat02Adapt(rel, lightUnitY, d65), d65);
         };
+        // Against the perfect diffuser: the light's white at E / pi, on the spectral scale.
+        auto absolute = [&](const std::vector<glm::dvec3>& v, std::size_t i) {
+            const glm::dvec3 rel = v[i] / (e / std::numbers::pi);
+            return colour::xyzToLab(colour::cat02Adapt(rel, lightUnitY, d65), d65);
+        };
+        std::vector<double> dmAbs;
+        std::vector<double> dcAbs;
         std::vector<double> six;
         std::vector<double> dm;
         std::vector<double> dc;
@@ -176,6 +183,11 @@ colorCheckerStudy(const DisplayInverse& inverse,
             pr.sixChannelDe00 = colour::ciede2000(base, relative(channel, i));
             pr.mappedDe00 = colour::ciede2000(base, relative(shownMapped, i));
             pr.clippedDe00 = colour::ciede2000(base, relative(shownClipped, i));
+            const colour::Lab baseAbs = absolute(spectral, i);
+            pr.mappedAbsoluteDe00 = colour::ciede2000(baseAbs, absolute(shownMapped, i));
+            pr.clippedAbsoluteDe00 = colour::ciede2000(baseAbs, absolute(shownClipped, i));
+            dmAbs.push_back(pr.mappedAbsoluteDe00);
+            dcAbs.push_back(pr.clippedAbsoluteDe00);
             six.push_back(pr.sixChannelDe00);
             dm.push_back(pr.mappedDe00);
             dc.push_back(pr.clippedDe00);
@@ -189,6 +201,8 @@ colorCheckerStudy(const DisplayInverse& inverse,
         lr.mapped = errorStats(dm);
         lr.clipped = errorStats(dc);
         lr.mappedInGamut = errorStats(dmIn);
+        lr.mappedAbsolute = errorStats(dmAbs);
+        lr.clippedAbsolute = errorStats(dcAbs);
         results.push_back(std::move(lr));
     }
     return results;

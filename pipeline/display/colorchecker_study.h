@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <pipeline/colour/channel_basis.h>
 #include <pipeline/display/display_inverse.h>
 
 namespace replica::pipeline::display {
@@ -29,6 +30,9 @@ enum class FlareHandling {
 };
 
 struct StudyOptions {
+    // The renderer's six-channel representation (the appliance's default is
+    // colour::loadDefaultChannelBasis; the box basis needs no file).
+    colour::ChannelBasis basis = colour::boxBasis();
     double illuminanceLux = 2000.0; // on the screen plane
     FlareHandling flare = FlareHandling::InBoothSubtract;
 };
@@ -48,7 +52,12 @@ struct PatchResult {
     double sixChannelDe00 = 0.0;                 // channels vs full spectral
     double mappedDe00 = 0.0;                     // screen output, hue-keeping mapping
     double clippedDe00 = 0.0;                    // screen output, per-channel clipping
-    glm::dvec3 targetXyz{0.0};                   // absolute, cd/m^2
+    // The same two without the paper's white-patch normalisation: every XYZ relative to the
+    // perfect diffuser under the light, so a white patch that had to be dimmed counts as dimmed
+    // instead of brightening every other patch.
+    double mappedAbsoluteDe00 = 0.0;
+    double clippedAbsoluteDe00 = 0.0;
+    glm::dvec3 targetXyz{0.0}; // absolute, cd/m^2
 };
 
 struct LightResult {
@@ -58,6 +67,8 @@ struct LightResult {
     ErrorStats mapped;
     ErrorStats clipped;
     ErrorStats mappedInGamut; // in-gamut patches only
+    ErrorStats mappedAbsolute;
+    ErrorStats clippedAbsolute;
     std::vector<std::string> outOfGamut;
 };
 

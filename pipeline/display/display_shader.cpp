@@ -94,17 +94,20 @@ vec4 displayInverse(vec3 xyzIn, int mode) {
     const float tol = 1e-5;
     bool inside = all(greaterThanEqual(r, vec3(-tol))) && all(lessThanEqual(r, vec3(1.0 + tol)));
     if (!inside && mode == 0) {
+        // As mapToGamut: towards the same-luminance neutral until no channel is negative, then
+        // scale down until none exceeds 1.
         float s = clamp((xyz.y - uDispBlackY) / span, 0.0, 1.0);
         float t = 1.0;
         for (int c = 0; c < 3; ++c) {
-            float d = r[c] - s;
-            if (r[c] > 1.0) {
-                t = min(t, (1.0 - s) / d);
-            } else if (r[c] < 0.0) {
-                t = min(t, s / -d);
+            if (r[c] < 0.0) {
+                t = min(t, s / (s - r[c]));
             }
         }
         r = vec3(s) + clamp(t, 0.0, 1.0) * (r - vec3(s));
+        float top = max(r.x, max(r.y, r.z));
+        if (top > 1.0) {
+            r /= top;
+        }
     }
     if (!inside && cls == 0.0) {
         cls = 1.0;

@@ -63,19 +63,24 @@ mapToGamut(const GamutGeometry& g, const glm::dvec3& xyzIn, GamutMode mode, doub
                                   : (inside ? GamutClass::InGamut : GamutClass::Chroma);
         return out;
     }
-    // Towards the neutral of the same luminance: M_Y g = Y - Y_k because M (1,1,1) = white - black.
+    // (a) A chromaticity outside the primaries' triangle (some r < 0): towards the neutral of the
+    // same luminance until no channel is negative. M_Y g = Y - Y_k because M (1,1,1) = white -
+    // black, so the line keeps luminance and dominant wavelength.
     const double s = std::clamp((xyz.y - g.blackY) / span, 0.0, 1.0);
     double t = 1.0;
     for (int c = 0; c < 3; ++c) {
-        const double d = r[c] - s;
-        if (r[c] > 1.0) {
-            t = std::min(t, (1.0 - s) / d);
-        } else if (r[c] < 0.0) {
-            t = std::min(t, s / -d);
+        if (r[c] < 0.0) {
+            t = std::min(t, s / (s - r[c]));
         }
     }
-    t = std::clamp(t, 0.0, 1.0);
-    out.r = glm::clamp(glm::dvec3(s) + t * (r - glm::dvec3(s)), 0.0, 1.0);
+    glm::dvec3 m = glm::dvec3(s) + std::clamp(t, 0.0, 1.0) * (r - glm::dvec3(s));
+    // (b) A reachable chromaticity too bright for the panel there (some r > 1): scale the light
+    // above black down, which keeps its chromaticity and gives up only luminance.
+    const double top = std::max({m.x, m.y, m.z});
+    if (top > 1.0) {
+        m /= top;
+    }
+    out.r = glm::clamp(m, 0.0, 1.0);
     out.gamutClass = overPeak ? GamutClass::OverPeak : GamutClass::Chroma;
     return out;
 }

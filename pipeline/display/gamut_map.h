@@ -3,11 +3,13 @@
 // Method (closed form per pixel, docs/display.md): (1) a colour brighter than peak white is scaled
 // down to peak white's luminance, keeping its chromaticity ("over peak"); (2) a colour below the
 // display black's luminance is shown as black ("below black": negative light after flare
-// subtraction, rendering-notes hard case 16); (3) otherwise, if some r_c leaves [0, 1], the colour
-// moves along the straight line in r-space towards the display's neutral of the same luminance,
-// g = s (1, 1, 1) with s = (Y - Y_k) / (Y_w - Y_k), to the last point inside the cube ("chroma").
-// The line runs through the neutral axis, so dominant wavelength (hue to first order) and
-// luminance are kept; only purity drops. Per-channel clipping, kept for comparison, does neither.
+// subtraction, rendering-notes hard case 16); (3) otherwise, if some r_c < 0 (a chromaticity
+// outside the primaries' triangle), the colour moves along the straight line in r-space towards the
+// display's neutral of the same luminance, g = s (1, 1, 1) with s = (Y - Y_k) / (Y_w - Y_k), to the
+// first point with no negative channel: dominant wavelength (hue to first order) and luminance are
+// kept, only purity drops; (4) if then some r_c > 1 (a reachable chromaticity too bright for the
+// panel there), r is scaled down to max r_c = 1: chromaticity above black is kept, only luminance
+// drops. (3) and (4) are "chroma". Per-channel clipping, kept for comparison, keeps neither.
 #pragma once
 
 #include <cstdint>

@@ -3,11 +3,17 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
+#include <numbers>
 #include <optional>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/base/data_dir.h>
+#include <pipeline/colour/channel_basis.h>
+#include <pipeline/display/colorchecker_study.h>
 #include <pipeline/display/display_fit.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
@@ -32,7 +38,17 @@ struct DisplayOptions {
     bool json = false;
     bool clip = false;
     std::uint64_t seed = 1;
+    double lux = 2000.0;
+    std::string flare = "subtract";
+    std::string panel = "model";
+    std::string basis = "replica_k6";
 };
+
+// The shipped profile, where a command takes the profile as an option.
+std::string defaultProfile()
+{
+    return (dataDir() / "displays" / "wide-ips-synthetic.json").string();
+}
 
 // "a,b,c" -> three finite numbers.
 std::optional<glm::dvec3> parseTriple(const std::string& s)
@@ -195,6 +211,227 @@ int forwardMain(const DisplayOptions& o)
     return kExitOk;
 }
 
+const char* shortClass(pd::GamutClass c)
+{
+    switch (c) {
+    case pd::GamutClass::InGamut:
+        return "in";
+    case pd::GamutClass::Chroma:
+        return "chroma";
+    case pd::GamutClass::OverPeak:
+        return "above peak";
+    case pd::GamutClass::BelowBlack:
+        return "below black";
+    }
+    return "?";
+}
+
+nlohmann::json statsJson(const pd::ErrorStats& s)
+{
+    return {{"n", s.count}, {"mean", s.mean}, {"std", s.std}, {"p90", s.p90}, {"max", s.max}};
+}
+
+std::string statsText(const pd::ErrorStats& s)
+{
+    return fmt::format("{:5.2f} {:5.2f} {:5.2f} {:5.2f}", s.mean, s.std, s.p90, s.max);
+}
+
+// Everything the study commands share: the profile, the panel a meter reads, the channel basis.
+struct StudySetup {
+    std::optional<pd::DisplayInverse> inverse;
+    std::function<glm::dvec3(const glm::dvec3&)> panel;
+    pd::StudyOptions options;
+};
+
+std::optional<StudySetup> studySetup(const DisplayOptions& o)
+{
+    auto log = logger("replica");
+    StudySetup s;
+    s.inverse = loadInverse(o.profile.empty() ? defaultProfile() : o.profile);
+    if (!s.inverse) {
+        return std::nullopt;
+    }
+    if (o.panel == "truth") {
+        if (!s.inverse->model().synthetic) {
+            log->error(
+                    "--panel truth: profile '{}' is of a real panel; only a synthetic profile has "
+                    "a known ground truth",
+                    s.inverse->model().name);
+            return std::nullopt;
+        }
+        const pd::SyntheticDisplay truth = pd::wideIpsGroundTruth();
+        s.panel = [truth](const glm::dvec3& c) { return truth.forward(c); };
+    } else {
+        const pd::DisplayModel model = s.inverse->model();
+        s.panel = [model](const glm::dvec3& c) { return model.forward(c); };
+    }
+    if (o.basis == "box6") {
+        s.options.basis = pipeline::colour::boxBasis();
+    } else {
+        auto basis =
+                pipeline::colour::loadChannelBasis(dataDir() / "channels" / (o.basis + ".csv"));
+        if (!basis) {
+            log->error("{}", basis.error().message);
+            return std::nullopt;
+        }
+        s.options.basis = std::move(*basis);
+    }
+    s.options.illuminanceLux = o.lux;
+    s.options.flare = o.flare == "dark"     ? pd::FlareHandling::Dark
+                      : o.flare == "ignore" ? pd::FlareHandling::InBoothIgnore
+                                            : pd::FlareHandling::InBoothSubtract;
+    return s;
+}
+
+int studyMain(const DisplayOptions& o)
+{
+    auto setup = studySetup(o);
+    if (!setup) {
+        return kExitFailure;
+    }
+    auto results = pd::colorCheckerStudy(*setup->inverse, setup->panel, dataDir(), setup->options);
+    if (!results) {
+        logger("replica")->error("{}", results.error().message);
+        return kExitFailure;
+    }
+    if (o.json) {
+        nlohmann::json lights = nlohmann::json::array();
+        for (const auto& lr : *results) {
+            nlohmann::json patches = nlohmann::json::array();
+            for (const auto& p : lr.patches) {
+                patches.push_back({{"name", p.name},
+                                   {"gamut", shortClass(p.gamutClass)},
+                                   {"six_channel_de00", p.sixChannelDe00},
+                                   {"mapped_de00", p.mappedDe00},
+                                   {"clipped_de00", p.clippedDe00},
+                                   {"mapped_absolute_de00", p.mappedAbsoluteDe00},
+                                   {"clipped_absolute_de00", p.clippedAbsoluteDe00}});
+            }
+            lights.push_back({{"light", lr.light},
+                              {"six_channel", statsJson(lr.sixChannel)},
+                              {"screen_mapped", statsJson(lr.mapped)},
+                              {"screen_clipped", statsJson(lr.clipped)},
+                              {"screen_mapped_in_gamut", statsJson(lr.mappedInGamut)},
+                              {"screen_mapped_absolute", statsJson(lr.mappedAbsolute)},
+                              {"screen_clipped_absolute", statsJson(lr.clippedAbsolute)},
+                              {"out_of_gamut", lr.outOfGamut},
+                              {"patches", patches}});
+        }
+        fmt::print("{}\n", nlohmann::json{{"profile", setup->inverse->model().name},
+                                          {"panel", o.panel},
+                                          {"basis", setup->options.basis.name},
+                                          {"lux", o.lux},
+                                          {"flare", o.flare},
+                                          {"lights", lights}}
+                                   .dump(1));
+        return kExitOk;
+    }
+    fmt::print("ColorChecker: spectral -> {} channels -> XYZ -> inverse display -> 8-bit counts "
+               "(dithered) -> {}\n",
+               setup->options.basis.name,
+               o.panel == "truth" ? "synthetic ground-truth panel" : "profile forward model");
+    fmt::print("profile {}, {} lux on the screen, front-surface flare: {}; CIEDE2000 after CAT02 "
+               "to D65, each workflow relative to its own white patch (as the paper)\n\n",
+               setup->inverse->model().name, o.lux, o.flare);
+    fmt::print("{:<26} {:>3}  {:^23}  {:^23}  {:^23}\n", "", "", "six-channel simulation",
+               "screen, hue-keeping map", "screen, per-channel clip");
+    fmt::print("{:<26} {:>3}  {:^23}  {:^23}  {:^23}\n", "light", "n", "mean   std  90th   max",
+               "mean   std  90th   max", "mean   std  90th   max");
+    for (const auto& lr : *results) {
+        fmt::print("{:<26} {:>3}  {}  {}  {}\n", lr.light, lr.sixChannel.count,
+                   statsText(lr.sixChannel), statsText(lr.mapped), statsText(lr.clipped));
+    }
+    for (const auto& lr : *results) {
+        if (lr.outOfGamut.empty()) {
+            continue;
+        }
+        std::vector<double> six;
+        std::vector<double> clipped;
+        for (const auto& p : lr.patches) {
+            if (p.gamutClass == pd::GamutClass::InGamut) {
+                six.push_back(p.sixChannelDe00);
+                clipped.push_back(p.clippedDe00);
+            }
+        }
+        fmt::print("{:<26} {:>3}  {}  {}  {}\n", fmt::format("  in-gamut, {}", lr.light),
+                   lr.mappedInGamut.count, statsText(pd::errorStats(six)),
+                   statsText(lr.mappedInGamut), statsText(pd::errorStats(clipped)));
+    }
+    fmt::print("\nwithout the white-patch normalisation (vs the perfect diffuser under each "
+               "light):\n");
+    fmt::print("{:<26} {:>3}  {:^23}  {:^23}\n", "light", "n", "screen, hue-keeping map",
+               "screen, per-channel clip");
+    for (const auto& lr : *results) {
+        fmt::print("{:<26} {:>3}  {}  {}\n", lr.light, lr.mappedAbsolute.count,
+                   statsText(lr.mappedAbsolute), statsText(lr.clippedAbsolute));
+    }
+    fmt::print("\n");
+    for (const auto& lr : *results) {
+        std::vector<std::string> named;
+        for (const auto& p : lr.patches) {
+            if (p.gamutClass != pd::GamutClass::InGamut) {
+                named.push_back(fmt::format("{} ({}; dE00 mapped {:.1f}, clipped {:.1f}; absolute "
+                                            "{:.1f}, {:.1f})",
+                                            p.name, shortClass(p.gamutClass), p.mappedDe00,
+                                            p.clippedDe00, p.mappedAbsoluteDe00,
+                                            p.clippedAbsoluteDe00));
+            }
+        }
+        fmt::print("out of gamut under {}: {}\n", lr.light,
+                   named.empty() ? std::string("none") : fmt::format("{}", fmt::join(named, ", ")));
+    }
+    fmt::print("\npaper (EIZO RX220, measured screen output): D65 0.8 0.4 1.4 1.6; D50 0.7 0.4 1.1 "
+               "1.8; A 3.8 4.2 11.0 14.0; A in-gamut (18) 1.8 1.6 5.0 5.9\n");
+    return kExitOk;
+}
+
+// How much the screen's own reflection of the booth light matters for dark colours: the study
+// with the reflection left in (what a viewer sees without correction) and subtracted.
+int flareMain(const DisplayOptions& o)
+{
+    DisplayOptions ignore = o;
+    ignore.flare = "ignore";
+    DisplayOptions subtract = o;
+    subtract.flare = "subtract";
+    auto a = studySetup(ignore);
+    auto b = studySetup(subtract);
+    if (!a || !b) {
+        return kExitFailure;
+    }
+    auto left = pd::colorCheckerStudy(*a->inverse, a->panel, dataDir(), a->options);
+    auto corrected = pd::colorCheckerStudy(*b->inverse, b->panel, dataDir(), b->options);
+    if (!left || !corrected) {
+        logger("replica")->error("{}", (!left ? left : corrected).error().message);
+        return kExitFailure;
+    }
+    const double rho = a->inverse->model().frontSurfaceReflectance;
+    fmt::print("front-surface reflection rho_d = {} at {} lux: {:.3f} cd/m^2 added to every "
+               "pixel; profile {} ({})\n",
+               rho, o.lux, rho * o.lux / std::numbers::pi, a->inverse->model().name,
+               a->inverse->model().condition == pd::MeasurementCondition::LitBooth
+                       ? "measured in the lit booth: its black already holds the reflection"
+                       : "measured in the dark");
+    fmt::print("{:<22} {:<14} {:>10} {:>14} {:>14}\n", "light", "patch", "Y cd/m^2", "dE00 left in",
+               "dE00 removed");
+    const std::vector<std::string> dark{"black_2",   "neutral_3.5",   "neutral_5",
+                                        "dark_skin", "purplish_blue", "neutral_8"};
+    for (std::size_t l = 0; l < left->size(); ++l) {
+        for (const auto& name : dark) {
+            for (std::size_t p = 0; p < (*left)[l].patches.size(); ++p) {
+                const auto& pl = (*left)[l].patches[p];
+                const auto& pc = (*corrected)[l].patches[p];
+                if (pl.name == name) {
+                    fmt::print("{:<22} {:<14} {:>10.3f} {:>14.2f} {:>14.2f}\n", (*left)[l].light,
+                               name, pl.targetXyz.y, pl.mappedDe00, pc.mappedDe00);
+                }
+            }
+        }
+        fmt::print("{:<22} {:<14} {:>10} {:>14.2f} {:>14.2f}\n", (*left)[l].light, "all 24 (mean)",
+                   "", (*left)[l].mapped.mean, (*corrected)[l].mapped.mean);
+    }
+    return kExitOk;
+}
+
 int synthMain(const DisplayOptions& o)
 {
     const auto rows = pd::syntheticMeasurements(pd::wideIpsGroundTruth(), pd::MeterNoise{}, o.seed);
@@ -261,6 +498,42 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
     fwdCmd->add_option("--rgb", fwd->triple, "R,G,B counts")->required();
     fwdCmd->add_flag("--json", fwd->json, "print {\"xyz\": [X, Y, Z]}");
     fwdCmd->callback([fwd, &exitCode] { exitCode = forwardMain(*fwd); });
+
+    auto addStudyOptions = [](CLI::App* cmd, DisplayOptions& opts) {
+        cmd->add_option("profile", opts.profile,
+                        "display profile (default: data/displays/wide-ips-synthetic.json)");
+        cmd->add_option("--lux", opts.lux, "illuminance on the screen (lux)")
+                ->check(CLI::Range(1.0, 1e5))
+                ->capture_default_str();
+        cmd->add_option("--panel", opts.panel,
+                        "what the meter reads: model (the profile's forward model) or truth (the "
+                        "synthetic panel's ground truth)")
+                ->check(CLI::IsMember({"model", "truth"}))
+                ->capture_default_str();
+        cmd->add_option("--basis", opts.basis,
+                        "channel basis: replica_k6 (the appliance's), general_k6, pca6, paper6 "
+                        "or box6")
+                ->capture_default_str();
+    };
+    auto study = std::make_shared<DisplayOptions>();
+    auto* studyCmd = display->add_subcommand(
+            "study", "the paper's Table 1 (right half): the ColorChecker through the whole chain "
+                     "under the booth lights A, F8 and F7, with and without gamut mapping");
+    addStudyOptions(studyCmd, *study);
+    studyCmd->add_option("--flare", study->flare,
+                         "the screen's reflection of the booth light: subtract (the pipeline), "
+                         "ignore (left in), or dark (no booth light on the screen)")
+            ->check(CLI::IsMember({"subtract", "ignore", "dark"}))
+            ->capture_default_str();
+    studyCmd->add_flag("--json", study->json, "print the table and every patch as JSON");
+    studyCmd->callback([study, &exitCode] { exitCode = studyMain(*study); });
+
+    auto flare = std::make_shared<DisplayOptions>();
+    auto* flareCmd = display->add_subcommand(
+            "flare", "how much subtracting the screen's front-surface reflection changes dark "
+                     "ColorChecker colours");
+    addStudyOptions(flareCmd, *flare);
+    flareCmd->callback([flare, &exitCode] { exitCode = flareMain(*flare); });
 
     auto syn = std::make_shared<DisplayOptions>();
     auto* synCmd = display->add_subcommand(

@@ -1,5 +1,6 @@
 // Hue-keeping gamut mapping and its counters: chroma, over-peak and negative light (rendering-notes
 // hard case 12; rendering-background hard cases 16 and 17).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -74,15 +75,38 @@ TEST_F(GamutMapTest, ChromaMappingKeepsLuminanceAndDominantWavelength)
     EXPECT_GT(std::abs(cross2(dirTarget, dirClip)), 1e-4);
 }
 
+TEST_F(GamutMapTest, TooBrightForItsChromaticityLosesOnlyLuminance)
+{
+    // Tungsten-white-like: inside the primaries' triangle, but red would need more than full drive.
+    const glm::dvec3 target = xyzOfLinear({1.2, 0.9, 0.4});
+    ASSERT_LT(target.y, model().whiteXyz().y); // not over peak: a chroma-class colour
+    const auto m = mapToGamut(inv_->geometry(), target, GamutMode::HueKeeping);
+    EXPECT_EQ(m.gamutClass, GamutClass::Chroma);
+    EXPECT_NEAR(m.r.x, 1.0, 1e-12);
+    const glm::dvec3 above = xyzOfLinear(m.r) - model().blackXyz;
+    const glm::dvec3 targetAbove = target - model().blackXyz;
+    EXPECT_NEAR(xy(above).x, xy(targetAbove).x, 1e-12);
+    EXPECT_NEAR(xy(above).y, xy(targetAbove).y, 1e-12);
+    EXPECT_NEAR(above.y / targetAbove.y, 1.0 / 1.2, 1e-12);
+}
+
 TEST_F(GamutMapTest, OverPeakScalesToPeakKeepingChromaticity)
 {
     const glm::dvec3 white = model().whiteXyz();
-    const glm::dvec3 target = xyzOfLinear({0.5, 0.4, 0.3}) * 5.0; // far above peak
+    // A near-neutral far above peak: scaled to peak luminance, then (its red channel above 1 at
+    // that luminance) down to full red drive; chromaticity kept throughout.
+    const glm::dvec3 target = xyzOfLinear({0.5, 0.4, 0.3}) * 5.0;
     ASSERT_GT(target.y, white.y);
     const auto m = mapToGamut(inv_->geometry(), target, GamutMode::HueKeeping);
     EXPECT_EQ(m.gamutClass, GamutClass::OverPeak);
     const glm::dvec3 shown = xyzOfLinear(m.r);
-    EXPECT_NEAR(shown.y, white.y, 1e-6 * white.y);
+    EXPECT_LE(shown.y, white.y * (1.0 + 1e-12));
+    EXPECT_NEAR(std::max({m.r.x, m.r.y, m.r.z}), 1.0, 1e-12);
+    EXPECT_NEAR(xy(shown).x, xy(target).x, 2e-3); // up to the black offset's share
+    EXPECT_NEAR(xy(shown).y, xy(target).y, 2e-3);
+    // The display's own white far above peak maps to exactly peak white.
+    const auto w = mapToGamut(inv_->geometry(), white * 3.0, GamutMode::HueKeeping);
+    EXPECT_NEAR(xyzOfLinear(w.r).y, white.y, 1e-6 * white.y);
     // A hot specular at 1e6 cd/m^2 (hard case 9): counts finite and in range.
     const auto hot = inv_->invert(white * 1e6);
     EXPECT_EQ(hot.gamutClass, GamutClass::OverPeak);
