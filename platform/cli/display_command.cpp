@@ -422,12 +422,12 @@ int flareMain(const DisplayOptions& o)
                 const auto& pc = (*corrected)[l].patches[p];
                 if (pl.name == name) {
                     fmt::print("{:<22} {:<14} {:>10.3f} {:>14.2f} {:>14.2f}\n", (*left)[l].light,
-                               name, pl.targetXyz.y, pl.mappedDe00, pc.mappedDe00);
+                               name, pl.targetXyz.y, pl.mappedAbsoluteDe00, pc.mappedAbsoluteDe00);
                 }
             }
         }
         fmt::print("{:<22} {:<14} {:>10} {:>14.2f} {:>14.2f}\n", (*left)[l].light, "all 24 (mean)",
-                   "", (*left)[l].mapped.mean, (*corrected)[l].mapped.mean);
+                   "", (*left)[l].mappedAbsolute.mean, (*corrected)[l].mappedAbsolute.mean);
     }
     return kExitOk;
 }
