@@ -10,6 +10,7 @@
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/frame_outputs.h>
+#include <platform/live_sources.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 
@@ -26,6 +27,7 @@ struct RunOptions {
     std::string digests;
     std::string snapshot;
     bool fast = false;
+    LiveOptions live;
 };
 
 std::optional<std::pair<int, int>> parseSize(const std::string& s)
@@ -44,10 +46,14 @@ std::optional<std::pair<int, int>> parseSize(const std::string& s)
 int runMain(const RunOptions& o)
 {
     auto log = logger("replica");
-    if (o.hal != "sim") {
-        log->error("--hal {}: only the built-in simulated sensors ('sim') are in this build; live "
-                   "drivers are not yet",
+    if (o.hal != "sim" && o.hal != "live") {
+        log->error("--hal {}: expected 'sim' (built-in simulated sensors) or 'live' (USB2000+, "
+                   "opentrack, IIO accelerometer)",
                    o.hal);
+        return kExitUsage;
+    }
+    if (o.hal == "live" && o.fast) {
+        log->error("--fast needs the simulated sensors: live sensors run on the wall clock");
         return kExitUsage;
     }
     if (o.output != "headless") {
@@ -70,7 +76,11 @@ int runMain(const RunOptions& o)
         log->error("{}", appliance.error().message);
         return kExitFailure;
     }
-    auto sources = makeSimSources(**appliance);
+    // Live devices stamp samples on this clock; the loop's ticks start with it (within the few
+    // milliseconds between here and the first tick, which only delays samples by that much).
+    hal::SteadyClock liveClock;
+    auto sources =
+            o.hal == "live" ? makeLiveSources(liveClock, o.live) : makeSimSources(**appliance);
     if (!sources) {
         log->error("{}", sources.error().message);
         return kExitFailure;
@@ -148,8 +158,19 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     auto* cmd =
             app.add_subcommand("run", "run the appliance: sensors -> scene -> render -> output at "
                                       "a fixed rate");
-    cmd->add_option("--hal", opts->hal, "sensor sources: sim (built-in simulated sensors)")
+    cmd->add_option("--hal", opts->hal,
+                    "sensor sources: sim (built-in simulated sensors) or live (USB2000+ over "
+                    "libusb, opentrack UDP head poses, IIO accelerometer)")
             ->capture_default_str();
+    cmd->add_option("--tracker-port", opts->live.trackerPort,
+                    "live: UDP port opentrack sends head poses to")
+            ->capture_default_str();
+    cmd->add_option("--tracker-bind", opts->live.trackerBind, "live: address to listen on")
+            ->capture_default_str();
+    cmd->add_option("--iio-root", opts->live.iioRoot, "live: where IIO devices are listed")
+            ->capture_default_str();
+    cmd->add_option("--accel-name", opts->live.accelName,
+                    "live: the accelerometer's IIO name (default: the first one)");
     cmd->add_option("--output", opts->output, "frame output: headless (surfaceless EGL)")
             ->capture_default_str();
     cmd->add_option("--frames", opts->frames, "number of frames to run")->capture_default_str();
