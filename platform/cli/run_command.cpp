@@ -28,6 +28,7 @@ struct RunOptions {
     std::string snapshot;
     bool fast = false;
     LiveOptions live;
+    OutputChoice outputChoice;
 };
 
 std::optional<std::pair<int, int>> parseSize(const std::string& s)
@@ -56,8 +57,9 @@ int runMain(const RunOptions& o)
         log->error("--fast needs the simulated sensors: live sensors run on the wall clock");
         return kExitUsage;
     }
-    if (o.output != "headless") {
-        log->error("--output {}: only 'headless' output is in this build; KMS output is not yet",
+    if (o.output != "headless" && o.output != "kms") {
+        log->error("--output {}: expected 'headless' (no display) or 'kms' (fullscreen on the "
+                   "console, no display server)",
                    o.output);
         return kExitUsage;
     }
@@ -71,7 +73,9 @@ int runMain(const RunOptions& o)
     config.height = size->second;
     config.rateHz = o.rateHz;
 
-    auto appliance = buildAppliance(config);
+    OutputChoice outputChoice = o.outputChoice;
+    outputChoice.kind = o.output;
+    auto appliance = buildAppliance(config, outputChoice);
     if (!appliance) {
         log->error("{}", appliance.error().message);
         return kExitFailure;
@@ -119,8 +123,13 @@ int runMain(const RunOptions& o)
 
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
     const auto plan = fixedRatePlan(config.periodNs(), o.frames);
+    // Scan-out needs the display pixels of every frame, digests or not.
+    auto readback = outputs.readback();
+    if (o.output == "kms" && readback == pipeline::render::Readback::None) {
+        readback = pipeline::render::Readback::Display;
+    }
     auto stats = runFrames(**appliance, *sources, plan, o.fast ? Pacing::Fast : Pacing::Realtime,
-                           recorder.get(), outputs.readback(), outputs.callback());
+                           recorder.get(), readback, outputs.callback());
     if (!stats) {
         log->error("{}", stats.error().message);
         return kExitFailure;
@@ -171,8 +180,13 @@ void registerRunCommand(CLI::App& app, int& exitCode)
             ->capture_default_str();
     cmd->add_option("--accel-name", opts->live.accelName,
                     "live: the accelerometer's IIO name (default: the first one)");
-    cmd->add_option("--output", opts->output, "frame output: headless (surfaceless EGL)")
+    cmd->add_option("--output", opts->output,
+                    "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")
             ->capture_default_str();
+    cmd->add_option("--kms-device", opts->outputChoice.kmsDevice, "kms: the DRM card to drive")
+            ->capture_default_str();
+    cmd->add_option("--kms-connector", opts->outputChoice.kmsConnector,
+                    "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
     cmd->add_option("--frames", opts->frames, "number of frames to run")->capture_default_str();
     cmd->add_option("--size", opts->size, "frame size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--rate", opts->rateHz, "frame rate (Hz)")
