@@ -122,13 +122,23 @@ int runMain(const RunOptions& o)
     }
 
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
-    const auto plan = fixedRatePlan(config.periodNs(), o.frames);
+    // --frames 0: run until SIGINT/SIGTERM (the kiosk), closing the recording properly.
+    installStopSignals();
+    const TickSource ticks =
+            o.frames == 0 ? endlessTicks(config.periodNs())
+                          : TickSource([plan = fixedRatePlan(config.periodNs(), o.frames),
+                                        k = std::size_t{0}]() mutable -> std::optional<TickPlan> {
+                                if (k >= plan.size()) {
+                                    return std::nullopt;
+                                }
+                                return plan[k++];
+                            });
     // Scan-out needs the display pixels of every frame, digests or not.
     auto readback = outputs.readback();
     if (o.output == "kms" && readback == pipeline::render::Readback::None) {
         readback = pipeline::render::Readback::Display;
     }
-    auto stats = runFrames(**appliance, *sources, plan, o.fast ? Pacing::Fast : Pacing::Realtime,
+    auto stats = runFrames(**appliance, *sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
                            recorder.get(), readback, outputs.callback());
     if (!stats) {
         log->error("{}", stats.error().message);
@@ -187,7 +197,9 @@ void registerRunCommand(CLI::App& app, int& exitCode)
             ->capture_default_str();
     cmd->add_option("--kms-connector", opts->outputChoice.kmsConnector,
                     "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
-    cmd->add_option("--frames", opts->frames, "number of frames to run")->capture_default_str();
+    cmd->add_option("--frames", opts->frames,
+                    "number of frames to run; 0 = until SIGINT/SIGTERM (the kiosk)")
+            ->capture_default_str();
     cmd->add_option("--size", opts->size, "frame size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--rate", opts->rateHz, "frame rate (Hz)")
             ->check(CLI::Range(1.0, 1000.0))
