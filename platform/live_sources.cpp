@@ -48,6 +48,11 @@ Expected<Sources> makeLiveSources(const hal::Clock& clock, const LiveOptions& op
     hal::spectrometer::Usb2000SourceOptions specOptions;
     specOptions.nextIntegrationUs = autoIntegration;
     hal::accel::IioAccelSourceOptions accelOptions;
+    auto mounting = hal::accel::parseAxisMapping(options.accelAxes);
+    if (!mounting) {
+        return tl::unexpected(mounting.error());
+    }
+    accelOptions.mounting = *mounting;
     accelOptions.root = options.iioRoot;
     accelOptions.name = options.accelName;
 

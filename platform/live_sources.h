@@ -16,7 +16,8 @@ struct LiveOptions {
     std::uint16_t trackerPort = 4242;
     std::string trackerBind = "127.0.0.1";
     std::filesystem::path iioRoot = "/sys/bus/iio/devices";
-    std::string accelName; // IIO 'name' attribute; empty = the first accelerometer
+    std::string accelName;           // IIO 'name' attribute; empty = the first accelerometer
+    std::string accelAxes = "x,y,z"; // see hal::accel::parseAxisMapping
 };
 
 // Devices that are absent at start are not an error: their sources report Lost, retry in the

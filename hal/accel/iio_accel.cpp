@@ -141,6 +141,54 @@ Expected<std::array<double, 3>> IioAccelDevice::read() const
     return a;
 }
 
+Expected<AxisMapping> parseAxisMapping(const std::string& text)
+{
+    AxisMapping m;
+    std::array<bool, 3> used{};
+    std::stringstream in(text);
+    std::string item;
+    int i = 0;
+    while (std::getline(in, item, ',')) {
+        if (i >= 3) {
+            i = 4; // a fourth axis: reported below
+            break;
+        }
+        double sign = 1.0;
+        if (!item.empty() && (item[0] == '-' || item[0] == '+')) {
+            sign = item[0] == '-' ? -1.0 : 1.0;
+            item.erase(0, 1);
+        }
+        if (item.size() != 1 || item[0] < 'x' || item[0] > 'z' ||
+            used[static_cast<std::size_t>(item[0] - 'x')]) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("accelerometer axes '{}': expected three of x, y, z, each "
+                                         "once, optionally signed, e.g. '-y,x,z'",
+                                         text));
+        }
+        used[static_cast<std::size_t>(item[0] - 'x')] = true;
+        m.axis[static_cast<std::size_t>(i)] = item[0] - 'x';
+        m.sign[static_cast<std::size_t>(i)] = sign;
+        ++i;
+    }
+    if (i != 3 || !in.eof()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("accelerometer axes '{}': expected three of x, y, z, each "
+                                     "once, optionally signed, e.g. '-y,x,z'",
+                                     text));
+    }
+    return m;
+}
+
+glm::dvec3 gravityInPanel(const std::array<double, 3>& reading, const AxisMapping& m)
+{
+    glm::dvec3 g;
+    for (int i = 0; i < 3; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        g[i] = -m.sign[k] * reading[static_cast<std::size_t>(m.axis[k])];
+    }
+    return g;
+}
+
 namespace {
 
 class IioAccelSource final : public AccelSource
@@ -222,7 +270,7 @@ private:
             AccelSample s;
             s.timestampNs = clock_.nowNs();
             s.sequence = sequence++;
-            s.gravity = {(*a)[0], (*a)[1], (*a)[2]};
+            s.gravity = gravityInPanel(*a, options_.mounting);
             {
                 std::lock_guard lock(mutex_);
                 queue_.push_back(s);

@@ -2,12 +2,15 @@
 // counts with scale and offset, and the live source that samples it on its own thread.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include <hal/clock.h>
 #include <hal/sources.h>
@@ -46,7 +49,21 @@ private:
 // Parses one sysfs attribute: a single C-locale number and a newline.
 Expected<double> readSysfsNumber(const std::filesystem::path& file);
 
+// How the sensor is mounted on the panel: for each panel axis (x right, y up the panel, z out of
+// the screen), which sensor axis and sign, e.g. "x,y,z" (aligned) or "-y,x,z".
+struct AxisMapping {
+    std::array<int, 3> axis{0, 1, 2};
+    std::array<double, 3> sign{1.0, 1.0, 1.0};
+};
+
+Expected<AxisMapping> parseAxisMapping(const std::string& text);
+
+// An accelerometer at rest reads the reaction to gravity (+1 g pointing up); the HAL's
+// AccelSample carries gravity itself (pointing down) in the panel frame: -(mapped reading).
+glm::dvec3 gravityInPanel(const std::array<double, 3>& reading, const AxisMapping& mapping);
+
 struct IioAccelSourceOptions {
+    AxisMapping mounting;
     std::filesystem::path root = "/sys/bus/iio/devices";
     std::string name;                   // the device's 'name' attribute; empty = the first
     std::int64_t periodNs = 10'000'000; // 100 Hz

@@ -15,5 +15,6 @@ void registerReplayCommand(CLI::App& app, int& exitCode);
 void registerInspectCommand(CLI::App& app, int& exitCode);
 void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
+void registerProbeCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform

@@ -190,6 +190,10 @@ void registerRunCommand(CLI::App& app, int& exitCode)
             ->capture_default_str();
     cmd->add_option("--accel-name", opts->live.accelName,
                     "live: the accelerometer's IIO name (default: the first one)");
+    cmd->add_option("--accel-axes", opts->live.accelAxes,
+                    "live: sensor axis for each panel axis (x right, y up, z out of the screen), "
+                    "e.g. -y,x,z")
+            ->capture_default_str();
     cmd->add_option("--output", opts->output,
                     "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")
             ->capture_default_str();

@@ -109,7 +109,8 @@ TEST_F(FakeIio, SourceSamplesLosesTheDeviceAndFindsItAgain)
         src->poll(clock.nowNs(), got);
         return got.size() >= 3;
     }));
-    EXPECT_DOUBLE_EQ(got[0].gravity.y, 1000 * 0.00980665);
+    // The reading is the reaction to gravity; the sample carries gravity itself.
+    EXPECT_DOUBLE_EQ(got[0].gravity.y, -1000 * 0.00980665);
     EXPECT_EQ(got[1].sequence, got[0].sequence + 1);
     fs::remove_all(dev_);
     ASSERT_TRUE(eventually([&] { return src->state() == hal::LinkState::Lost; }));
@@ -123,8 +124,23 @@ TEST_F(FakeIio, SourceSamplesLosesTheDeviceAndFindsItAgain)
     got.clear();
     ASSERT_TRUE(eventually([&] {
         src->poll(clock.nowNs(), got);
-        return !got.empty() && got.back().gravity.z > 9.0;
+        return !got.empty() && got.back().gravity.z < -9.0;
     }));
+}
+
+TEST(AxisMapping, ParsesSignedPermutationsAndRejectsTheRest)
+{
+    auto m = hal::accel::parseAxisMapping("-y,x,z");
+    ASSERT_TRUE(m) << m.error().message;
+    // Sensor reads (1, 2, 3): panel x = -(-y) = 2, panel y = -x = -1, panel z = -z = -3.
+    const glm::dvec3 g = hal::accel::gravityInPanel({1.0, 2.0, 3.0}, *m);
+    EXPECT_DOUBLE_EQ(g.x, 2.0);
+    EXPECT_DOUBLE_EQ(g.y, -1.0);
+    EXPECT_DOUBLE_EQ(g.z, -3.0);
+    for (const char* bad : {"x,y", "x,x,z", "x,y,w", "x,y,z,x", "", "xy,z,", "--x,y,z"}) {
+        auto e = hal::accel::parseAxisMapping(bad);
+        EXPECT_FALSE(e) << bad;
+    }
 }
 
 } // namespace
