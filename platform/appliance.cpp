@@ -153,7 +153,8 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
 
 } // namespace
 
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn)
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
+                                                    const OutputChoice& outputChoice)
 {
     RunConfig config = configIn;
     std::string displayId;
@@ -204,7 +205,9 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn)
         return tl::unexpected(surface.error());
     }
 
-    auto output = createHeadlessOutput();
+    auto output = outputChoice.kind == "kms"
+                          ? createKmsOutput(outputChoice.kmsDevice, outputChoice.kmsConnector)
+                          : createHeadlessOutput();
     if (!output) {
         return tl::unexpected(output.error());
     }
