@@ -18,6 +18,7 @@
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/synthetic_display.h>
+#include <pipeline/display/viewing_angle_csv.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
 
@@ -33,6 +34,7 @@ struct DisplayOptions {
     std::string name;
     std::string measuredIn = "dark";
     std::string triple;
+    std::string viewingTable;
     int bits = 0;
     bool synthetic = false;
     bool json = false;
@@ -105,7 +107,14 @@ int fitMain(const DisplayOptions& o)
         log->error("{}", model.error().message);
         return kExitFailure;
     }
-    if (o.synthetic) {
+    if (!o.viewingTable.empty()) {
+        auto table = pd::loadViewingAngleCsv(o.viewingTable);
+        if (!table) {
+            log->error("{}", table.error().message);
+            return kExitFailure;
+        }
+        model->viewing = std::move(*table);
+    } else if (o.synthetic) {
         // The synthetic panel's viewing-angle table travels with its profile.
         model->viewing = pd::wideIpsViewingAngles();
     }
@@ -478,6 +487,9 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
     fitCmd->add_flag("--synthetic", fit->synthetic,
                      "mark the profile as built from synthetic measurements (and attach the "
                      "synthetic panel's viewing-angle table)");
+    fitCmd->add_option("--viewing-table", fit->viewingTable,
+                       "full white measured off axis: CSV angle_deg,X,Y,Z (first row 0 deg); "
+                       "without it the profile has no viewing-angle compensation");
     fitCmd->add_flag("--json", fit->json, "print the fit report as JSON");
     fitCmd->callback([fit, &exitCode] { exitCode = fitMain(*fit); });
 

@@ -103,6 +103,57 @@ TEST_F(DisplayCli, FitThenForwardThenInverseRoundTrips)
     EXPECT_NEAR(j.at("rgb")[2].get<double>(), 200.0, 1e-3);
 }
 
+TEST_F(DisplayCli, FitAttachesAMeasuredViewingAngleTable)
+{
+    // White at 0, 15 and 25 deg: the paper's 90 % and 75 %, and a slight shift towards blue.
+    const std::string table = write("angles.csv", "# goniometer\nangle_deg,X,Y,Z\n"
+                                                  "0,950,1000,1089\n15,850,900,1000\n"
+                                                  "25,700,750,850\n");
+    const std::string profile = (dir_ / "p.json").string();
+    const auto fit = run("display fit " + shippedMeasurements() + " --out " + profile +
+                         " --viewing-table " + table);
+    ASSERT_EQ(fit.exitCode, 0) << fit.err;
+    std::ifstream f(profile);
+    const auto j = nlohmann::json::parse(f);
+    const auto& v = j.at("viewing_angle");
+    EXPECT_EQ(v.at("angle_deg").size(), 3u);
+    EXPECT_NEAR(v.at("luminance_ratio")[1].get<double>(), 0.90, 1e-12);
+    EXPECT_NEAR(v.at("luminance_ratio")[2].get<double>(), 0.75, 1e-12);
+    // x of white at 25 deg: 700 / 2300 against 950 / 3039 on axis.
+    EXPECT_NEAR(v.at("dx")[2].get<double>(), 700.0 / 2300.0 - 950.0 / 3039.0, 1e-12);
+
+    const auto bad = run("display fit " + shippedMeasurements() + " --out " + profile +
+                         " --viewing-table " + write("b.csv", "angle_deg,X,Y,Z\n10,1,1,1\n"));
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("b.csv:2: the first row must be on axis (angle_deg 0)"),
+              std::string::npos)
+            << bad.err;
+    const auto dark =
+            run("display fit " + shippedMeasurements() + " --out " + profile + " --viewing-table " +
+                write("d.csv", "angle_deg,X,Y,Z\n0,1,1,1\n30,0,0,0\n"));
+    EXPECT_EQ(dark.exitCode, 1);
+    EXPECT_NE(dark.err.find("d.csv:3: white must have Y > 0"), std::string::npos) << dark.err;
+}
+
+TEST_F(DisplayCli, ReplayRefusesAChangedProfile)
+{
+    // A recording made with a copy of the shipped profile replays while the copy is unchanged
+    // and fails, saying so, once it is edited.
+    const auto copy = dir_ / "panel.json";
+    std::filesystem::copy_file(shippedProfile(), copy);
+    const std::string rec = (dir_ / "r.mcap").string();
+    const auto made = run("run --fast --frames 3 --size 32x20 --display-profile " + copy.string() +
+                          " --record " + rec);
+    ASSERT_EQ(made.exitCode, 0) << made.err;
+    const auto same = run("replay " + rec + " --clock fast");
+    EXPECT_EQ(same.exitCode, 0) << same.err;
+    std::ofstream(copy, std::ios::app) << "\n";
+    const auto changed = run("replay " + rec + " --clock fast");
+    EXPECT_EQ(changed.exitCode, 1);
+    EXPECT_NE(changed.err.find("has changed since it was recorded"), std::string::npos)
+            << changed.err;
+}
+
 TEST_F(DisplayCli, InverseReportsOutOfGamutAndRejectsBadInput)
 {
     // Spectral 520 nm green is far outside any three-primary gamut.
