@@ -1,5 +1,6 @@
 // Tests of 'replica color de2000' and 'replica spectral eval' run as the built binary, and of the
 // channel-data file formats: bad files must fail naming file, line and problem.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -190,6 +191,30 @@ TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
                    dir_);
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.err.find("no representation named 'nine'"), std::string::npos) << r.err;
+}
+
+TEST_F(CliFiles, FitRejectsBadWeightsBeforeFitting)
+{
+    const std::string out = " --out " + (dir_ / "out").string();
+    const std::pair<const char*, const char*> cases[] = {
+            {"A30", "--weights: 'A30' is not NAME=WEIGHT"},
+            {"=3", "--weights: '=3' is not NAME=WEIGHT"},
+            {"A=x", "--weights: 'A=x' has no finite non-negative number after '='"},
+            {"A=-1", "--weights: 'A=-1' has no finite non-negative number after '='"},
+            {"A=3x", "--weights: 'A=3x' has no finite non-negative number after '='"},
+            {"A=inf", "--weights: 'A=inf' has no finite non-negative number after '='"},
+            {"NOPE=2", "--weights: "}};
+    for (const auto& [arg, message] : cases) {
+        const auto r = runReplica(std::string("spectral fit --weights ") + arg + out, dir_);
+        EXPECT_EQ(r.exitCode, 1) << arg;
+        EXPECT_NE(r.err.find(std::string("replica spectral fit: ") + message), std::string::npos)
+                << arg << ": " << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(dir_ / "out" / "replica_k6.csv"));
+    }
+    // An unknown lamp is named.
+    const auto r = runReplica("spectral fit --weights NOPE=2" + out, dir_);
+    EXPECT_NE(r.err.find("NOPE"), std::string::npos) << r.err;
 }
 
 TEST_F(CliFiles, ChannelBasisRoundTripsAndRejectsOffGridFiles)
