@@ -34,6 +34,7 @@ struct EvalOptions {
     std::string illuminant;
     std::string reflectances;
     std::string representation = spectral::kDefaultRepresentation;
+    std::string encodedFor; // adaptive representations: the light the surfaces were encoded for
     bool json = false;
 };
 
@@ -77,7 +78,31 @@ int runEval(const EvalOptions& o)
     if (!rep) {
         return fail(rep.error().message);
     }
-    auto report = spectral::evaluateRepresentation(*obs, *d65, **rep, *light, *set);
+    // An adaptive representation is encoded for the light it renders under unless --encoded-for
+    // names another (the frames between a light change and the end of the re-encode).
+    std::unique_ptr<spectral::Representation> encoded;
+    if (!o.encodedFor.empty()) {
+        auto forTable = colour::loadSpectralCsv(o.encodedFor);
+        if (!forTable) {
+            return fail(forTable.error().message);
+        }
+        auto forLight = forTable->spectrum("value");
+        if (!forLight) {
+            return fail(forLight.error().message);
+        }
+        auto adapted = (*rep)->adaptedTo(*forLight);
+        if (!adapted) {
+            return fail(fmt::format("{}: {}", o.encodedFor, adapted.error().message));
+        }
+        if (!*adapted) {
+            return fail(fmt::format("--encoded-for applies to a light-adaptive representation "
+                                    "(adaptive_k6); '{}' encodes the same for every light",
+                                    o.representation));
+        }
+        encoded = std::move(*adapted);
+    }
+    auto report =
+            spectral::evaluateRepresentation(*obs, *d65, encoded ? *encoded : **rep, *light, *set);
     if (!report) {
         return fail(fmt::format("{}: {}", o.reflectances, report.error().message));
     }
@@ -85,6 +110,9 @@ int runEval(const EvalOptions& o)
         nlohmann::json out;
         out["representation"] = report->representation;
         out["illuminant"] = o.illuminant;
+        if (!o.encodedFor.empty()) {
+            out["encoded_for"] = o.encodedFor;
+        }
         out["reflectances"] = o.reflectances;
         out["white"] = set->names[report->whiteIndex];
         out["grid"] = "380-730 nm, 10 nm (36 bands)";
@@ -121,9 +149,8 @@ int runEval(const EvalOptions& o)
 struct FitOptions {
     std::string reflectances = "ces99";
     std::string lights;
-    // Weights of named lights in replica_k6 (others 1): the booth's lamps (A for tungsten, F8 the
-    // D50 fluorescent simulator, F7 the D65 simulator) first, daylight next (docs/accuracy.md).
-    std::string weights = "A=30,F8=60,F7=30,D50=10,D65=10";
+    // Weights of named lights in replica_k6 (others 1), spectral::defaultLightWeights().
+    std::string weights = spectral::defaultLightWeightsText();
     std::string out;
     int rounds = 1000;
 };
@@ -388,6 +415,9 @@ void registerSpectralCommand(CLI::App& app, int& exitCode)
     e->add_option("--representation", eval->representation,
                   fmt::format("one of {}", fmt::join(spectral::representationNames(), ", ")))
             ->capture_default_str();
+    e->add_option("--encoded-for", eval->encodedFor,
+                  "adaptive_k6 only: evaluate surfaces encoded for this light (CSV as "
+                  "--illuminant) while rendering under --illuminant");
     e->add_flag("--json", eval->json, "print JSON with 'samples' and 'stats'");
     e->callback([eval, &exitCode] { exitCode = runEval(*eval); });
 
