@@ -71,7 +71,7 @@ public:
 
 private:
     AdaptiveEncoder() = default;
-    // Rows 'fixed' (r x 36, may be empty) completed by the best 6 - r rows; nullopt-like error when
+    // Rows 'fixed' (r x 36, may be empty) completed by the best 6 - r rows; an error when
     // the prior cannot be conditioned.
     Expected<colour::ChannelBasis> complete(const DenseMatrix& fixed) const;
 
