@@ -420,6 +420,8 @@ int flareMain(const DisplayOptions& o)
                a->inverse->model().condition == pd::MeasurementCondition::LitBooth
                        ? "measured in the lit booth: its black already holds the reflection"
                        : "measured in the dark");
+    fmt::print("CIEDE2000 against the perfect diffuser under each light (no white-patch "
+               "normalisation), hue-keeping map; Y is the surface's luminance\n");
     fmt::print("{:<22} {:<14} {:>10} {:>14} {:>14}\n", "light", "patch", "Y cd/m^2", "dE00 left in",
                "dE00 removed");
     const std::vector<std::string> dark{"black_2",   "neutral_3.5",   "neutral_5",
