@@ -62,23 +62,6 @@ void main() {
 }
 )";
 
-// Inverse display model: XYZ -> linear drive -> power-law encoding, clipped to the panel's range.
-const char* const kDisplayShader = R"(#version 310 es
-precision highp float;
-precision highp int;
-in vec2 vUv;
-out vec4 outRgba;
-uniform highp sampler2D uXyz;
-uniform mat3 uXyzToRgb;
-uniform vec3 uBlack;
-uniform float uInvGamma;
-void main() {
-    vec3 xyz = texelFetch(uXyz, ivec2(gl_FragCoord.xy), 0).xyz;
-    vec3 rgb = clamp(uXyzToRgb * (xyz - uBlack), 0.0, 1.0);
-    outRgba = vec4(pow(rgb, vec3(uInvGamma)), 1.0);
-}
-)";
-
 Expected<GLuint> compile(GLenum type, const char* source, const char* what)
 {
     GLuint shader = glCreateShader(type);
@@ -159,7 +142,6 @@ public:
         glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
         glDeleteVertexArrays(1, &vao_);
         glDeleteProgram(xyzProgram_);
-        glDeleteProgram(displayProgram_);
     }
     GlesRenderer(const GlesRenderer&) = delete;
     GlesRenderer& operator=(const GlesRenderer&) = delete;
@@ -171,11 +153,10 @@ public:
             return tl::unexpected(xyz.error());
         }
         xyzProgram_ = *xyz;
-        auto display = link(kDisplayShader, "display");
-        if (!display) {
+        if (auto display = displayPass_.init(setup_.display, setup_.width, setup_.height);
+            !display) {
             return tl::unexpected(display.error());
         }
-        displayProgram_ = *display;
         glGenVertexArrays(1, &vao_);
 
         const auto& s = setup_.surface;
@@ -196,23 +177,15 @@ public:
         coeffB_ = makeTexture(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, b.data());
         xyzTarget_ =
                 makeTexture(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
-        rgbaTarget_ = makeTexture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, setup_.width, setup_.height,
-                                  nullptr);
-        textures_ = {coeffA_, coeffB_, xyzTarget_, rgbaTarget_};
+        textures_ = {coeffA_, coeffB_, xyzTarget_};
 
-        glGenFramebuffers(2, fbos_.data());
-        for (int i = 0; i < 2; ++i) {
-            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[static_cast<std::size_t>(i)]);
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
-                                   i == 0 ? xyzTarget_ : rgbaTarget_, 0);
-            if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-                return makeError(
-                        ErrorCode::Unsupported,
-                        fmt::format(
-                                "render: the {} target is not renderable on this GL "
-                                "(float colour buffers need GLES 3.2 or EXT_color_buffer_float)",
-                                i == 0 ? "RGBA32F XYZ" : "RGBA8 display"));
-            }
+        glGenFramebuffers(1, fbos_.data());
+        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, xyzTarget_, 0);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            return makeError(ErrorCode::Unsupported,
+                             "render: the RGBA32F XYZ target is not renderable on this GL (float "
+                             "colour buffers need GLES 3.2 or EXT_color_buffer_float)");
         }
         if (GLenum err = glGetError(); err != GL_NO_ERROR) {
             return makeError(ErrorCode::Unsupported,
@@ -278,19 +251,20 @@ public:
         glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffB"), 1);
         glDrawArrays(GL_TRIANGLES, 0, 3);
 
-        // Pass 2: display drive values.
-        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[1]);
-        glUseProgram(displayProgram_);
-        const glm::mat3 inv = glm::mat3(glm::inverse(setup_.display.rgbToXyz));
-        glUniformMatrix3fv(glGetUniformLocation(displayProgram_, "uXyzToRgb"), 1, GL_FALSE,
-                           &inv[0][0]);
-        setVec3(displayProgram_, "uBlack", setup_.display.blackXyz);
-        glUniform1f(glGetUniformLocation(displayProgram_, "uInvGamma"),
-                    static_cast<float>(1.0 / setup_.display.gamma));
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, xyzTarget_);
-        glUniform1i(glGetUniformLocation(displayProgram_, "uXyz"), 0);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        // Pass 2: panel counts (display_pass.cpp).
+        DisplayPassFrame df;
+        df.pose = pose;
+        df.eyeM = state.eyeBoothM;
+        df.lights = &packed;
+        df.lightCount = count;
+        df.lightNormal = setup_.booth.emitter.normal;
+        const colour::Xyz lightXyz = colour::spectrumToXyz(setup_.observer, state.illuminant);
+        df.lightXyzUnitY = lightXyz.y > 0.0 ? lightXyz / lightXyz.y : glm::dvec3(0.0);
+        auto gamut = displayPass_.draw(xyzTarget_, df);
+        if (!gamut) {
+            return tl::unexpected(gamut.error());
+        }
+        out.gamut = *gamut;
 
         // Read back what the caller uses.
         out.width = w;
@@ -306,7 +280,7 @@ public:
         }
         if (readback != Readback::None) {
             out.rgba.resize(pixels * 4);
-            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[1]);
+            glBindFramebuffer(GL_FRAMEBUFFER, displayPass_.framebuffer());
             glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, out.rgba.data());
         } else {
             out.rgba.clear();
@@ -329,14 +303,13 @@ private:
 
     GlesRendererSetup setup_;
     GLuint xyzProgram_ = 0;
-    GLuint displayProgram_ = 0;
     GLuint vao_ = 0;
     GLuint coeffA_ = 0;
     GLuint coeffB_ = 0;
     GLuint xyzTarget_ = 0;
-    GLuint rgbaTarget_ = 0;
     std::vector<GLuint> textures_;
-    std::array<GLuint, 2> fbos_{};
+    std::array<GLuint, 1> fbos_{};
+    DisplayPass displayPass_;
 };
 
 } // namespace

@@ -26,6 +26,7 @@ int runCli(int argc, char** argv)
     registerRunCommand(app, exitCode);
     registerReplayCommand(app, exitCode);
     registerInspectCommand(app, exitCode);
+    registerDisplayCommand(app, exitCode);
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
     registerProbeCommand(app, exitCode);
