@@ -26,6 +26,7 @@ int runCli(int argc, char** argv)
     registerRunCommand(app, exitCode);
     registerReplayCommand(app, exitCode);
     registerInspectCommand(app, exitCode);
+    registerRecoverCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {

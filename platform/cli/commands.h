@@ -13,5 +13,6 @@ constexpr int kExitLossy = 3;
 void registerRunCommand(CLI::App& app, int& exitCode);
 void registerReplayCommand(CLI::App& app, int& exitCode);
 void registerInspectCommand(CLI::App& app, int& exitCode);
+void registerRecoverCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform
