@@ -27,6 +27,8 @@ int runCli(int argc, char** argv)
     registerReplayCommand(app, exitCode);
     registerInspectCommand(app, exitCode);
     registerRecoverCommand(app, exitCode);
+    registerColorCommand(app, exitCode);
+    registerSpectralCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {
