@@ -50,13 +50,18 @@ public:
     // Writes the chunk #0 (schemas, channels, session) synchronously, before the thread starts.
     static Expected<void> begin(mcap::FileWriter& file, const SessionInfo& session)
     {
+        const std::string sessionJson = encodeSession(session, kFormatVersion);
+        if (auto ok = file.addMetadata(
+                    {std::string(kSessionMetadataName), {{"session", sessionJson}}});
+            !ok) {
+            return ok;
+        }
         for (const auto& d : channelDefinitions()) {
             file.addSchema(d.schema);
             file.addChannel(d.channel);
         }
         const auto t = logTime(session.wallClockStartNs, 0);
-        file.addMessage({static_cast<std::uint16_t>(ChannelId::Session), 0, t, t,
-                         encodeSession(session, kFormatVersion)});
+        file.addMessage({static_cast<std::uint16_t>(ChannelId::Session), 0, t, t, sessionJson});
         return file.closeChunk(true);
     }
 

@@ -1,9 +1,11 @@
 // Recovery: a resynchronising linear scan, then a fresh writer for everything that survived.
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <set>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <recordings/mcap/reader.h>
 #include <recordings/mcap/writer.h>
@@ -44,7 +46,38 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
             options.fallbackSchemas[d.schema.id] = d.schema;
         }
     }
-    const auto s = mcap::scan(bytes, options);
+    auto s = mcap::scan(bytes, options);
+    // The session message lives in the first chunk; if that chunk was lost, restore it from the
+    // copy in the replica.session Metadata record.
+    const auto sessionId = static_cast<std::uint16_t>(ChannelId::Session);
+    const bool haveSession = std::any_of(s.messages.begin(), s.messages.end(),
+                                         [&](const auto& m) { return m.channelId == sessionId; });
+    bool sessionRestored = false;
+    if (!haveSession && !s.messages.empty() && options.fallbackChannels.contains(sessionId)) {
+        for (const auto& md : s.metadata) {
+            auto it = md.metadata.find("session");
+            if (md.name != kSessionMetadataName || it == md.metadata.end()) {
+                continue;
+            }
+            std::uint64_t t = 0;
+            try {
+                const auto j = nlohmann::json::parse(it->second);
+                t = static_cast<std::uint64_t>(
+                        std::max<std::int64_t>(0, j.at("wall_clock_start_ns").get<std::int64_t>()));
+            } catch (const std::exception&) {
+                break; // not a usable session description
+            }
+            const auto& def = options.fallbackChannels.at(sessionId);
+            if (!s.channels.contains(sessionId)) {
+                s.channels.emplace(sessionId, def);
+                s.schemas.emplace(def.schemaId, options.fallbackSchemas.at(def.schemaId));
+                s.channelsAssumed.push_back(sessionId);
+            }
+            s.messages.insert(s.messages.begin(), mcap::Message{sessionId, 0, t, t, it->second});
+            sessionRestored = true;
+            break;
+        }
+    }
     if (s.messages.empty()) {
         return makeError(
                 ErrorCode::Corrupt,
@@ -66,10 +99,16 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
         r.messagesDropped += *s.summaryMessageCount - s.messages.size();
     }
     r.channelsAssumed = s.channelsAssumed;
+    r.sessionRestored = sessionRestored;
 
     auto w = mcap::FileWriter::create(out, s.library.empty() ? "replica recover" : s.library);
     if (!w) {
         return tl::unexpected(w.error());
+    }
+    for (const auto& md : s.metadata) {
+        if (auto ok = (*w)->addMetadata(md); !ok) {
+            return tl::unexpected(ok.error());
+        }
     }
     std::set<std::uint16_t> schemasUsed;
     for (const auto& [id, c] : s.channels) {

@@ -18,6 +18,7 @@ struct RecoverReport {
     std::uint64_t messagesDropped = 0; // messages seen but unusable, plus any the summary claimed
     std::vector<std::string> problems; // what was wrong, one sentence each
     std::vector<std::uint16_t> channelsAssumed; // channel definitions re-created from the format
+    bool sessionRestored = false; // the session message came from the replica.session metadata
     bool lossy() const { return bytesDropped > 0 || messagesDropped > 0 || chunksDamaged > 0; }
 };
 

@@ -31,6 +31,9 @@ inline constexpr std::string_view kTrackerTopic = "/hal/tracker";
 inline constexpr std::string_view kAccelTopic = "/hal/accel";
 inline constexpr std::string_view kFrameTopic = "/replica/frame";
 inline constexpr std::string_view kRecorderTopic = "/replica/recorder";
+// A copy of the session message kept in a Metadata record outside every chunk (key "session"), so
+// that recover can restore the session when the first chunk is damaged.
+inline constexpr std::string_view kSessionMetadataName = "replica.session";
 
 // What the recorder itself reports on /replica/recorder: samples it could not write.
 struct RecorderStatus {

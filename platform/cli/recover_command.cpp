@@ -34,6 +34,7 @@ int recoverMain(const RecoverOptions& o)
                                           {"bytes_dropped", r->bytesDropped},
                                           {"messages_dropped", r->messagesDropped},
                                           {"channels_assumed", r->channelsAssumed},
+                                          {"session_restored", r->sessionRestored},
                                           {"problems", r->problems},
                                           {"lossy", r->lossy()}}
                                    .dump(2));

@@ -121,6 +121,14 @@ public:
             case Op::Chunk:
                 ok = chunk(content, at, next - at);
                 break;
+            case Op::Metadata:
+                if (auto m = decodeMetadata(content)) {
+                    s_.metadata.push_back(std::move(*m));
+                } else {
+                    problem(fmt::format("malformed Metadata record at byte {}", at));
+                    ok = false;
+                }
+                break;
             case Op::DataEnd:
                 s_.dataEnd = true;
                 s_.dataSectionEnd = at;

@@ -33,6 +33,7 @@ struct Scan {
     std::map<std::uint16_t, Schema> schemas;
     std::map<std::uint16_t, Channel> channels;
     std::vector<Message> messages;     // in file order, every one on a known channel
+    std::vector<Metadata> metadata;    // intact Metadata records of the data section
     std::vector<ChunkSpan> chunks;     // intact chunks
     std::vector<std::string> damage;   // one sentence each, with byte offsets; empty: file is sound
     std::uint64_t damageCount = 0;     // damage found (damage may hold fewer lines)

@@ -22,19 +22,69 @@ std::string encodeSchema(const Schema& s)
     return record(Op::Schema, w.bytes());
 }
 
-std::string encodeChannel(const Channel& c)
+namespace {
+
+std::string stringMap(const std::map<std::string, std::string>& m)
 {
     ByteWriter map;
-    for (const auto& [k, v] : c.metadata) {
+    for (const auto& [k, v] : m) {
         map.str(k);
         map.str(v);
     }
+    return std::move(map.bytes());
+}
+
+std::optional<std::map<std::string, std::string>> readStringMap(std::string_view bytes)
+{
+    ByteReader map(bytes);
+    std::map<std::string, std::string> out;
+    while (map.remaining() > 0 && !map.failed()) {
+        std::string k(map.str());
+        std::string v(map.str());
+        out[k] = v;
+    }
+    if (map.failed()) {
+        return std::nullopt;
+    }
+    return out;
+}
+
+} // namespace
+
+std::string encodeMetadata(const Metadata& m)
+{
+    ByteWriter w;
+    w.str(m.name);
+    w.str(stringMap(m.metadata));
+    return record(Op::Metadata, w.bytes());
+}
+
+std::optional<Metadata> decodeMetadata(std::string_view content)
+{
+    ByteReader r(content);
+    Metadata m;
+    m.name = r.str();
+    const auto bytes = r.str();
+    if (r.failed()) {
+        return std::nullopt;
+    }
+    auto map = readStringMap(bytes);
+    if (!map) {
+        return std::nullopt;
+    }
+    m.metadata = std::move(*map);
+    return m;
+}
+
+std::string encodeChannel(const Channel& c)
+{
+    const std::string map = stringMap(c.metadata);
     ByteWriter w;
     w.u16(c.id);
     w.u16(c.schemaId);
     w.str(c.topic);
     w.str(c.messageEncoding);
-    w.str(map.bytes());
+    w.str(map);
     return record(Op::Channel, w.bytes());
 }
 
@@ -71,18 +121,15 @@ std::optional<Channel> decodeChannel(std::string_view content)
     c.schemaId = r.u16();
     c.topic = r.str();
     c.messageEncoding = r.str();
-    ByteReader map(r.str());
+    const auto bytes = r.str();
     if (r.failed()) {
         return std::nullopt;
     }
-    while (map.remaining() > 0 && !map.failed()) {
-        std::string k(map.str());
-        std::string v(map.str());
-        c.metadata[k] = v;
-    }
-    if (map.failed()) {
+    auto map = readStringMap(bytes);
+    if (!map) {
         return std::nullopt;
     }
+    c.metadata = std::move(*map);
     return c;
 }
 

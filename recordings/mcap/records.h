@@ -57,6 +57,12 @@ struct Message {
     std::string data;
 };
 
+struct Metadata {
+    std::string name;
+    std::map<std::string, std::string> metadata;
+    bool operator==(const Metadata&) const = default;
+};
+
 // Appends little-endian fields to a byte string.
 class ByteWriter
 {
@@ -133,10 +139,12 @@ std::string record(Op op, std::string_view content);
 std::string encodeSchema(const Schema& s);
 std::string encodeChannel(const Channel& c);
 std::string encodeMessage(const Message& m);
+std::string encodeMetadata(const Metadata& m);
 
 // Decoders return nullopt when the content is too short or inconsistent.
 std::optional<Schema> decodeSchema(std::string_view content);
 std::optional<Channel> decodeChannel(std::string_view content);
 std::optional<Message> decodeMessage(std::string_view content);
+std::optional<Metadata> decodeMetadata(std::string_view content);
 
 } // namespace replica::recordings::mcap

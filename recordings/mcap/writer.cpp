@@ -129,6 +129,17 @@ void FileWriter::addMessage(const Message& m)
     lastTime_ = std::max(lastTime_, m.logTime);
 }
 
+Expected<void> FileWriter::addMetadata(const Metadata& m)
+{
+    const std::string rec = encodeMetadata(m);
+    const std::uint64_t at = offset_;
+    if (auto ok = put(rec); !ok) {
+        return ok;
+    }
+    metadataIndexes_.push_back({at, rec.size(), m.name});
+    return {};
+}
+
 Expected<void> FileWriter::closeChunk(bool sync)
 {
     if (failure_) {
@@ -265,6 +276,15 @@ Expected<void> FileWriter::finish()
         g += record(Op::ChunkIndex, w.bytes());
     }
     group(Op::ChunkIndex, g);
+    g.clear();
+    for (const auto& mi : metadataIndexes_) {
+        ByteWriter w;
+        w.u64(mi.offset);
+        w.u64(mi.length);
+        w.str(mi.name);
+        g += record(Op::MetadataIndex, w.bytes());
+    }
+    group(Op::MetadataIndex, g);
     {
         ByteWriter counts;
         for (const auto& [channel, n] : channelCounts_) {
@@ -276,7 +296,7 @@ Expected<void> FileWriter::finish()
         w.u16(static_cast<std::uint16_t>(schemas_.size()));
         w.u32(static_cast<std::uint32_t>(channels_.size()));
         w.u32(0);
-        w.u32(0);
+        w.u32(static_cast<std::uint32_t>(metadataIndexes_.size()));
         w.u32(static_cast<std::uint32_t>(chunkIndexes_.size()));
         w.u64(messageCount_ ? firstTime_ : 0);
         w.u64(messageCount_ ? lastTime_ : 0);

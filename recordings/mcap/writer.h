@@ -33,6 +33,9 @@ public:
     void addSchema(const Schema& s);
     void addChannel(const Channel& c);
     void addMessage(const Message& m);
+    // Written at once, outside any chunk (so it survives damage to the chunks), and indexed in the
+    // summary.
+    Expected<void> addMetadata(const Metadata& m);
 
     // Uncompressed bytes in the open chunk (0: nothing pending).
     std::size_t pendingBytes() const { return chunk_.size(); }
@@ -68,6 +71,11 @@ private:
     std::vector<Schema> schemas_;
     std::vector<Channel> channels_;
     std::vector<ChunkIndex> chunkIndexes_;
+    struct MetadataIndex {
+        std::uint64_t offset = 0, length = 0;
+        std::string name;
+    };
+    std::vector<MetadataIndex> metadataIndexes_;
     std::map<std::uint16_t, std::uint64_t> channelCounts_;
     std::uint64_t messageCount_ = 0, firstTime_ = UINT64_MAX, lastTime_ = 0;
     std::optional<Error> failure_;
