@@ -160,6 +160,41 @@ TEST(RecordingRead, FormatVersionOneSampleStillOpens)
     EXPECT_FALSE(r->spectra.empty());
 }
 
+TEST(RecordingRead, FormatVersionTwoSampleHoldsTheSameSessionAsVersionOne)
+{
+    // walk-v1 and walk-v2 were recorded from the same deterministic sim scenario by the two format
+    // versions' writers: the timing, poses and tilts must read back identical. (The simulated
+    // spectrometer gained a non-linearity and the configuration gained fields between the two, so
+    // counts and configuration legitimately differ.)
+    const auto dir = std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples";
+    auto v1 = readRecording(dir / "walk-v1.mcap");
+    auto v2 = readRecording(dir / "walk-v2.mcap");
+    ASSERT_TRUE(v1) << v1.error().message;
+    ASSERT_TRUE(v2) << v2.error().message;
+    EXPECT_EQ(v2->formatVersion, 2);
+    ASSERT_EQ(v2->frames.size(), v1->frames.size());
+    ASSERT_EQ(v2->poses.size(), v1->poses.size());
+    ASSERT_EQ(v2->accel.size(), v1->accel.size());
+    ASSERT_EQ(v2->spectra.size(), v1->spectra.size());
+    for (std::size_t i = 0; i < v1->frames.size(); ++i) {
+        EXPECT_EQ(v2->frames[i].tickNs, v1->frames[i].tickNs);
+        EXPECT_EQ(v2->frames[i].poseSequence, v1->frames[i].poseSequence);
+        EXPECT_EQ(v2->frames[i].spectrumSequence, v1->frames[i].spectrumSequence);
+    }
+    for (std::size_t i = 0; i < v1->poses.size(); ++i) {
+        EXPECT_EQ(v2->poses[i].eyeTrackerM, v1->poses[i].eyeTrackerM);
+        EXPECT_EQ(v2->poses[i].timestampNs, v1->poses[i].timestampNs);
+    }
+    for (std::size_t i = 0; i < v1->accel.size(); ++i) {
+        EXPECT_EQ(v2->accel[i].gravity, v1->accel[i].gravity);
+    }
+    for (std::size_t i = 0; i < v1->spectra.size(); ++i) {
+        EXPECT_EQ(v2->spectra[i].timestampNs, v1->spectra[i].timestampNs);
+        EXPECT_EQ(v2->spectra[i].counts.size(), v1->spectra[i].counts.size());
+        EXPECT_EQ(v2->spectra[i].wavelengthCoeffs, v1->spectra[i].wavelengthCoeffs);
+    }
+}
+
 TEST(RecordingRead, TruncatedFileIsReportedNotCrashed)
 {
     const auto path = tempFile("truncated");
