@@ -131,6 +131,33 @@ int inspectMain(const InspectOptions& o)
                      {"first_ns", first},
                      {"last_ns", last},
                      {"duration_s", static_cast<double>(last - first) * 1e-9}};
+    // The last decoded sample of each stream, in the channels' own field names: lets independent
+    // MCAP readers check decoded values, not just counts.
+    if (!rec->spectra.empty()) {
+        const auto& s = rec->spectra.back();
+        j["spectrometer"]["last"] = {{"seq", s.sequence},
+                                     {"integration_time_us", s.integrationTimeUs},
+                                     {"counts", s.counts},
+                                     {"wavelength_coeffs", s.wavelengthCoeffs},
+                                     {"nonlinearity_coeffs", s.nonlinearityCoeffs}};
+    }
+    if (!rec->poses.empty()) {
+        const auto& p = rec->poses.back();
+        j["tracker"]["last"] = {
+                {"seq", p.sequence},
+                {"tracked", p.tracked},
+                {"eye", {{"x", p.eyeTrackerM.x}, {"y", p.eyeTrackerM.y}, {"z", p.eyeTrackerM.z}}}};
+    }
+    if (!rec->accel.empty()) {
+        const auto& a = rec->accel.back();
+        j["accel"]["last"] = {
+                {"seq", a.sequence},
+                {"gravity", {{"x", a.gravity.x}, {"y", a.gravity.y}, {"z", a.gravity.z}}}};
+    }
+    if (!rec->frames.empty()) {
+        j["last_frame"] = {{"frame", rec->frames.back().frameIndex},
+                           {"tick_ns", rec->frames.back().tickNs}};
+    }
     if (o.json) {
         fmt::print("{}\n", j.dump(2));
         return kExitOk;
