@@ -69,8 +69,9 @@ Expected<void> FileWriter::fail(std::string what, int err)
         } else if (err == EFBIG) {
             hint = " (file size limit reached; what was written so far is kept)";
         }
-        failure_ = Error{ErrorCode::Io, fmt::format("{}: {}: {}{}", path_.string(), what,
-                                                    err ? std::strerror(err) : "failed", hint)};
+        failure_ = Error{ErrorCode::Io, err ? fmt::format("{}: {}: {}{}", path_.string(), what,
+                                                          std::strerror(err), hint)
+                                            : fmt::format("{}: {}{}", path_.string(), what, hint)};
     }
     return tl::unexpected(*failure_);
 }
