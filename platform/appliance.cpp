@@ -63,7 +63,8 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
     return c;
 }
 
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config)
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
+                                                    const OutputChoice& outputChoice)
 {
     const std::string dir = dataDir().string();
     auto app = std::make_unique<Appliance>();
@@ -108,7 +109,9 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config)
         return tl::unexpected(surface.error());
     }
 
-    auto output = createHeadlessOutput();
+    auto output = outputChoice.kind == "kms"
+                          ? createKmsOutput(outputChoice.kmsDevice, outputChoice.kmsConnector)
+                          : createHeadlessOutput();
     if (!output) {
         return tl::unexpected(output.error());
     }

@@ -56,7 +56,15 @@ struct Appliance {
 };
 
 // Creates the headless output and everything that renders. Fails with a one-line reason.
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config);
+// Where frames go; not part of RunConfig because it never changes what a frame looks like.
+struct OutputChoice {
+    std::string kind = "headless"; // or "kms"
+    std::string kmsDevice = "/dev/dri/card0";
+    std::string kmsConnector; // empty: the first connected one
+};
+
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
+                                                    const OutputChoice& output = {});
 
 // The built-in simulated sensors playing the scripted scenario.
 Expected<Sources> makeSimSources(const Appliance& appliance);

@@ -29,6 +29,7 @@ int runCli(int argc, char** argv)
     registerRecoverCommand(app, exitCode);
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
+    registerProbeCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {

@@ -16,5 +16,6 @@ void registerInspectCommand(CLI::App& app, int& exitCode);
 void registerRecoverCommand(CLI::App& app, int& exitCode);
 void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
+void registerProbeCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform
