@@ -220,6 +220,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     setup.surface = std::move(*surface);
     setup.basis = basis;
     setup.observer = *observer;
+    app->displayWhiteXyz = display->model.whiteXyz();
     setup.display = std::move(*display);
     setup.lightsU = config.lightsU;
     setup.lightsV = config.lightsV;

@@ -5,6 +5,8 @@
 #include <memory>
 #include <string>
 
+#include <glm/vec3.hpp>
+
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
 #include <pipeline/render/renderer.h>
@@ -63,7 +65,8 @@ struct Appliance {
             output; // owns the GL context: created before, destroyed after the renderer
     std::unique_ptr<pipeline::render::Renderer> renderer;
     std::unique_ptr<SceneUpdater> updater;
-    std::string displayProfileId; // as recorded in the session
+    std::string displayProfileId;    // as recorded in the session
+    glm::dvec3 displayWhiteXyz{0.0}; // the panel's full white (cd/m^2): Lab white of frame reports
     ~Appliance()
     {
         renderer.reset(); // GL objects go while the context still exists

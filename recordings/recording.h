@@ -1,8 +1,10 @@
 // What a Replica recording holds and the API to write and read one (MCAP on disk; see README.md).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,7 +17,9 @@
 namespace replica::recordings {
 
 // Bumped whenever what is written changes; readers open every earlier version they know.
-constexpr int kFormatVersion = 1;
+// 1: unchunked MCAP, JSON messages (recordings/samples/walk-v1.mcap).
+// 2: zstd chunks with CRCs and message indexes, summary, JSON Schemas, /replica/recorder.
+constexpr int kFormatVersion = 2;
 
 // For each rendered frame: its tick time and exactly which sample of each device it consumed (by
 // the device's sequence number), so replay never has to guess timing. nullopt: no sample yet.
@@ -45,16 +49,41 @@ struct Recording {
     std::vector<hal::PoseSample> poses;
     std::vector<hal::AccelSample> accel;
     std::vector<FrameRecord> frames;
-    std::uint64_t droppedMessages = 0; // what the writer recorded as dropped (queue full)
+    std::uint64_t droppedMessages = 0;   // what the writer recorded as dropped (queue full)
+    std::uint64_t rejectedNonFinite = 0; // samples the writer refused: a value was NaN or infinite
 };
 
-// Appends samples and frame records to a recording. write() never blocks the caller for I/O.
+struct WriterOptions {
+    // The open chunk is closed, written and fdatasync'ed at most this long after its first
+    // message: a power cut loses at most about this much.
+    std::chrono::milliseconds flushInterval{500};
+    std::size_t chunkBytes = 256 * 1024; // ...or once it holds this many uncompressed bytes
+    std::size_t queueCapacity = 16384;   // samples waiting for the writer thread; beyond: dropped
+    // Called once, from the writer thread, on the first I/O failure (disk full, file deleted, ...).
+    // Recording stops there; what was written stays readable.
+    std::function<void(const Error&)> onError;
+};
+
+struct WriterStats {
+    std::uint64_t messages = 0; // written into chunks
+    std::uint64_t dropped = 0;  // queue full
+    std::uint64_t rejected = 0; // NaN/infinite values
+    std::uint64_t chunks = 0;
+    std::uint64_t bytes = 0; // file bytes written so far
+    bool failed = false;
+};
+
+// Appends samples and frame records to a recording. write() never blocks the caller: it puts the
+// sample on a bounded queue that a writer thread drains (a full queue drops the sample and counts
+// it on /replica/recorder). write() must be called from one thread at a time.
 class RecordingWriter
 {
 public:
-    // Creates (truncates) the file and writes the header and session description.
+    // Creates (truncates) the file and writes, and syncs, the header, every schema and channel and
+    // the session description, so that a file that exists is a readable recording.
     static Expected<std::unique_ptr<RecordingWriter>> create(const std::filesystem::path& path,
-                                                             const SessionInfo& session);
+                                                             const SessionInfo& session,
+                                                             WriterOptions options = {});
     virtual ~RecordingWriter() = default;
 
     virtual void write(const hal::SpectrumSample& s) = 0;
@@ -64,9 +93,30 @@ public:
     // Flushes everything and writes the summary and footer. Safe to call once; the destructor calls
     // it.
     virtual Expected<void> close() = 0;
+    // Thread-safe snapshot of what the writer has done so far.
+    virtual WriterStats stats() const = 0;
 };
 
 // Reads a whole recording. Fails with a one-line reason (missing, empty, not a recording, damaged).
 Expected<Recording> readRecording(const std::filesystem::path& path);
+
+// What a file holds and what is wrong with it, for 'replica inspect'.
+struct ChannelReport {
+    std::uint16_t id = 0;
+    std::string topic, schemaName, messageEncoding;
+    std::uint64_t messages = 0;
+    std::uint64_t firstLogTime = 0, lastLogTime = 0;
+};
+struct FileReport {
+    std::uint64_t fileBytes = 0;
+    std::string library;
+    std::vector<ChannelReport> channels; // by id
+    std::uint64_t messages = 0, chunks = 0;
+    bool indexed = false;            // has a summary (statistics, chunk indexes)
+    std::vector<std::string> damage; // empty: the file is sound
+    std::uint64_t damageCount = 0;
+};
+// Fails only when the file cannot be read at all; damage is reported in the result.
+Expected<FileReport> inspectRecording(const std::filesystem::path& path);
 
 } // namespace replica::recordings

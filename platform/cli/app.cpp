@@ -27,6 +27,7 @@ int runCli(int argc, char** argv)
     registerReplayCommand(app, exitCode);
     registerInspectCommand(app, exitCode);
     registerDisplayCommand(app, exitCode);
+    registerRecoverCommand(app, exitCode);
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
     registerProbeCommand(app, exitCode);

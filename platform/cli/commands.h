@@ -14,6 +14,7 @@ void registerRunCommand(CLI::App& app, int& exitCode);
 void registerReplayCommand(CLI::App& app, int& exitCode);
 void registerInspectCommand(CLI::App& app, int& exitCode);
 void registerDisplayCommand(CLI::App& app, int& exitCode);
+void registerRecoverCommand(CLI::App& app, int& exitCode);
 void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
 void registerProbeCommand(CLI::App& app, int& exitCode);

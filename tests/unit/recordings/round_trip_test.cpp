@@ -90,6 +90,111 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     std::filesystem::remove(path);
 }
 
+TEST(RecordingRoundTrip, NonFiniteValuesAreRefusedAndCounted)
+{
+    const auto path = tempFile("nonfinite");
+    {
+        auto w = RecordingWriter::create(path, SessionInfo{});
+        ASSERT_TRUE(w) << w.error().message;
+        hal::AccelSample a;
+        a.sequence = 1;
+        a.gravity = {0.0, std::numeric_limits<double>::quiet_NaN(), 0.0};
+        (*w)->write(a);
+        hal::PoseSample p;
+        p.eyeTrackerM = {std::numeric_limits<double>::infinity(), 0.0, 0.0};
+        (*w)->write(p);
+        a.sequence = 2;
+        a.gravity = {0.0, -9.8, 0.0};
+        (*w)->write(a);
+        ASSERT_TRUE((*w)->close());
+        EXPECT_EQ((*w)->stats().rejected, 2u);
+    }
+    auto r = readRecording(path);
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ(r->accel.size(), 1u);
+    EXPECT_EQ(r->accel[0].sequence, 2u);
+    EXPECT_TRUE(r->poses.empty());
+    EXPECT_EQ(r->rejectedNonFinite, 2u); // recorded on /replica/recorder, not lost silently
+    EXPECT_EQ(r->droppedMessages, 0u);
+    std::filesystem::remove(path);
+}
+
+TEST(RecordingRoundTrip, FullQueueDropsAndRecordsTheDrops)
+{
+    const auto path = tempFile("drops");
+    std::uint64_t dropped = 0;
+    {
+        WriterOptions options;
+        options.queueCapacity = 4;
+        auto w = RecordingWriter::create(path, SessionInfo{}, options);
+        ASSERT_TRUE(w) << w.error().message;
+        hal::SpectrumSample s;
+        s.counts.assign(2048, 100);
+        // Far more than four spectra at once: the writer thread cannot keep up with a tight loop
+        // of large samples, so some must be dropped (write() never waits).
+        for (std::uint32_t i = 0; i < 20000; ++i) {
+            s.sequence = i;
+            (*w)->write(s);
+        }
+        ASSERT_TRUE((*w)->close());
+        dropped = (*w)->stats().dropped;
+    }
+    auto r = readRecording(path);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_GT(dropped, 0u);
+    EXPECT_EQ(r->droppedMessages, dropped);
+    EXPECT_EQ(r->spectra.size(), 20000u - dropped);
+    std::filesystem::remove(path);
+}
+
+TEST(RecordingRead, FormatVersionOneSampleStillOpens)
+{
+    // The version policy: every committed sample of an earlier format stays readable.
+    const auto sample =
+            std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples/walk-v1.mcap";
+    auto r = readRecording(sample);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->formatVersion, 1);
+    EXPECT_EQ(r->frames.size(), 90u);
+    EXPECT_FALSE(r->poses.empty());
+    EXPECT_FALSE(r->spectra.empty());
+}
+
+TEST(RecordingRead, FormatVersionTwoSampleHoldsTheSameSessionAsVersionOne)
+{
+    // walk-v1 and walk-v2 were recorded from the same deterministic sim scenario by the two format
+    // versions' writers: the timing, poses and tilts must read back identical. (The simulated
+    // spectrometer gained a non-linearity and the configuration gained fields between the two, so
+    // counts and configuration legitimately differ.)
+    const auto dir = std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples";
+    auto v1 = readRecording(dir / "walk-v1.mcap");
+    auto v2 = readRecording(dir / "walk-v2.mcap");
+    ASSERT_TRUE(v1) << v1.error().message;
+    ASSERT_TRUE(v2) << v2.error().message;
+    EXPECT_EQ(v2->formatVersion, 2);
+    ASSERT_EQ(v2->frames.size(), v1->frames.size());
+    ASSERT_EQ(v2->poses.size(), v1->poses.size());
+    ASSERT_EQ(v2->accel.size(), v1->accel.size());
+    ASSERT_EQ(v2->spectra.size(), v1->spectra.size());
+    for (std::size_t i = 0; i < v1->frames.size(); ++i) {
+        EXPECT_EQ(v2->frames[i].tickNs, v1->frames[i].tickNs);
+        EXPECT_EQ(v2->frames[i].poseSequence, v1->frames[i].poseSequence);
+        EXPECT_EQ(v2->frames[i].spectrumSequence, v1->frames[i].spectrumSequence);
+    }
+    for (std::size_t i = 0; i < v1->poses.size(); ++i) {
+        EXPECT_EQ(v2->poses[i].eyeTrackerM, v1->poses[i].eyeTrackerM);
+        EXPECT_EQ(v2->poses[i].timestampNs, v1->poses[i].timestampNs);
+    }
+    for (std::size_t i = 0; i < v1->accel.size(); ++i) {
+        EXPECT_EQ(v2->accel[i].gravity, v1->accel[i].gravity);
+    }
+    for (std::size_t i = 0; i < v1->spectra.size(); ++i) {
+        EXPECT_EQ(v2->spectra[i].timestampNs, v1->spectra[i].timestampNs);
+        EXPECT_EQ(v2->spectra[i].counts.size(), v1->spectra[i].counts.size());
+        EXPECT_EQ(v2->spectra[i].wavelengthCoeffs, v1->spectra[i].wavelengthCoeffs);
+    }
+}
+
 TEST(RecordingRead, TruncatedFileIsReportedNotCrashed)
 {
     const auto path = tempFile("truncated");
@@ -107,6 +212,7 @@ TEST(RecordingRead, TruncatedFileIsReportedNotCrashed)
     auto r = readRecording(path);
     ASSERT_FALSE(r);
     EXPECT_NE(r.error().message.find(path.string()), std::string::npos);
+    EXPECT_NE(r.error().message.find("replica recover"), std::string::npos);
     std::filesystem::remove(path);
 }
 

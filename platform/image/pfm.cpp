@@ -1,0 +1,86 @@
+// PFM reading and writing: a text header ("PF", size, scale whose sign gives the byte order) and
+// raw 32-bit floats, rows bottom-up.
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include <platform/image/pfm.h>
+
+namespace replica::platform {
+
+Expected<void> writePfm(const std::filesystem::path& path, const FloatImage& image)
+{
+    const auto pixels =
+            static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+    if (image.width <= 0 || image.height <= 0 || image.rgba.size() != pixels * 4) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: no image to write ({}x{}, {} values)", path.string(),
+                                     image.width, image.height, image.rgba.size()));
+    }
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) {
+        return makeError(ErrorCode::Io, fmt::format("{}: cannot create file", path.string()));
+    }
+    // Negative scale: little-endian floats (this writer only runs on little-endian machines).
+    static_assert(std::endian::native == std::endian::little);
+    out << "PF\n" << image.width << ' ' << image.height << "\n-1.0\n";
+    std::vector<float> rgb(pixels * 3);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            rgb[p * 3 + c] = image.rgba[p * 4 + c];
+        }
+    }
+    out.write(reinterpret_cast<const char*>(rgb.data()),
+              static_cast<std::streamsize>(rgb.size() * sizeof(float)));
+    if (!out) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: write failed (disk full?)", path.string()));
+    }
+    return {};
+}
+
+Expected<FloatImage> readPfm(const std::filesystem::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot open", path.string()));
+    }
+    std::string magic;
+    FloatImage image;
+    double scale = 0.0;
+    in >> magic >> image.width >> image.height >> scale;
+    in.get(); // the single whitespace byte before the raster
+    if (!in || magic != "PF" || image.width <= 0 || image.height <= 0 || scale == 0.0 ||
+        image.width > 65536 || image.height > 65536) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: not a 3-channel PFM image (bad header)", path.string()));
+    }
+    const auto pixels =
+            static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+    std::vector<std::uint32_t> raw(pixels * 3);
+    in.read(reinterpret_cast<char*>(raw.data()),
+            static_cast<std::streamsize>(raw.size() * sizeof(std::uint32_t)));
+    if (in.gcount() != static_cast<std::streamsize>(raw.size() * sizeof(std::uint32_t))) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: truncated PFM ({}x{} pixels expected)", path.string(),
+                                     image.width, image.height));
+    }
+    const bool swap = (scale > 0.0) != (std::endian::native == std::endian::big);
+    image.rgba.resize(pixels * 4);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            std::uint32_t v = raw[p * 3 + c];
+            if (swap) {
+                v = ((v & 0xffU) << 24) | ((v & 0xff00U) << 8) | ((v >> 8) & 0xff00U) | (v >> 24);
+            }
+            image.rgba[p * 4 + c] = std::bit_cast<float>(v);
+        }
+        image.rgba[p * 4 + 3] = 1.0f;
+    }
+    return image;
+}
+
+} // namespace replica::platform

@@ -1,0 +1,443 @@
+// Linear MCAP scanning: records one after another, chunks decompressed and CRC-checked, the summary
+// checked against what the data section really holds, and resynchronisation for recovery.
+#include <algorithm>
+#include <optional>
+
+#include <fmt/format.h>
+#include <zstd.h>
+
+#include <recordings/mcap/crc.h>
+#include <recordings/mcap/reader.h>
+
+namespace replica::recordings::mcap {
+namespace {
+
+// Refuse chunks claiming more than this uncompressed: no Replica chunk comes near it, and a corrupt
+// size field must not make the reader allocate gigabytes.
+constexpr std::uint64_t kMaxChunkBytes = 256ULL << 20;
+
+struct ChunkFields {
+    std::uint64_t startTime = 0, endTime = 0, uncompressedSize = 0;
+    std::uint32_t crc = 0;
+    std::string_view compression, records;
+};
+
+std::optional<ChunkFields> chunkFields(std::string_view content)
+{
+    ByteReader r(content);
+    ChunkFields c;
+    c.startTime = r.u64();
+    c.endTime = r.u64();
+    c.uncompressedSize = r.u64();
+    c.crc = r.u32();
+    c.compression = r.str();
+    c.records = r.bytes(r.u64());
+    if (r.failed() || r.remaining() != 0) {
+        return std::nullopt;
+    }
+    return c;
+}
+
+// Decompresses and checks a chunk; returns the reason it is unusable, or the records.
+std::string unpack(const ChunkFields& c, std::string& out)
+{
+    if (c.uncompressedSize > kMaxChunkBytes) {
+        return fmt::format("claims {} uncompressed bytes", c.uncompressedSize);
+    }
+    if (c.compression.empty()) {
+        out.assign(c.records);
+    } else if (c.compression == "zstd") {
+        out.resize(static_cast<std::size_t>(c.uncompressedSize));
+        const std::size_t n =
+                ZSTD_decompress(out.data(), out.size(), c.records.data(), c.records.size());
+        if (ZSTD_isError(n)) {
+            return fmt::format("does not decompress ({})", ZSTD_getErrorName(n));
+        }
+        out.resize(n);
+    } else {
+        return fmt::format("uses unsupported compression '{}'", c.compression);
+    }
+    if (out.size() != c.uncompressedSize) {
+        return fmt::format("decompresses to {} bytes, not the {} it claims", out.size(),
+                           c.uncompressedSize);
+    }
+    if (c.crc != 0 && crc32(0, out) != c.crc) {
+        return "fails its CRC check (corrupted)";
+    }
+    return {};
+}
+
+class Scanner
+{
+public:
+    Scanner(std::string_view file, const ScanOptions& o) : f_(file), o_(o) {}
+
+    Scan run()
+    {
+        if (f_.size() < kMagic.size() || f_.substr(0, kMagic.size()) != kMagic) {
+            problem("not an MCAP file (bad magic bytes at byte 0)");
+            return std::move(s_);
+        }
+        std::size_t at = kMagic.size();
+        while (at < f_.size()) {
+            const std::size_t left = f_.size() - at;
+            if (left < kRecordPrefix) {
+                problem(fmt::format("truncated: {} stray byte(s) at byte {} (the file was cut "
+                                    "short)",
+                                    left, at));
+                s_.bytesSkipped += left;
+                break;
+            }
+            ByteReader r(f_.substr(at, kRecordPrefix));
+            const auto op = r.u8();
+            const std::uint64_t len = r.u64();
+            if (op == 0 || len > left - kRecordPrefix) {
+                problem(op == 0 ? fmt::format("invalid record (opcode 0) at byte {}", at)
+                                : fmt::format("record at byte {} (opcode 0x{:02x}) claims {} bytes "
+                                              "but only {} remain: truncated or corrupted",
+                                              at, op, len, left - kRecordPrefix));
+                if (!resyncFrom(at)) {
+                    break;
+                }
+                at = resyncAt_;
+                continue;
+            }
+            const std::string_view content = f_.substr(at + kRecordPrefix, len);
+            const std::size_t next = at + kRecordPrefix + static_cast<std::size_t>(len);
+            bool ok = true;
+            switch (static_cast<Op>(op)) {
+            case Op::Header:
+                if (at == kMagic.size()) {
+                    ByteReader h(content);
+                    h.str();
+                    s_.library = h.str();
+                }
+                break;
+            case Op::Schema:
+            case Op::Channel:
+            case Op::Message:
+                ok = inner(static_cast<Op>(op), content, at);
+                break;
+            case Op::Chunk:
+                ok = chunk(content, at, next - at);
+                break;
+            case Op::Metadata:
+                if (auto m = decodeMetadata(content)) {
+                    s_.metadata.push_back(std::move(*m));
+                } else {
+                    problem(fmt::format("malformed Metadata record at byte {}", at));
+                    ok = false;
+                }
+                break;
+            case Op::DataEnd:
+                s_.dataEnd = true;
+                s_.dataSectionEnd = at;
+                dataEnd(content, at);
+                summary(next);
+                return std::move(s_);
+            case Op::Footer:
+                problem(fmt::format("footer at byte {} without a Data End record before it", at));
+                return std::move(s_);
+            default:
+                break; // indexes, attachments, metadata and private records carry no samples
+            }
+            if (!ok) {
+                if (!resyncFrom(at)) {
+                    if (!o_.resync) {
+                        at = next; // keep reporting: the length field looked sane
+                        continue;
+                    }
+                    break;
+                }
+                at = resyncAt_;
+                continue;
+            }
+            s_.dataSectionEnd = next;
+            at = next;
+        }
+        problem(fmt::format("no Data End record: the recording was cut short at byte {} (power "
+                            "cut or crash?); 'replica recover' rebuilds its index",
+                            f_.size()));
+        return std::move(s_);
+    }
+
+private:
+    void problem(std::string what)
+    {
+        ++s_.damageCount;
+        if (s_.damage.size() < o_.maxDamageReports) {
+            s_.damage.push_back(std::move(what));
+        }
+    }
+
+    // Finds the next plausible, intact chunk after `at`; without resync, reports failure.
+    bool resyncFrom(std::size_t at)
+    {
+        if (!o_.resync) {
+            return false;
+        }
+        for (std::size_t p = at + 1; p + kRecordPrefix <= f_.size(); ++p) {
+            if (static_cast<std::uint8_t>(f_[p]) != static_cast<std::uint8_t>(Op::Chunk)) {
+                continue;
+            }
+            ByteReader r(f_.substr(p + 1, 8));
+            const std::uint64_t len = r.u64();
+            if (len > f_.size() - p - kRecordPrefix) {
+                continue;
+            }
+            const auto c = chunkFields(f_.substr(p + kRecordPrefix, len));
+            if (!c || (c->compression != "zstd" && !c->compression.empty()) || c->crc == 0) {
+                continue;
+            }
+            std::string records;
+            if (!unpack(*c, records).empty()) {
+                continue;
+            }
+            s_.bytesSkipped += p - at;
+            resyncAt_ = p;
+            return true;
+        }
+        s_.bytesSkipped += f_.size() - at;
+        return false;
+    }
+
+    // A Schema, Channel or Message record, in the data section or inside a chunk.
+    bool inner(Op op, std::string_view content, std::size_t at)
+    {
+        if (op == Op::Schema) {
+            auto sc = decodeSchema(content);
+            if (!sc) {
+                problem(fmt::format("malformed Schema record at byte {}", at));
+                return false;
+            }
+            if (sc->id == 0) {
+                return true; // id 0 is invalid; readers ignore it
+            }
+            auto [it, fresh] = s_.schemas.emplace(sc->id, *sc);
+            if (!fresh && !(it->second == *sc)) {
+                problem(fmt::format("Schema {} at byte {} differs from an earlier one", sc->id,
+                                    at));
+            }
+        } else if (op == Op::Channel) {
+            auto ch = decodeChannel(content);
+            if (!ch) {
+                problem(fmt::format("malformed Channel record at byte {}", at));
+                return false;
+            }
+            auto [it, fresh] = s_.channels.emplace(ch->id, *ch);
+            if (!fresh && !(it->second == *ch)) {
+                problem(fmt::format("Channel {} at byte {} differs from an earlier one", ch->id,
+                                    at));
+            }
+        } else {
+            auto m = decodeMessage(content);
+            if (!m) {
+                problem(fmt::format("malformed Message record at byte {}", at));
+                ++s_.messagesDropped;
+                return false;
+            }
+            if (!s_.channels.contains(m->channelId) && o_.fallbackChannels.contains(m->channelId)) {
+                const auto& ch = o_.fallbackChannels.at(m->channelId);
+                s_.channels.emplace(ch.id, ch);
+                if (auto it = o_.fallbackSchemas.find(ch.schemaId);
+                    it != o_.fallbackSchemas.end()) {
+                    s_.schemas.emplace(it->first, it->second);
+                }
+                s_.channelsAssumed.push_back(ch.id);
+            }
+            if (!s_.channels.contains(m->channelId)) {
+                problem(fmt::format("message at byte {} on channel {} that was never defined", at,
+                                    m->channelId));
+                ++s_.messagesDropped;
+                return true;
+            }
+            s_.messages.push_back(std::move(*m));
+        }
+        return true;
+    }
+
+    bool chunk(std::string_view content, std::size_t at, std::size_t length)
+    {
+        const auto c = chunkFields(content);
+        if (!c) {
+            problem(fmt::format("chunk at byte {} has inconsistent size fields", at));
+            ++s_.chunksDamaged;
+            return false;
+        }
+        std::string records;
+        if (auto why = unpack(*c, records); !why.empty()) {
+            problem(fmt::format("chunk at byte {} {}", at, why));
+            ++s_.chunksDamaged;
+            return false;
+        }
+        const std::size_t before = s_.messages.size();
+        // A chunk whose CRC matched but whose records do not parse was written wrong: keep none of
+        // it.
+        auto reject = [&](std::string why) {
+            problem(fmt::format("chunk at byte {} {}", at, why));
+            ++s_.chunksDamaged;
+            s_.messages.resize(before);
+            return false;
+        };
+        std::size_t p = 0;
+        while (p < records.size()) {
+            if (records.size() - p < kRecordPrefix) {
+                return reject("ends in a partial record");
+            }
+            ByteReader r(std::string_view(records).substr(p, kRecordPrefix));
+            const auto op = r.u8();
+            const std::uint64_t len = r.u64();
+            if (len > records.size() - p - kRecordPrefix) {
+                return reject("holds a record that overruns it");
+            }
+            const auto body = std::string_view(records).substr(p + kRecordPrefix, len);
+            const auto kind = static_cast<Op>(op);
+            if (kind == Op::Schema || kind == Op::Channel || kind == Op::Message) {
+                if (!inner(kind, body, at)) {
+                    ++s_.chunksDamaged;
+                    s_.messages.resize(before);
+                    return false;
+                }
+            }
+            p += kRecordPrefix + static_cast<std::size_t>(len);
+        }
+        s_.chunks.push_back({at, length, s_.messages.size() - before});
+        return true;
+    }
+
+    void dataEnd(std::string_view content, std::size_t at)
+    {
+        ByteReader r(content);
+        const std::uint32_t crc = r.u32();
+        if (r.failed()) {
+            problem(fmt::format("Data End record at byte {} is malformed", at));
+            return;
+        }
+        if (crc != 0 && crc32(0, f_.substr(0, at)) != crc) {
+            problem("data section CRC mismatch: some byte before the Data End record changed");
+        }
+    }
+
+    // Checks footer, trailing magic, summary CRC and the statistics against the data section.
+    void summary(std::size_t afterDataEnd)
+    {
+        const std::size_t size = f_.size();
+        if (size < afterDataEnd + kFooterRecordSize + kMagic.size()) {
+            problem("the summary or footer is missing or cut short (the recording was not closed)");
+            return;
+        }
+        if (f_.substr(size - kMagic.size()) != kMagic) {
+            problem("the file does not end with the MCAP magic bytes");
+            return;
+        }
+        const std::size_t footerAt = size - kMagic.size() - kFooterRecordSize;
+        ByteReader fr(f_.substr(footerAt, kFooterRecordSize));
+        const auto op = fr.u8();
+        const auto len = fr.u64();
+        const auto summaryStart = fr.u64();
+        const auto offsetsStart = fr.u64();
+        const auto summaryCrc = fr.u32();
+        if (op != static_cast<std::uint8_t>(Op::Footer) || len != 20) {
+            problem(fmt::format("no valid footer at byte {}", footerAt));
+            return;
+        }
+        if (summaryCrc != 0 &&
+            crc32(0, f_.substr(afterDataEnd, footerAt + kRecordPrefix + 16 - afterDataEnd)) !=
+                    summaryCrc) {
+            problem("summary CRC mismatch: the summary or footer was corrupted");
+            return;
+        }
+        if (summaryStart == 0) {
+            s_.footer = true; // an unindexed file: nothing more to check
+            return;
+        }
+        const std::size_t summaryEnd = offsetsStart != 0 ? offsetsStart : footerAt;
+        if (summaryStart != afterDataEnd || summaryEnd < summaryStart || summaryEnd > footerAt) {
+            problem("the footer's summary offsets are inconsistent");
+            return;
+        }
+        s_.footer = true;
+        std::size_t p = summaryStart;
+        std::uint64_t chunkIndexes = 0;
+        while (p < summaryEnd) {
+            if (summaryEnd - p < kRecordPrefix) {
+                problem("the summary ends in a partial record");
+                return;
+            }
+            ByteReader r(f_.substr(p, kRecordPrefix));
+            const auto rop = static_cast<Op>(r.u8());
+            const auto rlen = r.u64();
+            if (rlen > summaryEnd - p - kRecordPrefix) {
+                problem(fmt::format("summary record at byte {} overruns the summary", p));
+                return;
+            }
+            const auto body = f_.substr(p + kRecordPrefix, rlen);
+            if (rop == Op::ChunkIndex) {
+                ++chunkIndexes;
+            } else if (rop == Op::Statistics) {
+                statistics(body);
+            } else if (rop == Op::Channel) {
+                auto ch = decodeChannel(body);
+                if (!ch || s_.channels.count(ch->id) == 0 || !(s_.channels.at(ch->id) == *ch)) {
+                    problem(fmt::format("summary Channel record at byte {} does not match the "
+                                        "data section",
+                                        p));
+                }
+            }
+            p += kRecordPrefix + static_cast<std::size_t>(rlen);
+        }
+        if (chunkIndexes != s_.chunks.size()) {
+            problem(fmt::format("the summary indexes {} chunks but the data section holds {}",
+                                chunkIndexes, s_.chunks.size()));
+        }
+    }
+
+    void statistics(std::string_view body)
+    {
+        ByteReader r(body);
+        const auto messageCount = r.u64();
+        r.u16();
+        r.u32();
+        r.u32();
+        r.u32();
+        const auto chunkCount = r.u32();
+        r.u64();
+        r.u64();
+        ByteReader map(r.str());
+        if (r.failed()) {
+            problem("malformed Statistics record in the summary");
+            return;
+        }
+        s_.summary = true;
+        s_.summaryMessageCount = messageCount;
+        std::map<std::uint16_t, std::uint64_t> claimed;
+        while (map.remaining() > 0 && !map.failed()) {
+            const auto channel = map.u16();
+            claimed[channel] = map.u64();
+        }
+        std::map<std::uint16_t, std::uint64_t> found;
+        for (const auto& m : s_.messages) {
+            ++found[m.channelId];
+        }
+        if (messageCount != s_.messages.size() || chunkCount != s_.chunks.size() ||
+            (!claimed.empty() && claimed != found)) {
+            problem(fmt::format("the summary's statistics ({} messages in {} chunks) disagree "
+                                "with the data section ({} messages in {} chunks)",
+                                messageCount, chunkCount, s_.messages.size(), s_.chunks.size()));
+        }
+    }
+
+    std::string_view f_;
+    ScanOptions o_;
+    Scan s_;
+    std::size_t resyncAt_ = 0;
+};
+
+} // namespace
+
+Scan scan(std::string_view file, const ScanOptions& options)
+{
+    return Scanner(file, options).run();
+}
+
+} // namespace replica::recordings::mcap

@@ -1,0 +1,54 @@
+// Linear MCAP reader that checks everything it can (CRCs, sizes, summary) and never trusts a
+// length.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <recordings/mcap/records.h>
+
+namespace replica::recordings::mcap {
+
+struct ScanOptions {
+    // After damage, search forward for the next chunk that decompresses and matches its CRC and go
+    // on from there (recover); otherwise stop at the first record that cannot be trusted.
+    bool resync = false;
+    std::size_t maxDamageReports = 20;
+    // Channels (and their schemas) to assume for messages on a channel the file never defines, for
+    // when the chunk that defined them was lost (recover knows each format's fixed channels).
+    std::map<std::uint16_t, Channel> fallbackChannels;
+    std::map<std::uint16_t, Schema> fallbackSchemas;
+};
+
+struct ChunkSpan {
+    std::uint64_t offset = 0, length = 0, messages = 0;
+};
+
+struct Scan {
+    std::string library; // the Header's library string ("" if none)
+    std::map<std::uint16_t, Schema> schemas;
+    std::map<std::uint16_t, Channel> channels;
+    std::vector<Message> messages;     // in file order, every one on a known channel
+    std::vector<Metadata> metadata;    // intact Metadata records of the data section
+    std::vector<ChunkSpan> chunks;     // intact chunks
+    std::vector<std::string> damage;   // one sentence each, with byte offsets; empty: file is sound
+    std::uint64_t damageCount = 0;     // damage found (damage may hold fewer lines)
+    std::uint64_t bytesSkipped = 0;    // bytes of the data section not part of any intact record
+    std::uint64_t messagesDropped = 0; // messages seen but unusable (unknown channel, malformed)
+    std::uint64_t chunksDamaged = 0;   // chunk records that failed a check
+    std::optional<std::uint64_t> summaryMessageCount; // what the summary's statistics claim
+    std::vector<std::uint16_t> channelsAssumed;       // taken from fallbackChannels
+    bool dataEnd = false;                             // the Data End record was reached
+    bool footer = false;              // footer and trailing magic present and consistent
+    bool summary = false;             // a summary with statistics was present and checked
+    std::uint64_t dataSectionEnd = 0; // offset just past the last intact data-section record
+};
+
+// Scans a whole file held in memory. Never throws on malformed input; reports it in damage.
+Scan scan(std::string_view file, const ScanOptions& options = {});
+
+} // namespace replica::recordings::mcap

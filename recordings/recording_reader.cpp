@@ -1,0 +1,143 @@
+// Reading recordings of every known format version (1: unchunked, 2: chunked) and inspecting files.
+#include <fstream>
+#include <iterator>
+
+#include <fmt/format.h>
+
+#include <recordings/mcap/reader.h>
+#include <recordings/recording.h>
+#include <recordings/sample_codec.h>
+
+namespace replica::recordings {
+namespace {
+
+Expected<std::string> slurp(const std::filesystem::path& path)
+{
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) {
+        return makeError(ErrorCode::NotFound, fmt::format("{}: no such recording", path.string()));
+    }
+    if (std::filesystem::is_directory(path, ec)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: is a directory, not a recording", path.string()));
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot open recording (permissions?)", path.string()));
+    }
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.empty()) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: file is empty, not a recording", path.string()));
+    }
+    return bytes;
+}
+
+} // namespace
+
+Expected<Recording> readRecording(const std::filesystem::path& path)
+{
+    const std::string name = path.string();
+    auto bytes = slurp(path);
+    if (!bytes) {
+        return tl::unexpected(bytes.error());
+    }
+    const auto s = mcap::scan(*bytes);
+    if (!s.damage.empty()) {
+        if (s.damage.front().starts_with("not an MCAP file")) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: not an MCAP recording (bad magic bytes)", name));
+        }
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: damaged recording: {}{}; 'replica recover {} OUT' "
+                                     "rebuilds what is intact",
+                                     name, s.damage.front(),
+                                     s.damageCount > 1 ? fmt::format(" (and {} more problems)",
+                                                                     s.damageCount - 1)
+                                                       : "",
+                                     name));
+    }
+    Recording rec;
+    bool haveSession = false;
+    for (const auto& m : s.messages) {
+        const std::string& topic = s.channels.at(m.channelId).topic;
+        try {
+            const auto j = nlohmann::json::parse(m.data);
+            if (topic == kSessionTopic) {
+                rec.session = decodeSession(j, rec.formatVersion);
+                haveSession = true;
+            } else if (topic == kSpectrometerTopic) {
+                rec.spectra.push_back(decodeSpectrum(j));
+            } else if (topic == kTrackerTopic) {
+                rec.poses.push_back(decodePose(j));
+            } else if (topic == kAccelTopic) {
+                rec.accel.push_back(decodeAccel(j));
+            } else if (topic == kFrameTopic) {
+                rec.frames.push_back(decodeFrame(j));
+            } else if (topic == kRecorderTopic) {
+                const auto r = decodeRecorderStatus(j);
+                rec.droppedMessages = r.droppedTotal();
+                rec.rejectedNonFinite = r.rejectedNonFinite;
+            }
+        } catch (const std::exception& e) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: damaged {} message (sequence {}): {}", name, topic,
+                                         m.sequence, e.what()));
+        }
+    }
+    if (!haveSession) {
+        return makeError(
+                ErrorCode::Corrupt,
+                fmt::format("{}: MCAP file without a replica session; not a replica recording",
+                            name));
+    }
+    if (rec.formatVersion < 1 || rec.formatVersion > kFormatVersion) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("{}: recording format {} is newer than this replica reads "
+                                     "(up to {}); update replica",
+                                     name, rec.formatVersion, kFormatVersion));
+    }
+    return rec;
+}
+
+Expected<FileReport> inspectRecording(const std::filesystem::path& path)
+{
+    auto bytes = slurp(path);
+    if (!bytes) {
+        return tl::unexpected(bytes.error());
+    }
+    const auto s = mcap::scan(*bytes);
+    FileReport r;
+    r.fileBytes = bytes->size();
+    r.library = s.library;
+    r.messages = s.messages.size();
+    r.chunks = s.chunks.size();
+    r.indexed = s.summary;
+    r.damage = s.damage;
+    r.damageCount = s.damageCount;
+    std::map<std::uint16_t, ChannelReport> channels;
+    for (const auto& [id, c] : s.channels) {
+        auto& cr = channels[id];
+        cr.id = id;
+        cr.topic = c.topic;
+        cr.messageEncoding = c.messageEncoding;
+        if (auto it = s.schemas.find(c.schemaId); it != s.schemas.end()) {
+            cr.schemaName = it->second.name;
+        }
+    }
+    for (const auto& m : s.messages) {
+        auto& cr = channels[m.channelId];
+        if (cr.messages == 0 || m.logTime < cr.firstLogTime) {
+            cr.firstLogTime = m.logTime;
+        }
+        cr.lastLogTime = std::max(cr.lastLogTime, m.logTime);
+        ++cr.messages;
+    }
+    for (auto& [id, cr] : channels) {
+        r.channels.push_back(std::move(cr));
+    }
+    return r;
+}
+
+} // namespace replica::recordings

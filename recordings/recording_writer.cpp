@@ -1,0 +1,286 @@
+// The recording writer: callers enqueue samples; a writer thread encodes them into chunks and
+// closes (and syncs) a chunk at least every flush interval, so a power cut loses at most that much.
+#include <algorithm>
+#include <array>
+#include <condition_variable>
+#include <csignal>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <variant>
+
+#include <fmt/format.h>
+
+#include <recordings/mcap/writer.h>
+#include <recordings/recording.h>
+#include <recordings/sample_codec.h>
+#include <recordings/sample_queue.h>
+
+namespace replica::recordings {
+namespace {
+
+using Item = std::variant<hal::SpectrumSample, hal::PoseSample, hal::AccelSample, FrameRecord>;
+using Clock = std::chrono::steady_clock;
+
+// How long the writer thread sleeps when the queue is empty (a write() also wakes it).
+constexpr auto kPoll = std::chrono::milliseconds(10);
+
+std::uint64_t logTime(std::int64_t wallStart, std::int64_t t)
+{
+    const std::int64_t v = wallStart + t;
+    return v > 0 ? static_cast<std::uint64_t>(v) : 0;
+}
+
+class ThreadedWriter final : public RecordingWriter
+{
+public:
+    ThreadedWriter(std::unique_ptr<mcap::FileWriter> file,
+                   const SessionInfo& session,
+                   WriterOptions options)
+        : file_(std::move(file)), options_(std::move(options)), queue_(options_.queueCapacity),
+          wallStart_(session.wallClockStartNs)
+    {
+        status_.queueCapacity = queue_.capacity();
+        bytes_ = file_->bytesWritten();
+        chunks_ = file_->chunkCount();
+        thread_ = std::thread([this] { loop(); });
+    }
+    ~ThreadedWriter() override { (void)close(); }
+
+    // Writes the chunk #0 (schemas, channels, session) synchronously, before the thread starts.
+    static Expected<void> begin(mcap::FileWriter& file, const SessionInfo& session)
+    {
+        const std::string sessionJson = encodeSession(session, kFormatVersion);
+        if (auto ok = file.addMetadata(
+                    {std::string(kSessionMetadataName), {{"session", sessionJson}}});
+            !ok) {
+            return ok;
+        }
+        for (const auto& d : channelDefinitions()) {
+            file.addSchema(d.schema);
+            file.addChannel(d.channel);
+        }
+        const auto t = logTime(session.wallClockStartNs, 0);
+        file.addMessage({static_cast<std::uint16_t>(ChannelId::Session), 0, t, t, sessionJson});
+        return file.closeChunk(true);
+    }
+
+    void write(const hal::SpectrumSample& s) override { push(s, dropped_[0]); }
+    void write(const hal::PoseSample& s) override { push(s, dropped_[1]); }
+    void write(const hal::AccelSample& s) override { push(s, dropped_[2]); }
+    void write(const FrameRecord& f) override { push(f, dropped_[3]); }
+
+    Expected<void> close() override
+    {
+        if (!closed_) {
+            closed_ = true;
+            stopping_.store(true, std::memory_order_release);
+            wake_.notify_one();
+            if (thread_.joinable()) {
+                thread_.join();
+            }
+        }
+        if (result_) {
+            return tl::unexpected(*result_);
+        }
+        return {};
+    }
+
+    WriterStats stats() const override
+    {
+        WriterStats s;
+        s.messages = messages_.load();
+        for (const auto& d : dropped_) {
+            s.dropped += d.load();
+        }
+        s.rejected = rejected_.load();
+        s.chunks = chunks_.load();
+        s.bytes = bytes_.load();
+        s.failed = failed_.load();
+        return s;
+    }
+
+private:
+    template <typename Sample>
+    void push(const Sample& sample, std::atomic<std::uint64_t>& dropCounter)
+    {
+        if (closed_ || !queue_.tryPush(sample)) {
+            dropCounter.fetch_add(1, std::memory_order_relaxed);
+        }
+        wake_.notify_one();
+    }
+
+    void loop()
+    {
+        std::unique_lock lock(mutex_);
+        std::optional<Clock::time_point> chunkOpened;
+        for (;;) {
+            const bool stopping = stopping_.load(std::memory_order_acquire);
+            while (auto item = queue_.tryPop()) {
+                if (!chunkOpened) {
+                    chunkOpened = Clock::now();
+                }
+                add(*item);
+                if (file_->pendingBytes() >= options_.chunkBytes) {
+                    flush(chunkOpened);
+                }
+            }
+            if (stopping) {
+                break;
+            }
+            // Close a little early so that a sample's queueing delay (at most kPoll) still fits
+            // inside the promised interval.
+            if (chunkOpened && Clock::now() - *chunkOpened + kPoll >= options_.flushInterval) {
+                flush(chunkOpened);
+            }
+            auto wait = kPoll;
+            if (chunkOpened) {
+                const auto due = std::chrono::duration_cast<std::chrono::milliseconds>(
+                        *chunkOpened + options_.flushInterval - kPoll - Clock::now());
+                wait = std::clamp(due, std::chrono::milliseconds(1), kPoll);
+            }
+            wake_.wait_for(lock, wait);
+        }
+        recordStatus(true);
+        if (!failed_) {
+            if (auto ok = file_->finish(); !ok) {
+                report(ok.error());
+            }
+            bytes_ = file_->bytesWritten();
+            chunks_ = file_->chunkCount();
+        }
+    }
+
+    void add(const Item& item)
+    {
+        if (failed_) {
+            return; // keep draining so that the producer never sees a full queue for our sake
+        }
+        std::optional<std::string> payload;
+        ChannelId channel{};
+        std::int64_t t = 0;
+        std::visit(
+                [&](const auto& s) {
+                    using S = std::decay_t<decltype(s)>;
+                    if constexpr (std::is_same_v<S, hal::SpectrumSample>) {
+                        payload = encodeSpectrum(s);
+                        channel = ChannelId::Spectrometer;
+                        t = s.timestampNs;
+                    } else if constexpr (std::is_same_v<S, hal::PoseSample>) {
+                        payload = encodePose(s);
+                        channel = ChannelId::Tracker;
+                        t = s.timestampNs;
+                    } else if constexpr (std::is_same_v<S, hal::AccelSample>) {
+                        payload = encodeAccel(s);
+                        channel = ChannelId::Accel;
+                        t = s.timestampNs;
+                    } else {
+                        payload = encodeFrame(s);
+                        channel = ChannelId::Frame;
+                        t = s.tickNs;
+                    }
+                },
+                item);
+        if (!payload) {
+            rejected_.fetch_add(1, std::memory_order_relaxed);
+            return;
+        }
+        message(channel, t, std::move(*payload));
+        lastTime_ = std::max(lastTime_, t);
+    }
+
+    void message(ChannelId channel, std::int64_t t, std::string payload)
+    {
+        const auto id = static_cast<std::uint16_t>(channel);
+        const auto lt = logTime(wallStart_, t);
+        file_->addMessage({id, sequence_[id]++, lt, lt, std::move(payload)});
+        messages_.fetch_add(1, std::memory_order_relaxed);
+    }
+
+    // Writes a /replica/recorder message when the drop counts changed (always when `final`).
+    void recordStatus(bool final)
+    {
+        if (failed_) {
+            return;
+        }
+        RecorderStatus now = status_;
+        now.droppedSpectra = dropped_[0].load();
+        now.droppedPoses = dropped_[1].load();
+        now.droppedAccel = dropped_[2].load();
+        now.droppedFrames = dropped_[3].load();
+        now.rejectedNonFinite = rejected_.load();
+        const bool changed = now.droppedTotal() != status_.droppedTotal() ||
+                             now.rejectedNonFinite != status_.rejectedNonFinite;
+        if (changed || final) {
+            status_ = now;
+            message(ChannelId::Recorder, lastTime_, encodeRecorderStatus(now));
+        }
+    }
+
+    void flush(std::optional<Clock::time_point>& chunkOpened)
+    {
+        chunkOpened.reset();
+        if (failed_) {
+            return;
+        }
+        recordStatus(false);
+        auto ok = file_->closeChunk(true);
+        bytes_ = file_->bytesWritten();
+        chunks_ = file_->chunkCount();
+        if (!ok) {
+            report(ok.error());
+        }
+    }
+
+    void report(const Error& e)
+    {
+        failed_ = true;
+        result_ = e;
+        if (options_.onError) {
+            options_.onError(e);
+        }
+    }
+
+    std::unique_ptr<mcap::FileWriter> file_;
+    WriterOptions options_;
+    SampleQueue<Item> queue_;
+    std::int64_t wallStart_ = 0;
+    std::int64_t lastTime_ = 0;
+    std::map<std::uint16_t, std::uint32_t> sequence_;
+    RecorderStatus status_;
+    std::array<std::atomic<std::uint64_t>, 4> dropped_{};
+    std::atomic<std::uint64_t> rejected_{0}, messages_{0}, chunks_{0}, bytes_{0};
+    std::atomic<bool> failed_{false}, stopping_{false};
+    std::optional<Error> result_;
+    bool closed_ = false;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::thread thread_;
+};
+
+} // namespace
+
+Expected<std::unique_ptr<RecordingWriter>> RecordingWriter::create(
+        const std::filesystem::path& path, const SessionInfo& session, WriterOptions options)
+{
+    // A write past a file size limit must fail with EFBIG, not kill the appliance with SIGXFSZ.
+    struct sigaction current {
+    };
+    if (::sigaction(SIGXFSZ, nullptr, &current) == 0 && current.sa_handler == SIG_DFL) {
+        std::signal(SIGXFSZ, SIG_IGN);
+    }
+    auto file = mcap::FileWriter::create(
+            path, fmt::format("{} (format {})",
+                              session.softwareVersion.empty() ? "replica" : session.softwareVersion,
+                              kFormatVersion));
+    if (!file) {
+        return tl::unexpected(file.error());
+    }
+    if (auto ok = ThreadedWriter::begin(**file, session); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return std::unique_ptr<RecordingWriter>(
+            std::make_unique<ThreadedWriter>(std::move(*file), session, std::move(options)));
+}
+
+} // namespace replica::recordings

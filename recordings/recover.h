@@ -1,0 +1,31 @@
+// Rebuilding a valid recording from a truncated or partly corrupted one ('replica recover').
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+
+namespace replica::recordings {
+
+struct RecoverReport {
+    std::uint64_t messagesKept = 0;
+    std::uint64_t chunksKept = 0;      // intact chunks whose messages were all kept
+    std::uint64_t chunksDamaged = 0;   // chunk records dropped because they failed a check
+    std::uint64_t bytesDropped = 0;    // input bytes that were not part of any intact record
+    std::uint64_t messagesDropped = 0; // messages seen but unusable, plus any the summary claimed
+    std::vector<std::string> problems; // what was wrong, one sentence each
+    std::vector<std::uint16_t> channelsAssumed; // channel definitions re-created from the format
+    bool sessionRestored = false; // the session message came from the replica.session metadata
+    bool lossy() const { return bytesDropped > 0 || messagesDropped > 0 || chunksDamaged > 0; }
+};
+
+// Reads `in` linearly (no footer needed), resynchronising on the next intact chunk after damage,
+// and writes every message it could keep to `out` as a complete, indexed recording. Fails when
+// `in` cannot be read, nothing is recoverable, or `out` cannot be written.
+Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
+                                         const std::filesystem::path& out);
+
+} // namespace replica::recordings

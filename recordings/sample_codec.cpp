@@ -1,0 +1,309 @@
+// JSON encoding of Replica's messages and the JSON Schemas that let MCAP viewers plot them.
+#include <cmath>
+
+#include <recordings/sample_codec.h>
+
+namespace replica::recordings {
+namespace {
+
+using nlohmann::json;
+
+bool finite(const glm::dvec3& v)
+{
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+template <std::size_t N>
+bool finite(const std::array<double, N>& a)
+{
+    for (double x : a) {
+        if (!std::isfinite(x)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+json vec3(const glm::dvec3& v)
+{
+    return {{"x", v.x}, {"y", v.y}, {"z", v.z}};
+}
+
+glm::dvec3 vec3From(const json& j)
+{
+    return {j.at("x").get<double>(), j.at("y").get<double>(), j.at("z").get<double>()};
+}
+
+json deviceJson(const hal::DeviceInfo& d)
+{
+    return {{"model", d.model},
+            {"serial", d.serial},
+            {"firmware", d.firmware},
+            {"source", hal::toString(d.kind)}};
+}
+
+hal::DeviceInfo deviceFromJson(const json& j)
+{
+    hal::DeviceInfo d{j.at("model"), j.at("serial"), j.at("firmware"), hal::SourceKind::Sim};
+    const std::string k = j.at("source");
+    d.kind = k == "live"     ? hal::SourceKind::Live
+             : k == "replay" ? hal::SourceKind::Replay
+                             : hal::SourceKind::Sim;
+    return d;
+}
+
+// JSON Schema fragments shared by the channel schemas.
+constexpr const char* kTimeProps =
+        R"("t": {"type": "integer", "description": "session time (ns) when the loop received it"},
+    "seq": {"type": "integer", "description": "the device's own counter; gaps are drops"})";
+constexpr const char* kVec3 =
+        R"({"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"},
+      "z": {"type": "number"}}, "required": ["x", "y", "z"]})";
+constexpr const char* kDevice =
+        R"({"type": "object", "properties": {"model": {"type": "string"},
+      "serial": {"type": "string"}, "firmware": {"type": "string"},
+      "source": {"type": "string", "enum": ["live", "sim", "replay"]}}})";
+
+std::string schemaText(const std::string& title,
+                       const std::string& description,
+                       const std::string& properties,
+                       const std::string& required)
+{
+    return R"({"$schema": "https://json-schema.org/draft/2020-12/schema", "title": ")" + title +
+           R"(", "description": ")" + description + R"(", "type": "object", "properties": {)" +
+           properties + R"(}, "required": [)" + required + "]}";
+}
+
+std::vector<ChannelDefinition> makeDefinitions()
+{
+    const std::string timeProps = kTimeProps;
+    const std::string vec = kVec3;
+    const std::string dev = kDevice;
+    struct Def {
+        ChannelId id;
+        std::string_view topic;
+        std::string name, schema;
+    };
+    const std::vector<Def> defs = {
+            {ChannelId::Session, kSessionTopic, "replica.Session",
+             schemaText(
+                     "replica.Session",
+                     "What was recorded: software, configuration, booth, scene, display, devices",
+                     R"("format_version": {"type": "integer"}, "software": {"type": "string"},
+    "config": {"type": "string", "description": "resolved run configuration, as JSON text"},
+    "booth": {"type": "string"}, "scene": {"type": "string"},
+    "display_profile": {"type": "string"},
+    "wall_clock_start_ns": {"type": "integer", "description": "Unix time (ns) at session time 0"},
+    "spectrometer": )" + dev +
+                             R"(, "tracker": )" + dev + R"(, "accel": )" + dev,
+                     R"("format_version", "software", "config", "wall_clock_start_ns")")},
+            {ChannelId::Spectrometer, kSpectrometerTopic, "replica.SpectrometerSample",
+             schemaText("replica.SpectrometerSample",
+                        "One raw spectrum with the device calibration needed to convert it",
+                        timeProps + R"(,
+    "integration_time_us": {"type": "integer"},
+    "counts": {"type": "array", "items": {"type": "integer", "minimum": 0, "maximum": 65535},
+      "description": "raw counts, pixel 0 first"},
+    "wavelength_coeffs": {"type": "array", "items": {"type": "number"}, "minItems": 4,
+      "maxItems": 4, "description": "wavelength (nm) of pixel p = c0 + c1 p + c2 p^2 + c3 p^3"},
+    "nonlinearity_coeffs": {"type": "array", "items": {"type": "number"}, "minItems": 8,
+      "maxItems": 8, "description": "counts correction polynomial, order 0..7"},
+    "saturated": {"type": "boolean"})",
+                        R"("t", "seq", "integration_time_us", "counts", "wavelength_coeffs",
+    "nonlinearity_coeffs", "saturated")")},
+            {ChannelId::Tracker, kTrackerTopic, "replica.TrackerPose",
+             schemaText("replica.TrackerPose",
+                        "The viewer's eye position in the tracker frame (m): x right, y up, z "
+                        "towards the viewer",
+                        timeProps + R"(, "tracked": {"type": "boolean"}, "eye": )" + vec,
+                        R"("t", "seq", "tracked", "eye")")},
+            {ChannelId::Accel, kAccelTopic, "replica.AccelSample",
+             schemaText("replica.AccelSample", "Gravity in the display's device frame (m/s^2)",
+                        timeProps + R"(, "gravity": )" + vec, R"("t", "seq", "gravity")")},
+            {ChannelId::Frame, kFrameTopic, "replica.Frame",
+             schemaText("replica.Frame",
+                        "A rendered frame: its tick time and the device sequence numbers of the "
+                        "samples it consumed (absent: none yet)",
+                        R"("frame": {"type": "integer"}, "tick_ns": {"type": "integer"},
+    "spectrum_seq": {"type": "integer"}, "pose_seq": {"type": "integer"},
+    "accel_seq": {"type": "integer"})",
+                        R"("frame", "tick_ns")")},
+            {ChannelId::Recorder, kRecorderTopic, "replica.RecorderStatus",
+             schemaText("replica.RecorderStatus",
+                        "Samples the recorder could not write (queue full, or NaN/infinite "
+                        "values), cumulative since the session start",
+                        R"("dropped_spectra": {"type": "integer"},
+    "dropped_poses": {"type": "integer"}, "dropped_accel": {"type": "integer"},
+    "dropped_frames": {"type": "integer"}, "dropped_total": {"type": "integer"},
+    "rejected_nonfinite": {"type": "integer"}, "queue_capacity": {"type": "integer"})",
+                        R"("dropped_total")")},
+    };
+    std::vector<ChannelDefinition> out;
+    for (const auto& d : defs) {
+        const auto id = static_cast<std::uint16_t>(d.id);
+        out.push_back({mcap::Schema{id, d.name, "jsonschema", d.schema},
+                       mcap::Channel{id, id, std::string(d.topic), "json", {}}});
+    }
+    return out;
+}
+
+} // namespace
+
+const std::vector<ChannelDefinition>& channelDefinitions()
+{
+    static const std::vector<ChannelDefinition> defs = makeDefinitions();
+    return defs;
+}
+
+std::string encodeSession(const SessionInfo& s, int formatVersion)
+{
+    return json{{"format_version", formatVersion},
+                {"software", s.softwareVersion},
+                {"config", s.configJson},
+                {"booth", s.boothModel},
+                {"scene", s.scene},
+                {"display_profile", s.displayProfile},
+                {"wall_clock_start_ns", s.wallClockStartNs},
+                {"spectrometer", deviceJson(s.spectrometer)},
+                {"tracker", deviceJson(s.tracker)},
+                {"accel", deviceJson(s.accel)}}
+            .dump();
+}
+
+std::optional<std::string> encodeSpectrum(const hal::SpectrumSample& s)
+{
+    if (!finite(s.wavelengthCoeffs) || !finite(s.nonlinearityCoeffs)) {
+        return std::nullopt;
+    }
+    return json{{"t", s.timestampNs},
+                {"seq", s.sequence},
+                {"integration_time_us", s.integrationTimeUs},
+                {"counts", s.counts},
+                {"wavelength_coeffs", s.wavelengthCoeffs},
+                {"nonlinearity_coeffs", s.nonlinearityCoeffs},
+                {"saturated", s.saturated}}
+            .dump();
+}
+
+std::optional<std::string> encodePose(const hal::PoseSample& s)
+{
+    if (!finite(s.eyeTrackerM)) {
+        return std::nullopt;
+    }
+    return json{{"t", s.timestampNs},
+                {"seq", s.sequence},
+                {"tracked", s.tracked},
+                {"eye", vec3(s.eyeTrackerM)}}
+            .dump();
+}
+
+std::optional<std::string> encodeAccel(const hal::AccelSample& s)
+{
+    if (!finite(s.gravity)) {
+        return std::nullopt;
+    }
+    return json{{"t", s.timestampNs}, {"seq", s.sequence}, {"gravity", vec3(s.gravity)}}.dump();
+}
+
+std::string encodeFrame(const FrameRecord& f)
+{
+    json j{{"frame", f.frameIndex}, {"tick_ns", f.tickNs}};
+    if (f.spectrumSequence) {
+        j["spectrum_seq"] = *f.spectrumSequence;
+    }
+    if (f.poseSequence) {
+        j["pose_seq"] = *f.poseSequence;
+    }
+    if (f.accelSequence) {
+        j["accel_seq"] = *f.accelSequence;
+    }
+    return j.dump();
+}
+
+std::string encodeRecorderStatus(const RecorderStatus& r)
+{
+    return json{{"dropped_spectra", r.droppedSpectra}, {"dropped_poses", r.droppedPoses},
+                {"dropped_accel", r.droppedAccel},     {"dropped_frames", r.droppedFrames},
+                {"dropped_total", r.droppedTotal()},   {"rejected_nonfinite", r.rejectedNonFinite},
+                {"queue_capacity", r.queueCapacity}}
+            .dump();
+}
+
+SessionInfo decodeSession(const json& j, int& formatVersion)
+{
+    SessionInfo s;
+    formatVersion = j.at("format_version");
+    s.softwareVersion = j.at("software");
+    s.configJson = j.at("config");
+    s.boothModel = j.at("booth");
+    s.scene = j.at("scene");
+    s.displayProfile = j.at("display_profile");
+    s.wallClockStartNs = j.at("wall_clock_start_ns");
+    s.spectrometer = deviceFromJson(j.at("spectrometer"));
+    s.tracker = deviceFromJson(j.at("tracker"));
+    s.accel = deviceFromJson(j.at("accel"));
+    return s;
+}
+
+hal::SpectrumSample decodeSpectrum(const json& j)
+{
+    hal::SpectrumSample s;
+    s.timestampNs = j.at("t");
+    s.sequence = j.at("seq");
+    s.integrationTimeUs = j.at("integration_time_us");
+    s.counts = j.at("counts").get<std::vector<std::uint16_t>>();
+    s.wavelengthCoeffs = j.at("wavelength_coeffs");
+    s.nonlinearityCoeffs = j.at("nonlinearity_coeffs");
+    s.saturated = j.at("saturated");
+    return s;
+}
+
+hal::PoseSample decodePose(const json& j)
+{
+    hal::PoseSample s;
+    s.timestampNs = j.at("t");
+    s.sequence = j.at("seq");
+    s.tracked = j.at("tracked");
+    s.eyeTrackerM = vec3From(j.at("eye"));
+    return s;
+}
+
+hal::AccelSample decodeAccel(const json& j)
+{
+    hal::AccelSample s;
+    s.timestampNs = j.at("t");
+    s.sequence = j.at("seq");
+    s.gravity = vec3From(j.at("gravity"));
+    return s;
+}
+
+FrameRecord decodeFrame(const json& j)
+{
+    FrameRecord f;
+    f.frameIndex = j.at("frame");
+    f.tickNs = j.at("tick_ns");
+    if (j.contains("spectrum_seq")) {
+        f.spectrumSequence = j.at("spectrum_seq").get<std::uint32_t>();
+    }
+    if (j.contains("pose_seq")) {
+        f.poseSequence = j.at("pose_seq").get<std::uint32_t>();
+    }
+    if (j.contains("accel_seq")) {
+        f.accelSequence = j.at("accel_seq").get<std::uint32_t>();
+    }
+    return f;
+}
+
+RecorderStatus decodeRecorderStatus(const json& j)
+{
+    RecorderStatus r;
+    r.droppedSpectra = j.value("dropped_spectra", std::uint64_t{0});
+    r.droppedPoses = j.value("dropped_poses", std::uint64_t{0});
+    r.droppedAccel = j.value("dropped_accel", std::uint64_t{0});
+    r.droppedFrames = j.value("dropped_frames", std::uint64_t{0});
+    r.rejectedNonFinite = j.value("rejected_nonfinite", std::uint64_t{0});
+    r.queueCapacity = j.value("queue_capacity", std::uint64_t{0});
+    return r;
+}
+
+} // namespace replica::recordings

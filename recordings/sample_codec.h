@@ -1,0 +1,74 @@
+// The channels of a Replica recording and the JSON encoding of each message (with its JSON Schema).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <hal/samples.h>
+#include <recordings/mcap/records.h>
+#include <recordings/recording.h>
+
+namespace replica::recordings {
+
+// Fixed channel ids (they never change within a format version; recover relies on that).
+enum class ChannelId : std::uint16_t {
+    Session = 1,
+    Spectrometer = 2,
+    Tracker = 3,
+    Accel = 4,
+    Frame = 5,
+    Recorder = 6,
+};
+
+inline constexpr std::string_view kSessionTopic = "/replica/session";
+inline constexpr std::string_view kSpectrometerTopic = "/hal/spectrometer";
+inline constexpr std::string_view kTrackerTopic = "/hal/tracker";
+inline constexpr std::string_view kAccelTopic = "/hal/accel";
+inline constexpr std::string_view kFrameTopic = "/replica/frame";
+inline constexpr std::string_view kRecorderTopic = "/replica/recorder";
+// A copy of the session message kept in a Metadata record outside every chunk (key "session"), so
+// that recover can restore the session when the first chunk is damaged.
+inline constexpr std::string_view kSessionMetadataName = "replica.session";
+
+// What the recorder itself reports on /replica/recorder: samples it could not write.
+struct RecorderStatus {
+    std::uint64_t droppedSpectra = 0, droppedPoses = 0, droppedAccel = 0, droppedFrames = 0;
+    std::uint64_t rejectedNonFinite = 0; // samples refused because a value was NaN or infinite
+    std::uint64_t queueCapacity = 0;
+    std::uint64_t droppedTotal() const
+    {
+        return droppedSpectra + droppedPoses + droppedAccel + droppedFrames;
+    }
+};
+
+// The schema and channel of every channel of the current format, in id order.
+struct ChannelDefinition {
+    mcap::Schema schema;
+    mcap::Channel channel;
+};
+const std::vector<ChannelDefinition>& channelDefinitions();
+
+// JSON payloads. Doubles are written in shortest round-trip form and parse back bit-identically;
+// encoders return nullopt when a double is NaN or infinite (JSON cannot spell them), and the
+// writer counts such samples as rejected instead of writing a value that would read back wrong.
+std::string encodeSession(const SessionInfo& s, int formatVersion);
+std::optional<std::string> encodeSpectrum(const hal::SpectrumSample& s);
+std::optional<std::string> encodePose(const hal::PoseSample& s);
+std::optional<std::string> encodeAccel(const hal::AccelSample& s);
+std::string encodeFrame(const FrameRecord& f);
+std::string encodeRecorderStatus(const RecorderStatus& r);
+
+// Decoders throw nlohmann::json exceptions on missing or mistyped fields.
+SessionInfo decodeSession(const nlohmann::json& j, int& formatVersion);
+hal::SpectrumSample decodeSpectrum(const nlohmann::json& j);
+hal::PoseSample decodePose(const nlohmann::json& j);
+hal::AccelSample decodeAccel(const nlohmann::json& j);
+FrameRecord decodeFrame(const nlohmann::json& j);
+RecorderStatus decodeRecorderStatus(const nlohmann::json& j);
+
+} // namespace replica::recordings
