@@ -1,7 +1,7 @@
 // Booth light geometry and the mapping of median-cut regions onto the emitter.
-#include <pipeline/booth/booth_light.h>
-
 #include <glm/geometric.hpp>
+
+#include <pipeline/booth/booth_light.h>
 
 namespace replica::pipeline::booth {
 
@@ -45,7 +45,8 @@ colour::Spectrum unitLuminanceSpd(const colour::Observer& obs, const colour::Spe
     return spd * (1.0 / y);
 }
 
-std::vector<PointLight> pointLights(const BoothLight& light, const std::vector<RegionLight>& regions)
+std::vector<PointLight> pointLights(const BoothLight& light,
+                                    const std::vector<RegionLight>& regions)
 {
     std::vector<PointLight> out;
     out.reserve(regions.size());

@@ -35,8 +35,8 @@ struct BoothLight {
     Vec3 pointAtTexel(double x, double y) const;
 };
 
-// The SPD scaled so that sum(spd * ybar) * 10 nm = 1: luminance L (cd/m^2) times this is the spectral
-// radiance whose CIE Y is L. Zero spectrum if the light has no luminous power.
+// The SPD scaled so that sum(spd * ybar) * 10 nm = 1: luminance L (cd/m^2) times this is the
+// spectral radiance whose CIE Y is L. Zero spectrum if the light has no luminous power.
 colour::Spectrum unitLuminanceSpd(const colour::Observer& obs, const colour::Spectrum& spd);
 
 // A point light from a median-cut region: eq. (1) uses sumCdM2 * texelArea as the intensity (cd)
@@ -46,7 +46,8 @@ struct PointLight {
     double sumCdM2 = 0.0;
 };
 
-std::vector<PointLight> pointLights(const BoothLight& light, const std::vector<RegionLight>& regions);
+std::vector<PointLight> pointLights(const BoothLight& light,
+                                    const std::vector<RegionLight>& regions);
 
 MedianCutOptions medianCutOptionsFor(const BoothLight& light, int count);
 

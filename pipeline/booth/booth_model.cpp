@@ -1,11 +1,10 @@
 // booth.json reading and writing; nlohmann exceptions are caught here and become Error values.
-#include <pipeline/booth/booth_model.h>
-
 #include <fstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
 
 namespace replica::pipeline::booth {
@@ -16,16 +15,20 @@ constexpr const char* kFormat = "replica-booth/1";
 Expected<Vec3> vec3Field(const nlohmann::json& j, const char* key, const std::string& where)
 {
     if (!j.contains(key) || !j[key].is_array() || j[key].size() != 3) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: '{}' must be an array of 3 numbers (metres)", where, key));
+        return makeError(
+                ErrorCode::Corrupt,
+                fmt::format("{}: '{}' must be an array of 3 numbers (metres)", where, key));
     }
     Vec3 v;
     for (int k = 0; k < 3; ++k) {
         if (!j[key][static_cast<std::size_t>(k)].is_number()) {
-            return makeError(ErrorCode::Corrupt, fmt::format("{}: '{}'[{}] is not a number", where, key, k));
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: '{}'[{}] is not a number", where, key, k));
         }
         v[k] = j[key][static_cast<std::size_t>(k)].get<double>();
         if (!std::isfinite(v[k])) {
-            return makeError(ErrorCode::Corrupt, fmt::format("{}: '{}'[{}] is not finite", where, key, k));
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: '{}'[{}] is not finite", where, key, k));
         }
     }
     return v;
@@ -57,21 +60,25 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
     const auto file = dir / "booth.json";
     std::ifstream in(file);
     if (!in) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot open booth model; run 'replica booth build' "
-                                                          "or point --booth at a folder with booth.json",
-                                                      file.string()));
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: cannot open booth model; run 'replica booth build' "
+                                     "or point --booth at a folder with booth.json",
+                                     file.string()));
     }
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(in);
     } catch (const nlohmann::json::exception& e) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
     }
     if (!j.contains("format") || j["format"] != kFormat) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: 'format' must be \"{}\"", file.string(), kFormat));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: 'format' must be \"{}\"", file.string(), kFormat));
     }
     if (!j.contains("lights") || !j["lights"].is_array() || j["lights"].empty()) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: 'lights' must be a non-empty array", file.string()));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: 'lights' must be a non-empty array", file.string()));
     }
     BoothModel booth;
     for (std::size_t k = 0; k < j["lights"].size(); ++k) {
@@ -79,8 +86,9 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
         const std::string where = fmt::format("{}: lights[{}]", file.string(), k);
         BoothLight l;
         if (!lj.contains("name") || !lj["name"].is_string() || !lj.contains("luminance") ||
-                !lj["luminance"].is_string()) {
-            return makeError(ErrorCode::Corrupt, where + ": needs string fields 'name' and 'luminance'");
+            !lj["luminance"].is_string()) {
+            return makeError(ErrorCode::Corrupt,
+                             where + ": needs string fields 'name' and 'luminance'");
         }
         l.name = lj["name"].get<std::string>();
         auto c = vec3Field(lj, "centre", where);
@@ -97,11 +105,13 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
         }
         if (!lj.contains("spd") || !lj["spd"].is_array() || lj["spd"].size() != colour::kBands) {
             return makeError(ErrorCode::Corrupt,
-                    fmt::format("{}: 'spd' must hold {} values (380-730 nm, 10 nm)", where, colour::kBands));
+                             fmt::format("{}: 'spd' must hold {} values (380-730 nm, 10 nm)", where,
+                                         colour::kBands));
         }
         for (std::size_t b = 0; b < colour::kBands; ++b) {
             if (!lj["spd"][b].is_number() || !std::isfinite(lj["spd"][b].get<double>())) {
-                return makeError(ErrorCode::Corrupt, fmt::format("{}: spd[{}] is not a finite number", where, b));
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}: spd[{}] is not a finite number", where, b));
             }
             // Negative sensor noise in a measured SPD is clipped: light power cannot be negative.
             l.spd[b] = std::max(lj["spd"][b].get<double>(), 0.0);
@@ -113,7 +123,9 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
         l.luminance.width = img->width;
         l.luminance.height = img->height;
         l.luminance.cdM2.assign(img->planes[0].begin(), img->planes[0].end());
-        if (auto ok = checkLuminance(l.luminance, (dir / lj["luminance"].get<std::string>()).string()); !ok) {
+        if (auto ok = checkLuminance(l.luminance,
+                                     (dir / lj["luminance"].get<std::string>()).string());
+            !ok) {
             return tl::unexpected(ok.error());
         }
         booth.lights.push_back(std::move(l));
@@ -126,7 +138,8 @@ Expected<void> saveBooth(const std::filesystem::path& dir, const BoothModel& boo
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot create folder ({})", dir.string(), ec.message()));
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot create folder ({})", dir.string(), ec.message()));
     }
     nlohmann::json j;
     j["format"] = kFormat;

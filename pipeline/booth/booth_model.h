@@ -17,7 +17,8 @@ struct BoothModel {
     std::string names() const; // "a, b, c" for messages
 };
 
-// Reads <dir>/booth.json and the EXRs it names (channel "Y", cd/m^2). Errors name the file and field.
+// Reads <dir>/booth.json and the EXRs it names (channel "Y", cd/m^2). Errors name the file and
+// field.
 Expected<BoothModel> loadBooth(const std::filesystem::path& dir);
 
 // Writes booth.json and <name>.exr per light into dir (created if needed).

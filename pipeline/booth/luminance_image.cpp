@@ -1,10 +1,10 @@
 // Luminance image checks and the zero-padded, area-averaged mip chain.
-#include <pipeline/booth/luminance_image.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
+
+#include <pipeline/booth/luminance_image.h>
 
 namespace replica::pipeline::booth {
 
@@ -38,18 +38,20 @@ double LuminanceImage::max() const
 Expected<void> checkLuminance(const LuminanceImage& img, const std::string& what)
 {
     if (img.width <= 0 || img.height <= 0 ||
-            img.cdM2.size() != static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height)) {
+        img.cdM2.size() !=
+                static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height)) {
         return makeError(ErrorCode::InvalidArgument,
-                fmt::format("{}: luminance image has no texels or a wrong size", what));
+                         fmt::format("{}: luminance image has no texels or a wrong size", what));
     }
     for (std::size_t k = 0; k < img.cdM2.size(); ++k) {
         const double v = img.cdM2[k];
         if (!std::isfinite(v) || v < 0.0) {
             return makeError(ErrorCode::Corrupt,
-                    fmt::format("{}: texel ({}, {}) has luminance {} cd/m^2; it must be finite and >= 0 "
-                                "(re-merge the capture without saturated frames)",
-                            what, k % static_cast<std::size_t>(img.width),
-                            k / static_cast<std::size_t>(img.width), v));
+                             fmt::format("{}: texel ({}, {}) has luminance {} cd/m^2; it must be "
+                                         "finite and >= 0 "
+                                         "(re-merge the capture without saturated frames)",
+                                         what, k % static_cast<std::size_t>(img.width),
+                                         k / static_cast<std::size_t>(img.width), v));
         }
     }
     return {};
@@ -84,7 +86,7 @@ double bilinear(const LuminanceImage& img, double u, double v)
         return img.at(x, y);
     };
     return (1.0 - ay) * ((1.0 - ax) * tex(x0, y0) + ax * tex(x0 + 1, y0)) +
-            ay * ((1.0 - ax) * tex(x0, y0 + 1) + ax * tex(x0 + 1, y0 + 1));
+           ay * ((1.0 - ax) * tex(x0, y0 + 1) + ax * tex(x0 + 1, y0 + 1));
 }
 
 } // namespace
@@ -133,7 +135,8 @@ double MipChain::sample(double u, double v, double level) const
     }
     const double tu = u * usedU;
     const double tv = v * usedV;
-    const double l = std::clamp(std::isfinite(level) ? level : 0.0, 0.0, static_cast<double>(maxLevel()));
+    const double l =
+            std::clamp(std::isfinite(level) ? level : 0.0, 0.0, static_cast<double>(maxLevel()));
     const int l0 = static_cast<int>(std::floor(l));
     const int l1 = std::min(l0 + 1, maxLevel());
     const double t = l - l0;

@@ -1,8 +1,8 @@
 // Median cut and variance-minimising cut over summed-area tables.
-#include <pipeline/booth/median_cut.h>
-
 #include <algorithm>
 #include <limits>
+
+#include <pipeline/booth/median_cut.h>
 
 namespace replica::pipeline::booth {
 
@@ -11,7 +11,8 @@ LuminanceSat::LuminanceSat(const LuminanceImage& img, double texelWidthM, double
       t_(static_cast<std::size_t>(w_ + 1) * static_cast<std::size_t>(h_ + 1))
 {
     const auto idx = [this](int x, int y) {
-        return static_cast<std::size_t>(y) * static_cast<std::size_t>(w_ + 1) + static_cast<std::size_t>(x);
+        return static_cast<std::size_t>(y) * static_cast<std::size_t>(w_ + 1) +
+               static_cast<std::size_t>(x);
     };
     for (int y = 0; y < h_; ++y) {
         Moments row;
@@ -38,7 +39,8 @@ LuminanceSat::LuminanceSat(const LuminanceImage& img, double texelWidthM, double
 LuminanceSat::Moments LuminanceSat::region(int x0, int y0, int x1, int y1) const
 {
     const auto at = [this](int x, int y) -> const Moments& {
-        return t_[static_cast<std::size_t>(y) * static_cast<std::size_t>(w_ + 1) + static_cast<std::size_t>(x)];
+        return t_[static_cast<std::size_t>(y) * static_cast<std::size_t>(w_ + 1) +
+                  static_cast<std::size_t>(x)];
     };
     const Moments& a = at(x1, y1);
     const Moments& b = at(x0, y1);
@@ -91,7 +93,8 @@ Cut chooseCut(const LuminanceSat& sat, const Region& r, const MedianCutOptions& 
         const double total = sat.region(r.x0, r.y0, r.x1, r.y1).l;
         double bestDiff = std::numeric_limits<double>::infinity();
         for (int c = lo + 1; c < hi; ++c) {
-            const double left = alongX ? sat.region(r.x0, r.y0, c, r.y1).l : sat.region(r.x0, r.y0, r.x1, c).l;
+            const double left =
+                    alongX ? sat.region(r.x0, r.y0, c, r.y1).l : sat.region(r.x0, r.y0, r.x1, c).l;
             const double diff = std::abs(2.0 * left - total);
             if (diff < bestDiff) {
                 bestDiff = diff;
@@ -109,8 +112,10 @@ Cut chooseCut(const LuminanceSat& sat, const Region& r, const MedianCutOptions& 
         const int lo = alongX ? r.x0 : r.y0;
         const int hi = alongX ? r.x1 : r.y1;
         for (int c = lo + 1; c < hi; ++c) {
-            const double a = alongX ? sat.variance(r.x0, r.y0, c, r.y1) : sat.variance(r.x0, r.y0, r.x1, c);
-            const double b = alongX ? sat.variance(c, r.y0, r.x1, r.y1) : sat.variance(r.x0, c, r.x1, r.y1);
+            const double a =
+                    alongX ? sat.variance(r.x0, r.y0, c, r.y1) : sat.variance(r.x0, r.y0, r.x1, c);
+            const double b =
+                    alongX ? sat.variance(c, r.y0, r.x1, r.y1) : sat.variance(r.x0, c, r.x1, r.y1);
             const double s = std::max(a, b);
             if (s < bestScore) {
                 bestScore = s;
@@ -121,7 +126,8 @@ Cut chooseCut(const LuminanceSat& sat, const Region& r, const MedianCutOptions& 
     return best;
 }
 
-double regionScore(const LuminanceSat& sat, const Region& r, const MedianCutOptions& o, double floor)
+double
+regionScore(const LuminanceSat& sat, const Region& r, const MedianCutOptions& o, double floor)
 {
     if ((r.x1 - r.x0) * (r.y1 - r.y0) <= 1 || !(sat.region(r.x0, r.y0, r.x1, r.y1).l > floor)) {
         return -1.0; // cannot or need not be split
@@ -188,9 +194,9 @@ std::vector<RegionLight> medianCut(const LuminanceImage& img, const MedianCutOpt
         if (m.l > floor && m.l > 0.0) {
             l.sumCdM2 = m.l;
             l.centroidX = std::clamp(sat.toTexelX(m.lx / m.l), static_cast<double>(r.x0),
-                    static_cast<double>(r.x1));
+                                     static_cast<double>(r.x1));
             l.centroidY = std::clamp(sat.toTexelY(m.ly / m.l), static_cast<double>(r.y0),
-                    static_cast<double>(r.y1));
+                                     static_cast<double>(r.y1));
         } else {
             l.centroidX = 0.5 * (r.x0 + r.x1);
             l.centroidY = 0.5 * (r.y0 + r.y1);

@@ -17,20 +17,21 @@ struct MedianCutOptions {
     int count = 32;
     SplitRule rule = SplitRule::VarianceMinimise;
     bool longestAxisOnly = false; // VM: search only the longest side (default: both sides)
-    double texelWidthM = 1.0;     // texel pitch along x and y, so "longest" and variance are in metres
+    double texelWidthM = 1.0; // texel pitch along x and y, so "longest" and variance are in metres
     double texelHeightM = 1.0;
 };
 
 struct RegionLight {
-    double sumCdM2 = 0.0;       // summed luminance of the region's texels (eq. 1's L_n)
-    double centroidX = 0.0;     // energy centroid, texel coordinates (texel x spans [x, x+1])
+    double sumCdM2 = 0.0;   // summed luminance of the region's texels (eq. 1's L_n)
+    double centroidX = 0.0; // energy centroid, texel coordinates (texel x spans [x, x+1])
     double centroidY = 0.0;
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0; // region [x0, x1) x [y0, y1)
 };
 
 // Summed-area tables of L, L x, L y, L x^2, L y^2 with coordinates in metres relative to the image
 // centre (double: the x^2 sums of a large HDR image lose a float's mantissa to cancellation).
-class LuminanceSat {
+class LuminanceSat
+{
 public:
     LuminanceSat(const LuminanceImage& img, double texelWidthM, double texelHeightM);
 

@@ -1,11 +1,11 @@
 // Ward lobes, Walter sampling and closed-form weights; every division and sqrt is guarded.
-#include <pipeline/brdf/ward.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include <glm/geometric.hpp>
+
+#include <pipeline/brdf/ward.h>
 
 namespace replica::pipeline::brdf {
 namespace {
@@ -90,8 +90,13 @@ Vec3 sampleWardHalfVectorLocal(double alpha, double u1, double u2)
     return Vec3(sinT * std::cos(phi), sinT * std::sin(phi), cosT);
 }
 
-WardSample sampleWard(WardModel model, double alpha, const Vec3& n, const Vec3& o, double u1, double u2,
-        int sampleCount)
+WardSample sampleWard(WardModel model,
+                      double alpha,
+                      const Vec3& n,
+                      const Vec3& o,
+                      double u1,
+                      double u2,
+                      int sampleCount)
 {
     WardSample s;
     const double co = glm::dot(n, o);
@@ -151,8 +156,8 @@ double wardAlbedo(WardModel model, double alpha, double thetaDeg, int grid)
     return sum / (static_cast<double>(grid) * grid);
 }
 
-double wardAlbedoQuadrature(WardModel model, double alpha, double thetaDeg, int thetaSteps,
-        int phiSteps)
+double
+wardAlbedoQuadrature(WardModel model, double alpha, double thetaDeg, int thetaSteps, int phiSteps)
 {
     const double t = thetaDeg * kPi / 180.0;
     const Vec3 n(0.0, 0.0, 1.0);

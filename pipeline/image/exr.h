@@ -1,4 +1,5 @@
-// Reading and writing float OpenEXR images with named channels; non-finite values are rejected at load.
+// Reading and writing float OpenEXR images with named channels; non-finite values are rejected at
+// load.
 #pragma once
 
 #include <filesystem>
@@ -19,15 +20,19 @@ struct ChannelImage {
     const std::vector<float>* plane(const std::string& name) const;
 };
 
-// Reads the named channels (all must exist, any pixel type, converted to float). Fails with the file
-// and the first offending pixel if any value is NaN or Inf (hard case 18), or if the file is not EXR.
-Expected<ChannelImage> readExr(const std::filesystem::path& path, const std::vector<std::string>& names);
+// Reads the named channels (all must exist, any pixel type, converted to float). Fails with the
+// file and the first offending pixel if any value is NaN or Inf (hard case 18), or if the file is
+// not EXR.
+Expected<ChannelImage> readExr(const std::filesystem::path& path,
+                               const std::vector<std::string>& names);
 
 // Names of every channel in the file, for messages and for reading all of them.
 Expected<std::vector<std::string>> exrChannelNames(const std::filesystem::path& path);
 
-// Writes 32-bit float channels with ZIP compression; string attributes are stored as header comments.
-Expected<void> writeExr(const std::filesystem::path& path, const ChannelImage& img,
-        const std::vector<std::pair<std::string, std::string>>& attributes = {});
+// Writes 32-bit float channels with ZIP compression; string attributes are stored as header
+// comments.
+Expected<void> writeExr(const std::filesystem::path& path,
+                        const ChannelImage& img,
+                        const std::vector<std::pair<std::string, std::string>>& attributes = {});
 
 } // namespace replica::pipeline::image

@@ -1,10 +1,10 @@
 // CIELAB and CIEDE2000 in double.
-#include <pipeline/reference/frame_error.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
+
+#include <pipeline/reference/frame_error.h>
 
 namespace replica::pipeline::reference {
 namespace {
@@ -84,7 +84,8 @@ double ciede2000(const Lab& x, const Lab& y)
         }
     }
     const double t = 1.0 - 0.17 * std::cos(rad(hBar - 30.0)) + 0.24 * std::cos(rad(2.0 * hBar)) +
-            0.32 * std::cos(rad(3.0 * hBar + 6.0)) - 0.20 * std::cos(rad(4.0 * hBar - 63.0));
+                     0.32 * std::cos(rad(3.0 * hBar + 6.0)) -
+                     0.20 * std::cos(rad(4.0 * hBar - 63.0));
     const double dTheta = 30.0 * std::exp(-((hBar - 275.0) / 25.0) * ((hBar - 275.0) / 25.0));
     const double cpBar7 = std::pow(cpBar, 7.0);
     const double rc = 2.0 * std::sqrt(cpBar7 / (cpBar7 + std::pow(25.0, 7.0)));
@@ -109,13 +110,15 @@ FrameError compareFrames(const shading::XyzFrame& reference, const shading::XyzF
     std::vector<double> d(n);
     double sum = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
-        d[k] = ciede2000(xyzToLab(reference.xyz[k], reference.whiteXyz), xyzToLab(test.xyz[k], reference.whiteXyz));
+        d[k] = ciede2000(xyzToLab(reference.xyz[k], reference.whiteXyz),
+                         xyzToLab(test.xyz[k], reference.whiteXyz));
         sum += d[k];
     }
     e.mean = sum / static_cast<double>(n);
     std::sort(d.begin(), d.end());
     e.max = d.back();
-    e.p95 = d[std::min(n - 1, static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n))) - 1)];
+    e.p95 = d[std::min(n - 1,
+                       static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n))) - 1)];
     return e;
 }
 

@@ -23,7 +23,8 @@ struct FrameError {
     double max = 0.0;
 };
 
-// Lab white: the reference frame's white (a perfect diffuser at the panel centre under the same light).
+// Lab white: the reference frame's white (a perfect diffuser at the panel centre under the same
+// light).
 FrameError compareFrames(const shading::XyzFrame& reference, const shading::XyzFrame& test);
 
 } // namespace replica::pipeline::reference

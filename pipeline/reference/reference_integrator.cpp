@@ -1,12 +1,12 @@
 // Reference integration over every light texel, spectral per pixel.
-#include <pipeline/reference/reference_integrator.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <thread>
 
 #include <glm/geometric.hpp>
+
+#include <pipeline/reference/reference_integrator.h>
 
 namespace replica::pipeline::reference {
 
@@ -27,13 +27,22 @@ TexelCloud texelCloud(const booth::BoothLight& light)
     return c;
 }
 
-TexelSums integrateTexels(const TexelCloud& light, const Vec3& p, const Vec3& nGeo, const Vec3& nShade,
-        const Vec3& toEye, brdf::WardModel model, double alpha, bool specular,
-        const std::vector<double>* sinHorizonByAzimuth, const Vec3& right, const Vec3& up)
+TexelSums integrateTexels(const TexelCloud& light,
+                          const Vec3& p,
+                          const Vec3& nGeo,
+                          const Vec3& nShade,
+                          const Vec3& toEye,
+                          brdf::WardModel model,
+                          double alpha,
+                          bool specular,
+                          const std::vector<double>* sinHorizonByAzimuth,
+                          const Vec3& right,
+                          const Vec3& up)
 {
     TexelSums s;
     const double a = light.texelAreaM2;
-    const int azimuths = sinHorizonByAzimuth != nullptr ? static_cast<int>(sinHorizonByAzimuth->size()) : 0;
+    const int azimuths =
+            sinHorizonByAzimuth != nullptr ? static_cast<int>(sinHorizonByAzimuth->size()) : 0;
     for (std::size_t k = 0; k < light.position.size(); ++k) {
         Vec3 d = light.position[k] - p;
         const double d2 = glm::dot(d, d);
@@ -66,7 +75,7 @@ TexelSums integrateTexels(const TexelCloud& light, const Vec3& p, const Vec3& nG
             const int k1 = (k0 + 1) % azimuths;
             const double t = f - std::floor(f);
             const double sinB = (1.0 - t) * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k0)] +
-                    t * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k1)];
+                                t * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k1)];
             if (!(cosG > sinB)) {
                 continue; // below the relief's horizon
             }
@@ -79,13 +88,17 @@ TexelSums integrateTexels(const TexelCloud& light, const Vec3& p, const Vec3& nG
     return s;
 }
 
-shading::XyzFrame renderReference(const surface::SurfaceScene& scene, const booth::BoothLight& light,
-        const shading::View& view, const colour::Observer& obs, const ReferenceOptions& options)
+shading::XyzFrame renderReference(const surface::SurfaceScene& scene,
+                                  const booth::BoothLight& light,
+                                  const shading::View& view,
+                                  const colour::Observer& obs,
+                                  const ReferenceOptions& options)
 {
     shading::XyzFrame frame;
     frame.width = view.pixelsX;
     frame.height = view.pixelsY;
-    frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height), colour::Xyz(0.0));
+    frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height),
+                     colour::Xyz(0.0));
     const TexelCloud cloud = texelCloud(light);
     const colour::Spectrum unitSpd = booth::unitLuminanceSpd(obs, light.spd);
     const colour::Xyz white = colour::spectrumToXyz(obs, unitSpd);
@@ -100,22 +113,29 @@ shading::XyzFrame renderReference(const surface::SurfaceScene& scene, const boot
         std::vector<double> horizon(static_cast<std::size_t>(flat ? 0 : options.horizonAzimuths));
         for (int py = y0; py < y1; ++py) {
             for (int px = 0; px < frame.width; ++px) {
-                const shading::ShadingPoint sp = shading::shadingPoint(view, scene, normals, px, py);
+                const shading::ShadingPoint sp =
+                        shading::shadingPoint(view, scene, normals, px, py);
                 for (std::size_t k = 0; k < horizon.size(); ++k) {
-                    const double phi = 2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(horizon.size());
-                    horizon[k] = surface::exactSinHorizon(scene.relief, sp.texX, sp.texY, phi, options.horizonDistanceM);
+                    const double phi = 2.0 * std::numbers::pi * static_cast<double>(k) /
+                                       static_cast<double>(horizon.size());
+                    horizon[k] = surface::exactSinHorizon(scene.relief, sp.texX, sp.texY, phi,
+                                                          options.horizonDistanceM);
                 }
                 Vec3 toEye = view.eye - sp.p;
                 const double eyeDist = glm::length(toEye);
                 toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
                 const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
                 c.behind += behind ? 1 : 0;
-                const TexelSums t = integrateTexels(cloud, sp.p, sp.nGeo, sp.nShade, toEye, scene.model, scene.alpha,
-                        glossy && !behind, flat ? nullptr : &horizon, sp.right, sp.up);
+                const TexelSums t = integrateTexels(cloud, sp.p, sp.nGeo, sp.nShade, toEye,
+                                                    scene.model, scene.alpha, glossy && !behind,
+                                                    flat ? nullptr : &horizon, sp.right, sp.up);
                 const colour::Spectrum rho = scene.reflectance(sp.tx, sp.ty);
-                const colour::Spectrum radiance = (rho * (t.irradiance / std::numbers::pi) + scene.rhoS * t.specular) * unitSpd;
+                const colour::Spectrum radiance =
+                        (rho * (t.irradiance / std::numbers::pi) + scene.rhoS * t.specular) *
+                        unitSpd;
                 const colour::Xyz surfaceXyz = colour::spectrumToXyz(obs, radiance);
-                const colour::Xyz flare = white * (shading::kScreenFlareRho * t.geoIrradiance / std::numbers::pi);
+                const colour::Xyz flare =
+                        white * (shading::kScreenFlareRho * t.geoIrradiance / std::numbers::pi);
                 colour::Xyz out = shading::subtractFlare(surfaceXyz, flare, c.flare);
                 if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z)) {
                     ++c.bad;
@@ -142,14 +162,16 @@ shading::XyzFrame renderReference(const surface::SurfaceScene& scene, const boot
         frame.nonFinite += c.bad;
     }
     const Vec3 n = view.panel.normal;
-    const TexelSums centre = integrateTexels(cloud, view.panel.centre, n, n, n, scene.model, scene.alpha, false,
-            nullptr, view.panel.right, view.panel.up);
+    const TexelSums centre =
+            integrateTexels(cloud, view.panel.centre, n, n, n, scene.model, scene.alpha, false,
+                            nullptr, view.panel.right, view.panel.up);
     frame.whiteY = centre.geoIrradiance / std::numbers::pi;
     frame.whiteXyz = white * frame.whiteY;
     return frame;
 }
 
-double polygonIrradiance(const std::vector<Vec3>& corners, const Vec3& p, const Vec3& n, double luminance)
+double
+polygonIrradiance(const std::vector<Vec3>& corners, const Vec3& p, const Vec3& n, double luminance)
 {
     double sum = 0.0;
     const std::size_t m = corners.size();

@@ -1,6 +1,4 @@
 // CPU model of the real-time renderer.
-#include <pipeline/shading/realtime_model.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -8,17 +6,21 @@
 
 #include <glm/geometric.hpp>
 
+#include <pipeline/shading/realtime_model.h>
+
 namespace replica::pipeline::shading {
 namespace {
 
-double horizonVisibility(const surface::HorizonMap* horizon, int tx, int ty, const Vec3& l, double softness)
+double horizonVisibility(
+        const surface::HorizonMap* horizon, int tx, int ty, const Vec3& l, double softness)
 {
     if (horizon == nullptr || horizon->directions <= 0) {
         return 1.0;
     }
     const double sinB = horizon->sinHorizon(tx, ty, l);
     if (sinB <= 0.0) {
-        return 1.0; // flat horizon: the geometric test already decided (keeps flat frames identical)
+        return 1.0; // flat horizon: the geometric test already decided (keeps flat frames
+                    // identical)
     }
     const double e0 = sinB - softness;
     const double e1 = sinB + softness;
@@ -38,11 +40,13 @@ double radicalInverse2(unsigned k)
     return static_cast<double>(k) * 2.3283064365386963e-10;
 }
 
-PreparedLight prepareLight(const booth::BoothLight& light, const colour::Observer& obs, int pointLightCount)
+PreparedLight
+prepareLight(const booth::BoothLight& light, const colour::Observer& obs, int pointLightCount)
 {
     PreparedLight p;
     p.light = &light;
-    const auto regions = booth::medianCut(light.luminance, booth::medianCutOptionsFor(light, pointLightCount));
+    const auto regions =
+            booth::medianCut(light.luminance, booth::medianCutOptionsFor(light, pointLightCount));
     p.points = booth::pointLights(light, regions);
     p.mips = booth::buildMipChain(light.luminance);
     p.unitSpd = booth::unitLuminanceSpd(obs, light.spd);
@@ -51,7 +55,8 @@ PreparedLight prepareLight(const booth::BoothLight& light, const colour::Observe
     return p;
 }
 
-PreparedScene prepareScene(const surface::SurfaceScene& scene, int horizonDirections, double horizonDistanceM)
+PreparedScene
+prepareScene(const surface::SurfaceScene& scene, int horizonDirections, double horizonDistanceM)
 {
     PreparedScene p;
     p.scene = &scene;
@@ -66,9 +71,18 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene, int horizonDirect
     return p;
 }
 
-double pointLightIrradiance(const std::vector<booth::PointLight>& lights, const Vec3& lightNormal,
-        double texelAreaM2, const Vec3& p, const Vec3& nGeo, const Vec3& nShade, const surface::HorizonMap* horizon,
-        int tx, int ty, const Vec3& right, const Vec3& up, double softness)
+double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
+                            const Vec3& lightNormal,
+                            double texelAreaM2,
+                            const Vec3& p,
+                            const Vec3& nGeo,
+                            const Vec3& nShade,
+                            const surface::HorizonMap* horizon,
+                            int tx,
+                            int ty,
+                            const Vec3& right,
+                            const Vec3& up,
+                            double softness)
 {
     double e = 0.0;
     for (const booth::PointLight& l : lights) {
@@ -91,9 +105,20 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights, const 
     return e * texelAreaM2;
 }
 
-double filteredSpecular(const PreparedLight& light, const Vec3& p, const Vec3& nGeo, const Vec3& nShade,
-        const Vec3& toEye, brdf::WardModel model, double alpha, int samples, const surface::HorizonMap* horizon,
-        int tx, int ty, const Vec3& right, const Vec3& up, double softness)
+double filteredSpecular(const PreparedLight& light,
+                        const Vec3& p,
+                        const Vec3& nGeo,
+                        const Vec3& nShade,
+                        const Vec3& toEye,
+                        brdf::WardModel model,
+                        double alpha,
+                        int samples,
+                        const surface::HorizonMap* horizon,
+                        int tx,
+                        int ty,
+                        const Vec3& right,
+                        const Vec3& up,
+                        double softness)
 {
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();
@@ -127,24 +152,30 @@ double filteredSpecular(const PreparedLight& light, const Vec3& p, const Vec3& n
         const double ratio = s.solidAngle * t * t / (a * cosL);
         const double lod = 0.5 * std::log2(std::max(ratio, 1e-20)) + 1.0;
         const Vec3 lt(glm::dot(s.i, right), glm::dot(s.i, up), cosG);
-        sum += light.mips.sample(u, v, lod) * s.weight * horizonVisibility(horizon, tx, ty, lt, softness);
+        sum += light.mips.sample(u, v, lod) * s.weight *
+               horizonVisibility(horizon, tx, ty, lt, softness);
     }
     return samples > 0 ? sum / samples : 0.0;
 }
 
-XyzFrame renderRealtime(const PreparedScene& ps, const PreparedLight& light, const View& view,
-        const colour::Observer& obs, const RenderSettings& settings)
+XyzFrame renderRealtime(const PreparedScene& ps,
+                        const PreparedLight& light,
+                        const View& view,
+                        const colour::Observer& obs,
+                        const RenderSettings& settings)
 {
     const surface::SurfaceScene& scene = *ps.scene;
     XyzFrame frame;
     frame.width = view.pixelsX;
     frame.height = view.pixelsY;
-    frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height), colour::Xyz(0.0));
+    frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height),
+                     colour::Xyz(0.0));
     const bool relief = settings.reliefPass && !ps.normals.empty();
     const bool specular = settings.specularPass && scene.glossy();
     const std::vector<Vec3> none;
     const std::vector<Vec3>& normals = relief ? ps.normals : none;
-    const surface::HorizonMap* horizon = relief && settings.horizonDirections > 0 ? &ps.horizon : nullptr;
+    const surface::HorizonMap* horizon =
+            relief && settings.horizonDirections > 0 ? &ps.horizon : nullptr;
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();
     const double a = bl.texelAreaM2();
@@ -162,12 +193,14 @@ XyzFrame renderRealtime(const PreparedScene& ps, const PreparedLight& light, con
                 toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
                 const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
                 c.behind += behind ? 1 : 0;
-                const double eGeo = pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr, 0, 0,
-                        sp.right, sp.up, 0.0);
+                const double eGeo =
+                        pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr,
+                                             0, 0, sp.right, sp.up, 0.0);
                 double e = eGeo;
                 if (relief) {
-                    e = pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon, sp.tx, sp.ty,
-                            sp.right, sp.up, settings.horizonSoftness);
+                    e = pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon,
+                                             sp.tx, sp.ty, sp.right, sp.up,
+                                             settings.horizonSoftness);
                 }
                 if (!settings.diffusePass) {
                     e = 0.0;
@@ -180,13 +213,15 @@ XyzFrame renderRealtime(const PreparedScene& ps, const PreparedLight& light, con
                     }
                     xyz *= e / std::numbers::pi;
                 } else {
-                    xyz = colour::spectrumToXyz(obs, scene.reflectance(sp.tx, sp.ty) * light.unitSpd) *
-                            (e / std::numbers::pi);
+                    xyz = colour::spectrumToXyz(obs,
+                                                scene.reflectance(sp.tx, sp.ty) * light.unitSpd) *
+                          (e / std::numbers::pi);
                 }
                 if (specular && !behind) {
-                    const double s = filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model,
-                            scene.alpha, settings.specularSamples, horizon, sp.tx, sp.ty, sp.right, sp.up,
-                            settings.horizonSoftness);
+                    const double s =
+                            filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model,
+                                             scene.alpha, settings.specularSamples, horizon, sp.tx,
+                                             sp.ty, sp.right, sp.up, settings.horizonSoftness);
                     xyz += specXyz * s;
                 }
                 const colour::Xyz flare = light.white * (kScreenFlareRho * eGeo / std::numbers::pi);
@@ -204,7 +239,7 @@ XyzFrame renderRealtime(const PreparedScene& ps, const PreparedLight& light, con
     std::vector<std::thread> pool;
     for (int t = 0; t < threads; ++t) {
         pool.emplace_back(renderRows, frame.height * t / threads, frame.height * (t + 1) / threads,
-                std::ref(counts[static_cast<std::size_t>(t)]));
+                          std::ref(counts[static_cast<std::size_t>(t)]));
     }
     for (auto& th : pool) {
         th.join();
@@ -215,9 +250,9 @@ XyzFrame renderRealtime(const PreparedScene& ps, const PreparedLight& light, con
         frame.nonFinite += c.bad;
     }
     const Vec3 n = view.panel.normal;
-    frame.whiteY = pointLightIrradiance(light.points, nl, a, view.panel.centre, n, n, nullptr, 0, 0, view.panel.right,
-                           view.panel.up, 0.0) /
-            std::numbers::pi;
+    frame.whiteY = pointLightIrradiance(light.points, nl, a, view.panel.centre, n, n, nullptr, 0, 0,
+                                        view.panel.right, view.panel.up, 0.0) /
+                   std::numbers::pi;
     frame.whiteXyz = light.white * frame.whiteY;
     return frame;
 }

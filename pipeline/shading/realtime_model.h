@@ -1,8 +1,8 @@
 // The real-time renderer's algorithm on the CPU: median-cut point lights (eq. 1) with normal-mapped
 // facets and horizon shadows, Ward specular by filtered importance sampling of the mip-mapped
 // luminance image, channel reflectance (eq. 2) and screen-flare subtraction. It is the executable
-// specification the GLES shaders follow (float there, double here) and what the speed-vs-error sweep
-// measures against the reference.
+// specification the GLES shaders follow (float there, double here) and what the speed-vs-error
+// sweep measures against the reference.
 #pragma once
 
 #include <vector>
@@ -27,23 +27,25 @@ struct RenderSettings {
     int horizonDirections = 8;
     ChannelRep channels = ChannelRep::Box6;
     bool diffusePass = true;
-    bool specularPass = true; // ignored (skipped) for a matte scene
-    bool reliefPass = true;   // normal map + horizon; ignored for a flat scene
+    bool specularPass = true;      // ignored (skipped) for a matte scene
+    bool reliefPass = true;        // normal map + horizon; ignored for a flat scene
     double horizonSoftness = 0.02; // half-width of the smoothstep in sin(elevation)
     int threads = 2;
 };
 
-// Per-light precomputation: median cut, mip chain, spectra. Rebuilt only when the light or N changes.
+// Per-light precomputation: median cut, mip chain, spectra. Rebuilt only when the light or N
+// changes.
 struct PreparedLight {
     const booth::BoothLight* light = nullptr;
     std::vector<booth::PointLight> points;
     booth::MipChain mips;
     colour::Spectrum unitSpd;
-    colour::Xyz white{0.0};             // XYZ of the unit-luminance light (Y = 1)
-    colour::ChannelToXyz channelXyz{};  // M_k for the Box6 path
+    colour::Xyz white{0.0};            // XYZ of the unit-luminance light (Y = 1)
+    colour::ChannelToXyz channelXyz{}; // M_k for the Box6 path
 };
 
-PreparedLight prepareLight(const booth::BoothLight& light, const colour::Observer& obs, int pointLightCount);
+PreparedLight
+prepareLight(const booth::BoothLight& light, const colour::Observer& obs, int pointLightCount);
 
 // Per-scene precomputation: normal and horizon maps, palette channel coefficients.
 struct PreparedScene {
@@ -53,21 +55,46 @@ struct PreparedScene {
     std::vector<colour::ChannelCoeffs> paletteCoeffs;
 };
 
-PreparedScene prepareScene(const surface::SurfaceScene& scene, int horizonDirections, double horizonDistanceM = 0.01);
+PreparedScene prepareScene(const surface::SurfaceScene& scene,
+                           int horizonDirections,
+                           double horizonDistanceM = 0.01);
 
 // Diffuse illuminance from point lights (eq. 1): both cosines clamped at 0, 1/d^2 clamped at one
 // texel area; vis(light direction) in [0, 1] multiplies each light.
-double pointLightIrradiance(const std::vector<booth::PointLight>& lights, const Vec3& lightNormal,
-        double texelAreaM2, const Vec3& p, const Vec3& nGeo, const Vec3& nShade, const surface::HorizonMap* horizon,
-        int tx, int ty, const Vec3& right, const Vec3& up, double softness);
+double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
+                            const Vec3& lightNormal,
+                            double texelAreaM2,
+                            const Vec3& p,
+                            const Vec3& nGeo,
+                            const Vec3& nShade,
+                            const surface::HorizonMap* horizon,
+                            int tx,
+                            int ty,
+                            const Vec3& right,
+                            const Vec3& up,
+                            double softness);
 
 // Specular radiance (cd/m^2, rho_s = 1) by FIS with N Hammersley samples (u1 = (k + 1/2) / N).
-double filteredSpecular(const PreparedLight& light, const Vec3& p, const Vec3& nGeo, const Vec3& nShade,
-        const Vec3& toEye, brdf::WardModel model, double alpha, int samples, const surface::HorizonMap* horizon,
-        int tx, int ty, const Vec3& right, const Vec3& up, double softness);
+double filteredSpecular(const PreparedLight& light,
+                        const Vec3& p,
+                        const Vec3& nGeo,
+                        const Vec3& nShade,
+                        const Vec3& toEye,
+                        brdf::WardModel model,
+                        double alpha,
+                        int samples,
+                        const surface::HorizonMap* horizon,
+                        int tx,
+                        int ty,
+                        const Vec3& right,
+                        const Vec3& up,
+                        double softness);
 
-XyzFrame renderRealtime(const PreparedScene& scene, const PreparedLight& light, const View& view,
-        const colour::Observer& obs, const RenderSettings& settings);
+XyzFrame renderRealtime(const PreparedScene& scene,
+                        const PreparedLight& light,
+                        const View& view,
+                        const colour::Observer& obs,
+                        const RenderSettings& settings);
 
 double radicalInverse2(unsigned k);
 

@@ -1,11 +1,11 @@
 // Panel pose from the hinge and the mapping of pixels to surface points.
-#include <pipeline/shading/view.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include <glm/geometric.hpp>
+
+#include <pipeline/shading/view.h>
 
 namespace replica::pipeline::shading {
 
@@ -36,19 +36,23 @@ Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, doub
     const int ix = static_cast<int>(x0);
     const int iy = static_cast<int>(y0);
     const Vec3 n = (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
-            ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
+                   ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
     const double len = glm::length(n);
     return len > 1e-12 ? n / len : Vec3(0.0, 0.0, 1.0);
 }
 
-ShadingPoint shadingPoint(const View& view, const surface::SurfaceScene& scene,
-        const std::vector<Vec3>& normals, int px, int py)
+ShadingPoint shadingPoint(const View& view,
+                          const surface::SurfaceScene& scene,
+                          const std::vector<Vec3>& normals,
+                          int px,
+                          int py)
 {
     ShadingPoint s;
     const double u = (px + 0.5) / view.pixelsX;
     const double v = (py + 0.5) / view.pixelsY;
     const PanelPose& pose = view.panel;
-    s.p = pose.centre + pose.right * ((u - 0.5) * scene.widthM) + pose.up * ((0.5 - v) * scene.heightM);
+    s.p = pose.centre + pose.right * ((u - 0.5) * scene.widthM) +
+          pose.up * ((0.5 - v) * scene.heightM);
     s.nGeo = pose.normal;
     s.right = pose.right;
     s.up = pose.up;

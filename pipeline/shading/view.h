@@ -50,10 +50,13 @@ struct ShadingPoint {
     int ty = 0;
 };
 
-// The pixel grid covers the whole surface. normals: the scene's normal map (bilinear, renormalised);
-// empty means flat.
-ShadingPoint shadingPoint(const View& view, const surface::SurfaceScene& scene,
-        const std::vector<Vec3>& normals, int px, int py);
+// The pixel grid covers the whole surface. normals: the scene's normal map (bilinear,
+// renormalised); empty means flat.
+ShadingPoint shadingPoint(const View& view,
+                          const surface::SurfaceScene& scene,
+                          const std::vector<Vec3>& normals,
+                          int px,
+                          int py);
 
 // Bilinear interpolation of a normal map at fractional texel coordinates, renormalised (never zero:
 // every stored normal has z > 0).

@@ -1,9 +1,9 @@
 // Normal and horizon maps from a height field.
-#include <pipeline/surface/relief.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+
+#include <pipeline/surface/relief.h>
 
 namespace replica::pipeline::surface {
 
@@ -25,7 +25,7 @@ double HeightField::sample(double x, double y) const
     const int ix = static_cast<int>(x0);
     const int iy = static_cast<int>(y0);
     return (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
-            ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
+           ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
 }
 
 bool HeightField::flat() const
@@ -51,7 +51,8 @@ std::vector<Vec3> normalMap(const HeightField& h)
             // Image rows run down, tangent +y runs up.
             const double dy = yd > yu ? -(h.at(x, yd) - h.at(x, yu)) / ((yd - yu) * h.pitchM) : 0.0;
             const Vec3 v(-dx, -dy, 1.0); // length >= 1: never zero
-            n[static_cast<std::size_t>(y) * h.width + x] = v / std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+            n[static_cast<std::size_t>(y) * h.width + x] =
+                    v / std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
         }
     }
     return n;
@@ -84,8 +85,8 @@ HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM)
     map.height = h.height;
     map.directions = std::max(directions, 1);
     map.sinBeta.assign(static_cast<std::size_t>(h.width) * static_cast<std::size_t>(h.height) *
-                    static_cast<std::size_t>(map.directions),
-            0.0f);
+                               static_cast<std::size_t>(map.directions),
+                       0.0f);
     if (h.flat()) {
         return map; // every horizon is the macro plane: identical result, no marching
     }

@@ -1,4 +1,5 @@
-// Small-scale geometry of a surface: height field (metres), its normal map and Sloan & Cohen horizon map.
+// Small-scale geometry of a surface: height field (metres), its normal map and Sloan & Cohen
+// horizon map.
 #pragma once
 
 #include <vector>
@@ -9,8 +10,8 @@ namespace replica::pipeline::surface {
 
 using Vec3 = glm::dvec3;
 
-// Tangent frame of the surface: +x along image columns, +y up the image (against row order), +z out of
-// the surface towards the viewer. Heights are in metres, texel pitch in metres.
+// Tangent frame of the surface: +x along image columns, +y up the image (against row order), +z out
+// of the surface towards the viewer. Heights are in metres, texel pitch in metres.
 struct HeightField {
     int width = 0;
     int height = 0;
@@ -23,13 +24,13 @@ struct HeightField {
     bool flat() const;
 };
 
-// Central differences over 2 pitches (one-sided at the edges), renormalised; a vertical cliff gives a
-// finite, nearly horizontal normal and never normalises a zero vector.
+// Central differences over 2 pitches (one-sided at the edges), renormalised; a vertical cliff gives
+// a finite, nearly horizontal normal and never normalises a zero vector.
 std::vector<Vec3> normalMap(const HeightField& h);
 
-// Horizon map: for each texel and k azimuths phi_k = 2 pi k / K (phi = 0 along +x, pi/2 along +y), the
-// sine of the highest occluder's elevation, floored at 0 (the macro plane's own horizon). Marching
-// reaches maxDistanceM.
+// Horizon map: for each texel and k azimuths phi_k = 2 pi k / K (phi = 0 along +x, pi/2 along +y),
+// the sine of the highest occluder's elevation, floored at 0 (the macro plane's own horizon).
+// Marching reaches maxDistanceM.
 struct HorizonMap {
     int width = 0;
     int height = 0;
@@ -42,8 +43,8 @@ struct HorizonMap {
 
 HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM);
 
-// The exact horizon at a fractional texel position and azimuth, by marching the bilinear height field
-// in steps of half a pitch: what the reference uses.
+// The exact horizon at a fractional texel position and azimuth, by marching the bilinear height
+// field in steps of half a pitch: what the reference uses.
 double exactSinHorizon(const HeightField& h, double x, double y, double phi, double maxDistanceM);
 
 } // namespace replica::pipeline::surface

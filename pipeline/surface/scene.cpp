@@ -1,6 +1,4 @@
 // Scene folder reading and writing with checks that name the file and the field or texel.
-#include <pipeline/surface/scene.h>
-
 #include <cmath>
 #include <fstream>
 
@@ -8,24 +6,27 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/image/exr.h>
+#include <pipeline/surface/scene.h>
 
 namespace replica::pipeline::surface {
 namespace {
 
 constexpr const char* kFormat = "replica-scene/1";
 
-Expected<colour::Spectrum> spectrumField(const nlohmann::json& j, const std::string& where, double maxValue)
+Expected<colour::Spectrum>
+spectrumField(const nlohmann::json& j, const std::string& where, double maxValue)
 {
     if (!j.is_array() || j.size() != colour::kBands) {
-        return makeError(ErrorCode::Corrupt,
+        return makeError(
+                ErrorCode::Corrupt,
                 fmt::format("{}: must hold {} values (380-730 nm, 10 nm)", where, colour::kBands));
     }
     colour::Spectrum s;
     for (std::size_t b = 0; b < colour::kBands; ++b) {
         if (!j[b].is_number() || !std::isfinite(j[b].get<double>()) || j[b].get<double>() < 0.0 ||
-                j[b].get<double>() > maxValue) {
-            return makeError(ErrorCode::Corrupt,
-                    fmt::format("{}[{}]: must be a number in [0, {}]", where, b, maxValue));
+            j[b].get<double>() > maxValue) {
+            return makeError(ErrorCode::Corrupt, fmt::format("{}[{}]: must be a number in [0, {}]",
+                                                             where, b, maxValue));
         }
         s[b] = j[b].get<double>();
     }
@@ -36,22 +37,25 @@ Expected<colour::Spectrum> spectrumField(const nlohmann::json& j, const std::str
 
 colour::Spectrum SurfaceScene::reflectance(int x, int y) const
 {
-    const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+    const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                          static_cast<std::size_t>(x);
     const double t = mix[k];
     return (palette[static_cast<std::size_t>(pigmentA[k])] * (1.0 - t) +
-                   palette[static_cast<std::size_t>(pigmentB[k])] * t) *
-            static_cast<double>(shade[k]);
+            palette[static_cast<std::size_t>(pigmentB[k])] * t) *
+           static_cast<double>(shade[k]);
 }
 
-colour::ChannelCoeffs SurfaceScene::channels(const std::vector<colour::ChannelCoeffs>& pc, int x, int y) const
+colour::ChannelCoeffs
+SurfaceScene::channels(const std::vector<colour::ChannelCoeffs>& pc, int x, int y) const
 {
-    const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+    const std::size_t k = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                          static_cast<std::size_t>(x);
     const double t = mix[k];
     colour::ChannelCoeffs c{};
     for (std::size_t j = 0; j < colour::kChannels; ++j) {
         c[j] = ((1.0 - t) * pc[static_cast<std::size_t>(pigmentA[k])][j] +
-                       t * pc[static_cast<std::size_t>(pigmentB[k])][j]) *
-                shade[k];
+                t * pc[static_cast<std::size_t>(pigmentB[k])][j]) *
+               shade[k];
     }
     return c;
 }
@@ -61,34 +65,41 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
     const auto file = dir / "scene.json";
     std::ifstream in(file);
     if (!in) {
-        return makeError(ErrorCode::NotFound,
-                fmt::format("{}: cannot open scene manifest; --scene must name a folder with scene.json", file.string()));
+        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot open scene manifest; --scene "
+                                                          "must name a folder with scene.json",
+                                                          file.string()));
     }
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(in);
     } catch (const nlohmann::json::exception& e) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
     }
     const std::string f = file.string();
     if (!j.contains("format") || j["format"] != kFormat) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: 'format' must be \"{}\"", f, kFormat));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: 'format' must be \"{}\"", f, kFormat));
     }
     SurfaceScene s;
     s.name = j.value("name", dir.filename().string());
-    if (!j.contains("size_m") || !j["size_m"].is_array() || j["size_m"].size() != 2 || !j["size_m"][0].is_number() ||
-            !j["size_m"][1].is_number() || !(j["size_m"][0].get<double>() > 0.0) ||
-            !(j["size_m"][1].get<double>() > 0.0)) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: 'size_m' must be [width, height] in metres, both > 0", f));
+    if (!j.contains("size_m") || !j["size_m"].is_array() || j["size_m"].size() != 2 ||
+        !j["size_m"][0].is_number() || !j["size_m"][1].is_number() ||
+        !(j["size_m"][0].get<double>() > 0.0) || !(j["size_m"][1].get<double>() > 0.0)) {
+        return makeError(
+                ErrorCode::Corrupt,
+                fmt::format("{}: 'size_m' must be [width, height] in metres, both > 0", f));
     }
     s.widthM = j["size_m"][0].get<double>();
     s.heightM = j["size_m"][1].get<double>();
     if (!j.contains("palette") || !j["palette"].is_array() || j["palette"].empty()) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: 'palette' must be a non-empty array", f));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: 'palette' must be a non-empty array", f));
     }
     for (std::size_t k = 0; k < j["palette"].size(); ++k) {
         const auto& p = j["palette"][k];
-        auto r = spectrumField(p.value("reflectance", nlohmann::json()), fmt::format("{}: palette[{}].reflectance", f, k), 1.5);
+        auto r = spectrumField(p.value("reflectance", nlohmann::json()),
+                               fmt::format("{}: palette[{}].reflectance", f, k), 1.5);
         if (!r) {
             return tl::unexpected(r.error());
         }
@@ -109,16 +120,17 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
     }
     const std::string model = w.value("model", "ward-duer-guarded");
     bool known = false;
-    for (auto m : {brdf::WardModel::Ward1992, brdf::WardModel::WardDur, brdf::WardModel::WardDurGuarded,
-                 brdf::WardModel::Gmd}) {
+    for (auto m : {brdf::WardModel::Ward1992, brdf::WardModel::WardDur,
+                   brdf::WardModel::WardDurGuarded, brdf::WardModel::Gmd}) {
         if (model == brdf::wardModelName(m)) {
             s.model = m;
             known = true;
         }
     }
     if (!known) {
-        return makeError(ErrorCode::Corrupt,
-                fmt::format("{}: ward.model '{}' unknown (ward-1992, ward-duer, ward-duer-guarded, ward-gmd)", f, model));
+        return makeError(ErrorCode::Corrupt, fmt::format("{}: ward.model '{}' unknown (ward-1992, "
+                                                         "ward-duer, ward-duer-guarded, ward-gmd)",
+                                                         f, model));
     }
     auto mat = image::readExr(dir / "material.exr", {"A", "B", "mix", "shade"});
     if (!mat) {
@@ -129,8 +141,9 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
         return tl::unexpected(hf.error());
     }
     if (hf->width != mat->width || hf->height != mat->height) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: height.exr is {}x{} but material.exr is {}x{}",
-                                                     dir.string(), hf->width, hf->height, mat->width, mat->height));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: height.exr is {}x{} but material.exr is {}x{}",
+                                     dir.string(), hf->width, hf->height, mat->width, mat->height));
     }
     s.width = mat->width;
     s.height = mat->height;
@@ -143,11 +156,12 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
         const float sh = mat->planes[3][k];
         const auto bad = [&](const char* what) {
             return makeError(ErrorCode::Corrupt,
-                    fmt::format("{}: texel ({}, {}): {}", (dir / "material.exr").string(), k % static_cast<std::size_t>(s.width),
-                            k / static_cast<std::size_t>(s.width), what));
+                             fmt::format("{}: texel ({}, {}): {}", (dir / "material.exr").string(),
+                                         k % static_cast<std::size_t>(s.width),
+                                         k / static_cast<std::size_t>(s.width), what));
         };
-        if (a != std::floor(a) || b != std::floor(b) || a < 0.0f || b < 0.0f || a >= static_cast<float>(paletteSize) ||
-                b >= static_cast<float>(paletteSize)) {
+        if (a != std::floor(a) || b != std::floor(b) || a < 0.0f || b < 0.0f ||
+            a >= static_cast<float>(paletteSize) || b >= static_cast<float>(paletteSize)) {
             return bad("pigment index is not an integer palette entry");
         }
         if (!(t >= 0.0f && t <= 1.0f) || !(sh >= 0.0f && sh <= 1.5f)) {
@@ -163,8 +177,9 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
     s.relief.pitchM = s.widthM / s.width;
     s.relief.m.assign(hf->planes[0].begin(), hf->planes[0].end());
     if (std::abs(s.heightM / s.height - s.relief.pitchM) > 1e-6 * s.relief.pitchM) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: texels must be square: size_m {}x{} over {}x{} texels", f,
-                                                     s.widthM, s.heightM, s.width, s.height));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: texels must be square: size_m {}x{} over {}x{} texels", f,
+                                     s.widthM, s.heightM, s.width, s.height));
     }
     return s;
 }
@@ -174,7 +189,8 @@ Expected<void> saveScene(const std::filesystem::path& dir, const SurfaceScene& s
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot create folder ({})", dir.string(), ec.message()));
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot create folder ({})", dir.string(), ec.message()));
     }
     nlohmann::json j;
     j["format"] = kFormat;
@@ -183,10 +199,12 @@ Expected<void> saveScene(const std::filesystem::path& dir, const SurfaceScene& s
     j["palette"] = nlohmann::json::array();
     for (std::size_t k = 0; k < s.palette.size(); ++k) {
         j["palette"].push_back({{"name", s.paletteNames[k]},
-                {"reflectance", std::vector<double>(s.palette[k].v.begin(), s.palette[k].v.end())}});
+                                {"reflectance", std::vector<double>(s.palette[k].v.begin(),
+                                                                    s.palette[k].v.end())}});
     }
-    j["ward"] = {{"alpha", s.alpha}, {"rho_s", std::vector<double>(s.rhoS.v.begin(), s.rhoS.v.end())},
-            {"model", brdf::wardModelName(s.model)}};
+    j["ward"] = {{"alpha", s.alpha},
+                 {"rho_s", std::vector<double>(s.rhoS.v.begin(), s.rhoS.v.end())},
+                 {"model", brdf::wardModelName(s.model)}};
     std::ofstream out(dir / "scene.json");
     out << j.dump(1) << "\n";
     if (!out) {

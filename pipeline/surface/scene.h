@@ -14,8 +14,8 @@
 
 namespace replica::pipeline::surface {
 
-// Per texel: reflectance = shade * ((1 - mix) * palette[a] + mix * palette[b]). Exact spectra for the
-// reference, and (by linearity) exact channel coefficients for the renderer.
+// Per texel: reflectance = shade * ((1 - mix) * palette[a] + mix * palette[b]). Exact spectra for
+// the reference, and (by linearity) exact channel coefficients for the renderer.
 struct SurfaceScene {
     std::string name;
     double widthM = 0.0; // physical size of the surface on the panel
@@ -27,12 +27,13 @@ struct SurfaceScene {
     std::vector<int> pigmentA, pigmentB;
     std::vector<float> mix, shade;
     HeightField relief;
-    double alpha = 0.1;         // Ward roughness
-    colour::Spectrum rhoS;      // spectral specular reflectance (all zero: matte)
+    double alpha = 0.1;    // Ward roughness
+    colour::Spectrum rhoS; // spectral specular reflectance (all zero: matte)
     brdf::WardModel model = brdf::WardModel::WardDurGuarded;
 
     colour::Spectrum reflectance(int x, int y) const;
-    colour::ChannelCoeffs channels(const std::vector<colour::ChannelCoeffs>& paletteCoeffs, int x, int y) const;
+    colour::ChannelCoeffs
+    channels(const std::vector<colour::ChannelCoeffs>& paletteCoeffs, int x, int y) const;
     bool glossy() const { return rhoS.max() > 0.0; }
     bool flat() const { return relief.flat(); }
 };

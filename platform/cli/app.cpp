@@ -24,6 +24,9 @@ int runCli(int argc, char** argv)
 
     int exitCode = 0;
     // (subcommands are registered here as they land)
+    registerRenderCommand(app, exitCode);
+    registerBoothCommand(app, exitCode);
+    registerSceneCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {

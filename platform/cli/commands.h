@@ -13,5 +13,8 @@ constexpr int kExitLossy = 3;
 void registerRunCommand(CLI::App& app, int& exitCode);
 void registerReplayCommand(CLI::App& app, int& exitCode);
 void registerInspectCommand(CLI::App& app, int& exitCode);
+void registerRenderCommand(CLI::App& app, int& exitCode);
+void registerBoothCommand(CLI::App& app, int& exitCode);
+void registerSceneCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform

@@ -1,9 +1,9 @@
 // booth.json + EXR round trip and the messages for broken booth folders.
-#include <pipeline/booth/booth_model.h>
-#include <pipeline/image/exr.h>
-
 #include <filesystem>
 #include <fstream>
+
+#include <pipeline/booth/booth_model.h>
+#include <pipeline/image/exr.h>
 
 #include <gtest/gtest.h>
 
@@ -36,7 +36,8 @@ TEST(BoothModel, RoundTripsThroughJsonAndExr)
     EXPECT_EQ(l.spd[5], 7.0);
     EXPECT_EQ(l.centre, b.lights[0].centre);
     for (std::size_t k = 0; k < l.luminance.cdM2.size(); ++k) {
-        EXPECT_FLOAT_EQ(static_cast<float>(l.luminance.cdM2[k]), static_cast<float>(b.lights[0].luminance.cdM2[k]));
+        EXPECT_FLOAT_EQ(static_cast<float>(l.luminance.cdM2[k]),
+                        static_cast<float>(b.lights[0].luminance.cdM2[k]));
     }
     EXPECT_NE(r->find("d50"), nullptr);
     EXPECT_EQ(r->find("nope"), nullptr);
@@ -46,15 +47,18 @@ TEST(BoothModel, ReportsMissingFolderAndBadFields)
 {
     auto r = loadBooth(freshDir("missing"));
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("booth.json: cannot open"), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find("booth.json: cannot open"), std::string::npos)
+            << r.error().message;
 
     const auto dir = freshDir("badfield");
     std::filesystem::create_directories(dir);
-    std::ofstream(dir / "booth.json") << R"({"format":"replica-booth/1","lights":[{"name":"a","luminance":"a.exr",
+    std::ofstream(dir / "booth.json")
+            << R"({"format":"replica-booth/1","lights":[{"name":"a","luminance":"a.exr",
         "centre":[0,1],"edge_u":[1,0,0],"edge_v":[0,0,1],"spd":[]}]})";
     r = loadBooth(dir);
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("lights[0]: 'centre' must be an array of 3"), std::string::npos)
+    EXPECT_NE(r.error().message.find("lights[0]: 'centre' must be an array of 3"),
+              std::string::npos)
             << r.error().message;
 
     std::ofstream(dir / "booth.json") << "{ not json";
@@ -78,7 +82,8 @@ TEST(BoothModel, RejectsNanInTheLuminanceExrNamingThePixel)
     ASSERT_TRUE(image::writeExr(dir / "test.exr", img));
     auto r = loadBooth(dir);
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("test.exr: channel 'Y' pixel (5, 2) is nan"), std::string::npos)
+    EXPECT_NE(r.error().message.find("test.exr: channel 'Y' pixel (5, 2) is nan"),
+              std::string::npos)
             << r.error().message;
 }
 

@@ -1,8 +1,8 @@
 // Median cut, summed-area tables and mip chain: conservation, degenerate images, hot texels.
-#include <pipeline/booth/median_cut.h>
-
 #include <cmath>
 #include <random>
+
+#include <pipeline/booth/median_cut.h>
 
 #include <gtest/gtest.h>
 
@@ -199,7 +199,8 @@ TEST(LuminanceCheck, NamesTheFirstBadTexel)
     img.at(3, 2) = std::numeric_limits<double>::infinity();
     auto r = checkLuminance(img, "light.exr");
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("light.exr: texel (3, 2)"), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find("light.exr: texel (3, 2)"), std::string::npos)
+            << r.error().message;
     img.at(3, 2) = -1.0;
     EXPECT_FALSE(checkLuminance(img, "light.exr"));
 }

@@ -1,27 +1,29 @@
 // Ward lobes: albedo against the published/measured tables, an independent quadrature, reciprocity,
 // and the hard cases (grazing, alpha -> 0 and large, degenerate half vectors, u1 = 0).
-#include <pipeline/brdf/ward.h>
-
 #include <cmath>
 #include <random>
 
 #include <glm/geometric.hpp>
+
+#include <pipeline/brdf/ward.h>
 
 #include <gtest/gtest.h>
 
 namespace replica::pipeline::brdf {
 namespace {
 
-constexpr WardModel kAll[] = {WardModel::Ward1992, WardModel::WardDur, WardModel::WardDurGuarded, WardModel::Gmd};
+constexpr WardModel kAll[] = {WardModel::Ward1992, WardModel::WardDur, WardModel::WardDurGuarded,
+                              WardModel::Gmd};
 
 TEST(WardAlbedo, WardDurMatchesTheMeasuredTable)
 {
-    // rendering-background.md 1.2 (3000^2 stratified grid, independent program): alpha, theta, albedo.
+    // rendering-background.md 1.2 (3000^2 stratified grid, independent program): alpha, theta,
+    // albedo.
     struct Row {
         double alpha, theta, albedo;
     };
-    for (const Row r : {Row{0.1, 0.0, 0.981}, Row{0.1, 60.0, 0.981}, Row{0.3, 0.0, 0.856}, Row{0.3, 85.0, 1.25},
-                 Row{0.5, 80.0, 0.880}, Row{0.2, 88.0, 1.95}}) {
+    for (const Row r : {Row{0.1, 0.0, 0.981}, Row{0.1, 60.0, 0.981}, Row{0.3, 0.0, 0.856},
+                        Row{0.3, 85.0, 1.25}, Row{0.5, 80.0, 0.880}, Row{0.2, 88.0, 1.95}}) {
         EXPECT_NEAR(wardAlbedo(WardModel::WardDur, r.alpha, r.theta, 1000), r.albedo, 0.006)
                 << "alpha " << r.alpha << " theta " << r.theta;
     }
@@ -47,8 +49,10 @@ TEST(WardAlbedo, BoundedModelsStayAtOrBelowOneUpToGrazing)
 {
     for (double alpha : {0.01, 0.05, 0.1, 0.3, 0.5, 1.0}) {
         for (double theta : {0.0, 30.0, 60.0, 80.0, 85.0, 88.0, 89.0, 89.9}) {
-            EXPECT_LE(wardAlbedo(WardModel::Gmd, alpha, theta, 400), 1.0 + 1e-4) << alpha << " " << theta;
-            EXPECT_LE(wardAlbedo(WardModel::WardDurGuarded, alpha, theta, 400), 1.0 + 1e-4) << alpha << " " << theta;
+            EXPECT_LE(wardAlbedo(WardModel::Gmd, alpha, theta, 400), 1.0 + 1e-4)
+                    << alpha << " " << theta;
+            EXPECT_LE(wardAlbedo(WardModel::WardDurGuarded, alpha, theta, 400), 1.0 + 1e-4)
+                    << alpha << " " << theta;
         }
     }
 }
@@ -61,8 +65,9 @@ TEST(WardAlbedo, PlainWardDurExceedsOneAtGrazingWhichIsWhyTheGuardExists)
 
 TEST(WardAlbedo, GuardLeavesTheOperatingEnvelopeAlmostAlone)
 {
-    // The guard only ever removes energy (its denominator is >= Duer's). Measured effect (docs/rendering.md):
-    // < 0.2 % for a viewer within 30 degrees, <= 3.4 % at 60 degrees, alpha <= 0.2.
+    // The guard only ever removes energy (its denominator is >= Duer's). Measured effect
+    // (docs/rendering.md): < 0.2 % for a viewer within 30 degrees, <= 3.4 % at 60 degrees, alpha <=
+    // 0.2.
     for (double alpha : {0.05, 0.1, 0.2}) {
         for (double theta : {0.0, 30.0, 60.0}) {
             const double d = wardAlbedo(WardModel::WardDur, alpha, theta, 400);
@@ -102,7 +107,7 @@ TEST(WardEval, ClosedFormWeightEqualsFCosOverPdf)
             const Vec3 h = glm::normalize(s.i + o);
             const double tan2 = (1.0 - h.z * h.z) / (h.z * h.z);
             const double pdf = std::exp(-tan2 / (alpha * alpha)) /
-                    (4.0 * M_PI * alpha * alpha * glm::dot(s.i, h) * h.z * h.z * h.z);
+                               (4.0 * M_PI * alpha * alpha * glm::dot(s.i, h) * h.z * h.z * h.z);
             const double w = wardEval(m, alpha, n, s.i, o) * s.i.z / pdf;
             EXPECT_NEAR(s.weight, w, 1e-9 * w) << wardModelName(m) << " u1 " << u1;
             EXPECT_NEAR(s.solidAngle, 1.0 / pdf, 1e-9 / pdf);
@@ -139,7 +144,8 @@ TEST(WardHardCases, AlphaZeroIsTheExactMirror)
             EXPECT_NEAR(s.i.x, -o.x, 1e-5);
             EXPECT_NEAR(s.i.y, -o.y, 1e-5);
             EXPECT_NEAR(s.i.z, o.z, 1e-5);
-            EXPECT_NEAR(s.weight, 1.0, 1e-5) << wardModelName(m); // rho_s times the mirrored radiance
+            EXPECT_NEAR(s.weight, 1.0, 1e-5)
+                    << wardModelName(m); // rho_s times the mirrored radiance
             EXPECT_LT(s.solidAngle, 1e-10);
         }
         EXPECT_TRUE(std::isfinite(wardEval(WardModel::WardDur, alpha, n, o, o)));

@@ -10,8 +10,8 @@
 
 namespace replica::test {
 
-inline pipeline::booth::BoothLight ceilingLight(int w, int h, double cdM2, double heightM = 0.6,
-        double sizeU = 1.0, double sizeV = 0.5)
+inline pipeline::booth::BoothLight ceilingLight(
+        int w, int h, double cdM2, double heightM = 0.6, double sizeU = 1.0, double sizeV = 0.5)
 {
     pipeline::booth::BoothLight l;
     l.name = "test";
@@ -53,7 +53,8 @@ inline pipeline::surface::SurfaceScene testScene(int w, int h, bool bumpy, bool 
     s.widthM = 0.2;
     s.heightM = 0.2 * h / w;
     s.paletteNames = {"light", "dark"};
-    s.palette = {pipeline::colour::Spectrum::constant(0.6), pipeline::colour::Spectrum::constant(0.1)};
+    s.palette = {pipeline::colour::Spectrum::constant(0.6),
+                 pipeline::colour::Spectrum::constant(0.1)};
     for (std::size_t b = 0; b < pipeline::colour::kBands; ++b) {
         s.palette[1][b] = 0.05 + 0.5 * static_cast<double>(b) / pipeline::colour::kBands; // reddish
     }

@@ -1,11 +1,11 @@
 // Normal and horizon maps against closed forms; scene folder round trip and its error messages.
-#include <pipeline/image/exr.h>
-#include <pipeline/surface/relief.h>
-#include <pipeline/surface/scene.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+
+#include <pipeline/image/exr.h>
+#include <pipeline/surface/relief.h>
+#include <pipeline/surface/scene.h>
 
 #include <gtest/gtest.h>
 
@@ -29,7 +29,8 @@ TEST(NormalMap, InclinedPlaneGivesItsExactNormal)
     HeightField f = field(16, 12, 0.001);
     for (int y = 0; y < 12; ++y) {
         for (int x = 0; x < 16; ++x) {
-            f.m[static_cast<std::size_t>(y) * 16 + x] = 0.5 * x * 0.001 - 0.25 * y * 0.001; // rises along +x and +y(up)
+            f.m[static_cast<std::size_t>(y) * 16 + x] =
+                    0.5 * x * 0.001 - 0.25 * y * 0.001; // rises along +x and +y(up)
         }
     }
     const auto n = normalMap(f);
@@ -66,7 +67,8 @@ TEST(HorizonMap, FlatFieldHasZeroHorizonsEverywhere)
 
 TEST(HorizonMap, WallGivesItsElevationInItsDirectionOnly)
 {
-    // A 2 mm wall 5 mm to the right (+x) of the texel: sin(atan(2/5)) towards +x, nothing towards -x.
+    // A 2 mm wall 5 mm to the right (+x) of the texel: sin(atan(2/5)) towards +x, nothing towards
+    // -x.
     HeightField f = field(40, 9, 0.001);
     for (int y = 0; y < 9; ++y) {
         for (int x = 25; x < 27; ++x) {
@@ -74,7 +76,8 @@ TEST(HorizonMap, WallGivesItsElevationInItsDirectionOnly)
         }
     }
     const HorizonMap m = horizonMap(f, 8, 0.02);
-    const int x = 20, y = 4; // texel centre 20.5: the wall's face is at 25 - 0.5 pitch of bilinear ramp
+    const int x = 20,
+              y = 4; // texel centre 20.5: the wall's face is at 25 - 0.5 pitch of bilinear ramp
     const float* b = &m.sinBeta[(static_cast<std::size_t>(y) * 40 + x) * 8];
     const double peak = std::sin(std::atan(0.002 / 0.005)); // top reached 5 texels away
     EXPECT_NEAR(b[0], peak, 0.03);
@@ -137,7 +140,8 @@ TEST(SceneFolder, ErrorsNameTheFileAndTheProblem)
     ASSERT_TRUE(saveScene(dir, s));
     auto r = loadScene(dir);
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("material.exr: texel (7, 2): pigment index"), std::string::npos)
+    EXPECT_NE(r.error().message.find("material.exr: texel (7, 2): pigment index"),
+              std::string::npos)
             << r.error().message;
 
     dir = freshDir("noheight");
@@ -146,7 +150,8 @@ TEST(SceneFolder, ErrorsNameTheFileAndTheProblem)
     std::filesystem::remove(dir / "height.exr");
     r = loadScene(dir);
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("height.exr: no such file"), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find("height.exr: no such file"), std::string::npos)
+            << r.error().message;
 
     dir = freshDir("nanheight");
     ASSERT_TRUE(saveScene(dir, s));
@@ -159,14 +164,17 @@ TEST(SceneFolder, ErrorsNameTheFileAndTheProblem)
     ASSERT_TRUE(image::writeExr(dir / "height.exr", h));
     r = loadScene(dir);
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("pixel (4, 3) is inf"), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find("pixel (4, 3) is inf"), std::string::npos)
+            << r.error().message;
 
     dir = freshDir("badjson");
     ASSERT_TRUE(saveScene(dir, s));
-    std::ofstream(dir / "scene.json") << R"({"format":"replica-scene/1","size_m":[0.2,0.1],"palette":[{"reflectance":[1,2]}]})";
+    std::ofstream(dir / "scene.json")
+            << R"({"format":"replica-scene/1","size_m":[0.2,0.1],"palette":[{"reflectance":[1,2]}]})";
     r = loadScene(dir);
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("palette[0].reflectance: must hold 36 values"), std::string::npos)
+    EXPECT_NE(r.error().message.find("palette[0].reflectance: must hold 36 values"),
+              std::string::npos)
             << r.error().message;
 }
 
