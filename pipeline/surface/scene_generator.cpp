@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/reference/frame_error.h>
 #include <pipeline/surface/scene_generator.h>
 
 namespace replica::pipeline::surface {
@@ -138,24 +139,42 @@ Expected<SurfaceScene> metamerTarget(const std::filesystem::path& dataDir)
     s.paletteNames.push_back("surround");
     for (int p = 0; p < 3; ++p) {
         const colour::Spectrum r1 = *cc->spectrum(bases[p]);
-        colour::Spectrum shape;
-        for (std::size_t i = 0; i < colour::kBands; ++i) {
-            const double t = static_cast<double>(i) / (colour::kBands - 1);
-            shape[i] = std::sin(2.0 * std::numbers::pi * (1.5 * t + 0.15 * p)) +
-                       0.6 * std::cos(2.0 * std::numbers::pi * 3.0 * t);
-        }
-        colour::Spectrum black = metamericBlack(*obs, f7, shape);
-        // Largest scale that keeps r2 within [0.02, 0.95].
-        double scale = 1e9;
-        for (std::size_t i = 0; i < colour::kBands; ++i) {
-            if (black[i] > 0.0) {
-                scale = std::min(scale, (0.95 - r1[i]) / black[i]);
-            } else if (black[i] < 0.0) {
-                scale = std::min(scale, (r1[i] - 0.02) / -black[i]);
+        // Among smooth candidate shapes, keep the metameric black that separates the pair most
+        // under tungsten (CIE A): the target should show a visible mismatch when the light is
+        // switched.
+        const colour::Spectrum a = *ill->spectrum("A");
+        const colour::Xyz whiteA =
+                colour::reflectanceToXyz(*obs, a, colour::Spectrum::constant(1.0));
+        colour::Spectrum bestR2 = r1;
+        double bestDe = -1.0;
+        for (int freq = 1; freq <= 4; ++freq) {
+            for (int phase = 0; phase < 8; ++phase) {
+                colour::Spectrum shape;
+                for (std::size_t i = 0; i < colour::kBands; ++i) {
+                    const double t = static_cast<double>(i) / (colour::kBands - 1);
+                    shape[i] = std::sin(std::numbers::pi * (freq * t + phase / 8.0));
+                }
+                const colour::Spectrum black = metamericBlack(*obs, f7, shape);
+                double scale = 1e9; // largest scale that keeps r2 within [0.02, 0.95]
+                for (std::size_t i = 0; i < colour::kBands; ++i) {
+                    if (black[i] > 0.0) {
+                        scale = std::min(scale, (0.95 - r1[i]) / black[i]);
+                    } else if (black[i] < 0.0) {
+                        scale = std::min(scale, (r1[i] - 0.02) / -black[i]);
+                    }
+                }
+                const colour::Spectrum r2 = r1 + black * (0.9 * std::max(scale, 0.0));
+                const double de = reference::ciede2000(
+                        reference::xyzToLab(colour::reflectanceToXyz(*obs, a, r1), whiteA),
+                        reference::xyzToLab(colour::reflectanceToXyz(*obs, a, r2), whiteA));
+                if (de > bestDe) {
+                    bestDe = de;
+                    bestR2 = r2;
+                }
             }
         }
         s.palette.push_back(r1);
-        s.palette.push_back(r1 + black * (0.9 * scale));
+        s.palette.push_back(bestR2);
         s.paletteNames.push_back(fmt::format("{}_a", bases[p]));
         s.paletteNames.push_back(fmt::format("{}_b_metamer_under_F7", bases[p]));
     }
