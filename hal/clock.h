@@ -6,9 +6,9 @@
 
 namespace replica::hal {
 
-// Every sample and every frame tick is stamped in session-monotonic nanoseconds: 0 is the moment the
-// session started, and time never goes backwards. Sim and replay sources run on virtual time, so the
-// loop asks a Clock rather than the system for "now".
+// Every sample and every frame tick is stamped in session-monotonic nanoseconds: 0 is the moment
+// the session started, and time never goes backwards. Sim and replay sources run on virtual time,
+// so the loop asks a Clock rather than the system for "now".
 class Clock
 {
 public:
@@ -24,7 +24,7 @@ public:
     std::int64_t nowNs() const override
     {
         return std::chrono::duration_cast<std::chrono::nanoseconds>(
-                std::chrono::steady_clock::now() - start_)
+                       std::chrono::steady_clock::now() - start_)
                 .count();
     }
 

@@ -1,4 +1,5 @@
-// Plain sample values produced by every device source (live, sim, replay) and written to recordings.
+// Plain sample values produced by every device source (live, sim, replay) and written to
+// recordings.
 #pragma once
 
 #include <array>
@@ -9,8 +10,8 @@
 
 namespace replica::hal {
 
-// One raw spectrum as the spectrometer delivers it, with everything needed to turn the counts into a
-// spectral power distribution later (the conversion lives in pipeline/, not here).
+// One raw spectrum as the spectrometer delivers it, with everything needed to turn the counts into
+// a spectral power distribution later (the conversion lives in pipeline/, not here).
 struct SpectrumSample {
     std::int64_t timestampNs = 0; // session time the spectrum became available
     std::uint32_t sequence = 0;   // per-source counter; gaps mean drops

@@ -1,17 +1,17 @@
 // Area loggers and level parsing.
-#include <platform/logging.h>
-
 #include <cstdlib>
 #include <mutex>
 #include <sstream>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 
+#include <platform/logging.h>
+
 namespace replica::platform {
 namespace {
 
 const char* const kAreas[] = {"hal.spectrometer", "hal.tracker", "hal.accel", "pipeline", "render",
-        "output", "rec", "loop", "replica"};
+                              "output",           "rec",         "loop",      "replica"};
 
 std::mutex& registryMutex()
 {

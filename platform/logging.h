@@ -1,5 +1,5 @@
-// Named spdlog loggers per area (hal.spectrometer, hal.tracker, hal.accel, pipeline, render, output,
-// rec, loop) and the --log-level / $REPLICA_LOG knob.
+// Named spdlog loggers per area (hal.spectrometer, hal.tracker, hal.accel, pipeline, render,
+// output, rec, loop) and the --log-level / $REPLICA_LOG knob.
 #pragma once
 
 #include <memory>

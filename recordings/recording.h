@@ -17,8 +17,8 @@ namespace replica::recordings {
 // Bumped whenever what is written changes; readers open every earlier version they know.
 constexpr int kFormatVersion = 1;
 
-// For each rendered frame: its tick time and exactly which sample of each device it consumed (by the
-// device's sequence number), so replay never has to guess timing. nullopt: no sample yet.
+// For each rendered frame: its tick time and exactly which sample of each device it consumed (by
+// the device's sequence number), so replay never has to guess timing. nullopt: no sample yet.
 struct FrameRecord {
     std::uint64_t frameIndex = 0;
     std::int64_t tickNs = 0;
@@ -29,11 +29,11 @@ struct FrameRecord {
 
 // Describes the session: enough to re-create the renderer's inputs other than the samples.
 struct SessionInfo {
-    std::string softwareVersion;     // "replica 0.1.0"
-    std::string configJson;          // the resolved run configuration (size, rate, scene, ...), JSON
-    std::string boothModel;          // booth model identifier
-    std::string scene;               // scene identifier
-    std::string displayProfile;      // display profile identifier
+    std::string softwareVersion; // "replica 0.1.0"
+    std::string configJson;      // the resolved run configuration (size, rate, scene, ...), JSON
+    std::string boothModel;      // booth model identifier
+    std::string scene;           // scene identifier
+    std::string displayProfile;  // display profile identifier
     std::int64_t wallClockStartNs = 0; // Unix time (ns) at session time 0, for viewers' dates
     hal::DeviceInfo spectrometer, tracker, accel;
 };
@@ -54,14 +54,15 @@ class RecordingWriter
 public:
     // Creates (truncates) the file and writes the header and session description.
     static Expected<std::unique_ptr<RecordingWriter>> create(const std::filesystem::path& path,
-            const SessionInfo& session);
+                                                             const SessionInfo& session);
     virtual ~RecordingWriter() = default;
 
     virtual void write(const hal::SpectrumSample& s) = 0;
     virtual void write(const hal::PoseSample& s) = 0;
     virtual void write(const hal::AccelSample& s) = 0;
     virtual void write(const FrameRecord& f) = 0;
-    // Flushes everything and writes the summary and footer. Safe to call once; the destructor calls it.
+    // Flushes everything and writes the summary and footer. Safe to call once; the destructor calls
+    // it.
     virtual Expected<void> close() = 0;
 };
 

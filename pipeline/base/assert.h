@@ -7,8 +7,8 @@
 #define REPLICA_ASSERT(cond, why)                                                                  \
     do {                                                                                           \
         if (!(cond)) {                                                                             \
-            std::fprintf(stderr, "%s:%d: assertion '%s' failed: %s\n", __FILE__, __LINE__, #cond, \
-                    why);                                                                          \
+            std::fprintf(stderr, "%s:%d: assertion '%s' failed: %s\n", __FILE__, __LINE__, #cond,  \
+                         why);                                                                     \
             std::abort();                                                                          \
         }                                                                                          \
     } while (false)

@@ -1,7 +1,7 @@
 // Channel bases and the per-light channel-to-XYZ matrix.
-#include <pipeline/colour/channel_basis.h>
-
 #include <algorithm>
+
+#include <pipeline/colour/channel_basis.h>
 
 namespace replica::pipeline::colour {
 
@@ -9,7 +9,8 @@ ChannelBasis boxBasis()
 {
     ChannelBasis b;
     b.name = "box6";
-    constexpr std::size_t kPerBand = 6; // 6 working bands per box; the last box gets the remaining 6
+    constexpr std::size_t kPerBand =
+            6; // 6 working bands per box; the last box gets the remaining 6
     for (std::size_t i = 0; i < kBands; ++i) {
         const std::size_t k = std::min(i / kPerBand, kChannels - 1);
         b.reconstruct[k][i] = 1.0;

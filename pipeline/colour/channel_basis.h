@@ -29,9 +29,10 @@ ChannelBasis boxBasis();
 
 ChannelCoeffs projectReflectance(const ChannelBasis& basis, const Spectrum& reflectance);
 
-// M_k = sum_l recon[k](l) * light(l) * cmf(l) * 10 nm, with the light scaled so that its own Y is 1.
-// Then XYZ (cd/m^2) of a Lambertian texel under illuminance E (lux) is E/pi * sum_k c_k M_k: exact
-// whenever the reflectance lies in the span of the basis. Returns zeros for a light with Y <= 0.
+// M_k = sum_l recon[k](l) * light(l) * cmf(l) * 10 nm, with the light scaled so that its own Y
+// is 1. Then XYZ (cd/m^2) of a Lambertian texel under illuminance E (lux) is E/pi * sum_k c_k M_k:
+// exact whenever the reflectance lies in the span of the basis. Returns zeros for a light with Y <=
+// 0.
 ChannelToXyz channelToXyz(const ChannelBasis& basis, const Observer& obs, const Spectrum& light);
 
 } // namespace replica::pipeline::colour

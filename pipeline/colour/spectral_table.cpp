@@ -1,12 +1,12 @@
 // Spectral CSV parsing with file:line error messages.
-#include <pipeline/colour/spectral_table.h>
-
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
+
+#include <pipeline/colour/spectral_table.h>
 
 namespace replica::pipeline::colour {
 namespace {
@@ -17,7 +17,8 @@ std::vector<std::string> splitCsvLine(const std::string& line)
     std::string cell;
     std::istringstream in(line);
     while (std::getline(in, cell, ',')) {
-        while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '\t')) {
+        while (!cell.empty() &&
+               (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '\t')) {
             cell.pop_back();
         }
         std::size_t start = 0;
@@ -68,13 +69,14 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
         if (!haveHeader) {
             if (cells.size() < 2 || cells[0] != "wavelength_nm") {
                 return makeError(ErrorCode::InvalidArgument,
-                        fmt::format("{}:{}: header must be 'wavelength_nm,<name>,...'", source,
-                                lineNo));
+                                 fmt::format("{}:{}: header must be 'wavelength_nm,<name>,...'",
+                                             source, lineNo));
             }
             for (std::size_t c = 1; c < cells.size(); ++c) {
                 if (cells[c].empty()) {
                     return makeError(ErrorCode::InvalidArgument,
-                            fmt::format("{}:{}: column {} has an empty name", source, lineNo, c + 1));
+                                     fmt::format("{}:{}: column {} has an empty name", source,
+                                                 lineNo, c + 1));
                 }
             }
             table.columns.assign(cells.begin() + 1, cells.end());
@@ -82,26 +84,30 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
             continue;
         }
         if (cells.size() != table.columns.size() + 1) {
-            return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}:{}: {} cells, expected {} (wavelength_nm and {} columns)", source,
-                            lineNo, cells.size(), table.columns.size() + 1, table.columns.size()));
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: {} cells, expected {} (wavelength_nm and {} columns)",
+                                source, lineNo, cells.size(), table.columns.size() + 1,
+                                table.columns.size()));
         }
         double wl = 0.0;
         if (!parseDouble(cells[0], wl)) {
             return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}:{}: wavelength '{}' is not a number", source, lineNo, cells[0]));
+                             fmt::format("{}:{}: wavelength '{}' is not a number", source, lineNo,
+                                         cells[0]));
         }
         if (!table.wavelengthNm.empty() && !(wl > table.wavelengthNm.back())) {
-            return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}:{}: wavelength {} nm does not increase (previous {} nm)", source,
-                            lineNo, wl, table.wavelengthNm.back()));
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: wavelength {} nm does not increase (previous {} nm)",
+                                source, lineNo, wl, table.wavelengthNm.back()));
         }
         std::vector<double> row(table.columns.size());
         for (std::size_t c = 0; c < row.size(); ++c) {
             if (!parseDouble(cells[c + 1], row[c])) {
                 return makeError(ErrorCode::InvalidArgument,
-                        fmt::format("{}:{}: column '{}' value '{}' is not a finite number", source,
-                                lineNo, table.columns[c], cells[c + 1]));
+                                 fmt::format("{}:{}: column '{}' value '{}' is not a finite number",
+                                             source, lineNo, table.columns[c], cells[c + 1]));
             }
         }
         table.wavelengthNm.push_back(wl);
@@ -109,11 +115,12 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
     }
     if (!haveHeader) {
         return makeError(ErrorCode::InvalidArgument,
-                fmt::format("{}: no header line 'wavelength_nm,...' found", source));
+                         fmt::format("{}: no header line 'wavelength_nm,...' found", source));
     }
     if (table.rows.size() < 2) {
         return makeError(ErrorCode::InvalidArgument,
-                fmt::format("{}: needs at least two data rows, found {}", source, table.rows.size()));
+                         fmt::format("{}: needs at least two data rows, found {}", source,
+                                     table.rows.size()));
     }
     return table;
 }
@@ -123,7 +130,8 @@ Expected<SpectralTable> loadSpectralCsv(const std::filesystem::path& path)
     std::ifstream file(path, std::ios::binary);
     if (!file) {
         return makeError(ErrorCode::NotFound,
-                fmt::format("{}: cannot open spectral table (does the file exist?)", path.string()));
+                         fmt::format("{}: cannot open spectral table (does the file exist?)",
+                                     path.string()));
     }
     std::ostringstream text;
     text << file.rdbuf();

@@ -1,4 +1,5 @@
-// Reading spectral CSV tables: '#' comment lines, a header 'wavelength_nm,<name>,...', numeric rows.
+// Reading spectral CSV tables: '#' comment lines, a header 'wavelength_nm,<name>,...', numeric
+// rows.
 #pragma once
 
 #include <filesystem>

@@ -1,10 +1,10 @@
 // Working-grid spectra and band-integrating resampling.
-#include <pipeline/colour/spectrum.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
+
+#include <pipeline/colour/spectrum.h>
 
 namespace replica::pipeline::colour {
 
@@ -62,23 +62,23 @@ Expected<Spectrum> resampleToWorkingGrid(const SampledSpectrum& s, const std::st
     const std::size_t n = wl.size();
     if (n < 2 || s.value.size() != n) {
         return makeError(ErrorCode::InvalidArgument,
-                fmt::format("{}: needs at least two samples with one value each", what));
+                         fmt::format("{}: needs at least two samples with one value each", what));
     }
     for (std::size_t i = 0; i < n; ++i) {
         if (!std::isfinite(wl[i]) || !std::isfinite(s.value[i])) {
             return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}: sample {} is not a finite number", what, i));
+                             fmt::format("{}: sample {} is not a finite number", what, i));
         }
         if (i > 0 && !(wl[i] > wl[i - 1])) {
             return makeError(ErrorCode::InvalidArgument,
-                    fmt::format("{}: wavelengths must increase, but {} nm follows {} nm", what, wl[i],
-                            wl[i - 1]));
+                             fmt::format("{}: wavelengths must increase, but {} nm follows {} nm",
+                                         what, wl[i], wl[i - 1]));
         }
     }
     if (wl.front() > kFirstNm || wl.back() < kLastNm) {
         return makeError(ErrorCode::InvalidArgument,
-                fmt::format("{}: covers {}-{} nm but must cover at least {}-{} nm", what, wl.front(),
-                        wl.back(), kFirstNm, kLastNm));
+                         fmt::format("{}: covers {}-{} nm but must cover at least {}-{} nm", what,
+                                     wl.front(), wl.back(), kFirstNm, kLastNm));
     }
 
     constexpr double kHalfBaseNm = 10.0;
@@ -102,7 +102,8 @@ Expected<Spectrum> resampleToWorkingGrid(const SampledSpectrum& s, const std::st
         // The triangle's full discrete weight is its area, kHalfBaseNm. What lies beyond the data
         // takes the nearest edge value (the CIE convention S(375) = S(380)).
         const double missing = std::max(0.0, kHalfBaseNm - weightInside);
-        const double edge = centre - wl.front() < wl.back() - centre ? s.value.front() : s.value.back();
+        const double edge =
+                centre - wl.front() < wl.back() - centre ? s.value.front() : s.value.back();
         out.v[b] = (weighted + missing * edge) / (weightInside + missing);
     }
     return out;

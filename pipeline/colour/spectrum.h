@@ -1,4 +1,5 @@
-// Spectra on the working grid (380-730 nm, 10 nm, 36 bands, as in the paper) and resampling onto it.
+// Spectra on the working grid (380-730 nm, 10 nm, 36 bands, as in the paper) and resampling onto
+// it.
 #pragma once
 
 #include <array>
@@ -20,8 +21,8 @@ constexpr double bandCentreNm(std::size_t i)
     return kFirstNm + kStepNm * static_cast<double>(i);
 }
 
-// A spectral quantity sampled at the 36 band centres. Units depend on use: relative power, reflectance
-// factor (0..1) or a colour-matching function.
+// A spectral quantity sampled at the 36 band centres. Units depend on use: relative power,
+// reflectance factor (0..1) or a colour-matching function.
 struct Spectrum {
     std::array<double, kBands> v{};
 
@@ -42,10 +43,10 @@ struct SampledSpectrum {
 };
 
 // Reduces a spectrum on any grid to the working grid with a triangular bandpass of 10 nm half-base
-// centred on each band: band value = sum_i tri(lambda_i) * dlambda_i * S_i / 10. On a 5 nm grid this is
-// exactly the 1/4, 1/2, 1/4 filter of the CIE triangular tables; it keeps the energy of narrow mercury
-// lines that point picking would drop (../docs: a picked F11 white moves by 0.025 in x). Where the
-// triangle reaches past the data (at 380 or 730 nm), the edge value is repeated.
+// centred on each band: band value = sum_i tri(lambda_i) * dlambda_i * S_i / 10. On a 5 nm grid
+// this is exactly the 1/4, 1/2, 1/4 filter of the CIE triangular tables; it keeps the energy of
+// narrow mercury lines that point picking would drop (../docs: a picked F11 white moves by 0.025 in
+// x). Where the triangle reaches past the data (at 380 or 730 nm), the edge value is repeated.
 // Fails when the samples do not cover 380..730 nm, are not strictly increasing, or are not finite.
 Expected<Spectrum> resampleToWorkingGrid(const SampledSpectrum& s, const std::string& what);
 

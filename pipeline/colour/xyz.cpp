@@ -1,7 +1,6 @@
 // CIE 1931 tristimulus integration on the working grid.
-#include <pipeline/colour/xyz.h>
-
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/colour/xyz.h>
 
 namespace replica::pipeline::colour {
 

@@ -1,10 +1,10 @@
-// Builds the 'replica' command line from the registered subcommands and maps outcomes to exit codes.
-#include <platform/cli/app.h>
-
+// Builds the 'replica' command line from the registered subcommands and maps outcomes to exit
+// codes.
 #include <cstdio>
 
 #include <CLI/CLI.hpp>
 
+#include <platform/cli/app.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
 
@@ -18,12 +18,14 @@ int runCli(int argc, char** argv)
     app.set_version_flag("--version", std::string("replica ") + REPLICA_VERSION);
     std::string logLevel = "info";
     app.add_option("--log-level", logLevel,
-            "log level for every logger (trace, debug, info, warn, error), or per logger as "
-            "'hal.tracker=debug,rec=info'; $REPLICA_LOG does the same")
+                   "log level for every logger (trace, debug, info, warn, error), or per logger as "
+                   "'hal.tracker=debug,rec=info'; $REPLICA_LOG does the same")
             ->capture_default_str();
 
     int exitCode = 0;
-    // (subcommands are registered here as they land)
+    registerRunCommand(app, exitCode);
+    registerReplayCommand(app, exitCode);
+    registerInspectCommand(app, exitCode);
     registerRenderCommand(app, exitCode);
     registerBoothCommand(app, exitCode);
     registerSceneCommand(app, exitCode);

@@ -12,7 +12,8 @@ TEST(Resample, FiveNanometreGridGivesTheCieTriangularFilter)
 {
     // Compare with the published triangular 10 nm table: same rule, independent arithmetic.
     auto fine = loadSpectralCsv(dataDir() / "spectra" / "cie_illuminants_F1_F12_5nm_380_780.csv");
-    auto tri = loadSpectralCsv(dataDir() / "spectra" / "cie_illuminants_10nm_380_730_triangular.csv");
+    auto tri =
+            loadSpectralCsv(dataDir() / "spectra" / "cie_illuminants_10nm_380_730_triangular.csv");
     ASSERT_TRUE(fine) << fine.error().message;
     ASSERT_TRUE(tri) << tri.error().message;
     for (const char* name : {"F2", "F7", "F11"}) {
@@ -71,7 +72,8 @@ TEST(SpectralCsv, RejectsMissingColumn)
 
 TEST(Xyz, IlluminantAWhitePointOnWorkingGrid)
 {
-    // CIE A on the 36-band grid: x,y within 0.001 of the published 2-degree white (0.44757, 0.40745).
+    // CIE A on the 36-band grid: x,y within 0.001 of the published 2-degree white (0.44757,
+    // 0.40745).
     auto obs = loadCie1931(dataDir());
     auto t = loadSpectralCsv(dataDir() / "spectra" / "cie_illuminants_A_D50_D65_5nm_300_780.csv");
     ASSERT_TRUE(obs && t);

@@ -1,1 +1,0 @@
-// placeholder so the hal library has a translation unit until its first source lands

@@ -1,0 +1,64 @@
+// Simulated spectrometer, head tracker and accelerometer: real implementations of the HAL
+// interfaces driven by the scripted scenario on virtual time, each on its own sample clock.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <hal/sim/scenario.h>
+#include <hal/sources.h>
+
+namespace replica::hal::sim {
+
+// A lamp's relative spectral power on any increasing wavelength grid (nm).
+struct SimLamp {
+    std::string name;
+    std::vector<double> wavelengthNm;
+    std::vector<double> power;
+};
+
+struct SimSpectrometerParams {
+    std::vector<SimLamp> lamps;         // indexed by the scenario's lamp number
+    std::vector<double> responsivityNm; // detector + grating relative responsivity
+    std::vector<double> responsivity;
+    std::int64_t periodNs = 200'000'000; // about five spectra a second, as in the paper
+    std::uint32_t integrationTimeUs = 100'000;
+    double peakCounts = 40'000.0; // counts at the brightest pixel at the set integration time
+    double darkCounts = 1'500.0;  // electrical offset
+    double readNoiseCounts = 6.0;
+    std::uint64_t seed = 1;
+};
+
+// Simulated Ocean Optics USB2000+: 2048 pixels, a realistic wavelength polynomial, dark
+// pixels 6..21 (masked on the detector), shot and read noise, 16-bit saturation.
+std::unique_ptr<SpectrometerSource> makeSimSpectrometer(ScenarioParams scenario,
+                                                        SimSpectrometerParams params);
+
+struct SimTrackerParams {
+    std::int64_t periodNs = 8'333'333;           // 120 Hz
+    glm::dvec3 trackerInBoothM{0.0, 0.42, 0.05}; // tracker origin in the booth frame (no rotation)
+    double jitterM = 0.0002;
+    std::uint64_t seed = 2;
+};
+
+std::unique_ptr<TrackerSource> makeSimTracker(ScenarioParams scenario, SimTrackerParams params);
+
+struct SimAccelParams {
+    std::int64_t periodNs = 10'000'000; // 100 Hz
+    double noiseMs2 = 0.02;
+    std::uint64_t seed = 3;
+};
+
+// Gravity in the panel frame (x right, y up the panel, z out of the screen) for the scenario's
+// tilt.
+std::unique_ptr<AccelSource> makeSimAccel(ScenarioParams scenario, SimAccelParams params);
+
+// The simulated detector's wavelength calibration (nm at pixel p = c0 + c1 p + c2 p^2 + c3 p^3).
+constexpr double kSimWavelengthCoeffs[4] = {339.2, 0.3797, -1.62e-5, -1.3e-10};
+constexpr int kSimPixels = 2048;
+constexpr int kSimDarkPixelFirst = 6;
+constexpr int kSimDarkPixelLast = 21;
+
+} // namespace replica::hal::sim

@@ -1,0 +1,353 @@
+// GLES 3.1 implementation of the renderer.
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <GLES3/gl31.h>
+#include <fmt/format.h>
+#include <glm/matrix.hpp>
+
+#include <pipeline/render/gles_renderer.h>
+
+namespace replica::pipeline::render {
+namespace {
+
+constexpr int kMaxLights = 256;
+
+// A triangle covering the viewport; vUv runs 0..1 across the panel's active area, v up.
+const char* const kVertexShader = R"(#version 310 es
+out vec2 vUv;
+void main() {
+    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    vUv = p;
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+// Paper eq. (1) over point lights, eq. (2) per channel, summed into absolute XYZ (cd/m^2).
+const char* const kXyzShader = R"(#version 310 es
+precision highp float;
+precision highp int;
+in vec2 vUv;
+out vec4 outXyz;
+uniform highp sampler2D uCoeffA;   // channels 0..2
+uniform highp sampler2D uCoeffB;   // channels 3..5
+uniform vec3 uPanelOrigin;
+uniform vec3 uPanelRight;
+uniform vec3 uPanelUp;
+uniform vec3 uPanelNormal;
+uniform vec3 uLightNormal;
+uniform int uLightCount;
+uniform vec4 uLights[256];         // xyz: position (m); w: L * a (cd)
+uniform vec3 uChannelXyz[6];
+const float kPi = 3.14159265358979;
+void main() {
+    vec3 p = uPanelOrigin + vUv.x * uPanelRight + vUv.y * uPanelUp;
+    float e = 0.0;
+    for (int i = 0; i < uLightCount; ++i) {
+        vec3 d = uLights[i].xyz - p;
+        // Guard 1/d^2: a light touching the surface contributes a bounded amount.
+        float d2 = max(dot(d, d), 1e-6);
+        vec3 dir = d * inversesqrt(d2);
+        float cosSurface = max(dot(uPanelNormal, dir), 0.0);
+        float cosLight = max(dot(uLightNormal, -dir), 0.0);
+        e += uLights[i].w * cosSurface * cosLight / d2;
+    }
+    vec3 a = texture(uCoeffA, vUv).rgb;
+    vec3 b = texture(uCoeffB, vUv).rgb;
+    vec3 xyz = a.r * uChannelXyz[0] + a.g * uChannelXyz[1] + a.b * uChannelXyz[2]
+             + b.r * uChannelXyz[3] + b.g * uChannelXyz[4] + b.b * uChannelXyz[5];
+    outXyz = vec4(xyz * (e / kPi), 1.0);
+}
+)";
+
+// Inverse display model: XYZ -> linear drive -> power-law encoding, clipped to the panel's range.
+const char* const kDisplayShader = R"(#version 310 es
+precision highp float;
+precision highp int;
+in vec2 vUv;
+out vec4 outRgba;
+uniform highp sampler2D uXyz;
+uniform mat3 uXyzToRgb;
+uniform vec3 uBlack;
+uniform float uInvGamma;
+void main() {
+    vec3 xyz = texelFetch(uXyz, ivec2(gl_FragCoord.xy), 0).xyz;
+    vec3 rgb = clamp(uXyzToRgb * (xyz - uBlack), 0.0, 1.0);
+    outRgba = vec4(pow(rgb, vec3(uInvGamma)), 1.0);
+}
+)";
+
+Expected<GLuint> compile(GLenum type, const char* source, const char* what)
+{
+    GLuint shader = glCreateShader(type);
+    glShaderSource(shader, 1, &source, nullptr);
+    glCompileShader(shader);
+    GLint ok = GL_FALSE;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        std::array<char, 4096> log{};
+        glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
+        glDeleteShader(shader);
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("render: {} shader does not compile: {}", what, log.data()));
+    }
+    return shader;
+}
+
+Expected<GLuint> link(const char* fragment, const char* what)
+{
+    auto vs = compile(GL_VERTEX_SHADER, kVertexShader, "fullscreen vertex");
+    if (!vs) {
+        return tl::unexpected(vs.error());
+    }
+    auto fs = compile(GL_FRAGMENT_SHADER, fragment, what);
+    if (!fs) {
+        glDeleteShader(*vs);
+        return tl::unexpected(fs.error());
+    }
+    GLuint program = glCreateProgram();
+    glAttachShader(program, *vs);
+    glAttachShader(program, *fs);
+    glLinkProgram(program);
+    glDeleteShader(*vs);
+    glDeleteShader(*fs);
+    GLint ok = GL_FALSE;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        std::array<char, 4096> log{};
+        glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
+        glDeleteProgram(program);
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("render: {} program does not link: {}", what, log.data()));
+    }
+    return program;
+}
+
+GLuint
+makeTexture(GLenum internalFormat, GLenum format, GLenum type, int w, int h, const void* data)
+{
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, w, h);
+    if (data != nullptr) {
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, type, data);
+    }
+    // Nearest sampling: exact texel values, no dependence on float-filtering extensions.
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return tex;
+}
+
+glm::vec3 toFloat(const glm::dvec3& v)
+{
+    return glm::vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
+}
+
+class GlesRenderer final : public Renderer
+{
+public:
+    explicit GlesRenderer(GlesRendererSetup setup) : setup_(std::move(setup)) {}
+    ~GlesRenderer() override
+    {
+        glDeleteFramebuffers(static_cast<GLsizei>(fbos_.size()), fbos_.data());
+        glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
+        glDeleteVertexArrays(1, &vao_);
+        glDeleteProgram(xyzProgram_);
+        glDeleteProgram(displayProgram_);
+    }
+    GlesRenderer(const GlesRenderer&) = delete;
+    GlesRenderer& operator=(const GlesRenderer&) = delete;
+
+    Expected<void> init()
+    {
+        auto xyz = link(kXyzShader, "XYZ");
+        if (!xyz) {
+            return tl::unexpected(xyz.error());
+        }
+        xyzProgram_ = *xyz;
+        auto display = link(kDisplayShader, "display");
+        if (!display) {
+            return tl::unexpected(display.error());
+        }
+        displayProgram_ = *display;
+        glGenVertexArrays(1, &vao_);
+
+        const auto& s = setup_.surface;
+        const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
+        if (s.width <= 0 || s.height <= 0 || s.coeffs.size() != texels * colour::kChannels) {
+            return makeError(ErrorCode::InvalidArgument, "render: the surface image is empty or "
+                                                         "has the wrong number of coefficients");
+        }
+        std::vector<float> a(texels * 3);
+        std::vector<float> b(texels * 3);
+        for (std::size_t i = 0; i < texels; ++i) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                a[i * 3 + c] = s.coeffs[i * colour::kChannels + c];
+                b[i * 3 + c] = s.coeffs[i * colour::kChannels + 3 + c];
+            }
+        }
+        coeffA_ = makeTexture(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, a.data());
+        coeffB_ = makeTexture(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, b.data());
+        xyzTarget_ =
+                makeTexture(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
+        rgbaTarget_ = makeTexture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, setup_.width, setup_.height,
+                                  nullptr);
+        textures_ = {coeffA_, coeffB_, xyzTarget_, rgbaTarget_};
+
+        glGenFramebuffers(2, fbos_.data());
+        for (int i = 0; i < 2; ++i) {
+            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[static_cast<std::size_t>(i)]);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
+                                   i == 0 ? xyzTarget_ : rgbaTarget_, 0);
+            if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+                return makeError(
+                        ErrorCode::Unsupported,
+                        fmt::format(
+                                "render: the {} target is not renderable on this GL "
+                                "(float colour buffers need GLES 3.2 or EXT_color_buffer_float)",
+                                i == 0 ? "RGBA32F XYZ" : "RGBA8 display"));
+            }
+        }
+        if (GLenum err = glGetError(); err != GL_NO_ERROR) {
+            return makeError(ErrorCode::Unsupported,
+                             fmt::format("render: GL error 0x{:04x} while setting up", err));
+        }
+        return {};
+    }
+
+    std::string description() const override
+    {
+        return fmt::format("gles-diffuse ({}x{} point lights, basis {})", setup_.lightsU,
+                           setup_.lightsV, setup_.basis.name);
+    }
+
+    Expected<void>
+    render(const scene::SceneState& state, RenderedFrame& out, Readback readback) override
+    {
+        const int w = setup_.width;
+        const int h = setup_.height;
+        const scene::PanelPose pose = scene::panelPose(setup_.stand, state.tiltRad);
+        const auto lights = scene::uniformGridLights(
+                setup_.booth.emitter, state.emitterLuminanceCdM2, setup_.lightsU, setup_.lightsV);
+        const colour::ChannelToXyz m =
+                colour::channelToXyz(setup_.basis, setup_.observer, state.illuminant);
+
+        glViewport(0, 0, w, h);
+        glBindVertexArray(vao_);
+
+        // Pass 1: absolute XYZ.
+        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
+        glUseProgram(xyzProgram_);
+        setVec3(xyzProgram_, "uPanelOrigin", pose.originM);
+        setVec3(xyzProgram_, "uPanelRight", pose.rightM);
+        setVec3(xyzProgram_, "uPanelUp", pose.upM);
+        setVec3(xyzProgram_, "uPanelNormal", pose.normal);
+        setVec3(xyzProgram_, "uLightNormal", setup_.booth.emitter.normal);
+        const int count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
+        std::vector<float> packed;
+        packed.reserve(static_cast<std::size_t>(count) * 4);
+        for (int i = 0; i < count; ++i) {
+            const auto& l = lights[static_cast<std::size_t>(i)];
+            packed.insert(packed.end(),
+                          {static_cast<float>(l.positionM.x), static_cast<float>(l.positionM.y),
+                           static_cast<float>(l.positionM.z), static_cast<float>(l.intensityCd)});
+        }
+        glUniform1i(glGetUniformLocation(xyzProgram_, "uLightCount"), count);
+        if (count > 0) {
+            glUniform4fv(glGetUniformLocation(xyzProgram_, "uLights"), count, packed.data());
+        }
+        std::array<float, colour::kChannels * 3> mf{};
+        for (std::size_t k = 0; k < colour::kChannels; ++k) {
+            for (int c = 0; c < 3; ++c) {
+                mf[k * 3 + static_cast<std::size_t>(c)] = static_cast<float>(m[k][c]);
+            }
+        }
+        glUniform3fv(glGetUniformLocation(xyzProgram_, "uChannelXyz"),
+                     static_cast<GLsizei>(colour::kChannels), mf.data());
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, coeffA_);
+        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffA"), 0);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, coeffB_);
+        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffB"), 1);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+
+        // Pass 2: display drive values.
+        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[1]);
+        glUseProgram(displayProgram_);
+        const glm::mat3 inv = glm::mat3(glm::inverse(setup_.display.rgbToXyz));
+        glUniformMatrix3fv(glGetUniformLocation(displayProgram_, "uXyzToRgb"), 1, GL_FALSE,
+                           &inv[0][0]);
+        setVec3(displayProgram_, "uBlack", setup_.display.blackXyz);
+        glUniform1f(glGetUniformLocation(displayProgram_, "uInvGamma"),
+                    static_cast<float>(1.0 / setup_.display.gamma));
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, xyzTarget_);
+        glUniform1i(glGetUniformLocation(displayProgram_, "uXyz"), 0);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+
+        // Read back what the caller uses.
+        out.width = w;
+        out.height = h;
+        const auto pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        if (readback == Readback::DisplayAndXyz) {
+            out.xyz.resize(pixels * 4);
+            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
+            glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, out.xyz.data());
+        } else {
+            out.xyz.clear();
+        }
+        if (readback != Readback::None) {
+            out.rgba.resize(pixels * 4);
+            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[1]);
+            glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, out.rgba.data());
+        } else {
+            out.rgba.clear();
+            glFinish(); // keep the frame in step with its tick even when nothing is read
+        }
+        if (GLenum err = glGetError(); err != GL_NO_ERROR) {
+            return makeError(
+                    ErrorCode::DeviceFailure,
+                    fmt::format("render: GL error 0x{:04x} in frame {}", err, state.frameIndex));
+        }
+        return {};
+    }
+
+private:
+    static void setVec3(GLuint program, const char* name, const glm::dvec3& v)
+    {
+        const glm::vec3 f = toFloat(v);
+        glUniform3f(glGetUniformLocation(program, name), f.x, f.y, f.z);
+    }
+
+    GlesRendererSetup setup_;
+    GLuint xyzProgram_ = 0;
+    GLuint displayProgram_ = 0;
+    GLuint vao_ = 0;
+    GLuint coeffA_ = 0;
+    GLuint coeffB_ = 0;
+    GLuint xyzTarget_ = 0;
+    GLuint rgbaTarget_ = 0;
+    std::vector<GLuint> textures_;
+    std::array<GLuint, 2> fbos_{};
+};
+
+} // namespace
+
+Expected<std::unique_ptr<Renderer>> createGlesRenderer(GlesRendererSetup setup)
+{
+    auto r = std::make_unique<GlesRenderer>(std::move(setup));
+    if (auto ok = r->init(); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return std::unique_ptr<Renderer>(std::move(r));
+}
+
+} // namespace replica::pipeline::render

@@ -1,0 +1,32 @@
+// The GLES 3.1 renderer: a fragment pass computing absolute XYZ per screen pixel, then a display
+// pass turning it into drive values. Needs a current GLES 3.1 context on the calling thread.
+#pragma once
+
+#include <memory>
+
+#include <pipeline/colour/channel_basis.h>
+#include <pipeline/colour/xyz.h>
+#include <pipeline/render/renderer.h>
+#include <pipeline/render/simple_display.h>
+#include <pipeline/render/surface_image.h>
+#include <pipeline/scene/booth.h>
+#include <pipeline/scene/stand.h>
+
+namespace replica::pipeline::render {
+
+struct GlesRendererSetup {
+    int width = 960;
+    int height = 600;
+    scene::Booth booth;
+    scene::StandModel stand;
+    SurfaceImage surface;
+    colour::ChannelBasis basis;
+    colour::Observer observer;
+    SimpleDisplay display;
+    int lightsU = 8; // point lights across the emitter (uniform grid until median cut lands)
+    int lightsV = 4;
+};
+
+Expected<std::unique_ptr<Renderer>> createGlesRenderer(GlesRendererSetup setup);
+
+} // namespace replica::pipeline::render

@@ -1,0 +1,37 @@
+// The renderer interface: scene state in, an absolute-XYZ frame and its display drive values out.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/scene/scene_state.h>
+
+namespace replica::pipeline::render {
+
+// One rendered frame, rows bottom-up (GL order).
+struct RenderedFrame {
+    int width = 0;
+    int height = 0;
+    std::vector<float> xyz;         // 4 floats per pixel: X, Y, Z in cd/m^2, then 1
+    std::vector<std::uint8_t> rgba; // 8-bit display counts, 4 per pixel
+};
+
+// What render() copies back from the GPU: reading back costs time, so the loop asks only for what
+// it uses (digests need both images; a snapshot needs the display values).
+enum class Readback { None, Display, DisplayAndXyz };
+
+class Renderer
+{
+public:
+    virtual ~Renderer() = default;
+    virtual std::string description() const = 0;
+    // Renders the frame for this state and reads back what 'readback' asks for into out (resized as
+    // needed; the other image is left empty). Returns once the GPU has finished the frame.
+    virtual Expected<void> render(const scene::SceneState& state,
+                                  RenderedFrame& out,
+                                  Readback readback = Readback::DisplayAndXyz) = 0;
+};
+
+} // namespace replica::pipeline::render

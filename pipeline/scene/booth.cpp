@@ -1,0 +1,52 @@
+// The shipped booth and its simplest point-light decomposition.
+#include <filesystem>
+
+#include <glm/geometric.hpp>
+
+#include <pipeline/colour/spectral_table.h>
+#include <pipeline/scene/booth.h>
+
+namespace replica::pipeline::scene {
+
+Expected<Booth> loadDefaultBooth(const std::string& dataDir)
+{
+    Booth booth;
+    booth.id = "replica-booth-1";
+    booth.lamps = {
+            {"tungsten", "cie_illuminants_A_D50_D65_5nm_300_780.csv", "A", 2200.0, {}},
+            {"d50-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F8", 2600.0, {}},
+            {"d65-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F7", 2600.0, {}},
+    };
+    for (auto& lamp : booth.lamps) {
+        auto table = colour::loadSpectralCsv(std::filesystem::path(dataDir) / "spectra" /
+                                             lamp.spectrumFile);
+        if (!table) {
+            return tl::unexpected(table.error());
+        }
+        auto s = table->spectrum(lamp.spectrumColumn);
+        if (!s) {
+            return tl::unexpected(s.error());
+        }
+        lamp.spectrum = *s;
+    }
+    return booth;
+}
+
+std::vector<PointLight> uniformGridLights(const Emitter& e, double luminanceCdM2, int nu, int nv)
+{
+    std::vector<PointLight> lights;
+    if (nu <= 0 || nv <= 0) {
+        return lights;
+    }
+    const double cellArea = glm::length(e.edgeUM) * glm::length(e.edgeVM) / (nu * nv);
+    for (int j = 0; j < nv; ++j) {
+        for (int i = 0; i < nu; ++i) {
+            const double u = (i + 0.5) / nu - 0.5;
+            const double v = (j + 0.5) / nv - 0.5;
+            lights.push_back({e.centreM + u * e.edgeUM + v * e.edgeVM, luminanceCdM2 * cellArea});
+        }
+    }
+    return lights;
+}
+
+} // namespace replica::pipeline::scene

@@ -1,0 +1,51 @@
+// The light booth: a planar ceiling emitter and the lamps it can show, in the booth frame (metres).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/colour/spectrum.h>
+
+namespace replica::pipeline::scene {
+
+// Booth frame: right-handed, metres; origin on the booth floor at its centre, x to the right, y up,
+// z out of the booth towards the viewer.
+struct Emitter {
+    glm::dvec3 centreM{0.0, 0.90, -0.10};
+    glm::dvec3 edgeUM{1.00, 0.0, 0.0}; // full edge vectors: the emitter spans centre +- edge/2
+    glm::dvec3 edgeVM{0.0, 0.0, 0.60};
+    glm::dvec3 normal{0.0, -1.0, 0.0}; // emits downwards into the booth
+};
+
+struct Lamp {
+    std::string name;         // "tungsten", "d50-fluorescent", "d65-fluorescent"
+    std::string spectrumFile; // under data/spectra/
+    std::string spectrumColumn;
+    double luminanceCdM2 = 0.0;  // mean luminance of the emitter with this lamp on
+    colour::Spectrum spectrum{}; // relative SPD on the working grid (filled by loadBooth)
+};
+
+struct Booth {
+    std::string id;
+    Emitter emitter;
+    std::vector<Lamp> lamps;
+};
+
+// The booth the appliance ships with: tungsten (CIE A), D50 fluorescent simulator (CIE F8) and D65
+// fluorescent simulator (CIE F7) behind one diffuser. Spectra are read from dataDir/spectra.
+Expected<Booth> loadDefaultBooth(const std::string& dataDir);
+
+// A point light standing for part of the emitter (paper eq. 1): its position, and L * a (cd), the
+// summed luminance of its region times the area of one texel.
+struct PointLight {
+    glm::dvec3 positionM{0.0};
+    double intensityCd = 0.0;
+};
+
+// Splits a uniform emitter into nu x nv equal cells, one point light at each cell centre.
+std::vector<PointLight> uniformGridLights(const Emitter& e, double luminanceCdM2, int nu, int nv);
+
+} // namespace replica::pipeline::scene

@@ -1,0 +1,100 @@
+// Raw spectrometer counts to a working-grid relative SPD.
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include <pipeline/colour/spectral_table.h>
+#include <pipeline/spectral/spectrometer_chain.h>
+
+namespace replica::pipeline::spectral {
+namespace {
+
+double interpolate(const std::vector<double>& x, const std::vector<double>& y, double at)
+{
+    if (x.size() < 2 || at < x.front() || at > x.back()) {
+        return 0.0;
+    }
+    const auto it = std::upper_bound(x.begin(), x.end(), at);
+    if (it == x.end()) {
+        return y.back();
+    }
+    const auto i = static_cast<std::size_t>(it - x.begin());
+    const double t = (at - x[i - 1]) / (x[i] - x[i - 1]);
+    return y[i - 1] + t * (y[i] - y[i - 1]);
+}
+
+} // namespace
+
+Expected<SpectrometerCalibration> loadSpectrometerCalibration(const std::filesystem::path& path)
+{
+    auto table = colour::loadSpectralCsv(path);
+    if (!table) {
+        return tl::unexpected(table.error());
+    }
+    if (table->columns.size() != 1 || table->columns[0] != "responsivity") {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("{}: expected columns wavelength_nm,responsivity", path.string()));
+    }
+    SpectrometerCalibration cal;
+    cal.wavelengthNm = table->wavelengthNm;
+    for (const auto& row : table->rows) {
+        if (!(row[0] > 0.0)) {
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}: responsivity must be positive everywhere", path.string()));
+        }
+        cal.responsivity.push_back(row[0]);
+    }
+    return cal;
+}
+
+Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
+                                            const SpectrometerCalibration& cal)
+{
+    const auto n = static_cast<int>(raw.counts.size());
+    if (n <= cal.darkPixelLast + 2 || cal.darkPixelFirst < 0 ||
+        cal.darkPixelLast < cal.darkPixelFirst) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("spectrum has {} pixels; too few for dark pixels {}..{}", n,
+                                     cal.darkPixelFirst, cal.darkPixelLast));
+    }
+    if (raw.integrationTimeUs == 0) {
+        return makeError(ErrorCode::InvalidArgument, "spectrum has an integration time of 0 us");
+    }
+    double dark = 0.0;
+    for (int p = cal.darkPixelFirst; p <= cal.darkPixelLast; ++p) {
+        dark += raw.counts[static_cast<std::size_t>(p)];
+    }
+    dark /= static_cast<double>(cal.darkPixelLast - cal.darkPixelFirst + 1);
+
+    const double seconds = static_cast<double>(raw.integrationTimeUs) * 1e-6;
+    colour::SampledSpectrum s;
+    s.wavelengthNm.reserve(static_cast<std::size_t>(n));
+    s.value.reserve(static_cast<std::size_t>(n));
+    const auto& c = raw.wavelengthCoeffs;
+    for (int p = cal.darkPixelLast + 1; p < n; ++p) {
+        const double x = p;
+        const double wl = c[0] + x * (c[1] + x * (c[2] + x * c[3]));
+        if (!s.wavelengthNm.empty() && !(wl > s.wavelengthNm.back())) {
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("wavelength calibration is not increasing at pixel {}", p));
+        }
+        const double signal = raw.counts[static_cast<std::size_t>(p)] - dark;
+        double poly = 0.0;
+        for (std::size_t i = raw.nonlinearityCoeffs.size(); i-- > 0;) {
+            poly = poly * signal + raw.nonlinearityCoeffs[i];
+        }
+        // A non-linearity polynomial that is not positive here is unusable; fall back to no
+        // correction.
+        const double corrected = poly > 1e-6 ? signal / poly : signal;
+        const double r = interpolate(cal.wavelengthNm, cal.responsivity, wl);
+        s.wavelengthNm.push_back(wl);
+        s.value.push_back(r > 1e-9 ? corrected / (seconds * r) : 0.0);
+    }
+    return colour::resampleToWorkingGrid(s, "spectrometer");
+}
+
+} // namespace replica::pipeline::spectral

@@ -1,0 +1,185 @@
+// Assembling the appliance.
+#include <cmath>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <hal/replay/replay_source.h>
+#include <hal/sim/sim_devices.h>
+#include <pipeline/base/data_dir.h>
+#include <pipeline/colour/spectral_table.h>
+#include <pipeline/render/gles_renderer.h>
+#include <platform/appliance.h>
+
+namespace replica::platform {
+
+std::int64_t RunConfig::periodNs() const
+{
+    return static_cast<std::int64_t>(std::llround(1e9 / rateHz));
+}
+
+std::string RunConfig::toJson() const
+{
+    nlohmann::json j{{"width", width},
+                     {"height", height},
+                     {"rate_hz", rateHz},
+                     {"booth", booth},
+                     {"scene", scene},
+                     {"basis", basis},
+                     {"lights_u", lightsU},
+                     {"lights_v", lightsV},
+                     {"spectrometer_calibration", spectrometerCalibration},
+                     {"display", display},
+                     {"display_peak_cd_m2", displayPeakCdM2},
+                     {"display_black_cd_m2", displayBlackCdM2}};
+    return j.dump();
+}
+
+Expected<RunConfig> RunConfig::fromJson(const std::string& json)
+{
+    RunConfig c;
+    try {
+        const auto j = nlohmann::json::parse(json);
+        c.width = j.at("width").get<int>();
+        c.height = j.at("height").get<int>();
+        c.rateHz = j.at("rate_hz").get<double>();
+        c.booth = j.at("booth").get<std::string>();
+        c.scene = j.at("scene").get<std::string>();
+        c.basis = j.at("basis").get<std::string>();
+        c.lightsU = j.at("lights_u").get<int>();
+        c.lightsV = j.at("lights_v").get<int>();
+        c.spectrometerCalibration = j.at("spectrometer_calibration").get<std::string>();
+        c.display = j.at("display").get<std::string>();
+        c.displayPeakCdM2 = j.at("display_peak_cd_m2").get<double>();
+        c.displayBlackCdM2 = j.at("display_black_cd_m2").get<double>();
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
+    }
+    if (c.width <= 0 || c.height <= 0 || c.width > 16384 || c.height > 16384 || !(c.rateHz > 0.0) ||
+        c.rateHz > 1000.0 || c.lightsU <= 0 || c.lightsV <= 0 || c.lightsU * c.lightsV > 256) {
+        return makeError(ErrorCode::InvalidArgument, "run configuration: size, rate or light count "
+                                                     "out of range");
+    }
+    return c;
+}
+
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config)
+{
+    const std::string dir = dataDir().string();
+    auto app = std::make_unique<Appliance>();
+    app->config = config;
+    if (config.booth != "replica-booth-1" || config.scene != "colorchecker" ||
+        config.basis != "box6") {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("unknown booth '{}', scene '{}' or basis '{}' (this build has "
+                                     "replica-booth-1, colorchecker, box6)",
+                                     config.booth, config.scene, config.basis));
+    }
+    auto booth = pipeline::scene::loadDefaultBooth(dir);
+    if (!booth) {
+        return tl::unexpected(booth.error());
+    }
+    app->booth = *booth;
+    auto observer = pipeline::colour::loadCie1931(dir);
+    if (!observer) {
+        return tl::unexpected(observer.error());
+    }
+    auto calibration = pipeline::spectral::loadSpectrometerCalibration(
+            std::filesystem::path(dir) / config.spectrometerCalibration);
+    if (!calibration) {
+        return tl::unexpected(calibration.error());
+    }
+    const auto basis = pipeline::colour::boxBasis();
+    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches.
+    auto surface = pipeline::render::makeColorCheckerSurface(dir, basis, 600, 400);
+    if (!surface) {
+        return tl::unexpected(surface.error());
+    }
+
+    auto output = createHeadlessOutput();
+    if (!output) {
+        return tl::unexpected(output.error());
+    }
+    app->output = std::move(*output);
+
+    pipeline::render::GlesRendererSetup setup;
+    setup.width = config.width;
+    setup.height = config.height;
+    setup.booth = app->booth;
+    setup.surface = std::move(*surface);
+    setup.basis = basis;
+    setup.observer = *observer;
+    setup.display =
+            pipeline::render::srgbLikeDisplay(config.displayPeakCdM2, config.displayBlackCdM2);
+    setup.lightsU = config.lightsU;
+    setup.lightsV = config.lightsV;
+    auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
+    if (!renderer) {
+        return tl::unexpected(renderer.error());
+    }
+    app->renderer = std::move(*renderer);
+
+    SceneUpdaterSetup updaterSetup;
+    updaterSetup.booth = app->booth;
+    updaterSetup.calibration = *calibration;
+    app->updater = std::make_unique<SceneUpdater>(std::move(updaterSetup));
+    return app;
+}
+
+Expected<Sources> makeSimSources(const Appliance& appliance)
+{
+    const std::filesystem::path dir = dataDir();
+    hal::sim::ScenarioParams scenario;
+    scenario.lampCount = static_cast<int>(appliance.booth.lamps.size());
+
+    hal::sim::SimSpectrometerParams spec;
+    for (const auto& lamp : appliance.booth.lamps) {
+        // The simulator sees each lamp at its table's own resolution, not the working grid.
+        auto table = pipeline::colour::loadSpectralCsv(dir / "spectra" / lamp.spectrumFile);
+        if (!table) {
+            return tl::unexpected(table.error());
+        }
+        hal::sim::SimLamp sim{lamp.name, table->wavelengthNm, {}};
+        std::size_t column = table->columns.size();
+        for (std::size_t c = 0; c < table->columns.size(); ++c) {
+            if (table->columns[c] == lamp.spectrumColumn) {
+                column = c;
+            }
+        }
+        if (column == table->columns.size()) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: no column '{}'", table->source, lamp.spectrumColumn));
+        }
+        for (const auto& row : table->rows) {
+            sim.power.push_back(row[column]);
+        }
+        spec.lamps.push_back(std::move(sim));
+    }
+    auto cal = pipeline::spectral::loadSpectrometerCalibration(
+            dir / appliance.config.spectrometerCalibration);
+    if (!cal) {
+        return tl::unexpected(cal.error());
+    }
+    spec.responsivityNm = cal->wavelengthNm;
+    spec.responsivity = cal->responsivity;
+
+    Sources s;
+    s.spectrometer = hal::sim::makeSimSpectrometer(scenario, std::move(spec));
+    s.tracker = hal::sim::makeSimTracker(scenario, {});
+    s.accel = hal::sim::makeSimAccel(scenario, {});
+    return s;
+}
+
+Sources makeReplaySources(const recordings::Recording& recording)
+{
+    Sources s;
+    s.spectrometer = std::make_unique<hal::ReplaySource<hal::SpectrumSample>>(
+            recording.session.spectrometer, recording.spectra);
+    s.tracker = std::make_unique<hal::ReplaySource<hal::PoseSample>>(recording.session.tracker,
+                                                                     recording.poses);
+    s.accel = std::make_unique<hal::ReplaySource<hal::AccelSample>>(recording.session.accel,
+                                                                    recording.accel);
+    return s;
+}
+
+} // namespace replica::platform

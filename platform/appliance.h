@@ -1,0 +1,67 @@
+// Builds the appliance's parts from a run configuration: output (GL context), renderer, scene
+// updater, and the HAL sources (simulated or replayed).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <hal/sources.h>
+#include <pipeline/base/expected.h>
+#include <pipeline/render/renderer.h>
+#include <platform/loop/scene_updater.h>
+#include <platform/output/output.h>
+#include <recordings/recording.h>
+
+namespace replica::platform {
+
+// Everything that decides what a frame looks like, apart from the samples. Recorded in the session
+// so that replay rebuilds the identical renderer.
+struct RunConfig {
+    int width = 960;
+    int height = 600;
+    double rateHz = 60.0;
+    std::string booth = "replica-booth-1";
+    std::string scene = "colorchecker";
+    std::string basis = "box6";
+    int lightsU = 8;
+    int lightsV = 4;
+    std::string spectrometerCalibration = "spectrometer/sim_usb2000_responsivity.csv";
+    std::string display = "srgb-like-800";
+    double displayPeakCdM2 = 800.0;
+    double displayBlackCdM2 = 0.4;
+
+    std::int64_t periodNs() const;
+    std::string toJson() const;
+    static Expected<RunConfig> fromJson(const std::string& json);
+};
+
+struct Sources {
+    std::unique_ptr<hal::SpectrometerSource> spectrometer;
+    std::unique_ptr<hal::TrackerSource> tracker;
+    std::unique_ptr<hal::AccelSource> accel;
+};
+
+struct Appliance {
+    RunConfig config;
+    pipeline::scene::Booth booth;
+    std::unique_ptr<Output>
+            output; // owns the GL context: created before, destroyed after the renderer
+    std::unique_ptr<pipeline::render::Renderer> renderer;
+    std::unique_ptr<SceneUpdater> updater;
+    ~Appliance()
+    {
+        renderer.reset(); // GL objects go while the context still exists
+        output.reset();
+    }
+};
+
+// Creates the headless output and everything that renders. Fails with a one-line reason.
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config);
+
+// The built-in simulated sensors playing the scripted scenario.
+Expected<Sources> makeSimSources(const Appliance& appliance);
+
+// Sources that return exactly what the recording holds.
+Sources makeReplaySources(const recordings::Recording& recording);
+
+} // namespace replica::platform

@@ -1,0 +1,35 @@
+// What the run and replay commands keep from each frame: digests and the last frame for a snapshot.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <pipeline/render/renderer.h>
+#include <platform/loop/frame_digest.h>
+#include <platform/loop/frame_loop.h>
+
+namespace replica::platform {
+
+class FrameOutputs
+{
+public:
+    // digests: hash every frame; keepLastFrame: keep the last frame's display values for a
+    // snapshot.
+    FrameOutputs(bool digests, bool keepLastFrame) : digest_(digests), keepLast_(keepLastFrame) {}
+    // What the loop must read back for this.
+    pipeline::render::Readback readback() const;
+    FrameCallback callback();
+    const std::vector<FrameDigest>& digests() const { return digests_; }
+    // Writes the digest file and the PNG snapshot of the last frame (either path may be empty).
+    Expected<void> finish(const std::string& digestPath, const std::string& snapshotPath) const;
+
+private:
+    bool digest_;
+    bool keepLast_;
+    std::vector<FrameDigest> digests_;
+    int lastWidth_ = 0;
+    int lastHeight_ = 0;
+    std::vector<std::uint8_t> lastRgba_;
+};
+
+} // namespace replica::platform

@@ -1,0 +1,18 @@
+// Writing 8-bit RGBA frames as PNG snapshots.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+
+namespace replica::platform {
+
+// rgba: width * height * 4 bytes, rows bottom-up (GL order); the PNG is written top-down.
+Expected<void> writePng(const std::filesystem::path& path,
+                        int width,
+                        int height,
+                        const std::vector<std::uint8_t>& rgba);
+
+} // namespace replica::platform

@@ -1,0 +1,86 @@
+// FNV-1a frame digests and their JSON file.
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <platform/loop/frame_digest.h>
+
+namespace replica::platform {
+
+std::uint64_t fnv1a64(std::span<const std::uint8_t> bytes)
+{
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    for (std::uint8_t b : bytes) {
+        h ^= b;
+        h *= 0x100000001b3ULL;
+    }
+    return h;
+}
+
+Expected<void> writeDigests(const std::filesystem::path& path, const std::vector<FrameDigest>& d)
+{
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot write digests (is the directory writable?)",
+                                     path.string()));
+    }
+    // One frame per line so that a diff of two digest files points at the frame.
+    out << "{\"format\": \"replica-digests\", \"version\": 1, \"frames\": [\n";
+    for (std::size_t i = 0; i < d.size(); ++i) {
+        out << fmt::format("  {{\"frame\": {}, \"tick_ns\": {}, \"xyz\": \"{:016x}\", \"rgba\": "
+                           "\"{:016x}\"}}{}\n",
+                           d[i].frameIndex, d[i].tickNs, d[i].xyz, d[i].rgba,
+                           i + 1 < d.size() ? "," : "");
+    }
+    out << "]}\n";
+    out.flush();
+    if (!out) {
+        return makeError(ErrorCode::Io, fmt::format("{}: writing digests failed", path.string()));
+    }
+    return {};
+}
+
+Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: cannot open digests", path.string()));
+    }
+    std::vector<FrameDigest> out;
+    try {
+        const auto j = nlohmann::json::parse(in);
+        if (j.value("format", "") != "replica-digests") {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: not a replica digest file", path.string()));
+        }
+        for (const auto& f : j.at("frames")) {
+            FrameDigest d;
+            d.frameIndex = f.at("frame").get<std::uint64_t>();
+            d.tickNs = f.at("tick_ns").get<std::int64_t>();
+            d.xyz = std::stoull(f.at("xyz").get<std::string>(), nullptr, 16);
+            d.rgba = std::stoull(f.at("rgba").get<std::string>(), nullptr, 16);
+            out.push_back(d);
+        }
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: malformed digest file: {}", path.string(), e.what()));
+    }
+    return out;
+}
+
+long firstDifference(const std::vector<FrameDigest>& a, const std::vector<FrameDigest>& b)
+{
+    const std::size_t n = std::min(a.size(), b.size());
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!(a[i] == b[i])) {
+            return static_cast<long>(i);
+        }
+    }
+    return a.size() == b.size() ? -1 : static_cast<long>(n);
+}
+
+} // namespace replica::platform

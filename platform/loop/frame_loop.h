@@ -1,0 +1,59 @@
+// The fixed-rate loop: at each tick, poll every source up to the tick time, take the latest sample
+// (or, in replay, exactly the sample the recorded frame consumed), update the scene, render, hand
+// the frame on, and record what was used.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/render/renderer.h>
+#include <platform/appliance.h>
+#include <recordings/recording.h>
+
+namespace replica::platform {
+
+enum class Pacing {
+    Realtime, // each tick waits for its wall-clock time (the appliance; replay "as recorded")
+    Fast,     // as fast as frames render (CI, replay "as fast as possible")
+    Step,     // waits for a line on standard input before each frame (frame-stepped replay)
+};
+
+// One planned frame. In replay, 'recorded' says which samples the original frame consumed.
+struct TickPlan {
+    std::uint64_t frameIndex = 0;
+    std::int64_t tickNs = 0;
+    std::optional<recordings::FrameRecord> recorded;
+};
+
+// Ticks k * period for k = 0 .. frames-1.
+std::vector<TickPlan> fixedRatePlan(std::int64_t periodNs, std::uint64_t frames);
+// The ticks of a recording, each with the samples it must consume.
+std::vector<TickPlan> replayPlan(const std::vector<recordings::FrameRecord>& frames);
+
+struct LoopStats {
+    std::uint64_t frames = 0;
+    std::uint64_t droppedSpectra = 0; // sequence gaps seen
+    std::uint64_t droppedPoses = 0;
+    std::uint64_t droppedAccel = 0;
+    std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
+    std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
+};
+
+using FrameCallback = std::function<void(const recordings::FrameRecord& frame,
+                                         const pipeline::scene::SceneState& state,
+                                         const pipeline::render::RenderedFrame& image)>;
+
+// Runs the plan. Every polled sample and every frame record go to 'recorder' when it is non-null;
+// 'readback' says which images onFrame needs.
+Expected<LoopStats> runFrames(Appliance& appliance,
+                              Sources& sources,
+                              const std::vector<TickPlan>& plan,
+                              Pacing pacing,
+                              recordings::RecordingWriter* recorder,
+                              pipeline::render::Readback readback,
+                              const FrameCallback& onFrame);
+
+} // namespace replica::platform

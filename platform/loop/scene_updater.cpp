@@ -1,0 +1,82 @@
+// Sample-to-scene conversion.
+#include <cmath>
+
+#include <pipeline/scene/stand.h>
+#include <platform/loop/scene_updater.h>
+
+namespace replica::platform {
+namespace {
+
+std::vector<pipeline::colour::Spectrum> lampSpectra(const pipeline::scene::Booth& booth)
+{
+    std::vector<pipeline::colour::Spectrum> out;
+    for (const auto& lamp : booth.lamps) {
+        out.push_back(lamp.spectrum);
+    }
+    return out;
+}
+
+double meanLuminance(const pipeline::scene::Booth& booth)
+{
+    double sum = 0.0;
+    for (const auto& lamp : booth.lamps) {
+        sum += lamp.luminanceCdM2;
+    }
+    return booth.lamps.empty() ? 0.0 : sum / static_cast<double>(booth.lamps.size());
+}
+
+} // namespace
+
+SceneUpdater::SceneUpdater(SceneUpdaterSetup setup)
+    : setup_(std::move(setup)), classifier_(lampSpectra(setup_.booth))
+{}
+
+void SceneUpdater::update(pipeline::scene::SceneState& state,
+                          const hal::SpectrumSample* spectrum,
+                          const hal::PoseSample* pose,
+                          const hal::AccelSample* accel)
+{
+    if (spectrum != nullptr && spectrum->sequence != lastSpectrum_) {
+        lastSpectrum_ = spectrum->sequence;
+        pipeline::spectral::RawSpectrum raw{spectrum->counts, spectrum->integrationTimeUs,
+                                            spectrum->wavelengthCoeffs,
+                                            spectrum->nonlinearityCoeffs};
+        auto spd = pipeline::spectral::countsToSpectrum(raw, setup_.calibration);
+        // A saturated spectrum has lost its peaks: its shape cannot be trusted, keep the last
+        // light.
+        if (spd && !spectrum->saturated) {
+            const int lamp = classifier_.classify(*spd);
+            state.lampIndex = lamp;
+            if (lamp >= 0) {
+                const auto& l = setup_.booth.lamps[static_cast<std::size_t>(lamp)];
+                state.illuminant = l.spectrum;
+                state.emitterLuminanceCdM2 = l.luminanceCdM2;
+            } else {
+                // Direct-sensor mode: the sensed shape, at the booth's typical luminance.
+                state.illuminant = *spd;
+                state.emitterLuminanceCdM2 = meanLuminance(setup_.booth);
+            }
+        } else {
+            ++rejectedSpectra_;
+        }
+    }
+    if (pose != nullptr && pose->sequence != lastPose_) {
+        lastPose_ = pose->sequence;
+        const glm::dvec3 e = pose->eyeTrackerM;
+        if (pose->tracked && std::isfinite(e.x) && std::isfinite(e.y) && std::isfinite(e.z)) {
+            state.eyeBoothM = e + setup_.trackerInBoothM;
+        } else {
+            ++rejectedPoses_;
+        }
+    }
+    if (accel != nullptr && accel->sequence != lastAccel_) {
+        lastAccel_ = accel->sequence;
+        if (auto tilt = pipeline::scene::tiltFromGravity(accel->gravity)) {
+            state.tiltRad = *tilt;
+        } else {
+            ++rejectedTilts_;
+        }
+    }
+}
+
+} // namespace replica::platform
