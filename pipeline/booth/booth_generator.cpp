@@ -79,11 +79,15 @@ Expected<BoothModel> generateShippedBooth(const std::filesystem::path& dataDir,
         return tl::unexpected(table.error());
     }
     BoothModel booth;
+    // Names and mean luminances as in scene::loadDefaultBooth, so the loop and the booth model
+    // agree.
     struct Spec {
         const char* name;
         const char* column;
+        double meanCdM2;
     };
-    for (const Spec s : {Spec{"tungsten", "A"}, Spec{"d50", "F8"}, Spec{"d65", "F7"}}) {
+    for (const Spec s : {Spec{"tungsten", "A", 2200.0}, Spec{"d50-fluorescent", "F8", 2600.0},
+                         Spec{"d65-fluorescent", "F7", 2600.0}}) {
         auto spd = table->spectrum(s.column);
         if (!spd) {
             return tl::unexpected(spd.error());
@@ -96,10 +100,14 @@ Expected<BoothModel> generateShippedBooth(const std::filesystem::path& dataDir,
         l.spd = *spd;
         if (l.name == "tungsten") {
             l.luminance = tungstenImage(g);
-        } else if (l.name == "d50") {
+        } else if (l.name == "d50-fluorescent") {
             l.luminance = tubeImage(g, {0.2, 0.4, 0.6, 0.8}, 500.0, 2600.0, 0.03);
         } else {
             l.luminance = tubeImage(g, {0.25, 0.5, 0.75}, 650.0, 3200.0, 0.04);
+        }
+        const double mean = l.luminance.sum() / static_cast<double>(l.luminance.cdM2.size());
+        for (double& v : l.luminance.cdM2) {
+            v *= s.meanCdM2 / mean;
         }
         booth.lights.push_back(std::move(l));
     }

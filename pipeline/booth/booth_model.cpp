@@ -43,7 +43,17 @@ const BoothLight* BoothModel::find(const std::string& name) const
             return &l;
         }
     }
-    return nullptr;
+    // Short forms: "d65" finds "d65-fluorescent" when exactly one light starts with "d65-".
+    const BoothLight* match = nullptr;
+    for (const auto& l : lights) {
+        if (l.name.rfind(name + "-", 0) == 0) {
+            if (match != nullptr) {
+                return nullptr;
+            }
+            match = &l;
+        }
+    }
+    return match;
 }
 
 std::string BoothModel::names() const

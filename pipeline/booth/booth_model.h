@@ -13,6 +13,7 @@ namespace replica::pipeline::booth {
 struct BoothModel {
     std::vector<BoothLight> lights;
 
+    // Exact name, or the one light whose name is 'name-...' ("d65" for "d65-fluorescent").
     const BoothLight* find(const std::string& name) const;
     std::string names() const; // "a, b, c" for messages
 };

@@ -9,15 +9,20 @@
 
 namespace replica::pipeline::shading {
 
-PanelPose panelPoseFromTilt(const StandModel& stand, double tiltDeg, double surfaceHeightM)
+PanelPose panelPoseFromTilt(const scene::StandModel& stand, double tiltDeg)
 {
-    const double t = tiltDeg * std::numbers::pi / 180.0;
+    const scene::PanelPose pose = scene::panelPose(stand, tiltDeg * std::numbers::pi / 180.0);
     PanelPose p;
-    p.right = Vec3(1.0, 0.0, 0.0);
-    p.up = Vec3(0.0, std::cos(t), -std::sin(t));
+    p.right = glm::normalize(pose.rightM);
+    p.up = glm::normalize(pose.upM);
     p.normal = glm::cross(p.right, p.up);
-    p.centre = stand.hinge + p.up * (stand.bottomOffsetM + 0.5 * surfaceHeightM);
+    p.centre = pose.originM + 0.5 * pose.rightM + 0.5 * pose.upM;
     return p;
+}
+
+PanelPose panelPoseFromTilt(double tiltDeg)
+{
+    return panelPoseFromTilt(scene::StandModel{}, tiltDeg);
 }
 
 Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, double y)

@@ -5,6 +5,7 @@
 #include <glm/vec3.hpp>
 
 #include <pipeline/brdf/ward.h>
+#include <pipeline/scene/stand.h>
 #include <pipeline/surface/scene.h>
 
 namespace replica::pipeline::shading {
@@ -19,20 +20,14 @@ struct PanelPose {
     Vec3 normal{0.0, 0.0, 1.0};
 };
 
-// Stand hinge: the panel rotates about a horizontal axis (+x) through 'hinge'; at tilt 0 it stands
-// vertical facing +z, positive tilt leans its top back (away from the viewer, towards the ceiling
-// light's side). The panel's bottom edge sits 'bottomOffsetM' above the hinge along the panel.
-// (Stand-in until the scene state's hinge model is merged; same conventions.)
-struct StandModel {
-    Vec3 hinge{0.0, 0.08, 0.10};
-    double bottomOffsetM = 0.02;
-};
-
-PanelPose panelPoseFromTilt(const StandModel& stand, double tiltDeg, double surfaceHeightM);
+// The panel's pose from the stand's hinge model (scene::panelPose): the surface is shown at its
+// physical size, centred on the panel's active area.
+PanelPose panelPoseFromTilt(const scene::StandModel& stand, double tiltDeg);
+PanelPose panelPoseFromTilt(double tiltDeg); // the default stand
 
 struct View {
     PanelPose panel;
-    Vec3 eye{0.0, 0.45, 0.75};
+    Vec3 eye{0.0, 0.45, 0.60}; // scene::SceneState's default eye
     int pixelsX = 96;
     int pixelsY = 60;
 };

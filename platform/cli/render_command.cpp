@@ -23,7 +23,7 @@ struct RenderArgs {
     std::string scene;
     std::string booth;
     std::string light;
-    std::string eye = "0,0.45,0.75";
+    std::string eye = "0,0.45,0.60";
     double tilt = 30.0;
     std::string size = "192x120";
     bool reference = false;
@@ -87,7 +87,7 @@ int runRender(const RenderArgs& a)
     if (!obs) {
         return fail(kExitFailure, obs.error().message);
     }
-    view.panel = shading::panelPoseFromTilt(shading::StandModel{}, a.tilt, scene->heightM);
+    view.panel = shading::panelPoseFromTilt(a.tilt);
 
     const auto t0 = std::chrono::steady_clock::now();
     shading::XyzFrame frame;

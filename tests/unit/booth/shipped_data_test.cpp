@@ -20,7 +20,9 @@ TEST(ShippedBooth, LoadsAndMatchesTheGenerator)
     ASSERT_TRUE(shipped) << shipped.error().message;
     auto fresh = booth::generateShippedBooth(dataDir());
     ASSERT_TRUE(fresh);
-    ASSERT_EQ(shipped->names(), "tungsten, d50, d65");
+    ASSERT_EQ(shipped->names(), "tungsten, d50-fluorescent, d65-fluorescent");
+    EXPECT_EQ(shipped->find("d65"), &shipped->lights[2]);
+    EXPECT_EQ(shipped->find("d"), nullptr);
     for (std::size_t k = 0; k < 3; ++k) {
         const auto& a = shipped->lights[k];
         const auto& b = fresh->lights[k];

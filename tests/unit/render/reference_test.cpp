@@ -121,7 +121,7 @@ struct Case {
 Case setup(bool bumpy, bool glossy, double tiltDeg, int px = 24, int py = 16)
 {
     Case s{test::testScene(48, 32, bumpy, glossy), test::stripedLight(64, 32, 0.6), {}};
-    s.view.panel = shading::panelPoseFromTilt(shading::StandModel{}, tiltDeg, s.scene.heightM);
+    s.view.panel = shading::panelPoseFromTilt(tiltDeg);
     s.view.pixelsX = px;
     s.view.pixelsY = py;
     return s;

@@ -42,7 +42,8 @@ TEST(RenderCli, RejectsBadArgumentsWithOneLine)
 {
     CliResult r = run("render --scene " + kScenes + "/metamer --light neon --out /tmp/x.exr");
     EXPECT_EQ(r.code, 2);
-    EXPECT_NE(r.err.find("--light 'neon' is not in the booth; choose one of: tungsten, d50, d65"),
+    EXPECT_NE(r.err.find("--light 'neon' is not in the booth; choose one of: tungsten, "
+                         "d50-fluorescent, d65-fluorescent"),
               std::string::npos)
             << r.err;
     r = run("render --scene " + kScenes + "/metamer --light d65 --eye 1,2 --out /tmp/x.exr");
