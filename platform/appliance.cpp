@@ -68,11 +68,15 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config)
     const std::string dir = dataDir().string();
     auto app = std::make_unique<Appliance>();
     app->config = config;
-    if (config.booth != "replica-booth-1" || config.scene != "colorchecker" ||
-        config.basis != "box6") {
+    // Channel bases: box6 (built in; what the first recordings used) or one fitted by 'replica
+    // spectral fit' under data/channels/ (docs/accuracy.md).
+    const bool knownBasis = config.basis == "box6" || config.basis == "replica_k6" ||
+                            config.basis == "general_k6" || config.basis == "pca6";
+    if (config.booth != "replica-booth-1" || config.scene != "colorchecker" || !knownBasis) {
         return makeError(ErrorCode::NotFound,
                          fmt::format("unknown booth '{}', scene '{}' or basis '{}' (this build has "
-                                     "replica-booth-1, colorchecker, box6)",
+                                     "replica-booth-1, colorchecker, and bases replica_k6, "
+                                     "general_k6, pca6, box6)",
                                      config.booth, config.scene, config.basis));
     }
     auto booth = pipeline::scene::loadDefaultBooth(dir);
@@ -89,7 +93,15 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config)
     if (!calibration) {
         return tl::unexpected(calibration.error());
     }
-    const auto basis = pipeline::colour::boxBasis();
+    pipeline::colour::ChannelBasis basis = pipeline::colour::boxBasis();
+    if (config.basis != "box6") {
+        auto fitted = pipeline::colour::loadChannelBasis(std::filesystem::path(dir) / "channels" /
+                                                         (config.basis + ".csv"));
+        if (!fitted) {
+            return tl::unexpected(fitted.error());
+        }
+        basis = std::move(*fitted);
+    }
     // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches.
     auto surface = pipeline::render::makeColorCheckerSurface(dir, basis, 600, 400);
     if (!surface) {

@@ -22,7 +22,7 @@ struct RunConfig {
     double rateHz = 60.0;
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
-    std::string basis = "box6";
+    std::string basis = "replica_k6"; // docs/accuracy.md; recordings made with box6 replay as such
     int lightsU = 8;
     int lightsV = 4;
     std::string spectrometerCalibration = "spectrometer/sim_usb2000_responsivity.csv";

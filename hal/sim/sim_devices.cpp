@@ -80,7 +80,7 @@ private:
         s.integrationTimeUs = params_.integrationTimeUs;
         s.wavelengthCoeffs = {kSimWavelengthCoeffs[0], kSimWavelengthCoeffs[1],
                               kSimWavelengthCoeffs[2], kSimWavelengthCoeffs[3]};
-        s.nonlinearityCoeffs = {1.0, 0, 0, 0, 0, 0, 0, 0};
+        s.nonlinearityCoeffs = {1.0, params_.nonlinearityK1, 0, 0, 0, 0, 0, 0};
         const int lamp = scenarioAt(scenario_, (startNs + endNs) / 2).lamp;
         const std::vector<double>* signal =
                 lamp >= 0 && static_cast<std::size_t>(lamp) < signals_.size()
@@ -92,7 +92,12 @@ private:
             // Shot noise grows with the square root of the signal; read noise is constant.
             const double shot = 0.8 * std::sqrt(std::max(sig, 0.0)) * noise_.gaussian();
             const double read = params_.readNoiseCounts * noise_.gaussian();
-            const double counts = std::round(params_.darkCounts + sig + shot + read);
+            // The collected charge (signal and its shot noise) passes through the detector's
+            // compressive response; read noise and the electrical dark offset come after it.
+            const double linear = sig + shot;
+            const double denom = 1.0 - params_.nonlinearityK1 * linear;
+            const double measured = denom > 1e-3 ? linear / denom : linear;
+            const double counts = std::round(params_.darkCounts + measured + read);
             const double clamped = std::clamp(counts, 0.0, 65535.0);
             s.saturated = s.saturated || clamped >= 65535.0;
             s.counts[static_cast<std::size_t>(p)] = static_cast<std::uint16_t>(clamped);

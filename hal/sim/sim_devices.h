@@ -28,11 +28,17 @@ struct SimSpectrometerParams {
     double peakCounts = 40'000.0; // counts at the brightest pixel at the set integration time
     double darkCounts = 1'500.0;  // electrical offset
     double readNoiseCounts = 6.0;
+    // Detector non-linearity: the counts above dark, m, compress as m = t / (1 - k t) for a linear
+    // signal t; the EEPROM then carries the correction polynomial 1 + k m, which the chain inverts
+    // exactly (t = m / (1 + k m)). -2e-6 compresses a 40 000-count peak by 7 %, typical of the
+    // ILX511B before correction. 0 = linear.
+    double nonlinearityK1 = -2.0e-6;
     std::uint64_t seed = 1;
 };
 
 // Simulated Ocean Optics USB2000+: 2048 pixels, a realistic wavelength polynomial, dark
-// pixels 6..21 (masked on the detector), shot and read noise, 16-bit saturation.
+// pixels 6..21 (masked on the detector), shot and read noise, detector non-linearity with its
+// EEPROM correction coefficients, 16-bit saturation.
 std::unique_ptr<SpectrometerSource> makeSimSpectrometer(ScenarioParams scenario,
                                                         SimSpectrometerParams params);
 

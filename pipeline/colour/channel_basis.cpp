@@ -1,7 +1,11 @@
 // Channel bases and the per-light channel-to-XYZ matrix.
 #include <algorithm>
+#include <fstream>
+
+#include <fmt/format.h>
 
 #include <pipeline/colour/channel_basis.h>
+#include <pipeline/colour/spectral_table.h>
 
 namespace replica::pipeline::colour {
 
@@ -43,6 +47,68 @@ ChannelToXyz channelToXyz(const ChannelBasis& basis, const Observer& obs, const 
         m[k] = spectrumToXyz(obs, unitLight * basis.reconstruct[k]);
     }
     return m;
+}
+
+Expected<ChannelBasis> loadChannelBasis(const std::filesystem::path& path)
+{
+    auto table = loadSpectralCsv(path);
+    if (!table) {
+        return tl::unexpected(table.error());
+    }
+    auto grid = checkWorkingGrid(*table);
+    if (!grid) {
+        return tl::unexpected(grid.error());
+    }
+    ChannelBasis basis;
+    basis.name = path.stem().string();
+    for (std::size_t k = 0; k < kChannels; ++k) {
+        auto p = workingGridColumn(*table, fmt::format("project_{}", k + 1));
+        auto r = workingGridColumn(*table, fmt::format("reconstruct_{}", k + 1));
+        if (!p || !r) {
+            return tl::unexpected(!p ? p.error() : r.error());
+        }
+        basis.project[k] = *p;
+        basis.reconstruct[k] = *r;
+    }
+    return basis;
+}
+
+Expected<void> saveChannelBasis(const ChannelBasis& basis,
+                                const std::filesystem::path& path,
+                                const std::string& provenance)
+{
+    std::string text = fmt::format("# Replica channel basis '{}': {}\n", basis.name, provenance);
+    text += "wavelength_nm";
+    for (std::size_t k = 0; k < kChannels; ++k) {
+        text += fmt::format(",project_{}", k + 1);
+    }
+    for (std::size_t k = 0; k < kChannels; ++k) {
+        text += fmt::format(",reconstruct_{}", k + 1);
+    }
+    text += "\n";
+    for (std::size_t l = 0; l < kBands; ++l) {
+        text += fmt::format("{}", bandCentreNm(l));
+        for (std::size_t k = 0; k < kChannels; ++k) {
+            text += fmt::format(",{:.17g}", basis.project[k][l]);
+        }
+        for (std::size_t k = 0; k < kChannels; ++k) {
+            text += fmt::format(",{:.17g}", basis.reconstruct[k][l]);
+        }
+        text += "\n";
+    }
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot write the channel basis (is the folder writable?)",
+                                     path.string()));
+    }
+    return {};
+}
+
+Expected<ChannelBasis> loadDefaultChannelBasis(const std::filesystem::path& dataDir)
+{
+    return loadChannelBasis(dataDir / "channels" / kDefaultChannelBasisFile);
 }
 
 } // namespace replica::pipeline::colour

@@ -4,8 +4,10 @@
 
 #include <array>
 #include <cstddef>
+#include <filesystem>
 #include <string>
 
+#include <pipeline/base/expected.h>
 #include <pipeline/colour/spectrum.h>
 #include <pipeline/colour/xyz.h>
 
@@ -34,5 +36,19 @@ ChannelCoeffs projectReflectance(const ChannelBasis& basis, const Spectrum& refl
 // exact whenever the reflectance lies in the span of the basis. Returns zeros for a light with Y <=
 // 0.
 ChannelToXyz channelToXyz(const ChannelBasis& basis, const Observer& obs, const Spectrum& light);
+
+// A basis file: '#' comments, header 'wavelength_nm,project_1,...,project_6,reconstruct_1,...,
+// reconstruct_6', then exactly the 36 rows of the working grid. The basis takes the file's stem as
+// its name. Errors name the file, the line and the problem.
+Expected<ChannelBasis> loadChannelBasis(const std::filesystem::path& path);
+// Writes a basis in that format, with 'provenance' as the comment line.
+Expected<void> saveChannelBasis(const ChannelBasis& basis,
+                                const std::filesystem::path& path,
+                                const std::string& provenance);
+
+// The basis the appliance renders with: data/channels/replica_k6.csv, written by 'replica spectral
+// fit' (see docs/accuracy.md for how it was derived and how accurate it is).
+constexpr const char* kDefaultChannelBasisFile = "replica_k6.csv";
+Expected<ChannelBasis> loadDefaultChannelBasis(const std::filesystem::path& dataDir);
 
 } // namespace replica::pipeline::colour

@@ -80,6 +80,7 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
                 }
             }
             table.columns.assign(cells.begin() + 1, cells.end());
+            table.headerLine = lineNo;
             haveHeader = true;
             continue;
         }
@@ -112,6 +113,7 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
         }
         table.wavelengthNm.push_back(wl);
         table.rows.push_back(std::move(row));
+        table.rowLines.push_back(lineNo);
     }
     if (!haveHeader) {
         return makeError(ErrorCode::InvalidArgument,
@@ -144,6 +146,19 @@ Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
         if (columns[c] != column) {
             continue;
         }
+        // Name the offending line when the data stop short of the working grid.
+        if (!wavelengthNm.empty() && wavelengthNm.front() > kFirstNm) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}:{}: data start at {} nm but must cover {}-{} nm",
+                                         source, rowLines.empty() ? 0 : rowLines.front(),
+                                         wavelengthNm.front(), kFirstNm, kLastNm));
+        }
+        if (!wavelengthNm.empty() && wavelengthNm.back() < kLastNm) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}:{}: data end at {} nm but must cover {}-{} nm", source,
+                                         rowLines.empty() ? 0 : rowLines.back(),
+                                         wavelengthNm.back(), kFirstNm, kLastNm));
+        }
         SampledSpectrum s;
         s.wavelengthNm = wavelengthNm;
         s.value.reserve(rows.size());
@@ -152,7 +167,8 @@ Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
         }
         return resampleToWorkingGrid(s, fmt::format("{}: column '{}'", source, column));
     }
-    return makeError(ErrorCode::NotFound, fmt::format("{}: no column named '{}'", source, column));
+    return makeError(ErrorCode::NotFound, fmt::format("{}:{}: no column named '{}' in the header",
+                                                      source, headerLine, column));
 }
 
 Expected<std::vector<Spectrum>> SpectralTable::allSpectra() const
@@ -166,6 +182,43 @@ Expected<std::vector<Spectrum>> SpectralTable::allSpectra() const
         out.push_back(*s);
     }
     return out;
+}
+
+Expected<void> checkWorkingGrid(const SpectralTable& table)
+{
+    if (table.wavelengthNm.size() != kBands) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("{}: has {} wavelength rows, expected the {} of the working grid "
+                            "({}-{} nm every {} nm)",
+                            table.source, table.wavelengthNm.size(), kBands, kFirstNm, kLastNm,
+                            kStepNm));
+    }
+    for (std::size_t i = 0; i < kBands; ++i) {
+        if (table.wavelengthNm[i] != bandCentreNm(i)) {
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}: wavelength row {} is {} nm, expected {} nm (the working grid)",
+                                table.source, i + 1, table.wavelengthNm[i], bandCentreNm(i)));
+        }
+    }
+    return {};
+}
+
+Expected<Spectrum> workingGridColumn(const SpectralTable& table, const std::string& column)
+{
+    for (std::size_t c = 0; c < table.columns.size(); ++c) {
+        if (table.columns[c] != column) {
+            continue;
+        }
+        Spectrum s;
+        for (std::size_t i = 0; i < kBands && i < table.rows.size(); ++i) {
+            s[i] = table.rows[i][c];
+        }
+        return s;
+    }
+    return makeError(ErrorCode::InvalidArgument,
+                     fmt::format("{}: no column named '{}'", table.source, column));
 }
 
 } // namespace replica::pipeline::colour

@@ -53,6 +53,13 @@ Expected<SpectrometerCalibration> loadSpectrometerCalibration(const std::filesys
 Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
                                             const SpectrometerCalibration& cal)
 {
+    return countsToSpectrum(raw, cal, ChainOptions{});
+}
+
+Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
+                                            const SpectrometerCalibration& cal,
+                                            const ChainOptions& options)
+{
     const auto n = static_cast<int>(raw.counts.size());
     if (n <= cal.darkPixelLast + 2 || cal.darkPixelFirst < 0 ||
         cal.darkPixelLast < cal.darkPixelFirst) {
@@ -90,11 +97,74 @@ Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
         // A non-linearity polynomial that is not positive here is unusable; fall back to no
         // correction.
         const double corrected = poly > 1e-6 ? signal / poly : signal;
-        const double r = interpolate(cal.wavelengthNm, cal.responsivity, wl);
         s.wavelengthNm.push_back(wl);
-        s.value.push_back(r > 1e-9 ? corrected / (seconds * r) : 0.0);
+        s.value.push_back(corrected);
+    }
+    if (options.boxcarHalfWidth < 0) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("boxcar half-width {} is negative", options.boxcarHalfWidth));
+    }
+    if (options.boxcarHalfWidth > 0) {
+        // Running mean over the pixels present (the window shrinks at the ends rather than
+        // inventing data).
+        const std::vector<double> linear = s.value;
+        const auto count = static_cast<std::ptrdiff_t>(linear.size());
+        const auto w = static_cast<std::ptrdiff_t>(options.boxcarHalfWidth);
+        for (std::ptrdiff_t i = 0; i < count; ++i) {
+            const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(0, i - w);
+            const std::ptrdiff_t hi = std::min<std::ptrdiff_t>(count - 1, i + w);
+            double sum = 0.0;
+            for (std::ptrdiff_t j = lo; j <= hi; ++j) {
+                sum += linear[static_cast<std::size_t>(j)];
+            }
+            s.value[static_cast<std::size_t>(i)] = sum / static_cast<double>(hi - lo + 1);
+        }
+    }
+    for (std::size_t i = 0; i < s.value.size(); ++i) {
+        const double r = interpolate(cal.wavelengthNm, cal.responsivity, s.wavelengthNm[i]);
+        s.value[i] = r > 1e-9 ? s.value[i] / (seconds * r) : 0.0;
     }
     return colour::resampleToWorkingGrid(s, "spectrometer");
+}
+
+AutoIntegrationDecision nextIntegrationTime(std::span<const std::uint16_t> counts,
+                                            double darkCounts,
+                                            std::uint32_t currentUs,
+                                            const AutoIntegrationParams& params)
+{
+    AutoIntegrationDecision d;
+    d.integrationTimeUs = currentUs;
+    double peak = 0.0;
+    for (std::uint16_t c : counts) {
+        peak = std::max(peak, static_cast<double>(c));
+    }
+    const double step = std::max<double>(params.stepUs, 1.0);
+    auto quantise = [&](double us) {
+        const double q = std::round(us / step) * step;
+        return static_cast<std::uint32_t>(std::clamp(q, static_cast<double>(params.minUs),
+                                                     static_cast<double>(params.maxUs)));
+    };
+    d.saturated = peak >= params.saturationCounts;
+    double next = currentUs;
+    if (d.saturated) {
+        next = currentUs / 4.0;
+    } else {
+        const double signal = peak - darkCounts;
+        const double target = params.targetFraction * params.saturationCounts - darkCounts;
+        if (!(signal > 0.0)) {
+            // Nothing above the dark level (lamp off, shutter closed): lengthen, but gently.
+            next = currentUs * 2.0;
+        } else if (std::abs(signal - target) > params.toleranceFraction * target) {
+            // Counts above dark grow in proportion to the integration time.
+            next = currentUs * target / signal;
+            // Do not lengthen by more than 8x at once: a flicker or a passing shadow can fake a dim
+            // scene, and a long integration would blind the next reading.
+            next = std::min(next, currentUs * 8.0);
+        }
+    }
+    d.integrationTimeUs = quantise(next);
+    d.changed = d.integrationTimeUs != currentUs;
+    return d;
 }
 
 } // namespace replica::pipeline::spectral

@@ -40,4 +40,41 @@ Expected<SpectrometerCalibration> loadSpectrometerCalibration(const std::filesys
 Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
                                             const SpectrometerCalibration& cal);
 
+struct ChainOptions {
+    // Boxcar smoothing over 2 w + 1 neighbouring pixels (SeaBreeze's "boxcar width" w), applied to
+    // the dark-subtracted, linearised counts before the responsivity; 0 = none. It trades noise for
+    // resolution: w = 5 averages about 4 nm, well inside one 10 nm band.
+    int boxcarHalfWidth = 0;
+};
+
+// The same with options.
+Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
+                                            const SpectrometerCalibration& cal,
+                                            const ChainOptions& options);
+
+// Auto-integration: the integration time for the next spectrum, chosen so that the highest raw
+// pixel (dark included, as the saturation level applies to raw counts) lands near targetFraction of
+// the saturation level. Assumes counts grow in proportion to integration time above the dark level.
+struct AutoIntegrationParams {
+    double saturationCounts = 65535.0; // EEPROM slot 17, or 65535 when not programmed
+    double targetFraction = 0.75;      // aim for the peak here...
+    double toleranceFraction = 0.15;   // ...and leave the time alone within +-15 % of the target
+    std::uint32_t minUs = 1'000;       // hardware-protocols.md: 1 ms .. 65 s in 1 ms steps
+    std::uint32_t maxUs = 65'000'000;
+    std::uint32_t stepUs = 1'000;
+};
+
+struct AutoIntegrationDecision {
+    std::uint32_t integrationTimeUs = 0;
+    bool saturated = false; // the spectrum just read reached the saturation level
+    bool changed = false;
+};
+
+// darkCounts is the electrical dark level (mean of the masked pixels). A saturated spectrum says
+// only that the peak is too high, not by how much: the time is cut to a quarter.
+AutoIntegrationDecision nextIntegrationTime(std::span<const std::uint16_t> counts,
+                                            double darkCounts,
+                                            std::uint32_t currentUs,
+                                            const AutoIntegrationParams& params = {});
+
 } // namespace replica::pipeline::spectral

@@ -29,6 +29,8 @@ int runCli(int argc, char** argv)
     registerRenderCommand(app, exitCode);
     registerBoothCommand(app, exitCode);
     registerSceneCommand(app, exitCode);
+    registerColorCommand(app, exitCode);
+    registerSpectralCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {

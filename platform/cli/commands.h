@@ -16,5 +16,7 @@ void registerInspectCommand(CLI::App& app, int& exitCode);
 void registerRenderCommand(CLI::App& app, int& exitCode);
 void registerBoothCommand(CLI::App& app, int& exitCode);
 void registerSceneCommand(CLI::App& app, int& exitCode);
+void registerColorCommand(CLI::App& app, int& exitCode);
+void registerSpectralCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform

@@ -1,0 +1,45 @@
+// The reference spectra Replica ships (data/spectra/): named reflectance sets and CIE illuminants,
+// loaded onto the working grid.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/colour/spectrum.h>
+
+namespace replica::pipeline::spectral {
+
+using colour::Spectrum;
+
+// Spectra with their column names, in file order.
+struct NamedSpectra {
+    std::string source;
+    std::vector<std::string> names;
+    std::vector<Spectrum> spectra;
+
+    std::size_t size() const { return spectra.size(); }
+    void append(const NamedSpectra& other);
+};
+
+// Every value column of a spectral CSV, resampled to the working grid.
+Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path);
+
+// Reflectance sets by name: "colorchecker" (BabelColor average, 24 patches), "colorchecker-ohta",
+// "ces99" (CIE 224:2017 / TM-30 evaluation samples), "tcs14" (CIE 13.3 test colour samples).
+Expected<NamedSpectra> loadReflectanceSet(const std::filesystem::path& dataDir,
+                                          const std::string& name);
+std::vector<std::string> reflectanceSetNames();
+
+// One CIE illuminant by its name in the shipped tables ("A", "D50", "D65", "F1".."F12",
+// "FL3.1".."FL3.15", "LED-B1".."LED-V2"), from the finest table available.
+Expected<Spectrum> loadCieIlluminant(const std::filesystem::path& dataDir, const std::string& name);
+// All of them, in that order.
+Expected<NamedSpectra> loadAllCieIlluminants(const std::filesystem::path& dataDir);
+
+// The lights of the accuracy table (issue 3): A, D50, D65, F2, F7, F8, F11 and LED-B4 (5000 K
+// phosphor-converted white LED).
+std::vector<std::string> evaluationLightNames();
+
+} // namespace replica::pipeline::spectral

@@ -1,0 +1,26 @@
+// The representations by name, as the CLI and the accuracy table use them, with the shipped channel
+// data from data/channels/.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/spectral/representation.h>
+
+namespace replica::pipeline::spectral {
+
+// "rgb3" (1), "paper6" (2), "replica_k6" (3, the appliance's default), "spectral36" (4), and for
+// comparison "general_k6" (light-aware, all training lights equal), "pca6" (principal components,
+// light-independent) and "box6" (six box bands).
+std::vector<std::string> representationNames();
+constexpr const char* kDefaultRepresentation = "replica_k6";
+
+Expected<std::unique_ptr<Representation>> makeRepresentation(const std::filesystem::path& dataDir,
+                                                             const Observer& obs,
+                                                             const Spectrum& d65,
+                                                             const std::string& name);
+
+} // namespace replica::pipeline::spectral

@@ -1,0 +1,170 @@
+// 'replica color de2000 PAIRS.csv': CIEDE2000 of each CIELAB pair in a CSV file.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/colour/ciede2000.h>
+#include <platform/cli/commands.h>
+
+namespace replica::platform {
+namespace {
+
+using pipeline::colour::Lab;
+
+struct PairRow {
+    int line = 0;
+    std::string text;
+    Lab lab1;
+    Lab lab2;
+};
+
+struct PairFile {
+    std::string header;
+    std::vector<PairRow> rows;
+};
+
+std::vector<std::string> splitCells(const std::string& line)
+{
+    std::vector<std::string> cells;
+    std::stringstream in(line);
+    std::string cell;
+    while (std::getline(in, cell, ',')) {
+        const auto first = cell.find_first_not_of(" \t");
+        const auto last = cell.find_last_not_of(" \t");
+        cells.push_back(first == std::string::npos ? "" : cell.substr(first, last - first + 1));
+    }
+    if (!line.empty() && line.back() == ',') {
+        cells.emplace_back();
+    }
+    return cells;
+}
+
+bool parseNumber(const std::string& cell, double& out)
+{
+    if (cell.empty()) {
+        return false;
+    }
+    const char* first = cell.data() + (cell[0] == '+' ? 1 : 0);
+    auto [ptr, ec] = std::from_chars(first, cell.data() + cell.size(), out);
+    return ec == std::errc() && ptr == cell.data() + cell.size() && std::isfinite(out);
+}
+
+Expected<PairFile> readPairs(const std::string& path)
+{
+    std::ifstream file(path, std::ios::binary);
+    if (!file) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: cannot open (does the file exist?)", path));
+    }
+    static const char* const kColumns[6] = {"L1", "a1", "b1", "L2", "a2", "b2"};
+    PairFile out;
+    std::size_t columnIndex[6] = {};
+    std::size_t width = 0;
+    bool haveHeader = false;
+    std::string line;
+    int lineNo = 0;
+    while (std::getline(file, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') {
+            line.pop_back();
+        }
+        if (line.empty() || line[0] == '#') {
+            continue;
+        }
+        const auto cells = splitCells(line);
+        if (!haveHeader) {
+            for (std::size_t c = 0; c < 6; ++c) {
+                const auto it = std::find(cells.begin(), cells.end(), kColumns[c]);
+                if (it == cells.end()) {
+                    return makeError(
+                            ErrorCode::InvalidArgument,
+                            fmt::format(
+                                    "{}:{}: header has no column '{}' (expected L1,a1,b1,L2,a2,b2)",
+                                    path, lineNo, kColumns[c]));
+                }
+                columnIndex[c] = static_cast<std::size_t>(it - cells.begin());
+            }
+            width = cells.size();
+            out.header = line;
+            haveHeader = true;
+            continue;
+        }
+        if (cells.size() != width) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}:{}: {} cells, expected {} as in the header", path,
+                                         lineNo, cells.size(), width));
+        }
+        double v[6] = {};
+        for (std::size_t c = 0; c < 6; ++c) {
+            if (!parseNumber(cells[columnIndex[c]], v[c])) {
+                return makeError(ErrorCode::InvalidArgument,
+                                 fmt::format("{}:{}: column '{}' value '{}' is not a finite number",
+                                             path, lineNo, kColumns[c], cells[columnIndex[c]]));
+            }
+        }
+        out.rows.push_back(PairRow{lineNo, line, Lab{v[0], v[1], v[2]}, Lab{v[3], v[4], v[5]}});
+    }
+    if (!haveHeader) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: no header line 'L1,a1,b1,L2,a2,b2' found", path));
+    }
+    return out;
+}
+
+} // namespace
+
+void registerColorCommand(CLI::App& app, int& exitCode)
+{
+    auto* color = app.add_subcommand("color", "colorimetry calculations");
+    color->require_subcommand(1);
+    auto* de = color->add_subcommand("de2000", "CIEDE2000 of CIELAB pairs: reads a CSV with header "
+                                               "columns L1,a1,b1,L2,a2,b2 and prints "
+                                               "the same rows with a de00 column");
+    auto path = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    de->add_option("PAIRS.csv", *path, "CSV file of pairs")->required();
+    de->add_flag("--json", *json, "print JSON ({\"pairs\": [...]}) instead of CSV");
+    de->callback([path, json, &exitCode] {
+        auto pairs = readPairs(*path);
+        if (!pairs) {
+            std::fprintf(stderr, "replica color de2000: %s\n", pairs.error().message.c_str());
+            exitCode = kExitFailure;
+            return;
+        }
+        if (*json) {
+            nlohmann::json out;
+            out["pairs"] = nlohmann::json::array();
+            for (const auto& r : pairs->rows) {
+                out["pairs"].push_back({{"line", r.line},
+                                        {"L1", r.lab1.L},
+                                        {"a1", r.lab1.a},
+                                        {"b1", r.lab1.b},
+                                        {"L2", r.lab2.L},
+                                        {"a2", r.lab2.a},
+                                        {"b2", r.lab2.b},
+                                        {"de00", pipeline::colour::ciede2000(r.lab1, r.lab2)}});
+            }
+            std::cout << out.dump(2) << "\n";
+        } else {
+            std::cout << pairs->header << ",de00\n";
+            for (const auto& r : pairs->rows) {
+                std::cout << r.text
+                          << fmt::format(",{:.6f}\n", pipeline::colour::ciede2000(r.lab1, r.lab2));
+            }
+        }
+        exitCode = kExitOk;
+    });
+}
+
+} // namespace replica::platform

@@ -1,0 +1,393 @@
+// 'replica spectral eval' (representation accuracy on a light and a reflectance set) and 'replica
+// spectral fit' (derive the channel data the appliance ships).
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/colour/spectral_table.h>
+#include <pipeline/spectral/accuracy.h>
+#include <pipeline/spectral/basis_fit.h>
+#include <pipeline/spectral/metamers.h>
+#include <pipeline/spectral/representation_catalogue.h>
+#include <pipeline/spectral/six_channel_model.h>
+#include <platform/cli/commands.h>
+
+namespace replica::platform {
+namespace {
+
+namespace colour = pipeline::colour;
+namespace spectral = pipeline::spectral;
+
+struct EvalOptions {
+    std::string illuminant;
+    std::string reflectances;
+    std::string representation = spectral::kDefaultRepresentation;
+    bool json = false;
+};
+
+nlohmann::json labJson(const colour::Lab& lab)
+{
+    return nlohmann::json::array({lab.L, lab.a, lab.b});
+}
+
+int runEval(const EvalOptions& o)
+{
+    auto fail = [](const std::string& msg) {
+        std::fprintf(stderr, "replica spectral eval: %s\n", msg.c_str());
+        return kExitFailure;
+    };
+    const auto data = dataDir();
+    auto obs = colour::loadCie1931(data);
+    if (!obs) {
+        return fail(obs.error().message);
+    }
+    auto d65 = spectral::loadCieIlluminant(data, "D65");
+    if (!d65) {
+        return fail(d65.error().message);
+    }
+    auto lightTable = colour::loadSpectralCsv(o.illuminant);
+    if (!lightTable) {
+        return fail(lightTable.error().message);
+    }
+    auto light = lightTable->spectrum("value");
+    if (!light) {
+        return fail(light.error().message);
+    }
+    if (!(colour::spectrumToXyz(*obs, *light).y > 0.0)) {
+        return fail(fmt::format("{}: the light has no luminance over 380-730 nm (Y <= 0)",
+                                o.illuminant));
+    }
+    auto set = spectral::loadNamedSpectra(o.reflectances);
+    if (!set) {
+        return fail(set.error().message);
+    }
+    auto rep = spectral::makeRepresentation(data, *obs, *d65, o.representation);
+    if (!rep) {
+        return fail(rep.error().message);
+    }
+    auto report = spectral::evaluateRepresentation(*obs, *d65, **rep, *light, *set);
+    if (!report) {
+        return fail(fmt::format("{}: {}", o.reflectances, report.error().message));
+    }
+    if (o.json) {
+        nlohmann::json out;
+        out["representation"] = report->representation;
+        out["illuminant"] = o.illuminant;
+        out["reflectances"] = o.reflectances;
+        out["white"] = set->names[report->whiteIndex];
+        out["grid"] = "380-730 nm, 10 nm (36 bands)";
+        out["samples"] = nlohmann::json::array();
+        for (const auto& s : report->samples) {
+            out["samples"].push_back({{"name", s.name},
+                                      {"lab_reference", labJson(s.labReference)},
+                                      {"lab_approx", labJson(s.labApprox)},
+                                      {"de00", s.de00}});
+        }
+        out["stats"] = {{"mean", report->stats.mean},
+                        {"std", report->stats.std},
+                        {"p90", report->stats.p90},
+                        {"max", report->stats.max}};
+        std::cout << out.dump(2) << "\n";
+        return kExitOk;
+    }
+    std::cout << fmt::format("representation {}, white sample '{}', CIEDE2000 against spectral36 "
+                             "(CAT02 to D65, white Y = 1/1.13)\n",
+                             report->representation, set->names[report->whiteIndex]);
+    std::cout << fmt::format("{:<24} {:>26} {:>26} {:>8}\n", "sample", "Lab reference",
+                             "Lab approx", "de00");
+    for (const auto& s : report->samples) {
+        std::cout << fmt::format("{:<24} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.4f}\n",
+                                 s.name, s.labReference.L, s.labReference.a, s.labReference.b,
+                                 s.labApprox.L, s.labApprox.a, s.labApprox.b, s.de00);
+    }
+    std::cout << fmt::format("mean {:.4f}  std {:.4f}  p90 {:.4f}  max {:.4f}\n",
+                             report->stats.mean, report->stats.std, report->stats.p90,
+                             report->stats.max);
+    return kExitOk;
+}
+
+struct FitOptions {
+    std::string reflectances = "ces99";
+    std::string lights;
+    std::string boothLights = "A,F8,F7";
+    double boothWeight = 10.0;
+    std::string out;
+    int rounds = 1000;
+};
+
+std::vector<std::string> splitList(const std::string& s)
+{
+    std::vector<std::string> out;
+    std::stringstream in(s);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        if (!item.empty()) {
+            out.push_back(item);
+        }
+    }
+    return out;
+}
+
+int runFit(const FitOptions& o)
+{
+    auto fail = [](const std::string& msg) {
+        std::fprintf(stderr, "replica spectral fit: %s\n", msg.c_str());
+        return kExitFailure;
+    };
+    const auto data = dataDir();
+    auto obs = colour::loadCie1931(data);
+    if (!obs) {
+        return fail(obs.error().message);
+    }
+    auto d65 = spectral::loadCieIlluminant(data, "D65");
+    if (!d65) {
+        return fail(d65.error().message);
+    }
+    spectral::NamedSpectra training;
+    for (const auto& name : splitList(o.reflectances)) {
+        if (name.rfind("colorchecker", 0) == 0) {
+            return fail(
+                    fmt::format("'{}' is the evaluation set; train on sets that exclude it (ces99, "
+                                "or a CSV of your own)",
+                                name));
+        }
+        auto set = name.find(".csv") != std::string::npos
+                           ? spectral::loadNamedSpectra(name)
+                           : spectral::loadReflectanceSet(data, name);
+        if (!set) {
+            return fail(set.error().message);
+        }
+        training.append(*set);
+    }
+    spectral::NamedSpectra lights;
+    const auto lightNames =
+            o.lights.empty() ? spectral::evaluationLightNames() : splitList(o.lights);
+    for (const auto& name : lightNames) {
+        auto l = spectral::loadCieIlluminant(data, name);
+        if (!l) {
+            return fail(l.error().message);
+        }
+        lights.names.push_back(name);
+        lights.spectra.push_back(*l);
+    }
+    const std::filesystem::path outDir =
+            o.out.empty() ? data / "channels" : std::filesystem::path(o.out);
+    std::error_code ec;
+    std::filesystem::create_directories(outDir, ec);
+    const std::string provenance =
+            fmt::format("fitted by 'replica spectral fit' on {} reflectances ({}) and {} lights "
+                        "({}); working grid "
+                        "380-730 nm at 10 nm; see docs/accuracy.md",
+                        training.size(), o.reflectances, lights.size(), fmt::join(lightNames, " "));
+
+    // replica_k6: every training light, the booth's own lamps weighted up; general_k6: all equal.
+    spectral::BasisFitOptions boothOptions;
+    const auto booth = splitList(o.boothLights);
+    for (const auto& name : booth) {
+        if (std::find(lightNames.begin(), lightNames.end(), name) == lightNames.end()) {
+            lights.names.push_back(name);
+            auto l = spectral::loadCieIlluminant(data, name);
+            if (!l) {
+                return fail(l.error().message);
+            }
+            lights.spectra.push_back(*l);
+        }
+    }
+    for (const auto& name : lights.names) {
+        const bool isBooth = std::find(booth.begin(), booth.end(), name) != booth.end();
+        boothOptions.lightWeights.push_back(isBooth ? o.boothWeight : 1.0);
+    }
+    auto k6 = spectral::fitChannelBasis(*obs, *d65, training, lights, boothOptions, "replica_k6");
+    if (!k6) {
+        return fail(k6.error().message);
+    }
+    auto general = spectral::fitChannelBasis(*obs, *d65, training, lights,
+                                             spectral::BasisFitOptions{}, "general_k6");
+    if (!general) {
+        return fail(general.error().message);
+    }
+    spectral::BasisFitOptions pca;
+    pca.lightAware = false;
+    auto pca6 = spectral::fitChannelBasis(*obs, *d65, training, lights, pca, "pca6");
+    if (!pca6) {
+        return fail(pca6.error().message);
+    }
+    spectral::SixChannelFitReport report;
+    auto paper6 = spectral::fitSixChannelModel(*obs, *d65, training, lights, *k6, o.rounds,
+                                               "paper6", &report);
+    if (!paper6) {
+        return fail(paper6.error().message);
+    }
+    const std::string boothNote =
+            fmt::format("; booth lamps {} weighted {}", o.boothLights, o.boothWeight);
+    const std::tuple<const colour::ChannelBasis*, const char*, std::string> outputs[] = {
+            {&*k6, "replica_k6.csv", boothNote},
+            {&*general, "general_k6.csv", ""},
+            {&*pca6, "pca6.csv", "; principal components, lights unused"}};
+    for (const auto& [basis, file, note] : outputs) {
+        auto saved = colour::saveChannelBasis(*basis, outDir / file, provenance + note);
+        if (!saved) {
+            return fail(saved.error().message);
+        }
+        std::cout << "wrote " << (outDir / file).string() << "\n";
+    }
+    auto saved = spectral::saveSixChannelModel(
+            *paper6, outDir / "paper6.csv",
+            provenance + fmt::format("; {} alternating least-squares rounds", o.rounds));
+    if (!saved) {
+        return fail(saved.error().message);
+    }
+    std::cout << "wrote " << (outDir / "paper6.csv").string()
+              << " and paper6_to_xyz.csv (objective "
+              << fmt::format("{:.4g} -> {:.4g}",
+                             report.objective.empty() ? 0.0 : report.objective.front(),
+                             report.objective.empty() ? 0.0 : report.objective.back())
+              << ")\n";
+    return kExitOk;
+}
+
+struct MetamerOptions {
+    std::string matchLight = "A";
+    std::string mismatchLight = "D65";
+    std::string seeds = "ces99";
+    std::string out;
+    std::size_t count = 6;
+    double minMismatch = 3.0;
+    double targetMismatch = 8.0;
+};
+
+int runMetamers(const MetamerOptions& o)
+{
+    auto fail = [](const std::string& msg) {
+        std::fprintf(stderr, "replica spectral metamers: %s\n", msg.c_str());
+        return kExitFailure;
+    };
+    const auto data = dataDir();
+    auto obs = colour::loadCie1931(data);
+    auto basis = colour::loadDefaultChannelBasis(data);
+    auto match = spectral::loadCieIlluminant(data, o.matchLight);
+    auto mismatch = spectral::loadCieIlluminant(data, o.mismatchLight);
+    auto seeds = spectral::loadReflectanceSet(data, o.seeds);
+    for (const Error* e : {obs ? nullptr : &obs.error(), basis ? nullptr : &basis.error(),
+                           match ? nullptr : &match.error(), mismatch ? nullptr : &mismatch.error(),
+                           seeds ? nullptr : &seeds.error()}) {
+        if (e != nullptr) {
+            return fail(e->message);
+        }
+    }
+    const auto pairs = spectral::findMetamerPairs(*obs, *basis, *match, *mismatch, *seeds, o.count,
+                                                  o.minMismatch, o.targetMismatch);
+    if (pairs.empty()) {
+        return fail(fmt::format("no seed in '{}' gives a pair with CIEDE2000 >= {} under {}",
+                                o.seeds, o.minMismatch, o.mismatchLight));
+    }
+    const std::filesystem::path out =
+            o.out.empty() ? data / "scenes" / "metamers" /
+                                    fmt::format("metamers_{}_{}.csv", o.matchLight, o.mismatchLight)
+                          : std::filesystem::path(o.out);
+    auto saved = spectral::saveMetamerPairs(pairs, out,
+                                            fmt::format("written by 'replica spectral metamers' in "
+                                                        "the span of {} from {} seeds; same XYZ "
+                                                        "under {}, different under {}",
+                                                        basis->name, o.seeds, o.matchLight,
+                                                        o.mismatchLight));
+    if (!saved) {
+        return fail(saved.error().message);
+    }
+    for (const auto& p : pairs) {
+        std::cout << fmt::format("{} (from {}): de00 {:.4f} under {}, {:.2f} under {}\n", p.name,
+                                 p.seed, p.de00Match, o.matchLight, p.de00Mismatch,
+                                 o.mismatchLight);
+    }
+    std::cout << "wrote " << out.string() << "\n";
+    return kExitOk;
+}
+
+} // namespace
+
+void registerSpectralCommand(CLI::App& app, int& exitCode)
+{
+    auto* spectralCmd =
+            app.add_subcommand("spectral", "spectral representations: accuracy and fitting");
+    spectralCmd->require_subcommand(1);
+
+    auto eval = std::make_shared<EvalOptions>();
+    auto* e = spectralCmd->add_subcommand("eval",
+                                          "CIEDE2000 of a representation against the full-spectral "
+                                          "calculation, for one light and a "
+                                          "reflectance set (white patch Y = 1/1.13, CAT02 to D65)");
+    e->add_option("--illuminant", eval->illuminant,
+                  "LIGHT.csv with columns wavelength_nm,value (any grid "
+                  "covering 380-730 nm)")
+            ->required();
+    e->add_option(
+             "--reflectances", eval->reflectances,
+             "SET.csv: wavelength_nm then one column per sample; the white is the sample named "
+             "'white', else the one with the highest Y")
+            ->required();
+    e->add_option("--representation", eval->representation,
+                  fmt::format("one of {}", fmt::join(spectral::representationNames(), ", ")))
+            ->capture_default_str();
+    e->add_flag("--json", eval->json, "print JSON with 'samples' and 'stats'");
+    e->callback([eval, &exitCode] { exitCode = runEval(*eval); });
+
+    auto fit = std::make_shared<FitOptions>();
+    auto* f = spectralCmd->add_subcommand(
+            "fit", "derive the channel data the appliance ships "
+                   "(replica_k6.csv, general_k6.csv, pca6.csv, paper6.csv) from "
+                   "named training sets");
+    f->add_option("--reflectances", fit->reflectances,
+                  "training reflectances: comma-separated set names (ces99, tcs14) or CSV paths")
+            ->capture_default_str();
+    f->add_option("--lights", fit->lights,
+                  fmt::format("training lights: comma-separated CIE illuminant names (default: {})",
+                              fmt::join(spectral::evaluationLightNames(), ",")));
+    f->add_option("--booth-lights", fit->boothLights,
+                  "the booth's own lamps (CIE names), weighted up in replica_k6")
+            ->capture_default_str();
+    f->add_option("--booth-weight", fit->boothWeight,
+                  "weight of each booth lamp against 1 for the others")
+            ->capture_default_str()
+            ->check(CLI::Range(0.0, 1e6));
+    f->add_option("--out", fit->out, "output folder (default: the data folder's channels/)");
+    f->add_option("--rounds", fit->rounds, "alternating least-squares rounds for paper6")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 100000));
+    f->callback([fit, &exitCode] { exitCode = runFit(*fit); });
+
+    auto met = std::make_shared<MetamerOptions>();
+    auto* m = spectralCmd->add_subcommand(
+            "metamers",
+            "write metameric reflectance pairs (same XYZ under one light, different under another) "
+            "inside the default channel basis, as a scene target");
+    m->add_option("--match-light", met->matchLight, "CIE illuminant of the match")
+            ->capture_default_str();
+    m->add_option("--mismatch-light", met->mismatchLight, "CIE illuminant of the mismatch")
+            ->capture_default_str();
+    m->add_option("--seeds", met->seeds, "reflectance set the pairs grow from")
+            ->capture_default_str();
+    m->add_option("--count", met->count, "number of pairs")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 50));
+    m->add_option("--min-mismatch", met->minMismatch, "smallest CIEDE2000 under the mismatch light")
+            ->capture_default_str();
+    m->add_option("--target-mismatch", met->targetMismatch,
+                  "CIEDE2000 the pairs are eased back to under the mismatch light (0: as large as "
+                  "possible)")
+            ->capture_default_str();
+    m->add_option("--out", met->out,
+                  "output CSV (default: data/scenes/metamers/metamers_<match>_<mismatch>.csv)");
+    m->callback([met, &exitCode] { exitCode = runMetamers(*met); });
+}
+
+} // namespace replica::platform

@@ -1,0 +1,254 @@
+// Tests of 'replica color de2000' and 'replica spectral eval' run as the built binary, and of the
+// channel-data file formats: bad files must fail naming file, line and problem.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/colour/channel_basis.h>
+#include <pipeline/colour/spectral_table.h>
+#include <pipeline/spectral/accuracy.h>
+#include <pipeline/spectral/representation_catalogue.h>
+#include <pipeline/spectral/six_channel_model.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::pipeline::spectral {
+namespace {
+
+struct RunResult {
+    int exitCode = -1;
+    std::string out; // stdout
+    std::string err; // stderr
+};
+
+RunResult runReplica(const std::string& args, const std::filesystem::path& dir)
+{
+    const auto errPath = dir / "stderr.txt";
+    const std::string cmd = std::string(REPLICA_BINARY) + " " + args + " 2>" + errPath.string();
+    RunResult r;
+    FILE* pipe = popen(cmd.c_str(), "r");
+    if (pipe == nullptr) {
+        return r;
+    }
+    char buf[4096];
+    std::size_t n = 0;
+    while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) {
+        r.out.append(buf, n);
+    }
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream e(errPath);
+    r.err.assign(std::istreambuf_iterator<char>(e), std::istreambuf_iterator<char>());
+    return r;
+}
+
+class CliFiles : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        dir_ = std::filesystem::temp_directory_path() /
+               ("replica_spectral_cli_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        std::filesystem::create_directories(dir_);
+    }
+    void TearDown() override { std::filesystem::remove_all(dir_); }
+    std::string write(const std::string& name, const std::string& text)
+    {
+        const auto p = dir_ / name;
+        std::ofstream(p) << text;
+        return p.string();
+    }
+    std::filesystem::path dir_;
+};
+
+TEST_F(CliFiles, De2000PrintsRowsWithTheirDifference)
+{
+    const auto f = write("pairs.csv", "L1,a1,b1,L2,a2,b2\n50,2.6772,-79.7751,50,0,-82.7485\n"
+                                      "50,2.5,0,73,25,-18\n");
+    const auto r = runReplica("color de2000 " + f, dir_);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    // Sharma et al. 2005 pairs 1 and 17: the rows come back as given, with de00 appended.
+    const std::string head = "L1,a1,b1,L2,a2,b2,de00\n50,2.6772,-79.7751,50,0,-82.7485,";
+    ASSERT_EQ(r.out.substr(0, head.size()), head);
+    const auto row2 = r.out.find("50,2.5,0,73,25,-18,");
+    ASSERT_NE(row2, std::string::npos);
+    EXPECT_NEAR(std::stod(r.out.substr(head.size())), 2.0425, 1e-4);
+    EXPECT_NEAR(std::stod(r.out.substr(row2 + 19)), 27.1492, 1e-4);
+    const auto j = runReplica("color de2000 --json " + f, dir_);
+    ASSERT_EQ(j.exitCode, 0);
+    const auto doc = nlohmann::json::parse(j.out);
+    EXPECT_NEAR(doc["pairs"][1]["de00"].get<double>(), 27.1492, 1e-4);
+}
+
+TEST_F(CliFiles, De2000BadFilesNameFileLineAndProblem)
+{
+    const auto cell = write("cell.csv", "L1,a1,b1,L2,a2,b2\n50,1,1,50,1,1\n50,x,1,50,1,1\n");
+    auto r = runReplica("color de2000 " + cell, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "replica color de2000: " + cell +
+                             ":3: column 'a1' value 'x' is not a finite number\n");
+    const auto header = write("header.csv", "# pairs\nL1,a1,b1,L2,a2\n");
+    r = runReplica("color de2000 " + header, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find(header + ":2: header has no column 'b2'"), std::string::npos) << r.err;
+    const auto shortRow = write("short.csv", "L1,a1,b1,L2,a2,b2\n50,1,1,50,1\n");
+    r = runReplica("color de2000 " + shortRow, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find(shortRow + ":2: 5 cells, expected 6"), std::string::npos) << r.err;
+    r = runReplica("color de2000 " + (dir_ / "missing.csv").string(), dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("missing.csv: cannot open"), std::string::npos) << r.err;
+}
+
+std::string lightCsv(const std::string& name)
+{
+    // The CIE table's column as 'wavelength_nm,value' on its own 5 nm grid.
+    auto table = colour::loadSpectralCsv(dataDir() / "spectra" /
+                                         "cie_illuminants_F1_F12_5nm_380_780.csv");
+    std::string text = "# " + name + " from the CIE 5 nm table\nwavelength_nm,value\n";
+    std::size_t c = 0;
+    while (table->columns[c] != name) {
+        ++c;
+    }
+    for (std::size_t i = 0; i < table->wavelengthNm.size(); ++i) {
+        text += std::to_string(table->wavelengthNm[i]) + "," + std::to_string(table->rows[i][c]) +
+                "\n";
+    }
+    return text;
+}
+
+TEST_F(CliFiles, EvalJsonMatchesTheLibrary)
+{
+    const auto light = write("f11.csv", lightCsv("F11"));
+    const auto set =
+            (dataDir() / "spectra" / "colorchecker24_babelcolor_avg_10nm_380_730.csv").string();
+    const auto r = runReplica("spectral eval --illuminant " + light + " --reflectances " + set +
+                                      " --representation paper6 --json",
+                              dir_);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto doc = nlohmann::json::parse(r.out);
+    ASSERT_EQ(doc["samples"].size(), 24u);
+    EXPECT_EQ(doc["samples"][0]["name"], "dark_skin");
+    EXPECT_EQ(doc["samples"][0]["lab_reference"].size(), 3u);
+    EXPECT_EQ(doc["white"], "white_9.5");
+
+    auto obs = colour::loadCie1931(dataDir());
+    auto d65 = loadCieIlluminant(dataDir(), "D65");
+    auto f11 = loadCieIlluminant(dataDir(), "F11");
+    auto cc = loadReflectanceSet(dataDir(), "colorchecker");
+    auto rep = makeRepresentation(dataDir(), *obs, *d65, "paper6");
+    ASSERT_TRUE(obs && d65 && f11 && cc && rep);
+    auto lib = evaluateRepresentation(*obs, *d65, **rep, *f11, *cc);
+    ASSERT_TRUE(lib);
+    // The CLI's light went through std::to_string (6 decimals); F11's table has 2, so it is exact.
+    EXPECT_NEAR(doc["stats"]["mean"].get<double>(), lib->stats.mean, 1e-12);
+    EXPECT_NEAR(doc["stats"]["max"].get<double>(), lib->stats.max, 1e-12);
+    EXPECT_NEAR(doc["samples"][14]["de00"].get<double>(), lib->samples[14].de00, 1e-12);
+}
+
+TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
+{
+    const auto set =
+            (dataDir() / "spectra" / "colorchecker24_babelcolor_avg_10nm_380_730.csv").string();
+    struct Case {
+        const char* file;
+        const char* text;
+        const char* expect;
+    };
+    const Case cases[] = {
+            {"nocol.csv", "wavelength_nm,power\n380,1\n730,1\n", ":1: no column named 'value'"},
+            {"cell.csv", "wavelength_nm,value\n380,1\n500,abc\n730,1\n",
+             ":3: column 'value' value 'abc' is not a finite number"},
+            {"order.csv", "wavelength_nm,value\n380,1\n600,1\n590,1\n730,1\n",
+             ":4: wavelength 590 nm does not increase (previous 600 nm)"},
+            {"narrow.csv", "# too short\nwavelength_nm,value\n400,1\n730,1\n",
+             ":3: data start at 400 nm but must cover 380-730 nm"},
+            {"narrow2.csv", "wavelength_nm,value\n380,1\n700,1\n", ":3: data end at 700 nm"},
+            {"dark.csv", "wavelength_nm,value\n380,0\n730,0\n", ": the light has no luminance"},
+    };
+    for (const auto& c : cases) {
+        const auto light = write(c.file, c.text);
+        const auto r =
+                runReplica("spectral eval --illuminant " + light + " --reflectances " + set, dir_);
+        EXPECT_EQ(r.exitCode, 1) << c.file;
+        EXPECT_NE(r.err.find(light + c.expect), std::string::npos) << c.file << ": " << r.err;
+    }
+    const auto light = write("ok.csv", lightCsv("F2"));
+    const auto badSet = write("set.csv", "wavelength_nm,a,b\n380,0.5,0.5\n730,0.5\n");
+    auto r = runReplica("spectral eval --illuminant " + light + " --reflectances " + badSet, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find(badSet + ":3: 2 cells, expected 3"), std::string::npos) << r.err;
+    r = runReplica("spectral eval --illuminant " + light + " --reflectances " + set +
+                           " --representation nine",
+                   dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("no representation named 'nine'"), std::string::npos) << r.err;
+}
+
+TEST_F(CliFiles, ChannelBasisRoundTripsAndRejectsOffGridFiles)
+{
+    auto basis = colour::loadDefaultChannelBasis(dataDir());
+    ASSERT_TRUE(basis) << basis.error().message;
+    const auto path = dir_ / "copy.csv";
+    ASSERT_TRUE(colour::saveChannelBasis(*basis, path, "test copy"));
+    auto back = colour::loadChannelBasis(path);
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->name, "copy");
+    for (std::size_t k = 0; k < colour::kChannels; ++k) {
+        for (std::size_t l = 0; l < colour::kBands; ++l) {
+            EXPECT_EQ(back->project[k][l], basis->project[k][l]);
+            EXPECT_EQ(back->reconstruct[k][l], basis->reconstruct[k][l]);
+        }
+    }
+    std::string header = "wavelength_nm";
+    for (int k = 1; k <= 6; ++k) {
+        header += ",project_" + std::to_string(k);
+    }
+    for (int k = 1; k <= 6; ++k) {
+        header += ",reconstruct_" + std::to_string(k);
+    }
+    std::string rows;
+    for (int i = 0; i < 36; ++i) {
+        rows += std::to_string(i == 5 ? 435 : 380 + 10 * i);
+        for (int c = 0; c < 12; ++c) {
+            rows += ",0.5";
+        }
+        rows += "\n";
+    }
+    const auto bad = write("offgrid.csv", header + "\n" + rows);
+    auto r = colour::loadChannelBasis(bad);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message,
+              bad + ": wavelength row 6 is 435 nm, expected 430 nm (the working grid)");
+    const auto missing = write("missing.csv", "wavelength_nm,project_1\n380,1\n390,1\n");
+    r = colour::loadChannelBasis(missing);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("has 2 wavelength rows, expected the 36"), std::string::npos);
+}
+
+TEST_F(CliFiles, SixChannelModelRoundTripsAndNamesItsMatrixFile)
+{
+    auto model = loadSixChannelModel(dataDir() / "channels" / "paper6.csv");
+    ASSERT_TRUE(model) << model.error().message;
+    const auto path = dir_ / "m.csv";
+    ASSERT_TRUE(saveSixChannelModel(*model, path, "copy"));
+    auto back = loadSixChannelModel(path);
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->toXyz[5].z, model->toXyz[5].z);
+    EXPECT_EQ(back->lightProject[2][17], model->lightProject[2][17]);
+    std::ofstream(dir_ / "m_to_xyz.csv") << "channel,X,Y,Z\n1,1,2,3\n2,1,2\n";
+    auto bad = loadSixChannelModel(path);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().message,
+              (dir_ / "m_to_xyz.csv").string() + ":3: 3 cells, expected 4 (channel,X,Y,Z)");
+}
+
+} // namespace
+} // namespace replica::pipeline::spectral
