@@ -29,7 +29,8 @@ Plan planRender(const surface::SurfaceScene& scene,
                 const colour::Observer& obs,
                 const ErrorBudget& budget,
                 int probeX,
-                int probeY)
+                int probeY,
+                const colour::ChannelBasis& basis)
 {
     Plan plan;
     const bool glossy = scene.glossy();
@@ -70,11 +71,11 @@ Plan planRender(const surface::SurfaceScene& scene,
     reference::FrameError best{1e9, 1e9, 1e9};
     for (const RenderSettings& s : candidates) {
         if (s.lights != preparedLights) {
-            pl = prepareLight(light, obs, s.lights);
+            pl = prepareLight(light, obs, s.lights, basis);
             preparedLights = s.lights;
         }
         if (s.horizonDirections != preparedDirs) {
-            ps = prepareScene(scene, std::max(s.horizonDirections, 1));
+            ps = prepareScene(scene, std::max(s.horizonDirections, 1), 0.01, basis);
             preparedDirs = s.horizonDirections;
         }
         const XyzFrame f = renderRealtime(ps, pl, probe, obs, s);

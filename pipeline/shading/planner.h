@@ -34,6 +34,7 @@ Plan planRender(const surface::SurfaceScene& scene,
                 const colour::Observer& obs,
                 const ErrorBudget& budget = {},
                 int probeX = 32,
-                int probeY = 20);
+                int probeY = 20,
+                const colour::ChannelBasis& basis = colour::boxBasis());
 
 } // namespace replica::pipeline::shading

@@ -40,8 +40,10 @@ double radicalInverse2(unsigned k)
     return static_cast<double>(k) * 2.3283064365386963e-10;
 }
 
-PreparedLight
-prepareLight(const booth::BoothLight& light, const colour::Observer& obs, int pointLightCount)
+PreparedLight prepareLight(const booth::BoothLight& light,
+                           const colour::Observer& obs,
+                           int pointLightCount,
+                           const colour::ChannelBasis& basis)
 {
     PreparedLight p;
     p.light = &light;
@@ -51,12 +53,14 @@ prepareLight(const booth::BoothLight& light, const colour::Observer& obs, int po
     p.mips = booth::buildMipChain(light.luminance);
     p.unitSpd = booth::unitLuminanceSpd(obs, light.spd);
     p.white = colour::spectrumToXyz(obs, p.unitSpd);
-    p.channelXyz = colour::channelToXyz(colour::boxBasis(), obs, light.spd);
+    p.channelXyz = colour::channelToXyz(basis, obs, light.spd);
     return p;
 }
 
-PreparedScene
-prepareScene(const surface::SurfaceScene& scene, int horizonDirections, double horizonDistanceM)
+PreparedScene prepareScene(const surface::SurfaceScene& scene,
+                           int horizonDirections,
+                           double horizonDistanceM,
+                           const colour::ChannelBasis& basis)
 {
     PreparedScene p;
     p.scene = &scene;
@@ -64,7 +68,6 @@ prepareScene(const surface::SurfaceScene& scene, int horizonDirections, double h
         p.normals = surface::normalMap(scene.relief);
         p.horizon = surface::horizonMap(scene.relief, horizonDirections, horizonDistanceM);
     }
-    const colour::ChannelBasis basis = colour::boxBasis();
     for (const auto& s : scene.palette) {
         p.paletteCoeffs.push_back(colour::projectReflectance(basis, s));
     }
@@ -206,7 +209,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                     e = 0.0;
                 }
                 colour::Xyz xyz(0.0);
-                if (settings.channels == ChannelRep::Box6) {
+                if (settings.channels == ChannelRep::Basis6) {
                     const colour::ChannelCoeffs cc = scene.channels(ps.paletteCoeffs, sp.tx, sp.ty);
                     for (std::size_t k = 0; k < colour::kChannels; ++k) {
                         xyz += light.channelXyz[k] * cc[k];

@@ -17,7 +17,8 @@
 namespace replica::pipeline::shading {
 
 enum class ChannelRep {
-    Box6,       // K = 6 channel coefficients per texel, 6 XYZ vectors per light (the GL path)
+    Basis6,     // K = 6 channel coefficients per texel, 6 XYZ vectors per light (the GL path), in
+                // the basis the scene and light were prepared with
     Spectral36, // full spectra per texel (what the channels approximate)
 };
 
@@ -25,7 +26,7 @@ struct RenderSettings {
     int lights = 32;
     int specularSamples = 16;
     int horizonDirections = 8;
-    ChannelRep channels = ChannelRep::Box6;
+    ChannelRep channels = ChannelRep::Basis6;
     bool diffusePass = true;
     bool specularPass = true;      // ignored (skipped) for a matte scene
     bool reliefPass = true;        // normal map + horizon; ignored for a flat scene
@@ -41,11 +42,14 @@ struct PreparedLight {
     booth::MipChain mips;
     colour::Spectrum unitSpd;
     colour::Xyz white{0.0};            // XYZ of the unit-luminance light (Y = 1)
-    colour::ChannelToXyz channelXyz{}; // M_k for the Box6 path
+    colour::ChannelToXyz channelXyz{}; // M_k for the Basis6 path
 };
 
-PreparedLight
-prepareLight(const booth::BoothLight& light, const colour::Observer& obs, int pointLightCount);
+// 'basis' must be the one the scene was prepared with (box6 when not given).
+PreparedLight prepareLight(const booth::BoothLight& light,
+                           const colour::Observer& obs,
+                           int pointLightCount,
+                           const colour::ChannelBasis& basis = colour::boxBasis());
 
 // Per-scene precomputation: normal and horizon maps, palette channel coefficients.
 struct PreparedScene {
@@ -57,7 +61,8 @@ struct PreparedScene {
 
 PreparedScene prepareScene(const surface::SurfaceScene& scene,
                            int horizonDirections,
-                           double horizonDistanceM = 0.01);
+                           double horizonDistanceM = 0.01,
+                           const colour::ChannelBasis& basis = colour::boxBasis());
 
 // Diffuse illuminance from point lights (eq. 1): both cosines clamped at 0, 1/d^2 clamped at one
 // texel area; vis(light direction) in [0, 1] multiplies each light.
