@@ -166,7 +166,8 @@ makeBoothScene(RunConfig& config,
 
 } // namespace
 
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config)
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
+                                                    const OutputChoice& outputChoice)
 {
     const std::string dir = dataDir().string();
     auto app = std::make_unique<Appliance>();
@@ -215,7 +216,9 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config)
         return tl::unexpected(surface.error());
     }
 
-    auto output = createHeadlessOutput();
+    auto output = outputChoice.kind == "kms"
+                          ? createKmsOutput(outputChoice.kmsDevice, outputChoice.kmsConnector)
+                          : createHeadlessOutput();
     if (!output) {
         return tl::unexpected(output.error());
     }

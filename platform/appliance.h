@@ -70,9 +70,17 @@ struct Appliance {
 std::filesystem::path resolveSceneDir(const std::string& sceneDir);
 Expected<std::string> sceneDigest(const std::filesystem::path& dir);
 
-// Creates the headless output and everything that renders. Fails with a one-line reason. With the
-// booth renderer, config.sceneDigest (when not empty) must match the scene on disk.
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config);
+// Where frames go; not part of RunConfig because it never changes what a frame looks like.
+struct OutputChoice {
+    std::string kind = "headless"; // or "kms"
+    std::string kmsDevice = "/dev/dri/card0";
+    std::string kmsConnector; // empty: the first connected one
+};
+
+// Creates the output and everything that renders. Fails with a one-line reason. With the booth
+// renderer, config.sceneDigest (when not empty) must match the scene on disk.
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
+                                                    const OutputChoice& output = {});
 
 // The built-in simulated sensors playing the scripted scenario.
 Expected<Sources> makeSimSources(const Appliance& appliance);

@@ -31,6 +31,7 @@ int runCli(int argc, char** argv)
     registerSceneCommand(app, exitCode);
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
+    registerProbeCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {

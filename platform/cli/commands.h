@@ -18,5 +18,6 @@ void registerBoothCommand(CLI::App& app, int& exitCode);
 void registerSceneCommand(CLI::App& app, int& exitCode);
 void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
+void registerProbeCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform

@@ -11,6 +11,7 @@
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/frame_outputs.h>
+#include <platform/live_sources.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 
@@ -29,6 +30,8 @@ struct RunOptions {
     bool fast = false;
     std::string scene;
     std::string renderer = "booth";
+    LiveOptions live;
+    OutputChoice outputChoice;
 };
 
 std::optional<std::pair<int, int>> parseSize(const std::string& s)
@@ -47,14 +50,19 @@ std::optional<std::pair<int, int>> parseSize(const std::string& s)
 int runMain(const RunOptions& o)
 {
     auto log = logger("replica");
-    if (o.hal != "sim") {
-        log->error("--hal {}: only the built-in simulated sensors ('sim') are in this build; live "
-                   "drivers are not yet",
+    if (o.hal != "sim" && o.hal != "live") {
+        log->error("--hal {}: expected 'sim' (built-in simulated sensors) or 'live' (USB2000+, "
+                   "opentrack, IIO accelerometer)",
                    o.hal);
         return kExitUsage;
     }
-    if (o.output != "headless") {
-        log->error("--output {}: only 'headless' output is in this build; KMS output is not yet",
+    if (o.hal == "live" && o.fast) {
+        log->error("--fast needs the simulated sensors: live sensors run on the wall clock");
+        return kExitUsage;
+    }
+    if (o.output != "headless" && o.output != "kms") {
+        log->error("--output {}: expected 'headless' (no display) or 'kms' (fullscreen on the "
+                   "console, no display server)",
                    o.output);
         return kExitUsage;
     }
@@ -83,12 +91,18 @@ int runMain(const RunOptions& o)
         }
     }
 
-    auto appliance = buildAppliance(config);
+    OutputChoice outputChoice = o.outputChoice;
+    outputChoice.kind = o.output;
+    auto appliance = buildAppliance(config, outputChoice);
     if (!appliance) {
         log->error("{}", appliance.error().message);
         return kExitFailure;
     }
-    auto sources = makeSimSources(**appliance);
+    // Live devices stamp samples on this clock; the loop's ticks start with it (within the few
+    // milliseconds between here and the first tick, which only delays samples by that much).
+    hal::SteadyClock liveClock;
+    auto sources =
+            o.hal == "live" ? makeLiveSources(liveClock, o.live) : makeSimSources(**appliance);
     if (!sources) {
         log->error("{}", sources.error().message);
         return kExitFailure;
@@ -128,9 +142,24 @@ int runMain(const RunOptions& o)
     }
 
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
-    const auto plan = fixedRatePlan(config.periodNs(), o.frames);
-    auto stats = runFrames(**appliance, *sources, plan, o.fast ? Pacing::Fast : Pacing::Realtime,
-                           recorder.get(), outputs.readback(), outputs.callback());
+    // --frames 0: run until SIGINT/SIGTERM (the kiosk), closing the recording properly.
+    installStopSignals();
+    const TickSource ticks =
+            o.frames == 0 ? endlessTicks(config.periodNs())
+                          : TickSource([plan = fixedRatePlan(config.periodNs(), o.frames),
+                                        k = std::size_t{0}]() mutable -> std::optional<TickPlan> {
+                                if (k >= plan.size()) {
+                                    return std::nullopt;
+                                }
+                                return plan[k++];
+                            });
+    // Scan-out needs the display pixels of every frame, digests or not.
+    auto readback = outputs.readback();
+    if (o.output == "kms" && readback == pipeline::render::Readback::None) {
+        readback = pipeline::render::Readback::Display;
+    }
+    auto stats = runFrames(**appliance, *sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
+                           recorder.get(), readback, outputs.callback());
     if (!stats) {
         log->error("{}", stats.error().message);
         return kExitFailure;
@@ -168,11 +197,33 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     auto* cmd =
             app.add_subcommand("run", "run the appliance: sensors -> scene -> render -> output at "
                                       "a fixed rate");
-    cmd->add_option("--hal", opts->hal, "sensor sources: sim (built-in simulated sensors)")
+    cmd->add_option("--hal", opts->hal,
+                    "sensor sources: sim (built-in simulated sensors) or live (USB2000+ over "
+                    "libusb, opentrack UDP head poses, IIO accelerometer)")
             ->capture_default_str();
-    cmd->add_option("--output", opts->output, "frame output: headless (surfaceless EGL)")
+    cmd->add_option("--tracker-port", opts->live.trackerPort,
+                    "live: UDP port opentrack sends head poses to")
             ->capture_default_str();
-    cmd->add_option("--frames", opts->frames, "number of frames to run")->capture_default_str();
+    cmd->add_option("--tracker-bind", opts->live.trackerBind, "live: address to listen on")
+            ->capture_default_str();
+    cmd->add_option("--iio-root", opts->live.iioRoot, "live: where IIO devices are listed")
+            ->capture_default_str();
+    cmd->add_option("--accel-name", opts->live.accelName,
+                    "live: the accelerometer's IIO name (default: the first one)");
+    cmd->add_option("--accel-axes", opts->live.accelAxes,
+                    "live: sensor axis for each panel axis (x right, y up, z out of the screen), "
+                    "e.g. -y,x,z")
+            ->capture_default_str();
+    cmd->add_option("--output", opts->output,
+                    "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")
+            ->capture_default_str();
+    cmd->add_option("--kms-device", opts->outputChoice.kmsDevice, "kms: the DRM card to drive")
+            ->capture_default_str();
+    cmd->add_option("--kms-connector", opts->outputChoice.kmsConnector,
+                    "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
+    cmd->add_option("--frames", opts->frames,
+                    "number of frames to run; 0 = until SIGINT/SIGTERM (the kiosk)")
+            ->capture_default_str();
     cmd->add_option("--size", opts->size, "frame size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--rate", opts->rateHz, "frame rate (Hz)")
             ->check(CLI::Range(1.0, 1000.0))

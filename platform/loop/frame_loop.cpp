@@ -1,5 +1,7 @@
 // The fixed-rate frame loop.
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -47,7 +49,43 @@ std::optional<std::uint32_t> sequenceOf(const Sample* s)
     return s != nullptr ? std::optional<std::uint32_t>(s->sequence) : std::nullopt;
 }
 
+volatile std::sig_atomic_t gStop = 0;
+
+extern "C" void onStopSignal(int)
+{
+    gStop = 1;
+}
+
 } // namespace
+
+void requestStop()
+{
+    gStop = 1;
+}
+
+bool stopRequested()
+{
+    return gStop != 0;
+}
+
+void installStopSignals()
+{
+    struct sigaction sa {
+    };
+    sa.sa_handler = onStopSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
+TickSource endlessTicks(std::int64_t periodNs)
+{
+    auto k = std::make_shared<std::uint64_t>(0);
+    return [periodNs, k]() -> std::optional<TickPlan> {
+        const std::uint64_t i = (*k)++;
+        return TickPlan{i, static_cast<std::int64_t>(i) * periodNs, std::nullopt};
+    };
+}
 
 std::vector<TickPlan> fixedRatePlan(std::int64_t periodNs, std::uint64_t frames)
 {
@@ -77,6 +115,24 @@ Expected<LoopStats> runFrames(Appliance& appliance,
                               pipeline::render::Readback readback,
                               const FrameCallback& onFrame)
 {
+    std::size_t next = 0;
+    const TickSource ticks = [&plan, &next]() -> std::optional<TickPlan> {
+        if (next >= plan.size()) {
+            return std::nullopt;
+        }
+        return plan[next++];
+    };
+    return runFrames(appliance, sources, ticks, pacing, recorder, readback, onFrame);
+}
+
+Expected<LoopStats> runFrames(Appliance& appliance,
+                              Sources& sources,
+                              const TickSource& ticks,
+                              Pacing pacing,
+                              recordings::RecordingWriter* recorder,
+                              pipeline::render::Readback readback,
+                              const FrameCallback& onFrame)
+{
     auto log = logger("loop");
     LoopStats stats;
     SampleLatch<hal::SpectrumSample> spectra;
@@ -90,7 +146,16 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     bool stepping = pacing == Pacing::Step;
     const auto wallStart = std::chrono::steady_clock::now();
 
-    for (const auto& tick : plan) {
+    for (;;) {
+        if (stopRequested()) {
+            log->info("stop requested: ending after {} frames", stats.frames);
+            break;
+        }
+        const std::optional<TickPlan> nextTick = ticks();
+        if (!nextTick) {
+            break;
+        }
+        const TickPlan& tick = *nextTick;
         if (pacing == Pacing::Realtime) {
             const auto due = wallStart + std::chrono::nanoseconds(tick.tickNs);
             if (std::chrono::steady_clock::now() > due + std::chrono::milliseconds(2)) {

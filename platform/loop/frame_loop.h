@@ -46,11 +46,32 @@ using FrameCallback = std::function<void(const recordings::FrameRecord& frame,
                                          const pipeline::scene::SceneState& state,
                                          const pipeline::render::RenderedFrame& image)>;
 
+// Yields the next tick, or nothing when the run is over. Lets the appliance run without end.
+using TickSource = std::function<std::optional<TickPlan>()>;
+
+// Ticks k * period for k = 0, 1, 2, ... without end (the kiosk).
+TickSource endlessTicks(std::int64_t periodNs);
+
+// Asks a running loop to stop after the frame in hand (async-signal-safe: SIGINT/SIGTERM handlers
+// call it), so that recordings are closed properly. installStopSignals() routes both signals here.
+void requestStop();
+bool stopRequested();
+void installStopSignals();
+
 // Runs the plan. Every polled sample and every frame record go to 'recorder' when it is non-null;
 // 'readback' says which images onFrame needs.
 Expected<LoopStats> runFrames(Appliance& appliance,
                               Sources& sources,
                               const std::vector<TickPlan>& plan,
+                              Pacing pacing,
+                              recordings::RecordingWriter* recorder,
+                              pipeline::render::Readback readback,
+                              const FrameCallback& onFrame);
+
+// The same, ticks drawn one at a time.
+Expected<LoopStats> runFrames(Appliance& appliance,
+                              Sources& sources,
+                              const TickSource& ticks,
                               Pacing pacing,
                               recordings::RecordingWriter* recorder,
                               pipeline::render::Readback readback,

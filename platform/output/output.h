@@ -1,4 +1,4 @@
-// The output interface: where rendered frames go (headless now, KMS scan-out later).
+// The output interface: where rendered frames go (headless, or KMS scan-out).
 #pragma once
 
 #include <cstdint>
@@ -32,5 +32,12 @@ public:
 // A surfaceless EGL context with GLES 3 (Mesa llvmpipe where there is no GPU); frames are kept in
 // memory only. Makes its context current on the calling thread.
 Expected<std::unique_ptr<Output>> createHeadlessOutput();
+
+// Fullscreen on a display with no display server: renders with the same surfaceless context and
+// scans frames out through KMS on 'device' (e.g. /dev/dri/card0), on the first connected
+// connector or the named one ("HDMI-A-1"), in its preferred mode. Frames smaller than the mode are
+// centred on black.
+Expected<std::unique_ptr<Output>> createKmsOutput(const std::string& device,
+                                                  const std::string& connector = {});
 
 } // namespace replica::platform

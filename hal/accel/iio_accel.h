@@ -1,0 +1,77 @@
+// Accelerometers through the Linux IIO subsystem (sysfs): finding the device, reading its raw
+// counts with scale and offset, and the live source that samples it on its own thread.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include <hal/clock.h>
+#include <hal/sources.h>
+#include <pipeline/base/expected.h>
+
+namespace replica::hal::accel {
+
+// One IIO device directory, e.g. /sys/bus/iio/devices/iio:device0, holding in_accel_* attributes.
+class IioAccelDevice
+{
+public:
+    // Opens 'dir' (a device directory), checking that it has in_accel_{x,y,z}_raw and a scale.
+    static Expected<IioAccelDevice> open(const std::filesystem::path& dir);
+
+    // The first device under 'root' (default /sys/bus/iio/devices) with accelerometer channels,
+    // or the one whose 'name' attribute equals 'name' when given.
+    static Expected<IioAccelDevice> find(const std::filesystem::path& root,
+                                         const std::string& name = {});
+
+    // a = (raw + offset) * scale per axis, m/s^2. Fails naming the attribute file if a read fails
+    // (the device was removed, or the driver returned garbage).
+    Expected<std::array<double, 3>> read() const;
+
+    const std::string& name() const { return name_; }
+    const std::filesystem::path& dir() const { return dir_; }
+    std::array<double, 3> scale() const { return scale_; }
+    std::array<double, 3> offset() const { return offset_; }
+
+private:
+    std::filesystem::path dir_;
+    std::string name_;
+    std::array<double, 3> scale_{};
+    std::array<double, 3> offset_{};
+};
+
+// Parses one sysfs attribute: a single C-locale number and a newline.
+Expected<double> readSysfsNumber(const std::filesystem::path& file);
+
+// How the sensor is mounted on the panel: for each panel axis (x right, y up the panel, z out of
+// the screen), which sensor axis and sign, e.g. "x,y,z" (aligned) or "-y,x,z".
+struct AxisMapping {
+    std::array<int, 3> axis{0, 1, 2};
+    std::array<double, 3> sign{1.0, 1.0, 1.0};
+};
+
+Expected<AxisMapping> parseAxisMapping(const std::string& text);
+
+// An accelerometer at rest reads the reaction to gravity (+1 g pointing up); the HAL's
+// AccelSample carries gravity itself (pointing down) in the panel frame: -(mapped reading).
+glm::dvec3 gravityInPanel(const std::array<double, 3>& reading, const AxisMapping& mapping);
+
+struct IioAccelSourceOptions {
+    AxisMapping mounting;
+    std::filesystem::path root = "/sys/bus/iio/devices";
+    std::string name;                   // the device's 'name' attribute; empty = the first
+    std::int64_t periodNs = 10'000'000; // 100 Hz
+    std::int64_t reconnectNs = 1'000'000'000;
+};
+
+// Live source: reads the device at a fixed period on its own thread; if it disappears, reports
+// Lost and looks for it again every second.
+std::unique_ptr<AccelSource> makeIioAccelSource(const Clock& clock, IioAccelSourceOptions options);
+
+} // namespace replica::hal::accel

@@ -1,0 +1,193 @@
+// libusb-1.0 implementation of UsbTransport.
+#include <limits>
+
+#include <fmt/format.h>
+#include <libusb.h>
+
+#include <hal/spectrometer/libusb_transport.h>
+
+namespace replica::hal::spectrometer {
+namespace {
+
+UsbStatus statusOf(int rc)
+{
+    switch (rc) {
+    case LIBUSB_SUCCESS:
+        return UsbStatus::Ok;
+    case LIBUSB_ERROR_TIMEOUT:
+        return UsbStatus::Timeout;
+    case LIBUSB_ERROR_NO_DEVICE:
+        return UsbStatus::Gone;
+    case LIBUSB_ERROR_PIPE:
+        return UsbStatus::Stall;
+    case LIBUSB_ERROR_OVERFLOW:
+        return UsbStatus::Overflow;
+    default:
+        return UsbStatus::Io;
+    }
+}
+
+struct ContextDeleter {
+    void operator()(libusb_context* c) const { libusb_exit(c); }
+};
+using ContextPtr = std::unique_ptr<libusb_context, ContextDeleter>;
+
+Expected<ContextPtr> makeContext()
+{
+    libusb_context* ctx = nullptr;
+    if (const int rc = libusb_init(&ctx); rc != LIBUSB_SUCCESS) {
+        return makeError(ErrorCode::Io, fmt::format("libusb could not start: {}; is /dev/bus/usb "
+                                                    "available (in a container, pass it through)?",
+                                                    libusb_strerror(rc)));
+    }
+    return ContextPtr(ctx);
+}
+
+class LibusbTransport final : public UsbTransport
+{
+public:
+    LibusbTransport(ContextPtr ctx, libusb_device_handle* handle, UsbDeviceId id)
+        : ctx_(std::move(ctx)), handle_(handle), id_(id)
+    {}
+    ~LibusbTransport() override
+    {
+        libusb_release_interface(handle_, 0);
+        libusb_close(handle_);
+    }
+    LibusbTransport(const LibusbTransport&) = delete;
+    LibusbTransport& operator=(const LibusbTransport&) = delete;
+
+    UsbResult
+    bulkWrite(std::uint8_t endpoint, std::span<const std::uint8_t> data, int timeoutMs) override
+    {
+        int done = 0;
+        // libusb takes a non-const buffer for both directions; it does not write to an OUT one.
+        const int rc = libusb_bulk_transfer(
+                handle_, endpoint, const_cast<unsigned char*>(data.data()),
+                static_cast<int>(data.size()), &done, static_cast<unsigned>(timeoutMs));
+        return {statusOf(rc), static_cast<std::size_t>(done)};
+    }
+
+    UsbResult
+    bulkRead(std::uint8_t endpoint, std::span<std::uint8_t> buffer, int timeoutMs) override
+    {
+        int done = 0;
+        const int len = static_cast<int>(
+                std::min<std::size_t>(buffer.size(), std::numeric_limits<int>::max()));
+        const int rc = libusb_bulk_transfer(handle_, endpoint, buffer.data(), len, &done,
+                                            static_cast<unsigned>(timeoutMs));
+        return {statusOf(rc), static_cast<std::size_t>(done)};
+    }
+
+    UsbStatus clearHalt(std::uint8_t endpoint) override
+    {
+        return statusOf(libusb_clear_halt(handle_, endpoint));
+    }
+
+    std::string describe() const override
+    {
+        return fmt::format("USB bus {} address {} ({:04x}:{:04x})", id_.bus, id_.address,
+                           id_.vendor, id_.product);
+    }
+
+private:
+    ContextPtr ctx_;
+    libusb_device_handle* handle_;
+    UsbDeviceId id_;
+};
+
+} // namespace
+
+Expected<std::vector<UsbDeviceId>> listUsbDevices(std::uint16_t vendor, std::uint16_t product)
+{
+    auto ctx = makeContext();
+    if (!ctx) {
+        return tl::unexpected(ctx.error());
+    }
+    libusb_device** list = nullptr;
+    const ssize_t n = libusb_get_device_list(ctx->get(), &list);
+    if (n < 0) {
+        return makeError(ErrorCode::Io, fmt::format("libusb could not list devices: {}",
+                                                    libusb_strerror(static_cast<int>(n))));
+    }
+    std::vector<UsbDeviceId> found;
+    for (ssize_t i = 0; i < n; ++i) {
+        libusb_device_descriptor d{};
+        if (libusb_get_device_descriptor(list[i], &d) == LIBUSB_SUCCESS && d.idVendor == vendor &&
+            d.idProduct == product) {
+            found.push_back({vendor, product, libusb_get_bus_number(list[i]),
+                             libusb_get_device_address(list[i])});
+        }
+    }
+    libusb_free_device_list(list, 1);
+    return found;
+}
+
+Expected<std::unique_ptr<UsbTransport>>
+openLibusbTransport(std::uint16_t vendor, std::uint16_t product, int bus, int address)
+{
+    auto ctx = makeContext();
+    if (!ctx) {
+        return tl::unexpected(ctx.error());
+    }
+    libusb_device** list = nullptr;
+    const ssize_t n = libusb_get_device_list(ctx->get(), &list);
+    if (n < 0) {
+        return makeError(ErrorCode::Io, fmt::format("libusb could not list devices: {}",
+                                                    libusb_strerror(static_cast<int>(n))));
+    }
+    libusb_device* chosen = nullptr;
+    UsbDeviceId id{vendor, product, 0, 0};
+    for (ssize_t i = 0; i < n && chosen == nullptr; ++i) {
+        libusb_device_descriptor d{};
+        if (libusb_get_device_descriptor(list[i], &d) != LIBUSB_SUCCESS || d.idVendor != vendor ||
+            d.idProduct != product) {
+            continue;
+        }
+        const int b = libusb_get_bus_number(list[i]);
+        const int a = libusb_get_device_address(list[i]);
+        if ((bus == 0 || bus == b) && (address == 0 || address == a)) {
+            chosen = list[i];
+            id.bus = b;
+            id.address = a;
+        }
+    }
+    libusb_device_handle* handle = nullptr;
+    int rc = chosen != nullptr ? libusb_open(chosen, &handle) : LIBUSB_ERROR_NOT_FOUND;
+    libusb_free_device_list(list, 1);
+    if (rc == LIBUSB_ERROR_NOT_FOUND) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("no USB device {:04x}:{:04x} found: check the cable and "
+                                     "`lsusb`",
+                                     vendor, product));
+    }
+    if (rc == LIBUSB_ERROR_ACCESS) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("USB device {:04x}:{:04x} at bus {} address {} is not "
+                                     "accessible to this user: install deploy/udev/"
+                                     "60-replica.rules and replug it",
+                                     vendor, product, id.bus, id.address));
+    }
+    if (rc != LIBUSB_SUCCESS) {
+        return makeError(ErrorCode::Io, fmt::format("could not open USB device {:04x}:{:04x}: {}",
+                                                    vendor, product, libusb_strerror(rc)));
+    }
+    libusb_set_auto_detach_kernel_driver(handle, 1);
+    if (rc = libusb_set_configuration(handle, 1); rc != LIBUSB_SUCCESS && rc != LIBUSB_ERROR_BUSY) {
+        libusb_close(handle);
+        return makeError(ErrorCode::DeviceFailure,
+                         fmt::format("USB device {:04x}:{:04x}: cannot select configuration 1: {}",
+                                     vendor, product, libusb_strerror(rc)));
+    }
+    if (rc = libusb_claim_interface(handle, 0); rc != LIBUSB_SUCCESS) {
+        libusb_close(handle);
+        return makeError(ErrorCode::Io,
+                         fmt::format("USB device {:04x}:{:04x}: cannot claim interface 0 ({}); "
+                                     "is another program (OceanView, seabreeze) using it?",
+                                     vendor, product, libusb_strerror(rc)));
+    }
+    return std::unique_ptr<UsbTransport>(
+            std::make_unique<LibusbTransport>(std::move(*ctx), handle, id));
+}
+
+} // namespace replica::hal::spectrometer

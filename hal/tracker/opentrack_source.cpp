@@ -1,0 +1,173 @@
+// UDP receiver thread for opentrack poses.
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <deque>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <arpa/inet.h>
+#include <fmt/format.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <spdlog/spdlog.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <hal/log.h>
+#include <hal/tracker/opentrack_source.h>
+
+namespace replica::hal::tracker {
+namespace {
+
+class OpentrackUdpSource final : public OpentrackSource
+{
+public:
+    OpentrackUdpSource(int fd,
+                       std::uint16_t port,
+                       const Clock& clock,
+                       OpentrackSourceOptions options)
+        : fd_(fd), port_(port), clock_(clock), options_(std::move(options))
+    {
+        info_.model = "opentrack-udp";
+        info_.serial = fmt::format("{}:{}", options_.bindAddress, port_);
+        info_.kind = SourceKind::Live;
+        thread_ = std::thread([this] { run(); });
+    }
+
+    ~OpentrackUdpSource() override
+    {
+        stop_ = true;
+        thread_.join();
+        ::close(fd_);
+    }
+
+    OpentrackUdpSource(const OpentrackUdpSource&) = delete;
+    OpentrackUdpSource& operator=(const OpentrackUdpSource&) = delete;
+
+    const DeviceInfo& info() const override { return info_; }
+    std::uint16_t boundPort() const override { return port_; }
+    long rejectedDatagrams() const override { return rejected_.load(); }
+
+    LinkState state() const override
+    {
+        const std::int64_t last = lastGoodNs_.load();
+        if (last < 0) {
+            return LinkState::Lost;
+        }
+        return clock_.nowNs() - last > options_.staleNs ? LinkState::Stalled : LinkState::Connected;
+    }
+
+    void poll(std::int64_t untilNs, std::vector<PoseSample>& out) override
+    {
+        std::lock_guard lock(mutex_);
+        while (!queue_.empty() && queue_.front().timestampNs <= untilNs) {
+            out.push_back(queue_.front());
+            queue_.pop_front();
+        }
+        // A tracker that went quiet must not leave the last pose standing as if still tracked.
+        const std::int64_t last = lastGoodNs_.load();
+        if (last >= 0 && untilNs - last > options_.staleNs && !reportedStale_) {
+            PoseSample s;
+            s.timestampNs = last + options_.staleNs;
+            s.sequence = sequence_++;
+            s.tracked = false;
+            out.push_back(s);
+            reportedStale_ = true;
+        }
+    }
+
+private:
+    void run()
+    {
+        std::vector<std::uint8_t> buf(512);
+        while (!stop_) {
+            pollfd p{fd_, POLLIN, 0};
+            const int n = ::poll(&p, 1, 50);
+            if (n <= 0) {
+                continue;
+            }
+            const ssize_t got = ::recv(fd_, buf.data(), buf.size(), 0);
+            if (got < 0) {
+                if (errno != EINTR && errno != EAGAIN) {
+                    deviceLog("hal.tracker")
+                            ->warn("UDP receive on port {} failed: {}", port_,
+                                   std::strerror(errno));
+                }
+                continue;
+            }
+            const auto pose = decodeOpentrack({buf.data(), static_cast<std::size_t>(got)});
+            if (!pose) {
+                if (++rejected_ == 1) {
+                    deviceLog("hal.tracker")
+                            ->warn("dropped a {}-byte datagram on port {} (opentrack "
+                                   "sends 48 finite bytes); is another program sending here?",
+                                   got, port_);
+                }
+                continue;
+            }
+            PoseSample s;
+            s.timestampNs = clock_.nowNs();
+            s.eyeTrackerM = eyeFromHeadPose(*pose, options_.mounting);
+            s.tracked = true;
+            std::lock_guard lock(mutex_);
+            s.sequence = sequence_++;
+            queue_.push_back(s);
+            if (queue_.size() > 1024) { // a loop that stopped polling must not grow us forever
+                queue_.pop_front();
+            }
+            lastGoodNs_ = s.timestampNs;
+            reportedStale_ = false;
+        }
+    }
+
+    int fd_;
+    std::uint16_t port_;
+    const Clock& clock_;
+    OpentrackSourceOptions options_;
+    DeviceInfo info_;
+    std::atomic<bool> stop_{false};
+    std::atomic<std::int64_t> lastGoodNs_{-1};
+    std::atomic<long> rejected_{0};
+    std::mutex mutex_;
+    std::deque<PoseSample> queue_;
+    std::uint32_t sequence_ = 0; // under mutex_
+    bool reportedStale_ = false; // under mutex_
+    std::thread thread_;
+};
+
+} // namespace
+
+Expected<std::unique_ptr<OpentrackSource>> makeOpentrackSource(const Clock& clock,
+                                                               OpentrackSourceOptions options)
+{
+    const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) {
+        return makeError(ErrorCode::Io, fmt::format("tracker: cannot create a UDP socket: {}",
+                                                    std::strerror(errno)));
+    }
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(options.port);
+    if (::inet_pton(AF_INET, options.bindAddress.c_str(), &addr.sin_addr) != 1) {
+        ::close(fd);
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("tracker: '{}' is not an IPv4 address", options.bindAddress));
+    }
+    if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
+        const int err = errno;
+        ::close(fd);
+        return makeError(ErrorCode::Io,
+                         fmt::format("tracker: cannot listen on UDP {}:{}: {}; is another "
+                                     "program (a second replica?) using the port?",
+                                     options.bindAddress, options.port, std::strerror(err)));
+    }
+    socklen_t len = sizeof addr;
+    ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+    const std::uint16_t port = ntohs(addr.sin_port);
+    return std::unique_ptr<OpentrackSource>(
+            std::make_unique<OpentrackUdpSource>(fd, port, clock, std::move(options)));
+}
+
+} // namespace replica::hal::tracker

@@ -1,0 +1,67 @@
+// Live sources for 'replica run --hal live'.
+#include <algorithm>
+#include <numeric>
+
+#include <hal/accel/iio_accel.h>
+#include <hal/spectrometer/usb2000_protocol.h>
+#include <hal/spectrometer/usb2000_source.h>
+#include <hal/tracker/opentrack_source.h>
+#include <pipeline/spectral/spectrometer_chain.h>
+#include <platform/live_sources.h>
+
+namespace replica::platform {
+
+namespace {
+
+// The pipeline's auto-integration controller, seen from the driver thread.
+std::uint32_t autoIntegration(const hal::SpectrumSample& s)
+{
+    namespace usb2000 = hal::spectrometer::usb2000;
+    if (s.counts.size() <= static_cast<std::size_t>(usb2000::kDarkPixelLast)) {
+        return 0;
+    }
+    const auto first = s.counts.begin() + usb2000::kDarkPixelFirst;
+    const auto last = s.counts.begin() + usb2000::kDarkPixelLast + 1;
+    const double dark = std::accumulate(first, last, 0.0) / static_cast<double>(last - first);
+    pipeline::spectral::AutoIntegrationParams params;
+    if (s.saturated) {
+        // The driver judged saturation against the EEPROM level, which may sit below 65535: make
+        // the controller see it too.
+        params.saturationCounts = *std::max_element(s.counts.begin(), s.counts.end());
+    }
+    const auto d =
+            pipeline::spectral::nextIntegrationTime(s.counts, dark, s.integrationTimeUs, params);
+    return d.changed ? d.integrationTimeUs : 0;
+}
+
+} // namespace
+
+Expected<Sources> makeLiveSources(const hal::Clock& clock, const LiveOptions& options)
+{
+    hal::tracker::OpentrackSourceOptions trackerOptions;
+    trackerOptions.port = options.trackerPort;
+    trackerOptions.bindAddress = options.trackerBind;
+    auto tracker = hal::tracker::makeOpentrackSource(clock, trackerOptions);
+    if (!tracker) {
+        return tl::unexpected(tracker.error());
+    }
+    hal::spectrometer::Usb2000SourceOptions specOptions;
+    specOptions.nextIntegrationUs = autoIntegration;
+    hal::accel::IioAccelSourceOptions accelOptions;
+    auto mounting = hal::accel::parseAxisMapping(options.accelAxes);
+    if (!mounting) {
+        return tl::unexpected(mounting.error());
+    }
+    accelOptions.mounting = *mounting;
+    accelOptions.root = options.iioRoot;
+    accelOptions.name = options.accelName;
+
+    Sources s;
+    s.tracker = std::move(*tracker);
+    s.spectrometer = hal::spectrometer::makeUsb2000Source(hal::spectrometer::libusbUsb2000Opener(),
+                                                          clock, std::move(specOptions));
+    s.accel = hal::accel::makeIioAccelSource(clock, std::move(accelOptions));
+    return s;
+}
+
+} // namespace replica::platform

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# 'replica probe' against a fake IIO accelerometer (tilted back 30 degrees) and a UDP sender
+# speaking opentrack's protocol; no spectrometer is attached here, so the report says so and the
+# exit status is 1.
+set -uo pipefail
+replica="$1"
+work="$2"
+rm -rf "$work" && mkdir -p "$work/iio/iio:device0"
+dev="$work/iio/iio:device0"
+echo lis3dh > "$dev/name"
+# Reaction to gravity for a panel leaning back 30 degrees: (0, g cos 30, g sin 30) in panel axes.
+python3 - "$dev" <<'PY'
+import math, sys
+d = sys.argv[1]
+scale = 0.001
+g = 9.80665
+for axis, v in (("x", 0.0), ("y", g * math.cos(math.radians(30))), ("z", g * math.sin(math.radians(30)))):
+    open(f"{d}/in_accel_{axis}_raw", "w").write(f"{round(v / scale)}\n")
+open(f"{d}/in_accel_scale", "w").write(f"{scale}\n")
+PY
+port=$(python3 -c 'import socket; s=socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+# The sender runs until the probe is done (python can take a second to start on a busy machine,
+# so the probe starts only once the sender is sending).
+python3 - "$port" "$work/sender-ready" <<'PY' &
+import socket, struct, sys, time
+s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+end = time.time() + 60.0
+first = True
+while time.time() < end:
+    s.sendto(struct.pack("<6d", 2.0, 45.0, 60.0, 0.0, 0.0, 0.0), ("127.0.0.1", int(sys.argv[1])))
+    if first:
+        open(sys.argv[2], "w").close()
+        first = False
+    time.sleep(0.01)
+PY
+sender=$!
+for _ in $(seq 1 300); do
+    [ -e "$work/sender-ready" ] && break
+    sleep 0.1
+done
+"$replica" probe --json --iio-root "$work/iio" --tracker-port "$port" --tracker-wait 1 \
+    > "$work/probe.json" 2> "$work/probe.log"
+code=$?
+kill "$sender" 2>/dev/null
+wait "$sender" 2>/dev/null
+python3 - "$work/probe.json" "$code" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+code = int(sys.argv[2])
+fail = []
+a = r["accelerometer"]
+if not a.get("ok") or abs(a["tilt_deg"] - 30.0) > 0.05:
+    fail.append(f"accelerometer: {a}")
+t = r["tracker"]
+if not t.get("found") or t["poses"] < 10:
+    fail.append(f"tracker: {t}")
+else:
+    eye = t["eye_tracker_m"]
+    if abs(eye[0] - 0.02) > 1e-12 or abs(eye[1] - 0.45) > 1e-12 or abs(eye[2] + 0.60) > 1e-12:
+        fail.append(f"tracker eye {eye}")
+s = r["spectrometer"]
+if s.get("found") or "2457:101e" not in s.get("error", ""):
+    fail.append(f"spectrometer: {s}")
+if r["all_found"] or code != 1:
+    fail.append(f"all_found {r['all_found']} exit {code}")
+if fail:
+    print("FAIL: " + "; ".join(fail), file=sys.stderr)
+    sys.exit(1)
+print(f"ok: tilt {a['tilt_deg']:.3f} deg, {t['poses']} poses, spectrometer reported missing, exit {code}")
+PY

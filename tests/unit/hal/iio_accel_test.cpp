@@ -1,0 +1,147 @@
+// The IIO accelerometer against a fake sysfs tree in a temporary directory: attribute layouts
+// (shared and per-axis scale, optional offset), bad values, and removal while running.
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <hal/accel/iio_accel.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::tests {
+namespace {
+namespace fs = std::filesystem;
+using hal::accel::IioAccelDevice;
+
+class FakeIio : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        root_ = fs::temp_directory_path() /
+                ("replica-iio-" +
+                 std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
+                 ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(root_);
+        fs::create_directories(root_ / "iio:device0");
+        write("iio:device0/name", "some-adc");
+        write("iio:device0/in_voltage0_raw", "12");
+        dev_ = root_ / "iio:device1";
+        fs::create_directories(dev_);
+        write("iio:device1/name", "lis3dh");
+        write("iio:device1/in_accel_x_raw", "-12");
+        write("iio:device1/in_accel_y_raw", "1000");
+        write("iio:device1/in_accel_z_raw", "40");
+        write("iio:device1/in_accel_scale", "0.009806650");
+    }
+    void TearDown() override { fs::remove_all(root_); }
+    void write(const std::string& rel, const std::string& text)
+    {
+        std::ofstream(root_ / rel) << text << "\n";
+    }
+    fs::path root_;
+    fs::path dev_;
+};
+
+TEST_F(FakeIio, FindsTheAccelerometerAndScalesItsCounts)
+{
+    auto d = IioAccelDevice::find(root_);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_EQ(d->name(), "lis3dh");
+    auto a = d->read();
+    ASSERT_TRUE(a);
+    EXPECT_DOUBLE_EQ((*a)[0], -12 * 0.00980665);
+    EXPECT_DOUBLE_EQ((*a)[1], 1000 * 0.00980665);
+    EXPECT_DOUBLE_EQ((*a)[2], 40 * 0.00980665);
+}
+
+TEST_F(FakeIio, PerAxisScaleAndOffsetWin)
+{
+    write("iio:device1/in_accel_y_scale", "0.02");
+    write("iio:device1/in_accel_y_offset", "-10");
+    auto d = IioAccelDevice::open(dev_);
+    ASSERT_TRUE(d);
+    auto a = d->read();
+    ASSERT_TRUE(a);
+    EXPECT_DOUBLE_EQ((*a)[1], (1000 - 10) * 0.02);
+    EXPECT_DOUBLE_EQ((*a)[0], -12 * 0.00980665);
+}
+
+TEST_F(FakeIio, BadAttributesNameTheFile)
+{
+    write("iio:device1/in_accel_z_raw", "4o");
+    auto d = IioAccelDevice::open(dev_);
+    ASSERT_TRUE(d);
+    auto a = d->read();
+    ASSERT_FALSE(a);
+    EXPECT_NE(a.error().message.find("in_accel_z_raw"), std::string::npos);
+    write("iio:device1/in_accel_scale", "0");
+    auto z = IioAccelDevice::open(dev_);
+    ASSERT_FALSE(z);
+    EXPECT_NE(z.error().message.find("not positive"), std::string::npos);
+    auto named = IioAccelDevice::find(root_, "bmi160");
+    ASSERT_FALSE(named);
+    EXPECT_NE(named.error().message.find("bmi160"), std::string::npos);
+    auto none = IioAccelDevice::find(root_ / "nowhere");
+    ASSERT_FALSE(none);
+}
+
+TEST_F(FakeIio, SourceSamplesLosesTheDeviceAndFindsItAgain)
+{
+    hal::SteadyClock clock;
+    hal::accel::IioAccelSourceOptions opt;
+    opt.root = root_;
+    opt.periodNs = 2'000'000;
+    opt.reconnectNs = 10'000'000;
+    auto src = hal::accel::makeIioAccelSource(clock, opt);
+    std::vector<hal::AccelSample> got;
+    auto eventually = [](auto f) {
+        for (int i = 0; i < 500; ++i) {
+            if (f()) {
+                return true;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        return false;
+    };
+    ASSERT_TRUE(eventually([&] {
+        src->poll(clock.nowNs(), got);
+        return got.size() >= 3;
+    }));
+    // The reading is the reaction to gravity; the sample carries gravity itself.
+    EXPECT_DOUBLE_EQ(got[0].gravity.y, -1000 * 0.00980665);
+    EXPECT_EQ(got[1].sequence, got[0].sequence + 1);
+    fs::remove_all(dev_);
+    ASSERT_TRUE(eventually([&] { return src->state() == hal::LinkState::Lost; }));
+    fs::create_directories(dev_);
+    write("iio:device1/name", "lis3dh");
+    write("iio:device1/in_accel_x_raw", "0");
+    write("iio:device1/in_accel_y_raw", "0");
+    write("iio:device1/in_accel_z_raw", "1000");
+    write("iio:device1/in_accel_scale", "0.00980665");
+    ASSERT_TRUE(eventually([&] { return src->state() == hal::LinkState::Connected; }));
+    got.clear();
+    ASSERT_TRUE(eventually([&] {
+        src->poll(clock.nowNs(), got);
+        return !got.empty() && got.back().gravity.z < -9.0;
+    }));
+}
+
+TEST(AxisMapping, ParsesSignedPermutationsAndRejectsTheRest)
+{
+    auto m = hal::accel::parseAxisMapping("-y,x,z");
+    ASSERT_TRUE(m) << m.error().message;
+    // Sensor reads (1, 2, 3): panel x = -(-y) = 2, panel y = -x = -1, panel z = -z = -3.
+    const glm::dvec3 g = hal::accel::gravityInPanel({1.0, 2.0, 3.0}, *m);
+    EXPECT_DOUBLE_EQ(g.x, 2.0);
+    EXPECT_DOUBLE_EQ(g.y, -1.0);
+    EXPECT_DOUBLE_EQ(g.z, -3.0);
+    for (const char* bad : {"x,y", "x,x,z", "x,y,w", "x,y,z,x", "", "xy,z,", "--x,y,z"}) {
+        auto e = hal::accel::parseAxisMapping(bad);
+        EXPECT_FALSE(e) << bad;
+    }
+}
+
+} // namespace
+} // namespace replica::tests
