@@ -321,7 +321,29 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     glBindTexture(GL_TEXTURE_2D_ARRAY, horizon_);
     glActiveTexture(GL_TEXTURE0 + kUnitLum);
     glBindTexture(GL_TEXTURE_2D, lum_);
+    // Pixels that show no surface are black: clear them and shade only the surface's rectangle
+    // (pixel u = (surface u - offset) / scale), widened by a pixel so that the shader's own
+    // bounds test decides every edge pixel exactly as it would without the scissor.
+    const auto span = [](double offset, double scale, int n) {
+        const double a = (0.0 - offset) / scale * n;
+        const double b = (1.0 - offset) / scale * n;
+        const int lo = std::clamp(static_cast<int>(std::floor(std::min(a, b))) - 1, 0, n);
+        const int hi = std::clamp(static_cast<int>(std::ceil(std::max(a, b))) + 1, 0, n);
+        return std::pair<int, int>(lo, hi);
+    };
+    const bool scissor = layout.scale.x > 0.0 && layout.scale.y > 0.0;
+    if (scissor) {
+        const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
+        const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
+        glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(x0, height - r1, x1 - x0, r1 - r0);
+    }
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (scissor) {
+        glDisable(GL_SCISSOR_TEST);
+    }
     glActiveTexture(GL_TEXTURE0);
     return glCheck("drawing the booth pass");
 }
