@@ -159,3 +159,34 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
 
 } // namespace
 } // namespace replica::pipeline::render
+
+namespace replica::platform {
+namespace {
+
+TEST(ApplianceBoothScene, RecordsTheSceneAndRefusesAChangedOne)
+{
+    RunConfig c;
+    c.width = 32;
+    c.height = 20;
+    c.sceneDir = "scenes/metamer";
+    auto app = buildAppliance(c);
+    if (!app && app.error().message.find("EGL") != std::string::npos) {
+        GTEST_SKIP() << app.error().message;
+    }
+    ASSERT_TRUE(app) << app.error().message;
+    // The configuration as built names the scene and its digest: what a recording stores.
+    EXPECT_EQ((*app)->config.scene, "metamer");
+    EXPECT_EQ((*app)->config.sceneDigest, *sceneDigest(resolveSceneDir("scenes/metamer")));
+    EXPECT_NE((*app)->renderer->description().find("gles-booth (scene metamer"), std::string::npos);
+    app->reset();
+
+    c.sceneDigest = "0123456789abcdef";
+    auto refused = buildAppliance(c);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("the scene has changed since it was recorded"),
+              std::string::npos)
+            << refused.error().message;
+}
+
+} // namespace
+} // namespace replica::platform
