@@ -11,10 +11,12 @@
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
 #include <pipeline/reference/reference_integrator.h>
+#include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/shading/planner.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/surface/scene.h>
 #include <platform/cli/commands.h>
+#include <platform/output/output.h>
 
 namespace replica::platform {
 namespace {
@@ -28,6 +30,7 @@ struct RenderArgs {
     std::string size = "192x120";
     bool reference = false;
     bool plan = false;
+    bool gl = false;
     int lights = 32;
     int samples = 16;
     int horizonDirections = 8;
@@ -88,6 +91,19 @@ int runRender(const RenderArgs& a)
         return fail(kExitFailure, obs.error().message);
     }
     view.panel = shading::panelPoseFromTilt(a.tilt);
+    // The appliance's channel basis (docs/accuracy.md), for the CPU model and the GL pass alike.
+    auto basis = colour::loadDefaultChannelBasis(dataDir());
+    if (!basis) {
+        return fail(kExitFailure, basis.error().message);
+    }
+    std::unique_ptr<platform::Output> output;
+    if (a.gl && !a.reference) {
+        auto out = platform::createHeadlessOutput();
+        if (!out) {
+            return fail(kExitFailure, out.error().message);
+        }
+        output = std::move(*out);
+    }
 
     const auto t0 = std::chrono::steady_clock::now();
     shading::XyzFrame frame;
@@ -102,13 +118,32 @@ int runRender(const RenderArgs& a)
         frame = reference::renderReference(*scene, *light, view, *obs);
     } else {
         if (a.plan) {
-            plan = shading::planRender(*scene, *light, view, *obs);
+            plan = shading::planRender(*scene, *light, view, *obs, {}, 32, 20, *basis);
             settings = plan.settings;
-            mode = "realtime-cpu, planned";
         }
-        const auto pl = shading::prepareLight(*light, *obs, settings.lights);
-        const auto ps = shading::prepareScene(*scene, std::max(settings.horizonDirections, 1));
-        frame = shading::renderRealtime(ps, pl, view, *obs, settings);
+        const auto pl = shading::prepareLight(*light, *obs, settings.lights, *basis);
+        const auto ps = shading::prepareScene(*scene, std::max(settings.horizonDirections, 1), 0.01,
+                                              *basis);
+        if (a.gl) {
+            mode = "realtime-gles";
+            auto pass = render::BoothShadingPass::create(ps, settings, *obs);
+            if (!pass) {
+                return fail(kExitFailure, pass.error().message);
+            }
+            if (auto ok = (*pass)->setLight(pl); !ok) {
+                return fail(kExitFailure, ok.error().message);
+            }
+            auto f = render::renderBoothFrame(**pass, pl, view);
+            if (!f) {
+                return fail(kExitFailure, f.error().message);
+            }
+            frame = std::move(*f);
+        } else {
+            frame = shading::renderRealtime(ps, pl, view, *obs, settings);
+        }
+        if (a.plan) {
+            mode += ", planned";
+        }
     }
     const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
@@ -148,6 +183,7 @@ int runRender(const RenderArgs& a)
                      {"eye_behind_pixels", frame.eyeBehindPixels}};
     if (!a.reference) {
         j["lights"] = settings.lights;
+        j["basis"] = basis->name;
         j["specular_samples"] =
                 scene->glossy() && settings.specularPass ? settings.specularSamples : 0;
         j["horizon_directions"] =
@@ -189,6 +225,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
             ->capture_default_str();
     cmd->add_option("--size", args->size, "output size WxH in pixels")->capture_default_str();
     cmd->add_flag("--reference", args->reference, "use the exact CPU reference integrator (slow)");
+    cmd->add_flag("--gl", args->gl,
+                  "render with the GLES 3.1 pass through surfaceless EGL (what the appliance runs) "
+                  "instead of its CPU model");
     cmd->add_flag("--plan", args->plan,
                   "let the planner pick the cheapest setting meeting dE00 p95 <= 1");
     cmd->add_option("--lights", args->lights, "median-cut point lights")

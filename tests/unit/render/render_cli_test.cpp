@@ -84,6 +84,19 @@ TEST(RenderCli, WritesFiniteAbsoluteXyzCloseToTheReference)
     }
     EXPECT_GT(sumB, 0.0);
     EXPECT_NEAR(sumA / sumB, 1.0, 0.02); // mean luminance within 2 % of the reference
+
+    // --gl: the same frame from the GLES pass the appliance runs (skipped without EGL).
+    const std::string gl = (dir / "replica_cli_gl.exr").string();
+    const CliResult g = run(common + "--lights 128 --samples 32 --gl --out " + gl);
+    if (g.code != 0 && g.err.find("EGL") != std::string::npos) {
+        GTEST_SKIP() << g.err;
+    }
+    ASSERT_EQ(g.code, 0) << g.err;
+    auto c = pipeline::image::readExr(gl, {"X", "Y", "Z"});
+    ASSERT_TRUE(c) << c.error().message;
+    for (std::size_t k = 0; k < a->planes[1].size(); ++k) {
+        EXPECT_NEAR(c->planes[1][k], a->planes[1][k], 1e-4 * a->planes[1][k] + 1e-3) << k;
+    }
 }
 
 } // namespace
