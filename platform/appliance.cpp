@@ -251,7 +251,11 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
     SceneUpdaterSetup updaterSetup;
     updaterSetup.booth = app->booth;
     updaterSetup.calibration = *calibration;
-    app->updater = std::make_unique<SceneUpdater>(std::move(updaterSetup));
+    auto updater = SceneUpdater::create(std::move(updaterSetup));
+    if (!updater) {
+        return tl::unexpected(updater.error());
+    }
+    app->updater = std::make_unique<SceneUpdater>(std::move(*updater));
     return app;
 }
 

@@ -103,12 +103,18 @@ Expected<AccuracyReport> evaluateRepresentation(const Observer& obs,
                          "accuracy: the light has no luminance (Y <= 0); is it all zeros?");
     }
     const Xyz d65Xyz = colour::spectrumToXyz(obs, d65);
-    const std::vector<Xyz> lightVectors = approx.lightVectors(light);
+    // An adaptive representation is evaluated as encoded for the light it renders under.
+    auto adapted = approx.adaptedTo(light);
+    if (!adapted) {
+        return tl::unexpected(adapted.error());
+    }
+    const Representation& rep = *adapted ? **adapted : approx;
+    const std::vector<Xyz> lightVectors = rep.lightVectors(light);
     std::vector<Xyz> reference;
     std::vector<Xyz> approximate;
     for (const auto& r : samples.spectra) {
         reference.push_back(colour::spectrumToXyz(obs, light * r) * (1.0 / lightXyz.y));
-        approximate.push_back(shade(approx.encode(r), lightVectors));
+        approximate.push_back(shade(rep.encode(r), lightVectors));
     }
     AccuracyReport report;
     report.representation = approx.name();

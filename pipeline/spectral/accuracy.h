@@ -52,8 +52,10 @@ Expected<std::vector<colour::Lab>> normalisedLab(const std::vector<Xyz>& xyz,
                                                  const Xyz& lightXyz,
                                                  const Xyz& d65Xyz);
 
-// Evaluates 'approx' against the full-spectral reference under 'light' for every sample. Fails for
-// a light without luminance, an empty set, or a white sample with Y <= 0.
+// Evaluates 'approx' against the full-spectral reference under 'light' for every sample. An
+// adaptive representation is evaluated as encoded for 'light' (its adaptedTo(light)); to see it
+// encoded for another light, pass that light's adaptedTo() result instead. Fails for a light
+// without luminance, an empty set, or a white sample with Y <= 0.
 Expected<AccuracyReport> evaluateRepresentation(const Observer& obs,
                                                 const Spectrum& d65,
                                                 const Representation& approx,

@@ -10,6 +10,20 @@ namespace replica::pipeline::spectral {
 using colour::kBands;
 using colour::kChannels;
 
+std::vector<std::pair<std::string, double>> defaultLightWeights()
+{
+    return {{"A", 30.0}, {"F8", 60.0}, {"F7", 30.0}, {"D50", 10.0}, {"D65", 10.0}};
+}
+
+std::string defaultLightWeightsText()
+{
+    std::string out;
+    for (const auto& [name, w] : defaultLightWeights()) {
+        out += fmt::format("{}{}={:g}", out.empty() ? "" : ",", name, w);
+    }
+    return out;
+}
+
 Expected<colour::ChannelBasis> fitChannelBasis(const Observer& obs,
                                                const Spectrum& d65,
                                                const NamedSpectra& reflectances,

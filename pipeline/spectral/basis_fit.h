@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <pipeline/base/expected.h>
@@ -27,6 +28,13 @@ struct BasisFitOptions {
     // makes them nearly exact while keeping the rest usable (docs/accuracy.md).
     std::vector<double> lightWeights;
 };
+
+// The light weights of the shipped replica_k6 (and of adaptive_k6's complement): the booth's lamps
+// (A for tungsten, F8 the D50 fluorescent simulator, F7 the D65 simulator) first, daylight next;
+// a training light not named weighs 1 (docs/accuracy.md).
+std::vector<std::pair<std::string, double>> defaultLightWeights();
+// The same as 'replica spectral fit --weights' spells them: "A=30,F8=60,...".
+std::string defaultLightWeightsText();
 
 // With C the weighted second moment of the training reflectances (plus the ridge) and G the stacked
 // H_j A_j of the training lights, the K-dimensional projection P minimising

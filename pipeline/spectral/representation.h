@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <pipeline/base/expected.h>
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/colour/spectrum.h>
 #include <pipeline/colour/xyz.h>
@@ -30,6 +31,15 @@ public:
     // Per-light vectors, channels() of them, for a light of any scale (normalised to Y = 1 inside).
     // A light with Y <= 0 gives zero vectors.
     virtual std::vector<Xyz> lightVectors(const Spectrum& light) const = 0;
+    // A representation whose texel data depend on the light (adaptive_k6) re-encodes every surface
+    // when the light changes: this is the fixed representation it becomes once encoded for
+    // 'light'. Null for the others, whose texel data never change. Fails for a light an adaptive
+    // representation cannot encode for (no luminance, bands not finite).
+    virtual Expected<std::unique_ptr<Representation>> adaptedTo(const Spectrum& light) const
+    {
+        (void)light;
+        return std::unique_ptr<Representation>{};
+    }
 };
 
 // XYZ = sum_k texel[k] * m[k]: the per-pixel work of every representation.

@@ -1,6 +1,7 @@
 // Representation names to objects, loading the fitted channel data the appliance ships.
 #include <fmt/format.h>
 
+#include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/spectral/six_channel_model.h>
 
@@ -8,7 +9,8 @@ namespace replica::pipeline::spectral {
 
 std::vector<std::string> representationNames()
 {
-    return {"rgb3", "paper6", "replica_k6", "spectral36", "general_k6", "pca6", "box6"};
+    return {"rgb3",       "paper6",     "replica_k6", "adaptive_k6",
+            "spectral36", "general_k6", "pca6",       "box6"};
 }
 
 Expected<std::unique_ptr<Representation>> makeRepresentation(const std::filesystem::path& dataDir,
@@ -25,6 +27,13 @@ Expected<std::unique_ptr<Representation>> makeRepresentation(const std::filesyst
     }
     if (name == "box6") {
         return makeBasisRepresentation(obs, colour::boxBasis());
+    }
+    if (name == "adaptive_k6") {
+        auto encoder = AdaptiveEncoder::createDefault(dataDir);
+        if (!encoder) {
+            return tl::unexpected(encoder.error());
+        }
+        return makeAdaptiveRepresentation(std::move(*encoder));
     }
     if (name == "paper6") {
         auto model = loadSixChannelModel(channels / "paper6.csv");

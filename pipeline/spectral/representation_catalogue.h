@@ -12,9 +12,10 @@
 
 namespace replica::pipeline::spectral {
 
-// "rgb3" (1), "paper6" (2), "replica_k6" (3, the appliance's default), "spectral36" (4), and for
-// comparison "general_k6" (light-aware, all training lights equal), "pca6" (principal components,
-// light-independent) and "box6" (six box bands).
+// "rgb3" (1), "paper6" (2), "replica_k6" (3, the appliance's default), "adaptive_k6" (3 re-encoded
+// for each light, adaptive_encoding.h), "spectral36" (4), and for comparison "general_k6"
+// (light-aware, all training lights equal), "pca6" (principal components, light-independent) and
+// "box6" (six box bands).
 std::vector<std::string> representationNames();
 constexpr const char* kDefaultRepresentation = "replica_k6";
 

@@ -7,11 +7,11 @@
 namespace replica::platform {
 namespace {
 
-std::vector<pipeline::colour::Spectrum> lampSpectra(const pipeline::scene::Booth& booth)
+std::vector<pipeline::spectral::StoredLight> lampLights(const pipeline::scene::Booth& booth)
 {
-    std::vector<pipeline::colour::Spectrum> out;
+    std::vector<pipeline::spectral::StoredLight> out;
     for (const auto& lamp : booth.lamps) {
-        out.push_back(lamp.spectrum);
+        out.push_back({lamp.name, lamp.spectrum});
     }
     return out;
 }
@@ -27,9 +27,25 @@ double meanLuminance(const pipeline::scene::Booth& booth)
 
 } // namespace
 
-SceneUpdater::SceneUpdater(SceneUpdaterSetup setup)
-    : setup_(std::move(setup)), classifier_(lampSpectra(setup_.booth))
-{}
+Expected<SceneUpdater> SceneUpdater::create(SceneUpdaterSetup setup,
+                                            const pipeline::spectral::LightClassifierParams& params)
+{
+    if (setup.booth.lamps.empty()) {
+        return SceneUpdater(std::move(setup), std::nullopt);
+    }
+    auto classifier = pipeline::spectral::LightClassifier::create(lampLights(setup.booth), params);
+    if (!classifier) {
+        return makeError(classifier.error().code,
+                         "booth '" + setup.booth.id + "': " + classifier.error().message);
+    }
+    return SceneUpdater(std::move(setup), std::move(*classifier));
+}
+
+pipeline::spectral::Classification SceneUpdater::classification() const
+{
+    return classifier_ ? classifier_->currentClassification()
+                       : pipeline::spectral::Classification{};
+}
 
 void SceneUpdater::update(pipeline::scene::SceneState& state,
                           const hal::SpectrumSample* spectrum,
@@ -45,7 +61,7 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
         // A saturated spectrum has lost its peaks: its shape cannot be trusted, keep the last
         // light.
         if (spd && !spectrum->saturated) {
-            const int lamp = classifier_.classify(*spd);
+            const int lamp = classifier_ ? classifier_->classify(*spd) : -1;
             state.lampIndex = lamp;
             if (lamp >= 0) {
                 const auto& l = setup_.booth.lamps[static_cast<std::size_t>(lamp)];

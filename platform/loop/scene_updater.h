@@ -9,6 +9,7 @@
 #include <glm/vec3.hpp>
 
 #include <hal/samples.h>
+#include <pipeline/base/expected.h>
 #include <pipeline/scene/booth.h>
 #include <pipeline/scene/scene_state.h>
 #include <pipeline/spectral/light_classifier.h>
@@ -25,7 +26,13 @@ struct SceneUpdaterSetup {
 class SceneUpdater
 {
 public:
-    explicit SceneUpdater(SceneUpdaterSetup setup);
+    // The booth's lamps become the classifier's stored lights, named as in the booth, with the full
+    // hysteresis of 'params' (pipeline/spectral/light_classifier.h): a lamp must win
+    // params.confirmSamples spectra in a row before it replaces the current answer, also at start,
+    // so the first spectra render in direct-sensor mode. A booth without lamps is always in
+    // direct-sensor mode. Fails for a lamp without energy or thresholds out of order.
+    static Expected<SceneUpdater>
+    create(SceneUpdaterSetup setup, const pipeline::spectral::LightClassifierParams& params = {});
 
     // Updates state from whichever samples are present (nullptr = none yet). A sample is used once:
     // the same sequence number again changes nothing. Unusable samples are counted and skipped.
@@ -39,9 +46,17 @@ public:
     std::uint64_t rejectedPoses() const { return rejectedPoses_; }
     std::uint64_t rejectedTilts() const { return rejectedTilts_; }
 
+    // The classifier's current answer (name "unknown" in direct-sensor mode).
+    pipeline::spectral::Classification classification() const;
+
 private:
+    SceneUpdater(SceneUpdaterSetup setup,
+                 std::optional<pipeline::spectral::LightClassifier> classifier)
+        : setup_(std::move(setup)), classifier_(std::move(classifier))
+    {}
+
     SceneUpdaterSetup setup_;
-    pipeline::spectral::LightClassifier classifier_;
+    std::optional<pipeline::spectral::LightClassifier> classifier_; // none: no lamps
     std::optional<std::uint32_t> lastSpectrum_;
     std::optional<std::uint32_t> lastPose_;
     std::optional<std::uint32_t> lastAccel_;

@@ -1,6 +1,7 @@
 // Accuracy and per-pixel cost of the colour representations (docs/accuracy.md). Prints the accuracy
 // table (CIEDE2000 against the 36-band calculation, issue 3's normalisation) and then times the
 // per-pixel shading of each representation in float, as a shader would run it.
+#include <algorithm>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/cct.h>
 #include <pipeline/spectral/accuracy.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/classifier_study.h>
 #include <pipeline/spectral/representation_catalogue.h>
 
@@ -19,7 +21,8 @@ namespace {
 using namespace replica;
 using namespace replica::pipeline::spectral;
 
-const char* const kReps[] = {"rgb3", "paper6", "replica_k6", "general_k6", "pca6", "spectral36"};
+const char* const kReps[] = {"rgb3",       "paper6", "replica_k6", "adaptive_k6",
+                             "general_k6", "pca6",   "spectral36"};
 
 void printAccuracyTable()
 {
@@ -65,6 +68,78 @@ void printAccuracyTable()
             }
             std::printf("\n");
         }
+    }
+    std::printf("\n");
+}
+
+// adaptive_k6 encoded for one light and rendered under another: what the appliance shows between a
+// light change and the end of the re-encode, and the general basis it starts from.
+void printAdaptiveTransitions()
+{
+    auto obs = pipeline::colour::loadCie1931(dataDir());
+    auto d65 = loadCieIlluminant(dataDir(), "D65");
+    auto set = loadReflectanceSet(dataDir(), "colorchecker");
+    auto rep = makeRepresentation(dataDir(), *obs, *d65, "adaptive_k6");
+    if (!obs || !d65 || !set || !rep) {
+        std::fprintf(stderr, "cannot load the adaptive representation\n");
+        return;
+    }
+    const auto lights = evaluationLightNames();
+    // Largest error encoded for the light itself, beyond the 3 decimals of the table.
+    double worst = 0.0;
+    for (const char* setName : {"colorchecker", "tcs14"}) {
+        auto s = loadReflectanceSet(dataDir(), setName);
+        for (const auto& l : lights) {
+            auto light = loadCieIlluminant(dataDir(), l);
+            auto res = evaluateRepresentation(*obs, *d65, **rep, *light, *s);
+            worst = res ? std::max(worst, res->stats.max) : 1e9;
+        }
+    }
+    std::printf("adaptive_k6 encoded for the light present: largest CIEDE2000 over both sets and "
+                "the eight lights %.2e\n\n",
+                worst);
+    std::printf("adaptive_k6 on the ColorChecker, encoded for the row's light, rendered under the "
+                "column's: mean / max\n\n| encoded for |");
+    for (const auto& l : lights) {
+        std::printf(" %s |", l.c_str());
+    }
+    std::printf("\n|---|");
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        std::printf("---|");
+    }
+    std::printf("\n");
+    std::vector<std::string> rows = {"(none: general)"};
+    rows.insert(rows.end(), lights.begin(), lights.end());
+    for (const auto& row : rows) {
+        std::unique_ptr<Representation> fixed;
+        if (row[0] != '(') {
+            auto encodedFor = loadCieIlluminant(dataDir(), row);
+            auto a = (*rep)->adaptedTo(*encodedFor);
+            if (!a) {
+                continue;
+            }
+            fixed = std::move(*a);
+        }
+        std::printf("| %s |", row.c_str());
+        for (const auto& l : lights) {
+            auto light = loadCieIlluminant(dataDir(), l);
+            // The general basis is (*rep) itself before adaptation; a fixed one is not adaptive.
+            auto res = fixed ? evaluateRepresentation(*obs, *d65, *fixed, *light, *set)
+                             : Expected<AccuracyReport>(makeError(ErrorCode::InvalidArgument, ""));
+            if (!fixed) {
+                auto general = makeBasisRepresentation(*obs, [&] {
+                    auto enc = AdaptiveEncoder::createDefault(dataDir());
+                    return enc->generalBasis();
+                }());
+                res = evaluateRepresentation(*obs, *d65, *general, *light, *set);
+            }
+            if (!res) {
+                std::printf(" error |");
+                continue;
+            }
+            std::printf(" %.3f / %.3f |", res->stats.mean, res->stats.max);
+        }
+        std::printf("\n");
     }
     std::printf("\n");
 }
@@ -208,19 +283,67 @@ void lightVectors(benchmark::State& state, const char* name)
     }
 }
 
+// adaptive_k6 on a light change: the new basis (CPU, double), then every texel re-encoded from its
+// 36 bands (float, one core), what a worker thread does before the upload.
+void adaptiveBasisFor(benchmark::State& state)
+{
+    auto encoder = AdaptiveEncoder::createDefault(dataDir());
+    auto f11 = loadCieIlluminant(dataDir(), "F11");
+    if (!encoder || !f11) {
+        state.SkipWithError("cannot build the adaptive encoder");
+        return;
+    }
+    for (auto _ : state) {
+        auto b = encoder->basisFor(*f11);
+        benchmark::DoNotOptimize(b->project[0].v.data());
+    }
+}
+
+void reencodeTexels(benchmark::State& state)
+{
+    constexpr std::size_t kTexels = 1 << 16;
+    auto encoder = AdaptiveEncoder::createDefault(dataDir());
+    auto f11 = loadCieIlluminant(dataDir(), "F11");
+    auto basis = encoder && f11 ? encoder->basisFor(*f11)
+                                : Expected<pipeline::colour::ChannelBasis>(
+                                          makeError(ErrorCode::InvalidArgument, "no encoder"));
+    if (!basis) {
+        state.SkipWithError(basis.error().message.c_str());
+        return;
+    }
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<float> bands(kTexels * pipeline::colour::kBands);
+    for (auto& b : bands) {
+        b = u(rng);
+    }
+    std::vector<float> coeffs(kTexels * pipeline::colour::kChannels);
+    for (auto _ : state) {
+        encodeTexels(*basis, bands.data(), kTexels, coeffs.data());
+        benchmark::DoNotOptimize(coeffs.data());
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) *
+                            static_cast<int64_t>(kTexels));
+}
+
 BENCHMARK_TEMPLATE(shadeFrame, 3)->Name("shade_per_pixel/rgb3");
-BENCHMARK_TEMPLATE(shadeFrame, 6)->Name("shade_per_pixel/six_channel(paper6,replica_k6)");
+BENCHMARK_TEMPLATE(shadeFrame, 6)
+        ->Name("shade_per_pixel/six_channel(paper6,replica_k6,adaptive_k6)");
 BENCHMARK_TEMPLATE(shadeFrame, 36)->Name("shade_per_pixel/spectral36");
 BENCHMARK_CAPTURE(lightVectors, rgb3, "rgb3");
 BENCHMARK_CAPTURE(lightVectors, paper6, "paper6");
 BENCHMARK_CAPTURE(lightVectors, replica_k6, "replica_k6");
 BENCHMARK_CAPTURE(lightVectors, spectral36, "spectral36");
+BENCHMARK(adaptiveBasisFor)->Name("adaptive_k6/basis_per_light_change");
+BENCHMARK(reencodeTexels)->Name("adaptive_k6/reencode_per_texel");
 
 } // namespace
 
 int main(int argc, char** argv)
 {
     printAccuracyTable();
+    printAdaptiveTransitions();
     printClassifierStudy();
     benchmark::Initialize(&argc, argv);
     benchmark::RunSpecifiedBenchmarks();

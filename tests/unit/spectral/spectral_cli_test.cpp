@@ -1,5 +1,6 @@
 // Tests of 'replica color de2000' and 'replica spectral eval' run as the built binary, and of the
 // channel-data file formats: bad files must fail naming file, line and problem.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -153,6 +154,53 @@ TEST_F(CliFiles, EvalJsonMatchesTheLibrary)
     EXPECT_NEAR(doc["samples"][14]["de00"].get<double>(), lib->samples[14].de00, 1e-12);
 }
 
+TEST_F(CliFiles, EvalAdaptiveIsExactForItsLightAndEncodedForAnotherMatchesTheLibrary)
+{
+    const auto f11 = write("f11.csv", lightCsv("F11"));
+    const auto f7 = write("f7.csv", lightCsv("F7"));
+    const auto set =
+            (dataDir() / "spectra" / "colorchecker24_babelcolor_avg_10nm_380_730.csv").string();
+    const std::string base = "spectral eval --illuminant " + f11 + " --reflectances " + set;
+    auto r = runReplica(base + " --representation adaptive_k6 --json", dir_);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    auto doc = nlohmann::json::parse(r.out);
+    EXPECT_EQ(doc["representation"], "adaptive_k6");
+    EXPECT_LT(doc["stats"]["max"].get<double>(), 1e-6);
+
+    // Encoded for F7, rendered under F11: the library's figure, and clearly not exact.
+    r = runReplica(base + " --representation adaptive_k6 --encoded-for " + f7 + " --json", dir_);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    doc = nlohmann::json::parse(r.out);
+    EXPECT_EQ(doc["encoded_for"], f7);
+    auto obs = colour::loadCie1931(dataDir());
+    auto d65 = loadCieIlluminant(dataDir(), "D65");
+    auto cc = loadReflectanceSet(dataDir(), "colorchecker");
+    auto rep = makeRepresentation(dataDir(), *obs, *d65, "adaptive_k6");
+    ASSERT_TRUE(obs && d65 && cc && rep);
+    auto forF7 = (*rep)->adaptedTo(*loadCieIlluminant(dataDir(), "F7"));
+    ASSERT_TRUE(forF7 && *forF7);
+    auto lib =
+            evaluateRepresentation(*obs, *d65, **forF7, *loadCieIlluminant(dataDir(), "F11"), *cc);
+    ASSERT_TRUE(lib);
+    EXPECT_GT(lib->stats.max, 0.1);
+    EXPECT_NEAR(doc["stats"]["mean"].get<double>(), lib->stats.mean, 1e-12);
+    EXPECT_NEAR(doc["stats"]["max"].get<double>(), lib->stats.max, 1e-12);
+
+    // --encoded-for needs an adaptive representation and a light with luminance.
+    r = runReplica(base + " --representation replica_k6 --encoded-for " + f7, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "replica spectral eval: --encoded-for applies to a light-adaptive "
+                     "representation (adaptive_k6); 'replica_k6' encodes the same for every "
+                     "light\n");
+    const auto dark = write("dark.csv", "wavelength_nm,value\n380,0\n730,0\n");
+    r = runReplica(base + " --representation adaptive_k6 --encoded-for " + dark, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err, "replica spectral eval: " + dark +
+                             ": adaptive encoding: the light has no luminance (Y <= 0); a dark or "
+                             "all-zero spectrum cannot be encoded for, keep the previous "
+                             "encoding\n");
+}
+
 TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
 {
     const auto set =
@@ -190,6 +238,30 @@ TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
                    dir_);
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.err.find("no representation named 'nine'"), std::string::npos) << r.err;
+}
+
+TEST_F(CliFiles, FitRejectsBadWeightsBeforeFitting)
+{
+    const std::string out = " --out " + (dir_ / "out").string();
+    const std::pair<const char*, const char*> cases[] = {
+            {"A30", "--weights: 'A30' is not NAME=WEIGHT"},
+            {"=3", "--weights: '=3' is not NAME=WEIGHT"},
+            {"A=x", "--weights: 'A=x' has no finite non-negative number after '='"},
+            {"A=-1", "--weights: 'A=-1' has no finite non-negative number after '='"},
+            {"A=3x", "--weights: 'A=3x' has no finite non-negative number after '='"},
+            {"A=inf", "--weights: 'A=inf' has no finite non-negative number after '='"},
+            {"NOPE=2", "--weights: "}};
+    for (const auto& [arg, message] : cases) {
+        const auto r = runReplica(std::string("spectral fit --weights ") + arg + out, dir_);
+        EXPECT_EQ(r.exitCode, 1) << arg;
+        EXPECT_NE(r.err.find(std::string("replica spectral fit: ") + message), std::string::npos)
+                << arg << ": " << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(dir_ / "out" / "replica_k6.csv"));
+    }
+    // An unknown lamp is named.
+    const auto r = runReplica("spectral fit --weights NOPE=2" + out, dir_);
+    EXPECT_NE(r.err.find("NOPE"), std::string::npos) << r.err;
 }
 
 TEST_F(CliFiles, ChannelBasisRoundTripsAndRejectsOffGridFiles)

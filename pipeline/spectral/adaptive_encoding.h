@@ -1,0 +1,121 @@
+// Light-adaptive channel encoding (representation "adaptive_k6"): a K = 6 basis rebuilt whenever
+// the light changes, whose first three coefficients span exactly that light's XYZ functionals (so
+// the light present is rendered exactly, any reflectance) and whose other three are the best
+// complement for the other training lights (so the previous light, and a light not yet re-encoded
+// for, degrade gracefully). Per pixel it costs what every K = 6 representation costs; per light
+// change the CPU rebuilds the basis (about a millisecond) and re-encodes each surface from its
+// 36-band reflectance kept on the CPU (36 x 6 multiply-adds per texel). See docs/accuracy.md.
+//
+// How the appliance is meant to use it (not wired in yet):
+//   at start:      encoder = AdaptiveEncoder::createDefault(dataDir()); keep each surface's
+//                  ReflectanceImage; render with encoder.generalBasis() and its encodeTexels().
+//   light changes: (the classifier confirms a new lamp, or in direct-sensor mode the sensed shape
+//                  moves by more than the classifier's accept distance) a worker thread calls
+//                  encodeSurface(encoder, image, light) (or basisFor() once, then encodeTexels()
+//                  over row ranges, dropping the job if the light changes again); when it is done
+//                  the loop swaps in the new coefficients and basis together, on a frame boundary.
+//   every frame:   M = colour::channelToXyz(surface.basis, observer, state.illuminant), as now:
+//                  exact once the surface was encoded for this light, graceful before.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/colour/channel_basis.h>
+#include <pipeline/spectral/dense_matrix.h>
+#include <pipeline/spectral/reference_sets.h>
+#include <pipeline/spectral/representation.h>
+
+namespace replica::pipeline::spectral {
+
+struct AdaptiveEncoderOptions {
+    // Tikhonov term on the reflectance prior, relative to its mean diagonal (as BasisFitOptions).
+    double ridge = 1e-4;
+    // Weight of each training light in the complement's objective (empty: all 1).
+    std::vector<double> lightWeights;
+    // A direction of the light's XYZ functionals whose prior variance is below this fraction of
+    // the largest counts as absent (a single- or two-band light has one or two, not three); the
+    // freed coefficients go to the complement. Larger values drop real, weak directions (1e-9
+    // leaves a 1e-5 XYZ error under a 30 nm wide line light), smaller ones keep rounding noise.
+    double rankTolerance = 1e-12;
+};
+
+class AdaptiveEncoder
+{
+public:
+    // The prior (second moment of 'reflectances', CIELAB-weighted as the fits are) and the lights
+    // whose colour errors the three free functions minimise (CIELAB-like metric, fit_metric.h).
+    static Expected<AdaptiveEncoder> create(const Observer& obs,
+                                            const Spectrum& d65,
+                                            const NamedSpectra& reflectances,
+                                            const NamedSpectra& lights,
+                                            const AdaptiveEncoderOptions& options = {});
+    // The shipped choice: CES01-99, the eight lights weighted as replica_k6 is
+    // (options.lightWeights is replaced by those weights).
+    static Expected<AdaptiveEncoder> createDefault(const std::filesystem::path& dataDir,
+                                                   AdaptiveEncoderOptions options = {});
+
+    // The basis for 'light' (any scale). With r the rank of the light's XYZ functionals (3 unless
+    // it is nearly monochromatic), project[0..r) span them (r = 3: they are the functionals
+    // themselves, so a texel's first three coefficients are its XYZ under the light at Y = 1), and
+    // reconstruct is the prior's least-squares estimate given all six, W = C P^T (P C P^T)^-1, so
+    // that channelToXyz(basis, light) reproduces the light's XYZ of every reflectance exactly.
+    // Fails for a band that is not finite and for a light without luminance (Y <= 0).
+    Expected<colour::ChannelBasis> basisFor(const Spectrum& light) const;
+    // The basis before any light is known: the best light-aware basis for the training lights (it
+    // spans what fitChannelBasis finds with the same data).
+    const colour::ChannelBasis& generalBasis() const { return general_; }
+    const Observer& observer() const { return obs_; }
+
+private:
+    AdaptiveEncoder() = default;
+    // Rows 'fixed' (r x 36, may be empty) completed by the best 6 - r rows; an error when
+    // the prior cannot be conditioned.
+    Expected<colour::ChannelBasis> complete(const DenseMatrix& fixed) const;
+
+    Observer obs_;
+    DenseMatrix c_;   // 36 x 36 reflectance prior, ridge included
+    DenseMatrix gtg_; // 36 x 36, sum over lights of w_j (H_j A_j)^T (H_j A_j)
+    double rankTolerance_ = 1e-12;
+    colour::ChannelBasis general_;
+};
+
+// c[k] = sum_l project[k](l) bands[l] for 'count' texels: 'bands' holds kBands floats per texel,
+// 'coeffs' receives kChannels floats per texel (the layout of render::SurfaceImage). Float, as the
+// textures are; about 1e-7 relative rounding.
+void encodeTexels(const colour::ChannelBasis& basis,
+                  const float* bands,
+                  std::size_t count,
+                  float* coeffs);
+
+// A surface's diffuse reflectance kept on the CPU: kBands floats per texel, rows from the bottom
+// up (GL texture order, as render::SurfaceImage).
+struct ReflectanceImage {
+    int width = 0;
+    int height = 0;
+    std::vector<float> bands;
+};
+
+// A surface encoded for one light: the basis, the six XYZ vectors under that light
+// (channelToXyz(basis, observer, light), what the renderer uploads as its 6 x 3 matrix) and
+// kChannels coefficients per texel (planes 1-3 and 4-6 are the paper's two RGB float images).
+struct AdaptiveSurface {
+    colour::ChannelBasis basis;
+    colour::ChannelToXyz toXyz{};
+    int width = 0;
+    int height = 0;
+    std::vector<float> coeffs;
+};
+
+// basisFor(light), then encodeTexels over the whole image. Fails as basisFor does, and for an
+// image whose size does not match its data.
+Expected<AdaptiveSurface>
+encodeSurface(const AdaptiveEncoder& encoder, const ReflectanceImage& image, const Spectrum& light);
+
+// Representation "adaptive_k6": encode()/lightVectors() use the general basis; adaptedTo(light)
+// gives the fixed basis representation encoded for that light.
+std::unique_ptr<Representation> makeAdaptiveRepresentation(AdaptiveEncoder encoder);
+
+} // namespace replica::pipeline::spectral
