@@ -133,7 +133,9 @@ TEST_F(BoothPassTest, PlannedSettingMeetsTheErrorBudgetAgainstTheReference)
     // picks for these scenes under d65-fluorescent on its 32x20 probe (replica render --plan;
     // docs/rendering.md); running the planner here would take half a minute. The GL pass with
     // that setting must meet the budget against the exact reference on a different frame
-    // (24x15: the reference integrates every luminance texel for every pixel).
+    // (24x15: the reference integrates every luminance texel for every pixel; at 20x12 a row of
+    // pixel centres falls exactly on a texel edge of the painting, texY = 60.0, where float and
+    // double pick different texels).
     const shading::View v = view(24, 15);
     struct Case {
         const char* scene;
