@@ -2,6 +2,8 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <span>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -11,8 +13,11 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/display/display_profile.h>
+#include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
 #include <platform/appliance.h>
+#include <platform/loop/frame_digest.h>
 
 namespace replica::platform {
 
@@ -40,7 +45,13 @@ std::string RunConfig::toJson() const
                      {"scene_digest", sceneDigest},
                      {"booth_lights", boothLights},
                      {"specular_samples", specularSamples},
-                     {"horizon_directions", horizonDirections}};
+                     {"horizon_directions", horizonDirections},
+                     {"display_digest", displayDigest},
+                     {"display_inverse", displayInverse},
+                     {"gamut_mapping", gamutMapping},
+                     {"viewing_compensation", viewingCompensation},
+                     {"flare_subtraction", flareSubtraction},
+                     {"false_colour", falseColour}};
     return j.dump();
 }
 
@@ -68,6 +79,14 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.boothLights = j.value("booth_lights", c.boothLights);
         c.specularSamples = j.value("specular_samples", c.specularSamples);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
+        // Recordings made before display profiles had none of these: the plain pass 2 they had
+        // was on-axis, without flare subtraction.
+        c.displayDigest = j.value("display_digest", std::string());
+        c.displayInverse = j.value("display_inverse", std::string("analytic"));
+        c.gamutMapping = j.value("gamut_mapping", std::string("hue"));
+        c.viewingCompensation = j.value("viewing_compensation", false);
+        c.flareSubtraction = j.value("flare_subtraction", false);
+        c.falseColour = j.value("false_colour", false);
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
     }
@@ -83,6 +102,13 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("run configuration: renderer '{}' is not 'booth' or 'flat'",
                                      c.renderer));
+    }
+    if ((c.displayInverse != "analytic" && c.displayInverse != "lut3d") ||
+        (c.gamutMapping != "hue" && c.gamutMapping != "clip")) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("run configuration: display inverse '{}' (analytic, lut3d) "
+                                     "or gamut mapping '{}' (hue, clip) unknown",
+                                     c.displayInverse, c.gamutMapping));
     }
     return c;
 }
@@ -114,6 +140,14 @@ Expected<std::string> sceneDigest(const std::filesystem::path& dir)
         }
     }
     return fmt::format("{:016x}", h);
+}
+
+std::string displayProfileId(const RunConfig& config, const std::string& profileName)
+{
+    if (config.display == kUncalibratedDisplay) {
+        return fmt::format("{} (uncalibrated nominal model)", kUncalibratedDisplay);
+    }
+    return fmt::format("{} ({}, fnv1a64 {})", profileName, config.display, config.displayDigest);
 }
 
 namespace {
@@ -157,6 +191,8 @@ makeBoothScene(RunConfig& config,
     setup.settings.lights = config.boothLights;
     setup.settings.specularSamples = config.specularSamples;
     setup.settings.horizonDirections = config.horizonDirections;
+    // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
+    setup.settings.subtractFlare = !config.flareSubtraction;
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
     if (!pass) {
         return tl::unexpected(pass.error());
@@ -164,11 +200,68 @@ makeBoothScene(RunConfig& config,
     return std::shared_ptr<pipeline::render::BoothScenePass>(std::move(*pass));
 }
 
+// The display pass's setup from the configuration: the profile (checked against the digest a
+// recording holds) or the nominal model.
+Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std::string& id)
+{
+    namespace pd = pipeline::display;
+    pipeline::render::DisplayPassSetup d;
+    if (config.display == kUncalibratedDisplay) {
+        d.model = pd::nominalDisplayModel(kUncalibratedDisplay, config.displayPeakCdM2,
+                                          config.displayBlackCdM2);
+    } else {
+        std::filesystem::path path(config.display);
+        if (path.is_relative()) {
+            path = dataDir() / path;
+        }
+        std::ifstream f(path, std::ios::binary);
+        if (!f) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("no display profile at {}: characterise the panel "
+                                         "('replica display fit MEAS.csv --out PROFILE') and pass "
+                                         "--display-profile PROFILE, or run --uncalibrated",
+                                         path.string()));
+        }
+        const std::string bytes((std::istreambuf_iterator<char>(f)),
+                                std::istreambuf_iterator<char>());
+        const std::string digest = fmt::format(
+                "{:016x}", fnv1a64(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()),
+                                             bytes.size())));
+        if (!config.displayDigest.empty() && config.displayDigest != digest) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("display profile {} has changed since it was recorded "
+                                         "(fnv1a64 {} now, {} then): restore that file to replay "
+                                         "the recording as it was",
+                                         path.string(), digest, config.displayDigest));
+        }
+        config.displayDigest = digest;
+        auto model = pd::profileFromJson(bytes, path.string());
+        if (!model) {
+            return tl::unexpected(model.error());
+        }
+        d.model = std::move(*model);
+    }
+    d.method = config.displayInverse == "lut3d" ? pipeline::render::InverseMethod::Lut3d
+                                                : pipeline::render::InverseMethod::Analytic;
+    d.gamut = config.gamutMapping == "clip" ? pd::GamutMode::Clip : pd::GamutMode::HueKeeping;
+    d.viewingCompensation = config.viewingCompensation;
+    d.flareSubtraction = config.flareSubtraction;
+    d.falseColour = config.falseColour;
+    id = displayProfileId(config, d.model.name);
+    return d;
+}
+
 } // namespace
 
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
                                                     const OutputChoice& outputChoice)
 {
+    RunConfig config = configIn;
+    std::string displayId;
+    auto display = displaySetup(config, displayId);
+    if (!display) {
+        return tl::unexpected(display.error());
+    }
     const std::string dir = dataDir().string();
     auto app = std::make_unique<Appliance>();
     app->config = config;
@@ -231,8 +324,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
     setup.surface = std::move(*surface);
     setup.basis = basis;
     setup.observer = *observer;
-    setup.display =
-            pipeline::render::srgbLikeDisplay(config.displayPeakCdM2, config.displayBlackCdM2);
+    setup.display = std::move(*display);
     setup.lightsU = config.lightsU;
     setup.lightsV = config.lightsV;
     if (config.renderer == "booth") {
@@ -247,6 +339,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
         return tl::unexpected(renderer.error());
     }
     app->renderer = std::move(*renderer);
+    app->displayProfileId = displayId;
 
     SceneUpdaterSetup updaterSetup;
     updaterSetup.booth = app->booth;

@@ -36,14 +36,29 @@ struct RunConfig {
     int lightsU = 8;
     int lightsV = 4;
     std::string spectrometerCalibration = "spectrometer/sim_usb2000_responsivity.csv";
-    std::string display = "srgb-like-800";
+    // The display profile: a path under data/ (or absolute), or kUncalibratedDisplay for the
+    // nominal sRGB-like model of displayPeakCdM2/displayBlackCdM2 ('replica run --uncalibrated';
+    // also what recordings made before profiles existed replay with).
+    std::string display = "displays/wide-ips-synthetic.json";
+    std::string displayDigest; // FNV-1a 64 of the profile file, hex; checked again on replay
     double displayPeakCdM2 = 800.0;
     double displayBlackCdM2 = 0.4;
+    std::string displayInverse = "analytic"; // or "lut3d" (docs/display.md compares them)
+    std::string gamutMapping = "hue";        // or "clip" (per channel, for comparison only)
+    bool viewingCompensation = true;
+    bool flareSubtraction = true;
+    bool falseColour = false;
 
     std::int64_t periodNs() const;
     std::string toJson() const;
     static Expected<RunConfig> fromJson(const std::string& json);
 };
+
+constexpr const char* kUncalibratedDisplay = "srgb-like-800";
+
+// What a recording's session names the display by: the profile's name and file digest, or the
+// nominal model's name marked uncalibrated.
+std::string displayProfileId(const RunConfig& config, const std::string& profileName);
 
 struct Sources {
     std::unique_ptr<hal::SpectrometerSource> spectrometer;
@@ -58,6 +73,7 @@ struct Appliance {
             output; // owns the GL context: created before, destroyed after the renderer
     std::unique_ptr<pipeline::render::Renderer> renderer;
     std::unique_ptr<SceneUpdater> updater;
+    std::string displayProfileId; // as recorded in the session
     ~Appliance()
     {
         renderer.reset(); // GL objects go while the context still exists

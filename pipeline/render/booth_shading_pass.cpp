@@ -200,7 +200,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     glUniform1i(loc(program_, "uHorizonDirs"), horizonDirs_);
     glUniform1f(loc(program_, "uSoftness"), static_cast<float>(settings_.horizonSoftness));
     glUniform1i(loc(program_, "uDiffuse"), settings_.diffusePass ? 1 : 0);
-    glUniform1f(loc(program_, "uFlareRho"), static_cast<float>(shading::kScreenFlareRho));
+    glUniform1f(loc(program_, "uFlareRho"),
+                static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));
     const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
     glUniform1i(loc(program_, "uSpecSamples"), specular ? settings_.specularSamples : 0);
     glUniform1f(loc(program_, "uAlpha"), static_cast<float>(s.alpha));

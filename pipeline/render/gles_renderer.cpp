@@ -62,23 +62,6 @@ void main() {
 }
 )";
 
-// Inverse display model: XYZ -> linear drive -> power-law encoding, clipped to the panel's range.
-const char* const kDisplayShader = R"(#version 310 es
-precision highp float;
-precision highp int;
-in vec2 vUv;
-out vec4 outRgba;
-uniform highp sampler2D uXyz;
-uniform mat3 uXyzToRgb;
-uniform vec3 uBlack;
-uniform float uInvGamma;
-void main() {
-    vec3 xyz = texelFetch(uXyz, ivec2(gl_FragCoord.xy), 0).xyz;
-    vec3 rgb = clamp(uXyzToRgb * (xyz - uBlack), 0.0, 1.0);
-    outRgba = vec4(pow(rgb, vec3(uInvGamma)), 1.0);
-}
-)";
-
 Expected<GLuint> compile(GLenum type, const char* source, const char* what)
 {
     GLuint shader = glCreateShader(type);
@@ -159,7 +142,6 @@ public:
         glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
         glDeleteVertexArrays(1, &vao_);
         glDeleteProgram(xyzProgram_);
-        glDeleteProgram(displayProgram_);
     }
     GlesRenderer(const GlesRenderer&) = delete;
     GlesRenderer& operator=(const GlesRenderer&) = delete;
@@ -171,11 +153,10 @@ public:
             return tl::unexpected(xyz.error());
         }
         xyzProgram_ = *xyz;
-        auto display = link(kDisplayShader, "display");
-        if (!display) {
+        if (auto display = displayPass_.init(setup_.display, setup_.width, setup_.height);
+            !display) {
             return tl::unexpected(display.error());
         }
-        displayProgram_ = *display;
         glGenVertexArrays(1, &vao_);
 
         const auto& s = setup_.surface;
@@ -196,23 +177,15 @@ public:
         coeffB_ = makeTexture(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, b.data());
         xyzTarget_ =
                 makeTexture(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
-        rgbaTarget_ = makeTexture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, setup_.width, setup_.height,
-                                  nullptr);
-        textures_ = {coeffA_, coeffB_, xyzTarget_, rgbaTarget_};
+        textures_ = {coeffA_, coeffB_, xyzTarget_};
 
-        glGenFramebuffers(2, fbos_.data());
-        for (int i = 0; i < 2; ++i) {
-            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[static_cast<std::size_t>(i)]);
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
-                                   i == 0 ? xyzTarget_ : rgbaTarget_, 0);
-            if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-                return makeError(
-                        ErrorCode::Unsupported,
-                        fmt::format(
-                                "render: the {} target is not renderable on this GL "
-                                "(float colour buffers need GLES 3.2 or EXT_color_buffer_float)",
-                                i == 0 ? "RGBA32F XYZ" : "RGBA8 display"));
-            }
+        glGenFramebuffers(1, fbos_.data());
+        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, xyzTarget_, 0);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            return makeError(ErrorCode::Unsupported,
+                             "render: the RGBA32F XYZ target is not renderable on this GL (float "
+                             "colour buffers need GLES 3.2 or EXT_color_buffer_float)");
         }
         if (GLenum err = glGetError(); err != GL_NO_ERROR) {
             return makeError(ErrorCode::Unsupported,
@@ -235,6 +208,20 @@ public:
     {
         const int w = setup_.width;
         const int h = setup_.height;
+        // The panel pose and the uniform grid of lights: pass 1 of the flat image and pass 2's
+        // flare estimate use them.
+        const scene::PanelPose pose = scene::panelPose(setup_.stand, state.tiltRad);
+        const auto lights = scene::uniformGridLights(
+                setup_.booth.emitter, state.emitterLuminanceCdM2, setup_.lightsU, setup_.lightsV);
+        const int count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
+        std::vector<float> packed;
+        packed.reserve(static_cast<std::size_t>(count) * 4);
+        for (int i = 0; i < count; ++i) {
+            const auto& l = lights[static_cast<std::size_t>(i)];
+            packed.insert(packed.end(),
+                          {static_cast<float>(l.positionM.x), static_cast<float>(l.positionM.y),
+                           static_cast<float>(l.positionM.z), static_cast<float>(l.intensityCd)});
+        }
         glViewport(0, 0, w, h);
 
         // Pass 1: absolute XYZ.
@@ -244,24 +231,25 @@ public:
                 return ok;
             }
         } else {
-            drawFlatXyz(state);
+            drawFlatXyz(state, pose, packed, count);
         }
         glViewport(0, 0, w, h);
         glBindVertexArray(vao_);
 
-        // Pass 2: display drive values.
-        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[1]);
-        glUseProgram(displayProgram_);
-        const glm::mat3 inv = glm::mat3(glm::inverse(setup_.display.rgbToXyz));
-        glUniformMatrix3fv(glGetUniformLocation(displayProgram_, "uXyzToRgb"), 1, GL_FALSE,
-                           &inv[0][0]);
-        setVec3(displayProgram_, "uBlack", setup_.display.blackXyz);
-        glUniform1f(glGetUniformLocation(displayProgram_, "uInvGamma"),
-                    static_cast<float>(1.0 / setup_.display.gamma));
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, xyzTarget_);
-        glUniform1i(glGetUniformLocation(displayProgram_, "uXyz"), 0);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        // Pass 2: panel counts (display_pass.cpp).
+        DisplayPassFrame df;
+        df.pose = pose;
+        df.eyeM = state.eyeBoothM;
+        df.lights = &packed;
+        df.lightCount = count;
+        df.lightNormal = setup_.booth.emitter.normal;
+        const colour::Xyz lightXyz = colour::spectrumToXyz(setup_.observer, state.illuminant);
+        df.lightXyzUnitY = lightXyz.y > 0.0 ? lightXyz / lightXyz.y : glm::dvec3(0.0);
+        auto gamut = displayPass_.draw(xyzTarget_, df);
+        if (!gamut) {
+            return tl::unexpected(gamut.error());
+        }
+        out.gamut = *gamut;
 
         // Read back what the caller uses.
         out.width = w;
@@ -277,7 +265,7 @@ public:
         }
         if (readback != Readback::None) {
             out.rgba.resize(pixels * 4);
-            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[1]);
+            glBindFramebuffer(GL_FRAMEBUFFER, displayPass_.framebuffer());
             glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, out.rgba.data());
         } else {
             out.rgba.clear();
@@ -293,11 +281,11 @@ public:
 
 private:
     // Pass 1 of the flat patch image: eq. (1) over a uniform grid of lights, eq. (2).
-    void drawFlatXyz(const scene::SceneState& state)
+    void drawFlatXyz(const scene::SceneState& state,
+                     const scene::PanelPose& pose,
+                     const std::vector<float>& packed,
+                     int count)
     {
-        const scene::PanelPose pose = scene::panelPose(setup_.stand, state.tiltRad);
-        const auto lights = scene::uniformGridLights(
-                setup_.booth.emitter, state.emitterLuminanceCdM2, setup_.lightsU, setup_.lightsV);
         const colour::ChannelToXyz m =
                 colour::channelToXyz(setup_.basis, setup_.observer, state.illuminant);
 
@@ -309,15 +297,6 @@ private:
         setVec3(xyzProgram_, "uPanelUp", pose.upM);
         setVec3(xyzProgram_, "uPanelNormal", pose.normal);
         setVec3(xyzProgram_, "uLightNormal", setup_.booth.emitter.normal);
-        const int count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
-        std::vector<float> packed;
-        packed.reserve(static_cast<std::size_t>(count) * 4);
-        for (int i = 0; i < count; ++i) {
-            const auto& l = lights[static_cast<std::size_t>(i)];
-            packed.insert(packed.end(),
-                          {static_cast<float>(l.positionM.x), static_cast<float>(l.positionM.y),
-                           static_cast<float>(l.positionM.z), static_cast<float>(l.intensityCd)});
-        }
         glUniform1i(glGetUniformLocation(xyzProgram_, "uLightCount"), count);
         if (count > 0) {
             glUniform4fv(glGetUniformLocation(xyzProgram_, "uLights"), count, packed.data());
@@ -347,14 +326,13 @@ private:
 
     GlesRendererSetup setup_;
     GLuint xyzProgram_ = 0;
-    GLuint displayProgram_ = 0;
     GLuint vao_ = 0;
     GLuint coeffA_ = 0;
     GLuint coeffB_ = 0;
     GLuint xyzTarget_ = 0;
-    GLuint rgbaTarget_ = 0;
     std::vector<GLuint> textures_;
-    std::array<GLuint, 2> fbos_{};
+    std::array<GLuint, 1> fbos_{};
+    DisplayPass displayPass_;
 };
 
 } // namespace

@@ -1,5 +1,6 @@
 // The GLES 3.1 renderer: a fragment pass computing absolute XYZ per screen pixel, then a display
-// pass turning it into drive values. Needs a current GLES 3.1 context on the calling thread.
+// pass (display_pass.h) turning it into panel counts. Needs a current GLES 3.1 context on the
+// calling thread.
 #pragma once
 
 #include <memory>
@@ -7,8 +8,8 @@
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/colour/xyz.h>
 #include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/render/display_pass.h>
 #include <pipeline/render/renderer.h>
-#include <pipeline/render/simple_display.h>
 #include <pipeline/render/surface_image.h>
 #include <pipeline/scene/booth.h>
 #include <pipeline/scene/stand.h>
@@ -23,7 +24,7 @@ struct GlesRendererSetup {
     SurfaceImage surface;
     colour::ChannelBasis basis;
     colour::Observer observer;
-    SimpleDisplay display;
+    DisplayPassSetup display; // pass 2: the display profile and what the pass does with it
     int lightsU = 8; // point lights across the emitter (uniform grid until median cut lands)
     int lightsV = 4;
     // When set, pass 1 is the booth-lit surface scene (booth_scene_pass.h) instead of the flat

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/display/gamut_map.h>
 #include <pipeline/scene/scene_state.h>
 
 namespace replica::pipeline::render {
@@ -16,6 +17,7 @@ struct RenderedFrame {
     int height = 0;
     std::vector<float> xyz;         // 4 floats per pixel: X, Y, Z in cd/m^2, then 1
     std::vector<std::uint8_t> rgba; // 8-bit display counts, 4 per pixel
+    display::GamutCounters gamut;   // pixels out of the display's gamut, by class (every frame)
 };
 
 // What render() copies back from the GPU: reading back costs time, so the loop asks only for what

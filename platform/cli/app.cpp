@@ -29,6 +29,7 @@ int runCli(int argc, char** argv)
     registerRenderCommand(app, exitCode);
     registerBoothCommand(app, exitCode);
     registerSceneCommand(app, exitCode);
+    registerDisplayCommand(app, exitCode);
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
     registerProbeCommand(app, exitCode);

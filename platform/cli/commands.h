@@ -16,6 +16,7 @@ void registerInspectCommand(CLI::App& app, int& exitCode);
 void registerRenderCommand(CLI::App& app, int& exitCode);
 void registerBoothCommand(CLI::App& app, int& exitCode);
 void registerSceneCommand(CLI::App& app, int& exitCode);
+void registerDisplayCommand(CLI::App& app, int& exitCode);
 void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
 void registerProbeCommand(CLI::App& app, int& exitCode);

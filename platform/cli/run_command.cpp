@@ -30,6 +30,13 @@ struct RunOptions {
     bool fast = false;
     std::string scene;
     std::string renderer = "booth";
+    std::string displayProfile;
+    bool uncalibrated = false;
+    std::string displayInverse = "analytic";
+    std::string gamut = "hue";
+    bool noViewing = false;
+    bool noFlare = false;
+    bool falseColour = false;
     LiveOptions live;
     OutputChoice outputChoice;
 };
@@ -90,6 +97,24 @@ int runMain(const RunOptions& o)
             return kExitUsage;
         }
     }
+    if (o.uncalibrated && !o.displayProfile.empty()) {
+        log->error("--uncalibrated and --display-profile {} contradict each other: give one",
+                   o.displayProfile);
+        return kExitUsage;
+    }
+    if (o.uncalibrated) {
+        config.display = kUncalibratedDisplay;
+        log->warn("--uncalibrated: driving a nominal sRGB-like {} cd/m^2 model, not a "
+                  "characterised panel; colours on screen are not the surface's",
+                  config.displayPeakCdM2);
+    } else if (!o.displayProfile.empty()) {
+        config.display = std::filesystem::absolute(o.displayProfile).string();
+    }
+    config.displayInverse = o.displayInverse;
+    config.gamutMapping = o.gamut;
+    config.viewingCompensation = !o.noViewing;
+    config.flareSubtraction = !o.noFlare;
+    config.falseColour = o.falseColour;
 
     OutputChoice outputChoice = o.outputChoice;
     outputChoice.kind = o.output;
@@ -108,25 +133,26 @@ int runMain(const RunOptions& o)
         return kExitFailure;
     }
     log->info("hal: spectrometer={} [{} {}], tracker={} [{} {}], accel={} [{} {}]; output={}; "
-              "renderer={} on {}; {}x{} at {} Hz",
+              "renderer={} on {}; {}x{} at {} Hz; display {}",
               hal::toString(sources->spectrometer->info().kind),
               sources->spectrometer->info().model, sources->spectrometer->info().serial,
               hal::toString(sources->tracker->info().kind), sources->tracker->info().model,
               sources->tracker->info().serial, hal::toString(sources->accel->info().kind),
               sources->accel->info().model, sources->accel->info().serial,
               (*appliance)->output->name(), (*appliance)->renderer->description(),
-              (*appliance)->output->glRenderer(), config.width, config.height, config.rateHz);
+              (*appliance)->output->glRenderer(), config.width, config.height, config.rateHz,
+              (*appliance)->displayProfileId);
 
     std::unique_ptr<recordings::RecordingWriter> recorder;
     if (!o.record.empty()) {
         recordings::SessionInfo session;
         session.softwareVersion = std::string("replica ") + REPLICA_VERSION;
-        // The configuration as built: it names the scene folder and its digest.
+        // The configuration as built: the scene folder and digest, the display profile's digest.
         const RunConfig& built = (*appliance)->config;
         session.configJson = built.toJson();
         session.boothModel = built.booth;
         session.scene = built.scene;
-        session.displayProfile = built.display;
+        session.displayProfile = (*appliance)->displayProfileId;
         session.wallClockStartNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
                                            std::chrono::system_clock::now().time_since_epoch())
                                            .count();
@@ -183,9 +209,10 @@ int runMain(const RunOptions& o)
     if (!o.snapshot.empty()) {
         fmt::print("snapshot: {}\n", o.snapshot);
     }
-    log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}; late frames {}",
+    log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}; late frames {}; "
+              "out of gamut: mean {:.4f}, max {:.4f} of pixels",
               stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
-              stats->lateFrames);
+              stats->lateFrames, stats->meanOutOfGamutFraction(), stats->maxOutOfGamutFraction);
     return code;
 }
 
@@ -242,6 +269,28 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     cmd->add_flag("--fast", opts->fast,
                   "do not wait for each tick's wall-clock time (same frames, rendered as fast as "
                   "possible)");
+    cmd->add_option("--display-profile", opts->displayProfile,
+                    "display profile (JSON, from 'replica display fit'); default: the shipped "
+                    "data/displays/wide-ips-synthetic.json");
+    cmd->add_flag("--uncalibrated", opts->uncalibrated,
+                  "run without a display profile, on a nominal sRGB-like model (colours are then "
+                  "not faithful)");
+    cmd->add_option("--display-inverse", opts->displayInverse,
+                    "inverse display model in the shader: analytic or lut3d")
+            ->check(CLI::IsMember({"analytic", "lut3d"}))
+            ->capture_default_str();
+    cmd->add_option("--gamut", opts->gamut,
+                    "out-of-gamut colours: hue (hue-keeping mapping) or clip (per channel; for "
+                    "comparison)")
+            ->check(CLI::IsMember({"hue", "clip"}))
+            ->capture_default_str();
+    cmd->add_flag("--no-viewing-compensation", opts->noViewing,
+                  "drive every pixel as if seen on the panel normal");
+    cmd->add_flag("--no-flare-subtraction", opts->noFlare,
+                  "do not subtract the screen's own reflection of the booth light");
+    cmd->add_flag("--false-colour", opts->falseColour,
+                  "field-staff overlay: stripe out-of-gamut pixels (magenta: chroma, cyan: above "
+                  "peak, blue: below black)");
     cmd->callback([opts, &exitCode] { exitCode = runMain(*opts); });
 }
 

@@ -1,4 +1,5 @@
 // The fixed-rate frame loop.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -210,6 +211,13 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         if (auto ok = appliance.renderer->render(state, image, readback); !ok) {
             return tl::unexpected(ok.error());
         }
+        const double oog = image.gamut.outOfGamutFraction();
+        log->debug("frame {}: {:.4f} of pixels out of gamut (chroma {}, above peak {}, below "
+                   "black {})",
+                   tick.frameIndex, oog, image.gamut.chroma, image.gamut.overPeak,
+                   image.gamut.belowBlack);
+        stats.sumOutOfGamutFraction += oog;
+        stats.maxOutOfGamutFraction = std::max(stats.maxOutOfGamutFraction, oog);
         DisplayFrame frame{image.width, image.height, image.rgba};
         if (auto ok = appliance.output->present(frame); !ok) {
             log->warn("output {}: {}", appliance.output->name(), ok.error().message);

@@ -40,6 +40,12 @@ struct LoopStats {
     std::uint64_t droppedAccel = 0;
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
     std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
+    double sumOutOfGamutFraction = 0.0; // over frames: the display pass's per-frame count
+    double maxOutOfGamutFraction = 0.0;
+    double meanOutOfGamutFraction() const
+    {
+        return frames > 0 ? sumOutOfGamutFraction / static_cast<double>(frames) : 0.0;
+    }
 };
 
 using FrameCallback = std::function<void(const recordings::FrameRecord& frame,

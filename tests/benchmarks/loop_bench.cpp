@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
 #include <platform/loop/frame_digest.h>
 #include <platform/output/output.h>
@@ -34,7 +35,7 @@ Fixture* fixture()
         s.observer = *pipeline::colour::loadCie1931(dataDir());
         s.surface =
                 *pipeline::render::makeColorCheckerSurface(dataDir().string(), s.basis, 600, 400);
-        s.display = pipeline::render::srgbLikeDisplay(800.0, 0.4);
+        s.display.model = pipeline::display::nominalDisplayModel("srgb-like-800", 800.0, 0.4);
         fx->state.illuminant = s.booth.lamps[0].spectrum;
         fx->state.emitterLuminanceCdM2 = 2200.0;
         fx->state.tiltRad = 0.35;

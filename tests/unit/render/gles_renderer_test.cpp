@@ -5,6 +5,8 @@
 #include <glm/geometric.hpp>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/display/display_inverse.h>
+#include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
 #include <platform/output/output.h>
 
@@ -40,7 +42,9 @@ protected:
         s.surface.width = 2;
         s.surface.height = 2;
         s.surface.coeffs.assign(2 * 2 * colour::kChannels, static_cast<float>(reflectance));
-        s.display = srgbLikeDisplay(800.0, 0.4);
+        s.display.model = display::nominalDisplayModel("srgb-like-800", 800.0, 0.4);
+        s.display.viewingCompensation = false; // the CPU reference below is on-axis, flare-free
+        s.display.flareSubtraction = false;
         s.lightsU = lightsU;
         s.lightsV = lightsV;
         setup_ = s;
@@ -136,11 +140,13 @@ TEST_F(GlesRendererTest, DisplayPassMatchesTheCpuInverseWithinOneCount)
     ASSERT_TRUE(r);
     RenderedFrame f;
     ASSERT_TRUE(r->render(state(0.35), f));
+    auto inverse = display::DisplayInverse::build(setup_.display.model);
+    ASSERT_TRUE(inverse);
     for (std::size_t px = 0; px < static_cast<std::size_t>(f.width * f.height); px += 97) {
         const glm::dvec3 xyz{f.xyz[px * 4], f.xyz[px * 4 + 1], f.xyz[px * 4 + 2]};
-        const glm::dvec3 drive = simpleDisplayInverse(setup_.display, xyz);
+        const auto counts = inverse->invert(xyz).counts;
         for (int c = 0; c < 3; ++c) {
-            EXPECT_NEAR(f.rgba[px * 4 + static_cast<std::size_t>(c)], drive[c] * 255.0, 1.0);
+            EXPECT_NEAR(f.rgba[px * 4 + static_cast<std::size_t>(c)], counts[c], 1.0);
         }
     }
 }

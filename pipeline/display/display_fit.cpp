@@ -1,0 +1,456 @@
+// Display model fit.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <tuple>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+#include <pipeline/display/display_fit.h>
+#include <pipeline/display/xyz_difference.h>
+
+namespace replica::pipeline::display {
+namespace {
+
+constexpr std::array<char, 3> kChannelNames{'R', 'G', 'B'};
+
+struct RampPoint {
+    double count = 0.0;
+    glm::dvec3 xyz{0.0};
+    int line = 0;
+};
+
+// Mean XYZ of repeated measurements of the same counts; keeps the first line number.
+std::vector<Measurement> averageRepeats(const std::vector<Measurement>& rows)
+{
+    std::map<std::tuple<double, double, double>, std::pair<Measurement, int>> groups;
+    std::vector<std::tuple<double, double, double>> order;
+    for (const auto& m : rows) {
+        const auto key = std::make_tuple(m.counts.x, m.counts.y, m.counts.z);
+        auto it = groups.find(key);
+        if (it == groups.end()) {
+            groups.emplace(key, std::make_pair(m, 1));
+            order.push_back(key);
+        } else {
+            it->second.first.xyz += m.xyz;
+            ++it->second.second;
+        }
+    }
+    std::vector<Measurement> out;
+    for (const auto& key : order) {
+        auto [m, n] = groups.at(key);
+        m.xyz /= static_cast<double>(n);
+        out.push_back(m);
+    }
+    return out;
+}
+
+double percentile(std::vector<double> v, double p)
+{
+    if (v.empty()) {
+        return 0.0;
+    }
+    std::sort(v.begin(), v.end());
+    const double pos = p * static_cast<double>(v.size() - 1);
+    const auto i = static_cast<std::size_t>(std::floor(pos));
+    const std::size_t j = std::min(i + 1, v.size() - 1);
+    return v[i] + (pos - static_cast<double>(i)) * (v[j] - v[i]);
+}
+
+double mean(const std::vector<double>& v)
+{
+    return v.empty() ? 0.0
+                     : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+glm::dvec2 chromaticity(const glm::dvec3& xyz)
+{
+    const double s = xyz.x + xyz.y + xyz.z;
+    return s > 0.0 ? glm::dvec2(xyz.x / s, xyz.y / s) : glm::dvec2(0.0);
+}
+
+// The model for one candidate matrix: tone curves re-derived from the ramps.
+struct Candidate {
+    glm::dmat3 matrix{1.0};
+    std::array<ToneCurve, 3> tone;
+    int corrections = 0;
+};
+
+Candidate deriveCandidate(const glm::dmat3& m,
+                          const glm::dvec3& black,
+                          const std::array<std::vector<RampPoint>, 3>& ramps)
+{
+    Candidate cand;
+    cand.matrix = m;
+    const glm::dmat3 inv = glm::inverse(m);
+    for (std::size_t c = 0; c < 3; ++c) {
+        std::vector<double> counts{0.0};
+        std::vector<double> values{0.0};
+        for (const auto& p : ramps[c]) {
+            counts.push_back(p.count);
+            values.push_back((inv * (p.xyz - black))[static_cast<int>(c)]);
+        }
+        const auto mono = poolAdjacentViolators(values);
+        for (std::size_t i = 0; i < mono.size(); ++i) {
+            cand.corrections += mono[i] != values[i] ? 1 : 0;
+        }
+        cand.tone[c] = ToneCurve(std::move(counts), mono);
+    }
+    return cand;
+}
+
+glm::dvec3
+candidateForward(const Candidate& cand, const glm::dvec3& black, const glm::dvec3& counts)
+{
+    return black + cand.matrix * glm::dvec3(cand.tone[0](counts.x), cand.tone[1](counts.y),
+                                            cand.tone[2](counts.z));
+}
+
+// Nelder-Mead on f over n parameters from x0 with initial step 'step'; returns the best point.
+template <typename F>
+std::vector<double> nelderMead(F f, std::vector<double> x0, double step, int maxEval, int& evals)
+{
+    const std::size_t n = x0.size();
+    std::vector<std::vector<double>> pts(n + 1, x0);
+    std::vector<double> val(n + 1);
+    for (std::size_t i = 0; i < n; ++i) {
+        pts[i + 1][i] += step;
+    }
+    for (std::size_t i = 0; i <= n; ++i) {
+        val[i] = f(pts[i]);
+    }
+    evals = static_cast<int>(n + 1);
+    while (evals < maxEval) {
+        std::vector<std::size_t> idx(n + 1);
+        std::iota(idx.begin(), idx.end(), 0);
+        std::sort(idx.begin(), idx.end(),
+                  [&](std::size_t a, std::size_t b) { return val[a] < val[b]; });
+        const std::size_t best = idx[0];
+        const std::size_t worst = idx[n];
+        const std::size_t second = idx[n - 1];
+        if (std::abs(val[worst] - val[best]) < 1e-10 * (1.0 + std::abs(val[best]))) {
+            break;
+        }
+        std::vector<double> centroid(n, 0.0);
+        for (std::size_t i = 0; i <= n; ++i) {
+            if (i != worst) {
+                for (std::size_t d = 0; d < n; ++d) {
+                    centroid[d] += pts[i][d] / static_cast<double>(n);
+                }
+            }
+        }
+        auto along = [&](double t) {
+            std::vector<double> p(n);
+            for (std::size_t d = 0; d < n; ++d) {
+                p[d] = centroid[d] + t * (pts[worst][d] - centroid[d]);
+            }
+            return p;
+        };
+        auto reflected = along(-1.0);
+        const double fr = f(reflected);
+        ++evals;
+        if (fr < val[best]) {
+            auto expanded = along(-2.0);
+            const double fe = f(expanded);
+            ++evals;
+            if (fe < fr) {
+                pts[worst] = expanded;
+                val[worst] = fe;
+            } else {
+                pts[worst] = reflected;
+                val[worst] = fr;
+            }
+        } else if (fr < val[second]) {
+            pts[worst] = reflected;
+            val[worst] = fr;
+        } else {
+            auto contracted = along(fr < val[worst] ? -0.5 : 0.5);
+            const double fc = f(contracted);
+            ++evals;
+            if (fc < std::min(fr, val[worst])) {
+                pts[worst] = contracted;
+                val[worst] = fc;
+            } else {
+                for (std::size_t i = 0; i <= n; ++i) {
+                    if (i != best) {
+                        for (std::size_t d = 0; d < n; ++d) {
+                            pts[i][d] = pts[best][d] + 0.5 * (pts[i][d] - pts[best][d]);
+                        }
+                        val[i] = f(pts[i]);
+                        ++evals;
+                    }
+                }
+            }
+        }
+    }
+    const auto it = std::min_element(val.begin(), val.end());
+    return pts[static_cast<std::size_t>(it - val.begin())];
+}
+
+} // namespace
+
+Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& options)
+{
+    const std::string& src = set.source;
+    const double maxCount = std::ldexp(1.0, set.bitDepth) - 1.0;
+    const auto rows = averageRepeats(set.rows);
+
+    // Black / flare offset.
+    const auto blackIt = std::find_if(rows.begin(), rows.end(), [](const Measurement& m) {
+        return m.counts == glm::dvec3(0.0);
+    });
+    if (blackIt == rows.end()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: no black (0,0,0) measurement: the black/flare offset "
+                                     "cannot be fitted; measure the panel at 0,0,0",
+                                     src));
+    }
+    const glm::dvec3 black = blackIt->xyz;
+
+    // Single-channel ramps.
+    std::array<std::vector<RampPoint>, 3> ramps;
+    std::vector<Measurement> colours;
+    for (const auto& m : rows) {
+        int nonZero = 0;
+        int channel = 0;
+        for (int c = 0; c < 3; ++c) {
+            if (m.counts[c] > 0.0) {
+                ++nonZero;
+                channel = c;
+            }
+        }
+        if (nonZero == 1) {
+            ramps[static_cast<std::size_t>(channel)].push_back({m.counts[channel], m.xyz, m.line});
+        } else if (nonZero > 1) {
+            colours.push_back(m);
+        }
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+        auto& r = ramps[c];
+        std::sort(r.begin(), r.end(),
+                  [](const RampPoint& a, const RampPoint& b) { return a.count < b.count; });
+        const bool hasFull = !r.empty() && r.back().count == maxCount;
+        if (static_cast<int>(r.size()) < options.minRampLevels || !hasFull) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: missing ramp: channel {} has {} non-zero levels{} "
+                                         "(needs at least {} with the others at 0, full drive "
+                                         "{} included)",
+                                         src, kChannelNames[c], r.size(),
+                                         hasFull ? "" : " and no full-drive point",
+                                         options.minRampLevels, maxCount));
+        }
+    }
+
+    // Dead channels and a singular primaries matrix.
+    std::array<glm::dvec3, 3> primary{};
+    double total = 0.0;
+    for (std::size_t c = 0; c < 3; ++c) {
+        primary[c] = ramps[c].back().xyz - black;
+        total += std::max(0.0, primary[c].x + primary[c].y + primary[c].z);
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+        const double s = primary[c].x + primary[c].y + primary[c].z;
+        if (!(s > options.deadChannelFraction * total) || !(total > 0.0)) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}:{}: channel {} is dead: full drive gives X+Y+Z = "
+                                         "{:.4g} cd/m^2 above black ({:.2g}% of the three "
+                                         "primaries); check the cable and the panel",
+                                         src, ramps[c].back().line, kChannelNames[c], s,
+                                         total > 0.0 ? 100.0 * s / total : 0.0));
+        }
+    }
+    const glm::dmat3 m0(primary[0], primary[1], primary[2]);
+    const double normDet =
+            std::abs(glm::determinant(m0)) /
+            (glm::length(primary[0]) * glm::length(primary[1]) * glm::length(primary[2]));
+    if (!(normDet > 1e-3)) {
+        std::size_t a = 0;
+        std::size_t b = 1;
+        double best = -1.0;
+        for (std::size_t i = 0; i < 3; ++i) {
+            for (std::size_t j = i + 1; j < 3; ++j) {
+                const double cosAngle =
+                        std::abs(glm::dot(glm::normalize(primary[i]), glm::normalize(primary[j])));
+                if (cosAngle > best) {
+                    best = cosAngle;
+                    a = i;
+                    b = j;
+                }
+            }
+        }
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: the primaries matrix is singular (normalised "
+                                     "determinant {:.2g}): channels {} and {} have nearly the same "
+                                     "chromaticity; the ramps may be mislabelled",
+                                     src, normDet, kChannelNames[a], kChannelNames[b]));
+    }
+
+    // Monotonicity, judged on the direct-primaries derivation: small dips are meter noise and are
+    // pooled; a drop beyond the tolerance is a broken ramp.
+    {
+        const glm::dmat3 inv = glm::inverse(m0);
+        for (std::size_t c = 0; c < 3; ++c) {
+            double runMax = 0.0;
+            double runMaxCount = 0.0;
+            for (const auto& p : ramps[c]) {
+                const double r = (inv * (p.xyz - black))[static_cast<int>(c)];
+                if (runMax - r > options.monotonicTolerance) {
+                    return makeError(ErrorCode::InvalidArgument,
+                                     fmt::format("{}:{}: channel {} response is not monotonic: "
+                                                 "r drops from {:.3f} at count {} to {:.3f} at "
+                                                 "count {} (more than {:.0f}% of full drive); a "
+                                                 "stuck or mis-ordered ramp?",
+                                                 src, p.line, kChannelNames[c], runMax, runMaxCount,
+                                                 r, p.count, 100.0 * options.monotonicTolerance));
+                }
+                if (r > runMax) {
+                    runMax = r;
+                    runMaxCount = p.count;
+                }
+            }
+        }
+    }
+
+    // Training and held-out colours: alternate off-ramp colours in file order.
+    if (static_cast<int>(colours.size()) < options.minColours) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: only {} measured colours off the single-channel ramps; "
+                                     "the fit and its held-out check need at least {}",
+                                     src, colours.size(), options.minColours));
+    }
+    std::vector<Measurement> training;
+    std::vector<Measurement> heldOut;
+    for (std::size_t i = 0; i < colours.size(); ++i) {
+        (i % 2 == 0 ? training : heldOut).push_back(colours[i]);
+    }
+    const auto whiteIt = std::find_if(rows.begin(), rows.end(), [&](const Measurement& m) {
+        return m.counts == glm::dvec3(maxCount);
+    });
+    const glm::dvec3 refWhite = whiteIt != rows.end() ? whiteIt->xyz : black + m0 * glm::dvec3(1.0);
+
+    auto errors = [&](const Candidate& cand, const std::vector<Measurement>& set2) {
+        std::vector<double> e;
+        e.reserve(set2.size());
+        for (const auto& m : set2) {
+            e.push_back(deltaE2000Xyz(candidateForward(cand, black, m.counts), m.xyz, refWhite));
+        }
+        return e;
+    };
+
+    const Candidate direct = deriveCandidate(m0, black, ramps);
+    FitReport report;
+    report.directPrimariesHeldOutMeanDe00 = mean(errors(direct, heldOut));
+
+    // Optimise the matrix: parameters are relative changes of each entry, scaled by its column.
+    std::array<double, 3> colNorm{glm::length(primary[0]), glm::length(primary[1]),
+                                  glm::length(primary[2])};
+    auto matrixFor = [&](const std::vector<double>& p) {
+        glm::dmat3 m = m0;
+        for (int col = 0; col < 3; ++col) {
+            for (int row = 0; row < 3; ++row) {
+                m[col][row] += p[static_cast<std::size_t>(col * 3 + row)] *
+                               colNorm[static_cast<std::size_t>(col)];
+            }
+        }
+        return m;
+    };
+    Candidate best = direct;
+    if (options.maxEvaluations > 0) {
+        auto objective = [&](const std::vector<double>& p) {
+            const glm::dmat3 m = matrixFor(p);
+            const double det = glm::determinant(m);
+            if (!std::isfinite(det) || std::abs(det) < 1e-12) {
+                return 1e9;
+            }
+            return mean(errors(deriveCandidate(m, black, ramps), training));
+        };
+        int evals = 0;
+        const auto p = nelderMead(objective, std::vector<double>(9, 0.0), 0.01,
+                                  options.maxEvaluations, evals);
+        report.optimiserEvaluations = evals;
+        Candidate opt = deriveCandidate(matrixFor(p), black, ramps);
+        if (mean(errors(opt, training)) < mean(errors(direct, training))) {
+            best = std::move(opt);
+        }
+    }
+
+    // Normalise so that r runs from 0 at count 0 to 1 at full drive (forward unchanged).
+    DisplayModel model;
+    model.name = options.name;
+    model.description = options.description;
+    model.synthetic = options.synthetic;
+    model.bitDepth = set.bitDepth;
+    model.condition = options.condition;
+    glm::dvec3 lo{0.0};
+    glm::dvec3 span{1.0};
+    for (std::size_t c = 0; c < 3; ++c) {
+        const auto& v = best.tone[c].values();
+        lo[static_cast<int>(c)] = v.front();
+        span[static_cast<int>(c)] = v.back() - v.front();
+        if (!(span[static_cast<int>(c)] > 0.0)) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: channel {} has no response after fitting (flat "
+                                         "ramp)",
+                                         src, kChannelNames[c]));
+        }
+        std::vector<double> values(v.size());
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            values[i] = (v[i] - v.front()) / span[static_cast<int>(c)];
+        }
+        values.front() = 0.0;
+        values.back() = 1.0;
+        model.tone[c] = ToneCurve(best.tone[c].counts(), std::move(values));
+    }
+    model.blackXyz = black + best.matrix * lo;
+    model.matrix = best.matrix * glm::dmat3(glm::dvec3(span.x, 0, 0), glm::dvec3(0, span.y, 0),
+                                            glm::dvec3(0, 0, span.z));
+    if (model.blackXyz.x < 0.0 || model.blackXyz.y < 0.0 || model.blackXyz.z < 0.0) {
+        model.blackXyz = glm::max(model.blackXyz, glm::dvec3(0.0));
+    }
+
+    // Report.
+    auto finalErrors = [&](const std::vector<Measurement>& s) {
+        std::vector<double> e;
+        for (const auto& m : s) {
+            e.push_back(deltaE2000Xyz(model.forward(m.counts), m.xyz, refWhite));
+        }
+        return e;
+    };
+    const auto held = finalErrors(heldOut);
+    report.trainingColours = static_cast<int>(training.size());
+    report.heldOutColours = static_cast<int>(heldOut.size());
+    report.heldOutMeanDe00 = mean(held);
+    report.heldOutP90De00 = percentile(held, 0.9);
+    report.heldOutMaxDe00 = held.empty() ? 0.0 : *std::max_element(held.begin(), held.end());
+    report.trainingMeanDe00 = mean(finalErrors(training));
+    report.monotonicCorrections = best.corrections;
+    if (whiteIt != rows.end()) {
+        // Additivity: the measured white against the sum of the measured primaries.
+        const glm::dvec3 sum = black + primary[0] + primary[1] + primary[2];
+        report.additivityDe00 = deltaE2000Xyz(whiteIt->xyz, sum, refWhite);
+        report.additivityLuminancePercent =
+                sum.y > 0.0 ? 100.0 * (whiteIt->xyz.y - sum.y) / sum.y : 0.0;
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+        const glm::dvec2 full = chromaticity(primary[c]);
+        double drift = 0.0;
+        for (const auto& p : ramps[c]) {
+            const glm::dvec3 above = p.xyz - black;
+            if (above.y + above.x + above.z > 0.1 * (primary[c].x + primary[c].y + primary[c].z)) {
+                drift = std::max(drift, glm::length(chromaticity(above) - full));
+            }
+        }
+        report.chromaticityDrift[c] = drift;
+    }
+    model.fit = report;
+    if (auto ok = model.validate(); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return model;
+}
+
+} // namespace replica::pipeline::display

@@ -1,0 +1,70 @@
+// The characterised display (Day, Taplin & Berns 2004): per-channel tone curves, a 3x3 primaries
+// matrix and a black/flare offset, XYZ = M r(d) + XYZ_k, in absolute cd/m^2.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include <pipeline/display/tone_curve.h>
+#include <pipeline/display/viewing_angle.h>
+
+namespace replica::pipeline::display {
+
+// Where the characterisation was measured: in the dark, or in the lit booth (then the black
+// already holds the screen's own reflection of the booth light and it must not be subtracted
+// again: the flare double-count trap).
+enum class MeasurementCondition { Dark, LitBooth };
+
+// Fit diagnostics kept with the profile, so a field check can compare against them.
+struct FitReport {
+    int trainingColours = 0;
+    int heldOutColours = 0;
+    double heldOutMeanDe00 = 0.0;
+    double heldOutP90De00 = 0.0;
+    double heldOutMaxDe00 = 0.0;
+    double trainingMeanDe00 = 0.0;
+    double directPrimariesHeldOutMeanDe00 = 0.0; // before optimising the matrix
+    double additivityDe00 = -1.0;                // measured white vs R+G+B; -1 when not measured
+    double additivityLuminancePercent = 0.0;     // (Y_white - Y_sum) / Y_sum * 100
+    std::array<double, 3> chromaticityDrift{};   // max |dxy| of each primary along its ramp
+    int monotonicCorrections = 0;                // ramp points moved by pool-adjacent-violators
+    int optimiserEvaluations = 0;
+};
+
+struct DisplayModel {
+    std::string name;
+    std::string description;
+    bool synthetic = false;
+    int bitDepth = 8;
+    // Columns: XYZ (cd/m^2) of each channel at full drive above black, so white = black + M
+    // (1,1,1).
+    glm::dmat3 matrix{1.0};
+    glm::dvec3 blackXyz{0.0};
+    // r_c(count), 0 at count 0 and 1 at full drive.
+    std::array<ToneCurve, 3> tone;
+    MeasurementCondition condition = MeasurementCondition::Dark;
+    double frontSurfaceReflectance = 0.002; // rho_d of the panel's front surface (paper)
+    ViewingAngleTable viewing;
+    FitReport fit;
+
+    double maxCount() const;
+    glm::dvec3 whiteXyz() const { return blackXyz + matrix * glm::dvec3(1.0); }
+    // r for real-valued counts.
+    glm::dvec3 linearFromCounts(const glm::dvec3& counts) const;
+    // Absolute XYZ on the panel normal for real-valued counts.
+    glm::dvec3 forward(const glm::dvec3& counts) const;
+    // Checks the invariants a loaded or fitted model must hold; fails with the reason.
+    Expected<void> validate() const;
+};
+
+// The screen's own diffuse reflection of the booth light reaching the eye: rho_d E / pi in the
+// light's colour (lightXyz scaled so that its Y is 1), zero when the profile was measured in the
+// lit booth (its black already holds it).
+glm::dvec3 frontSurfaceFlareXyz(const DisplayModel& model,
+                                double illuminanceLux,
+                                const glm::dvec3& lightXyzUnitY);
+
+} // namespace replica::pipeline::display

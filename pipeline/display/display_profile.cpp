@@ -1,0 +1,176 @@
+// Display profile JSON.
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <pipeline/display/display_profile.h>
+
+namespace replica::pipeline::display {
+namespace {
+
+constexpr int kFormatVersion = 1;
+constexpr std::array<const char*, 3> kChannelKeys{"r", "g", "b"};
+
+nlohmann::json vec3Json(const glm::dvec3& v)
+{
+    return nlohmann::json::array({v.x, v.y, v.z});
+}
+
+glm::dvec3 vec3From(const nlohmann::json& j)
+{
+    if (!j.is_array() || j.size() != 3) {
+        throw std::runtime_error("expected an array of 3 numbers");
+    }
+    return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
+
+} // namespace
+
+std::string profileToJson(const DisplayModel& m)
+{
+    nlohmann::json j;
+    j["format"] = "replica-display-profile";
+    j["version"] = kFormatVersion;
+    j["name"] = m.name;
+    j["description"] = m.description;
+    j["synthetic"] = m.synthetic;
+    j["bit_depth"] = m.bitDepth;
+    j["measured_in"] = m.condition == MeasurementCondition::LitBooth ? "lit-booth" : "dark";
+    j["front_surface_reflectance"] = m.frontSurfaceReflectance;
+    j["black_xyz_cd_m2"] = vec3Json(m.blackXyz);
+    j["primaries_xyz_cd_m2"] = {{"r", vec3Json(m.matrix[0])},
+                                {"g", vec3Json(m.matrix[1])},
+                                {"b", vec3Json(m.matrix[2])}};
+    nlohmann::json tone;
+    for (std::size_t c = 0; c < 3; ++c) {
+        tone[kChannelKeys[c]] = {{"counts", m.tone[c].counts()}, {"r", m.tone[c].values()}};
+    }
+    j["tone_curves"] = tone;
+    j["viewing_angle"] = {{"angle_deg", m.viewing.angleDeg},
+                          {"luminance_ratio", m.viewing.luminanceRatio},
+                          {"dx", m.viewing.dx},
+                          {"dy", m.viewing.dy}};
+    const auto& f = m.fit;
+    j["fit"] = {{"training_colours", f.trainingColours},
+                {"held_out_colours", f.heldOutColours},
+                {"held_out_mean_de00", f.heldOutMeanDe00},
+                {"held_out_p90_de00", f.heldOutP90De00},
+                {"held_out_max_de00", f.heldOutMaxDe00},
+                {"training_mean_de00", f.trainingMeanDe00},
+                {"direct_primaries_held_out_mean_de00", f.directPrimariesHeldOutMeanDe00},
+                {"additivity_de00", f.additivityDe00},
+                {"additivity_luminance_percent", f.additivityLuminancePercent},
+                {"chromaticity_drift", f.chromaticityDrift},
+                {"monotonic_corrections", f.monotonicCorrections},
+                {"optimiser_evaluations", f.optimiserEvaluations}};
+    return j.dump(2) + "\n";
+}
+
+Expected<DisplayModel> profileFromJson(const std::string& text, const std::string& source)
+{
+    DisplayModel m;
+    try {
+        const auto j = nlohmann::json::parse(text);
+        if (j.value("format", "") != "replica-display-profile") {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: not a Replica display profile (no \"format\": "
+                                         "\"replica-display-profile\")",
+                                         source));
+        }
+        if (j.at("version").get<int>() != kFormatVersion) {
+            return makeError(ErrorCode::Unsupported,
+                             fmt::format("{}: profile version {} (this build reads {})", source,
+                                         j.at("version").get<int>(), kFormatVersion));
+        }
+        m.name = j.at("name").get<std::string>();
+        m.description = j.value("description", "");
+        m.synthetic = j.value("synthetic", false);
+        m.bitDepth = j.at("bit_depth").get<int>();
+        const auto cond = j.at("measured_in").get<std::string>();
+        if (cond != "dark" && cond != "lit-booth") {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: measured_in '{}' must be 'dark' or 'lit-booth'",
+                                         source, cond));
+        }
+        m.condition = cond == "dark" ? MeasurementCondition::Dark : MeasurementCondition::LitBooth;
+        m.frontSurfaceReflectance = j.at("front_surface_reflectance").get<double>();
+        m.blackXyz = vec3From(j.at("black_xyz_cd_m2"));
+        const auto& p = j.at("primaries_xyz_cd_m2");
+        m.matrix = glm::dmat3(vec3From(p.at("r")), vec3From(p.at("g")), vec3From(p.at("b")));
+        for (std::size_t c = 0; c < 3; ++c) {
+            const auto& t = j.at("tone_curves").at(kChannelKeys[c]);
+            auto counts = t.at("counts").get<std::vector<double>>();
+            auto values = t.at("r").get<std::vector<double>>();
+            bool ok = counts.size() == values.size() && counts.size() >= 2;
+            for (std::size_t i = 1; ok && i < counts.size(); ++i) {
+                ok = counts[i] > counts[i - 1] && values[i] >= values[i - 1];
+            }
+            if (!ok) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}: tone curve '{}' needs at least 2 points, "
+                                             "counts strictly increasing and r non-decreasing",
+                                             source, kChannelKeys[c]));
+            }
+            m.tone[c] = ToneCurve(std::move(counts), std::move(values));
+        }
+        if (j.contains("viewing_angle")) {
+            const auto& v = j.at("viewing_angle");
+            m.viewing.angleDeg = v.at("angle_deg").get<std::vector<double>>();
+            m.viewing.luminanceRatio = v.at("luminance_ratio").get<std::vector<double>>();
+            m.viewing.dx = v.at("dx").get<std::vector<double>>();
+            m.viewing.dy = v.at("dy").get<std::vector<double>>();
+        }
+        if (j.contains("fit")) {
+            const auto& f = j.at("fit");
+            m.fit.trainingColours = f.value("training_colours", 0);
+            m.fit.heldOutColours = f.value("held_out_colours", 0);
+            m.fit.heldOutMeanDe00 = f.value("held_out_mean_de00", 0.0);
+            m.fit.heldOutP90De00 = f.value("held_out_p90_de00", 0.0);
+            m.fit.heldOutMaxDe00 = f.value("held_out_max_de00", 0.0);
+            m.fit.trainingMeanDe00 = f.value("training_mean_de00", 0.0);
+            m.fit.directPrimariesHeldOutMeanDe00 =
+                    f.value("direct_primaries_held_out_mean_de00", 0.0);
+            m.fit.additivityDe00 = f.value("additivity_de00", -1.0);
+            m.fit.additivityLuminancePercent = f.value("additivity_luminance_percent", 0.0);
+            if (f.contains("chromaticity_drift")) {
+                m.fit.chromaticityDrift = f.at("chromaticity_drift").get<std::array<double, 3>>();
+            }
+            m.fit.monotonicCorrections = f.value("monotonic_corrections", 0);
+            m.fit.optimiserEvaluations = f.value("optimiser_evaluations", 0);
+        }
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Corrupt, fmt::format("{}: {}", source, e.what()));
+    }
+    if (auto ok = m.validate(); !ok) {
+        return makeError(ok.error().code, fmt::format("{}: {}", source, ok.error().message));
+    }
+    return m;
+}
+
+Expected<DisplayModel> loadProfile(const std::filesystem::path& path)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: cannot open the display profile", path.string()));
+    }
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    return profileFromJson(ss.str(), path.string());
+}
+
+Expected<void> saveProfile(const DisplayModel& model, const std::filesystem::path& path)
+{
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f << profileToJson(model);
+    f.close();
+    if (!f) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot write the display profile", path.string()));
+    }
+    return {};
+}
+
+} // namespace replica::pipeline::display

@@ -1,0 +1,48 @@
+// What the GPU display pass needs from a profile, as plain data (uniform values and float arrays
+// for textures), and the GLSL of the inverse model that reads them. The renderer owns the GL
+// objects; this file owns the maths, so the shader and the CPU reference (display_inverse.h) are
+// written side by side.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <pipeline/display/display_inverse.h>
+#include <pipeline/display/dither.h>
+
+namespace replica::pipeline::display {
+
+constexpr int kMaxViewingRows = 16;
+
+struct DisplayShaderParams {
+    std::array<float, 9> xyzToLinear{}; // M^-1, column-major (glUniformMatrix3fv, transpose false)
+    std::array<float, 3> blackXyz{};
+    float blackY = 0.0f;
+    float whiteY = 1.0f;
+    float maxCount = 255.0f;
+    // Inverse tone LUTs: a lutSize x 3 R32F texture, row c = channel c, texel j = counts / maxCount
+    // at r = (j / (lutSize - 1))^3 (the cube-root domain keeps near-black precision).
+    int lutSize = 0;
+    std::vector<float> lut;
+    // 16 x 16 R32F texture of ordered-dither thresholds in (0, 1), indexed by pixel modulo 16.
+    std::array<float, kDitherSize * kDitherSize> dither{};
+    // Viewing-angle gains at the table rows: (angle deg, gain X, gain Y, gain Z); rows beyond
+    // kMaxViewingRows are dropped (the shipped table has 12).
+    int viewingRows = 0;
+    std::array<float, 4 * kMaxViewingRows> viewing{};
+    // Front-surface flare per lux of illuminance, before the light's colour: rho_d / pi; 0 when the
+    // profile was measured in the lit booth (its black already holds the reflection).
+    float flarePerLux = 0.0f;
+};
+
+DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse);
+
+// GLSL ES 3.10 declarations and functions (no #version, no main): uniforms uDisp*, samplers
+// uDispToneLut and uDispDither, and
+//   vec4 displayInverse(vec3 xyz, int mode)  // counts (real) in .xyz, gamut class in .w
+//   vec3 displayViewingGain(float angleDeg)
+//   vec3 displayQuantise(vec3 counts, ivec2 pixel) // integer counts as floats
+// mirroring mapToGamut, DisplayInverse::countsFromLinear (Lut), viewingGain and quantiseCount.
+extern const char* const kDisplayInverseGlsl;
+
+} // namespace replica::pipeline::display

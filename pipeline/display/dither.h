@@ -1,0 +1,18 @@
+// The fixed ordered-dither pattern used when quantising real-valued counts: deterministic (the same
+// frame quantises to the same counts on every run, which replay needs) and with no low-frequency
+// structure, so an 8-bit gradient shows no bands.
+#pragma once
+
+#include <array>
+
+namespace replica::pipeline::display {
+
+constexpr int kDitherSize = 16;
+
+// Thresholds in (0, 1): (Bayer index + 0.5) / 256 for a 16x16 Bayer matrix, row-major.
+const std::array<float, kDitherSize * kDitherSize>& ditherPattern();
+
+// floor(counts + threshold(x, y)) clamped to [0, maxCount]. Non-finite counts give 0.
+int quantiseCount(double counts, int x, int y, double maxCount);
+
+} // namespace replica::pipeline::display

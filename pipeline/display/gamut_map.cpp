@@ -1,0 +1,88 @@
+// Hue-keeping gamut mapping.
+#include <algorithm>
+#include <cmath>
+
+#include <pipeline/display/gamut_map.h>
+
+namespace replica::pipeline::display {
+
+void GamutCounters::add(GamutClass c)
+{
+    ++pixels;
+    switch (c) {
+    case GamutClass::InGamut:
+        break;
+    case GamutClass::Chroma:
+        ++chroma;
+        break;
+    case GamutClass::OverPeak:
+        ++overPeak;
+        break;
+    case GamutClass::BelowBlack:
+        ++belowBlack;
+        break;
+    }
+}
+
+double GamutCounters::outOfGamutFraction() const
+{
+    return pixels == 0 ? 0.0 : static_cast<double>(outOfGamut()) / static_cast<double>(pixels);
+}
+
+MappedLinear
+mapToGamut(const GamutGeometry& g, const glm::dvec3& xyzIn, GamutMode mode, double tolerance)
+{
+    MappedLinear out;
+    if (!std::isfinite(xyzIn.x) || !std::isfinite(xyzIn.y) || !std::isfinite(xyzIn.z)) {
+        out.gamutClass = GamutClass::BelowBlack;
+        return out;
+    }
+    glm::dvec3 xyz = xyzIn;
+    bool overPeak = false;
+    if (xyz.y > g.whiteY) {
+        // Scale to peak luminance: chromaticity kept. (Clip mode leaves it for the clip below.)
+        overPeak = true;
+        if (mode == GamutMode::HueKeeping) {
+            xyz *= g.whiteY / xyz.y;
+        }
+    }
+    const glm::dvec3 r = g.xyzToLinear * (xyz - g.blackXyz);
+    const double span = g.whiteY - g.blackY;
+    if (!(xyz.y - g.blackY >= 0.0) || !(span > 0.0)) {
+        out.gamutClass = GamutClass::BelowBlack;
+        if (mode == GamutMode::Clip) {
+            out.r = glm::clamp(r, 0.0, 1.0);
+        }
+        return out;
+    }
+    const bool inside = r.x >= -tolerance && r.y >= -tolerance && r.z >= -tolerance &&
+                        r.x <= 1.0 + tolerance && r.y <= 1.0 + tolerance && r.z <= 1.0 + tolerance;
+    if (inside || mode == GamutMode::Clip) {
+        out.r = glm::clamp(r, 0.0, 1.0);
+        out.gamutClass = overPeak ? GamutClass::OverPeak
+                                  : (inside ? GamutClass::InGamut : GamutClass::Chroma);
+        return out;
+    }
+    // (a) A chromaticity outside the primaries' triangle (some r < 0): towards the neutral of the
+    // same luminance until no channel is negative. M_Y g = Y - Y_k because M (1,1,1) = white -
+    // black, so the line keeps luminance and dominant wavelength.
+    const double s = std::clamp((xyz.y - g.blackY) / span, 0.0, 1.0);
+    double t = 1.0;
+    for (int c = 0; c < 3; ++c) {
+        if (r[c] < 0.0) {
+            t = std::min(t, s / (s - r[c]));
+        }
+    }
+    glm::dvec3 m = glm::dvec3(s) + std::clamp(t, 0.0, 1.0) * (r - glm::dvec3(s));
+    // (b) A reachable chromaticity too bright for the panel there (some r > 1): scale the light
+    // above black down, which keeps its chromaticity and gives up only luminance.
+    const double top = std::max({m.x, m.y, m.z});
+    if (top > 1.0) {
+        m /= top;
+    }
+    out.r = glm::clamp(m, 0.0, 1.0);
+    out.gamutClass = overPeak ? GamutClass::OverPeak : GamutClass::Chroma;
+    return out;
+}
+
+} // namespace replica::pipeline::display

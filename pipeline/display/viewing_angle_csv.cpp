@@ -1,0 +1,128 @@
+// Viewing-angle measurement CSV.
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include <pipeline/display/viewing_angle_csv.h>
+
+namespace replica::pipeline::display {
+namespace {
+
+std::string trim(const std::string& s)
+{
+    const auto b = s.find_first_not_of(" \t\r");
+    if (b == std::string::npos) {
+        return {};
+    }
+    const auto e = s.find_last_not_of(" \t\r");
+    return s.substr(b, e - b + 1);
+}
+
+bool parseNumber(const std::string& s, double& v)
+{
+    std::size_t used = 0;
+    try {
+        v = std::stod(s, &used);
+    } catch (const std::exception&) {
+        return false;
+    }
+    return !s.empty() && used == s.size() && std::isfinite(v);
+}
+
+} // namespace
+
+Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const std::string& source)
+{
+    ViewingAngleTable t;
+    std::istringstream in(text);
+    std::string raw;
+    int lineNo = 0;
+    bool header = false;
+    double x0 = 0.0;
+    double y0 = 0.0;
+    double lum0 = 0.0;
+    while (std::getline(in, raw)) {
+        ++lineNo;
+        const std::string line = trim(raw);
+        if (line.empty() || line[0] == '#') {
+            continue;
+        }
+        std::vector<std::string> cells;
+        std::istringstream row(line);
+        for (std::string cell; std::getline(row, cell, ',');) {
+            cells.push_back(trim(cell));
+        }
+        if (!header) {
+            if (cells != std::vector<std::string>{"angle_deg", "X", "Y", "Z"}) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}:{}: header must be angle_deg,X,Y,Z (full white "
+                                             "measured off axis, cd/m^2); found '{}'",
+                                             source, lineNo, line));
+            }
+            header = true;
+            continue;
+        }
+        double v[4] = {};
+        if (cells.size() != 4) {
+            return makeError(ErrorCode::Corrupt, fmt::format("{}:{}: expected 4 values, found {}",
+                                                             source, lineNo, cells.size()));
+        }
+        for (std::size_t i = 0; i < 4; ++i) {
+            if (!parseNumber(cells[i], v[i])) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}:{}: '{}' is not a finite number", source, lineNo,
+                                             cells[i]));
+            }
+        }
+        const double sum = v[1] + v[2] + v[3];
+        if (!(v[2] > 0.0) || !(sum > 0.0)) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}:{}: white must have Y > 0 at every angle (the panel "
+                                         "was not lit, or the meter missed it)",
+                                         source, lineNo));
+        }
+        const double x = v[1] / sum;
+        const double y = v[2] / sum;
+        if (t.angleDeg.empty()) {
+            if (v[0] != 0.0) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}:{}: the first row must be on axis (angle_deg 0)",
+                                             source, lineNo));
+            }
+            x0 = x;
+            y0 = y;
+            lum0 = v[2];
+        }
+        t.angleDeg.push_back(v[0]);
+        t.luminanceRatio.push_back(v[2] / lum0);
+        t.dx.push_back(x - x0);
+        t.dy.push_back(y - y0);
+    }
+    if (!header || t.angleDeg.empty()) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: no measurements (header angle_deg,X,Y,Z, then one row "
+                                     "per angle)",
+                                     source));
+    }
+    if (auto ok = t.validate(); !ok) {
+        return makeError(ErrorCode::Corrupt, fmt::format("{}: {}", source, ok.error().message));
+    }
+    return t;
+}
+
+Expected<ViewingAngleTable> loadViewingAngleCsv(const std::filesystem::path& path)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: cannot open the viewing-angle table", path.string()));
+    }
+    std::ostringstream s;
+    s << f.rdbuf();
+    return parseViewingAngleCsv(s.str(), path.string());
+}
+
+} // namespace replica::pipeline::display

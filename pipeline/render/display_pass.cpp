@@ -1,0 +1,374 @@
+// The display pass on GLES 3.1.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <string>
+
+#include <fmt/format.h>
+
+#include <pipeline/display/display_inverse.h>
+#include <pipeline/display/display_shader.h>
+#include <pipeline/render/display_pass.h>
+
+namespace replica::pipeline::render {
+namespace {
+
+const char* const kVertexShader = R"(#version 310 es
+out vec2 vUv;
+void main() {
+    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    vUv = p;
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* const kFragmentHead = R"(#version 310 es
+precision highp float;
+precision highp int;
+precision highp sampler3D;
+in vec2 vUv;
+layout(location = 0) out vec4 outRgba;
+layout(location = 1) out float outClass;
+uniform highp sampler2D uXyz;
+uniform int uDispMethod;        // 0 analytic, 1 3-D LUT
+uniform int uDispGamutMode;     // 0 hue-keeping, 1 per-channel clip
+uniform int uDispViewingOn;
+uniform int uDispFalseColour;
+uniform vec3 uDispEye;
+uniform vec3 uDispPanelOrigin;
+uniform vec3 uDispPanelRight;
+uniform vec3 uDispPanelUp;
+uniform vec3 uDispPanelNormal;
+uniform int uDispLightCount;
+uniform vec4 uDispLights[256];  // xyz: position (m); w: intensity (cd)
+uniform vec3 uDispLightNormal;
+uniform vec3 uDispFlarePerLux;  // rho_d / pi times the light's XYZ with Y = 1; 0 when off
+)";
+
+// Flare first (the reflection reaches the eye whatever the panel emits), then the viewing-angle
+// gain (it scales only what the panel emits): eye = gain * emitted + flare.
+const char* const kFragmentMain = R"(
+const vec3 kFalseColour[4] = vec3[4](vec3(0.0), vec3(1.0, 0.0, 1.0), vec3(0.0, 1.0, 1.0),
+                                     vec3(0.0, 0.3, 1.0));
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec3 xyz = texelFetch(uXyz, px, 0).xyz;
+    vec3 p = uDispPanelOrigin + vUv.x * uDispPanelRight + vUv.y * uDispPanelUp;
+    if (any(notEqual(uDispFlarePerLux, vec3(0.0)))) {
+        float e = 0.0;
+        for (int i = 0; i < uDispLightCount; ++i) {
+            vec3 d = uDispLights[i].xyz - p;
+            float d2 = max(dot(d, d), 1e-6);
+            vec3 dir = d * inversesqrt(d2);
+            e += uDispLights[i].w * max(dot(uDispPanelNormal, dir), 0.0)
+                 * max(dot(uDispLightNormal, -dir), 0.0) / d2;
+        }
+        xyz -= e * uDispFlarePerLux;
+    }
+    if (uDispViewingOn != 0) {
+        vec3 toEye = uDispEye - p;
+        float len = length(toEye);
+        float c = len > 1e-6 ? dot(toEye, uDispPanelNormal) / len : 1.0;
+        float angle = c > 0.0 ? degrees(acos(min(c, 1.0))) : 90.0;
+        xyz /= max(displayViewingGain(angle), vec3(1e-3));
+    }
+    vec3 counts;
+    float cls;
+    if (uDispMethod == 1) {
+        cls = displayGamutClass(xyz);
+        counts = displayLut3dCounts(xyz);
+    } else {
+        vec4 inv = displayInverse(xyz, uDispGamutMode);
+        counts = inv.xyz;
+        cls = inv.w;
+    }
+    vec3 q = displayQuantise(counts, px) / uDispMaxCount;
+    if (uDispFalseColour != 0 && cls > 0.0 && ((px.x + px.y) & 4) == 0) {
+        q = kFalseColour[int(cls)];
+    }
+    outRgba = vec4(q, 1.0);
+    outClass = cls / 255.0;
+}
+)";
+
+// One invocation per pixel; only out-of-gamut pixels touch the counters.
+const char* const kCountShader = R"(#version 310 es
+layout(local_size_x = 16, local_size_y = 16) in;
+uniform highp sampler2D uClass;
+uniform ivec2 uSize;
+layout(std430, binding = 0) buffer Counts { uint counts[4]; };
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= uSize.x || p.y >= uSize.y) {
+        return;
+    }
+    int cls = int(texelFetch(uClass, p, 0).r * 255.0 + 0.5);
+    if (cls > 0 && cls < 4) {
+        atomicAdd(counts[cls], 1u);
+    }
+}
+)";
+
+Expected<GLuint> compile(GLenum type, const std::string& source, const char* what)
+{
+    GLuint shader = glCreateShader(type);
+    const char* src = source.c_str();
+    glShaderSource(shader, 1, &src, nullptr);
+    glCompileShader(shader);
+    GLint ok = GL_FALSE;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        std::array<char, 4096> log{};
+        glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
+        glDeleteShader(shader);
+        return makeError(
+                ErrorCode::Unsupported,
+                fmt::format("display pass: {} shader does not compile: {}", what, log.data()));
+    }
+    return shader;
+}
+
+Expected<GLuint> link(std::initializer_list<GLuint> shaders, const char* what)
+{
+    GLuint program = glCreateProgram();
+    for (GLuint s : shaders) {
+        glAttachShader(program, s);
+    }
+    glLinkProgram(program);
+    for (GLuint s : shaders) {
+        glDeleteShader(s);
+    }
+    GLint ok = GL_FALSE;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        std::array<char, 4096> log{};
+        glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
+        glDeleteProgram(program);
+        return makeError(
+                ErrorCode::Unsupported,
+                fmt::format("display pass: {} program does not link: {}", what, log.data()));
+    }
+    return program;
+}
+
+GLuint texture2d(GLenum internalFormat, GLenum format, GLenum type, int w, int h, const void* data)
+{
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, w, h);
+    if (data != nullptr) {
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, type, data);
+    }
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return tex;
+}
+
+void setVec3(GLuint program, const char* name, const glm::dvec3& v)
+{
+    glUniform3f(glGetUniformLocation(program, name), static_cast<float>(v.x),
+                static_cast<float>(v.y), static_cast<float>(v.z));
+}
+
+void setInt(GLuint program, const char* name, int v)
+{
+    glUniform1i(glGetUniformLocation(program, name), v);
+}
+
+} // namespace
+
+DisplayPass::~DisplayPass()
+{
+    const std::array<GLuint, 5> textures{rgbaTarget_, classTarget_, toneLut_, dither_, lut3d_};
+    glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+    glDeleteBuffers(1, &counts_);
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteProgram(program_);
+    glDeleteProgram(countProgram_);
+}
+
+Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int height)
+{
+    setup_ = setup;
+    width_ = width;
+    height_ = height;
+    if (setup.model.bitDepth != 8) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("display profile '{}' is {}-bit; this build drives 8-bit "
+                                     "panels only (an RGBA8 output)",
+                                     setup.model.name, setup.model.bitDepth));
+    }
+    auto inverse = display::DisplayInverse::build(setup.model);
+    if (!inverse) {
+        return tl::unexpected(inverse.error());
+    }
+    const display::DisplayShaderParams params = display::makeDisplayShaderParams(*inverse);
+    white_ = setup.model.whiteXyz();
+    flarePerLux_ = setup.flareSubtraction ? params.flarePerLux : 0.0f;
+
+    auto vs = compile(GL_VERTEX_SHADER, kVertexShader, "fullscreen vertex");
+    if (!vs) {
+        return tl::unexpected(vs.error());
+    }
+    auto fs = compile(GL_FRAGMENT_SHADER,
+                      std::string(kFragmentHead) + display::kDisplayInverseGlsl + kFragmentMain,
+                      "display");
+    if (!fs) {
+        glDeleteShader(*vs);
+        return tl::unexpected(fs.error());
+    }
+    auto program = link({*vs, *fs}, "display");
+    if (!program) {
+        return tl::unexpected(program.error());
+    }
+    program_ = *program;
+    auto cs = compile(GL_COMPUTE_SHADER, kCountShader, "gamut count");
+    if (!cs) {
+        return tl::unexpected(cs.error());
+    }
+    auto count = link({*cs}, "gamut count");
+    if (!count) {
+        return tl::unexpected(count.error());
+    }
+    countProgram_ = *count;
+
+    rgbaTarget_ = texture2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height, nullptr);
+    classTarget_ = texture2d(GL_R8, GL_RED, GL_UNSIGNED_BYTE, width, height, nullptr);
+    toneLut_ = texture2d(GL_R32F, GL_RED, GL_FLOAT, params.lutSize, 3, params.lut.data());
+    dither_ = texture2d(GL_R32F, GL_RED, GL_FLOAT, display::kDitherSize, display::kDitherSize,
+                        params.dither.data());
+    // A 3-D texture always exists (a 2^3 dummy on the analytic path) so that the sampler is valid.
+    const int n = setup.method == InverseMethod::Lut3d ? std::max(setup.lut3dSize, 2) : 2;
+    std::vector<float> lattice(static_cast<std::size_t>(n * n * n) * 4, 0.0f);
+    glm::dvec3 latticeScale(0.0);
+    if (setup.method == InverseMethod::Lut3d) {
+        const auto lut = display::DisplayLut3d::build(*inverse, n);
+        for (std::size_t i = 0; i < lut.nodes().size(); ++i) {
+            for (int c = 0; c < 3; ++c) {
+                lattice[i * 4 + static_cast<std::size_t>(c)] =
+                        static_cast<float>(lut.nodes()[i][c]);
+            }
+        }
+        latticeScale = lut.scale();
+    }
+    glGenTextures(1, &lut3d_);
+    glBindTexture(GL_TEXTURE_3D, lut3d_);
+    glTexStorage3D(GL_TEXTURE_3D, 1, GL_RGBA32F, n, n, n);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, n, n, n, GL_RGBA, GL_FLOAT, lattice.data());
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+
+    glGenBuffers(1, &counts_);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, 4 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
+
+    glGenFramebuffers(1, &fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, rgbaTarget_, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, classTarget_, 0);
+    const std::array<GLenum, 2> buffers{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers.data());
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        return makeError(ErrorCode::Unsupported,
+                         "display pass: the RGBA8 + R8 display target is not renderable");
+    }
+    // The read buffer stays attachment 0: what glReadPixels on this framebuffer returns.
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+
+    // Uniforms that never change.
+    glUseProgram(program_);
+    glUniformMatrix3fv(glGetUniformLocation(program_, "uDispXyzToLinear"), 1, GL_FALSE,
+                       params.xyzToLinear.data());
+    glUniform3fv(glGetUniformLocation(program_, "uDispBlackXyz"), 1, params.blackXyz.data());
+    glUniform1f(glGetUniformLocation(program_, "uDispBlackY"), params.blackY);
+    glUniform1f(glGetUniformLocation(program_, "uDispWhiteY"), params.whiteY);
+    glUniform1f(glGetUniformLocation(program_, "uDispMaxCount"), params.maxCount);
+    setInt(program_, "uDispLutSize", params.lutSize);
+    setInt(program_, "uDispViewingRows", params.viewingRows);
+    if (params.viewingRows > 0) {
+        glUniform4fv(glGetUniformLocation(program_, "uDispViewing"), params.viewingRows,
+                     params.viewing.data());
+    }
+    setInt(program_, "uDispMethod", setup.method == InverseMethod::Lut3d ? 1 : 0);
+    setInt(program_, "uDispGamutMode", setup.gamut == display::GamutMode::Clip ? 1 : 0);
+    setInt(program_, "uDispViewingOn", setup.viewingCompensation ? 1 : 0);
+    setInt(program_, "uDispFalseColour", setup.falseColour ? 1 : 0);
+    setInt(program_, "uDispLut3dSize", n);
+    setVec3(program_, "uDispLut3dScale", latticeScale);
+    setInt(program_, "uXyz", 0);
+    setInt(program_, "uDispToneLut", 1);
+    setInt(program_, "uDispDither", 2);
+    setInt(program_, "uDispLut3d", 3);
+    glUseProgram(countProgram_);
+    setInt(countProgram_, "uClass", 0);
+    glUniform2i(glGetUniformLocation(countProgram_, "uSize"), width, height);
+    glUseProgram(0);
+    if (GLenum err = glGetError(); err != GL_NO_ERROR) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("display pass: GL error 0x{:04x} while setting up", err));
+    }
+    return {};
+}
+
+Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const DisplayPassFrame& frame)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, width_, height_);
+    glUseProgram(program_);
+    setVec3(program_, "uDispEye", frame.eyeM);
+    setVec3(program_, "uDispPanelOrigin", frame.pose.originM);
+    setVec3(program_, "uDispPanelRight", frame.pose.rightM);
+    setVec3(program_, "uDispPanelUp", frame.pose.upM);
+    setVec3(program_, "uDispPanelNormal", frame.pose.normal);
+    setVec3(program_, "uDispLightNormal", frame.lightNormal);
+    const int lights = frame.lights != nullptr ? frame.lightCount : 0;
+    setInt(program_, "uDispLightCount", lights);
+    if (lights > 0) {
+        glUniform4fv(glGetUniformLocation(program_, "uDispLights"), lights, frame.lights->data());
+    }
+    setVec3(program_, "uDispFlarePerLux", static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, xyzTexture);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, toneLut_);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, dither_);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_3D, lut3d_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+
+    // Count the classes on the GPU: 16 bytes come back instead of the class image.
+    const std::array<GLuint, 4> zero{};
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), zero.data());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, counts_);
+    glUseProgram(countProgram_);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, classTarget_);
+    glDispatchCompute(static_cast<GLuint>((width_ + 15) / 16),
+                      static_cast<GLuint>((height_ + 15) / 16), 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    display::GamutCounters counters;
+    const void* mapped =
+            glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), GL_MAP_READ_BIT);
+    if (mapped == nullptr) {
+        return makeError(ErrorCode::DeviceFailure, "display pass: cannot read the gamut counts");
+    }
+    std::array<GLuint, 4> c{};
+    std::memcpy(c.data(), mapped, sizeof(c));
+    glUnmapBuffer(GL_SHADER_STORAGE_BUFFER);
+    counters.pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
+    counters.chroma = c[1];
+    counters.overPeak = c[2];
+    counters.belowBlack = c[3];
+    glUseProgram(0);
+    return counters;
+}
+
+} // namespace replica::pipeline::render

@@ -1,0 +1,81 @@
+// The renderer's second pass: absolute XYZ (cd/m^2) per pixel -> panel counts through a display
+// profile's inverse model, with front-surface flare subtraction and viewing-angle compensation per
+// pixel, hue-keeping gamut mapping, ordered dither to the panel's bit depth, an optional
+// false-colour overlay of out-of-gamut pixels, and a GPU count of those pixels per frame. Needs a
+// current GLES 3.1 context; the maths is pipeline/display's (display_shader.h mirrors
+// display_inverse.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <GLES3/gl31.h>
+#include <glm/vec3.hpp>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/display/display_model.h>
+#include <pipeline/display/gamut_map.h>
+#include <pipeline/scene/stand.h>
+
+namespace replica::pipeline::render {
+
+enum class InverseMethod {
+    Analytic, // M^-1, gamut mapping, per-channel inverse tone LUT (1-D, cube-root domain)
+    Lut3d,    // a 33^3 lattice of the analytic path's counts, tetrahedral interpolation
+};
+
+struct DisplayPassSetup {
+    display::DisplayModel model; // the profile (or the nominal model under --uncalibrated)
+    display::GamutMode gamut = display::GamutMode::HueKeeping;
+    InverseMethod method = InverseMethod::Analytic;
+    int lut3dSize = 33;
+    bool viewingCompensation = true; // from the profile's table and the tracked eye; off: on-axis
+    bool flareSubtraction = true;    // rho_d E / pi per pixel; never for a lit-booth profile
+    bool falseColour = false;        // field-staff overlay: out-of-gamut pixels striped in colour
+};
+
+// What changes per frame. 'lights' is the renderer's packed list (x, y, z in m, intensity in cd).
+struct DisplayPassFrame {
+    scene::PanelPose pose;
+    glm::dvec3 eyeM{0.0};
+    const std::vector<float>* lights = nullptr;
+    int lightCount = 0;
+    glm::dvec3 lightNormal{0.0, -1.0, 0.0};
+    glm::dvec3 lightXyzUnitY{0.0}; // the booth light's colour, Y = 1
+};
+
+class DisplayPass
+{
+public:
+    DisplayPass() = default;
+    ~DisplayPass();
+    DisplayPass(const DisplayPass&) = delete;
+    DisplayPass& operator=(const DisplayPass&) = delete;
+
+    // Fails when the profile does not validate, is not 8-bit (the output target in this build), or
+    // the GL lacks what the pass needs.
+    Expected<void> init(const DisplayPassSetup& setup, int width, int height);
+    // Reads xyzTexture (RGBA32F, texelFetch), draws into framebuffer(), counts the gamut classes.
+    Expected<display::GamutCounters> draw(GLuint xyzTexture, const DisplayPassFrame& frame);
+    // The RGBA8 display target (counts / 255; alpha 1).
+    GLuint framebuffer() const { return fbo_; }
+
+private:
+    DisplayPassSetup setup_;
+    int width_ = 0;
+    int height_ = 0;
+    GLuint program_ = 0;
+    GLuint countProgram_ = 0;
+    GLuint fbo_ = 0;
+    GLuint rgbaTarget_ = 0;
+    GLuint classTarget_ = 0;
+    GLuint toneLut_ = 0;
+    GLuint dither_ = 0;
+    GLuint lut3d_ = 0;
+    GLuint counts_ = 0; // SSBO of 4 uints, one per gamut class
+    float flarePerLux_ = 0.0f;
+    glm::dvec3 white_{0.0};
+};
+
+} // namespace replica::pipeline::render

@@ -1,0 +1,94 @@
+// Profile JSON round trip, bad profiles, and the shipped synthetic IPS profile: it loads, says it
+// is synthetic, and is exactly what the shipped tool and measurement set produce.
+#include <filesystem>
+#include <fstream>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/display/display_profile.h>
+
+#include <gtest/gtest.h>
+
+#include "display_test_support.h"
+
+namespace replica::pipeline::display {
+namespace {
+
+TEST(DisplayProfile, RoundTripsThroughJson)
+{
+    const DisplayModel& m = test::fittedSyntheticIps();
+    auto back = profileFromJson(profileToJson(m), "p.json");
+    ASSERT_TRUE(back.has_value()) << back.error().message;
+    for (const glm::dvec3& c :
+         {glm::dvec3(0.0), glm::dvec3(12.5, 200.0, 77.0), glm::dvec3(255.0)}) {
+        const glm::dvec3 a = m.forward(c);
+        const glm::dvec3 b = back->forward(c);
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_NEAR(a[k], b[k], 1e-9 * (1.0 + std::abs(a[k])));
+        }
+    }
+    EXPECT_EQ(back->viewing.angleDeg, m.viewing.angleDeg);
+    EXPECT_DOUBLE_EQ(back->fit.heldOutMeanDe00, m.fit.heldOutMeanDe00);
+    EXPECT_EQ(back->condition, MeasurementCondition::Dark);
+}
+
+TEST(DisplayProfile, BadProfilesAreRejectedWithTheReason)
+{
+    auto err = [](const std::string& text) {
+        auto p = profileFromJson(text, "p.json");
+        EXPECT_FALSE(p.has_value());
+        return p ? std::string() : p.error().message;
+    };
+    EXPECT_NE(err("{").find("p.json: "), std::string::npos);
+    EXPECT_EQ(err("{\"name\": 1}"),
+              "p.json: not a Replica display profile (no \"format\": \"replica-display-profile\")");
+    std::string good = profileToJson(test::fittedSyntheticIps());
+    auto replaced = [&](const std::string& from, const std::string& to) {
+        std::string s = good;
+        const auto at = s.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        return s.replace(at, from.size(), to);
+    };
+    EXPECT_EQ(err(replaced("\"version\": 1", "\"version\": 9")),
+              "p.json: profile version 9 (this build reads 1)");
+    EXPECT_EQ(err(replaced("\"measured_in\": \"dark\"", "\"measured_in\": \"outdoors\"")),
+              "p.json: measured_in 'outdoors' must be 'dark' or 'lit-booth'");
+    EXPECT_EQ(err(replaced("\"bit_depth\": 8", "\"bit_depth\": 10")),
+              "p.json: display profile 'test-ips': channel R tone curve must run from count 0 "
+              "(r = 0) to count 1023 (r = 1)");
+    EXPECT_EQ(loadProfile("/nonexistent/p.json").error().message,
+              "/nonexistent/p.json: cannot open the display profile");
+}
+
+TEST(DisplayProfile, ShippedSyntheticProfileIsReproducible)
+{
+    const auto dir = dataDir() / "displays";
+    auto shipped = loadProfile(dir / "wide-ips-synthetic.json");
+    ASSERT_TRUE(shipped.has_value()) << shipped.error().message;
+    EXPECT_TRUE(shipped->synthetic);
+    EXPECT_NE(shipped->description.find("SYNTHETIC"), std::string::npos);
+    EXPECT_EQ(shipped->bitDepth, 8);
+    EXPECT_FALSE(shipped->viewing.empty());
+    EXPECT_GT(shipped->whiteXyz().y, 850.0);
+
+    // The shipped measurements are what 'replica display synth --seed 1' writes, and the profile
+    // is what 'replica display fit' makes of them.
+    auto meas = loadMeasurementCsv(dir / "wide-ips-synthetic-measurements.csv");
+    ASSERT_TRUE(meas.has_value()) << meas.error().message;
+    const auto regenerated = syntheticMeasurements(wideIpsGroundTruth(), MeterNoise{}, 1);
+    ASSERT_EQ(meas->rows.size(), regenerated.size());
+    for (std::size_t i = 0; i < regenerated.size(); ++i) {
+        EXPECT_EQ(meas->rows[i].counts, regenerated[i].counts);
+        EXPECT_NEAR(meas->rows[i].xyz.y, regenerated[i].xyz.y, 1e-6);
+    }
+    FitOptions o;
+    o.name = shipped->name;
+    o.synthetic = true;
+    auto refit = fitDisplay(*meas, o);
+    ASSERT_TRUE(refit.has_value()) << refit.error().message;
+    for (const glm::dvec3& c : {glm::dvec3(30.0, 60.0, 90.0), glm::dvec3(255.0)}) {
+        EXPECT_NEAR(refit->forward(c).y, shipped->forward(c).y, 1e-6 * shipped->forward(c).y);
+    }
+}
+
+} // namespace
+} // namespace replica::pipeline::display

@@ -1,0 +1,189 @@
+// The GPU display pass against the CPU display model, with the shipped profile: flare subtraction
+// and viewing-angle compensation per pixel, both inverse methods, and the per-frame gamut counts.
+#include <cmath>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/display/display_inverse.h>
+#include <pipeline/display/display_profile.h>
+#include <pipeline/render/gles_renderer.h>
+#include <platform/output/output.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::pipeline::render {
+namespace {
+
+class DisplayPassTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        auto out = platform::createHeadlessOutput();
+        if (!out) {
+            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        }
+        output_ = std::move(*out);
+        auto profile = display::loadProfile(dataDir() / "displays" / "wide-ips-synthetic.json");
+        ASSERT_TRUE(profile) << profile.error().message;
+        profile_ = *profile;
+    }
+
+    std::unique_ptr<Renderer> make(InverseMethod method, double reflectance)
+    {
+        GlesRendererSetup s;
+        s.width = 64;
+        s.height = 40;
+        s.booth = *scene::loadDefaultBooth(dataDir().string());
+        s.basis = colour::boxBasis();
+        s.observer = *colour::loadCie1931(dataDir());
+        // Left half grey, right half a saturated red (out of gamut at the booth's light level).
+        s.surface.width = 2;
+        s.surface.height = 1;
+        s.surface.coeffs = {static_cast<float>(reflectance),
+                            static_cast<float>(reflectance),
+                            static_cast<float>(reflectance),
+                            static_cast<float>(reflectance),
+                            static_cast<float>(reflectance),
+                            static_cast<float>(reflectance),
+                            0.0f,
+                            0.0f,
+                            0.0f,
+                            0.02f,
+                            0.6f,
+                            0.9f};
+        s.display.model = profile_;
+        s.display.method = method;
+        setup_ = s;
+        auto r = createGlesRenderer(s);
+        EXPECT_TRUE(r) << r.error().message;
+        return r ? std::move(*r) : nullptr;
+    }
+
+    scene::SceneState state() const
+    {
+        scene::SceneState st;
+        st.illuminant = setup_.booth.lamps[0].spectrum;
+        st.emitterLuminanceCdM2 = 2000.0;
+        st.tiltRad = 0.3;
+        st.eyeBoothM = {0.25, 0.55, 0.35}; // off to one side and close: angles up to ~40 deg
+        return st;
+    }
+
+    // What the pass should drive, from the CPU model: (XYZ - flare) / viewing gain, inverted.
+    display::InverseResult
+    expected(const display::DisplayInverse& inv, const RenderedFrame& f, int x, int y) const
+    {
+        const auto st = state();
+        const auto pose = scene::panelPose(setup_.stand, st.tiltRad);
+        const glm::dvec3 p =
+                pose.originM + (x + 0.5) / f.width * pose.rightM + (y + 0.5) / f.height * pose.upM;
+        double e = 0.0;
+        for (const auto& l : scene::uniformGridLights(setup_.booth.emitter, st.emitterLuminanceCdM2,
+                                                      setup_.lightsU, setup_.lightsV)) {
+            const glm::dvec3 d = l.positionM - p;
+            const double d2 = glm::dot(d, d);
+            const glm::dvec3 dir = d / std::sqrt(d2);
+            e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *
+                 std::max(glm::dot(setup_.booth.emitter.normal, -dir), 0.0) / d2;
+        }
+        const colour::Xyz light = colour::spectrumToXyz(setup_.observer, st.illuminant);
+        const glm::dvec3 flare = display::frontSurfaceFlareXyz(profile_, e, light / light.y);
+        const double angle = display::viewingAngleDeg(p, pose.normal, st.eyeBoothM);
+        const glm::dvec3 gain = display::viewingGain(profile_.viewing, profile_.whiteXyz(), angle);
+        const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(f.width) +
+                               static_cast<std::size_t>(x)) *
+                              4;
+        const glm::dvec3 xyz{f.xyz[i], f.xyz[i + 1], f.xyz[i + 2]};
+        return inv.invert((xyz - flare) / gain);
+    }
+
+    std::unique_ptr<platform::Output> output_;
+    display::DisplayModel profile_;
+    GlesRendererSetup setup_;
+};
+
+TEST_F(DisplayPassTest, AnalyticPassMatchesTheCpuModelWithFlareAndViewingAngle)
+{
+    auto r = make(InverseMethod::Analytic, 0.35);
+    ASSERT_TRUE(r);
+    RenderedFrame f;
+    ASSERT_TRUE(r->render(state(), f));
+    auto inv = display::DisplayInverse::build(profile_);
+    ASSERT_TRUE(inv);
+    std::uint64_t cpuOut = 0;
+    for (int y = 0; y < f.height; ++y) {
+        for (int x = 0; x < f.width; ++x) {
+            const auto want = expected(*inv, f, x, y);
+            cpuOut += want.inGamut() ? 0 : 1;
+            const std::size_t i =
+                    (static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x)) * 4;
+            for (int c = 0; c < 3; ++c) {
+                // Dither adds [0, 1) before the floor; float vs double adds a little more.
+                const double got = f.rgba[i + static_cast<std::size_t>(c)];
+                ASSERT_GE(got, std::floor(want.counts[c] - 0.02) - 1e-9) << x << "," << y;
+                ASSERT_LE(got, std::ceil(want.counts[c] + 0.02) + 1e-9) << x << "," << y;
+            }
+        }
+    }
+    // The red half is out of gamut, the grey half in: the GPU count agrees with the CPU's.
+    EXPECT_GT(cpuOut, 64u * 40u / 4u);
+    EXPECT_EQ(f.gamut.pixels, 64u * 40u);
+    EXPECT_NEAR(static_cast<double>(f.gamut.outOfGamut()), static_cast<double>(cpuOut), 4.0);
+}
+
+TEST_F(DisplayPassTest, CompensationChangesWhatIsDrivenInTheRightDirection)
+{
+    auto r = make(InverseMethod::Analytic, 0.35);
+    ASSERT_TRUE(r);
+    RenderedFrame on;
+    ASSERT_TRUE(r->render(state(), on));
+    setup_.display.viewingCompensation = false;
+    setup_.display.flareSubtraction = false;
+    auto plain = createGlesRenderer(setup_);
+    ASSERT_TRUE(plain);
+    RenderedFrame off;
+    ASSERT_TRUE((*plain)->render(state(), off));
+    // On the grey half: off axis the panel is dimmer, so compensation drives harder, even after
+    // taking the reflection away.
+    long sumOn = 0;
+    long sumOff = 0;
+    for (int y = 0; y < 40; ++y) {
+        for (int x = 0; x < 30; ++x) {
+            const std::size_t i =
+                    (static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x)) * 4;
+            sumOn += on.rgba[i + 1];
+            sumOff += off.rgba[i + 1];
+        }
+    }
+    EXPECT_GT(sumOn, sumOff);
+}
+
+TEST_F(DisplayPassTest, LutPassAgreesWithTheAnalyticPass)
+{
+    auto a = make(InverseMethod::Analytic, 0.2);
+    ASSERT_TRUE(a);
+    RenderedFrame fa;
+    ASSERT_TRUE(a->render(state(), fa));
+    auto l = make(InverseMethod::Lut3d, 0.2);
+    ASSERT_TRUE(l);
+    RenderedFrame fl;
+    ASSERT_TRUE(l->render(state(), fl));
+    int worst = 0;
+    for (int y = 0; y < 40; ++y) {
+        for (int x = 0; x < 30; ++x) { // the in-gamut grey half
+            const std::size_t i =
+                    (static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x)) * 4;
+            for (std::size_t c = 0; c < 3; ++c) {
+                worst = std::max(worst, std::abs(fa.rgba[i + c] - fl.rgba[i + c]));
+            }
+        }
+    }
+    EXPECT_LE(worst, 2); // a 33^3 lattice is within a count or so of the analytic inverse
+    EXPECT_EQ(fa.gamut.outOfGamut(), fl.gamut.outOfGamut()); // same classification
+}
+
+} // namespace
+} // namespace replica::pipeline::render
