@@ -1,4 +1,5 @@
 // Assembling the appliance.
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -10,6 +11,7 @@
 #include <hal/replay/replay_source.h>
 #include <hal/sim/sim_devices.h>
 #include <pipeline/base/data_dir.h>
+#include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/nominal_display.h>
@@ -38,6 +40,12 @@ std::string RunConfig::toJson() const
                      {"display", display},
                      {"display_peak_cd_m2", displayPeakCdM2},
                      {"display_black_cd_m2", displayBlackCdM2},
+                     {"renderer", renderer},
+                     {"scene_dir", sceneDir},
+                     {"scene_digest", sceneDigest},
+                     {"booth_lights", boothLights},
+                     {"specular_samples", specularSamples},
+                     {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
                      {"display_inverse", displayInverse},
                      {"gamut_mapping", gamutMapping},
@@ -64,6 +72,13 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.display = j.at("display").get<std::string>();
         c.displayPeakCdM2 = j.at("display_peak_cd_m2").get<double>();
         c.displayBlackCdM2 = j.at("display_black_cd_m2").get<double>();
+        // Absent in recordings made before the booth renderer: those replay with the flat one.
+        c.renderer = j.value("renderer", std::string("flat"));
+        c.sceneDir = j.value("scene_dir", c.sceneDir);
+        c.sceneDigest = j.value("scene_digest", std::string());
+        c.boothLights = j.value("booth_lights", c.boothLights);
+        c.specularSamples = j.value("specular_samples", c.specularSamples);
+        c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
         // Recordings made before display profiles had none of these: the plain pass 2 they had
         // was on-axis, without flare subtraction.
         c.displayDigest = j.value("display_digest", std::string());
@@ -76,9 +91,17 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
     }
     if (c.width <= 0 || c.height <= 0 || c.width > 16384 || c.height > 16384 || !(c.rateHz > 0.0) ||
-        c.rateHz > 1000.0 || c.lightsU <= 0 || c.lightsV <= 0 || c.lightsU * c.lightsV > 256) {
-        return makeError(ErrorCode::InvalidArgument, "run configuration: size, rate or light count "
-                                                     "out of range");
+        c.rateHz > 1000.0 || c.lightsU <= 0 || c.lightsV <= 0 || c.lightsU * c.lightsV > 256 ||
+        c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < 0 ||
+        c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32) {
+        return makeError(ErrorCode::InvalidArgument, "run configuration: size, rate, light count, "
+                                                     "specular samples or horizon directions out "
+                                                     "of range");
+    }
+    if (c.renderer != "booth" && c.renderer != "flat") {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("run configuration: renderer '{}' is not 'booth' or 'flat'",
+                                     c.renderer));
     }
     if ((c.displayInverse != "analytic" && c.displayInverse != "lut3d") ||
         (c.gamutMapping != "hue" && c.gamutMapping != "clip")) {
@@ -90,6 +113,35 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
     return c;
 }
 
+std::filesystem::path resolveSceneDir(const std::string& sceneDir)
+{
+    const std::filesystem::path p(sceneDir);
+    return p.is_relative() ? dataDir() / p : p;
+}
+
+Expected<std::string> sceneDigest(const std::filesystem::path& dir)
+{
+    std::uint64_t h = 14695981039346656037ull;
+    for (const char* name : {"scene.json", "channels.exr", "height.exr", "material.exr"}) {
+        std::ifstream in(dir / name, std::ios::binary);
+        if (!in) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot read the scene file", (dir / name).string()));
+        }
+        for (const char c : std::string(name)) {
+            h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+        }
+        std::array<char, 65536> buf{};
+        while (in.read(buf.data(), buf.size()) || in.gcount() > 0) {
+            for (std::streamsize i = 0; i < in.gcount(); ++i) {
+                h = (h ^ static_cast<unsigned char>(buf[static_cast<std::size_t>(i)])) *
+                    1099511628211ull;
+            }
+        }
+    }
+    return fmt::format("{:016x}", h);
+}
+
 std::string displayProfileId(const RunConfig& config, const std::string& profileName)
 {
     if (config.display == kUncalibratedDisplay) {
@@ -99,6 +151,54 @@ std::string displayProfileId(const RunConfig& config, const std::string& profile
 }
 
 namespace {
+
+// The booth renderer's pass 1: the booth model, the scene folder, the settings.
+Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
+makeBoothScene(RunConfig& config,
+               const pipeline::scene::Booth& lamps,
+               const pipeline::colour::ChannelBasis& basis,
+               const pipeline::colour::Observer& observer)
+{
+    const auto dir = resolveSceneDir(config.sceneDir);
+    auto digest = sceneDigest(dir);
+    if (!digest) {
+        return tl::unexpected(digest.error());
+    }
+    if (!config.sceneDigest.empty() && config.sceneDigest != *digest) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: the scene has changed since it was recorded (digest {}, "
+                                     "recorded {}); replay needs the recorded scene",
+                                     dir.string(), *digest, config.sceneDigest));
+    }
+    config.sceneDigest = *digest;
+    auto scene = pipeline::surface::loadScene(dir);
+    if (!scene) {
+        return tl::unexpected(scene.error());
+    }
+    config.scene = scene->name;
+    auto booth = pipeline::booth::loadBooth(dataDir() / "booth");
+    if (!booth) {
+        return tl::unexpected(booth.error());
+    }
+    pipeline::render::BoothSceneSetup setup;
+    setup.booth = std::move(*booth);
+    for (const auto& lamp : lamps.lamps) {
+        setup.lamps.push_back(lamp.name);
+    }
+    setup.scene = std::move(*scene);
+    setup.basis = basis;
+    setup.observer = observer;
+    setup.settings.lights = config.boothLights;
+    setup.settings.specularSamples = config.specularSamples;
+    setup.settings.horizonDirections = config.horizonDirections;
+    // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
+    setup.settings.subtractFlare = !config.flareSubtraction;
+    auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
+    if (!pass) {
+        return tl::unexpected(pass.error());
+    }
+    return std::shared_ptr<pipeline::render::BoothScenePass>(std::move(*pass));
+}
 
 // The display pass's setup from the configuration: the profile (checked against the digest a
 // recording holds) or the nominal model.
@@ -169,7 +269,8 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     // spectral fit' under data/channels/ (docs/accuracy.md).
     const bool knownBasis = config.basis == "box6" || config.basis == "replica_k6" ||
                             config.basis == "general_k6" || config.basis == "pca6";
-    if (config.booth != "replica-booth-1" || config.scene != "colorchecker" || !knownBasis) {
+    const bool knownScene = config.renderer == "booth" || config.scene == "colorchecker";
+    if (config.booth != "replica-booth-1" || !knownScene || !knownBasis) {
         return makeError(ErrorCode::NotFound,
                          fmt::format("unknown booth '{}', scene '{}' or basis '{}' (this build has "
                                      "replica-booth-1, colorchecker, and bases replica_k6, "
@@ -199,8 +300,11 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
         }
         basis = std::move(*fitted);
     }
-    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches.
-    auto surface = pipeline::render::makeColorCheckerSurface(dir, basis, 600, 400);
+    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches. The
+    // booth renderer does not read it (its scene has its own textures).
+    auto surface = config.renderer == "flat"
+                           ? pipeline::render::makeColorCheckerSurface(dir, basis, 600, 400)
+                           : pipeline::render::makeColorCheckerSurface(dir, basis, 6, 4);
     if (!surface) {
         return tl::unexpected(surface.error());
     }
@@ -224,6 +328,13 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     setup.display = std::move(*display);
     setup.lightsU = config.lightsU;
     setup.lightsV = config.lightsV;
+    if (config.renderer == "booth") {
+        auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer);
+        if (!boothScene) {
+            return tl::unexpected(boothScene.error());
+        }
+        setup.boothScene = std::move(*boothScene);
+    }
     auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
     if (!renderer) {
         return tl::unexpected(renderer.error());

@@ -2,6 +2,7 @@
 // updater, and the HAL sources (simulated or replayed).
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -24,6 +25,15 @@ struct RunConfig {
     double rateHz = 60.0;
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
+    // "booth": the surface scene in sceneDir lit by the booth model (pass 1 from
+    // render/booth_scene_pass.h); "flat": the flat patch image under a uniform grid of lights, what
+    // recordings made before the booth renderer hold (a configuration without "renderer").
+    std::string renderer = "booth";
+    std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
+    std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
+    int boothLights = 32;    // median-cut point lights
+    int specularSamples = 16;
+    int horizonDirections = 8;
     std::string basis = "replica_k6"; // docs/accuracy.md; recordings made with box6 replay as such
     int lightsU = 8;
     int lightsV = 4;
@@ -74,7 +84,11 @@ struct Appliance {
     }
 };
 
-// Creates the headless output and everything that renders. Fails with a one-line reason.
+// The scene folder a configuration names (relative: under the data folder), and the digest of the
+// files that make the scene (scene.json, channels.exr, height.exr, material.exr).
+std::filesystem::path resolveSceneDir(const std::string& sceneDir);
+Expected<std::string> sceneDigest(const std::filesystem::path& dir);
+
 // Where frames go; not part of RunConfig because it never changes what a frame looks like.
 struct OutputChoice {
     std::string kind = "headless"; // or "kms"
@@ -82,6 +96,8 @@ struct OutputChoice {
     std::string kmsConnector; // empty: the first connected one
 };
 
+// Creates the output and everything that renders. Fails with a one-line reason. With the booth
+// renderer, config.sceneDigest (when not empty) must match the scene on disk.
 Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
                                                     const OutputChoice& output = {});
 

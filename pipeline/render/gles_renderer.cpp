@@ -196,6 +196,9 @@ public:
 
     std::string description() const override
     {
+        if (setup_.boothScene) {
+            return setup_.boothScene->description();
+        }
         return fmt::format("gles-diffuse ({}x{} point lights, basis {})", setup_.lightsU,
                            setup_.lightsV, setup_.basis.name);
     }
@@ -205,23 +208,11 @@ public:
     {
         const int w = setup_.width;
         const int h = setup_.height;
+        // The panel pose and the uniform grid of lights: pass 1 of the flat image and pass 2's
+        // flare estimate use them.
         const scene::PanelPose pose = scene::panelPose(setup_.stand, state.tiltRad);
         const auto lights = scene::uniformGridLights(
                 setup_.booth.emitter, state.emitterLuminanceCdM2, setup_.lightsU, setup_.lightsV);
-        const colour::ChannelToXyz m =
-                colour::channelToXyz(setup_.basis, setup_.observer, state.illuminant);
-
-        glViewport(0, 0, w, h);
-        glBindVertexArray(vao_);
-
-        // Pass 1: absolute XYZ.
-        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
-        glUseProgram(xyzProgram_);
-        setVec3(xyzProgram_, "uPanelOrigin", pose.originM);
-        setVec3(xyzProgram_, "uPanelRight", pose.rightM);
-        setVec3(xyzProgram_, "uPanelUp", pose.upM);
-        setVec3(xyzProgram_, "uPanelNormal", pose.normal);
-        setVec3(xyzProgram_, "uLightNormal", setup_.booth.emitter.normal);
         const int count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
         std::vector<float> packed;
         packed.reserve(static_cast<std::size_t>(count) * 4);
@@ -231,25 +222,19 @@ public:
                           {static_cast<float>(l.positionM.x), static_cast<float>(l.positionM.y),
                            static_cast<float>(l.positionM.z), static_cast<float>(l.intensityCd)});
         }
-        glUniform1i(glGetUniformLocation(xyzProgram_, "uLightCount"), count);
-        if (count > 0) {
-            glUniform4fv(glGetUniformLocation(xyzProgram_, "uLights"), count, packed.data());
-        }
-        std::array<float, colour::kChannels * 3> mf{};
-        for (std::size_t k = 0; k < colour::kChannels; ++k) {
-            for (int c = 0; c < 3; ++c) {
-                mf[k * 3 + static_cast<std::size_t>(c)] = static_cast<float>(m[k][c]);
+        glViewport(0, 0, w, h);
+
+        // Pass 1: absolute XYZ.
+        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
+        if (setup_.boothScene) {
+            if (auto ok = setup_.boothScene->draw(state, w, h); !ok) {
+                return ok;
             }
+        } else {
+            drawFlatXyz(state, pose, packed, count);
         }
-        glUniform3fv(glGetUniformLocation(xyzProgram_, "uChannelXyz"),
-                     static_cast<GLsizei>(colour::kChannels), mf.data());
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, coeffA_);
-        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffA"), 0);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, coeffB_);
-        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffB"), 1);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glViewport(0, 0, w, h);
+        glBindVertexArray(vao_);
 
         // Pass 2: panel counts (display_pass.cpp).
         DisplayPassFrame df;
@@ -295,6 +280,44 @@ public:
     }
 
 private:
+    // Pass 1 of the flat patch image: eq. (1) over a uniform grid of lights, eq. (2).
+    void drawFlatXyz(const scene::SceneState& state,
+                     const scene::PanelPose& pose,
+                     const std::vector<float>& packed,
+                     int count)
+    {
+        const colour::ChannelToXyz m =
+                colour::channelToXyz(setup_.basis, setup_.observer, state.illuminant);
+
+        glBindVertexArray(vao_);
+
+        glUseProgram(xyzProgram_);
+        setVec3(xyzProgram_, "uPanelOrigin", pose.originM);
+        setVec3(xyzProgram_, "uPanelRight", pose.rightM);
+        setVec3(xyzProgram_, "uPanelUp", pose.upM);
+        setVec3(xyzProgram_, "uPanelNormal", pose.normal);
+        setVec3(xyzProgram_, "uLightNormal", setup_.booth.emitter.normal);
+        glUniform1i(glGetUniformLocation(xyzProgram_, "uLightCount"), count);
+        if (count > 0) {
+            glUniform4fv(glGetUniformLocation(xyzProgram_, "uLights"), count, packed.data());
+        }
+        std::array<float, colour::kChannels * 3> mf{};
+        for (std::size_t k = 0; k < colour::kChannels; ++k) {
+            for (int c = 0; c < 3; ++c) {
+                mf[k * 3 + static_cast<std::size_t>(c)] = static_cast<float>(m[k][c]);
+            }
+        }
+        glUniform3fv(glGetUniformLocation(xyzProgram_, "uChannelXyz"),
+                     static_cast<GLsizei>(colour::kChannels), mf.data());
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, coeffA_);
+        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffA"), 0);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, coeffB_);
+        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffB"), 1);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+
     static void setVec3(GLuint program, const char* name, const glm::dvec3& v)
     {
         const glm::vec3 f = toFloat(v);

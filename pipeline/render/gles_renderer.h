@@ -7,6 +7,7 @@
 
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/display_pass.h>
 #include <pipeline/render/renderer.h>
 #include <pipeline/render/surface_image.h>
@@ -26,6 +27,9 @@ struct GlesRendererSetup {
     DisplayPassSetup display; // pass 2: the display profile and what the pass does with it
     int lightsU = 8; // point lights across the emitter (uniform grid until median cut lands)
     int lightsV = 4;
+    // When set, pass 1 is the booth-lit surface scene (booth_scene_pass.h) instead of the flat
+    // patch image under the uniform grid of lights above.
+    std::shared_ptr<BoothScenePass> boothScene;
 };
 
 Expected<std::unique_ptr<Renderer>> createGlesRenderer(GlesRendererSetup setup);

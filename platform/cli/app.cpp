@@ -26,6 +26,9 @@ int runCli(int argc, char** argv)
     registerRunCommand(app, exitCode);
     registerReplayCommand(app, exitCode);
     registerInspectCommand(app, exitCode);
+    registerRenderCommand(app, exitCode);
+    registerBoothCommand(app, exitCode);
+    registerSceneCommand(app, exitCode);
     registerDisplayCommand(app, exitCode);
     registerRecoverCommand(app, exitCode);
     registerColorCommand(app, exitCode);

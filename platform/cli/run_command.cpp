@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/data_dir.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/frame_outputs.h>
@@ -28,6 +29,8 @@ struct RunOptions {
     std::string digests;
     std::string snapshot;
     bool fast = false;
+    std::string scene;
+    std::string renderer = "booth";
     std::string displayProfile;
     bool uncalibrated = false;
     std::string displayInverse = "analytic";
@@ -80,6 +83,21 @@ int runMain(const RunOptions& o)
     config.width = size->first;
     config.height = size->second;
     config.rateHz = o.rateHz;
+    config.renderer = o.renderer;
+    if (!o.scene.empty()) {
+        // Stored relative to the data folder when it is inside it, so that a recording replays on
+        // another installation.
+        std::error_code ec;
+        const auto abs = std::filesystem::weakly_canonical(o.scene, ec);
+        const auto data = std::filesystem::weakly_canonical(dataDir(), ec);
+        const auto rel = abs.lexically_relative(data);
+        config.sceneDir = !rel.empty() && *rel.begin() != ".." ? rel.string() : abs.string();
+        if (!std::filesystem::is_regular_file(abs / "scene.json")) {
+            log->error("--scene {}: no scene.json there; name a scene folder such as {}", o.scene,
+                       (dataDir() / "scenes" / "painting").string());
+            return kExitUsage;
+        }
+    }
     if (o.uncalibrated && !o.displayProfile.empty()) {
         log->error("--uncalibrated and --display-profile {} contradict each other: give one",
                    o.displayProfile);
@@ -131,9 +149,11 @@ int runMain(const RunOptions& o)
     if (!o.record.empty()) {
         recordings::SessionInfo session;
         session.softwareVersion = std::string("replica ") + REPLICA_VERSION;
-        session.configJson = (*appliance)->config.toJson(); // with the profile's digest
-        session.boothModel = config.booth;
-        session.scene = config.scene;
+        // The configuration as built: the scene folder and digest, the display profile's digest.
+        const RunConfig& built = (*appliance)->config;
+        session.configJson = built.toJson();
+        session.boothModel = built.booth;
+        session.scene = built.scene;
         session.displayProfile = (*appliance)->displayProfileId;
         session.wallClockStartNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
                                            std::chrono::system_clock::now().time_since_epoch())
@@ -255,6 +275,14 @@ void registerRunCommand(CLI::App& app, int& exitCode)
             ->capture_default_str();
     cmd->add_option("--digests", opts->digests, "write one digest per frame to FILE (JSON)");
     cmd->add_option("--snapshot", opts->snapshot, "write the last frame to FILE (PNG)");
+    cmd->add_option("--scene", opts->scene,
+                    "surface scene folder (scene.json + EXRs); default: the shipped ColorChecker, "
+                    "data/scenes/colorchecker");
+    cmd->add_option("--renderer", opts->renderer,
+                    "booth (the scene lit by the booth model) or flat (the first recordings' patch "
+                    "renderer)")
+            ->check(CLI::IsMember({"booth", "flat"}))
+            ->capture_default_str();
     cmd->add_flag("--fast", opts->fast,
                   "do not wait for each tick's wall-clock time (same frames, rendered as fast as "
                   "possible)");

@@ -1,0 +1,68 @@
+// Booth light geometry and the mapping of median-cut regions onto the emitter.
+#include <glm/geometric.hpp>
+
+#include <pipeline/booth/booth_light.h>
+
+namespace replica::pipeline::booth {
+
+Vec3 BoothLight::normal() const
+{
+    return glm::normalize(glm::cross(edgeU, edgeV));
+}
+
+double BoothLight::areaM2() const
+{
+    return glm::length(glm::cross(edgeU, edgeV));
+}
+
+double BoothLight::texelAreaM2() const
+{
+    const double n = static_cast<double>(luminance.width) * static_cast<double>(luminance.height);
+    return n > 0.0 ? areaM2() / n : 0.0;
+}
+
+double BoothLight::texelWidthM() const
+{
+    return luminance.width > 0 ? glm::length(edgeU) / luminance.width : 0.0;
+}
+
+double BoothLight::texelHeightM() const
+{
+    return luminance.height > 0 ? glm::length(edgeV) / luminance.height : 0.0;
+}
+
+Vec3 BoothLight::pointAtTexel(double x, double y) const
+{
+    return centre + edgeU * (x / luminance.width - 0.5) + edgeV * (y / luminance.height - 0.5);
+}
+
+colour::Spectrum unitLuminanceSpd(const colour::Observer& obs, const colour::Spectrum& spd)
+{
+    const double y = colour::spectrumToXyz(obs, spd).y;
+    if (!(y > 0.0)) {
+        return colour::Spectrum{};
+    }
+    return spd * (1.0 / y);
+}
+
+std::vector<PointLight> pointLights(const BoothLight& light,
+                                    const std::vector<RegionLight>& regions)
+{
+    std::vector<PointLight> out;
+    out.reserve(regions.size());
+    for (const RegionLight& r : regions) {
+        out.push_back(PointLight{light.pointAtTexel(r.centroidX, r.centroidY), r.sumCdM2});
+    }
+    return out;
+}
+
+MedianCutOptions medianCutOptionsFor(const BoothLight& light, int count)
+{
+    MedianCutOptions o;
+    o.count = count;
+    o.texelWidthM = light.texelWidthM();
+    o.texelHeightM = light.texelHeightM();
+    return o;
+}
+
+} // namespace replica::pipeline::booth

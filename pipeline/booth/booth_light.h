@@ -1,0 +1,54 @@
+// A booth light: a planar emitter with size and pose, a luminance image (cd/m^2) and an SPD.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include <pipeline/booth/luminance_image.h>
+#include <pipeline/booth/median_cut.h>
+#include <pipeline/colour/spectrum.h>
+#include <pipeline/colour/xyz.h>
+
+namespace replica::pipeline::booth {
+
+using Vec3 = glm::dvec3;
+
+// Booth frame: right-handed, metres, y up. The emitter is the rectangle centre + s*edgeU + t*edgeV,
+// s, t in [-1/2, 1/2]; image x runs along edgeU, image y along edgeV; the emitting side is
+// normalize(cross(edgeU, edgeV)) (pointing down into the booth for a ceiling light).
+struct BoothLight {
+    std::string name;
+    Vec3 centre{0.0};
+    Vec3 edgeU{1.0, 0.0, 0.0};
+    Vec3 edgeV{0.0, 0.0, 1.0};
+    LuminanceImage luminance;
+    colour::Spectrum spd; // relative spectral power; the luminance image carries the absolute scale
+
+    Vec3 normal() const;
+    double areaM2() const;
+    double texelAreaM2() const; // A/P in eq. (1)
+    double texelWidthM() const;
+    double texelHeightM() const;
+    // Point on the emitter at texel coordinates (x, y) (texel x spans [x, x+1]).
+    Vec3 pointAtTexel(double x, double y) const;
+};
+
+// The SPD scaled so that sum(spd * ybar) * 10 nm = 1: luminance L (cd/m^2) times this is the
+// spectral radiance whose CIE Y is L. Zero spectrum if the light has no luminous power.
+colour::Spectrum unitLuminanceSpd(const colour::Observer& obs, const colour::Spectrum& spd);
+
+// A point light from a median-cut region: eq. (1) uses sumCdM2 * texelArea as the intensity (cd)
+// normal to the plane, with the two cosines and 1/d^2.
+struct PointLight {
+    Vec3 position{0.0};
+    double sumCdM2 = 0.0;
+};
+
+std::vector<PointLight> pointLights(const BoothLight& light,
+                                    const std::vector<RegionLight>& regions);
+
+MedianCutOptions medianCutOptionsFor(const BoothLight& light, int count);
+
+} // namespace replica::pipeline::booth

@@ -1,0 +1,135 @@
+// OpenEXR wrappers: exceptions from the library stop here and become Error values.
+#include <cmath>
+#include <exception>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <fmt/format.h>
+
+#include <pipeline/image/exr.h>
+
+namespace replica::pipeline::image {
+
+const std::vector<float>* ChannelImage::plane(const std::string& name) const
+{
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        if (names[i] == name) {
+            return &planes[i];
+        }
+    }
+    return nullptr;
+}
+
+Expected<std::vector<std::string>> exrChannelNames(const std::filesystem::path& path)
+{
+    if (!std::filesystem::exists(path)) {
+        return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
+    }
+    try {
+        Imf::InputFile file(path.c_str());
+        std::vector<std::string> out;
+        for (auto it = file.header().channels().begin(); it != file.header().channels().end();
+             ++it) {
+            out.emplace_back(it.name());
+        }
+        return out;
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Corrupt, fmt::format("{}: not a readable OpenEXR file ({})",
+                                                         path.string(), e.what()));
+    }
+}
+
+Expected<ChannelImage> readExr(const std::filesystem::path& path,
+                               const std::vector<std::string>& names)
+{
+    if (!std::filesystem::exists(path)) {
+        return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
+    }
+    ChannelImage img;
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imath::Box2i dw = file.header().dataWindow();
+        img.width = dw.max.x - dw.min.x + 1;
+        img.height = dw.max.y - dw.min.y + 1;
+        if (img.width <= 0 || img.height <= 0) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: empty data window", path.string()));
+        }
+        const auto n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
+        Imf::FrameBuffer fb;
+        img.names = names;
+        img.planes.assign(names.size(), std::vector<float>(n, 0.0f));
+        for (std::size_t c = 0; c < names.size(); ++c) {
+            if (file.header().channels().findChannel(names[c]) == nullptr) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}: has no channel '{}'", path.string(), names[c]));
+            }
+            char* base = reinterpret_cast<char*>(img.planes[c].data()) -
+                         (static_cast<std::ptrdiff_t>(dw.min.x) +
+                          static_cast<std::ptrdiff_t>(dw.min.y) * img.width) *
+                                 static_cast<std::ptrdiff_t>(sizeof(float));
+            fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, sizeof(float),
+                                           sizeof(float) * static_cast<std::size_t>(img.width)));
+        }
+        file.setFrameBuffer(fb);
+        file.readPixels(dw.min.y, dw.max.y);
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Corrupt, fmt::format("{}: not a readable OpenEXR file ({})",
+                                                         path.string(), e.what()));
+    }
+    for (std::size_t c = 0; c < names.size(); ++c) {
+        const auto& p = img.planes[c];
+        for (std::size_t k = 0; k < p.size(); ++k) {
+            if (!std::isfinite(p[k])) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}: channel '{}' pixel ({}, {}) is {}; fix or "
+                                             "re-capture the image",
+                                             path.string(), names[c],
+                                             k % static_cast<std::size_t>(img.width),
+                                             k / static_cast<std::size_t>(img.width), p[k]));
+            }
+        }
+    }
+    return img;
+}
+
+Expected<void> writeExr(const std::filesystem::path& path,
+                        const ChannelImage& img,
+                        const std::vector<std::pair<std::string, std::string>>& attributes)
+{
+    if (img.width <= 0 || img.height <= 0 || img.names.size() != img.planes.size()) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("{}: refusing to write an empty or inconsistent image", path.string()));
+    }
+    try {
+        Imf::Header header(img.width, img.height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const auto& [k, v] : attributes) {
+            header.insert(k, Imf::StringAttribute(v));
+        }
+        Imf::FrameBuffer fb;
+        for (std::size_t c = 0; c < img.names.size(); ++c) {
+            header.channels().insert(img.names[c], Imf::Channel(Imf::FLOAT));
+            fb.insert(
+                    img.names[c],
+                    Imf::Slice(
+                            Imf::FLOAT,
+                            const_cast<char*>(reinterpret_cast<const char*>(img.planes[c].data())),
+                            sizeof(float), sizeof(float) * static_cast<std::size_t>(img.width)));
+        }
+        Imf::OutputFile file(path.c_str(), header);
+        file.setFrameBuffer(fb);
+        file.writePixels(img.height);
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot write OpenEXR ({})", path.string(), e.what()));
+    }
+    return {};
+}
+
+} // namespace replica::pipeline::image

@@ -1,0 +1,192 @@
+// Reference integration over every light texel, spectral per pixel.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include <glm/geometric.hpp>
+
+#include <pipeline/reference/reference_integrator.h>
+
+namespace replica::pipeline::reference {
+
+TexelCloud texelCloud(const booth::BoothLight& light)
+{
+    TexelCloud c;
+    c.normal = light.normal();
+    c.texelAreaM2 = light.texelAreaM2();
+    for (int y = 0; y < light.luminance.height; ++y) {
+        for (int x = 0; x < light.luminance.width; ++x) {
+            const double l = light.luminance.at(x, y);
+            if (l > 0.0) {
+                c.position.push_back(light.pointAtTexel(x + 0.5, y + 0.5));
+                c.cdM2.push_back(l);
+            }
+        }
+    }
+    return c;
+}
+
+TexelSums integrateTexels(const TexelCloud& light,
+                          const Vec3& p,
+                          const Vec3& nGeo,
+                          const Vec3& nShade,
+                          const Vec3& toEye,
+                          brdf::WardModel model,
+                          double alpha,
+                          bool specular,
+                          const std::vector<double>* sinHorizonByAzimuth,
+                          const Vec3& right,
+                          const Vec3& up)
+{
+    TexelSums s;
+    const double a = light.texelAreaM2;
+    const int azimuths =
+            sinHorizonByAzimuth != nullptr ? static_cast<int>(sinHorizonByAzimuth->size()) : 0;
+    for (std::size_t k = 0; k < light.position.size(); ++k) {
+        Vec3 d = light.position[k] - p;
+        const double d2 = glm::dot(d, d);
+        if (!(d2 > 0.0)) {
+            continue; // the point is the texel centre: direction undefined, no contribution
+        }
+        d /= std::sqrt(d2);
+        const double d2c = std::max(d2, a); // at most one texel's worth of solid angle per texel
+        const double cosL = -glm::dot(light.normal, d);
+        const double cosG = glm::dot(nGeo, d);
+        if (!(cosL > 0.0) || !(cosG > 0.0)) {
+            continue;
+        }
+        const double l = light.cdM2[k];
+        const double dw = a * cosL / d2c;
+        s.geoIrradiance += l * cosG * dw;
+        const double cosS = glm::dot(nShade, d);
+        if (!(cosS > 0.0)) {
+            continue;
+        }
+        if (azimuths > 0) {
+            const double lx = glm::dot(d, right);
+            const double ly = glm::dot(d, up);
+            double phi = std::atan2(ly, lx);
+            if (phi < 0.0) {
+                phi += 2.0 * std::numbers::pi;
+            }
+            const double f = phi / (2.0 * std::numbers::pi) * azimuths;
+            const int k0 = static_cast<int>(std::floor(f)) % azimuths;
+            const int k1 = (k0 + 1) % azimuths;
+            const double t = f - std::floor(f);
+            const double sinB = (1.0 - t) * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k0)] +
+                                t * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k1)];
+            if (!(cosG > sinB)) {
+                continue; // below the relief's horizon
+            }
+        }
+        s.irradiance += l * cosS * dw;
+        if (specular) {
+            s.specular += l * brdf::wardEval(model, alpha, nShade, d, toEye) * cosS * dw;
+        }
+    }
+    return s;
+}
+
+shading::XyzFrame renderReference(const surface::SurfaceScene& scene,
+                                  const booth::BoothLight& light,
+                                  const shading::View& view,
+                                  const colour::Observer& obs,
+                                  const ReferenceOptions& options)
+{
+    shading::XyzFrame frame;
+    frame.width = view.pixelsX;
+    frame.height = view.pixelsY;
+    frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height),
+                     colour::Xyz(0.0));
+    const TexelCloud cloud = texelCloud(light);
+    const colour::Spectrum unitSpd = booth::unitLuminanceSpd(obs, light.spd);
+    const colour::Xyz white = colour::spectrumToXyz(obs, unitSpd);
+    const bool flat = scene.flat();
+    const std::vector<Vec3> normals = flat ? std::vector<Vec3>{} : surface::normalMap(scene.relief);
+    const bool glossy = scene.glossy();
+
+    struct Counts {
+        long flare = 0, behind = 0, bad = 0;
+    };
+    const auto renderRows = [&](int y0, int y1, Counts& c) {
+        std::vector<double> horizon(static_cast<std::size_t>(flat ? 0 : options.horizonAzimuths));
+        for (int py = y0; py < y1; ++py) {
+            for (int px = 0; px < frame.width; ++px) {
+                const shading::ShadingPoint sp =
+                        shading::shadingPoint(view, scene, normals, px, py);
+                for (std::size_t k = 0; k < horizon.size(); ++k) {
+                    const double phi = 2.0 * std::numbers::pi * static_cast<double>(k) /
+                                       static_cast<double>(horizon.size());
+                    horizon[k] = surface::exactSinHorizon(scene.relief, sp.texX, sp.texY, phi,
+                                                          options.horizonDistanceM);
+                }
+                Vec3 toEye = view.eye - sp.p;
+                const double eyeDist = glm::length(toEye);
+                toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
+                const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
+                c.behind += behind ? 1 : 0;
+                const TexelSums t = integrateTexels(cloud, sp.p, sp.nGeo, sp.nShade, toEye,
+                                                    scene.model, scene.alpha, glossy && !behind,
+                                                    flat ? nullptr : &horizon, sp.right, sp.up);
+                const colour::Spectrum rho = scene.reflectance(sp.tx, sp.ty);
+                const colour::Spectrum radiance =
+                        (rho * (t.irradiance / std::numbers::pi) + scene.rhoS * t.specular) *
+                        unitSpd;
+                const colour::Xyz surfaceXyz = colour::spectrumToXyz(obs, radiance);
+                const colour::Xyz flare =
+                        white * (shading::kScreenFlareRho * t.geoIrradiance / std::numbers::pi);
+                colour::Xyz out = shading::subtractFlare(surfaceXyz, flare, c.flare);
+                if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z)) {
+                    ++c.bad;
+                    out = colour::Xyz(0.0);
+                }
+                frame.xyz[static_cast<std::size_t>(py) * frame.width + px] = out;
+            }
+        }
+    };
+    const int threads = std::clamp(options.threads, 1, std::max(frame.height, 1));
+    std::vector<Counts> counts(static_cast<std::size_t>(threads));
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) {
+        const int y0 = frame.height * t / threads;
+        const int y1 = frame.height * (t + 1) / threads;
+        pool.emplace_back(renderRows, y0, y1, std::ref(counts[static_cast<std::size_t>(t)]));
+    }
+    for (auto& th : pool) {
+        th.join();
+    }
+    for (const auto& c : counts) {
+        frame.flareClamped += c.flare;
+        frame.eyeBehindPixels += c.behind;
+        frame.nonFinite += c.bad;
+    }
+    const Vec3 n = view.panel.normal;
+    const TexelSums centre =
+            integrateTexels(cloud, view.panel.centre, n, n, n, scene.model, scene.alpha, false,
+                            nullptr, view.panel.right, view.panel.up);
+    frame.whiteY = centre.geoIrradiance / std::numbers::pi;
+    frame.whiteXyz = white * frame.whiteY;
+    return frame;
+}
+
+double
+polygonIrradiance(const std::vector<Vec3>& corners, const Vec3& p, const Vec3& n, double luminance)
+{
+    double sum = 0.0;
+    const std::size_t m = corners.size();
+    for (std::size_t k = 0; k < m; ++k) {
+        const Vec3 a = glm::normalize(corners[k] - p);
+        const Vec3 b = glm::normalize(corners[(k + 1) % m] - p);
+        const Vec3 c = glm::cross(a, b);
+        const double len = glm::length(c);
+        if (!(len > 0.0)) {
+            continue;
+        }
+        const double angle = std::atan2(len, glm::dot(a, b));
+        sum += angle * glm::dot(n, c / len);
+    }
+    return 0.5 * luminance * std::abs(sum);
+}
+
+} // namespace replica::pipeline::reference

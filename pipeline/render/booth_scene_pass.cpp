@@ -1,0 +1,102 @@
+// Scene state to booth pass: light selection and caching, view from eye and tilt.
+#include <algorithm>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include <pipeline/render/booth_scene_pass.h>
+
+namespace replica::pipeline::render {
+
+booth::BoothLight
+uniformEmitter(const booth::BoothLight& like, double luminanceCdM2, const colour::Spectrum& spd)
+{
+    booth::BoothLight l;
+    l.name = "sensed";
+    l.centre = like.centre;
+    l.edgeU = like.edgeU;
+    l.edgeV = like.edgeV;
+    // A coarse image is exact for a uniform emitter: median cut splits it into equal cells.
+    l.luminance = booth::LuminanceImage::filled(32, 16, std::max(luminanceCdM2, 0.0));
+    l.spd = spd;
+    return l;
+}
+
+Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup setup)
+{
+    if (setup.booth.lights.empty()) {
+        return makeError(ErrorCode::InvalidArgument, "render: the booth model has no lights");
+    }
+    for (const auto& lamp : setup.lamps) {
+        if (setup.booth.find(lamp) == nullptr) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("render: lamp '{}' has no light in the booth model "
+                                         "(it has {})",
+                                         lamp, setup.booth.names()));
+        }
+    }
+    std::unique_ptr<BoothScenePass> p(new BoothScenePass());
+    p->setup_ = std::move(setup);
+    const auto& s = p->setup_;
+    p->prepared_ = shading::prepareScene(s.scene, std::max(s.settings.horizonDirections, 1), 0.01,
+                                         s.basis);
+    auto pass = BoothShadingPass::create(p->prepared_, s.settings, p->setup_.observer);
+    if (!pass) {
+        return tl::unexpected(pass.error());
+    }
+    p->pass_ = std::move(*pass);
+    return p;
+}
+
+std::string BoothScenePass::description() const
+{
+    const auto& s = setup_.settings;
+    return fmt::format("gles-booth (scene {}, {} median-cut lights, {} specular samples, {} "
+                       "horizon directions, basis {})",
+                       setup_.scene.name, s.lights, setup_.scene.glossy() ? s.specularSamples : 0,
+                       setup_.scene.flat() ? 0 : s.horizonDirections, setup_.basis.name);
+}
+
+Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
+{
+    const int lamp = state.lampIndex;
+    if (lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.lamps.size()) {
+        const booth::BoothLight* l =
+                setup_.booth.find(setup_.lamps[static_cast<std::size_t>(lamp)]);
+        const int index = static_cast<int>(l - setup_.booth.lights.data());
+        if (index == lightIndex_) {
+            return {};
+        }
+        light_ = shading::prepareLight(*l, setup_.observer, setup_.settings.lights, setup_.basis);
+        lightIndex_ = index;
+    } else {
+        // Direct-sensor mode: rebuilt only when the sensed spectrum or luminance changes.
+        if (lightIndex_ == -1 && state.illuminant.v == directSpd_.v &&
+            state.emitterLuminanceCdM2 == directLuminance_) {
+            return {};
+        }
+        direct_ = uniformEmitter(setup_.booth.lights.front(), state.emitterLuminanceCdM2,
+                                 state.illuminant);
+        light_ = shading::prepareLight(direct_, setup_.observer, setup_.settings.lights,
+                                       setup_.basis);
+        directSpd_ = state.illuminant;
+        directLuminance_ = state.emitterLuminanceCdM2;
+        lightIndex_ = -1;
+    }
+    return pass_->setLight(light_);
+}
+
+Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, int height)
+{
+    if (auto ok = selectLight(state); !ok) {
+        return ok;
+    }
+    shading::View view;
+    view.panel = shading::panelPoseFromTilt(setup_.stand, state.tiltRad * 180.0 / std::numbers::pi);
+    view.eye = state.eyeBoothM;
+    view.pixelsX = width;
+    view.pixelsY = height;
+    return pass_->draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand));
+}
+
+} // namespace replica::pipeline::render

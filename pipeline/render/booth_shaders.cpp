@@ -1,0 +1,306 @@
+// GLSL sources of the booth shading pass; each block names the function of realtime_model.cpp,
+// brdf/ward.cpp or booth/luminance_image.cpp it mirrors, so the two stay in step.
+#include <pipeline/render/booth_shaders.h>
+
+namespace replica::pipeline::render {
+
+const char* const kBoothVertexShader = R"(#version 310 es
+void main() {
+    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* const kBoothXyzShader = R"(#version 310 es
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp sampler2DArray;
+out vec4 outXyz;
+
+// Pixel -> surface: su, sv (sv down the image) = offset + scale * (pixel centre / viewport).
+uniform vec2 uViewport;
+uniform vec2 uSurfOffset;
+uniform vec2 uSurfScale;
+// The surface in the booth frame (metres): centre, unit axes, physical size; texels.
+uniform vec3 uCentre;
+uniform vec3 uRight;
+uniform vec3 uUp;
+uniform vec3 uNormal;
+uniform vec2 uSizeM;
+uniform ivec2 uTexels;
+uniform vec3 uEye;
+
+uniform sampler2D uCoeffA;      // channels 0..2 per texel (row 0 = top row of the scene)
+uniform sampler2D uCoeffB;      // channels 3..5
+uniform sampler2D uNormals;     // tangent-space normal per texel
+uniform sampler2DArray uHorizon; // sin(horizon elevation), 4 directions per layer
+uniform bool uRelief;
+uniform int uHorizonDirs;       // 0: no horizon shadowing
+uniform float uSoftness;
+
+layout(std140) uniform BoothLights {
+    vec4 uLight[256];           // xyz: position (m); w: summed luminance * texel area (cd)
+};
+uniform int uLightCount;
+uniform vec3 uLightNormal;      // emitting side of the ceiling
+uniform float uTexelArea;       // m^2: floor of d^2 (a light never nearer than one texel)
+uniform bool uDiffuse;
+uniform vec3 uChannelXyz[6];    // M_k of the light (Y = 1 light)
+uniform vec3 uWhite;            // XYZ of the light scaled to Y = 1
+uniform float uFlareRho;
+
+uniform int uSpecSamples;       // 0: no specular pass
+uniform float uAlpha;
+uniform int uWardModel;         // 0 Ward 1992, 1 Ward-Duer, 2 Ward-Duer guarded, 3 GMD
+uniform vec3 uSpecXyz;          // XYZ of rho_s times the unit-luminance light
+uniform vec3 uLightCentre;
+uniform vec3 uEdgeU;
+uniform vec3 uEdgeV;
+uniform vec2 uInvEdge2;         // 1 / |edgeU|^2, 1 / |edgeV|^2
+uniform sampler2D uLum;         // luminance mip chain (cd/m^2), padded to powers of two with 0
+uniform int uLumMaxLevel;
+uniform ivec2 uLumSize;         // level 0
+uniform vec2 uLumUsed;          // the light's share of the padded texture
+
+const float kPi = 3.14159265358979;
+const float kMinCosView = 1e-3;
+const float kMinU1 = 1.0 / 16777216.0;
+
+float hz[32];
+
+// surface::HorizonMap::sinHorizon + realtime_model.cpp horizonVisibility.
+float visibility(vec3 l) {
+    if (uHorizonDirs <= 0) {
+        return 1.0;
+    }
+    float phi = (abs(l.x) > 0.0 || abs(l.y) > 0.0) ? atan(l.y, l.x) : 0.0;
+    if (phi < 0.0) {
+        phi += 2.0 * kPi;
+    }
+    float f = phi / (2.0 * kPi) * float(uHorizonDirs);
+    int k0 = int(floor(f)) % uHorizonDirs;
+    int k1 = (k0 + 1) % uHorizonDirs;
+    float t = f - floor(f);
+    float sinB = (1.0 - t) * hz[k0] + t * hz[k1];
+    if (sinB <= 0.0) {
+        return 1.0;
+    }
+    float e0 = sinB - uSoftness;
+    float e1 = sinB + uSoftness;
+    float s = clamp((l.z - e0) / max(e1 - e0, 1e-12), 0.0, 1.0);
+    return s * s * (3.0 - 2.0 * s);
+}
+
+// booth/luminance_image.cpp bilinear(): texel centres at (x + 0.5) / w, border 0.
+float lumTexel(ivec2 c, int level, ivec2 size) {
+    if (c.x < 0 || c.y < 0 || c.x >= size.x || c.y >= size.y) {
+        return 0.0;
+    }
+    return texelFetch(uLum, c, level).r;
+}
+float lumBilinear(float u, float v, int level) {
+    // Level size from the base size: textureSize() with a per-pixel level is not reliable on
+    // every driver (llvmpipe answers one level for a whole quad).
+    ivec2 size = max(uLumSize >> level, ivec2(1));
+    float fx = u * float(size.x) - 0.5;
+    float fy = v * float(size.y) - 0.5;
+    float x0 = floor(fx);
+    float y0 = floor(fy);
+    float ax = fx - x0;
+    float ay = fy - y0;
+    ivec2 c = ivec2(int(x0), int(y0));
+    return (1.0 - ay) * ((1.0 - ax) * lumTexel(c, level, size) + ax * lumTexel(c + ivec2(1, 0), level, size))
+         + ay * ((1.0 - ax) * lumTexel(c + ivec2(0, 1), level, size) + ax * lumTexel(c + ivec2(1, 1), level, size));
+}
+// booth::MipChain::sample.
+float lumSample(float u, float v, float level) {
+    float l = clamp(level, 0.0, float(uLumMaxLevel));
+    int l0 = int(floor(l));
+    int l1 = min(l0 + 1, uLumMaxLevel);
+    float t = l - float(l0);
+    float a = lumBilinear(u * uLumUsed.x, v * uLumUsed.y, l0);
+    if (t <= 0.0 || l1 == l0) {
+        return a;
+    }
+    return (1.0 - t) * a + t * lumBilinear(u * uLumUsed.x, v * uLumUsed.y, l1);
+}
+
+// shading::radicalInverse2.
+// (bit arithmetic on ints: exact for k < 2^24, and free of uint-to-float conversions).
+float radicalInverse2(int k) {
+    float r = 0.0;
+    float f = 0.5;
+    for (int n = k; n > 0; n >>= 1) {
+        if ((n & 1) == 1) {
+            r += f;
+        }
+        f *= 0.5;
+    }
+    return r;
+}
+
+// realtime_model.cpp filteredSpecular with brdf::sampleWard inlined (rho_s = 1).
+float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
+    float co = dot(n, o);
+    if (!(co > 0.0)) {
+        return 0.0;
+    }
+    // brdf::Frame::fromNormal (Duff et al. 2017).
+    float sgn = n.z >= 0.0 ? 1.0 : -1.0;
+    float fa = -1.0 / (sgn + n.z);
+    float fb = n.x * n.y * fa;
+    vec3 ft = vec3(1.0 + sgn * n.x * n.x * fa, sgn * fb, -sgn * n.x);
+    vec3 fbt = vec3(fb, sgn + n.y * n.y * fa, -n.y);
+    float sum = 0.0;
+    float nf = float(uSpecSamples);
+    for (int k = 0; k < uSpecSamples; ++k) {
+        float u1 = clamp((float(k) + 0.5) / nf, kMinU1, 1.0);
+        float u2 = radicalInverse2(k);
+        float tan2 = -uAlpha * uAlpha * log(u1);
+        float cosT = inversesqrt(1.0 + tan2);
+        float sinT = sqrt(tan2) * cosT;
+        float phi = 2.0 * kPi * u2;
+        vec3 hl = vec3(sinT * cos(phi), sinT * sin(phi), cosT);
+        vec3 h = ft * hl.x + fbt * hl.y + n * hl.z;
+        float oh = dot(o, h);
+        if (!(oh > 0.0)) {
+            continue;
+        }
+        vec3 i = 2.0 * oh * h - o;
+        float ci = dot(n, i);
+        if (!(ci > 0.0)) {
+            continue;
+        }
+        float hz3 = hl.z * hl.z * hl.z;
+        float w;
+        if (uWardModel == 0) {
+            w = ci * oh * hz3 / sqrt(max(ci, kMinCosView) * max(co, kMinCosView));
+        } else if (uWardModel == 1) {
+            w = (ci / max(ci, kMinCosView)) * oh * hz3 / max(co, kMinCosView);
+        } else if (uWardModel == 2) {
+            w = ci * oh * hz3 / max(ci * co, oh * oh * hz3 * hl.z);
+        } else {
+            w = ci / (oh * hl.z);
+        }
+        float solidAngle = 4.0 * kPi * uAlpha * uAlpha * oh * hz3 / (nf * u1);
+        float cosG = dot(nGeo, i);
+        float denom = dot(i, uLightNormal);
+        if (!(cosG > 0.0) || !(denom < 0.0)) {
+            continue;
+        }
+        float t = dot(uLightCentre - p, uLightNormal) / denom;
+        if (!(t > 0.0) || isinf(t)) {
+            continue;
+        }
+        vec3 hit = p + i * t - uLightCentre;
+        float lu = dot(hit, uEdgeU) * uInvEdge2.x + 0.5;
+        float lv = dot(hit, uEdgeV) * uInvEdge2.y + 0.5;
+        if (!(lu >= 0.0 && lu <= 1.0 && lv >= 0.0 && lv <= 1.0)) {
+            continue;
+        }
+        float ratio = solidAngle * t * t / (uTexelArea * -denom);
+        float lod = 0.5 * log2(max(ratio, 1e-20)) + 1.0;
+        vec3 lt = vec3(dot(i, uRight), dot(i, uUp), cosG);
+        sum += lumSample(lu, lv, lod) * w * visibility(lt);
+    }
+    return sum / nf;
+}
+
+vec3 bilinearNormal(float x, float y) {
+    float fx = x - 0.5;
+    float fy = y - 0.5;
+    float x0 = floor(fx);
+    float y0 = floor(fy);
+    float ax = fx - x0;
+    float ay = fy - y0;
+    ivec2 c = ivec2(int(x0), int(y0));
+    ivec2 hi = uTexels - 1;
+    vec3 n00 = texelFetch(uNormals, clamp(c, ivec2(0), hi), 0).xyz;
+    vec3 n10 = texelFetch(uNormals, clamp(c + ivec2(1, 0), ivec2(0), hi), 0).xyz;
+    vec3 n01 = texelFetch(uNormals, clamp(c + ivec2(0, 1), ivec2(0), hi), 0).xyz;
+    vec3 n11 = texelFetch(uNormals, clamp(c + ivec2(1, 1), ivec2(0), hi), 0).xyz;
+    vec3 n = (1.0 - ay) * ((1.0 - ax) * n00 + ax * n10) + ay * ((1.0 - ax) * n01 + ax * n11);
+    float len = length(n);
+    return len > 1e-12 ? n / len : vec3(0.0, 0.0, 1.0);
+}
+
+void main() {
+    vec2 frag = gl_FragCoord.xy / uViewport;
+    float u = uSurfOffset.x + uSurfScale.x * frag.x;
+    float v = uSurfOffset.y + uSurfScale.y * (1.0 - frag.y);
+    if (!(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0)) {
+        outXyz = vec4(0.0, 0.0, 0.0, 1.0); // the panel around the surface stays black
+        return;
+    }
+    vec3 p = uCentre + uRight * ((u - 0.5) * uSizeM.x) + uUp * ((0.5 - v) * uSizeM.y);
+    float texX = u * float(uTexels.x);
+    float texY = v * float(uTexels.y);
+    ivec2 tc = clamp(ivec2(int(texX), int(texY)), ivec2(0), uTexels - 1);
+    vec3 nShade = uNormal;
+    if (uRelief) {
+        vec3 nl = bilinearNormal(texX, texY);
+        nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
+        int layers = (uHorizonDirs + 3) / 4;
+        for (int j = 0; j < layers; ++j) {
+            vec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
+            hz[4 * j] = b.x;
+            hz[4 * j + 1] = b.y;
+            hz[4 * j + 2] = b.z;
+            hz[4 * j + 3] = b.w;
+        }
+    }
+    vec3 toEye = uEye - p;
+    float eyeDist = length(toEye);
+    toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;
+    bool behind = !(dot(toEye, uNormal) > 0.0);
+
+    // Eq. (1): eGeo with the macro normal (flare, flat scenes), e with facets and horizons.
+    float eGeo = 0.0;
+    float e = 0.0;
+    for (int i = 0; i < uLightCount; ++i) {
+        vec4 l = uLight[i];
+        vec3 d = l.xyz - p;
+        float d2 = dot(d, d);
+        if (!(d2 > 0.0) || !(l.w > 0.0)) {
+            continue;
+        }
+        d *= inversesqrt(d2);
+        float cosL = -dot(uLightNormal, d);
+        float cosG = dot(uNormal, d);
+        if (!(cosL > 0.0) || !(cosG > 0.0)) {
+            continue;
+        }
+        float g = l.w * cosL / max(d2, uTexelArea);
+        eGeo += g * cosG;
+        if (uRelief) {
+            float cosS = dot(nShade, d);
+            if (cosS > 0.0) {
+                e += g * cosS * visibility(vec3(dot(d, uRight), dot(d, uUp), cosG));
+            }
+        }
+    }
+    if (!uRelief) {
+        e = eGeo;
+    }
+    if (!uDiffuse) {
+        e = 0.0;
+    }
+    // Eq. (2): channel coefficients times the light's per-channel XYZ.
+    vec3 a = texelFetch(uCoeffA, tc, 0).rgb;
+    vec3 b = texelFetch(uCoeffB, tc, 0).rgb;
+    vec3 xyz = a.r * uChannelXyz[0] + a.g * uChannelXyz[1] + a.b * uChannelXyz[2]
+             + b.r * uChannelXyz[3] + b.g * uChannelXyz[4] + b.b * uChannelXyz[5];
+    xyz *= e / kPi;
+    if (uSpecSamples > 0 && !behind) {
+        xyz += uSpecXyz * filteredSpecular(p, uNormal, nShade, toEye);
+    }
+    vec3 outv = max(xyz - uWhite * (uFlareRho * eGeo / kPi), vec3(0.0));
+    if (any(isnan(outv)) || any(isinf(outv))) {
+        outv = vec3(0.0); // never reaches a pixel; the read-back check counts none
+    }
+    outXyz = vec4(outv, 1.0);
+}
+)";
+
+} // namespace replica::pipeline::render

@@ -1,0 +1,438 @@
+// Host side of the booth shading pass: texture and uniform upload, draw, read-back.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+
+#include <pipeline/render/booth_shaders.h>
+#include <pipeline/render/booth_shading_pass.h>
+#include <pipeline/render/gl_program.h>
+
+namespace replica::pipeline::render {
+namespace {
+
+enum TextureUnit : GLint { kUnitCoeffA = 0, kUnitCoeffB, kUnitNormals, kUnitHorizon, kUnitLum };
+
+// Float textures are read with texelFetch only: nearest sampling keeps them complete without the
+// float-filtering extension, and the shader does its own (border-0) bilinear where the model does.
+void nearest(GLenum target)
+{
+    glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+GLuint texture2d(GLenum internalFormat, GLenum format, int w, int h, const float* data)
+{
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, w, h);
+    if (data != nullptr) {
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, GL_FLOAT, data);
+    }
+    nearest(GL_TEXTURE_2D);
+    return tex;
+}
+
+glm::vec3 f3(const glm::dvec3& v)
+{
+    return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+}
+
+GLint loc(GLuint program, const char* name)
+{
+    return glGetUniformLocation(program, name);
+}
+
+void set3(GLuint program, const char* name, const glm::dvec3& v)
+{
+    const glm::vec3 f = f3(v);
+    glUniform3f(loc(program, name), f.x, f.y, f.z);
+}
+
+int wardModelIndex(brdf::WardModel m)
+{
+    switch (m) {
+    case brdf::WardModel::Ward1992:
+        return 0;
+    case brdf::WardModel::WardDur:
+        return 1;
+    case brdf::WardModel::WardDurGuarded:
+        return 2;
+    case brdf::WardModel::Gmd:
+        return 3;
+    }
+    return 2;
+}
+
+Expected<void> glCheck(const char* what)
+{
+    if (GLenum err = glGetError(); err != GL_NO_ERROR) {
+        return makeError(ErrorCode::DeviceFailure,
+                         fmt::format("render: GL error 0x{:04x} while {}", err, what));
+    }
+    return {};
+}
+
+} // namespace
+
+SurfaceLayout layoutOnPanel(const surface::SurfaceScene& scene, const scene::StandModel& stand)
+{
+    SurfaceLayout l;
+    if (scene.widthM > 0.0 && scene.heightM > 0.0) {
+        l.scale = {stand.panelWidthM / scene.widthM, stand.panelHeightM / scene.heightM};
+        l.offset = {0.5 - 0.5 * l.scale.x, 0.5 - 0.5 * l.scale.y};
+    }
+    return l;
+}
+
+Expected<std::unique_ptr<BoothShadingPass>>
+BoothShadingPass::create(const shading::PreparedScene& scene,
+                         const shading::RenderSettings& settings,
+                         const colour::Observer& obs)
+{
+    if (scene.scene == nullptr || scene.scene->width <= 0 || scene.scene->height <= 0) {
+        return makeError(ErrorCode::InvalidArgument, "render: the booth pass needs a loaded scene");
+    }
+    std::unique_ptr<BoothShadingPass> pass(new BoothShadingPass());
+    pass->settings_ = settings;
+    pass->observer_ = &obs;
+    if (auto ok = pass->init(scene); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return pass;
+}
+
+Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
+{
+    scene_ = &ps;
+    const surface::SurfaceScene& s = *ps.scene;
+    relief_ = settings_.reliefPass && !ps.normals.empty();
+    horizonDirs_ = relief_ && settings_.horizonDirections > 0 ? ps.horizon.directions : 0;
+    if (horizonDirs_ > kBoothMaxHorizonDirections) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: {} horizon directions; the GL pass holds at most {}",
+                                     horizonDirs_, kBoothMaxHorizonDirections));
+    }
+    auto program = linkProgram(kBoothVertexShader, kBoothXyzShader, "booth XYZ");
+    if (!program) {
+        return tl::unexpected(program.error());
+    }
+    program_ = *program;
+    glGenVertexArrays(1, &vao_);
+
+    // Channel coefficients per texel, exactly as the CPU model forms them (then rounded to float).
+    const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
+    std::vector<float> a(texels * 3), b(texels * 3);
+    for (int y = 0; y < s.height; ++y) {
+        for (int x = 0; x < s.width; ++x) {
+            const colour::ChannelCoeffs c = s.channels(ps.paletteCoeffs, x, y);
+            const std::size_t i = static_cast<std::size_t>(y) * s.width + x;
+            for (std::size_t k = 0; k < 3; ++k) {
+                a[i * 3 + k] = static_cast<float>(c[k]);
+                b[i * 3 + k] = static_cast<float>(c[3 + k]);
+            }
+        }
+    }
+    coeffA_ = texture2d(GL_RGB32F, GL_RGB, s.width, s.height, a.data());
+    coeffB_ = texture2d(GL_RGB32F, GL_RGB, s.width, s.height, b.data());
+
+    std::vector<float> n(relief_ ? texels * 3 : 3, 0.0f);
+    if (relief_) {
+        for (std::size_t i = 0; i < texels; ++i) {
+            for (int k = 0; k < 3; ++k) {
+                n[i * 3 + static_cast<std::size_t>(k)] = static_cast<float>(ps.normals[i][k]);
+            }
+        }
+    } else {
+        n[2] = 1.0f;
+    }
+    normals_ = relief_ ? texture2d(GL_RGB32F, GL_RGB, s.width, s.height, n.data())
+                       : texture2d(GL_RGB32F, GL_RGB, 1, 1, n.data());
+
+    // Horizon map: four directions per layer of an RGBA32F array.
+    const int layers = std::max((horizonDirs_ + 3) / 4, 1);
+    const int hw = horizonDirs_ > 0 ? s.width : 1;
+    const int hh = horizonDirs_ > 0 ? s.height : 1;
+    std::vector<float> hz(static_cast<std::size_t>(hw) * hh * 4 * layers, 0.0f);
+    if (horizonDirs_ > 0) {
+        const auto k = static_cast<std::size_t>(horizonDirs_);
+        for (std::size_t i = 0; i < texels; ++i) {
+            for (std::size_t d = 0; d < k; ++d) {
+                const std::size_t layer = d / 4;
+                hz[(layer * texels + i) * 4 + d % 4] = ps.horizon.sinBeta[i * k + d];
+            }
+        }
+    }
+    glGenTextures(1, &horizon_);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, horizon_);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, hw, hh, layers);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, hw, hh, layers, GL_RGBA, GL_FLOAT, hz.data());
+    nearest(GL_TEXTURE_2D_ARRAY);
+
+    glGenBuffers(1, &lightsUbo_);
+    glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
+    glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 4 * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
+    const GLuint block = glGetUniformBlockIndex(program_, "BoothLights");
+    if (block == GL_INVALID_INDEX) {
+        return makeError(ErrorCode::Unsupported, "render: the booth shader has no light block");
+    }
+    glUniformBlockBinding(program_, block, 0);
+
+    glUseProgram(program_);
+    glUniform1i(loc(program_, "uCoeffA"), kUnitCoeffA);
+    glUniform1i(loc(program_, "uCoeffB"), kUnitCoeffB);
+    glUniform1i(loc(program_, "uNormals"), kUnitNormals);
+    glUniform1i(loc(program_, "uHorizon"), kUnitHorizon);
+    glUniform1i(loc(program_, "uLum"), kUnitLum);
+    glUniform2i(loc(program_, "uTexels"), s.width, s.height);
+    glUniform2f(loc(program_, "uSizeM"), static_cast<float>(s.widthM),
+                static_cast<float>(s.heightM));
+    glUniform1i(loc(program_, "uRelief"), relief_ ? 1 : 0);
+    glUniform1i(loc(program_, "uHorizonDirs"), horizonDirs_);
+    glUniform1f(loc(program_, "uSoftness"), static_cast<float>(settings_.horizonSoftness));
+    glUniform1i(loc(program_, "uDiffuse"), settings_.diffusePass ? 1 : 0);
+    glUniform1f(loc(program_, "uFlareRho"),
+                static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));
+    const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
+    glUniform1i(loc(program_, "uSpecSamples"), specular ? settings_.specularSamples : 0);
+    glUniform1f(loc(program_, "uAlpha"), static_cast<float>(s.alpha));
+    glUniform1i(loc(program_, "uWardModel"), wardModelIndex(s.model));
+    return glCheck("uploading the scene");
+}
+
+BoothShadingPass::~BoothShadingPass()
+{
+    const std::array<GLuint, 5> textures{coeffA_, coeffB_, normals_, horizon_, lum_};
+    glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+    glDeleteBuffers(1, &lightsUbo_);
+    glDeleteVertexArrays(1, &vao_);
+    glDeleteProgram(program_);
+}
+
+Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
+{
+    if (pl.light == nullptr || pl.mips.levels.empty()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "render: the booth pass needs a prepared light");
+    }
+    light_ = &pl;
+    const booth::BoothLight& bl = *pl.light;
+    const double a = bl.texelAreaM2();
+    lightCount_ = static_cast<int>(std::min<std::size_t>(pl.points.size(), kBoothMaxLights));
+    std::vector<float> packed(static_cast<std::size_t>(kBoothMaxLights) * 4, 0.0f);
+    for (int i = 0; i < lightCount_; ++i) {
+        const booth::PointLight& p = pl.points[static_cast<std::size_t>(i)];
+        const glm::vec3 pos = f3(p.position);
+        const std::size_t k = static_cast<std::size_t>(i) * 4;
+        packed[k] = pos.x;
+        packed[k + 1] = pos.y;
+        packed[k + 2] = pos.z;
+        packed[k + 3] = static_cast<float>(p.sumCdM2 * a);
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, static_cast<GLsizeiptr>(packed.size() * sizeof(float)),
+                    packed.data());
+
+    // Mip chain exactly as booth::buildMipChain made it (each level uploaded, not regenerated).
+    glDeleteTextures(1, &lum_);
+    glGenTextures(1, &lum_);
+    glBindTexture(GL_TEXTURE_2D, lum_);
+    const auto& levels = pl.mips.levels;
+    lumMaxLevel_ = static_cast<int>(levels.size()) - 1;
+    glTexStorage2D(GL_TEXTURE_2D, static_cast<GLsizei>(levels.size()), GL_R32F, levels[0].width,
+                   levels[0].height);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    std::vector<float> level;
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+        level.assign(levels[l].cdM2.begin(), levels[l].cdM2.end());
+        glTexSubImage2D(GL_TEXTURE_2D, static_cast<GLint>(l), 0, 0, levels[l].width,
+                        levels[l].height, GL_RED, GL_FLOAT, level.data());
+    }
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, lumMaxLevel_);
+    nearest(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+
+    const surface::SurfaceScene& s = *scene_->scene;
+    specXyz_ = colour::spectrumToXyz(*observer_, s.rhoS * pl.unitSpd);
+    glUseProgram(program_);
+    glUniform1i(loc(program_, "uLightCount"), lightCount_);
+    set3(program_, "uLightNormal", bl.normal());
+    glUniform1f(loc(program_, "uTexelArea"), static_cast<float>(a));
+    std::array<float, colour::kChannels * 3> m{};
+    for (std::size_t k = 0; k < colour::kChannels; ++k) {
+        for (int c = 0; c < 3; ++c) {
+            m[k * 3 + static_cast<std::size_t>(c)] = static_cast<float>(pl.channelXyz[k][c]);
+        }
+    }
+    glUniform3fv(loc(program_, "uChannelXyz"), static_cast<GLsizei>(colour::kChannels), m.data());
+    set3(program_, "uWhite", pl.white);
+    set3(program_, "uSpecXyz", specXyz_);
+    set3(program_, "uLightCentre", bl.centre);
+    set3(program_, "uEdgeU", bl.edgeU);
+    set3(program_, "uEdgeV", bl.edgeV);
+    const double u2 = glm::dot(bl.edgeU, bl.edgeU);
+    const double v2 = glm::dot(bl.edgeV, bl.edgeV);
+    glUniform2f(loc(program_, "uInvEdge2"), static_cast<float>(u2 > 0.0 ? 1.0 / u2 : 0.0),
+                static_cast<float>(v2 > 0.0 ? 1.0 / v2 : 0.0));
+    glUniform1i(loc(program_, "uLumMaxLevel"), lumMaxLevel_);
+    glUniform2i(loc(program_, "uLumSize"), levels[0].width, levels[0].height);
+    glUniform2f(loc(program_, "uLumUsed"), static_cast<float>(pl.mips.usedU),
+                static_cast<float>(pl.mips.usedV));
+    return glCheck("uploading the light");
+}
+
+Expected<void> BoothShadingPass::draw(const shading::View& view,
+                                      int width,
+                                      int height,
+                                      const SurfaceLayout& layout) const
+{
+    if (light_ == nullptr) {
+        return makeError(ErrorCode::InvalidArgument, "render: booth pass drawn before setLight");
+    }
+    glViewport(0, 0, width, height);
+    glBindVertexArray(vao_);
+    glUseProgram(program_);
+    glUniform2f(loc(program_, "uViewport"), static_cast<float>(width), static_cast<float>(height));
+    glUniform2f(loc(program_, "uSurfOffset"), static_cast<float>(layout.offset.x),
+                static_cast<float>(layout.offset.y));
+    glUniform2f(loc(program_, "uSurfScale"), static_cast<float>(layout.scale.x),
+                static_cast<float>(layout.scale.y));
+    set3(program_, "uCentre", view.panel.centre);
+    set3(program_, "uRight", view.panel.right);
+    set3(program_, "uUp", view.panel.up);
+    set3(program_, "uNormal", view.panel.normal);
+    set3(program_, "uEye", view.eye);
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightsUbo_);
+    glActiveTexture(GL_TEXTURE0 + kUnitCoeffA);
+    glBindTexture(GL_TEXTURE_2D, coeffA_);
+    glActiveTexture(GL_TEXTURE0 + kUnitCoeffB);
+    glBindTexture(GL_TEXTURE_2D, coeffB_);
+    glActiveTexture(GL_TEXTURE0 + kUnitNormals);
+    glBindTexture(GL_TEXTURE_2D, normals_);
+    glActiveTexture(GL_TEXTURE0 + kUnitHorizon);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, horizon_);
+    glActiveTexture(GL_TEXTURE0 + kUnitLum);
+    glBindTexture(GL_TEXTURE_2D, lum_);
+    // Pixels that show no surface are black: clear them and shade only the surface's rectangle
+    // (pixel u = (surface u - offset) / scale), widened by a pixel so that the shader's own
+    // bounds test decides every edge pixel exactly as it would without the scissor.
+    const auto span = [](double offset, double scale, int n) {
+        const double a = (0.0 - offset) / scale * n;
+        const double b = (1.0 - offset) / scale * n;
+        const int lo = std::clamp(static_cast<int>(std::floor(std::min(a, b))) - 1, 0, n);
+        const int hi = std::clamp(static_cast<int>(std::ceil(std::max(a, b))) + 1, 0, n);
+        return std::pair<int, int>(lo, hi);
+    };
+    const bool scissor = layout.scale.x > 0.0 && layout.scale.y > 0.0;
+    if (scissor) {
+        const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
+        const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
+        glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(x0, height - r1, x1 - x0, r1 - r0);
+    }
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (scissor) {
+        glDisable(GL_SCISSOR_TEST);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    return glCheck("drawing the booth pass");
+}
+
+Expected<std::unique_ptr<XyzTarget>> XyzTarget::create(int width, int height)
+{
+    if (width <= 0 || height <= 0) {
+        return makeError(ErrorCode::InvalidArgument, "render: empty XYZ target");
+    }
+    std::unique_ptr<XyzTarget> t(new XyzTarget());
+    t->width_ = width;
+    t->height_ = height;
+    t->texture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
+    glGenFramebuffers(1, &t->fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->texture_, 0);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        return makeError(ErrorCode::Unsupported,
+                         "render: an RGBA32F target is not renderable on this GL (float colour "
+                         "buffers need GLES 3.2 or EXT_color_buffer_float)");
+    }
+    if (auto ok = glCheck("creating the XYZ target"); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return t;
+}
+
+XyzTarget::~XyzTarget()
+{
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteTextures(1, &texture_);
+}
+
+void XyzTarget::bind() const
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+}
+
+shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
+                                  const shading::View& view) const
+{
+    shading::XyzFrame f;
+    f.width = width_;
+    f.height = height_;
+    std::vector<float> px(static_cast<std::size_t>(width_) * height_ * 4);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, px.data());
+    f.xyz.resize(static_cast<std::size_t>(width_) * height_);
+    for (int y = 0; y < height_; ++y) {
+        const std::size_t src = static_cast<std::size_t>(height_ - 1 - y) * width_; // GL rows up
+        for (int x = 0; x < width_; ++x) {
+            const float* p = &px[(src + x) * 4];
+            colour::Xyz v(p[0], p[1], p[2]);
+            for (int c = 0; c < 3; ++c) {
+                if (!std::isfinite(v[c])) {
+                    ++f.nonFinite;
+                    v[c] = 0.0;
+                }
+            }
+            f.xyz[static_cast<std::size_t>(y) * width_ + x] = v;
+        }
+    }
+    if (light.light != nullptr) {
+        const booth::BoothLight& bl = *light.light;
+        const shading::Vec3 n = view.panel.normal;
+        f.whiteY = shading::pointLightIrradiance(light.points, bl.normal(), bl.texelAreaM2(),
+                                                 view.panel.centre, n, n, nullptr, 0, 0,
+                                                 view.panel.right, view.panel.up, 0.0) /
+                   std::numbers::pi;
+        f.whiteXyz = light.white * f.whiteY;
+    }
+    return f;
+}
+
+Expected<shading::XyzFrame> renderBoothFrame(const BoothShadingPass& pass,
+                                             const shading::PreparedLight& light,
+                                             const shading::View& view)
+{
+    auto target = XyzTarget::create(view.pixelsX, view.pixelsY);
+    if (!target) {
+        return tl::unexpected(target.error());
+    }
+    (*target)->bind();
+    if (auto ok = pass.draw(view, view.pixelsX, view.pixelsY); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return (*target)->read(light, view);
+}
+
+} // namespace replica::pipeline::render

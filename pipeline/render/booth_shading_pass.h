@@ -1,0 +1,107 @@
+// The booth shading pass on the GPU: a booth-lit surface scene rendered to absolute XYZ (cd/m^2)
+// in GLES 3.1 fragment shaders, following shading/realtime_model.h (the executable specification).
+// Needs a current GLES 3.1 context on the calling thread for every call, including destruction.
+#pragma once
+
+#include <memory>
+
+#include <GLES3/gl31.h>
+#include <glm/vec2.hpp>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/colour/xyz.h>
+#include <pipeline/scene/stand.h>
+#include <pipeline/shading/frame.h>
+#include <pipeline/shading/realtime_model.h>
+#include <pipeline/shading/view.h>
+
+namespace replica::pipeline::render {
+
+// Which part of the surface a framebuffer pixel shows: surface (u, v) = offset + scale * pixel
+// (u, v), v down the image; pixels that land outside [0, 1]^2 are black. {0, 0}, {1, 1}: the frame
+// covers the surface exactly, as shading::View does.
+struct SurfaceLayout {
+    glm::dvec2 offset{0.0, 0.0};
+    glm::dvec2 scale{1.0, 1.0};
+};
+
+// The surface at its physical size, centred on the panel's active area (the appliance's frame
+// covers the whole panel). The matching View's panel centre is the active area's centre.
+SurfaceLayout layoutOnPanel(const surface::SurfaceScene& scene, const scene::StandModel& stand);
+
+class BoothShadingPass
+{
+public:
+    // Uploads the scene's textures: K = 6 coefficients per texel in the basis the scene was
+    // prepared with, normal map and horizon map (when the settings use them). The settings stay
+    // fixed for the pass's life; 'scene' and 'obs' must outlive it.
+    static Expected<std::unique_ptr<BoothShadingPass>>
+    create(const shading::PreparedScene& scene,
+           const shading::RenderSettings& settings,
+           const colour::Observer& obs);
+    ~BoothShadingPass();
+    BoothShadingPass(const BoothShadingPass&) = delete;
+    BoothShadingPass& operator=(const BoothShadingPass&) = delete;
+
+    // Uploads a light: its median-cut point lights (at most 256), luminance mip chain and
+    // per-channel XYZ vectors (prepared in the scene's basis). 'light' must outlive the pass or the
+    // next call.
+    Expected<void> setLight(const shading::PreparedLight& light);
+
+    // Draws into the bound framebuffer (viewport width x height, an RGBA32F colour target).
+    Expected<void>
+    draw(const shading::View& view, int width, int height, const SurfaceLayout& layout = {}) const;
+
+    const shading::RenderSettings& settings() const { return settings_; }
+
+private:
+    BoothShadingPass() = default;
+    Expected<void> init(const shading::PreparedScene& scene);
+
+    shading::RenderSettings settings_;
+    const shading::PreparedScene* scene_ = nullptr;
+    const shading::PreparedLight* light_ = nullptr;
+    const colour::Observer* observer_ = nullptr;
+    bool relief_ = false;
+    int horizonDirs_ = 0;
+    int lightCount_ = 0;
+    int lumMaxLevel_ = 0;
+    colour::Xyz specXyz_{0.0};
+    GLuint program_ = 0;
+    GLuint vao_ = 0;
+    GLuint lightsUbo_ = 0;
+    GLuint coeffA_ = 0, coeffB_ = 0, normals_ = 0, horizon_ = 0, lum_ = 0;
+};
+
+// An RGBA32F render target with read-back into an XyzFrame (rows top-down, like the CPU model):
+// what the tests and the benchmark render into.
+class XyzTarget
+{
+public:
+    static Expected<std::unique_ptr<XyzTarget>> create(int width, int height);
+    ~XyzTarget();
+    XyzTarget(const XyzTarget&) = delete;
+    XyzTarget& operator=(const XyzTarget&) = delete;
+
+    void bind() const;
+    // Waits for the frame and reads it back. nonFinite counts components that are NaN or Inf (the
+    // shader must never produce one); whiteY/whiteXyz are filled from 'light' at the view's panel
+    // centre exactly as shading::renderRealtime does.
+    shading::XyzFrame read(const shading::PreparedLight& light, const shading::View& view) const;
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+private:
+    XyzTarget() = default;
+    int width_ = 0;
+    int height_ = 0;
+    GLuint texture_ = 0;
+    GLuint fbo_ = 0;
+};
+
+// One frame of the GPU path into a fresh target: for tests and the benchmark.
+Expected<shading::XyzFrame> renderBoothFrame(const BoothShadingPass& pass,
+                                             const shading::PreparedLight& light,
+                                             const shading::View& view);
+
+} // namespace replica::pipeline::render

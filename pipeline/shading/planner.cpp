@@ -1,0 +1,101 @@
+// Planner: enumerate settings by modelled cost, render the probe, stop at the first that meets the
+// budget.
+#include <algorithm>
+
+#include <pipeline/reference/reference_integrator.h>
+#include <pipeline/shading/planner.h>
+
+namespace replica::pipeline::shading {
+
+double settingCost(const RenderSettings& s, bool glossy, bool relief)
+{
+    // One point light with cosines ~ 1 unit; with relief a second normal-mapped evaluation plus the
+    // horizon interpolation ~ 1.5 units; one FIS sample (sampling, plane hit, trilinear mip read)
+    // ~ 6.
+    double c = s.lights * 1.0;
+    if (relief && s.reliefPass) {
+        c += s.lights * 1.5 + 0.25 * s.horizonDirections;
+    }
+    if (glossy && s.specularPass) {
+        c += s.specularSamples * 6.0 *
+             (relief && s.reliefPass && s.horizonDirections > 0 ? 1.3 : 1.0);
+    }
+    return c;
+}
+
+Plan planRender(const surface::SurfaceScene& scene,
+                const booth::BoothLight& light,
+                const View& view,
+                const colour::Observer& obs,
+                const ErrorBudget& budget,
+                int probeX,
+                int probeY,
+                const colour::ChannelBasis& basis)
+{
+    Plan plan;
+    const bool glossy = scene.glossy();
+    const bool relief = !scene.flat();
+    if (!glossy) {
+        plan.skipped.emplace_back("specular: rho_s is zero in every band (matte scene)");
+    }
+    if (!relief) {
+        plan.skipped.emplace_back("normal map and horizon: the height field is flat");
+    }
+    View probe = view;
+    probe.pixelsX = probeX;
+    probe.pixelsY = probeY;
+    const XyzFrame ref = reference::renderReference(scene, light, probe, obs);
+
+    std::vector<RenderSettings> candidates;
+    for (int lights : {8, 16, 32, 64, 128, 256}) {
+        for (int samples : glossy ? std::vector<int>{1, 4, 8, 16, 32, 64} : std::vector<int>{0}) {
+            for (int dirs : relief ? std::vector<int>{8, 16} : std::vector<int>{0}) {
+                RenderSettings s;
+                s.lights = lights;
+                s.specularSamples = samples;
+                s.specularPass = glossy;
+                s.horizonDirections = dirs;
+                s.reliefPass = relief;
+                candidates.push_back(s);
+            }
+        }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [&](const RenderSettings& a, const RenderSettings& b) {
+                         return settingCost(a, glossy, relief) < settingCost(b, glossy, relief);
+                     });
+    int preparedLights = -1;
+    int preparedDirs = -1;
+    PreparedLight pl;
+    PreparedScene ps;
+    reference::FrameError best{1e9, 1e9, 1e9};
+    for (const RenderSettings& s : candidates) {
+        if (s.lights != preparedLights) {
+            pl = prepareLight(light, obs, s.lights, basis);
+            preparedLights = s.lights;
+        }
+        if (s.horizonDirections != preparedDirs) {
+            ps = prepareScene(scene, std::max(s.horizonDirections, 1), 0.01, basis);
+            preparedDirs = s.horizonDirections;
+        }
+        const XyzFrame f = renderRealtime(ps, pl, probe, obs, s);
+        const reference::FrameError e = reference::compareFrames(ref, f);
+        ++plan.evaluated;
+        if (e.p95 <= budget.p95 && e.max <= budget.max) {
+            plan.settings = s;
+            plan.probeError = e;
+            plan.relativeCost = settingCost(s, glossy, relief);
+            plan.met = true;
+            return plan;
+        }
+        if (e.p95 < best.p95) {
+            best = e;
+            plan.settings = s;
+            plan.probeError = e;
+            plan.relativeCost = settingCost(s, glossy, relief);
+        }
+    }
+    return plan;
+}
+
+} // namespace replica::pipeline::shading

@@ -1,0 +1,263 @@
+// CPU model of the real-time renderer.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include <glm/geometric.hpp>
+
+#include <pipeline/shading/realtime_model.h>
+
+namespace replica::pipeline::shading {
+namespace {
+
+double horizonVisibility(
+        const surface::HorizonMap* horizon, int tx, int ty, const Vec3& l, double softness)
+{
+    if (horizon == nullptr || horizon->directions <= 0) {
+        return 1.0;
+    }
+    const double sinB = horizon->sinHorizon(tx, ty, l);
+    if (sinB <= 0.0) {
+        return 1.0; // flat horizon: the geometric test already decided (keeps flat frames
+                    // identical)
+    }
+    const double e0 = sinB - softness;
+    const double e1 = sinB + softness;
+    const double t = std::clamp((l.z - e0) / std::max(e1 - e0, 1e-12), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+} // namespace
+
+double radicalInverse2(unsigned k)
+{
+    k = (k << 16u) | (k >> 16u);
+    k = ((k & 0x55555555u) << 1u) | ((k & 0xAAAAAAAAu) >> 1u);
+    k = ((k & 0x33333333u) << 2u) | ((k & 0xCCCCCCCCu) >> 2u);
+    k = ((k & 0x0F0F0F0Fu) << 4u) | ((k & 0xF0F0F0F0u) >> 4u);
+    k = ((k & 0x00FF00FFu) << 8u) | ((k & 0xFF00FF00u) >> 8u);
+    return static_cast<double>(k) * 2.3283064365386963e-10;
+}
+
+PreparedLight prepareLight(const booth::BoothLight& light,
+                           const colour::Observer& obs,
+                           int pointLightCount,
+                           const colour::ChannelBasis& basis)
+{
+    PreparedLight p;
+    p.light = &light;
+    const auto regions =
+            booth::medianCut(light.luminance, booth::medianCutOptionsFor(light, pointLightCount));
+    p.points = booth::pointLights(light, regions);
+    p.mips = booth::buildMipChain(light.luminance);
+    p.unitSpd = booth::unitLuminanceSpd(obs, light.spd);
+    p.white = colour::spectrumToXyz(obs, p.unitSpd);
+    p.channelXyz = colour::channelToXyz(basis, obs, light.spd);
+    return p;
+}
+
+PreparedScene prepareScene(const surface::SurfaceScene& scene,
+                           int horizonDirections,
+                           double horizonDistanceM,
+                           const colour::ChannelBasis& basis)
+{
+    PreparedScene p;
+    p.scene = &scene;
+    if (!scene.flat()) {
+        p.normals = surface::normalMap(scene.relief);
+        p.horizon = surface::horizonMap(scene.relief, horizonDirections, horizonDistanceM);
+    }
+    for (const auto& s : scene.palette) {
+        p.paletteCoeffs.push_back(colour::projectReflectance(basis, s));
+    }
+    return p;
+}
+
+double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
+                            const Vec3& lightNormal,
+                            double texelAreaM2,
+                            const Vec3& p,
+                            const Vec3& nGeo,
+                            const Vec3& nShade,
+                            const surface::HorizonMap* horizon,
+                            int tx,
+                            int ty,
+                            const Vec3& right,
+                            const Vec3& up,
+                            double softness)
+{
+    double e = 0.0;
+    for (const booth::PointLight& l : lights) {
+        Vec3 d = l.position - p;
+        const double d2 = glm::dot(d, d);
+        if (!(d2 > 0.0) || !(l.sumCdM2 > 0.0)) {
+            continue;
+        }
+        d /= std::sqrt(d2);
+        const double cosL = -glm::dot(lightNormal, d);
+        const double cosG = glm::dot(nGeo, d);
+        const double cosS = glm::dot(nShade, d);
+        if (!(cosL > 0.0) || !(cosG > 0.0) || !(cosS > 0.0)) {
+            continue;
+        }
+        const Vec3 lt(glm::dot(d, right), glm::dot(d, up), cosG);
+        const double v = horizonVisibility(horizon, tx, ty, lt, softness);
+        e += l.sumCdM2 * cosS * cosL / std::max(d2, texelAreaM2) * v;
+    }
+    return e * texelAreaM2;
+}
+
+double filteredSpecular(const PreparedLight& light,
+                        const Vec3& p,
+                        const Vec3& nGeo,
+                        const Vec3& nShade,
+                        const Vec3& toEye,
+                        brdf::WardModel model,
+                        double alpha,
+                        int samples,
+                        const surface::HorizonMap* horizon,
+                        int tx,
+                        int ty,
+                        const Vec3& right,
+                        const Vec3& up,
+                        double softness)
+{
+    const booth::BoothLight& bl = *light.light;
+    const Vec3 nl = bl.normal();
+    const double a = bl.texelAreaM2();
+    const double invU2 = 1.0 / glm::dot(bl.edgeU, bl.edgeU);
+    const double invV2 = 1.0 / glm::dot(bl.edgeV, bl.edgeV);
+    double sum = 0.0;
+    for (int k = 0; k < samples; ++k) {
+        const double u1 = (k + 0.5) / samples;
+        const double u2 = radicalInverse2(static_cast<unsigned>(k));
+        const brdf::WardSample s = brdf::sampleWard(model, alpha, nShade, toEye, u1, u2, samples);
+        if (!s.valid) {
+            continue;
+        }
+        const double cosG = glm::dot(nGeo, s.i);
+        const double denom = glm::dot(s.i, nl);
+        if (!(cosG > 0.0) || !(denom < 0.0)) {
+            continue; // below the macro surface, or heading away from the emitting side
+        }
+        const double t = glm::dot(bl.centre - p, nl) / denom;
+        if (!(t > 0.0) || !std::isfinite(t)) {
+            continue;
+        }
+        const Vec3 hit = p + s.i * t - bl.centre;
+        const double u = glm::dot(hit, bl.edgeU) * invU2 + 0.5;
+        const double v = glm::dot(hit, bl.edgeV) * invV2 + 0.5;
+        if (!(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0)) {
+            continue; // the dark booth
+        }
+        const double cosL = -denom;
+        const double ratio = s.solidAngle * t * t / (a * cosL);
+        const double lod = 0.5 * std::log2(std::max(ratio, 1e-20)) + 1.0;
+        const Vec3 lt(glm::dot(s.i, right), glm::dot(s.i, up), cosG);
+        sum += light.mips.sample(u, v, lod) * s.weight *
+               horizonVisibility(horizon, tx, ty, lt, softness);
+    }
+    return samples > 0 ? sum / samples : 0.0;
+}
+
+XyzFrame renderRealtime(const PreparedScene& ps,
+                        const PreparedLight& light,
+                        const View& view,
+                        const colour::Observer& obs,
+                        const RenderSettings& settings)
+{
+    const surface::SurfaceScene& scene = *ps.scene;
+    XyzFrame frame;
+    frame.width = view.pixelsX;
+    frame.height = view.pixelsY;
+    frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height),
+                     colour::Xyz(0.0));
+    const bool relief = settings.reliefPass && !ps.normals.empty();
+    const bool specular = settings.specularPass && scene.glossy();
+    const std::vector<Vec3> none;
+    const std::vector<Vec3>& normals = relief ? ps.normals : none;
+    const surface::HorizonMap* horizon =
+            relief && settings.horizonDirections > 0 ? &ps.horizon : nullptr;
+    const booth::BoothLight& bl = *light.light;
+    const Vec3 nl = bl.normal();
+    const double a = bl.texelAreaM2();
+    const colour::Xyz specXyz = colour::spectrumToXyz(obs, scene.rhoS * light.unitSpd);
+
+    struct Counts {
+        long flare = 0, behind = 0, bad = 0;
+    };
+    const auto renderRows = [&](int y0, int y1, Counts& c) {
+        for (int py = y0; py < y1; ++py) {
+            for (int px = 0; px < frame.width; ++px) {
+                const ShadingPoint sp = shadingPoint(view, scene, normals, px, py);
+                Vec3 toEye = view.eye - sp.p;
+                const double eyeDist = glm::length(toEye);
+                toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
+                const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
+                c.behind += behind ? 1 : 0;
+                const double eGeo =
+                        pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr,
+                                             0, 0, sp.right, sp.up, 0.0);
+                double e = eGeo;
+                if (relief) {
+                    e = pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon,
+                                             sp.tx, sp.ty, sp.right, sp.up,
+                                             settings.horizonSoftness);
+                }
+                if (!settings.diffusePass) {
+                    e = 0.0;
+                }
+                colour::Xyz xyz(0.0);
+                if (settings.channels == ChannelRep::Basis6) {
+                    const colour::ChannelCoeffs cc = scene.channels(ps.paletteCoeffs, sp.tx, sp.ty);
+                    for (std::size_t k = 0; k < colour::kChannels; ++k) {
+                        xyz += light.channelXyz[k] * cc[k];
+                    }
+                    xyz *= e / std::numbers::pi;
+                } else {
+                    xyz = colour::spectrumToXyz(obs,
+                                                scene.reflectance(sp.tx, sp.ty) * light.unitSpd) *
+                          (e / std::numbers::pi);
+                }
+                if (specular && !behind) {
+                    const double s =
+                            filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model,
+                                             scene.alpha, settings.specularSamples, horizon, sp.tx,
+                                             sp.ty, sp.right, sp.up, settings.horizonSoftness);
+                    xyz += specXyz * s;
+                }
+                const colour::Xyz flare = light.white * (kScreenFlareRho * eGeo / std::numbers::pi);
+                colour::Xyz out = subtractFlare(xyz, flare, c.flare);
+                if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z)) {
+                    ++c.bad;
+                    out = colour::Xyz(0.0);
+                }
+                frame.xyz[static_cast<std::size_t>(py) * frame.width + px] = out;
+            }
+        }
+    };
+    const int threads = std::clamp(settings.threads, 1, std::max(frame.height, 1));
+    std::vector<Counts> counts(static_cast<std::size_t>(threads));
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) {
+        pool.emplace_back(renderRows, frame.height * t / threads, frame.height * (t + 1) / threads,
+                          std::ref(counts[static_cast<std::size_t>(t)]));
+    }
+    for (auto& th : pool) {
+        th.join();
+    }
+    for (const auto& c : counts) {
+        frame.flareClamped += c.flare;
+        frame.eyeBehindPixels += c.behind;
+        frame.nonFinite += c.bad;
+    }
+    const Vec3 n = view.panel.normal;
+    frame.whiteY = pointLightIrradiance(light.points, nl, a, view.panel.centre, n, n, nullptr, 0, 0,
+                                        view.panel.right, view.panel.up, 0.0) /
+                   std::numbers::pi;
+    frame.whiteXyz = light.white * frame.whiteY;
+    return frame;
+}
+
+} // namespace replica::pipeline::shading

@@ -1,0 +1,77 @@
+// Panel pose from the hinge and the mapping of pixels to surface points.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+
+#include <pipeline/shading/view.h>
+
+namespace replica::pipeline::shading {
+
+PanelPose panelPoseFromTilt(const scene::StandModel& stand, double tiltDeg)
+{
+    const scene::PanelPose pose = scene::panelPose(stand, tiltDeg * std::numbers::pi / 180.0);
+    PanelPose p;
+    p.right = glm::normalize(pose.rightM);
+    p.up = glm::normalize(pose.upM);
+    p.normal = glm::cross(p.right, p.up);
+    p.centre = pose.originM + 0.5 * pose.rightM + 0.5 * pose.upM;
+    return p;
+}
+
+PanelPose panelPoseFromTilt(double tiltDeg)
+{
+    return panelPoseFromTilt(scene::StandModel{}, tiltDeg);
+}
+
+Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, double y)
+{
+    const double fx = x - 0.5;
+    const double fy = y - 0.5;
+    const double x0 = std::floor(fx);
+    const double y0 = std::floor(fy);
+    const double ax = fx - x0;
+    const double ay = fy - y0;
+    const auto at = [&](int ix, int iy) {
+        ix = std::clamp(ix, 0, w - 1);
+        iy = std::clamp(iy, 0, h - 1);
+        return normals[static_cast<std::size_t>(iy) * w + ix];
+    };
+    const int ix = static_cast<int>(x0);
+    const int iy = static_cast<int>(y0);
+    const Vec3 n = (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
+                   ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
+    const double len = glm::length(n);
+    return len > 1e-12 ? n / len : Vec3(0.0, 0.0, 1.0);
+}
+
+ShadingPoint shadingPoint(const View& view,
+                          const surface::SurfaceScene& scene,
+                          const std::vector<Vec3>& normals,
+                          int px,
+                          int py)
+{
+    ShadingPoint s;
+    const double u = (px + 0.5) / view.pixelsX;
+    const double v = (py + 0.5) / view.pixelsY;
+    const PanelPose& pose = view.panel;
+    s.p = pose.centre + pose.right * ((u - 0.5) * scene.widthM) +
+          pose.up * ((0.5 - v) * scene.heightM);
+    s.nGeo = pose.normal;
+    s.right = pose.right;
+    s.up = pose.up;
+    s.texX = u * scene.width;
+    s.texY = v * scene.height;
+    s.tx = std::clamp(static_cast<int>(s.texX), 0, scene.width - 1);
+    s.ty = std::clamp(static_cast<int>(s.texY), 0, scene.height - 1);
+    if (normals.empty()) {
+        s.nShade = s.nGeo;
+    } else {
+        const Vec3 nl = sampleNormal(normals, scene.width, scene.height, s.texX, s.texY);
+        s.nShade = glm::normalize(pose.right * nl.x + pose.up * nl.y + pose.normal * nl.z);
+    }
+    return s;
+}
+
+} // namespace replica::pipeline::shading

@@ -1,0 +1,60 @@
+// The viewing set-up in the booth frame: panel pose from the stand's tilt, eye position, and the
+// per-pixel shading point (position, geometric and normal-mapped normals) on the virtual surface.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <pipeline/brdf/ward.h>
+#include <pipeline/scene/stand.h>
+#include <pipeline/surface/scene.h>
+
+namespace replica::pipeline::shading {
+
+using Vec3 = glm::dvec3;
+
+// A rectangle in the booth frame with unit axes; normal = cross(right, up) faces the viewer.
+struct PanelPose {
+    Vec3 centre{0.0};
+    Vec3 right{1.0, 0.0, 0.0};
+    Vec3 up{0.0, 1.0, 0.0};
+    Vec3 normal{0.0, 0.0, 1.0};
+};
+
+// The panel's pose from the stand's hinge model (scene::panelPose): the surface is shown at its
+// physical size, centred on the panel's active area.
+PanelPose panelPoseFromTilt(const scene::StandModel& stand, double tiltDeg);
+PanelPose panelPoseFromTilt(double tiltDeg); // the default stand
+
+struct View {
+    PanelPose panel;
+    Vec3 eye{0.0, 0.45, 0.60}; // scene::SceneState's default eye
+    int pixelsX = 96;
+    int pixelsY = 60;
+};
+
+// What one pixel sees: the point on the surface and its frame.
+struct ShadingPoint {
+    Vec3 p{0.0};
+    Vec3 nGeo{0.0, 0.0, 1.0};
+    Vec3 nShade{0.0, 0.0, 1.0};
+    Vec3 right{1.0, 0.0, 0.0}; // macro tangent frame (for horizon azimuths)
+    Vec3 up{0.0, 1.0, 0.0};
+    double texX = 0.0; // fractional texel coordinates in the scene
+    double texY = 0.0;
+    int tx = 0;
+    int ty = 0;
+};
+
+// The pixel grid covers the whole surface. normals: the scene's normal map (bilinear,
+// renormalised); empty means flat.
+ShadingPoint shadingPoint(const View& view,
+                          const surface::SurfaceScene& scene,
+                          const std::vector<Vec3>& normals,
+                          int px,
+                          int py);
+
+// Bilinear interpolation of a normal map at fractional texel coordinates, renormalised (never zero:
+// every stored normal has z > 0).
+Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, double y);
+
+} // namespace replica::pipeline::shading

@@ -1,0 +1,124 @@
+// Normal and horizon maps from a height field.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <pipeline/surface/relief.h>
+
+namespace replica::pipeline::surface {
+
+double HeightField::at(int x, int y) const
+{
+    x = std::clamp(x, 0, width - 1);
+    y = std::clamp(y, 0, height - 1);
+    return m[static_cast<std::size_t>(y) * width + x];
+}
+
+double HeightField::sample(double x, double y) const
+{
+    const double fx = x - 0.5;
+    const double fy = y - 0.5;
+    const double x0 = std::floor(fx);
+    const double y0 = std::floor(fy);
+    const double ax = fx - x0;
+    const double ay = fy - y0;
+    const int ix = static_cast<int>(x0);
+    const int iy = static_cast<int>(y0);
+    return (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
+           ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
+}
+
+bool HeightField::flat() const
+{
+    for (double v : m) {
+        if (v != m.front()) {
+            return false;
+        }
+    }
+    return true;
+}
+
+std::vector<Vec3> normalMap(const HeightField& h)
+{
+    std::vector<Vec3> n(static_cast<std::size_t>(h.width) * static_cast<std::size_t>(h.height));
+    for (int y = 0; y < h.height; ++y) {
+        for (int x = 0; x < h.width; ++x) {
+            const int xl = std::max(x - 1, 0);
+            const int xr = std::min(x + 1, h.width - 1);
+            const int yu = std::max(y - 1, 0);
+            const int yd = std::min(y + 1, h.height - 1);
+            const double dx = xr > xl ? (h.at(xr, y) - h.at(xl, y)) / ((xr - xl) * h.pitchM) : 0.0;
+            // Image rows run down, tangent +y runs up.
+            const double dy = yd > yu ? -(h.at(x, yd) - h.at(x, yu)) / ((yd - yu) * h.pitchM) : 0.0;
+            const Vec3 v(-dx, -dy, 1.0); // length >= 1: never zero
+            n[static_cast<std::size_t>(y) * h.width + x] =
+                    v / std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+        }
+    }
+    return n;
+}
+
+double exactSinHorizon(const HeightField& h, double x, double y, double phi, double maxDistanceM)
+{
+    const double h0 = h.sample(x, y);
+    const double cx = std::cos(phi);
+    const double cy = std::sin(phi);
+    double best = 0.0; // tan of the elevation, floored at the macro plane
+    const double step = 0.5;
+    const int steps = static_cast<int>(std::ceil(maxDistanceM / (step * h.pitchM)));
+    for (int s = 1; s <= steps; ++s) {
+        const double t = s * step;
+        const double px = x + cx * t;
+        const double py = y - cy * t; // +y in tangent space is up the image
+        if (px < 0.0 || py < 0.0 || px > h.width || py > h.height) {
+            break;
+        }
+        best = std::max(best, (h.sample(px, py) - h0) / (t * h.pitchM));
+    }
+    return best / std::sqrt(1.0 + best * best); // sin(atan(best)), finite for cliffs
+}
+
+HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM)
+{
+    HorizonMap map;
+    map.width = h.width;
+    map.height = h.height;
+    map.directions = std::max(directions, 1);
+    map.sinBeta.assign(static_cast<std::size_t>(h.width) * static_cast<std::size_t>(h.height) *
+                               static_cast<std::size_t>(map.directions),
+                       0.0f);
+    if (h.flat()) {
+        return map; // every horizon is the macro plane: identical result, no marching
+    }
+    for (int y = 0; y < h.height; ++y) {
+        for (int x = 0; x < h.width; ++x) {
+            for (int k = 0; k < map.directions; ++k) {
+                const double phi = 2.0 * std::numbers::pi * k / map.directions;
+                map.sinBeta[(static_cast<std::size_t>(y) * h.width + x) * map.directions + k] =
+                        static_cast<float>(exactSinHorizon(h, x + 0.5, y + 0.5, phi, maxDistanceM));
+            }
+        }
+    }
+    return map;
+}
+
+double HorizonMap::sinHorizon(int x, int y, const Vec3& l) const
+{
+    if (directions <= 0 || width <= 0) {
+        return 0.0;
+    }
+    x = std::clamp(x, 0, width - 1);
+    y = std::clamp(y, 0, height - 1);
+    double phi = std::atan2(l.y, l.x); // atan2(0, 0) = 0: defined for a light straight overhead
+    if (phi < 0.0) {
+        phi += 2.0 * std::numbers::pi;
+    }
+    const double f = phi / (2.0 * std::numbers::pi) * directions;
+    const int k0 = static_cast<int>(std::floor(f)) % directions;
+    const int k1 = (k0 + 1) % directions;
+    const double t = f - std::floor(f);
+    const float* b = &sinBeta[(static_cast<std::size_t>(y) * width + x) * directions];
+    return (1.0 - t) * b[k0] + t * b[k1];
+}
+
+} // namespace replica::pipeline::surface

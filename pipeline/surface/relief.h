@@ -1,0 +1,50 @@
+// Small-scale geometry of a surface: height field (metres), its normal map and Sloan & Cohen
+// horizon map.
+#pragma once
+
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace replica::pipeline::surface {
+
+using Vec3 = glm::dvec3;
+
+// Tangent frame of the surface: +x along image columns, +y up the image (against row order), +z out
+// of the surface towards the viewer. Heights are in metres, texel pitch in metres.
+struct HeightField {
+    int width = 0;
+    int height = 0;
+    double pitchM = 1e-3;
+    std::vector<double> m; // row-major, row 0 at the top
+
+    double at(int x, int y) const; // clamped to the edge
+    // Bilinear at texel coordinates (texel centres at x + 0.5).
+    double sample(double x, double y) const;
+    bool flat() const;
+};
+
+// Central differences over 2 pitches (one-sided at the edges), renormalised; a vertical cliff gives
+// a finite, nearly horizontal normal and never normalises a zero vector.
+std::vector<Vec3> normalMap(const HeightField& h);
+
+// Horizon map: for each texel and k azimuths phi_k = 2 pi k / K (phi = 0 along +x, pi/2 along +y),
+// the sine of the highest occluder's elevation, floored at 0 (the macro plane's own horizon).
+// Marching reaches maxDistanceM.
+struct HorizonMap {
+    int width = 0;
+    int height = 0;
+    int directions = 0;
+    std::vector<float> sinBeta; // [(y * width + x) * directions + k]
+
+    // Interpolated linearly in azimuth; l is a tangent-space unit direction.
+    double sinHorizon(int x, int y, const Vec3& l) const;
+};
+
+HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM);
+
+// The exact horizon at a fractional texel position and azimuth, by marching the bilinear height
+// field in steps of half a pitch: what the reference uses.
+double exactSinHorizon(const HeightField& h, double x, double y, double phi, double maxDistanceM);
+
+} // namespace replica::pipeline::surface

@@ -1,0 +1,24 @@
+// The three shipped scenes: a semi-gloss ColorChecker, a metamer target and a varnished
+// painting-like surface (canvas weave, impasto strokes, measured reflectances). Deterministic on
+// every machine.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/colour/xyz.h>
+#include <pipeline/surface/scene.h>
+
+namespace replica::pipeline::surface {
+
+// kind: "colorchecker", "metamer" or "painting".
+Expected<SurfaceScene> generateScene(const std::string& kind, const std::filesystem::path& dataDir);
+
+// Metamer pairs: r2 = r1 + a metameric black for 'light' (CIE 1931), scaled to stay in [0.02,
+// 0.95]. The pair matches exactly under 'light' and differs under others.
+colour::Spectrum metamericBlack(const colour::Observer& obs,
+                                const colour::Spectrum& light,
+                                const colour::Spectrum& shape);
+
+} // namespace replica::pipeline::surface

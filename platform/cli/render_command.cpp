@@ -1,0 +1,247 @@
+// 'replica render': one frame of absolute XYZ (cd/m^2) for a scene, light, eye and tilt, as
+// OpenEXR.
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/booth/booth_model.h>
+#include <pipeline/image/exr.h>
+#include <pipeline/reference/reference_integrator.h>
+#include <pipeline/render/booth_shading_pass.h>
+#include <pipeline/shading/planner.h>
+#include <pipeline/shading/realtime_model.h>
+#include <pipeline/surface/scene.h>
+#include <platform/cli/commands.h>
+#include <platform/output/output.h>
+
+namespace replica::platform {
+namespace {
+
+struct RenderArgs {
+    std::string scene;
+    std::string booth;
+    std::string light;
+    std::string eye = "0,0.45,0.60";
+    double tilt = 30.0;
+    std::string size = "192x120";
+    bool reference = false;
+    bool plan = false;
+    bool gl = false;
+    int lights = 32;
+    int samples = 16;
+    int horizonDirections = 8;
+    std::string out;
+    bool json = false;
+};
+
+bool parseTriple(const std::string& s, glm::dvec3& v)
+{
+    char c1 = 0, c2 = 0;
+    std::istringstream in(s);
+    in >> v.x >> c1 >> v.y >> c2 >> v.z;
+    return in && c1 == ',' && c2 == ',' && in.peek() == std::char_traits<char>::eof();
+}
+
+bool parseSize(const std::string& s, int& w, int& h)
+{
+    char x = 0;
+    std::istringstream in(s);
+    in >> w >> x >> h;
+    return in && (x == 'x' || x == 'X') && w > 0 && h > 0 && w <= 8192 && h <= 8192 &&
+           in.peek() == std::char_traits<char>::eof();
+}
+
+int fail(int code, const std::string& msg)
+{
+    std::fprintf(stderr, "replica render: %s\n", msg.c_str());
+    return code;
+}
+
+int runRender(const RenderArgs& a)
+{
+    using namespace pipeline;
+    shading::View view;
+    if (!parseTriple(a.eye, view.eye)) {
+        return fail(kExitUsage,
+                    fmt::format("--eye '{}' must be X,Y,Z in metres (booth frame)", a.eye));
+    }
+    if (!parseSize(a.size, view.pixelsX, view.pixelsY)) {
+        return fail(kExitUsage, fmt::format("--size '{}' must be WxH, e.g. 960x600", a.size));
+    }
+    auto booth = booth::loadBooth(a.booth.empty() ? dataDir() / "booth"
+                                                  : std::filesystem::path(a.booth));
+    if (!booth) {
+        return fail(kExitFailure, booth.error().message);
+    }
+    const booth::BoothLight* light = booth->find(a.light);
+    if (light == nullptr) {
+        return fail(kExitUsage, fmt::format("--light '{}' is not in the booth; choose one of: {}",
+                                            a.light, booth->names()));
+    }
+    auto scene = surface::loadScene(a.scene);
+    if (!scene) {
+        return fail(kExitFailure, scene.error().message);
+    }
+    auto obs = colour::loadCie1931(dataDir());
+    if (!obs) {
+        return fail(kExitFailure, obs.error().message);
+    }
+    view.panel = shading::panelPoseFromTilt(a.tilt);
+    // The appliance's channel basis (docs/accuracy.md), for the CPU model and the GL pass alike.
+    auto basis = colour::loadDefaultChannelBasis(dataDir());
+    if (!basis) {
+        return fail(kExitFailure, basis.error().message);
+    }
+    std::unique_ptr<platform::Output> output;
+    if (a.gl && !a.reference) {
+        auto out = platform::createHeadlessOutput();
+        if (!out) {
+            return fail(kExitFailure, out.error().message);
+        }
+        output = std::move(*out);
+    }
+
+    const auto t0 = std::chrono::steady_clock::now();
+    shading::XyzFrame frame;
+    shading::RenderSettings settings;
+    settings.lights = a.lights;
+    settings.specularSamples = a.samples;
+    settings.horizonDirections = a.horizonDirections;
+    std::string mode = "realtime-cpu";
+    shading::Plan plan;
+    if (a.reference) {
+        mode = "reference";
+        frame = reference::renderReference(*scene, *light, view, *obs);
+    } else {
+        if (a.plan) {
+            plan = shading::planRender(*scene, *light, view, *obs, {}, 32, 20, *basis);
+            settings = plan.settings;
+        }
+        const auto pl = shading::prepareLight(*light, *obs, settings.lights, *basis);
+        const auto ps = shading::prepareScene(*scene, std::max(settings.horizonDirections, 1), 0.01,
+                                              *basis);
+        if (a.gl) {
+            mode = "realtime-gles";
+            auto pass = render::BoothShadingPass::create(ps, settings, *obs);
+            if (!pass) {
+                return fail(kExitFailure, pass.error().message);
+            }
+            if (auto ok = (*pass)->setLight(pl); !ok) {
+                return fail(kExitFailure, ok.error().message);
+            }
+            auto f = render::renderBoothFrame(**pass, pl, view);
+            if (!f) {
+                return fail(kExitFailure, f.error().message);
+            }
+            frame = std::move(*f);
+        } else {
+            frame = shading::renderRealtime(ps, pl, view, *obs, settings);
+        }
+        if (a.plan) {
+            mode += ", planned";
+        }
+    }
+    const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count();
+    if (frame.nonFinite != 0) {
+        return fail(kExitFailure,
+                    fmt::format("{} pixels were not finite; this is a bug, please report it",
+                                frame.nonFinite));
+    }
+    image::ChannelImage img;
+    img.width = frame.width;
+    img.height = frame.height;
+    img.names = {"X", "Y", "Z"};
+    img.planes.assign(3, std::vector<float>(frame.xyz.size()));
+    for (std::size_t k = 0; k < frame.xyz.size(); ++k) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            img.planes[c][k] = static_cast<float>(frame.xyz[k][static_cast<int>(c)]);
+        }
+    }
+    if (auto ok = image::writeExr(
+                a.out, img,
+                {{"units",
+                  "absolute CIE 1931 XYZ, cd/m^2 (panel emission after screen-flare subtraction)"},
+                 {"renderer", mode},
+                 {"light", a.light},
+                 {"scene", scene->name}});
+        !ok) {
+        return fail(kExitFailure, ok.error().message);
+    }
+    nlohmann::json j{{"out", a.out},
+                     {"mode", mode},
+                     {"ms", ms},
+                     {"width", frame.width},
+                     {"height", frame.height},
+                     {"white_y_cdm2", frame.whiteY},
+                     {"flare_clamped", frame.flareClamped},
+                     {"eye_behind_pixels", frame.eyeBehindPixels}};
+    if (!a.reference) {
+        j["lights"] = settings.lights;
+        j["basis"] = basis->name;
+        j["specular_samples"] =
+                scene->glossy() && settings.specularPass ? settings.specularSamples : 0;
+        j["horizon_directions"] =
+                !scene->flat() && settings.reliefPass ? settings.horizonDirections : 0;
+        if (a.plan) {
+            j["plan_met_budget"] = plan.met;
+            j["plan_probe_de00_p95"] = plan.probeError.p95;
+            j["plan_skipped"] = plan.skipped;
+        }
+    }
+    if (a.json) {
+        std::printf("%s\n", j.dump().c_str());
+    } else {
+        std::printf("%s: %dx%d %s frame in %.0f ms; white %.1f cd/m^2; flare clamps %ld; "
+                    "eye-behind pixels %ld\n",
+                    a.out.c_str(), frame.width, frame.height, mode.c_str(), ms, frame.whiteY,
+                    frame.flareClamped, frame.eyeBehindPixels);
+    }
+    return frame.eyeBehindPixels > 0 ? kExitLossy : kExitOk;
+}
+
+} // namespace
+
+void registerRenderCommand(CLI::App& app, int& exitCode)
+{
+    auto args = std::make_shared<RenderArgs>();
+    CLI::App* cmd = app.add_subcommand(
+            "render",
+            "render one frame of a scene under a booth light to an absolute-XYZ OpenEXR (cd/m^2)");
+    cmd->add_option("--scene", args->scene, "scene folder (with scene.json)")->required();
+    cmd->add_option("--light", args->light,
+                    "booth light name (tungsten, d50, d65 in the shipped booth)")
+            ->required();
+    cmd->add_option("--booth", args->booth, "booth model folder (default: the shipped data/booth)");
+    cmd->add_option("--eye", args->eye, "eye position X,Y,Z in metres, booth frame")
+            ->capture_default_str();
+    cmd->add_option("--tilt", args->tilt,
+                    "panel tilt in degrees (0 = upright, positive leans back)")
+            ->capture_default_str();
+    cmd->add_option("--size", args->size, "output size WxH in pixels")->capture_default_str();
+    cmd->add_flag("--reference", args->reference, "use the exact CPU reference integrator (slow)");
+    cmd->add_flag("--gl", args->gl,
+                  "render with the GLES 3.1 pass through surfaceless EGL (what the appliance runs) "
+                  "instead of its CPU model");
+    cmd->add_flag("--plan", args->plan,
+                  "let the planner pick the cheapest setting meeting dE00 p95 <= 1");
+    cmd->add_option("--lights", args->lights, "median-cut point lights")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 4096));
+    cmd->add_option("--samples", args->samples, "specular FIS samples per pixel")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 1024));
+    cmd->add_option("--horizon-directions", args->horizonDirections, "horizon map azimuths")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 64));
+    cmd->add_option("--out", args->out, "output .exr")->required();
+    cmd->add_flag("--json", args->json, "print the summary as JSON");
+    cmd->callback([args, &exitCode] { exitCode = runRender(*args); });
+}
+
+} // namespace replica::platform

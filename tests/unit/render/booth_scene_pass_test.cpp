@@ -1,0 +1,192 @@
+// The loop's booth pass: lamp -> booth light, unknown -> sensed spectrum on a uniform emitter, and
+// the appliance configuration that records the scene for replay.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/render/booth_scene_pass.h>
+#include <platform/appliance.h>
+#include <platform/output/output.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::pipeline::render {
+namespace {
+
+class BoothScenePassTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        auto out = platform::createHeadlessOutput();
+        if (!out) {
+            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        }
+        output_ = std::move(*out);
+        setup_.booth = *booth::loadBooth(dataDir() / "booth");
+        setup_.lamps = {"tungsten", "d50-fluorescent", "d65-fluorescent"};
+        setup_.scene = *surface::loadScene(dataDir() / "scenes" / "metamer");
+        setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
+        setup_.observer = *colour::loadCie1931(dataDir());
+        setup_.settings.lights = 16;
+    }
+
+    std::vector<colour::Xyz> frame(BoothScenePass& pass, const scene::SceneState& st)
+    {
+        auto target = XyzTarget::create(kW, kH);
+        EXPECT_TRUE(target);
+        (*target)->bind();
+        EXPECT_TRUE(pass.draw(st, kW, kH));
+        return (*target)->read({}, {}).xyz;
+    }
+
+    static constexpr int kW = 52, kH = 32;
+    std::unique_ptr<platform::Output> output_;
+    BoothSceneSetup setup_;
+};
+
+TEST_F(BoothScenePassTest, ClassifiedLampUsesItsBoothLight)
+{
+    auto pass = BoothScenePass::create(setup_);
+    ASSERT_TRUE(pass) << pass.error().message;
+    scene::SceneState st;
+    st.lampIndex = 2;
+    st.tiltRad = 0.5;
+    const auto got = frame(**pass, st);
+
+    // The same light, view and layout through the shading pass directly.
+    const auto ps = shading::prepareScene(setup_.scene, 8, 0.01, setup_.basis);
+    auto direct = BoothShadingPass::create(ps, setup_.settings, setup_.observer);
+    ASSERT_TRUE(direct);
+    const auto pl = shading::prepareLight(*setup_.booth.find("d65-fluorescent"), setup_.observer,
+                                          16, setup_.basis);
+    ASSERT_TRUE((*direct)->setLight(pl));
+    auto target = XyzTarget::create(kW, kH);
+    ASSERT_TRUE(target);
+    (*target)->bind();
+    shading::View v;
+    v.panel = shading::panelPoseFromTilt(setup_.stand, 0.5 * 180.0 / std::numbers::pi);
+    v.eye = st.eyeBoothM;
+    ASSERT_TRUE((*direct)->draw(v, kW, kH, layoutOnPanel(setup_.scene, setup_.stand)));
+    const auto want = (*target)->read({}, {}).xyz;
+    ASSERT_EQ(got.size(), want.size());
+    double lit = 0.0;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i].y, want[i].y) << i;
+        lit += got[i].y;
+    }
+    EXPECT_GT(lit, 0.0);
+}
+
+TEST_F(BoothScenePassTest, UnknownLightIsTheSensedSpectrumOnAUniformEmitter)
+{
+    auto pass = BoothScenePass::create(setup_);
+    ASSERT_TRUE(pass);
+    scene::SceneState st;
+    st.lampIndex = -1;
+    st.tiltRad = 0.3;
+    for (std::size_t b = 0; b < colour::kBands; ++b) {
+        st.illuminant[b] = 1.0 + 0.02 * static_cast<double>(b); // a sensed shape no lamp has
+    }
+    st.emitterLuminanceCdM2 = 1000.0;
+    const auto a = frame(**pass, st);
+    st.emitterLuminanceCdM2 = 2000.0;
+    const auto b = frame(**pass, st);
+    // Linear in the emitter's luminance (a changed light is re-prepared, not cached).
+    long lit = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        ASSERT_TRUE(std::isfinite(b[i].y));
+        if (a[i].y > 1.0) {
+            EXPECT_NEAR(b[i].y / a[i].y, 2.0, 1e-4);
+            ++lit;
+        }
+    }
+    EXPECT_GT(lit, kW * kH / 8);
+    // The uniform emitter keeps the booth light's geometry.
+    const auto e = uniformEmitter(setup_.booth.lights[0], 1000.0, st.illuminant);
+    EXPECT_EQ(e.centre, setup_.booth.lights[0].centre);
+    EXPECT_DOUBLE_EQ(e.luminance.max(), 1000.0);
+}
+
+TEST_F(BoothScenePassTest, LampWithoutABoothLightIsRefused)
+{
+    setup_.lamps.push_back("neon");
+    auto pass = BoothScenePass::create(setup_);
+    ASSERT_FALSE(pass);
+    EXPECT_NE(pass.error().message.find("lamp 'neon' has no light in the booth model"),
+              std::string::npos)
+            << pass.error().message;
+}
+
+TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested)
+{
+    platform::RunConfig c;
+    std::string json = c.toJson();
+    // A configuration written before the booth renderer has none of its keys.
+    for (const char* key : {"renderer", "scene_dir", "scene_digest", "booth_lights",
+                            "specular_samples", "horizon_directions"}) {
+        ASSERT_NE(json.find(key), std::string::npos);
+    }
+    auto parsed = platform::RunConfig::fromJson(json);
+    ASSERT_TRUE(parsed);
+    EXPECT_EQ(parsed->renderer, "booth");
+    const std::string old =
+            R"({"width":160,"height":100,"rate_hz":60.0,"booth":"replica-booth-1",)"
+            R"("scene":"colorchecker","basis":"box6","lights_u":8,"lights_v":4,)"
+            R"("spectrometer_calibration":"x.csv","display":"d","display_peak_cd_m2":800.0,)"
+            R"("display_black_cd_m2":0.4})";
+    auto o = platform::RunConfig::fromJson(old);
+    ASSERT_TRUE(o) << o.error().message;
+    EXPECT_EQ(o->renderer, "flat");
+
+    const auto shipped = platform::resolveSceneDir("scenes/metamer");
+    auto d1 = platform::sceneDigest(shipped);
+    ASSERT_TRUE(d1);
+    const auto copy = std::filesystem::temp_directory_path() / "replica_digest_scene";
+    std::filesystem::remove_all(copy);
+    std::filesystem::copy(shipped, copy);
+    EXPECT_EQ(*platform::sceneDigest(copy), *d1);
+    std::ofstream(copy / "height.exr", std::ios::app) << 'x';
+    EXPECT_NE(*platform::sceneDigest(copy), *d1);
+    std::filesystem::remove(copy / "material.exr");
+    auto missing = platform::sceneDigest(copy);
+    ASSERT_FALSE(missing);
+    EXPECT_NE(missing.error().message.find("material.exr: cannot read the scene file"),
+              std::string::npos);
+    std::filesystem::remove_all(copy);
+}
+
+} // namespace
+} // namespace replica::pipeline::render
+
+namespace replica::platform {
+namespace {
+
+TEST(ApplianceBoothScene, RecordsTheSceneAndRefusesAChangedOne)
+{
+    RunConfig c;
+    c.width = 32;
+    c.height = 20;
+    c.sceneDir = "scenes/metamer";
+    auto app = buildAppliance(c);
+    if (!app && app.error().message.find("EGL") != std::string::npos) {
+        GTEST_SKIP() << app.error().message;
+    }
+    ASSERT_TRUE(app) << app.error().message;
+    // The configuration as built names the scene and its digest: what a recording stores.
+    EXPECT_EQ((*app)->config.scene, "metamer");
+    EXPECT_EQ((*app)->config.sceneDigest, *sceneDigest(resolveSceneDir("scenes/metamer")));
+    EXPECT_NE((*app)->renderer->description().find("gles-booth (scene metamer"), std::string::npos);
+    app->reset();
+
+    c.sceneDigest = "0123456789abcdef";
+    auto refused = buildAppliance(c);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("the scene has changed since it was recorded"),
+              std::string::npos)
+            << refused.error().message;
+}
+
+} // namespace
+} // namespace replica::platform

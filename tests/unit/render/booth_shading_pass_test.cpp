@@ -1,0 +1,235 @@
+// The GLES booth pass on the real headless EGL path against the CPU model it follows
+// (shading::renderRealtime) and against the exact reference, on every shipped scene.
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <glm/geometric.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/booth/booth_model.h>
+#include <pipeline/reference/frame_error.h>
+#include <pipeline/reference/reference_integrator.h>
+#include <pipeline/render/booth_shading_pass.h>
+#include <platform/output/output.h>
+
+#include <gtest/gtest.h>
+
+#include "render_fixtures.h"
+
+namespace replica::pipeline::render {
+namespace {
+
+// Float (shader) against double (model): the largest relative difference of any pixel's Y,
+// counted over pixels brighter than 1% of the white, and CIEDE2000 between the two frames.
+struct Agreement {
+    double maxRelY = 0.0;
+    double fracOverTol = 0.0; // share of pixels with a relative Y difference above kRelTol
+    reference::FrameError de;
+};
+constexpr double kRelTol = 1e-4;
+
+Agreement agree(const shading::XyzFrame& cpu, const shading::XyzFrame& gl)
+{
+    Agreement a;
+    long over = 0, counted = 0;
+    for (std::size_t i = 0; i < cpu.xyz.size(); ++i) {
+        const double ref = cpu.xyz[i].y;
+        if (ref < 0.01 * cpu.whiteY) {
+            continue;
+        }
+        const double rel = std::abs(gl.xyz[i].y - ref) / ref;
+        a.maxRelY = std::max(a.maxRelY, rel);
+        over += rel > kRelTol ? 1 : 0;
+        ++counted;
+    }
+    a.fracOverTol = counted > 0 ? static_cast<double>(over) / static_cast<double>(counted) : 1.0;
+    a.de = reference::compareFrames(cpu, gl);
+    return a;
+}
+
+class BoothPassTest : public ::testing::Test
+{
+protected:
+    static void SetUpTestSuite()
+    {
+        obs_ = new colour::Observer(*colour::loadCie1931(dataDir()));
+        booth_ = new booth::BoothModel(*booth::loadBooth(dataDir() / "booth"));
+        basis_ = new colour::ChannelBasis(*colour::loadDefaultChannelBasis(dataDir()));
+        for (const char* name : {"colorchecker", "metamer", "painting"}) {
+            auto s = surface::loadScene(dataDir() / "scenes" / name);
+            ASSERT_TRUE(s) << s.error().message;
+            scenes_[name] = *s;
+        }
+    }
+    static void TearDownTestSuite()
+    {
+        delete obs_;
+        delete booth_;
+        delete basis_;
+        scenes_.clear();
+    }
+    void SetUp() override
+    {
+        auto out = platform::createHeadlessOutput();
+        if (!out) {
+            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        }
+        output_ = std::move(*out);
+    }
+
+    static shading::View view(int w, int h, double tiltDeg = 30.0)
+    {
+        shading::View v;
+        v.panel = shading::panelPoseFromTilt(tiltDeg);
+        v.pixelsX = w;
+        v.pixelsY = h;
+        return v;
+    }
+
+    static colour::Observer* obs_;
+    static booth::BoothModel* booth_;
+    static colour::ChannelBasis* basis_;
+    static std::map<std::string, surface::SurfaceScene> scenes_;
+    std::unique_ptr<platform::Output> output_;
+};
+
+colour::Observer* BoothPassTest::obs_ = nullptr;
+booth::BoothModel* BoothPassTest::booth_ = nullptr;
+colour::ChannelBasis* BoothPassTest::basis_ = nullptr;
+std::map<std::string, surface::SurfaceScene> BoothPassTest::scenes_;
+
+TEST_F(BoothPassTest, MatchesTheCpuModelOnEveryShippedSceneAndLight)
+{
+    const shading::RenderSettings settings; // the default: 32 lights, 16 samples, 8 horizons
+    const shading::View v = view(64, 40);
+    for (const auto& [name, scene] : scenes_) {
+        const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, *basis_);
+        auto pass = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_TRUE(pass) << pass.error().message;
+        for (const auto& light : booth_->lights) {
+            const auto pl = shading::prepareLight(light, *obs_, settings.lights, *basis_);
+            ASSERT_TRUE((*pass)->setLight(pl));
+            const auto cpu = shading::renderRealtime(ps, pl, v, *obs_, settings);
+            auto gl = renderBoothFrame(**pass, pl, v);
+            ASSERT_TRUE(gl) << gl.error().message;
+            EXPECT_EQ(gl->nonFinite, 0);
+            EXPECT_DOUBLE_EQ(gl->whiteY, cpu.whiteY);
+            const Agreement a = agree(cpu, *gl);
+            // Stated tolerance: float against double agrees to 1e-4 in Y on all but 0.2% of the
+            // pixels (where a cosine or horizon test may sit on its threshold), and to 0.01 dE00
+            // at most (measured: 1e-5 and 2e-4 on the shipped scenes).
+            EXPECT_LE(a.fracOverTol, 0.002)
+                    << name << " / " << light.name << " max rel " << a.maxRelY;
+            EXPECT_LE(a.de.max, 0.01) << name << " / " << light.name;
+            EXPECT_LE(a.de.mean, 0.001) << name << " / " << light.name;
+        }
+    }
+}
+
+TEST_F(BoothPassTest, PlannedSettingMeetsTheErrorBudgetAgainstTheReference)
+{
+    // The budget: dE00 95th <= 1, max <= 3. The settings are what shading::planRender
+    // picks for these scenes under d65-fluorescent on its 32x20 probe (replica render --plan;
+    // docs/rendering.md); running the planner here would take half a minute. The GL pass with
+    // that setting must meet the budget against the exact reference on a different frame
+    // (24x15: the reference integrates every luminance texel for every pixel; at 20x12 a row of
+    // pixel centres falls exactly on a texel edge of the painting, texY = 60.0, where float and
+    // double pick different texels).
+    const shading::View v = view(24, 15);
+    struct Case {
+        const char* scene;
+        int lights, samples, dirs;
+    };
+    for (const Case c : {Case{"colorchecker", 16, 32, 0}, Case{"painting", 32, 8, 8}}) {
+        const auto& scene = scenes_.at(c.scene);
+        const auto& light = booth_->lights[2]; // d65-fluorescent: tubes, the hardest image
+        shading::RenderSettings settings;
+        settings.lights = c.lights;
+        settings.specularSamples = c.samples;
+        settings.horizonDirections = c.dirs;
+        const auto ps = shading::prepareScene(scene, std::max(settings.horizonDirections, 1), 0.01,
+                                              *basis_);
+        auto pass = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_TRUE(pass) << pass.error().message;
+        const auto pl = shading::prepareLight(light, *obs_, settings.lights, *basis_);
+        ASSERT_TRUE((*pass)->setLight(pl));
+        auto gl = renderBoothFrame(**pass, pl, v);
+        ASSERT_TRUE(gl);
+        const auto ref = reference::renderReference(scene, light, v, *obs_);
+        const auto e = reference::compareFrames(ref, *gl);
+        EXPECT_LE(e.p95, 1.0) << c.scene;
+        EXPECT_LE(e.max, 3.0) << c.scene;
+    }
+}
+
+TEST_F(BoothPassTest, HardCasesNeverPutNaNOrInfInAPixel)
+{
+    auto scene = test::testScene(48, 32, true, true);
+    shading::RenderSettings settings;
+    settings.lights = 16;
+    settings.specularSamples = 8;
+    for (double alpha : {0.0, 1e-6, 0.1, 2.0}) {
+        scene.alpha = alpha;
+        const auto ps = shading::prepareScene(scene, 8);
+        auto pass = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_TRUE(pass) << pass.error().message;
+        // A single hot texel, a zero image, and a light almost in the surface plane.
+        auto hot = test::ceilingLight(32, 16, 0.0);
+        hot.luminance.at(5, 7) = 1e7;
+        auto dark = test::ceilingLight(32, 16, 0.0);
+        auto low = test::ceilingLight(32, 16, 3000.0, 0.12);
+        for (const auto* light : {&hot, &dark, &low}) {
+            const auto pl = shading::prepareLight(*light, *obs_, settings.lights);
+            ASSERT_TRUE((*pass)->setLight(pl));
+            for (double tilt : {0.0, 30.0, 89.9, 90.0, 135.0}) {
+                for (const shading::Vec3 eye :
+                     {shading::Vec3(0.0, 0.45, 0.60), shading::Vec3(0.0, 0.2, -0.5)}) {
+                    shading::View v = view(24, 16, tilt);
+                    v.eye = eye;
+                    auto gl = renderBoothFrame(**pass, pl, v);
+                    ASSERT_TRUE(gl);
+                    EXPECT_EQ(gl->nonFinite, 0) << "alpha " << alpha << " tilt " << tilt;
+                    for (const auto& px : gl->xyz) {
+                        ASSERT_GE(px.y, 0.0);
+                        if (light == &dark) {
+                            ASSERT_EQ(px.y, 0.0);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+TEST_F(BoothPassTest, PanelLayoutShowsTheSurfaceAtPhysicalSizeAndBlackAround)
+{
+    const auto& scene = scenes_.at("colorchecker");
+    const shading::RenderSettings settings;
+    const auto ps = shading::prepareScene(scene, 8, 0.01, *basis_);
+    auto pass = BoothShadingPass::create(ps, settings, *obs_);
+    ASSERT_TRUE(pass);
+    const auto pl = shading::prepareLight(booth_->lights[0], *obs_, 32, *basis_);
+    ASSERT_TRUE((*pass)->setLight(pl));
+    const scene::StandModel stand;
+    const SurfaceLayout layout = layoutOnPanel(scene, stand);
+    EXPECT_NEAR(layout.scale.x, stand.panelWidthM / scene.widthM, 1e-12);
+    const int w = 104, h = 65; // 5 mm pixels on the 0.518 x 0.324 m panel
+    auto target = XyzTarget::create(w, h);
+    ASSERT_TRUE(target);
+    (*target)->bind();
+    shading::View v = view(w, h);
+    ASSERT_TRUE((*pass)->draw(v, w, h, layout));
+    const auto f = (*target)->read(pl, v);
+    // Lit columns: the surface's width in pixels, centred.
+    int lit = 0;
+    for (int x = 0; x < w; ++x) {
+        lit += f.xyz[static_cast<std::size_t>(h / 2) * w + x].y > 0.0 ? 1 : 0;
+    }
+    EXPECT_NEAR(lit, scene.widthM / stand.panelWidthM * w, 1.5);
+    EXPECT_EQ(f.xyz[0].y, 0.0);
+    EXPECT_GT(f.xyz[static_cast<std::size_t>(h / 2) * w + w / 2].y, 0.0);
+}
+
+} // namespace
+} // namespace replica::pipeline::render

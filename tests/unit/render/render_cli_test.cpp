@@ -1,0 +1,103 @@
+// 'replica render', 'replica booth' and 'replica scene' as a person runs them: exit codes, one-line
+// errors, and EXR frames with no NaN/Inf that agree with the reference.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <sys/wait.h>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/image/exr.h>
+
+#include <gtest/gtest.h>
+
+namespace replica {
+namespace {
+
+struct CliResult {
+    int code = -1;
+    std::string err;
+};
+
+CliResult run(const std::string& args)
+{
+    const auto errFile = std::filesystem::temp_directory_path() / "replica_render_cli_err.txt";
+    const std::string cmd =
+            std::string(REPLICA_BINARY) + " " + args + " >/dev/null 2>" + errFile.string();
+    const int status = std::system(cmd.c_str());
+    CliResult r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream in(errFile);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    r.err = ss.str();
+    return r;
+}
+
+const std::string kScenes = (dataDir() / "scenes").string();
+
+TEST(RenderCli, RejectsBadArgumentsWithOneLine)
+{
+    CliResult r = run("render --scene " + kScenes + "/metamer --light neon --out /tmp/x.exr");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--light 'neon' is not in the booth; choose one of: tungsten, "
+                         "d50-fluorescent, d65-fluorescent"),
+              std::string::npos)
+            << r.err;
+    r = run("render --scene " + kScenes + "/metamer --light d65 --eye 1,2 --out /tmp/x.exr");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--eye '1,2' must be X,Y,Z"), std::string::npos) << r.err;
+    r = run("render --scene /nonexistent --light d65 --out /tmp/x.exr");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("/nonexistent/scene.json: cannot open scene manifest"), std::string::npos)
+            << r.err;
+    r = run("render --scene " + kScenes + "/metamer --light d65 --size 0x5 --out /tmp/x.exr");
+    EXPECT_EQ(r.code, 2);
+    r = run("scene generate --kind teapot --out /tmp/replica_teapot");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("unknown scene kind 'teapot'"), std::string::npos) << r.err;
+    r = run("booth build --capture /nonexistent/capture.json --out /tmp/replica_booth_x");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("/nonexistent/capture.json: cannot open"), std::string::npos) << r.err;
+}
+
+TEST(RenderCli, WritesFiniteAbsoluteXyzCloseToTheReference)
+{
+    const auto dir = std::filesystem::temp_directory_path();
+    const std::string fast = (dir / "replica_cli_fast.exr").string();
+    const std::string ref = (dir / "replica_cli_ref.exr").string();
+    const std::string common = "render --scene " + kScenes +
+                               "/colorchecker --light d50 --eye 0,0.45,0.7 --tilt 35 --size 24x16 ";
+    ASSERT_EQ(run(common + "--lights 128 --samples 32 --out " + fast).code, 0);
+    ASSERT_EQ(run(common + "--reference --out " + ref).code, 0);
+    auto a = pipeline::image::readExr(fast, {"X", "Y", "Z"});
+    auto b = pipeline::image::readExr(ref, {"X", "Y", "Z"});
+    ASSERT_TRUE(a) << a.error().message; // readExr itself rejects NaN/Inf
+    ASSERT_TRUE(b) << b.error().message;
+    double sumA = 0.0, sumB = 0.0;
+    for (std::size_t k = 0; k < a->planes[1].size(); ++k) {
+        EXPECT_GE(a->planes[1][k], 0.0f);
+        sumA += a->planes[1][k];
+        sumB += b->planes[1][k];
+    }
+    EXPECT_GT(sumB, 0.0);
+    EXPECT_NEAR(sumA / sumB, 1.0, 0.02); // mean luminance within 2 % of the reference
+
+    // --gl: the same frame from the GLES pass the appliance runs (skipped without EGL).
+    const std::string gl = (dir / "replica_cli_gl.exr").string();
+    const CliResult g = run(common + "--lights 128 --samples 32 --gl --out " + gl);
+    if (g.code != 0 && g.err.find("EGL") != std::string::npos) {
+        GTEST_SKIP() << g.err;
+    }
+    ASSERT_EQ(g.code, 0) << g.err;
+    auto c = pipeline::image::readExr(gl, {"X", "Y", "Z"});
+    ASSERT_TRUE(c) << c.error().message;
+    for (std::size_t k = 0; k < a->planes[1].size(); ++k) {
+        EXPECT_NEAR(c->planes[1][k], a->planes[1][k], 1e-4 * a->planes[1][k] + 1e-3) << k;
+    }
+}
+
+} // namespace
+} // namespace replica

@@ -1,0 +1,182 @@
+// Normal and horizon maps against closed forms; scene folder round trip and its error messages.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <pipeline/image/exr.h>
+#include <pipeline/surface/relief.h>
+#include <pipeline/surface/scene.h>
+
+#include <gtest/gtest.h>
+
+#include "../render/render_fixtures.h"
+
+namespace replica::pipeline::surface {
+namespace {
+
+HeightField field(int w, int h, double pitch)
+{
+    HeightField f;
+    f.width = w;
+    f.height = h;
+    f.pitchM = pitch;
+    f.m.assign(static_cast<std::size_t>(w) * h, 0.0);
+    return f;
+}
+
+TEST(NormalMap, InclinedPlaneGivesItsExactNormal)
+{
+    HeightField f = field(16, 12, 0.001);
+    for (int y = 0; y < 12; ++y) {
+        for (int x = 0; x < 16; ++x) {
+            f.m[static_cast<std::size_t>(y) * 16 + x] =
+                    0.5 * x * 0.001 - 0.25 * y * 0.001; // rises along +x and +y(up)
+        }
+    }
+    const auto n = normalMap(f);
+    const double len = std::sqrt(0.25 + 0.0625 + 1.0);
+    for (const auto& v : n) {
+        EXPECT_NEAR(v.x, -0.5 / len, 1e-12);
+        EXPECT_NEAR(v.y, -0.25 / len, 1e-12);
+        EXPECT_NEAR(v.z, 1.0 / len, 1e-12);
+    }
+}
+
+TEST(NormalMap, VerticalCliffStaysFinite)
+{
+    HeightField f = field(8, 4, 1e-4);
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 4; x < 8; ++x) {
+            f.m[static_cast<std::size_t>(y) * 8 + x] = 1.0; // 1 m step over 0.1 mm
+        }
+    }
+    for (const auto& v : normalMap(f)) {
+        EXPECT_TRUE(std::isfinite(v.x) && std::isfinite(v.z));
+        EXPECT_NEAR(v.x * v.x + v.y * v.y + v.z * v.z, 1.0, 1e-12);
+        EXPECT_GT(v.z, 0.0);
+    }
+}
+
+TEST(HorizonMap, FlatFieldHasZeroHorizonsEverywhere)
+{
+    const HorizonMap m = horizonMap(field(10, 10, 0.001), 8, 0.01);
+    for (float v : m.sinBeta) {
+        EXPECT_EQ(v, 0.0f);
+    }
+}
+
+TEST(HorizonMap, WallGivesItsElevationInItsDirectionOnly)
+{
+    // A 2 mm wall 5 mm to the right (+x) of the texel: sin(atan(2/5)) towards +x, nothing towards
+    // -x.
+    HeightField f = field(40, 9, 0.001);
+    for (int y = 0; y < 9; ++y) {
+        for (int x = 25; x < 27; ++x) {
+            f.m[static_cast<std::size_t>(y) * 40 + x] = 0.002;
+        }
+    }
+    const HorizonMap m = horizonMap(f, 8, 0.02);
+    const int x = 20,
+              y = 4; // texel centre 20.5: the wall's face is at 25 - 0.5 pitch of bilinear ramp
+    const float* b = &m.sinBeta[(static_cast<std::size_t>(y) * 40 + x) * 8];
+    const double peak = std::sin(std::atan(0.002 / 0.005)); // top reached 5 texels away
+    EXPECT_NEAR(b[0], peak, 0.03);
+    EXPECT_EQ(b[4], 0.0f);
+    // Interpolation between directions is linear in azimuth.
+    EXPECT_NEAR(m.sinHorizon(x, y, Vec3(1.0, 0.0, 0.5)), b[0], 1e-6);
+    const Vec3 halfway(std::cos(M_PI / 8), std::sin(M_PI / 8), 0.3);
+    EXPECT_NEAR(m.sinHorizon(x, y, halfway), 0.5 * (b[0] + b[1]), 1e-6);
+    // A cliff face: horizons approach 90 degrees but stay finite.
+    HeightField cliff = field(10, 3, 1e-4);
+    for (int y2 = 0; y2 < 3; ++y2) {
+        cliff.m[static_cast<std::size_t>(y2) * 10 + 6] = 1.0;
+    }
+    const double s = exactSinHorizon(cliff, 5.5, 1.5, 0.0, 0.01);
+    EXPECT_TRUE(std::isfinite(s));
+    EXPECT_GT(s, 0.999);
+    EXPECT_LE(s, 1.0);
+}
+
+std::filesystem::path freshDir(const std::string& name)
+{
+    auto d = std::filesystem::temp_directory_path() / ("replica_scene_test_" + name);
+    std::filesystem::remove_all(d);
+    return d;
+}
+
+TEST(SceneFolder, RoundTrips)
+{
+    const SurfaceScene s = test::testScene(20, 10, true, true);
+    const auto dir = freshDir("roundtrip");
+    ASSERT_TRUE(saveScene(dir, s));
+    auto r = loadScene(dir);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->width, 20);
+    EXPECT_EQ(r->palette.size(), 2u);
+    EXPECT_DOUBLE_EQ(r->alpha, 0.1);
+    EXPECT_EQ(r->model, brdf::WardModel::WardDurGuarded);
+    EXPECT_TRUE(r->glossy());
+    EXPECT_FALSE(r->flat());
+    for (int x : {0, 15}) {
+        const auto a = r->reflectance(x, 3);
+        const auto b = s.reflectance(x, 3);
+        for (std::size_t k = 0; k < colour::kBands; ++k) {
+            EXPECT_DOUBLE_EQ(a[k], b[k]);
+        }
+    }
+    EXPECT_FLOAT_EQ(static_cast<float>(r->relief.m[33]), static_cast<float>(s.relief.m[33]));
+    // channels.exr holds the box6 projection of each texel's spectrum.
+    auto ch = image::readExr(dir / "channels.exr", {"c0", "c5"});
+    ASSERT_TRUE(ch) << ch.error().message;
+    const auto c = colour::projectReflectance(colour::boxBasis(), s.reflectance(15, 3));
+    EXPECT_NEAR((*ch->plane("c5"))[3 * 20 + 15], c[5], 1e-6);
+}
+
+TEST(SceneFolder, ErrorsNameTheFileAndTheProblem)
+{
+    SurfaceScene s = test::testScene(20, 10, false, false);
+    auto dir = freshDir("badindex");
+    s.pigmentB[47] = 5; // no such palette entry
+    ASSERT_TRUE(saveScene(dir, s));
+    auto r = loadScene(dir);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("material.exr: texel (7, 2): pigment index"),
+              std::string::npos)
+            << r.error().message;
+
+    dir = freshDir("noheight");
+    s = test::testScene(20, 10, false, false);
+    ASSERT_TRUE(saveScene(dir, s));
+    std::filesystem::remove(dir / "height.exr");
+    r = loadScene(dir);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("height.exr: no such file"), std::string::npos)
+            << r.error().message;
+
+    dir = freshDir("nanheight");
+    ASSERT_TRUE(saveScene(dir, s));
+    image::ChannelImage h;
+    h.width = 20;
+    h.height = 10;
+    h.names = {"H"};
+    h.planes.assign(1, std::vector<float>(200, 0.0f));
+    h.planes[0][3 * 20 + 4] = INFINITY;
+    ASSERT_TRUE(image::writeExr(dir / "height.exr", h));
+    r = loadScene(dir);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("pixel (4, 3) is inf"), std::string::npos)
+            << r.error().message;
+
+    dir = freshDir("badjson");
+    ASSERT_TRUE(saveScene(dir, s));
+    std::ofstream(dir / "scene.json")
+            << R"({"format":"replica-scene/1","size_m":[0.2,0.1],"palette":[{"reflectance":[1,2]}]})";
+    r = loadScene(dir);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("palette[0].reflectance: must hold 36 values"),
+              std::string::npos)
+            << r.error().message;
+}
+
+} // namespace
+} // namespace replica::pipeline::surface
