@@ -186,6 +186,28 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
 
 Expected<void> saveScene(const std::filesystem::path& dir, const SurfaceScene& s)
 {
+    // An in-memory scene with a pigment index outside its palette must not reach the disk (nor the
+    // channel projection below, which indexes the palette with it).
+    const std::size_t texels =
+            static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
+    if (s.pigmentA.size() != texels || s.pigmentB.size() != texels || s.mix.size() != texels ||
+        s.shade.size() != texels) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("scene '{}': material planes do not hold {}x{} texels", s.name,
+                                     s.width, s.height));
+    }
+    for (std::size_t k = 0; k < texels; ++k) {
+        if (s.pigmentA[k] < 0 || s.pigmentB[k] < 0 ||
+            static_cast<std::size_t>(s.pigmentA[k]) >= s.palette.size() ||
+            static_cast<std::size_t>(s.pigmentB[k]) >= s.palette.size()) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("scene '{}': texel ({}, {}) names pigment {}/{}, but the "
+                                         "palette has {} entries",
+                                         s.name, k % static_cast<std::size_t>(s.width),
+                                         k / static_cast<std::size_t>(s.width), s.pigmentA[k],
+                                         s.pigmentB[k], s.palette.size()));
+        }
+    }
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) {

@@ -100,7 +100,8 @@ TEST(OpentrackSource, ReceivesPosesDropsBadOnesAndGoesStale)
     hal::SteadyClock clock;
     OpentrackSourceOptions opt;
     opt.port = 0;
-    opt.staleNs = 100'000'000;
+    // Long enough that a loaded machine cannot make the fresh poses stale before they are polled.
+    opt.staleNs = 1'000'000'000;
     auto src = makeOpentrackSource(clock, opt);
     ASSERT_TRUE(src) << src.error().message;
     const std::uint16_t port = (*src)->boundPort();

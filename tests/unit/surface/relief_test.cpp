@@ -136,8 +136,20 @@ TEST(SceneFolder, ErrorsNameTheFileAndTheProblem)
 {
     SurfaceScene s = test::testScene(20, 10, false, false);
     auto dir = freshDir("badindex");
-    s.pigmentB[47] = 5; // no such palette entry
     ASSERT_TRUE(saveScene(dir, s));
+    {
+        // saveScene refuses such a scene, so damage the file on disk: no such palette entry.
+        auto bad = s;
+        bad.pigmentB[47] = 5;
+        auto refused = saveScene(freshDir("refused"), bad);
+        ASSERT_FALSE(refused);
+        EXPECT_NE(refused.error().message.find("texel (7, 2)"), std::string::npos)
+                << refused.error().message;
+        auto mat = image::readExr(dir / "material.exr", {"A", "B", "mix", "shade"});
+        ASSERT_TRUE(mat) << mat.error().message;
+        mat->planes[1][47] = 5.0f;
+        ASSERT_TRUE(image::writeExr(dir / "material.exr", *mat));
+    }
     auto r = loadScene(dir);
     ASSERT_FALSE(r);
     EXPECT_NE(r.error().message.find("material.exr: texel (7, 2): pigment index"),
