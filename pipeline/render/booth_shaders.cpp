@@ -4,13 +4,6 @@
 
 namespace replica::pipeline::render {
 
-const char* const kBoothVertexShader = R"(#version 310 es
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-)";
-
 const char* const kBoothXyzShader = R"(#version 310 es
 precision highp float;
 precision highp int;

@@ -3,9 +3,7 @@
 
 namespace replica::pipeline::render {
 
-// Fullscreen triangle; no attributes.
-extern const char* const kBoothVertexShader;
-
+// Drawn with gl_program.h's kFullscreenVertexShader.
 // The real-time algorithm of shading/realtime_model.cpp, line for line in float: eq. (1) over the
 // median-cut point lights with normal-mapped facets and horizon shadows, eq. (2) with K = 6
 // channel coefficients, Ward specular by filtered importance sampling of the luminance mip chain,

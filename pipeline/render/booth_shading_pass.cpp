@@ -121,7 +121,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                          fmt::format("render: {} horizon directions; the GL pass holds at most {}",
                                      horizonDirs_, kBoothMaxHorizonDirections));
     }
-    auto program = linkProgram(kBoothVertexShader, kBoothXyzShader, "booth XYZ");
+    auto program = linkProgram(kFullscreenVertexShader, kBoothXyzShader, "booth XYZ");
     if (!program) {
         return tl::unexpected(program.error());
     }

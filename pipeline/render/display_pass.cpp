@@ -10,18 +10,10 @@
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_shader.h>
 #include <pipeline/render/display_pass.h>
+#include <pipeline/render/gl_program.h>
 
 namespace replica::pipeline::render {
 namespace {
-
-const char* const kVertexShader = R"(#version 310 es
-out vec2 vUv;
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    vUv = p;
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-)";
 
 const char* const kFragmentHead = R"(#version 310 es
 precision highp float;
@@ -110,48 +102,6 @@ void main() {
 }
 )";
 
-Expected<GLuint> compile(GLenum type, const std::string& source, const char* what)
-{
-    GLuint shader = glCreateShader(type);
-    const char* src = source.c_str();
-    glShaderSource(shader, 1, &src, nullptr);
-    glCompileShader(shader);
-    GLint ok = GL_FALSE;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (ok != GL_TRUE) {
-        std::array<char, 4096> log{};
-        glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
-        glDeleteShader(shader);
-        return makeError(
-                ErrorCode::Unsupported,
-                fmt::format("display pass: {} shader does not compile: {}", what, log.data()));
-    }
-    return shader;
-}
-
-Expected<GLuint> link(std::initializer_list<GLuint> shaders, const char* what)
-{
-    GLuint program = glCreateProgram();
-    for (GLuint s : shaders) {
-        glAttachShader(program, s);
-    }
-    glLinkProgram(program);
-    for (GLuint s : shaders) {
-        glDeleteShader(s);
-    }
-    GLint ok = GL_FALSE;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (ok != GL_TRUE) {
-        std::array<char, 4096> log{};
-        glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
-        glDeleteProgram(program);
-        return makeError(
-                ErrorCode::Unsupported,
-                fmt::format("display pass: {} program does not link: {}", what, log.data()));
-    }
-    return program;
-}
-
 GLuint texture2d(GLenum internalFormat, GLenum format, GLenum type, int w, int h, const void* data)
 {
     GLuint tex = 0;
@@ -211,27 +161,18 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     white_ = setup.model.whiteXyz();
     flarePerLux_ = setup.flareSubtraction ? params.flarePerLux : 0.0f;
 
-    auto vs = compile(GL_VERTEX_SHADER, kVertexShader, "fullscreen vertex");
-    if (!vs) {
-        return tl::unexpected(vs.error());
-    }
-    auto fs = compile(GL_FRAGMENT_SHADER,
-                      std::string(kFragmentHead) + display::kDisplayInverseGlsl + kFragmentMain,
-                      "display");
-    if (!fs) {
-        glDeleteShader(*vs);
-        return tl::unexpected(fs.error());
-    }
-    auto program = link({*vs, *fs}, "display");
+    const std::string fragment =
+            std::string(kFragmentHead) + display::kDisplayInverseGlsl + kFragmentMain;
+    auto program = linkProgram(kFullscreenVertexShader, fragment.c_str(), "display");
     if (!program) {
         return tl::unexpected(program.error());
     }
     program_ = *program;
-    auto cs = compile(GL_COMPUTE_SHADER, kCountShader, "gamut count");
+    auto cs = compileShader(GL_COMPUTE_SHADER, kCountShader, "gamut count");
     if (!cs) {
         return tl::unexpected(cs.error());
     }
-    auto count = link({*cs}, "gamut count");
+    auto count = linkShaders({*cs}, "gamut count");
     if (!count) {
         return tl::unexpected(count.error());
     }

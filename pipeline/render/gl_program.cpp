@@ -8,6 +8,31 @@
 namespace replica::pipeline::render {
 namespace {
 
+const char* stageName(GLenum type)
+{
+    switch (type) {
+    case GL_VERTEX_SHADER:
+        return "vertex";
+    case GL_FRAGMENT_SHADER:
+        return "fragment";
+    case GL_COMPUTE_SHADER:
+        return "compute";
+    default:
+        return "unknown";
+    }
+}
+
+} // namespace
+
+const char* const kFullscreenVertexShader = R"(#version 310 es
+out vec2 vUv;
+void main() {
+    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    vUv = p;
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
 Expected<GLuint> compileShader(GLenum type, const char* source, const char* what)
 {
     GLuint shader = glCreateShader(type);
@@ -21,12 +46,32 @@ Expected<GLuint> compileShader(GLenum type, const char* source, const char* what
         glDeleteShader(shader);
         return makeError(ErrorCode::Unsupported,
                          fmt::format("render: {} {} shader does not compile: {}", what,
-                                     type == GL_VERTEX_SHADER ? "vertex" : "fragment", log.data()));
+                                     stageName(type), log.data()));
     }
     return shader;
 }
 
-} // namespace
+Expected<GLuint> linkShaders(std::initializer_list<GLuint> shaders, const char* what)
+{
+    GLuint program = glCreateProgram();
+    for (const GLuint s : shaders) {
+        glAttachShader(program, s);
+    }
+    glLinkProgram(program);
+    for (const GLuint s : shaders) {
+        glDeleteShader(s);
+    }
+    GLint ok = GL_FALSE;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        std::array<char, 4096> log{};
+        glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
+        glDeleteProgram(program);
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("render: {} program does not link: {}", what, log.data()));
+    }
+    return program;
+}
 
 Expected<GLuint> linkProgram(const char* vertexSource, const char* fragmentSource, const char* what)
 {
@@ -39,22 +84,7 @@ Expected<GLuint> linkProgram(const char* vertexSource, const char* fragmentSourc
         glDeleteShader(*vs);
         return tl::unexpected(fs.error());
     }
-    GLuint program = glCreateProgram();
-    glAttachShader(program, *vs);
-    glAttachShader(program, *fs);
-    glLinkProgram(program);
-    glDeleteShader(*vs);
-    glDeleteShader(*fs);
-    GLint ok = GL_FALSE;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (ok != GL_TRUE) {
-        std::array<char, 4096> log{};
-        glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
-        glDeleteProgram(program);
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("render: {} program does not link: {}", what, log.data()));
-    }
-    return program;
+    return linkShaders({*vs, *fs}, what);
 }
 
 } // namespace replica::pipeline::render

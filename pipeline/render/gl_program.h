@@ -1,5 +1,8 @@
-// Compiling and linking a GLES program with errors that carry the driver's log.
+// Compiling and linking GLES programs with errors that carry the driver's log, and the one
+// full-screen vertex shader every pass draws with.
 #pragma once
+
+#include <initializer_list>
 
 #include <GLES3/gl31.h>
 
@@ -7,7 +10,16 @@
 
 namespace replica::pipeline::render {
 
+// A triangle covering the viewport (drawn with glDrawArrays(GL_TRIANGLES, 0, 3)); vUv runs 0..1.
+extern const char* const kFullscreenVertexShader;
+
 // Needs a current GLES 3.1 context. 'what' names the program in error messages.
+Expected<GLuint> compileShader(GLenum type, const char* source, const char* what);
+
+// Links the compiled shaders into a program and deletes them, whether or not it links.
+Expected<GLuint> linkShaders(std::initializer_list<GLuint> shaders, const char* what);
+
+// Vertex + fragment from source.
 Expected<GLuint>
 linkProgram(const char* vertexSource, const char* fragmentSource, const char* what);
 

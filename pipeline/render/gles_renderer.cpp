@@ -8,22 +8,13 @@
 #include <fmt/format.h>
 #include <glm/matrix.hpp>
 
+#include <pipeline/render/gl_program.h>
 #include <pipeline/render/gles_renderer.h>
 
 namespace replica::pipeline::render {
 namespace {
 
 constexpr int kMaxLights = 256;
-
-// A triangle covering the viewport; vUv runs 0..1 across the panel's active area, v up.
-const char* const kVertexShader = R"(#version 310 es
-out vec2 vUv;
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    vUv = p;
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-)";
 
 // Paper eq. (1) over point lights, eq. (2) per channel, summed into absolute XYZ (cd/m^2).
 const char* const kXyzShader = R"(#version 310 es
@@ -61,52 +52,6 @@ void main() {
     outXyz = vec4(xyz * (e / kPi), 1.0);
 }
 )";
-
-Expected<GLuint> compile(GLenum type, const char* source, const char* what)
-{
-    GLuint shader = glCreateShader(type);
-    glShaderSource(shader, 1, &source, nullptr);
-    glCompileShader(shader);
-    GLint ok = GL_FALSE;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (ok != GL_TRUE) {
-        std::array<char, 4096> log{};
-        glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
-        glDeleteShader(shader);
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("render: {} shader does not compile: {}", what, log.data()));
-    }
-    return shader;
-}
-
-Expected<GLuint> link(const char* fragment, const char* what)
-{
-    auto vs = compile(GL_VERTEX_SHADER, kVertexShader, "fullscreen vertex");
-    if (!vs) {
-        return tl::unexpected(vs.error());
-    }
-    auto fs = compile(GL_FRAGMENT_SHADER, fragment, what);
-    if (!fs) {
-        glDeleteShader(*vs);
-        return tl::unexpected(fs.error());
-    }
-    GLuint program = glCreateProgram();
-    glAttachShader(program, *vs);
-    glAttachShader(program, *fs);
-    glLinkProgram(program);
-    glDeleteShader(*vs);
-    glDeleteShader(*fs);
-    GLint ok = GL_FALSE;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (ok != GL_TRUE) {
-        std::array<char, 4096> log{};
-        glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
-        glDeleteProgram(program);
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("render: {} program does not link: {}", what, log.data()));
-    }
-    return program;
-}
 
 GLuint
 makeTexture(GLenum internalFormat, GLenum format, GLenum type, int w, int h, const void* data)
@@ -148,7 +93,7 @@ public:
 
     Expected<void> init()
     {
-        auto xyz = link(kXyzShader, "XYZ");
+        auto xyz = linkProgram(kFullscreenVertexShader, kXyzShader, "XYZ");
         if (!xyz) {
             return tl::unexpected(xyz.error());
         }
