@@ -9,6 +9,7 @@
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/basis_fit.h>
 #include <pipeline/spectral/fit_metric.h>
+#include <pipeline/spectral/light_classifier.h>
 
 namespace replica::pipeline::spectral {
 namespace {
@@ -362,6 +363,34 @@ private:
 };
 
 } // namespace
+
+Expected<Spectrum>
+shiftedLight(const Observer& obs, const Spectrum& from, const Spectrum& towards, double distance)
+{
+    const double yFrom = colour::spectrumToXyz(obs, from).y;
+    const double yTowards = colour::spectrumToXyz(obs, towards).y;
+    if (!(yFrom > 0.0) || !(yTowards > 0.0) || !(distance > 0.0)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "shifted light: both lights need luminance and the distance must be > 0");
+    }
+    const Spectrum a = from * (1.0 / yFrom);
+    const Spectrum b = towards * (1.0 / yTowards);
+    const auto mix = [&](double t) { return a * (1.0 - t) + b * t; };
+    if (!(spectralShapeDistance(a, b) >= distance)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("shifted light: the two lights are only {:.4f} apart in shape",
+                                     spectralShapeDistance(a, b)));
+    }
+    // The distance grows from 0 at t = 0; take the smallest t that reaches it (bisection on the
+    // first crossing is enough for mixtures, whose distance rises monotonically in practice).
+    double lo = 0.0;
+    double hi = 1.0;
+    for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (spectralShapeDistance(a, mix(mid)) < distance ? lo : hi) = mid;
+    }
+    return mix(hi);
+}
 
 std::unique_ptr<Representation> makeAdaptiveRepresentation(AdaptiveEncoder encoder)
 {

@@ -114,6 +114,23 @@ struct AdaptiveSurface {
 Expected<AdaptiveSurface>
 encodeSurface(const AdaptiveEncoder& encoder, const ReflectanceImage& image, const Spectrum& light);
 
+// Direct-sensor mode with a light-adaptive encoder: the surface is re-encoded when the sensed
+// spectrum's shape (spectralShapeDistance) has moved more than this from the one it was last
+// encoded for. The error of the stale encoding grows linearly with the drift: at 0.01, surfaces
+// encoded for the old shape and shown under the new one stay within 0.012 mean / 0.042 max dE00
+// on the ColorChecker (worst over the eight lights moved towards each other and by band
+// noise; docs/accuracy.md), a quarter of the mean goal and a seventh of its max goal,
+// leaving the rest to the spectrometer. It is 7 times the noise floor at data-sheet noise (p99.9
+// distance 0.0014), so sensor noise alone does not re-encode.
+constexpr double kAdaptiveReencodeDistance = 0.01;
+
+// For choosing when a drifting sensed light needs a re-encode: the light (1 - a) from + a towards
+// (each scaled to Y = 1) whose spectralShapeDistance from 'from' is 'distance', a found by
+// bisection. Fails for a light without luminance, a distance <= 0, and when even 'towards'
+// itself is closer to 'from' than 'distance'.
+Expected<Spectrum>
+shiftedLight(const Observer& obs, const Spectrum& from, const Spectrum& towards, double distance);
+
 // Representation "adaptive_k6": encode()/lightVectors() use the general basis; adaptedTo(light)
 // gives the fixed basis representation encoded for that light.
 std::unique_ptr<Representation> makeAdaptiveRepresentation(AdaptiveEncoder encoder);

@@ -2,6 +2,7 @@
 // reflectance), graceful for another light, stable for degenerate lights, clear errors.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <pipeline/base/data_dir.h>
@@ -10,6 +11,7 @@
 #include <pipeline/spectral/accuracy.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/basis_fit.h>
+#include <pipeline/spectral/light_classifier.h>
 #include <pipeline/spectral/representation_catalogue.h>
 
 #include <gtest/gtest.h>
@@ -357,6 +359,82 @@ TEST_F(Adaptive, EncoderRefusesBadTrainingData)
     e = AdaptiveEncoder::create(obs_, d65_, ces_, lights);
     ASSERT_FALSE(e);
     EXPECT_EQ(e.error().message, "adaptive encoder: every training light needs luminance (Y > 0)");
+}
+
+} // namespace
+} // namespace replica::pipeline::spectral
+
+namespace replica::pipeline::spectral {
+namespace {
+
+// The direct-sensor re-encode threshold: surfaces encoded for a light and shown under a light
+// whose shape has drifted by kAdaptiveReencodeDistance (towards any other light of the issue, or
+// by band noise) stay far inside the issue's goal, so re-encoding only past it costs nothing
+// visible; and the drift, once past it, is re-encoded exactly.
+TEST_F(Adaptive, DriftUpToTheReencodeDistanceStaysFarInsideTheGoal)
+{
+    auto rep = makeRepresentation(dataDir(), obs_, d65_, "adaptive_k6");
+    ASSERT_TRUE(rep);
+    const auto names = evaluationLightNames();
+    double worstMean = 0.0;
+    double worstMax = 0.0;
+    double worstMaxFarther = 0.0; // at twice the distance: the threshold is not vacuous
+    std::mt19937 rng(7);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    for (const auto& from : names) {
+        auto encoded = (*rep)->adaptedTo(light(from));
+        ASSERT_TRUE(encoded) << encoded.error().message;
+        std::vector<std::pair<Spectrum, bool>> shifted; // the light, at the threshold (or 2x)
+        for (const auto& to : names) {
+            for (double d : {kAdaptiveReencodeDistance, 2.0 * kAdaptiveReencodeDistance}) {
+                auto s = shiftedLight(obs_, light(from), light(to), d);
+                if (to == from) {
+                    EXPECT_FALSE(s); // no distance at all towards itself
+                    continue;
+                }
+                ASSERT_TRUE(s) << from << " -> " << to << ": " << s.error().message;
+                EXPECT_NEAR(spectralShapeDistance(light(from), *s), d, 1e-9);
+                shifted.emplace_back(*s, d == kAdaptiveReencodeDistance);
+            }
+        }
+        // Band noise scaled to the same shape distance (what a noisy sensor reading looks like).
+        for (int k = 0; k < 4; ++k) {
+            Spectrum noise;
+            for (std::size_t b = 0; b < kBands; ++b) {
+                noise[b] = light(from)[b] * (1.0 + 0.1 * gauss(rng));
+            }
+            auto s = shiftedLight(obs_, light(from), noise, kAdaptiveReencodeDistance);
+            ASSERT_TRUE(s) << s.error().message;
+            shifted.emplace_back(*s, true);
+        }
+        for (const auto& [s, atThreshold] : shifted) {
+            auto r = evaluateRepresentation(obs_, d65_, **encoded, s, cc_);
+            ASSERT_TRUE(r) << r.error().message;
+            if (atThreshold) {
+                worstMean = std::max(worstMean, r->stats.mean);
+                worstMax = std::max(worstMax, r->stats.max);
+            } else {
+                worstMaxFarther = std::max(worstMaxFarther, r->stats.max);
+            }
+        }
+    }
+    // Measured 0.0118 / 0.0402 at the threshold (max 0.070 at twice it); the issue's goal
+    // is mean <= 0.05, max <= 0.3.
+    EXPECT_LE(worstMean, 0.015);
+    EXPECT_LE(worstMax, 0.05);
+    EXPECT_GT(worstMaxFarther, worstMax);
+    std::printf("drift %.3f: worst mean %.4f, worst max %.4f; at %.3f: worst max %.4f\n",
+                kAdaptiveReencodeDistance, worstMean, worstMax, 2.0 * kAdaptiveReencodeDistance,
+                worstMaxFarther);
+}
+
+TEST_F(Adaptive, ShiftedLightRefusesWhatItCannotReach)
+{
+    EXPECT_FALSE(shiftedLight(obs_, Spectrum{}, light("A"), 0.01));
+    EXPECT_FALSE(shiftedLight(obs_, light("A"), light("F11"), 0.0));
+    auto far = shiftedLight(obs_, light("A"), light("A") * 2.0, 0.01);
+    ASSERT_FALSE(far);
+    EXPECT_NE(far.error().message.find("apart in shape"), std::string::npos) << far.error().message;
 }
 
 } // namespace
