@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/spectral/light_classifier.h>
 
 namespace replica::pipeline::render {
 
@@ -67,6 +68,9 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
         if (index == lightIndex_) {
             return {};
         }
+        if (auto ok = encodeFor(l->spd, true); !ok) {
+            return ok;
+        }
         light_ = shading::prepareLight(*l, setup_.observer, setup_.settings.lights, setup_.basis);
         lightIndex_ = index;
     } else {
@@ -74,6 +78,9 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
         if (lightIndex_ == -1 && state.illuminant.v == directSpd_.v &&
             state.emitterLuminanceCdM2 == directLuminance_) {
             return {};
+        }
+        if (auto ok = encodeFor(state.illuminant, false); !ok) {
+            return ok;
         }
         direct_ = uniformEmitter(setup_.booth.lights.front(), state.emitterLuminanceCdM2,
                                  state.illuminant);
@@ -84,6 +91,33 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
         lightIndex_ = -1;
     }
     return pass_->setLight(light_);
+}
+
+Expected<void> BoothScenePass::encodeFor(const colour::Spectrum& spd, bool lampChange)
+{
+    if (!setup_.adaptive) {
+        return {};
+    }
+    if (encoded_ && (lampChange ? spd.v == encodedFor_.v
+                                : spectral::spectralShapeDistance(spd, encodedFor_) <=
+                                          setup_.reencodeDistance)) {
+        return {};
+    }
+    auto basis = setup_.adaptive->basisFor(spd);
+    if (!basis) {
+        return {}; // no luminance or a non-finite band: keep rendering with the encoding we have
+    }
+    setup_.basis = std::move(*basis);
+    // By linearity a texel's coefficients follow from its palette entries'
+    // (SurfaceScene::channels).
+    for (std::size_t i = 0; i < setup_.scene.palette.size(); ++i) {
+        prepared_.paletteCoeffs[i] =
+                colour::projectReflectance(setup_.basis, setup_.scene.palette[i]);
+    }
+    encodedFor_ = spd;
+    encoded_ = true;
+    ++encodings_;
+    return pass_->setChannels(prepared_);
 }
 
 Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, int height)

@@ -1,7 +1,10 @@
 // The booth pass driven by the loop's scene state: the classified lamp picks the booth light (its
 // measured luminance image), an unknown light becomes a uniform emitter with the sensed spectrum
 // (the paper's direct-sensor mode); the eye comes from the tracker, the panel pose from the tilt
-// through the stand's hinge model. Needs a current GLES 3.1 context for every call.
+// through the stand's hinge model. With a light-adaptive encoder (basis "adaptive_k6") the surface
+// is re-encoded for each new light, synchronously, inside the draw that first sees it, so that
+// which frame shows the new encoding follows from the scene states alone (replay stays bit-exact).
+// Needs a current GLES 3.1 context for every call.
 #pragma once
 
 #include <memory>
@@ -12,6 +15,7 @@
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/scene/booth.h>
 #include <pipeline/scene/scene_state.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 
 namespace replica::pipeline::render {
 
@@ -23,6 +27,11 @@ struct BoothSceneSetup {
     colour::Observer observer;
     scene::StandModel stand;
     shading::RenderSettings settings;
+    // Basis "adaptive_k6": when set, 'basis' is the encoder's general basis until the first light
+    // with luminance, and every new lamp (or a sensed shape moved by more than reencodeDistance)
+    // gets a basis of its own and a re-encoded surface (pipeline/spectral/adaptive_encoding.h).
+    std::shared_ptr<const spectral::AdaptiveEncoder> adaptive;
+    double reencodeDistance = spectral::kAdaptiveReencodeDistance;
 };
 
 class BoothScenePass
@@ -36,9 +45,19 @@ public:
 
     std::string description() const;
 
+    // The basis the surface is encoded in now, and how many times it has been re-encoded (0
+    // without an adaptive encoder).
+    const colour::ChannelBasis& basis() const { return setup_.basis; }
+    int encodings() const { return encodings_; }
+
 private:
     BoothScenePass() = default;
     Expected<void> selectLight(const scene::SceneState& state);
+    // With an adaptive encoder: a new basis for 'spd' and the palette re-projected onto it, the
+    // coefficient textures replaced. A lamp change always re-encodes (unless already encoded for
+    // exactly that spectrum); direct-sensor mode only past reencodeDistance. A light the encoder
+    // refuses (no luminance, a non-finite band) keeps the encoding it has.
+    Expected<void> encodeFor(const colour::Spectrum& spd, bool lampChange);
 
     BoothSceneSetup setup_;
     shading::PreparedScene prepared_;
@@ -49,6 +68,9 @@ private:
     double directLuminance_ = -1.0;
     booth::BoothLight direct_;
     shading::PreparedLight light_;
+    bool encoded_ = false; // encodedFor_ holds the light of the current adaptive basis
+    colour::Spectrum encodedFor_{};
+    int encodings_ = 0;
 };
 
 // A uniform emitter with the geometry of 'like', the given luminance and spectrum: what the booth

@@ -81,6 +81,26 @@ Expected<void> glCheck(const char* what)
     return {};
 }
 
+// Channel coefficients per texel, exactly as the CPU model forms them (then rounded to float):
+// channels 0-2 in 'a', 3-5 in 'b' (the paper's two RGB float images).
+void channelPlanes(const shading::PreparedScene& ps, std::vector<float>& a, std::vector<float>& b)
+{
+    const surface::SurfaceScene& s = *ps.scene;
+    const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
+    a.assign(texels * 3, 0.0f);
+    b.assign(texels * 3, 0.0f);
+    for (int y = 0; y < s.height; ++y) {
+        for (int x = 0; x < s.width; ++x) {
+            const colour::ChannelCoeffs c = s.channels(ps.paletteCoeffs, x, y);
+            const std::size_t i = static_cast<std::size_t>(y) * s.width + x;
+            for (std::size_t k = 0; k < 3; ++k) {
+                a[i * 3 + k] = static_cast<float>(c[k]);
+                b[i * 3 + k] = static_cast<float>(c[3 + k]);
+            }
+        }
+    }
+}
+
 } // namespace
 
 SurfaceLayout layoutOnPanel(const surface::SurfaceScene& scene, const scene::StandModel& stand)
@@ -128,19 +148,9 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     program_ = *program;
     glGenVertexArrays(1, &vao_);
 
-    // Channel coefficients per texel, exactly as the CPU model forms them (then rounded to float).
     const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
-    std::vector<float> a(texels * 3), b(texels * 3);
-    for (int y = 0; y < s.height; ++y) {
-        for (int x = 0; x < s.width; ++x) {
-            const colour::ChannelCoeffs c = s.channels(ps.paletteCoeffs, x, y);
-            const std::size_t i = static_cast<std::size_t>(y) * s.width + x;
-            for (std::size_t k = 0; k < 3; ++k) {
-                a[i * 3 + k] = static_cast<float>(c[k]);
-                b[i * 3 + k] = static_cast<float>(c[3 + k]);
-            }
-        }
-    }
+    std::vector<float> a, b;
+    channelPlanes(ps, a, b);
     coeffA_ = texture2d(GL_RGB32F, GL_RGB, s.width, s.height, a.data());
     coeffB_ = texture2d(GL_RGB32F, GL_RGB, s.width, s.height, b.data());
 
@@ -216,6 +226,27 @@ BoothShadingPass::~BoothShadingPass()
     glDeleteBuffers(1, &lightsUbo_);
     glDeleteVertexArrays(1, &vao_);
     glDeleteProgram(program_);
+}
+
+Expected<void> BoothShadingPass::setChannels(const shading::PreparedScene& ps)
+{
+    if (ps.scene == nullptr || scene_ == nullptr || ps.scene->width != scene_->scene->width ||
+        ps.scene->height != scene_->scene->height ||
+        ps.paletteCoeffs.size() != ps.scene->palette.size()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "render: new channel coefficients must be for a scene of the same size, "
+                         "with one set per palette entry");
+    }
+    scene_ = &ps;
+    std::vector<float> a, b;
+    channelPlanes(ps, a, b);
+    const surface::SurfaceScene& s = *ps.scene;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glBindTexture(GL_TEXTURE_2D, coeffA_);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_FLOAT, a.data());
+    glBindTexture(GL_TEXTURE_2D, coeffB_);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_FLOAT, b.data());
+    return glCheck("replacing the channel coefficients");
 }
 
 Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)

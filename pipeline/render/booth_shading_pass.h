@@ -43,6 +43,12 @@ public:
     BoothShadingPass(const BoothShadingPass&) = delete;
     BoothShadingPass& operator=(const BoothShadingPass&) = delete;
 
+    // Replaces the per-texel channel coefficients with those of 'scene' (the same surface with its
+    // palette projected onto another basis: a light-adaptive re-encode). Synchronous: the next
+    // draw uses them. The next setLight must carry XYZ vectors of the new basis. 'scene' must
+    // outlive the pass or the next call.
+    Expected<void> setChannels(const shading::PreparedScene& scene);
+
     // Uploads a light: its median-cut point lights (at most 256), luminance mip chain and
     // per-channel XYZ vectors (prepared in the scene's basis). 'light' must outlive the pass or the
     // next call.
