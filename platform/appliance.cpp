@@ -16,6 +16,7 @@
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 #include <platform/appliance.h>
 #include <platform/loop/frame_digest.h>
 
@@ -157,7 +158,8 @@ Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
 makeBoothScene(RunConfig& config,
                const pipeline::scene::Booth& lamps,
                const pipeline::colour::ChannelBasis& basis,
-               const pipeline::colour::Observer& observer)
+               const pipeline::colour::Observer& observer,
+               std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive)
 {
     const auto dir = resolveSceneDir(config.sceneDir);
     auto digest = sceneDigest(dir);
@@ -187,6 +189,7 @@ makeBoothScene(RunConfig& config,
     }
     setup.scene = std::move(*scene);
     setup.basis = basis;
+    setup.adaptive = std::move(adaptive);
     setup.observer = observer;
     setup.settings.lights = config.boothLights;
     setup.settings.specularSamples = config.specularSamples;
@@ -265,17 +268,24 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     const std::string dir = dataDir().string();
     auto app = std::make_unique<Appliance>();
     app->config = config;
-    // Channel bases: box6 (built in; what the first recordings used) or one fitted by 'replica
-    // spectral fit' under data/channels/ (docs/accuracy.md).
-    const bool knownBasis = config.basis == "box6" || config.basis == "replica_k6" ||
+    // Channel bases: adaptive_k6 (re-encoded for each light; the default), box6 (built in; what
+    // the first recordings used) or one fitted by 'replica spectral fit' under data/channels/
+    // (docs/accuracy.md).
+    const bool adaptive = config.basis == kAdaptiveBasis;
+    const bool knownBasis = adaptive || config.basis == "box6" || config.basis == "replica_k6" ||
                             config.basis == "general_k6" || config.basis == "pca6";
     const bool knownScene = config.renderer == "booth" || config.scene == "colorchecker";
     if (config.booth != "replica-booth-1" || !knownScene || !knownBasis) {
         return makeError(ErrorCode::NotFound,
                          fmt::format("unknown booth '{}', scene '{}' or basis '{}' (this build has "
-                                     "replica-booth-1, colorchecker, and bases replica_k6, "
-                                     "general_k6, pca6, box6)",
+                                     "replica-booth-1, colorchecker, and bases adaptive_k6, "
+                                     "replica_k6, general_k6, pca6, box6)",
                                      config.booth, config.scene, config.basis));
+    }
+    if (adaptive && config.renderer != "booth") {
+        return makeError(ErrorCode::InvalidArgument,
+                         "basis adaptive_k6 re-encodes the booth renderer's surface scene; the "
+                         "flat renderer needs a fixed basis (--basis replica_k6)");
     }
     auto booth = pipeline::scene::loadDefaultBooth(dir);
     if (!booth) {
@@ -292,7 +302,15 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
         return tl::unexpected(calibration.error());
     }
     pipeline::colour::ChannelBasis basis = pipeline::colour::boxBasis();
-    if (config.basis != "box6") {
+    std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> encoder;
+    if (adaptive) {
+        auto made = pipeline::spectral::AdaptiveEncoder::createDefault(dir);
+        if (!made) {
+            return tl::unexpected(made.error());
+        }
+        encoder = std::make_shared<const pipeline::spectral::AdaptiveEncoder>(std::move(*made));
+        basis = encoder->generalBasis();
+    } else if (config.basis != "box6") {
         auto fitted = pipeline::colour::loadChannelBasis(std::filesystem::path(dir) / "channels" /
                                                          (config.basis + ".csv"));
         if (!fitted) {
@@ -329,10 +347,11 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     setup.lightsU = config.lightsU;
     setup.lightsV = config.lightsV;
     if (config.renderer == "booth") {
-        auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer);
+        auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer, encoder);
         if (!boothScene) {
             return tl::unexpected(boothScene.error());
         }
+        app->boothScene = *boothScene;
         setup.boothScene = std::move(*boothScene);
     }
     auto renderer = pipeline::render::createGlesRenderer(std::move(setup));

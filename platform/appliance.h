@@ -10,6 +10,7 @@
 
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
+#include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/renderer.h>
 #include <platform/loop/scene_updater.h>
 #include <platform/output/output.h>
@@ -34,7 +35,9 @@ struct RunConfig {
     int boothLights = 32;    // median-cut point lights
     int specularSamples = 16;
     int horizonDirections = 8;
-    std::string basis = "replica_k6"; // docs/accuracy.md; recordings made with box6 replay as such
+    // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
+    // light; recordings made with replica_k6 or box6 replay as such.
+    std::string basis = "adaptive_k6";
     int lightsU = 8;
     int lightsV = 4;
     std::string spectrometerCalibration = "spectrometer/sim_usb2000_responsivity.csv";
@@ -56,6 +59,9 @@ struct RunConfig {
     static Expected<RunConfig> fromJson(const std::string& json);
 };
 
+// The light-adaptive basis (pipeline/spectral/adaptive_encoding.h): the default for new runs.
+constexpr const char* kAdaptiveBasis = "adaptive_k6";
+
 constexpr const char* kUncalibratedDisplay = "srgb-like-800";
 
 // What a recording's session names the display by: the profile's name and file digest, or the
@@ -74,11 +80,15 @@ struct Appliance {
     std::unique_ptr<Output>
             output; // owns the GL context: created before, destroyed after the renderer
     std::unique_ptr<pipeline::render::Renderer> renderer;
+    // The booth renderer's pass 1 (shared with the renderer), null with the flat renderer: what
+    // tests ask about the adaptive encoding (its basis, how often it re-encoded).
+    std::shared_ptr<pipeline::render::BoothScenePass> boothScene;
     std::unique_ptr<SceneUpdater> updater;
     std::string displayProfileId;    // as recorded in the session
     glm::dvec3 displayWhiteXyz{0.0}; // the panel's full white (cd/m^2): Lab white of frame reports
     ~Appliance()
     {
+        boothScene.reset();
         renderer.reset(); // GL objects go while the context still exists
         output.reset();
     }

@@ -14,6 +14,7 @@
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/shading/planner.h>
 #include <pipeline/shading/realtime_model.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/surface/scene.h>
 #include <platform/cli/commands.h>
 #include <platform/output/output.h>
@@ -34,9 +35,30 @@ struct RenderArgs {
     int lights = 32;
     int samples = 16;
     int horizonDirections = 8;
+    std::string basis = "adaptive_k6";
     std::string out;
     bool json = false;
 };
+
+// The channel basis by name: adaptive_k6 is built for the light rendered (the appliance's
+// default: exact for that light), the others are fixed (box6 built in, the rest fitted files under
+// data/channels/).
+Expected<pipeline::colour::ChannelBasis> namedBasis(const std::string& name,
+                                                    const pipeline::colour::Spectrum& light)
+{
+    using namespace pipeline;
+    if (name == "adaptive_k6") {
+        auto encoder = spectral::AdaptiveEncoder::createDefault(dataDir());
+        if (!encoder) {
+            return tl::unexpected(encoder.error());
+        }
+        return encoder->basisFor(light);
+    }
+    if (name == "box6") {
+        return colour::boxBasis();
+    }
+    return colour::loadChannelBasis(dataDir() / "channels" / (name + ".csv"));
+}
 
 bool parseTriple(const std::string& s, glm::dvec3& v)
 {
@@ -91,8 +113,8 @@ int runRender(const RenderArgs& a)
         return fail(kExitFailure, obs.error().message);
     }
     view.panel = shading::panelPoseFromTilt(a.tilt);
-    // The appliance's channel basis (docs/accuracy.md), for the CPU model and the GL pass alike.
-    auto basis = colour::loadDefaultChannelBasis(dataDir());
+    // The channel basis (docs/accuracy.md), for the CPU model and the GL pass alike.
+    auto basis = namedBasis(a.basis, light->spd);
     if (!basis) {
         return fail(kExitFailure, basis.error().message);
     }
@@ -239,6 +261,11 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--horizon-directions", args->horizonDirections, "horizon map azimuths")
             ->capture_default_str()
             ->check(CLI::Range(1, 64));
+    cmd->add_option("--basis", args->basis,
+                    "channel basis: adaptive_k6 (encoded for the light: the appliance's default), "
+                    "replica_k6, general_k6, pca6, box6 (docs/accuracy.md)")
+            ->check(CLI::IsMember({"adaptive_k6", "replica_k6", "general_k6", "pca6", "box6"}))
+            ->capture_default_str();
     cmd->add_option("--out", args->out, "output .exr")->required();
     cmd->add_flag("--json", args->json, "print the summary as JSON");
     cmd->callback([args, &exitCode] { exitCode = runRender(*args); });

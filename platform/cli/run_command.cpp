@@ -31,6 +31,7 @@ struct RunOptions {
     bool fast = false;
     std::string scene;
     std::string renderer = "booth";
+    std::string basis; // empty: adaptive_k6 for the booth renderer, replica_k6 for the flat one
     std::string displayProfile;
     bool uncalibrated = false;
     std::string displayInverse = "analytic";
@@ -84,6 +85,10 @@ int runMain(const RunOptions& o)
     config.height = size->second;
     config.rateHz = o.rateHz;
     config.renderer = o.renderer;
+    // The flat renderer has no 36-band scene to re-encode: it keeps the best fixed basis.
+    config.basis = !o.basis.empty() ? o.basis
+                                    : (o.renderer == "flat" ? std::string("replica_k6")
+                                                            : std::string(kAdaptiveBasis));
     if (!o.scene.empty()) {
         // Stored relative to the data folder when it is inside it, so that a recording replays on
         // another installation.
@@ -283,6 +288,11 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                     "renderer)")
             ->check(CLI::IsMember({"booth", "flat"}))
             ->capture_default_str();
+    cmd->add_option("--basis", opts->basis,
+                    "channel basis: adaptive_k6 (re-encoded for each light, exact for the light "
+                    "present; the default, booth renderer only), replica_k6 (fixed; the flat "
+                    "renderer's default), general_k6, pca6, box6 (docs/accuracy.md)")
+            ->check(CLI::IsMember({"adaptive_k6", "replica_k6", "general_k6", "pca6", "box6"}));
     cmd->add_flag("--fast", opts->fast,
                   "do not wait for each tick's wall-clock time (same frames, rendered as fast as "
                   "possible)");
