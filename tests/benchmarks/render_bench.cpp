@@ -21,6 +21,7 @@
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/shading/planner.h>
 #include <pipeline/shading/realtime_model.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 #include <platform/image/png_writer.h>
 #include <platform/output/output.h>
 
@@ -156,7 +157,8 @@ int main(int argc, char** argv)
     auto obs = colour::loadCie1931(dataDir());
     auto booth = booth::loadBooth(dataDir() / "booth");
     auto basis = colour::loadDefaultChannelBasis(dataDir());
-    if (!output || !obs || !booth || !basis) {
+    auto encoder = spectral::AdaptiveEncoder::createDefault(dataDir());
+    if (!output || !obs || !booth || !basis || !encoder) {
         std::fprintf(stderr, "cannot set up: no GL context or data missing\n");
         return 1;
     }
@@ -223,13 +225,21 @@ int main(int argc, char** argv)
                 std::fflush(stdout);
             }
             // Channel representations: the fitted bases on the GL path, full spectra on the CPU
-            // model (the GL path holds K = 6).
-            for (const char* b :
-                 sweep ? std::vector<const char*>{"box6", "pca6"} : std::vector<const char*>{}) {
-                auto other = colour::loadChannelBasis(dataDir() / "channels" /
-                                                      (std::string(b) + ".csv"));
-                const colour::ChannelBasis bb =
-                        std::string(b) == "box6" ? colour::boxBasis() : *other;
+            // model (the GL path holds K = 6). adaptive_k6 (the appliance's default: a basis
+            // built for this light, the surface re-encoded) under every light.
+            for (const char* b : sweep ? std::vector<const char*>{"adaptive_k6", "box6", "pca6"}
+                                       : std::vector<const char*>{"adaptive_k6"}) {
+                const std::string name(b);
+                Expected<colour::ChannelBasis> other =
+                        name == "adaptive_k6" ? encoder->basisFor(light.spd)
+                        : name == "box6"      ? Expected<colour::ChannelBasis>(colour::boxBasis())
+                                              : colour::loadChannelBasis(dataDir() / "channels" /
+                                                                         (name + ".csv"));
+                if (!other) {
+                    std::fprintf(stderr, "%s\n", other.error().message.c_str());
+                    return 1;
+                }
+                const colour::ChannelBasis& bb = *other;
                 const Result r = measure(*scene, light, *obs, bb, def, view, ref, tw, th);
                 std::printf("| %s | %s | default, basis %s | %.0f | %.3f | %.3f | %.3f |\n",
                             sceneName, light.name.c_str(), b, r.ms, r.error.mean, r.error.p95,
