@@ -3,7 +3,8 @@
 // samples 1-64, horizon directions, channel representation), ms per 1920x1200 frame measured on
 // the GPU path and CIEDE2000 mean / 95th / max against the exact reference on an error frame;
 // the planner's choice and its saving; a Pareto-front PNG.
-// Usage: replica_bench_render [OUT_DIR] [WIDTHxHEIGHT of the error frame, default 64x40]
+// Usage: replica_bench_render [OUT_DIR] [WIDTHxHEIGHT of the error frame, default 64x40] [SCENE]
+// (SCENE: only that shipped scene, e.g. metamer; default all three)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -174,7 +175,11 @@ int main(int argc, char** argv)
                 "|\n|---|---|---|---|---|---|---|\n");
     std::vector<Point> pareto;
     std::vector<std::string> planLines;
+    const std::string only = argc > 3 ? argv[3] : "";
     for (const char* sceneName : {"colorchecker", "metamer", "painting"}) {
+        if (!only.empty() && only != sceneName) {
+            continue;
+        }
         auto scene = surface::loadScene(dataDir() / "scenes" / sceneName);
         if (!scene) {
             std::fprintf(stderr, "%s\n", scene.error().message.c_str());
@@ -316,6 +321,9 @@ int main(int argc, char** argv)
             std::printf("| %s | %.0f | %.3f | %.3f | %.3f |\n", p.label.c_str(), p.msFullHd, p.p95,
                         p.mean, p.max);
         }
+    }
+    if (pareto.empty()) {
+        return 0; // the painting was not swept
     }
     writePareto(outDir / "render_pareto.png", pareto);
     std::printf("\nPareto plot: %s (x: log ms per 1920x1200 frame, decade ticks; y: dE00 p95; "

@@ -216,12 +216,21 @@ TEST_F(Spectral, ShippedPaperModelLoadsAndIsComparableToThePaper)
     EXPECT_LT(stats(**paper, "A", cc_).mean, 1.6);
 }
 
-// The appliance renders with the fitted default basis (docs/accuracy.md), not the box bands.
-TEST(DefaultBasis, ApplianceConfigNamesTheShippedFittedBasis)
+// The appliance renders new runs with the light-adaptive basis (docs/accuracy.md), a
+// representation of the catalogue; the fixed default (the flat renderer's, and what the adaptive
+// encoder starts from) is the shipped fitted basis, not the box bands.
+TEST(DefaultBasis, ApplianceConfigNamesTheAdaptiveBasisAndTheFixedOneIsTheFittedFile)
 {
     const platform::RunConfig config;
-    EXPECT_EQ(config.basis, kDefaultRepresentation);
-    auto basis = colour::loadChannelBasis(dataDir() / "channels" / (config.basis + ".csv"));
+    EXPECT_EQ(config.basis, "adaptive_k6");
+    auto obs = colour::loadCie1931(dataDir());
+    auto d65 = loadCieIlluminant(dataDir(), "D65");
+    ASSERT_TRUE(obs && d65);
+    auto rep = makeRepresentation(dataDir(), *obs, *d65, config.basis);
+    ASSERT_TRUE(rep) << rep.error().message;
+    EXPECT_EQ((*rep)->name(), "adaptive_k6");
+    auto basis = colour::loadChannelBasis(dataDir() / "channels" /
+                                          (std::string(kDefaultRepresentation) + ".csv"));
     ASSERT_TRUE(basis) << basis.error().message;
     auto def = colour::loadDefaultChannelBasis(dataDir());
     ASSERT_TRUE(def);
