@@ -6,16 +6,17 @@
 // change the CPU rebuilds the basis (about a millisecond) and re-encodes each surface from its
 // 36-band reflectance kept on the CPU (36 x 6 multiply-adds per texel). See docs/accuracy.md.
 //
-// How the appliance is meant to use it (not wired in yet):
-//   at start:      encoder = AdaptiveEncoder::createDefault(dataDir()); keep each surface's
-//                  ReflectanceImage; render with encoder.generalBasis() and its encodeTexels().
-//   light changes: (the classifier confirms a new lamp, or in direct-sensor mode the sensed shape
-//                  moves by more than the classifier's accept distance) a worker thread calls
-//                  encodeSurface(encoder, image, light) (or basisFor() once, then encodeTexels()
-//                  over row ranges, dropping the job if the light changes again); when it is done
-//                  the loop swaps in the new coefficients and basis together, on a frame boundary.
-//   every frame:   M = colour::channelToXyz(surface.basis, observer, state.illuminant), as now:
-//                  exact once the surface was encoded for this light, graceful before.
+// How the appliance uses it (render/booth_scene_pass.h, basis "adaptive_k6", the default):
+//   at start:      encoder = AdaptiveEncoder::createDefault(dataDir()); the surface is uploaded in
+//                  encoder.generalBasis().
+//   light changes: (a newly classified lamp, or in direct-sensor mode a sensed shape moved by more
+//                  than kAdaptiveReencodeDistance) basisFor(light), the scene's palette projected
+//                  onto it (texels follow by linearity) and the textures replaced, synchronously
+//                  in the draw that first sees the light (a few ms), so that the swap frame is a
+//                  function of the recorded inputs. Surfaces without a palette would keep a
+//                  ReflectanceImage and call encodeSurface()/encodeTexels() instead.
+//   every frame:   M = colour::channelToXyz(basis, observer, light): [I3 | 0] for the light
+//                  encoded for, graceful for any other.
 #pragma once
 
 #include <cstddef>
