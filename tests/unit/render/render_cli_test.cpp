@@ -10,6 +10,7 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/image/exr.h>
+#include <pipeline/reference/frame_error.h>
 
 #include <gtest/gtest.h>
 
@@ -61,6 +62,49 @@ TEST(RenderCli, RejectsBadArgumentsWithOneLine)
     r = run("booth build --capture /nonexistent/capture.json --out /tmp/replica_booth_x");
     EXPECT_EQ(r.code, 1);
     EXPECT_NE(r.err.find("/nonexistent/capture.json: cannot open"), std::string::npos) << r.err;
+}
+
+// --basis: adaptive_k6 (the default) builds the basis for the light rendered. On the metamer target
+// under the D65 tube light, where the fixed replica_k6 basis misses, it lands far closer to the
+// exact reference (CIEDE2000 against the reference's brightest pixel as white).
+TEST(RenderCli, AdaptiveBasisIsTheDefaultAndCloserToTheReferenceOnTheMetamer)
+{
+    const auto dir = std::filesystem::temp_directory_path();
+    const std::string common = "render --scene " + kScenes +
+                               "/metamer --light d65-fluorescent --size 24x16 --lights 64 ";
+    const std::string ref = (dir / "replica_cli_metamer_ref.exr").string();
+    ASSERT_EQ(run(common + "--reference --out " + ref).code, 0);
+    auto b = pipeline::image::readExr(ref, {"X", "Y", "Z"});
+    ASSERT_TRUE(b) << b.error().message;
+    std::size_t brightest = 0;
+    for (std::size_t k = 0; k < b->planes[1].size(); ++k) {
+        brightest = b->planes[1][k] > b->planes[1][brightest] ? k : brightest;
+    }
+    const auto xyz = [](const pipeline::image::ChannelImage& img, std::size_t k) {
+        return pipeline::colour::Xyz(img.planes[0][k], img.planes[1][k], img.planes[2][k]);
+    };
+    const pipeline::colour::Xyz white = xyz(*b, brightest);
+    const auto meanDe = [&](const std::string& basisArgs) {
+        const std::string out = (dir / "replica_cli_metamer_basis.exr").string();
+        const CliResult r = run(common + basisArgs + "--out " + out);
+        EXPECT_EQ(r.code, 0) << r.err;
+        auto a = pipeline::image::readExr(out, {"X", "Y", "Z"});
+        EXPECT_TRUE(a);
+        double sum = 0.0;
+        for (std::size_t k = 0; a && k < a->planes[1].size(); ++k) {
+            sum += pipeline::reference::ciede2000(pipeline::reference::xyzToLab(xyz(*a, k), white),
+                                                  pipeline::reference::xyzToLab(xyz(*b, k), white));
+        }
+        return a ? sum / static_cast<double>(a->planes[1].size()) : 1e9;
+    };
+    const double byDefault = meanDe("");
+    const double adaptive = meanDe("--basis adaptive_k6 ");
+    const double fixed = meanDe("--basis replica_k6 ");
+    EXPECT_EQ(byDefault, adaptive);
+    EXPECT_LT(adaptive, 0.5 * fixed) << adaptive << " vs " << fixed;
+    const CliResult bad = run(common + "--basis k7 --out /tmp/x.exr");
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("k7"), std::string::npos) << bad.err;
 }
 
 TEST(RenderCli, WritesFiniteAbsoluteXyzCloseToTheReference)
