@@ -53,9 +53,10 @@ std::string BoothScenePass::description() const
 {
     const auto& s = setup_.settings;
     return fmt::format("gles-booth (scene {}, {} median-cut lights, {} specular samples, {} "
-                       "horizon directions, basis {})",
+                       "horizon directions, basis {}{})",
                        setup_.scene.name, s.lights, setup_.scene.glossy() ? s.specularSamples : 0,
-                       setup_.scene.flat() ? 0 : s.horizonDirections, setup_.basis.name);
+                       setup_.scene.flat() ? 0 : s.horizonDirections, setup_.basis.name,
+                       setup_.adaptive ? ", re-encoded for each new light" : "");
 }
 
 Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
