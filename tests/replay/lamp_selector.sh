@@ -2,7 +2,7 @@
 # The simulated lamp selector end to end: a run with a correctly wired switch gives no warning; a
 # mis-wired one is overruled by the spectrometer with exactly one warning naming the wiring; both
 # recordings hold the lamp channel, and replay gives the live digests bit for bit (the decisions
-# depend only on recorded inputs).
+# depend only on recorded inputs). Bad selector options are refused with a clear reason.
 set -euo pipefail
 replica="$1"
 work="$2"
@@ -21,6 +21,25 @@ for wiring in sim sim-miswired; do
     fi
     "$replica" inspect --json "$work/$wiring.mcap" > "$work/$wiring.inspect.json"
 done
+# Bad selector options: a usage error (2) or a one-line reason (1), before any device is opened.
+expect() {
+    local want="$1" text="$2"
+    shift 2
+    local err code
+    err=$("$replica" run --output headless --size 32x20 --frames 1 "$@" 2>&1 >/dev/null)
+    code=$?
+    if [ "$code" -ne "$want" ] || ! printf '%s' "$err" | grep -q -- "$text"; then
+        echo "FAIL: replica run $* -> exit $code (want $want), '$err' (want '$text')" >&2
+        exit 1
+    fi
+}
+set +e
+expect 2 "--lamp-gpio needs --hal live" --hal sim --lamp-gpio gpiochip0:17,27,22
+expect 2 "is for --hal sim" --hal live --lamp-selector sim
+expect 2 "lamp-selector" --hal sim --lamp-selector bogus
+expect 1 "2 lines for a booth with 3 lamps" --hal live --lamp-gpio gpiochip0:17,27
+expect 1 "expected CHIP:OFFSET" --hal live --lamp-gpio gpiochip0
+set -e
 python3 - "$work" <<'PY'
 import json, sys
 work = sys.argv[1]
