@@ -187,6 +187,37 @@ TEST(GpioLampSource, AChipThatCannotBeOpenedMeansLostAndALostSampleThenItRecover
     EXPECT_EQ(src->state(), hal::LinkState::Connected);
 }
 
+TEST(GpioLampSource, AChipUnpluggedWhileRunningIsReportedLostThenReopened)
+{
+    hal::SteadyClock steady;
+    hal::VirtualClock fakeTime;
+    int opens = 0;
+    hal::lamp::GpioOpener opener =
+            [&](const hal::lamp::GpioLineSpec&) -> Expected<std::unique_ptr<hal::lamp::GpioLines>> {
+        ++opens;
+        auto lines = std::make_unique<FakeGpioLines>(fakeTime, opens == 1 ? 0b001u : 0b010u,
+                                                     std::vector<FakeGpioLines::Change>{});
+        lines->sleepWhenIdle();
+        if (opens == 1) {
+            lines->failFrom(fakeTime.nowNs() + 30 * kMs, "fakechip: waiting for edges failed (No "
+                                                         "such device); was the GPIO chip "
+                                                         "removed?");
+        }
+        return std::unique_ptr<hal::lamp::GpioLines>(std::move(lines));
+    };
+    hal::lamp::GpioLampSourceOptions options;
+    options.lines = {"fakechip", {1, 2, 3}};
+    options.reconnectNs = 20 * kMs;
+    options.maxWaitNs = 5 * kMs;
+    auto src = hal::lamp::makeGpioLampSource(opener, steady, options);
+    const auto got = pollUntil(*src, 3);
+    ASSERT_EQ(got.size(), 3u);
+    EXPECT_EQ(got[0].lamp, 0);
+    EXPECT_EQ(got[1].lamp, hal::kLampLost) << "the unplugging reaches the loop and the recording";
+    EXPECT_EQ(got[2].lamp, 1) << "replugged: the position read at the new open";
+    EXPECT_EQ(got[2].sequence, 2u);
+}
+
 TEST(LibgpiodLines, AMissingChipIsAClearErrorNamingIt)
 {
     auto lines = hal::lamp::libgpiodOpener()({"replica-no-such-gpiochip", {0, 1, 2}});
