@@ -231,6 +231,21 @@ void main() {
         }
     }
 
+    if (uMode == 0 && !inside) {
+        // Around the surface only E_geo (pass 2's flare): eq. (1) with the macro normal, the
+        // cosines clamped instead of tested (the same sum; no divergent branches to pay for).
+        float eg = 0.0;
+        for (int i = 0; i < uLightCount; ++i) {
+            vec4 l = uLight[i];
+            vec3 d = l.xyz - p;
+            float d2 = max(dot(d, d), 1e-30);
+            d *= inversesqrt(d2);
+            eg += l.w * max(-dot(uLightNormal, d), 0.0) * max(dot(uNormal, d), 0.0)
+                  / max(d2, uTexelArea);
+        }
+        outXyz = vec4(0.0, 0.0, 0.0, (isnan(eg) || isinf(eg)) ? 0.0 : eg);
+        return;
+    }
     if (uMode == 0) {
         // Eq. (1): eGeo with the macro normal (flare, flat scenes), e with facets and horizons.
         bool relief = inside && uRelief;
@@ -273,11 +288,22 @@ void main() {
                 + b.r * uChannelXyz[3] + b.g * uChannelXyz[4] + b.b * uChannelXyz[5];
             xyz *= e / kPi;
         }
+        if (isnan(eGeo) || isinf(eGeo)) {
+            eGeo = 0.0;
+        }
+        if (uSpecSamples == 0 && uFlareRho == 0.0) {
+            // Nothing left for the compose: the cache is the frame (clamped as mode 1 would).
+            xyz = max(xyz, vec3(0.0));
+            if (any(isnan(xyz)) || any(isinf(xyz))) {
+                xyz = vec3(0.0);
+            }
+        }
         outXyz = vec4(xyz, eGeo);
         return;
     }
 
-    // Compose: the cached diffuse term and E_geo, plus this eye's specular, minus the flare.
+    // Compose (drawn over the surface's rectangle only; around it the frame is the cache): the
+    // cached diffuse term and E_geo, plus this eye's specular, minus the flare.
     vec4 cached = texelFetch(uCache, ivec2(gl_FragCoord.xy), 0);
     vec3 xyz = cached.rgb;
     float eGeo = cached.a;

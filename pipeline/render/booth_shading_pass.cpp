@@ -428,14 +428,40 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         cacheValid_ = true;
         ++cacheRefreshes_;
     }
-    // Compose every pixel (alpha carries E_geo around the surface too); the specular term, for
-    // this frame's pose and eye, only on the surface's pixels (the shader's own bounds test).
+    // The frame is the cache around the surface ((0, 0, 0) and E_geo) and, without a specular
+    // term or flare to add, on it too: copy it. Then compose the surface's rectangle (widened by a
+    // pixel so that the shader's own bounds test decides every edge pixel): the cached part, the
+    // specular term for this frame's pose and eye, minus the flare.
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, cacheFbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     restore();
-    setPose(view.panel);
-    glUniform1i(loc(program_, "uMode"), 1);
-    glBindTexture(GL_TEXTURE_2D, cacheTexture_); // unit kUnitCache is active
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glBindTexture(GL_TEXTURE_2D, 0);
+    const bool specular =
+            settings_.specularPass && scene_->scene->glossy() && settings_.specularSamples > 0;
+    if (specular || settings_.subtractFlare) {
+        const auto span = [](double offset, double scale, int n) {
+            const double a = (0.0 - offset) / scale * n;
+            const double b = (1.0 - offset) / scale * n;
+            const int lo = std::clamp(static_cast<int>(std::floor(std::min(a, b))) - 1, 0, n);
+            const int hi = std::clamp(static_cast<int>(std::ceil(std::max(a, b))) + 1, 0, n);
+            return std::pair<int, int>(lo, hi);
+        };
+        const bool scissor = layout.scale.x > 0.0 && layout.scale.y > 0.0;
+        if (scissor) {
+            const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
+            const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(x0, height - r1, x1 - x0, r1 - r0);
+        }
+        setPose(view.panel);
+        glUniform1i(loc(program_, "uMode"), 1);
+        glBindTexture(GL_TEXTURE_2D, cacheTexture_); // unit kUnitCache is active
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        if (scissor) {
+            glDisable(GL_SCISSOR_TEST);
+        }
+    }
     glActiveTexture(GL_TEXTURE0);
     return glCheck("drawing the booth pass");
 }

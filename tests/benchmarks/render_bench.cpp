@@ -4,10 +4,13 @@
 // the GPU path and CIEDE2000 mean / 95th / max against the exact reference on an error frame;
 // the planner's choice and its saving; a Pareto-front PNG.
 // Usage: replica_bench_render [OUT_DIR] [WIDTHxHEIGHT of the error frame, default 64x40]
+//        [--defaults-only [SPECULAR_SAMPLES]: the default setting (or it with that many specular
+//        samples) under every scene and light; no sweep, no planner, no plot]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -151,6 +154,8 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "error frame: expected WIDTHxHEIGHT\n");
         return 2;
     }
+    const bool defaultsOnly = argc > 3 && std::string(argv[3]) == "--defaults-only";
+    const int defaultSamples = defaultsOnly && argc > 4 ? std::atoi(argv[4]) : 0;
     std::filesystem::create_directories(outDir);
     auto output = platform::createHeadlessOutput();
     auto obs = colour::loadCie1931(dataDir());
@@ -184,11 +189,14 @@ int main(int argc, char** argv)
             view.pixelsX = fw;
             view.pixelsY = fh;
             const auto ref = reference::renderReference(*scene, light, view, *obs);
-            const shading::RenderSettings def;
+            shading::RenderSettings def;
+            if (defaultSamples > 0) {
+                def.specularSamples = defaultSamples;
+            }
             std::vector<std::pair<std::string, shading::RenderSettings>> configs;
             configs.emplace_back("default (" + describe(def, *scene) + ")", def);
             // The whole sweep under the hardest light (tubes); the default alone under the others.
-            const bool sweep = light.name == "d65-fluorescent";
+            const bool sweep = !defaultsOnly && light.name == "d65-fluorescent";
             for (int n : sweep ? std::vector<int>{8, 128, 256} : std::vector<int>{}) {
                 auto s = def;
                 s.lights = n;
@@ -287,6 +295,9 @@ int main(int argc, char** argv)
                 }
             }
         }
+    }
+    if (defaultsOnly) {
+        return 0;
     }
     std::printf("\n## planner (budget dE00 p95 <= 1, max <= 3)\n\n| scene | light | chosen | "
                 "skipped | candidates tried | ms 1920x1200 | default ms | saving x | fps 960x600 "
