@@ -39,4 +39,27 @@ struct AccelSample {
     glm::dvec3 gravity{0.0};
 };
 
+// What the booth's lamp selector switch says, once its GPIO lines have settled (debounced).
+// Wiring (hal/README.md): one line per lamp, in the booth's lamp order, active low with the
+// pull-up on: the switch connects exactly one line to ground per lamp position, none at "off".
+inline constexpr int kLampOff = -1;     // no line active: the switch is at "off"
+inline constexpr int kLampInvalid = -2; // several lines active: a wiring fault or a broken switch
+inline constexpr int kLampLost = -3;    // the lines cannot be read (chip unplugged, driver error)
+
+struct LampSample {
+    std::int64_t timestampNs = 0; // session time the position settled (last edge + debounce)
+    std::uint32_t sequence = 0;
+    int lamp = kLampOff;          // index into the booth's lamps, or kLampOff/Invalid/Lost
+    std::uint32_t lineLevels = 0; // bit i: line i active (after debouncing), lines as configured
+    std::uint32_t lineCount = 0;  // how many lines the selector has (at most 32)
+};
+
+inline const char* lampStateName(int lamp)
+{
+    return lamp >= 0              ? "lamp"
+           : lamp == kLampOff     ? "off"
+           : lamp == kLampInvalid ? "invalid"
+                                  : "lost";
+}
+
 } // namespace replica::hal

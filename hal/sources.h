@@ -25,5 +25,6 @@ public:
 using SpectrometerSource = Source<SpectrumSample>;
 using TrackerSource = Source<PoseSample>;
 using AccelSource = Source<AccelSample>;
+using LampSelectorSource = Source<LampSample>;
 
 } // namespace replica::hal

@@ -353,8 +353,13 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     return app;
 }
 
-Expected<Sources> makeSimSources(const Appliance& appliance)
+Expected<Sources> makeSimSources(const Appliance& appliance, const std::string& lampSelector)
 {
+    if (lampSelector != "none" && lampSelector != "sim" && lampSelector != "sim-miswired") {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("--lamp-selector {}: expected none, sim or sim-miswired",
+                                     lampSelector));
+    }
     const std::filesystem::path dir = dataDir();
     hal::sim::ScenarioParams scenario;
     scenario.lampCount = static_cast<int>(appliance.booth.lamps.size());
@@ -394,6 +399,13 @@ Expected<Sources> makeSimSources(const Appliance& appliance)
     s.spectrometer = hal::sim::makeSimSpectrometer(scenario, std::move(spec));
     s.tracker = hal::sim::makeSimTracker(scenario, {});
     s.accel = hal::sim::makeSimAccel(scenario, {});
+    if (lampSelector != "none") {
+        hal::sim::SimLampSelectorParams selector;
+        if (lampSelector == "sim-miswired") {
+            selector.wiring = {0, 2, 1};
+        }
+        s.lampSelector = hal::sim::makeSimLampSelector(scenario, selector);
+    }
     return s;
 }
 
@@ -406,6 +418,10 @@ Sources makeReplaySources(const recordings::Recording& recording)
                                                                      recording.poses);
     s.accel = std::make_unique<hal::ReplaySource<hal::AccelSample>>(recording.session.accel,
                                                                     recording.accel);
+    if (!recording.session.lampSelector.model.empty() || !recording.lampSelector.empty()) {
+        s.lampSelector = std::make_unique<hal::ReplaySource<hal::LampSample>>(
+                recording.session.lampSelector, recording.lampSelector);
+    }
     return s;
 }
 

@@ -66,6 +66,7 @@ struct Sources {
     std::unique_ptr<hal::SpectrometerSource> spectrometer;
     std::unique_ptr<hal::TrackerSource> tracker;
     std::unique_ptr<hal::AccelSource> accel;
+    std::unique_ptr<hal::LampSelectorSource> lampSelector; // null: the booth has none
 };
 
 struct Appliance {
@@ -101,8 +102,11 @@ struct OutputChoice {
 Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
                                                     const OutputChoice& output = {});
 
-// The built-in simulated sensors playing the scripted scenario.
-Expected<Sources> makeSimSources(const Appliance& appliance);
+// The built-in simulated sensors playing the scripted scenario. lampSelector: "none", "sim" (a
+// switch that follows the scenario's lamps), or "sim-miswired" (its lines for lamps 1 and 2
+// swapped, to exercise the disagreement path).
+Expected<Sources> makeSimSources(const Appliance& appliance,
+                                 const std::string& lampSelector = "none");
 
 // Sources that return exactly what the recording holds.
 Sources makeReplaySources(const recordings::Recording& recording);

@@ -1,8 +1,13 @@
 // Live sources for 'replica run --hal live'.
 #include <algorithm>
 #include <numeric>
+#include <optional>
+
+#include <fmt/format.h>
 
 #include <hal/accel/iio_accel.h>
+#include <hal/lamp/gpio_lamp_source.h>
+#include <hal/lamp/libgpiod_lines.h>
 #include <hal/spectrometer/usb2000_protocol.h>
 #include <hal/spectrometer/usb2000_source.h>
 #include <hal/tracker/opentrack_source.h>
@@ -36,8 +41,23 @@ std::uint32_t autoIntegration(const hal::SpectrumSample& s)
 
 } // namespace
 
-Expected<Sources> makeLiveSources(const hal::Clock& clock, const LiveOptions& options)
+Expected<Sources>
+makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t lampCount)
 {
+    std::optional<hal::lamp::GpioLineSpec> lampLines;
+    if (!options.lampGpio.empty()) {
+        auto spec = hal::lamp::parseGpioLineSpec(options.lampGpio);
+        if (!spec) {
+            return tl::unexpected(spec.error());
+        }
+        if (spec->offsets.size() != lampCount) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("--lamp-gpio {}: {} lines for a booth with {} lamps; give "
+                                         "one line per lamp, in the booth's lamp order",
+                                         options.lampGpio, spec->offsets.size(), lampCount));
+        }
+        lampLines = std::move(*spec);
+    }
     hal::tracker::OpentrackSourceOptions trackerOptions;
     trackerOptions.port = options.trackerPort;
     trackerOptions.bindAddress = options.trackerBind;
@@ -61,6 +81,14 @@ Expected<Sources> makeLiveSources(const hal::Clock& clock, const LiveOptions& op
     s.spectrometer = hal::spectrometer::makeUsb2000Source(hal::spectrometer::libusbUsb2000Opener(),
                                                           clock, std::move(specOptions));
     s.accel = hal::accel::makeIioAccelSource(clock, std::move(accelOptions));
+    if (lampLines) {
+        // A chip that cannot be opened is not fatal: the source reports Lost and retries, and
+        // the light comes from the spectrometer alone meanwhile.
+        hal::lamp::GpioLampSourceOptions lampOptions;
+        lampOptions.lines = std::move(*lampLines);
+        s.lampSelector = hal::lamp::makeGpioLampSource(hal::lamp::libgpiodOpener(), clock,
+                                                       std::move(lampOptions));
+    }
     return s;
 }
 

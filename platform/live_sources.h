@@ -1,5 +1,6 @@
 // The live HAL: the real spectrometer (libusb), head tracker (opentrack UDP) and accelerometer
-// (Linux IIO), wired to the pipeline's auto-integration controller.
+// (Linux IIO), the lamp selector (GPIO, when configured), wired to the pipeline's
+// auto-integration controller.
 #pragma once
 
 #include <cstdint>
@@ -18,11 +19,16 @@ struct LiveOptions {
     std::filesystem::path iioRoot = "/sys/bus/iio/devices";
     std::string accelName;           // IIO 'name' attribute; empty = the first accelerometer
     std::string accelAxes = "x,y,z"; // see hal::accel::parseAxisMapping
+    // The booth's lamp selector: "CHIP:OFF1,OFF2,..." (one line per lamp, lamp order); empty =
+    // none (the spectrometer alone decides the light).
+    std::string lampGpio;
 };
 
 // Devices that are absent at start are not an error: their sources report Lost, retry in the
 // background, and the loop keeps the last (or default) light, eye and tilt. Only a request that
 // can never work (a tracker port in use, a bad address) fails here.
-Expected<Sources> makeLiveSources(const hal::Clock& clock, const LiveOptions& options);
+// lampCount: the booth's lamps, which the selector's lines must match one for one.
+Expected<Sources>
+makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t lampCount = 3);
 
 } // namespace replica::platform

@@ -19,7 +19,9 @@ namespace replica::recordings {
 // Bumped whenever what is written changes; readers open every earlier version they know.
 // 1: unchunked MCAP, JSON messages (recordings/samples/walk-v1.mcap).
 // 2: zstd chunks with CRCs and message indexes, summary, JSON Schemas, /replica/recorder.
-constexpr int kFormatVersion = 2;
+// 3: the lamp selector: /hal/lamp_selector (id 7), lamp_seq in frames, lamp_selector in the
+// session.
+constexpr int kFormatVersion = 3;
 
 // For each rendered frame: its tick time and exactly which sample of each device it consumed (by
 // the device's sequence number), so replay never has to guess timing. nullopt: no sample yet.
@@ -29,6 +31,7 @@ struct FrameRecord {
     std::optional<std::uint32_t> spectrumSequence;
     std::optional<std::uint32_t> poseSequence;
     std::optional<std::uint32_t> accelSequence;
+    std::optional<std::uint32_t> lampSequence; // format 3; none in earlier recordings
 };
 
 // Describes the session: enough to re-create the renderer's inputs other than the samples.
@@ -40,6 +43,7 @@ struct SessionInfo {
     std::string displayProfile;  // display profile identifier
     std::int64_t wallClockStartNs = 0; // Unix time (ns) at session time 0, for viewers' dates
     hal::DeviceInfo spectrometer, tracker, accel;
+    hal::DeviceInfo lampSelector; // empty model: the session had no lamp selector (format < 3)
 };
 
 struct Recording {
@@ -48,6 +52,7 @@ struct Recording {
     std::vector<hal::SpectrumSample> spectra;
     std::vector<hal::PoseSample> poses;
     std::vector<hal::AccelSample> accel;
+    std::vector<hal::LampSample> lampSelector;
     std::vector<FrameRecord> frames;
     std::uint64_t droppedMessages = 0;   // what the writer recorded as dropped (queue full)
     std::uint64_t rejectedNonFinite = 0; // samples the writer refused: a value was NaN or infinite
@@ -89,6 +94,7 @@ public:
     virtual void write(const hal::SpectrumSample& s) = 0;
     virtual void write(const hal::PoseSample& s) = 0;
     virtual void write(const hal::AccelSample& s) = 0;
+    virtual void write(const hal::LampSample& s) = 0;
     virtual void write(const FrameRecord& f) = 0;
     // Flushes everything and writes the summary and footer. Safe to call once; the destructor calls
     // it.

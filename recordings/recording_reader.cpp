@@ -1,4 +1,5 @@
-// Reading recordings of every known format version (1: unchunked, 2: chunked) and inspecting files.
+// Reading recordings of every known format version (1: unchunked, 2: chunked, 3: lamp selector) and
+// inspecting files.
 #include <fstream>
 #include <iterator>
 
@@ -73,6 +74,8 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                 rec.poses.push_back(decodePose(j));
             } else if (topic == kAccelTopic) {
                 rec.accel.push_back(decodeAccel(j));
+            } else if (topic == kLampSelectorTopic) {
+                rec.lampSelector.push_back(decodeLamp(j));
             } else if (topic == kFrameTopic) {
                 rec.frames.push_back(decodeFrame(j));
             } else if (topic == kRecorderTopic) {

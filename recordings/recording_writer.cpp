@@ -19,7 +19,11 @@
 namespace replica::recordings {
 namespace {
 
-using Item = std::variant<hal::SpectrumSample, hal::PoseSample, hal::AccelSample, FrameRecord>;
+using Item = std::variant<hal::SpectrumSample,
+                          hal::PoseSample,
+                          hal::AccelSample,
+                          FrameRecord,
+                          hal::LampSample>;
 using Clock = std::chrono::steady_clock;
 
 // How long the writer thread sleeps when the queue is empty (a write() also wakes it).
@@ -69,6 +73,7 @@ public:
     void write(const hal::PoseSample& s) override { push(s, dropped_[1]); }
     void write(const hal::AccelSample& s) override { push(s, dropped_[2]); }
     void write(const FrameRecord& f) override { push(f, dropped_[3]); }
+    void write(const hal::LampSample& s) override { push(s, dropped_[4]); }
 
     Expected<void> close() override
     {
@@ -174,6 +179,10 @@ private:
                         payload = encodeAccel(s);
                         channel = ChannelId::Accel;
                         t = s.timestampNs;
+                    } else if constexpr (std::is_same_v<S, hal::LampSample>) {
+                        payload = encodeLamp(s);
+                        channel = ChannelId::LampSelector;
+                        t = s.timestampNs;
                     } else {
                         payload = encodeFrame(s);
                         channel = ChannelId::Frame;
@@ -208,6 +217,7 @@ private:
         now.droppedPoses = dropped_[1].load();
         now.droppedAccel = dropped_[2].load();
         now.droppedFrames = dropped_[3].load();
+        now.droppedLamp = dropped_[4].load();
         now.rejectedNonFinite = rejected_.load();
         const bool changed = now.droppedTotal() != status_.droppedTotal() ||
                              now.rejectedNonFinite != status_.rejectedNonFinite;
@@ -248,7 +258,7 @@ private:
     std::int64_t lastTime_ = 0;
     std::map<std::uint16_t, std::uint32_t> sequence_;
     RecorderStatus status_;
-    std::array<std::atomic<std::uint64_t>, 4> dropped_{};
+    std::array<std::atomic<std::uint64_t>, 5> dropped_{};
     std::atomic<std::uint64_t> rejected_{0}, messages_{0}, chunks_{0}, bytes_{0};
     std::atomic<bool> failed_{false}, stopping_{false};
     std::optional<Error> result_;

@@ -39,8 +39,10 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
     options.maxDamageReports = 50;
     // Replica's channel ids are fixed per format version: a file whose first chunk (the channel
     // definitions) was lost can still have its samples recovered.
+    // Format 3 only added channel 7, so its definitions serve format 2 files as well.
     const auto probe = bytes.substr(0, 256);
-    if (probe.find(fmt::format("(format {})", kFormatVersion)) != std::string::npos) {
+    if (probe.find(fmt::format("(format {})", kFormatVersion)) != std::string::npos ||
+        probe.find("(format 2)") != std::string::npos) {
         for (const auto& d : channelDefinitions()) {
             options.fallbackChannels[d.channel.id] = d.channel;
             options.fallbackSchemas[d.schema.id] = d.schema;

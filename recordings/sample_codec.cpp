@@ -1,5 +1,7 @@
 // JSON encoding of Replica's messages and the JSON Schemas that let MCAP viewers plot them.
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <recordings/sample_codec.h>
 
@@ -95,7 +97,8 @@ std::vector<ChannelDefinition> makeDefinitions()
     "display_profile": {"type": "string"},
     "wall_clock_start_ns": {"type": "integer", "description": "Unix time (ns) at session time 0"},
     "spectrometer": )" + dev +
-                             R"(, "tracker": )" + dev + R"(, "accel": )" + dev,
+                             R"(, "tracker": )" + dev + R"(, "accel": )" + dev +
+                             R"(, "lamp_selector": )" + dev,
                      R"("format_version", "software", "config", "wall_clock_start_ns")")},
             {ChannelId::Spectrometer, kSpectrometerTopic, "replica.SpectrometerSample",
              schemaText("replica.SpectrometerSample",
@@ -126,7 +129,7 @@ std::vector<ChannelDefinition> makeDefinitions()
                         "samples it consumed (absent: none yet)",
                         R"("frame": {"type": "integer"}, "tick_ns": {"type": "integer"},
     "spectrum_seq": {"type": "integer"}, "pose_seq": {"type": "integer"},
-    "accel_seq": {"type": "integer"})",
+    "accel_seq": {"type": "integer"}, "lamp_seq": {"type": "integer"})",
                         R"("frame", "tick_ns")")},
             {ChannelId::Recorder, kRecorderTopic, "replica.RecorderStatus",
              schemaText("replica.RecorderStatus",
@@ -134,9 +137,21 @@ std::vector<ChannelDefinition> makeDefinitions()
                         "values), cumulative since the session start",
                         R"("dropped_spectra": {"type": "integer"},
     "dropped_poses": {"type": "integer"}, "dropped_accel": {"type": "integer"},
-    "dropped_frames": {"type": "integer"}, "dropped_total": {"type": "integer"},
+    "dropped_frames": {"type": "integer"}, "dropped_lamp": {"type": "integer"},
+    "dropped_total": {"type": "integer"},
     "rejected_nonfinite": {"type": "integer"}, "queue_capacity": {"type": "integer"})",
                         R"("dropped_total")")},
+            {ChannelId::LampSelector, kLampSelectorTopic, "replica.LampSelectorSample",
+             schemaText("replica.LampSelectorSample",
+                        "The booth's lamp selector switch once its GPIO lines settled (debounced): "
+                        "one line per lamp, in the booth's lamp order",
+                        timeProps + R"(,
+    "lamp": {"type": "integer", "minimum": -3, "description":
+      "booth lamp index (line i alone active = lamp i); -1 off, -2 invalid (several lines), -3 lines lost"},
+    "state": {"type": "string", "enum": ["lamp", "off", "invalid", "lost"]},
+    "levels": {"type": "array", "items": {"type": "integer", "minimum": 0, "maximum": 1},
+      "maxItems": 32, "description": "debounced level of each line, 1 = active: the switch closes it"})",
+                        R"("t", "seq", "lamp", "levels")")},
     };
     std::vector<ChannelDefinition> out;
     for (const auto& d : defs) {
@@ -166,7 +181,8 @@ std::string encodeSession(const SessionInfo& s, int formatVersion)
                 {"wall_clock_start_ns", s.wallClockStartNs},
                 {"spectrometer", deviceJson(s.spectrometer)},
                 {"tracker", deviceJson(s.tracker)},
-                {"accel", deviceJson(s.accel)}}
+                {"accel", deviceJson(s.accel)},
+                {"lamp_selector", deviceJson(s.lampSelector)}}
             .dump();
 }
 
@@ -205,6 +221,20 @@ std::optional<std::string> encodeAccel(const hal::AccelSample& s)
     return json{{"t", s.timestampNs}, {"seq", s.sequence}, {"gravity", vec3(s.gravity)}}.dump();
 }
 
+std::string encodeLamp(const hal::LampSample& s)
+{
+    std::vector<int> levels;
+    for (std::uint32_t i = 0; i < std::min<std::uint32_t>(s.lineCount, 32); ++i) {
+        levels.push_back((s.lineLevels >> i) & 1u ? 1 : 0);
+    }
+    return json{{"t", s.timestampNs},
+                {"seq", s.sequence},
+                {"lamp", s.lamp},
+                {"state", hal::lampStateName(s.lamp)},
+                {"levels", levels}}
+            .dump();
+}
+
 std::string encodeFrame(const FrameRecord& f)
 {
     json j{{"frame", f.frameIndex}, {"tick_ns", f.tickNs}};
@@ -217,14 +247,21 @@ std::string encodeFrame(const FrameRecord& f)
     if (f.accelSequence) {
         j["accel_seq"] = *f.accelSequence;
     }
+    if (f.lampSequence) {
+        j["lamp_seq"] = *f.lampSequence;
+    }
     return j.dump();
 }
 
 std::string encodeRecorderStatus(const RecorderStatus& r)
 {
-    return json{{"dropped_spectra", r.droppedSpectra}, {"dropped_poses", r.droppedPoses},
-                {"dropped_accel", r.droppedAccel},     {"dropped_frames", r.droppedFrames},
-                {"dropped_total", r.droppedTotal()},   {"rejected_nonfinite", r.rejectedNonFinite},
+    return json{{"dropped_spectra", r.droppedSpectra},
+                {"dropped_poses", r.droppedPoses},
+                {"dropped_accel", r.droppedAccel},
+                {"dropped_frames", r.droppedFrames},
+                {"dropped_lamp", r.droppedLamp},
+                {"dropped_total", r.droppedTotal()},
+                {"rejected_nonfinite", r.rejectedNonFinite},
                 {"queue_capacity", r.queueCapacity}}
             .dump();
 }
@@ -242,6 +279,9 @@ SessionInfo decodeSession(const json& j, int& formatVersion)
     s.spectrometer = deviceFromJson(j.at("spectrometer"));
     s.tracker = deviceFromJson(j.at("tracker"));
     s.accel = deviceFromJson(j.at("accel"));
+    if (j.contains("lamp_selector")) { // format 3
+        s.lampSelector = deviceFromJson(j.at("lamp_selector"));
+    }
     return s;
 }
 
@@ -277,6 +317,23 @@ hal::AccelSample decodeAccel(const json& j)
     return s;
 }
 
+hal::LampSample decodeLamp(const json& j)
+{
+    hal::LampSample s;
+    s.timestampNs = j.at("t");
+    s.sequence = j.at("seq");
+    s.lamp = j.at("lamp");
+    const auto levels = j.at("levels").get<std::vector<int>>();
+    if (levels.size() > 32 || s.lamp < hal::kLampLost) {
+        throw std::out_of_range("lamp selector sample: more than 32 lines or an unknown lamp code");
+    }
+    s.lineCount = static_cast<std::uint32_t>(levels.size());
+    for (std::size_t i = 0; i < levels.size(); ++i) {
+        s.lineLevels |= levels[i] != 0 ? (1u << i) : 0u;
+    }
+    return s;
+}
+
 FrameRecord decodeFrame(const json& j)
 {
     FrameRecord f;
@@ -291,6 +348,9 @@ FrameRecord decodeFrame(const json& j)
     if (j.contains("accel_seq")) {
         f.accelSequence = j.at("accel_seq").get<std::uint32_t>();
     }
+    if (j.contains("lamp_seq")) {
+        f.lampSequence = j.at("lamp_seq").get<std::uint32_t>();
+    }
     return f;
 }
 
@@ -301,6 +361,7 @@ RecorderStatus decodeRecorderStatus(const json& j)
     r.droppedPoses = j.value("dropped_poses", std::uint64_t{0});
     r.droppedAccel = j.value("dropped_accel", std::uint64_t{0});
     r.droppedFrames = j.value("dropped_frames", std::uint64_t{0});
+    r.droppedLamp = j.value("dropped_lamp", std::uint64_t{0});
     r.rejectedNonFinite = j.value("rejected_nonfinite", std::uint64_t{0});
     r.queueCapacity = j.value("queue_capacity", std::uint64_t{0});
     return r;

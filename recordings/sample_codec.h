@@ -23,6 +23,7 @@ enum class ChannelId : std::uint16_t {
     Accel = 4,
     Frame = 5,
     Recorder = 6,
+    LampSelector = 7, // format 3
 };
 
 inline constexpr std::string_view kSessionTopic = "/replica/session";
@@ -31,6 +32,7 @@ inline constexpr std::string_view kTrackerTopic = "/hal/tracker";
 inline constexpr std::string_view kAccelTopic = "/hal/accel";
 inline constexpr std::string_view kFrameTopic = "/replica/frame";
 inline constexpr std::string_view kRecorderTopic = "/replica/recorder";
+inline constexpr std::string_view kLampSelectorTopic = "/hal/lamp_selector";
 // A copy of the session message kept in a Metadata record outside every chunk (key "session"), so
 // that recover can restore the session when the first chunk is damaged.
 inline constexpr std::string_view kSessionMetadataName = "replica.session";
@@ -38,11 +40,12 @@ inline constexpr std::string_view kSessionMetadataName = "replica.session";
 // What the recorder itself reports on /replica/recorder: samples it could not write.
 struct RecorderStatus {
     std::uint64_t droppedSpectra = 0, droppedPoses = 0, droppedAccel = 0, droppedFrames = 0;
+    std::uint64_t droppedLamp = 0;
     std::uint64_t rejectedNonFinite = 0; // samples refused because a value was NaN or infinite
     std::uint64_t queueCapacity = 0;
     std::uint64_t droppedTotal() const
     {
-        return droppedSpectra + droppedPoses + droppedAccel + droppedFrames;
+        return droppedSpectra + droppedPoses + droppedAccel + droppedFrames + droppedLamp;
     }
 };
 
@@ -60,6 +63,7 @@ std::string encodeSession(const SessionInfo& s, int formatVersion);
 std::optional<std::string> encodeSpectrum(const hal::SpectrumSample& s);
 std::optional<std::string> encodePose(const hal::PoseSample& s);
 std::optional<std::string> encodeAccel(const hal::AccelSample& s);
+std::string encodeLamp(const hal::LampSample& s);
 std::string encodeFrame(const FrameRecord& f);
 std::string encodeRecorderStatus(const RecorderStatus& r);
 
@@ -68,6 +72,7 @@ SessionInfo decodeSession(const nlohmann::json& j, int& formatVersion);
 hal::SpectrumSample decodeSpectrum(const nlohmann::json& j);
 hal::PoseSample decodePose(const nlohmann::json& j);
 hal::AccelSample decodeAccel(const nlohmann::json& j);
+hal::LampSample decodeLamp(const nlohmann::json& j);
 FrameRecord decodeFrame(const nlohmann::json& j);
 RecorderStatus decodeRecorderStatus(const nlohmann::json& j);
 

@@ -1,10 +1,7 @@
 // IIO accelerometer over sysfs.
 #include <atomic>
 #include <charconv>
-#include <condition_variable>
-#include <deque>
 #include <fstream>
-#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -12,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include <hal/accel/iio_accel.h>
+#include <hal/live_queue.h>
 #include <hal/log.h>
 
 namespace replica::hal::accel {
@@ -204,11 +202,7 @@ public:
     }
     ~IioAccelSource() override
     {
-        {
-            std::lock_guard lock(mutex_);
-            stop_ = true;
-        }
-        wake_.notify_all();
+        queue_.stop();
         thread_.join();
     }
     IioAccelSource(const IioAccelSource&) = delete;
@@ -219,20 +213,11 @@ public:
 
     void poll(std::int64_t untilNs, std::vector<AccelSample>& out) override
     {
-        std::lock_guard lock(mutex_);
-        while (!queue_.empty() && queue_.front().timestampNs <= untilNs) {
-            out.push_back(queue_.front());
-            queue_.pop_front();
-        }
+        queue_.drain(untilNs, out);
     }
 
 private:
-    bool waitFor(std::int64_t ns)
-    {
-        std::unique_lock lock(mutex_);
-        return !wake_.wait_for(lock, std::chrono::nanoseconds(std::max<std::int64_t>(ns, 0)),
-                               [this] { return stop_; });
-    }
+    bool waitFor(std::int64_t ns) { return queue_.waitFor(ns); }
 
     void run()
     {
@@ -271,13 +256,7 @@ private:
             s.timestampNs = clock_.nowNs();
             s.sequence = sequence++;
             s.gravity = gravityInPanel(*a, options_.mounting);
-            {
-                std::lock_guard lock(mutex_);
-                queue_.push_back(s);
-                if (queue_.size() > 1024) {
-                    queue_.pop_front();
-                }
-            }
+            queue_.push(s);
             if (!waitFor(options_.periodNs - (clock_.nowNs() - started))) {
                 return;
             }
@@ -288,10 +267,7 @@ private:
     IioAccelSourceOptions options_;
     DeviceInfo info_;
     std::atomic<LinkState> state_{LinkState::Lost};
-    std::mutex mutex_;
-    std::condition_variable wake_;
-    std::deque<AccelSample> queue_;
-    bool stop_ = false;
+    LiveQueue<AccelSample> queue_{1024};
     std::thread thread_;
 };
 

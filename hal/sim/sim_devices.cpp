@@ -1,7 +1,10 @@
 // Simulated devices on virtual time.
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <utility>
 
+#include <hal/lamp/lamp_debouncer.h>
 #include <hal/sim/noise.h>
 #include <hal/sim/sim_devices.h>
 
@@ -187,7 +190,123 @@ private:
     std::int64_t next_ = 0;
 };
 
+class SimLampSelector final : public LampSelectorSource
+{
+public:
+    SimLampSelector(ScenarioParams scenario, SimLampSelectorParams params)
+        : scenario_(scenario), params_(std::move(params)), debouncer_(params_.debounceNs)
+    {
+        info_ = DeviceInfo{"lamp selector (simulated)", "SIM-LAMPSEL-0001", "sim", SourceKind::Sim};
+        lineCount_ = std::max(scenario_.lampCount, 1);
+        for (int i : params_.wiring) {
+            lineCount_ = std::max(lineCount_, i + 1);
+        }
+        lineCount_ = std::min(lineCount_, 32);
+    }
+    const DeviceInfo& info() const override { return info_; }
+    LinkState state() const override { return LinkState::Connected; }
+
+    void poll(std::int64_t untilNs, std::vector<LampSample>& out) override
+    {
+        if (untilNs < 0) {
+            return;
+        }
+        if (!started_) {
+            started_ = true;
+            const auto s = debouncer_.start(levelsOf(scenarioAt(scenario_, 0).lamp), 0);
+            out.push_back(make(s));
+        }
+        const auto periodNs = static_cast<std::int64_t>(std::llround(scenario_.lampPeriodS * 1e9));
+        // Generate the raw edges of every turn of the knob that has begun by untilNs.
+        while (periodNs > 0 && scenario_.lampCount > 1 && nextTurn_ * periodNs <= untilNs) {
+            addTurn(nextTurn_ * periodNs, nextTurn_);
+            ++nextTurn_;
+        }
+        while (!edges_.empty() && edges_.front().first <= untilNs) {
+            const auto [t, levels] = edges_.front();
+            edges_.pop_front();
+            if (auto s = debouncer_.settle(t)) {
+                out.push_back(make(*s));
+            }
+            debouncer_.observe(levels, t);
+        }
+        if (auto s = debouncer_.settle(untilNs)) {
+            out.push_back(make(*s));
+        }
+    }
+
+private:
+    std::uint32_t levelsOf(int lamp) const
+    {
+        if (lamp < 0) {
+            return 0;
+        }
+        const int line = static_cast<std::size_t>(lamp) < params_.wiring.size()
+                                 ? params_.wiring[static_cast<std::size_t>(lamp)]
+                                 : lamp;
+        return line >= 0 && line < lineCount_ ? (1u << line) : 0u;
+    }
+
+    LampSample make(const lamp::SettledLevels& s)
+    {
+        LampSample out;
+        out.timestampNs = s.settledNs;
+        out.sequence = sequence_++;
+        out.lineLevels = s.levels;
+        out.lineCount = static_cast<std::uint32_t>(lineCount_);
+        out.lamp = lamp::decodeOneHot(s.levels);
+        return out;
+    }
+
+    // The edges of turn k at tNs, from its own noise stream so that they do not depend on how the
+    // loop happened to poll.
+    void addTurn(std::int64_t tNs, std::int64_t k)
+    {
+        const std::uint32_t from = levelsOf(scenarioAt(scenario_, tNs - 1).lamp);
+        const std::uint32_t to = levelsOf(scenarioAt(scenario_, tNs).lamp);
+        if (from == to) {
+            return;
+        }
+        Noise noise(params_.seed * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(k));
+        const auto bounce = static_cast<double>(params_.bounceNs);
+        const auto at = [&](double fraction) {
+            return tNs + static_cast<std::int64_t>(std::llround(fraction * bounce));
+        };
+        // Break: the old contact opens, touches once more, opens for good.
+        edges_.push_back({tNs, 0});
+        edges_.push_back({at(0.05 + 0.05 * noise.uniform()), from});
+        edges_.push_back({at(0.12 + 0.05 * noise.uniform()), 0});
+        // Make: the new contact closes after a gap and chatters an odd number of times.
+        double f = 0.25 + 0.1 * noise.uniform();
+        const int chatter = 2 * (1 + static_cast<int>(noise.uniform() * 3.0)) + 1;
+        for (int i = 0; i < chatter; ++i) {
+            edges_.push_back({at(f), (i % 2 == 0) ? to : 0});
+            f += (0.95 - f) / static_cast<double>(chatter - i) * (0.5 + noise.uniform());
+            f = std::min(f, 1.0);
+        }
+        // Keep the edges in time order (rounding can tie, never reverse).
+        std::stable_sort(edges_.begin(), edges_.end(),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
+    }
+
+    ScenarioParams scenario_;
+    SimLampSelectorParams params_;
+    lamp::LampDebouncer debouncer_;
+    DeviceInfo info_;
+    int lineCount_ = 1;
+    bool started_ = false;
+    std::int64_t nextTurn_ = 1;
+    std::uint32_t sequence_ = 0;
+    std::deque<std::pair<std::int64_t, std::uint32_t>> edges_;
+};
+
 } // namespace
+
+std::unique_ptr<LampSelectorSource> makeSimLampSelector(ScenarioParams scenario,
+                                                        SimLampSelectorParams params)
+{
+    return std::make_unique<SimLampSelector>(scenario, std::move(params));
+}
 
 std::unique_ptr<SpectrometerSource> makeSimSpectrometer(ScenarioParams scenario,
                                                         SimSpectrometerParams params)

@@ -61,6 +61,23 @@ struct SimAccelParams {
 // tilt.
 std::unique_ptr<AccelSource> makeSimAccel(ScenarioParams scenario, SimAccelParams params);
 
+struct SimLampSelectorParams {
+    // The line each scenario lamp's switch position connects (lamp i -> line wiring[i]); empty =
+    // line i for lamp i. A permutation plays a mis-wired switch.
+    std::vector<int> wiring;
+    std::int64_t debounceNs = 30'000'000; // as the live driver (hal/lamp/lamp_debouncer.h)
+    // Contact bounce at each turn of the knob: the old contact chatters as it breaks, the new one
+    // makes contact after a short gap and chatters up to this long.
+    std::int64_t bounceNs = 6'000'000;
+    std::uint64_t seed = 4;
+};
+
+// The booth's lamp selector switch, turned at the instants the scenario changes lamps (so switch
+// and light agree), with break-before-make and contact bounce that the same debouncer as the live
+// driver removes. One line per lamp, one-hot.
+std::unique_ptr<LampSelectorSource> makeSimLampSelector(ScenarioParams scenario,
+                                                        SimLampSelectorParams params);
+
 // The simulated detector's wavelength calibration (nm at pixel p = c0 + c1 p + c2 p^2 + c3 p^3).
 constexpr double kSimWavelengthCoeffs[4] = {339.2, 0.3797, -1.62e-5, -1.3e-10};
 constexpr int kSimPixels = 2048;

@@ -1,14 +1,12 @@
 // Reader thread for the live USB2000+.
 #include <algorithm>
 #include <atomic>
-#include <condition_variable>
-#include <deque>
-#include <mutex>
 #include <string>
 #include <thread>
 
 #include <spdlog/spdlog.h>
 
+#include <hal/live_queue.h>
 #include <hal/log.h>
 #include <hal/spectrometer/libusb_transport.h>
 #include <hal/spectrometer/usb2000_protocol.h>
@@ -21,7 +19,8 @@ class Usb2000Source final : public SpectrometerSource
 {
 public:
     Usb2000Source(TransportOpener opener, const Clock& clock, Usb2000SourceOptions options)
-        : opener_(std::move(opener)), clock_(clock), options_(std::move(options))
+        : opener_(std::move(opener)), clock_(clock), options_(std::move(options)),
+          queue_(options_.queueCapacity)
     {
         info_.model = "USB2000+";
         info_.kind = SourceKind::Live;
@@ -30,11 +29,7 @@ public:
 
     ~Usb2000Source() override
     {
-        {
-            std::lock_guard lock(mutex_);
-            stop_ = true;
-        }
-        wake_.notify_all();
+        queue_.stop();
         thread_.join();
     }
 
@@ -47,27 +42,14 @@ public:
 
     void poll(std::int64_t untilNs, std::vector<SpectrumSample>& out) override
     {
-        std::lock_guard lock(mutex_);
-        while (!queue_.empty() && queue_.front().timestampNs <= untilNs) {
-            out.push_back(std::move(queue_.front()));
-            queue_.pop_front();
-        }
+        queue_.drain(untilNs, out);
     }
 
 private:
     // Sleeps until 'ns' of session time have passed or the source is stopped; false when stopped.
-    bool waitFor(std::int64_t ns)
-    {
-        std::unique_lock lock(mutex_);
-        return !wake_.wait_for(lock, std::chrono::nanoseconds(std::max<std::int64_t>(ns, 0)),
-                               [this] { return stop_; });
-    }
+    bool waitFor(std::int64_t ns) { return queue_.waitFor(ns); }
 
-    bool stopping()
-    {
-        std::lock_guard lock(mutex_);
-        return stop_;
-    }
+    bool stopping() const { return queue_.stopping(); }
 
     void run()
     {
@@ -141,15 +123,15 @@ private:
 
     void push(SpectrumSample s)
     {
-        std::lock_guard lock(mutex_);
-        if (queue_.size() >= options_.queueCapacity) {
-            queue_.pop_front();
-            if (++dropped_ == 1 || dropped_ % 100 == 0) {
+        // Beyond the queue's capacity the oldest spectrum goes; say so now and then.
+        const std::uint64_t dropped = queue_.push(std::move(s));
+        if (dropped != dropped_) {
+            dropped_ = dropped;
+            if (dropped_ == 1 || dropped_ % 100 == 0) {
                 deviceLog("hal.spectrometer")
                         ->warn("the loop is not consuming spectra; {} dropped", dropped_);
             }
         }
-        queue_.push_back(std::move(s));
     }
 
     void dropDevice(const Error& e)
@@ -167,11 +149,8 @@ private:
     std::atomic<LinkState> state_{LinkState::Lost};
     std::unique_ptr<Usb2000Device> device_; // reader thread only
     std::uint32_t sequence_ = 0;            // reader thread only
-    std::mutex mutex_;
-    std::condition_variable wake_;
-    std::deque<SpectrumSample> queue_;
-    long dropped_ = 0;
-    bool stop_ = false;
+    LiveQueue<SpectrumSample> queue_;
+    std::uint64_t dropped_ = 0; // reader thread only
     std::thread thread_;
 };
 

@@ -103,6 +103,9 @@ int inspectMain(const InspectOptions& o)
     for (const auto& s : rec->accel) {
         span(s.timestampNs);
     }
+    for (const auto& s : rec->lampSelector) {
+        span(s.timestampNs);
+    }
     for (const auto& f : rec->frames) {
         span(f.tickNs);
     }
@@ -118,6 +121,7 @@ int inspectMain(const InspectOptions& o)
                      {"spectrometer", streamJson(rec->session.spectrometer, rec->spectra)},
                      {"tracker", streamJson(rec->session.tracker, rec->poses)},
                      {"accel", streamJson(rec->session.accel, rec->accel)},
+                     {"lamp_selector", streamJson(rec->session.lampSelector, rec->lampSelector)},
                      {"frames", rec->frames.size()},
                      {"dropped_messages", rec->droppedMessages},
                      {"rejected_nonfinite", rec->rejectedNonFinite},
@@ -154,6 +158,17 @@ int inspectMain(const InspectOptions& o)
                 {"seq", a.sequence},
                 {"gravity", {{"x", a.gravity.x}, {"y", a.gravity.y}, {"z", a.gravity.z}}}};
     }
+    if (!rec->lampSelector.empty()) {
+        const auto& l = rec->lampSelector.back();
+        std::vector<int> levels;
+        for (std::uint32_t i = 0; i < l.lineCount; ++i) {
+            levels.push_back((l.lineLevels >> i) & 1u ? 1 : 0);
+        }
+        j["lamp_selector"]["last"] = {{"seq", l.sequence},
+                                      {"lamp", l.lamp},
+                                      {"state", hal::lampStateName(l.lamp)},
+                                      {"levels", levels}};
+    }
     if (!rec->frames.empty()) {
         j["last_frame"] = {{"frame", rec->frames.back().frameIndex},
                            {"tick_ns", rec->frames.back().tickNs}};
@@ -173,6 +188,9 @@ int inspectMain(const InspectOptions& o)
     line("spectrometer", rec->session.spectrometer, rec->spectra.size());
     line("tracker", rec->session.tracker, rec->poses.size());
     line("accelerometer", rec->session.accel, rec->accel.size());
+    if (!rec->session.lampSelector.model.empty() || !rec->lampSelector.empty()) {
+        line("lamp selector", rec->session.lampSelector, rec->lampSelector.size());
+    }
     fmt::print("  {:<13} {:>7} frames\n", "frames", rec->frames.size());
     fmt::print("  time span {:.3f} s ({} .. {} ns); dropped messages {}, rejected (NaN/inf) {}\n",
                static_cast<double>(last - first) * 1e-9, first, last, rec->droppedMessages,

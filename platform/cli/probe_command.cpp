@@ -1,6 +1,6 @@
-// 'replica probe': what live sensors this machine can see, for field staff setting up or
-// checking an appliance. Opens each device the way 'replica run --hal live' would, takes one
-// reading, and says what to do about anything missing.
+// 'replica probe': what live sensors this machine can see (and its GPIO chips, for the lamp
+// selector), for field staff setting up or checking an appliance. Opens each device the way
+// 'replica run --hal live' would, takes one reading, and says what to do about anything missing.
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include <hal/accel/iio_accel.h>
+#include <hal/lamp/gpio_lamp_source.h>
+#include <hal/lamp/libgpiod_lines.h>
 #include <hal/spectrometer/libusb_transport.h>
 #include <hal/spectrometer/usb2000_device.h>
 #include <hal/spectrometer/usb2000_protocol.h>
@@ -28,6 +30,8 @@ struct ProbeOptions {
     std::string iioRoot = "/sys/bus/iio/devices";
     std::string accelName;
     std::string accelAxes = "x,y,z";
+    std::string lampGpio; // CHIP:OFFSETS; empty = only list the GPIO chips
+    std::string gpioDev = "/dev";
     bool json = false;
 };
 
@@ -142,15 +146,71 @@ nlohmann::json probeTracker(const ProbeOptions& o)
     return j;
 }
 
+// The lamp selector: every GPIO chip this machine has, and with --lamp-gpio the configured lines
+// opened as 'replica run --hal live' would and read once.
+nlohmann::json probeLampSelector(const ProbeOptions& o)
+{
+    nlohmann::json chips = nlohmann::json::array();
+    for (const auto& c : hal::lamp::listGpioChips(o.gpioDev)) {
+        nlohmann::json cj{
+                {"path", c.path}, {"name", c.name}, {"label", c.label}, {"lines", c.lines}};
+        if (!c.error.empty()) {
+            cj["error"] = c.error;
+        }
+        chips.push_back(cj);
+    }
+    nlohmann::json j{{"chips", chips}, {"configured", !o.lampGpio.empty()}};
+    if (o.lampGpio.empty()) {
+        return j;
+    }
+    auto spec = hal::lamp::parseGpioLineSpec(o.lampGpio);
+    if (!spec) {
+        j["found"] = false;
+        j["error"] = spec.error().message;
+        return j;
+    }
+    j["lines"] = hal::lamp::toString(*spec);
+    auto lines = hal::lamp::libgpiodOpener()(*spec);
+    if (!lines) {
+        j["found"] = false;
+        j["error"] = lines.error().message;
+        return j;
+    }
+    j["found"] = true;
+    j["where"] = (*lines)->describe();
+    hal::SteadyClock clock;
+    hal::lamp::LampSelectorReader reader(std::move(*lines), spec->offsets.size(), clock);
+    auto s = reader.start(0);
+    if (!s) {
+        j["ok"] = false;
+        j["error"] = s.error().message;
+        return j;
+    }
+    j["ok"] = true;
+    j["lamp"] = s->lamp;
+    j["state"] = hal::lampStateName(s->lamp);
+    std::vector<int> levels;
+    for (std::uint32_t i = 0; i < s->lineCount; ++i) {
+        levels.push_back((s->lineLevels >> i) & 1u ? 1 : 0);
+    }
+    j["levels"] = levels;
+    return j;
+}
+
 int runProbe(const ProbeOptions& o)
 {
     nlohmann::json report{{"spectrometer", probeSpectrometer()},
                           {"accelerometer", probeAccel(o)},
-                          {"tracker", probeTracker(o)}};
+                          {"tracker", probeTracker(o)},
+                          {"lamp_selector", probeLampSelector(o)}};
     bool all = true;
     for (const char* k : {"spectrometer", "accelerometer", "tracker"}) {
         const auto& d = report[k];
         all = all && d.value("found", false) && d.value("ok", true);
+    }
+    const auto& lamp = report["lamp_selector"];
+    if (lamp["configured"].get<bool>()) {
+        all = all && lamp.value("found", false) && lamp.value("ok", true);
     }
     report["all_found"] = all;
     if (o.json) {
@@ -186,6 +246,31 @@ int runProbe(const ProbeOptions& o)
     } else {
         fmt::print("tracker        MISSING: {}\n", t["error"].get<std::string>());
     }
+    std::string chipList;
+    for (const auto& c : lamp["chips"]) {
+        chipList += fmt::format("{}{} [{}] {} lines{}", chipList.empty() ? "" : ", ",
+                                c["name"].get<std::string>(), c["label"].get<std::string>(),
+                                c["lines"].get<unsigned>(),
+                                c.contains("error") ? " (cannot open: permission?)" : "");
+    }
+    if (chipList.empty()) {
+        chipList = fmt::format("none under {}", o.gpioDev);
+    }
+    if (!lamp["configured"].get<bool>()) {
+        fmt::print("lamp selector  not configured (--lamp-gpio CHIP:OFFSETS); GPIO chips: {}\n",
+                   chipList);
+    } else if (lamp.value("ok", false)) {
+        std::string levels;
+        for (const auto& v : lamp["levels"]) {
+            levels += v.get<int>() != 0 ? '1' : '0';
+        }
+        const int l = lamp["lamp"].get<int>();
+        fmt::print("lamp selector  {}: {} (line levels {})\n", lamp["where"].get<std::string>(),
+                   l >= 0 ? fmt::format("lamp {}", l) : lamp["state"].get<std::string>(), levels);
+    } else {
+        fmt::print("lamp selector  MISSING: {}; GPIO chips: {}\n", lamp["error"].get<std::string>(),
+                   chipList);
+    }
     return all ? kExitOk : kExitFailure;
 }
 
@@ -209,6 +294,10 @@ void registerProbeCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--accel-axes", o->accelAxes,
                     "sensor axis for each panel axis (x right, y up, z out of the screen)")
             ->capture_default_str();
+    cmd->add_option("--lamp-gpio", o->lampGpio,
+                    "the lamp selector's lines, CHIP:OFFSET,OFFSET,... (one per lamp, lamp "
+                    "order); without it the GPIO chips are only listed");
+    cmd->add_option("--gpio-dev", o->gpioDev, "where GPIO chips are listed")->capture_default_str();
     cmd->add_flag("--json", o->json, "print the report as JSON");
     cmd->callback([o, &exitCode] { exitCode = runProbe(*o); });
 }

@@ -113,12 +113,12 @@ int replayMain(const ReplayOptions& o)
     const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
                           : o.clock == "step"   ? Pacing::Step
                                                 : Pacing::Fast;
-    log->info("replay {}: {} frames, {} spectra, {} poses, {} accel samples (recorded by {}); "
-              "clock={}; renderer={} on {}; {}x{}",
+    log->info("replay {}: {} frames, {} spectra, {} poses, {} accel samples, {} lamp selector "
+              "samples (recorded by {}); clock={}; renderer={} on {}; {}x{}",
               o.file, recording->frames.size(), recording->spectra.size(), recording->poses.size(),
-              recording->accel.size(), recording->session.softwareVersion, o.clock,
-              (*appliance)->renderer->description(), (*appliance)->output->glRenderer(),
-              config->width, config->height);
+              recording->accel.size(), recording->lampSelector.size(),
+              recording->session.softwareVersion, o.clock, (*appliance)->renderer->description(),
+              (*appliance)->output->glRenderer(), config->width, config->height);
 
     std::optional<std::vector<FrameDigest>> golden;
     if (!o.check.empty()) {

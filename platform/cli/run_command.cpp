@@ -20,6 +20,7 @@ namespace {
 
 struct RunOptions {
     std::string hal = "sim";
+    std::string lampSelector = "none"; // sim only: none, sim, sim-miswired
     std::string output = "headless";
     std::uint64_t frames = 180;
     std::string size = "960x600";
@@ -127,8 +128,20 @@ int runMain(const RunOptions& o)
     // Live devices stamp samples on this clock; the loop's ticks start with it (within the few
     // milliseconds between here and the first tick, which only delays samples by that much).
     hal::SteadyClock liveClock;
-    auto sources =
-            o.hal == "live" ? makeLiveSources(liveClock, o.live) : makeSimSources(**appliance);
+    if (o.hal == "live" && o.lampSelector != "none") {
+        log->error("--lamp-selector {} is for --hal sim; a live booth's switch is read with "
+                   "--lamp-gpio CHIP:OFFSETS",
+                   o.lampSelector);
+        return kExitUsage;
+    }
+    if (o.hal == "sim" && !o.live.lampGpio.empty()) {
+        log->error("--lamp-gpio needs --hal live; the simulated booth's switch is "
+                   "--lamp-selector sim");
+        return kExitUsage;
+    }
+    auto sources = o.hal == "live"
+                           ? makeLiveSources(liveClock, o.live, (*appliance)->booth.lamps.size())
+                           : makeSimSources(**appliance, o.lampSelector);
     if (!sources) {
         log->error("{}", sources.error().message);
         return kExitFailure;
@@ -161,6 +174,9 @@ int runMain(const RunOptions& o)
         session.spectrometer = sources->spectrometer->info();
         session.tracker = sources->tracker->info();
         session.accel = sources->accel->info();
+        if (sources->lampSelector) {
+            session.lampSelector = sources->lampSelector->info();
+        }
         recordings::WriterOptions options;
         options.flushInterval = std::chrono::milliseconds(o.recordFlushMs);
         // Called once from the writer thread; the loop keeps displaying without the recording.
@@ -221,6 +237,12 @@ int runMain(const RunOptions& o)
     if (!o.snapshot.empty()) {
         fmt::print("snapshot: {}\n", o.snapshot);
     }
+    if (sources->lampSelector) {
+        log->info("lamp selector {} [{} {}]: overruled by the spectrometer {} times",
+                  hal::toString(sources->lampSelector->info().kind),
+                  sources->lampSelector->info().model, sources->lampSelector->info().serial,
+                  (*appliance)->updater->lampArbiter().overruled());
+    }
     log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}; late frames {}; "
               "out of gamut: mean {:.4f}, max {:.4f} of pixels",
               stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
@@ -252,6 +274,15 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--accel-axes", opts->live.accelAxes,
                     "live: sensor axis for each panel axis (x right, y up, z out of the screen), "
                     "e.g. -y,x,z")
+            ->capture_default_str();
+    cmd->add_option("--lamp-gpio", opts->live.lampGpio,
+                    "live: the booth's lamp selector switch, CHIP:OFFSET,OFFSET,... with one GPIO "
+                    "line per lamp in the booth's lamp order (active low, pull-up), e.g. "
+                    "gpiochip0:17,27,22; without it the spectrometer alone decides the light");
+    cmd->add_option("--lamp-selector", opts->lampSelector,
+                    "sim: none, sim (a switch that follows the simulated lamps, with contact "
+                    "bounce) or sim-miswired (its lines for lamps 1 and 2 swapped)")
+            ->check(CLI::IsMember({"none", "sim", "sim-miswired"}))
             ->capture_default_str();
     cmd->add_option("--output", opts->output,
                     "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")

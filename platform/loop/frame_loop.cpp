@@ -139,9 +139,11 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     SampleLatch<hal::SpectrumSample> spectra;
     SampleLatch<hal::PoseSample> poses;
     SampleLatch<hal::AccelSample> accels;
+    SampleLatch<hal::LampSample> selector;
     std::vector<hal::SpectrumSample> freshSpectra;
     std::vector<hal::PoseSample> freshPoses;
     std::vector<hal::AccelSample> freshAccel;
+    std::vector<hal::LampSample> freshLamp;
     pipeline::scene::SceneState state;
     pipeline::render::RenderedFrame image;
     bool stepping = pacing == Pacing::Step;
@@ -173,12 +175,17 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         freshSpectra.clear();
         freshPoses.clear();
         freshAccel.clear();
+        freshLamp.clear();
         sources.spectrometer->poll(tick.tickNs, freshSpectra);
         sources.tracker->poll(tick.tickNs, freshPoses);
         sources.accel->poll(tick.tickNs, freshAccel);
+        if (sources.lampSelector) {
+            sources.lampSelector->poll(tick.tickNs, freshLamp);
+        }
         recordAll(recorder, freshSpectra);
         recordAll(recorder, freshPoses);
         recordAll(recorder, freshAccel);
+        recordAll(recorder, freshLamp);
         if (auto d = spectra.push(freshSpectra); d > 0) {
             stats.droppedSpectra += d;
             log->warn("spectrometer {}: {} spectra dropped before t={} ns",
@@ -194,6 +201,11 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             log->warn("accelerometer {}: {} samples dropped before t={} ns",
                       sources.accel->info().serial, d, tick.tickNs);
         }
+        if (auto d = selector.push(freshLamp); d > 0) {
+            stats.droppedLamp += d;
+            log->warn("lamp selector {}: {} samples dropped before t={} ns",
+                      sources.lampSelector->info().serial, d, tick.tickNs);
+        }
 
         const bool replaying = tick.recorded.has_value();
         const auto& rec = tick.recorded;
@@ -204,10 +216,12 @@ Expected<LoopStats> runFrames(Appliance& appliance,
                                           replaying, stats.replayMismatches);
         const hal::AccelSample* a = choose(accels, replaying ? rec->accelSequence : std::nullopt,
                                            replaying, stats.replayMismatches);
+        const hal::LampSample* l = choose(selector, replaying ? rec->lampSequence : std::nullopt,
+                                          replaying, stats.replayMismatches);
 
         state.frameIndex = tick.frameIndex;
         state.tickNs = tick.tickNs;
-        appliance.updater->update(state, s, p, a);
+        appliance.updater->update(state, s, p, a, l);
         if (auto ok = appliance.renderer->render(state, image, readback); !ok) {
             return tl::unexpected(ok.error());
         }
@@ -223,8 +237,8 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             log->warn("output {}: {}", appliance.output->name(), ok.error().message);
         }
 
-        recordings::FrameRecord record{tick.frameIndex, tick.tickNs, sequenceOf(s), sequenceOf(p),
-                                       sequenceOf(a)};
+        recordings::FrameRecord record{tick.frameIndex, tick.tickNs,   sequenceOf(s),
+                                       sequenceOf(p),   sequenceOf(a), sequenceOf(l)};
         if (recorder != nullptr) {
             recorder->write(record);
         }

@@ -38,6 +38,7 @@ struct LoopStats {
     std::uint64_t droppedSpectra = 0; // sequence gaps seen
     std::uint64_t droppedPoses = 0;
     std::uint64_t droppedAccel = 0;
+    std::uint64_t droppedLamp = 0;
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
     std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
     double sumOutOfGamutFraction = 0.0; // over frames: the display pass's per-frame count

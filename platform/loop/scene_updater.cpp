@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include <pipeline/scene/stand.h>
+#include <platform/logging.h>
 #include <platform/loop/scene_updater.h>
 
 namespace replica::platform {
@@ -47,11 +48,26 @@ pipeline::spectral::Classification SceneUpdater::classification() const
                        : pipeline::spectral::Classification{};
 }
 
+void SceneUpdater::showLamp(pipeline::scene::SceneState& state, int lamp) const
+{
+    const auto& l = setup_.booth.lamps[static_cast<std::size_t>(lamp)];
+    state.lampIndex = lamp;
+    state.illuminant = l.spectrum;
+    state.emitterLuminanceCdM2 = l.luminanceCdM2;
+}
+
 void SceneUpdater::update(pipeline::scene::SceneState& state,
                           const hal::SpectrumSample* spectrum,
                           const hal::PoseSample* pose,
-                          const hal::AccelSample* accel)
+                          const hal::AccelSample* accel,
+                          const hal::LampSample* selector)
 {
+    if (selector != nullptr && selector->sequence != lastSelector_) {
+        lastSelector_ = selector->sequence;
+        if (const auto lamp = arbiter_.onSelector(*selector)) {
+            showLamp(state, *lamp); // a turn of the switch shows at once
+        }
+    }
     if (spectrum != nullptr && spectrum->sequence != lastSpectrum_) {
         lastSpectrum_ = spectrum->sequence;
         pipeline::spectral::RawSpectrum raw{spectrum->counts, spectrum->integrationTimeUs,
@@ -61,12 +77,14 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
         // A saturated spectrum has lost its peaks: its shape cannot be trusted, keep the last
         // light.
         if (spd && !spectrum->saturated) {
-            const int lamp = classifier_ ? classifier_->classify(*spd) : -1;
+            const int lamp = arbiter_.onClassified(classifier_ ? classifier_->classify(*spd) : -1,
+                                                   spectrum->timestampNs);
+            if (auto warning = arbiter_.takeWarning()) {
+                logger("loop")->warn("{}", *warning);
+            }
             state.lampIndex = lamp;
             if (lamp >= 0) {
-                const auto& l = setup_.booth.lamps[static_cast<std::size_t>(lamp)];
-                state.illuminant = l.spectrum;
-                state.emitterLuminanceCdM2 = l.luminanceCdM2;
+                showLamp(state, lamp);
             } else {
                 // Direct-sensor mode: the sensed shape, at the booth's typical luminance.
                 state.illuminant = *spd;

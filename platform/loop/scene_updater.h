@@ -14,6 +14,7 @@
 #include <pipeline/scene/scene_state.h>
 #include <pipeline/spectral/light_classifier.h>
 #include <pipeline/spectral/spectrometer_chain.h>
+#include <platform/loop/lamp_arbiter.h>
 
 namespace replica::platform {
 
@@ -36,10 +37,12 @@ public:
 
     // Updates state from whichever samples are present (nullptr = none yet). A sample is used once:
     // the same sequence number again changes nothing. Unusable samples are counted and skipped.
+    // The lamp selector, when there is one, is reconciled with the classifier by LampArbiter.
     void update(pipeline::scene::SceneState& state,
                 const hal::SpectrumSample* spectrum,
                 const hal::PoseSample* pose,
-                const hal::AccelSample* accel);
+                const hal::AccelSample* accel,
+                const hal::LampSample* selector = nullptr);
 
     // Counts of samples ignored because they could not be used.
     std::uint64_t rejectedSpectra() const { return rejectedSpectra_; }
@@ -48,18 +51,23 @@ public:
 
     // The classifier's current answer (name "unknown" in direct-sensor mode).
     pipeline::spectral::Classification classification() const;
+    const LampArbiter& lampArbiter() const { return arbiter_; }
 
 private:
     SceneUpdater(SceneUpdaterSetup setup,
                  std::optional<pipeline::spectral::LightClassifier> classifier)
-        : setup_(std::move(setup)), classifier_(std::move(classifier))
+        : setup_(std::move(setup)), classifier_(std::move(classifier)),
+          arbiter_(static_cast<int>(setup_.booth.lamps.size()))
     {}
+    void showLamp(pipeline::scene::SceneState& state, int lamp) const;
 
     SceneUpdaterSetup setup_;
     std::optional<pipeline::spectral::LightClassifier> classifier_; // none: no lamps
     std::optional<std::uint32_t> lastSpectrum_;
     std::optional<std::uint32_t> lastPose_;
     std::optional<std::uint32_t> lastAccel_;
+    LampArbiter arbiter_;
+    std::optional<std::uint32_t> lastSelector_;
     std::uint64_t rejectedSpectra_ = 0;
     std::uint64_t rejectedPoses_ = 0;
     std::uint64_t rejectedTilts_ = 0;

@@ -103,7 +103,8 @@ std::uint64_t feed(recordings::RecordingWriter& w, int seconds, bool realTime)
         }
         if (t == due(nF, kFrameHz)) {
             w.write(recordings::FrameRecord{nF, t, nS ? std::optional(nS - 1) : std::nullopt,
-                                            nT - 1, nA ? std::optional(nA - 1) : std::nullopt});
+                                            nT - 1, nA ? std::optional(nA - 1) : std::nullopt,
+                                            std::nullopt});
             ++nF;
             ++written;
         }
@@ -180,6 +181,58 @@ void BM_LiveRateCpu(benchmark::State& st)
     std::filesystem::remove(path);
 }
 BENCHMARK(BM_LiveRateCpu)->Arg(5)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
+// The lamp selector's channel: what one message costs the writer (encode, compress, write) and the
+// file. A booth's switch turns a few times per session, so the channel's share is this times the
+// turns per second; the appliance's other streams write 285 messages per second.
+void BM_LampSelectorMessages(benchmark::State& st)
+{
+    const auto count = static_cast<std::uint32_t>(st.range(0));
+    const auto path = benchFile("lamp");
+    double wall = 0.0;
+    std::uint64_t bytes = 0, empty = 0;
+    for (auto _ : st) {
+        recordings::WriterOptions options;
+        options.queueCapacity = 1 << 20;
+        // The same session with no messages: what the file costs without the channel's traffic.
+        {
+            auto w0 = recordings::RecordingWriter::create(path, session(), options);
+            if (!w0) {
+                st.SkipWithError(w0.error().message.c_str());
+                return;
+            }
+            (void)(*w0)->close();
+            empty += (*w0)->stats().bytes;
+        }
+        const auto t0 = Clock::now();
+        auto w = recordings::RecordingWriter::create(path, session(), options);
+        if (!w) {
+            st.SkipWithError(w.error().message.c_str());
+            return;
+        }
+        for (std::uint32_t i = 0; i < count; ++i) {
+            hal::LampSample l;
+            l.timestampNs = std::int64_t{i} * 2'000'000'000 + 33'000'000 + (i * 7919) % 6'000'000;
+            l.sequence = i;
+            l.lineCount = 3;
+            l.lamp = static_cast<int>(i % 3);
+            l.lineLevels = 1u << (i % 3);
+            (*w)->write(l);
+        }
+        (void)(*w)->close();
+        wall += std::chrono::duration<double>(Clock::now() - t0).count();
+        bytes += (*w)->stats().bytes;
+    }
+    const double n = static_cast<double>(count) * static_cast<double>(st.iterations());
+    st.counters["us_per_message"] = wall / n * 1e6;
+    st.counters["file_bytes_per_message"] = static_cast<double>(bytes - empty) / n;
+    std::filesystem::remove(path);
+}
+BENCHMARK(BM_LampSelectorMessages)
+        ->Arg(100000)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(3);
 
 // Sensor-only replay: read and decode the recording, then poll the replay sources for every
 // frame tick, as the loop does before rendering. Session seconds per wall second.

@@ -83,6 +83,11 @@ function compare(label, { counts, last }) {
                                                  "wavelength_coeffs", "nonlinearity_coeffs"]),
                 inspect.spectrometer.last);
   }
+  if (inspect.lamp_selector && inspect.lamp_selector.last) {
+    expectEqual(`${label} last /hal/lamp_selector`,
+                pick(last["/hal/lamp_selector"], ["seq", "lamp", "state", "levels"]),
+                inspect.lamp_selector.last);
+  }
   if (inspect.last_frame) {
     expectEqual(`${label} last /replica/frame`, pick(last["/replica/frame"], ["frame", "tick_ns"]),
                 inspect.last_frame);

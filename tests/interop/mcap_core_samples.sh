@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reads recordings with @mcap/core and compares them with 'replica inspect --json': every committed
-# sample (format 1 and 2), a fresh recording, and a recording killed with SIGKILL then recovered.
+# sample (formats 1 to 3), a fresh recording with the lamp selector, and a recording killed with SIGKILL then recovered.
 set -euo pipefail
 replica="$1"
 samples="$2"
@@ -20,6 +20,6 @@ check() {
 for rec in "$samples"/*.mcap; do
     check "$rec"
 done
-"$replica" --log-level warn run --hal sim --output headless --frames 30 --size 64x40 --fast \
-    --record "$work/fresh.mcap" >/dev/null
+"$replica" --log-level warn run --hal sim --output headless --frames 50 --size 64x40 --fast \
+    --rate 20 --lamp-selector sim --record "$work/fresh.mcap" >/dev/null
 check "$work/fresh.mcap"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # 'replica probe' against a fake IIO accelerometer (tilted back 30 degrees) and a UDP sender
-# speaking opentrack's protocol; no spectrometer is attached here, so the report says so and the
-# exit status is 1.
+# speaking opentrack's protocol; no spectrometer is attached here and the lamp selector names a GPIO
+# chip that does not exist, so the report says so and the exit status is 1.
 set -uo pipefail
 replica="$1"
 work="$2"
@@ -39,6 +39,7 @@ for _ in $(seq 1 300); do
     sleep 0.1
 done
 "$replica" probe --json --iio-root "$work/iio" --tracker-port "$port" --tracker-wait 1 \
+    --lamp-gpio replica-no-such-gpiochip:17,27,22 --gpio-dev "$work" \
     > "$work/probe.json" 2> "$work/probe.log"
 code=$?
 kill "$sender" 2>/dev/null
@@ -61,10 +62,14 @@ else:
 s = r["spectrometer"]
 if s.get("found") or "2457:101e" not in s.get("error", ""):
     fail.append(f"spectrometer: {s}")
+l = r["lamp_selector"]
+if (not l["configured"] or l.get("found") or l["chips"] != []
+        or "'replica-no-such-gpiochip' not found" not in l.get("error", "")):
+    fail.append(f"lamp selector: {l}")
 if r["all_found"] or code != 1:
     fail.append(f"all_found {r['all_found']} exit {code}")
 if fail:
     print("FAIL: " + "; ".join(fail), file=sys.stderr)
     sys.exit(1)
-print(f"ok: tilt {a['tilt_deg']:.3f} deg, {t['poses']} poses, spectrometer reported missing, exit {code}")
+print(f"ok: tilt {a['tilt_deg']:.3f} deg, {t['poses']} poses, spectrometer and lamp selector chip reported missing, exit {code}")
 PY

@@ -80,7 +80,7 @@ const Sample& sample()
                 (*w)->write(sp);
             }
             if (i % 2 == 0) {
-                (*w)->write(FrameRecord{i / 2, t, std::nullopt, i, i});
+                (*w)->write(FrameRecord{i / 2, t, std::nullopt, i, i, std::nullopt});
             }
         }
         EXPECT_TRUE((*w)->close());

@@ -31,6 +31,8 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     session.spectrometer = {"USB2000+", "S1", "fw", hal::SourceKind::Live};
     session.tracker = {"TrackIR", "T1", "", hal::SourceKind::Sim};
     session.accel = {"accel", "A1", "", hal::SourceKind::Replay};
+    session.lampSelector = {"lamp selector (GPIO)", "gpiochip0:17,27,22", "",
+                            hal::SourceKind::Live};
 
     hal::SpectrumSample s;
     s.timestampNs = 100'000'000;
@@ -49,13 +51,25 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     a.timestampNs = 10'000'000;
     a.sequence = 2;
     a.gravity = {1e-17, -9.80665, 2.0 / 7.0};
-    FrameRecord f{3, 50'000'001, 7, std::nullopt, 2};
+    hal::LampSample l;
+    l.timestampNs = 2'035'123'456;
+    l.sequence = 4;
+    l.lamp = 2;
+    l.lineCount = 3;
+    l.lineLevels = 0b100;
+    hal::LampSample invalid = l;
+    invalid.sequence = 5;
+    invalid.lamp = hal::kLampInvalid;
+    invalid.lineLevels = 0b101;
+    FrameRecord f{3, 50'000'001, 7, std::nullopt, 2, 4};
     {
         auto w = RecordingWriter::create(path, session);
         ASSERT_TRUE(w) << w.error().message;
         (*w)->write(s);
         (*w)->write(p);
         (*w)->write(a);
+        (*w)->write(l);
+        (*w)->write(invalid);
         (*w)->write(f);
         ASSERT_TRUE((*w)->close());
     }
@@ -87,6 +101,18 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     EXPECT_EQ(r->frames[0].spectrumSequence, f.spectrumSequence);
     EXPECT_FALSE(r->frames[0].poseSequence.has_value());
     EXPECT_EQ(r->frames[0].accelSequence, f.accelSequence);
+    EXPECT_EQ(r->frames[0].lampSequence, f.lampSequence);
+    EXPECT_EQ(r->session.lampSelector.serial, "gpiochip0:17,27,22");
+    EXPECT_EQ(r->session.lampSelector.kind, hal::SourceKind::Live);
+    ASSERT_EQ(r->lampSelector.size(), 2u);
+    for (std::size_t i = 0; i < 2; ++i) {
+        const auto& want = i == 0 ? l : invalid;
+        EXPECT_EQ(r->lampSelector[i].timestampNs, want.timestampNs);
+        EXPECT_EQ(r->lampSelector[i].sequence, want.sequence);
+        EXPECT_EQ(r->lampSelector[i].lamp, want.lamp);
+        EXPECT_EQ(r->lampSelector[i].lineLevels, want.lineLevels);
+        EXPECT_EQ(r->lampSelector[i].lineCount, want.lineCount);
+    }
     std::filesystem::remove(path);
 }
 
@@ -214,6 +240,45 @@ TEST(RecordingRead, TruncatedFileIsReportedNotCrashed)
     EXPECT_NE(r.error().message.find(path.string()), std::string::npos);
     EXPECT_NE(r.error().message.find("replica recover"), std::string::npos);
     std::filesystem::remove(path);
+}
+
+} // namespace
+} // namespace replica::recordings
+
+namespace replica::recordings {
+namespace {
+
+TEST(RecordingRead, RecordingsWithoutALampSelectorHaveNoneAndNoLampSequences)
+{
+    // Formats 1 and 2 predate the selector: they must read as "no selector", which replays as
+    // the classifier alone, exactly as they were recorded.
+    const auto dir = std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples";
+    for (const char* name : {"walk-v1.mcap", "walk-v2.mcap"}) {
+        auto r = readRecording(dir / name);
+        ASSERT_TRUE(r) << r.error().message;
+        EXPECT_TRUE(r->lampSelector.empty()) << name;
+        EXPECT_TRUE(r->session.lampSelector.model.empty()) << name;
+        for (const auto& f : r->frames) {
+            EXPECT_FALSE(f.lampSequence.has_value()) << name;
+        }
+    }
+}
+
+TEST(RecordingRead, FormatVersionThreeSampleHoldsTheSimulatedSwitch)
+{
+    const auto dir = std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples";
+    auto r = readRecording(dir / "walk-v3.mcap");
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->formatVersion, 3);
+    EXPECT_EQ(r->session.lampSelector.model, "lamp selector (simulated)");
+    // The position at t = 0 and the turn to lamp 1 at 2 s (debounced), as the scenario plays it.
+    ASSERT_EQ(r->lampSelector.size(), 2u);
+    EXPECT_EQ(r->lampSelector[0].lamp, 0);
+    EXPECT_EQ(r->lampSelector[1].lamp, 1);
+    EXPECT_GE(r->lampSelector[1].timestampNs, 2'030'000'000);
+    ASSERT_FALSE(r->frames.empty());
+    EXPECT_EQ(r->frames.back().lampSequence, 1u);
+    EXPECT_EQ(r->frames.front().lampSequence, 0u);
 }
 
 } // namespace
