@@ -32,7 +32,7 @@ struct RunConfig {
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
     int boothLights = 32;    // median-cut point lights
-    int specularSamples = 16;
+    int specularSamples = 48;
     int horizonDirections = 8;
     std::string basis = "replica_k6"; // docs/accuracy.md; recordings made with box6 replay as such
     int lightsU = 8;
