@@ -33,7 +33,7 @@ struct RunConfig {
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
     int boothLights = 32;    // median-cut point lights
-    int specularSamples = 16;
+    int specularSamples = 48;
     int horizonDirections = 8;
     // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
     // light; recordings made with replica_k6 or box6 replay as such.

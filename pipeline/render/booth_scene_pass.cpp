@@ -1,5 +1,6 @@
 // Scene state to booth pass: light selection and caching, view from eye and tilt.
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -59,8 +60,9 @@ std::string BoothScenePass::description() const
                        setup_.adaptive ? ", re-encoded for each new light" : "");
 }
 
-Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
+Expected<void> BoothScenePass::selectLight(const scene::SceneState& state, bool& changed)
 {
+    changed = false;
     const int lamp = state.lampIndex;
     if (lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.lamps.size()) {
         const booth::BoothLight* l =
@@ -74,6 +76,7 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
         }
         light_ = shading::prepareLight(*l, setup_.observer, setup_.settings.lights, setup_.basis);
         lightIndex_ = index;
+        changed = true;
     } else {
         // Direct-sensor mode: rebuilt only when the sensed spectrum or luminance changes.
         if (lightIndex_ == -1 && state.illuminant.v == directSpd_.v &&
@@ -90,6 +93,7 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
         directSpd_ = state.illuminant;
         directLuminance_ = state.emitterLuminanceCdM2;
         lightIndex_ = -1;
+        changed = true;
     }
     return pass_->setLight(light_);
 }
@@ -123,15 +127,41 @@ Expected<void> BoothScenePass::encodeFor(const colour::Spectrum& spd, bool lampC
 
 Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, int height)
 {
-    if (auto ok = selectLight(state); !ok) {
+    bool lightChanged = false;
+    if (auto ok = selectLight(state, lightChanged); !ok) {
         return ok;
     }
+    // The cached diffuse term's tilt: the mean of the last kTiltWindow sensed tilts, taken when
+    // the light changes (the cache is recomputed anyway) or when that mean has moved more than
+    // kTiltHoldRad from the held tilt. Non-finite tilts are left out.
+    if (std::isfinite(state.tiltRad)) {
+        tiltWindow_[tiltNext_] = state.tiltRad;
+        tiltNext_ = (tiltNext_ + 1) % tiltWindow_.size();
+        tiltCount_ = std::min(tiltCount_ + 1, tiltWindow_.size());
+    }
+    if (tiltCount_ > 0) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < tiltCount_; ++i) {
+            sum += tiltWindow_[i];
+        }
+        const double mean = sum / static_cast<double>(tiltCount_);
+        if (lightChanged || !heldValid_ || std::abs(mean - heldTiltRad_) > kTiltHoldRad) {
+            heldTiltRad_ = mean;
+            heldValid_ = true;
+        }
+    }
+    const auto pose = [&](double tiltRad) {
+        return shading::panelPoseFromTilt(setup_.stand, tiltRad * 180.0 / std::numbers::pi);
+    };
+    const shading::PanelPose held = pose(heldTiltRad_);
     shading::View view;
-    view.panel = shading::panelPoseFromTilt(setup_.stand, state.tiltRad * 180.0 / std::numbers::pi);
+    // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel);
+    // a non-finite one falls back to the held tilt.
+    view.panel = std::isfinite(state.tiltRad) ? pose(state.tiltRad) : held;
     view.eye = state.eyeBoothM;
     view.pixelsX = width;
     view.pixelsY = height;
-    return pass_->draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand));
+    return pass_->draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand), &held);
 }
 
 } // namespace replica::pipeline::render

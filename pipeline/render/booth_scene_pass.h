@@ -7,6 +7,7 @@
 // Needs a current GLES 3.1 context for every call.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,14 +35,37 @@ struct BoothSceneSetup {
     double reencodeDistance = spectral::kAdaptiveReencodeDistance;
 };
 
+// The cached diffuse term's tilt is the mean of the last kTiltWindow sensed tilts (the
+// accelerometer's 0.02 m/s^2 noise is 0.12 degrees a sample, 0.03 degrees in the mean), re-taken
+// when it moves more than kTiltHoldRad: 0.15 degrees, 3.5 standard deviations of the difference
+// of two such means, so noise alone almost never recomputes the cache. Holding the diffuse term
+// 0.15 degrees off costs at most ΔE00 p95 0.25 at a 5-degree tilt (the ceiling light grazes the
+// panel there; the painting's relief) and 0.11 from 20 degrees up, on every shipped scene and
+// light (CPU model, booth_cache_test.cpp; docs/rendering.md): about what one sample's noise costs.
+constexpr std::size_t kTiltWindow = 16;
+constexpr double kTiltHoldRad = 0.15 * 3.14159265358979323846 / 180.0;
+
 class BoothScenePass
 {
 public:
     static Expected<std::unique_ptr<BoothScenePass>> create(BoothSceneSetup setup);
 
     // Draws the state's frame into the bound RGBA32F framebuffer (viewport width x height, the
-    // whole panel; the surface at its physical size in the middle, black around it).
+    // whole panel; the surface at its physical size in the middle, black around it; alpha: the
+    // illuminance on the panel, lux). The cached diffuse term is drawn at heldTiltRad(), so that
+    // sensor noise on the tilt does not recompute it every frame; the specular term at the
+    // state's tilt and eye.
     Expected<void> draw(const scene::SceneState& state, int width, int height);
+
+    // The tilt of the cached diffuse term: the mean of the last kTiltWindow sensed tilts as it
+    // was at the last light change or the last time that mean moved more than kTiltHoldRad away
+    // from it. A deterministic function of the states drawn so far, so replay renders the same
+    // frames.
+    double heldTiltRad() const { return heldTiltRad_; }
+    // The pass's cache of the eye-independent part (booth_shading_pass.h): how often it was
+    // recomputed, and a way to force it (e.g. after the channel encoding changed).
+    long cacheRefreshes() const { return pass_->cacheRefreshes(); }
+    void invalidateCache() { pass_->invalidateCache(); }
 
     std::string description() const;
 
@@ -52,7 +76,8 @@ public:
 
 private:
     BoothScenePass() = default;
-    Expected<void> selectLight(const scene::SceneState& state);
+    // Uploads the state's light when it differs from the one on the GPU; 'changed' says so.
+    Expected<void> selectLight(const scene::SceneState& state, bool& changed);
     // With an adaptive encoder: a new basis for 'spd' and the palette re-projected onto it, the
     // coefficient textures replaced. A lamp change always re-encodes (unless already encoded for
     // exactly that spectrum); direct-sensor mode only past reencodeDistance. A light the encoder
@@ -71,6 +96,11 @@ private:
     bool encoded_ = false; // encodedFor_ holds the light of the current adaptive basis
     colour::Spectrum encodedFor_{};
     int encodings_ = 0;
+    std::array<double, kTiltWindow> tiltWindow_{};
+    std::size_t tiltNext_ = 0;
+    std::size_t tiltCount_ = 0;
+    double heldTiltRad_ = 0.0;
+    bool heldValid_ = false;
 };
 
 // A uniform emitter with the geometry of 'like', the given luminance and spectrum: what the booth

@@ -42,9 +42,18 @@ uniform bool uDiffuse;
 uniform vec3 uChannelXyz[6];    // M_k of the light (Y = 1 light)
 uniform vec3 uWhite;            // XYZ of the light scaled to Y = 1
 uniform float uFlareRho;
+// 0: the eye-independent part into the cache (diffuse XYZ, E_geo in alpha); 1: compose the frame
+// from the cache plus the eye-dependent specular term (booth_shading_pass.cpp says when each runs).
+uniform int uMode;
+uniform sampler2D uCache;       // RGBA32F, the viewport's size: what mode 0 wrote
 
 uniform int uSpecSamples;       // 0: no specular pass
-uniform float uAlpha;
+// brdf::sampleWardHalfVectorLocal for sample k (u1 = (k + 1/2) / N, u2 = radicalInverse2(k)),
+// computed once on the CPU in double: xyz the half vector in the local frame, w the sample's
+// solid angle without its o.h factor, 4 pi alpha^2 cos^3 / (N u1).
+layout(std140) uniform BoothSpecSamples {
+    vec4 uSpecSample[256];
+};
 uniform int uWardModel;         // 0 Ward 1992, 1 Ward-Duer, 2 Ward-Duer guarded, 3 GMD
 uniform vec3 uSpecXyz;          // XYZ of rho_s times the unit-luminance light
 uniform vec3 uLightCentre;
@@ -58,7 +67,6 @@ uniform vec2 uLumUsed;          // the light's share of the padded texture
 
 const float kPi = 3.14159265358979;
 const float kMinCosView = 1e-3;
-const float kMinU1 = 1.0 / 16777216.0;
 
 float hz[32];
 
@@ -119,20 +127,6 @@ float lumSample(float u, float v, float level) {
     return (1.0 - t) * a + t * lumBilinear(u * uLumUsed.x, v * uLumUsed.y, l1);
 }
 
-// shading::radicalInverse2.
-// (bit arithmetic on ints: exact for k < 2^24, and free of uint-to-float conversions).
-float radicalInverse2(int k) {
-    float r = 0.0;
-    float f = 0.5;
-    for (int n = k; n > 0; n >>= 1) {
-        if ((n & 1) == 1) {
-            r += f;
-        }
-        f *= 0.5;
-    }
-    return r;
-}
-
 // realtime_model.cpp filteredSpecular with brdf::sampleWard inlined (rho_s = 1).
 float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
     float co = dot(n, o);
@@ -148,13 +142,8 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
     float sum = 0.0;
     float nf = float(uSpecSamples);
     for (int k = 0; k < uSpecSamples; ++k) {
-        float u1 = clamp((float(k) + 0.5) / nf, kMinU1, 1.0);
-        float u2 = radicalInverse2(k);
-        float tan2 = -uAlpha * uAlpha * log(u1);
-        float cosT = inversesqrt(1.0 + tan2);
-        float sinT = sqrt(tan2) * cosT;
-        float phi = 2.0 * kPi * u2;
-        vec3 hl = vec3(sinT * cos(phi), sinT * sin(phi), cosT);
+        vec4 sk = uSpecSample[k];
+        vec3 hl = sk.xyz;
         vec3 h = ft * hl.x + fbt * hl.y + n * hl.z;
         float oh = dot(o, h);
         if (!(oh > 0.0)) {
@@ -176,7 +165,7 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
         } else {
             w = ci / (oh * hl.z);
         }
-        float solidAngle = 4.0 * kPi * uAlpha * uAlpha * oh * hz3 / (nf * u1);
+        float solidAngle = sk.w * oh;
         float cosG = dot(nGeo, i);
         float denom = dot(i, uLightNormal);
         if (!(cosG > 0.0) || !(denom < 0.0)) {
@@ -222,16 +211,14 @@ void main() {
     vec2 frag = gl_FragCoord.xy / uViewport;
     float u = uSurfOffset.x + uSurfScale.x * frag.x;
     float v = uSurfOffset.y + uSurfScale.y * (1.0 - frag.y);
-    if (!(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0)) {
-        outXyz = vec4(0.0, 0.0, 0.0, 1.0); // the panel around the surface stays black
-        return;
-    }
+    bool inside = u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0;
+    // On the panel plane also around the surface: the flare term needs E_geo on every pixel.
     vec3 p = uCentre + uRight * ((u - 0.5) * uSizeM.x) + uUp * ((0.5 - v) * uSizeM.y);
     float texX = u * float(uTexels.x);
     float texY = v * float(uTexels.y);
     ivec2 tc = clamp(ivec2(int(texX), int(texY)), ivec2(0), uTexels - 1);
     vec3 nShade = uNormal;
-    if (uRelief) {
+    if (inside && uRelief && (uMode == 0 || uSpecSamples > 0)) {
         vec3 nl = bilinearNormal(texX, texY);
         nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
         int layers = (uHorizonDirs + 3) / 4;
@@ -243,56 +230,102 @@ void main() {
             hz[4 * j + 3] = b.w;
         }
     }
-    vec3 toEye = uEye - p;
-    float eyeDist = length(toEye);
-    toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;
-    bool behind = !(dot(toEye, uNormal) > 0.0);
 
-    // Eq. (1): eGeo with the macro normal (flare, flat scenes), e with facets and horizons.
-    float eGeo = 0.0;
-    float e = 0.0;
-    for (int i = 0; i < uLightCount; ++i) {
-        vec4 l = uLight[i];
-        vec3 d = l.xyz - p;
-        float d2 = dot(d, d);
-        if (!(d2 > 0.0) || !(l.w > 0.0)) {
-            continue;
+    if (uMode == 0 && !inside) {
+        // Around the surface only E_geo (pass 2's flare): eq. (1) with the macro normal, the
+        // cosines clamped instead of tested: the same sum, and on llvmpipe about half the cost of
+        // the full loop below, which ran here on every pixel of the panel (measured: a metamer
+        // frame that recomputes the cache, 393 -> 217 ms on the loaded 2-core machine).
+        float eg = 0.0;
+        for (int i = 0; i < uLightCount; ++i) {
+            vec4 l = uLight[i];
+            vec3 d = l.xyz - p;
+            float d2 = max(dot(d, d), 1e-30);
+            d *= inversesqrt(d2);
+            eg += l.w * max(-dot(uLightNormal, d), 0.0) * max(dot(uNormal, d), 0.0)
+                  / max(d2, uTexelArea);
         }
-        d *= inversesqrt(d2);
-        float cosL = -dot(uLightNormal, d);
-        float cosG = dot(uNormal, d);
-        if (!(cosL > 0.0) || !(cosG > 0.0)) {
-            continue;
-        }
-        float g = l.w * cosL / max(d2, uTexelArea);
-        eGeo += g * cosG;
-        if (uRelief) {
-            float cosS = dot(nShade, d);
-            if (cosS > 0.0) {
-                e += g * cosS * visibility(vec3(dot(d, uRight), dot(d, uUp), cosG));
+        outXyz = vec4(0.0, 0.0, 0.0, (isnan(eg) || isinf(eg)) ? 0.0 : eg);
+        return;
+    }
+    if (uMode == 0) {
+        // Eq. (1): eGeo with the macro normal (flare, flat scenes), e with facets and horizons.
+        bool relief = inside && uRelief;
+        float eGeo = 0.0;
+        float e = 0.0;
+        for (int i = 0; i < uLightCount; ++i) {
+            vec4 l = uLight[i];
+            vec3 d = l.xyz - p;
+            float d2 = dot(d, d);
+            if (!(d2 > 0.0) || !(l.w > 0.0)) {
+                continue;
+            }
+            d *= inversesqrt(d2);
+            float cosL = -dot(uLightNormal, d);
+            float cosG = dot(uNormal, d);
+            if (!(cosL > 0.0) || !(cosG > 0.0)) {
+                continue;
+            }
+            float g = l.w * cosL / max(d2, uTexelArea);
+            eGeo += g * cosG;
+            if (relief) {
+                float cosS = dot(nShade, d);
+                if (cosS > 0.0) {
+                    e += g * cosS * visibility(vec3(dot(d, uRight), dot(d, uUp), cosG));
+                }
             }
         }
+        if (!relief) {
+            e = eGeo;
+        }
+        if (!uDiffuse) {
+            e = 0.0;
+        }
+        vec3 xyz = vec3(0.0); // the panel around the surface stays black
+        if (inside) {
+            // Eq. (2): channel coefficients times the light's per-channel XYZ.
+            vec3 a = texelFetch(uCoeffA, tc, 0).rgb;
+            vec3 b = texelFetch(uCoeffB, tc, 0).rgb;
+            xyz = a.r * uChannelXyz[0] + a.g * uChannelXyz[1] + a.b * uChannelXyz[2]
+                + b.r * uChannelXyz[3] + b.g * uChannelXyz[4] + b.b * uChannelXyz[5];
+            xyz *= e / kPi;
+        }
+        if (isnan(eGeo) || isinf(eGeo)) {
+            eGeo = 0.0;
+        }
+        if (uSpecSamples == 0 && uFlareRho == 0.0) {
+            // Nothing left for the compose: the cache is the frame (clamped as mode 1 would).
+            xyz = max(xyz, vec3(0.0));
+            if (any(isnan(xyz)) || any(isinf(xyz))) {
+                xyz = vec3(0.0);
+            }
+        }
+        outXyz = vec4(xyz, eGeo);
+        return;
     }
-    if (!uRelief) {
-        e = eGeo;
-    }
-    if (!uDiffuse) {
-        e = 0.0;
-    }
-    // Eq. (2): channel coefficients times the light's per-channel XYZ.
-    vec3 a = texelFetch(uCoeffA, tc, 0).rgb;
-    vec3 b = texelFetch(uCoeffB, tc, 0).rgb;
-    vec3 xyz = a.r * uChannelXyz[0] + a.g * uChannelXyz[1] + a.b * uChannelXyz[2]
-             + b.r * uChannelXyz[3] + b.g * uChannelXyz[4] + b.b * uChannelXyz[5];
-    xyz *= e / kPi;
-    if (uSpecSamples > 0 && !behind) {
-        xyz += uSpecXyz * filteredSpecular(p, uNormal, nShade, toEye);
+
+    // Compose (drawn over the surface's rectangle only; around it the frame is the cache): the
+    // cached diffuse term and E_geo, plus this eye's specular, minus the flare.
+    vec4 cached = texelFetch(uCache, ivec2(gl_FragCoord.xy), 0);
+    vec3 xyz = cached.rgb;
+    float eGeo = cached.a;
+    if (inside && uSpecSamples > 0) {
+        vec3 toEye = uEye - p;
+        float eyeDist = length(toEye);
+        toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;
+        bool behind = !(dot(toEye, uNormal) > 0.0);
+        if (!behind) {
+            xyz += uSpecXyz * filteredSpecular(p, uNormal, nShade, toEye);
+        }
     }
     vec3 outv = max(xyz - uWhite * (uFlareRho * eGeo / kPi), vec3(0.0));
     if (any(isnan(outv)) || any(isinf(outv))) {
         outv = vec3(0.0); // never reaches a pixel; the read-back check counts none
     }
-    outXyz = vec4(outv, 1.0);
+    if (isnan(eGeo) || isinf(eGeo)) {
+        eGeo = 0.0;
+    }
+    outXyz = vec4(outv, eGeo);
 }
 )";
 

@@ -7,10 +7,13 @@ namespace replica::pipeline::render {
 // The real-time algorithm of shading/realtime_model.cpp, line for line in float: eq. (1) over the
 // median-cut point lights with normal-mapped facets and horizon shadows, eq. (2) with K = 6
 // channel coefficients, Ward specular by filtered importance sampling of the luminance mip chain,
-// minus the screen's front-surface flare. Writes XYZ (cd/m^2) and 1.
+// minus the screen's front-surface flare. Two modes of one program: uMode 0 writes the
+// eye-independent part (diffuse XYZ, and E_geo, the illuminance on the panel plane, in alpha, on
+// every pixel of the panel) into a cache; uMode 1 reads it and writes XYZ (cd/m^2) and E_geo.
 extern const char* const kBoothXyzShader;
 
 constexpr int kBoothMaxLights = 256;           // std140 uniform block of vec4: 4 KiB
 constexpr int kBoothMaxHorizonDirections = 32; // local array in the shader
+constexpr int kBoothMaxSpecularSamples = 256;  // std140 uniform block of vec4: 4 KiB
 
 } // namespace replica::pipeline::render

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include <pipeline/brdf/ward.h>
 #include <pipeline/render/booth_shaders.h>
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/render/gl_program.h>
@@ -15,7 +16,14 @@
 namespace replica::pipeline::render {
 namespace {
 
-enum TextureUnit : GLint { kUnitCoeffA = 0, kUnitCoeffB, kUnitNormals, kUnitHorizon, kUnitLum };
+enum TextureUnit : GLint {
+    kUnitCoeffA = 0,
+    kUnitCoeffB,
+    kUnitNormals,
+    kUnitHorizon,
+    kUnitLum,
+    kUnitCache
+};
 
 // Float textures are read with texelFetch only: nearest sampling keeps them complete without the
 // float-filtering extension, and the shader does its own (border-0) bilinear where the model does.
@@ -197,12 +205,46 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     }
     glUniformBlockBinding(program_, block, 0);
 
+    // The specular samples' half vectors depend only on alpha and N: once here, in double.
+    const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
+    const int samples = specular ? settings_.specularSamples : 0;
+    if (samples > kBoothMaxSpecularSamples) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: {} specular samples; the GL pass takes at most {}",
+                                     samples, kBoothMaxSpecularSamples));
+    }
+    std::vector<float> table(static_cast<std::size_t>(kBoothMaxSpecularSamples) * 4, 0.0f);
+    for (int k = 0; k < samples; ++k) {
+        const double u1 = (k + 0.5) / samples;
+        const shading::Vec3 hl = brdf::sampleWardHalfVectorLocal(
+                s.alpha, u1, shading::radicalInverse2(static_cast<unsigned>(k)));
+        const double u = std::clamp(u1, brdf::kMinU1, 1.0);
+        const double w = 4.0 * std::numbers::pi * s.alpha * s.alpha * hl.z * hl.z * hl.z /
+                         (static_cast<double>(samples) * u);
+        const auto i = static_cast<std::size_t>(k) * 4;
+        table[i] = static_cast<float>(hl.x);
+        table[i + 1] = static_cast<float>(hl.y);
+        table[i + 2] = static_cast<float>(hl.z);
+        table[i + 3] = static_cast<float>(w);
+    }
+    glGenBuffers(1, &samplesUbo_);
+    glBindBuffer(GL_UNIFORM_BUFFER, samplesUbo_);
+    glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(table.size() * sizeof(float)),
+                 table.data(), GL_STATIC_DRAW);
+    const GLuint samplesBlock = glGetUniformBlockIndex(program_, "BoothSpecSamples");
+    if (samplesBlock == GL_INVALID_INDEX) {
+        return makeError(ErrorCode::Unsupported,
+                         "render: the booth shader has no specular sample block");
+    }
+    glUniformBlockBinding(program_, samplesBlock, 1);
+
     glUseProgram(program_);
     glUniform1i(loc(program_, "uCoeffA"), kUnitCoeffA);
     glUniform1i(loc(program_, "uCoeffB"), kUnitCoeffB);
     glUniform1i(loc(program_, "uNormals"), kUnitNormals);
     glUniform1i(loc(program_, "uHorizon"), kUnitHorizon);
     glUniform1i(loc(program_, "uLum"), kUnitLum);
+    glUniform1i(loc(program_, "uCache"), kUnitCache);
     glUniform2i(loc(program_, "uTexels"), s.width, s.height);
     glUniform2f(loc(program_, "uSizeM"), static_cast<float>(s.widthM),
                 static_cast<float>(s.heightM));
@@ -212,18 +254,18 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     glUniform1i(loc(program_, "uDiffuse"), settings_.diffusePass ? 1 : 0);
     glUniform1f(loc(program_, "uFlareRho"),
                 static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));
-    const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
-    glUniform1i(loc(program_, "uSpecSamples"), specular ? settings_.specularSamples : 0);
-    glUniform1f(loc(program_, "uAlpha"), static_cast<float>(s.alpha));
+    glUniform1i(loc(program_, "uSpecSamples"), samples);
     glUniform1i(loc(program_, "uWardModel"), wardModelIndex(s.model));
     return glCheck("uploading the scene");
 }
 
 BoothShadingPass::~BoothShadingPass()
 {
-    const std::array<GLuint, 5> textures{coeffA_, coeffB_, normals_, horizon_, lum_};
+    const std::array<GLuint, 6> textures{coeffA_, coeffB_, normals_, horizon_, lum_, cacheTexture_};
     glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+    glDeleteFramebuffers(1, &cacheFbo_);
     glDeleteBuffers(1, &lightsUbo_);
+    glDeleteBuffers(1, &samplesUbo_);
     glDeleteVertexArrays(1, &vao_);
     glDeleteProgram(program_);
 }
@@ -246,6 +288,7 @@ Expected<void> BoothShadingPass::setChannels(const shading::PreparedScene& ps)
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_FLOAT, a.data());
     glBindTexture(GL_TEXTURE_2D, coeffB_);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_FLOAT, b.data());
+    cacheValid_ = false; // the cached diffuse term was shaded from the old coefficients
     return glCheck("replacing the channel coefficients");
 }
 
@@ -256,6 +299,7 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
                          "render: the booth pass needs a prepared light");
     }
     light_ = &pl;
+    cacheValid_ = false;
     const booth::BoothLight& bl = *pl.light;
     const double a = bl.texelAreaM2();
     lightCount_ = static_cast<int>(std::min<std::size_t>(pl.points.size(), kBoothMaxLights));
@@ -321,13 +365,57 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     return glCheck("uploading the light");
 }
 
+void BoothShadingPass::setPose(const shading::PanelPose& panel) const
+{
+    set3(program_, "uCentre", panel.centre);
+    set3(program_, "uRight", panel.right);
+    set3(program_, "uUp", panel.up);
+    set3(program_, "uNormal", panel.normal);
+}
+
+Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
+{
+    if (cacheTexture_ != 0 && cacheWidth_ == width && cacheHeight_ == height) {
+        return {};
+    }
+    glDeleteFramebuffers(1, &cacheFbo_);
+    glDeleteTextures(1, &cacheTexture_);
+    glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
+    cacheTexture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &cacheFbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, cacheTexture_, 0);
+    const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    cacheWidth_ = width;
+    cacheHeight_ = height;
+    cacheValid_ = false;
+    if (!complete) {
+        return makeError(ErrorCode::Unsupported,
+                         "render: the booth pass's RGBA32F cache is not renderable on this GL");
+    }
+    return glCheck("creating the booth pass's cache");
+}
+
 Expected<void> BoothShadingPass::draw(const shading::View& view,
                                       int width,
                                       int height,
-                                      const SurfaceLayout& layout) const
+                                      const SurfaceLayout& layout,
+                                      const shading::PanelPose* cachePose) const
 {
     if (light_ == nullptr) {
         return makeError(ErrorCode::InvalidArgument, "render: booth pass drawn before setLight");
+    }
+    if (width <= 0 || height <= 0) {
+        return makeError(ErrorCode::InvalidArgument, "render: booth pass drawn into an empty "
+                                                     "viewport");
+    }
+    GLint target = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
+    const auto restore = [&] { glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target)); };
+    if (auto ok = ensureCacheTarget(width, height); !ok) {
+        restore();
+        return ok;
     }
     glViewport(0, 0, width, height);
     glBindVertexArray(vao_);
@@ -337,12 +425,9 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                 static_cast<float>(layout.offset.y));
     glUniform2f(loc(program_, "uSurfScale"), static_cast<float>(layout.scale.x),
                 static_cast<float>(layout.scale.y));
-    set3(program_, "uCentre", view.panel.centre);
-    set3(program_, "uRight", view.panel.right);
-    set3(program_, "uUp", view.panel.up);
-    set3(program_, "uNormal", view.panel.normal);
     set3(program_, "uEye", view.eye);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightsUbo_);
+    glBindBufferBase(GL_UNIFORM_BUFFER, 1, samplesUbo_);
     glActiveTexture(GL_TEXTURE0 + kUnitCoeffA);
     glBindTexture(GL_TEXTURE_2D, coeffA_);
     glActiveTexture(GL_TEXTURE0 + kUnitCoeffB);
@@ -353,28 +438,61 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     glBindTexture(GL_TEXTURE_2D_ARRAY, horizon_);
     glActiveTexture(GL_TEXTURE0 + kUnitLum);
     glBindTexture(GL_TEXTURE_2D, lum_);
-    // Pixels that show no surface are black: clear them and shade only the surface's rectangle
-    // (pixel u = (surface u - offset) / scale), widened by a pixel so that the shader's own
-    // bounds test decides every edge pixel exactly as it would without the scissor.
-    const auto span = [](double offset, double scale, int n) {
-        const double a = (0.0 - offset) / scale * n;
-        const double b = (1.0 - offset) / scale * n;
-        const int lo = std::clamp(static_cast<int>(std::floor(std::min(a, b))) - 1, 0, n);
-        const int hi = std::clamp(static_cast<int>(std::ceil(std::max(a, b))) + 1, 0, n);
-        return std::pair<int, int>(lo, hi);
-    };
-    const bool scissor = layout.scale.x > 0.0 && layout.scale.y > 0.0;
-    if (scissor) {
-        const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
-        const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
-        glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-        glClear(GL_COLOR_BUFFER_BIT);
-        glEnable(GL_SCISSOR_TEST);
-        glScissor(x0, height - r1, x1 - x0, r1 - r0);
+    glActiveTexture(GL_TEXTURE0 + kUnitCache);
+    glBindTexture(GL_TEXTURE_2D, 0); // not sampled while it is the render target
+
+    const shading::PanelPose& diffusePose = cachePose != nullptr ? *cachePose : view.panel;
+    const CacheKey key{diffusePose.centre,
+                       diffusePose.right,
+                       diffusePose.up,
+                       diffusePose.normal,
+                       width,
+                       height,
+                       layout.offset,
+                       layout.scale};
+    if (!cacheValid_ || !(key == cacheKey_)) {
+        // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare).
+        glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
+        setPose(diffusePose);
+        glUniform1i(loc(program_, "uMode"), 0);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        cacheKey_ = key;
+        cacheValid_ = true;
+        ++cacheRefreshes_;
     }
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    if (scissor) {
-        glDisable(GL_SCISSOR_TEST);
+    // The frame is the cache around the surface ((0, 0, 0) and E_geo) and, without a specular
+    // term or flare to add, on it too: copy it. Then compose the surface's rectangle (widened by a
+    // pixel so that the shader's own bounds test decides every edge pixel): the cached part, the
+    // specular term for this frame's pose and eye, minus the flare.
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, cacheFbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    restore();
+    const bool specular =
+            settings_.specularPass && scene_->scene->glossy() && settings_.specularSamples > 0;
+    if (specular || settings_.subtractFlare) {
+        const auto span = [](double offset, double scale, int n) {
+            const double a = (0.0 - offset) / scale * n;
+            const double b = (1.0 - offset) / scale * n;
+            const int lo = std::clamp(static_cast<int>(std::floor(std::min(a, b))) - 1, 0, n);
+            const int hi = std::clamp(static_cast<int>(std::ceil(std::max(a, b))) + 1, 0, n);
+            return std::pair<int, int>(lo, hi);
+        };
+        const bool scissor = layout.scale.x > 0.0 && layout.scale.y > 0.0;
+        if (scissor) {
+            const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
+            const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(x0, height - r1, x1 - x0, r1 - r0);
+        }
+        setPose(view.panel);
+        glUniform1i(loc(program_, "uMode"), 1);
+        glBindTexture(GL_TEXTURE_2D, cacheTexture_); // unit kUnitCache is active
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        if (scissor) {
+            glDisable(GL_SCISSOR_TEST);
+        }
     }
     glActiveTexture(GL_TEXTURE0);
     return glCheck("drawing the booth pass");

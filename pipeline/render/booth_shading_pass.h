@@ -54,15 +54,33 @@ public:
     // next call.
     Expected<void> setLight(const shading::PreparedLight& light);
 
-    // Draws into the bound framebuffer (viewport width x height, an RGBA32F colour target).
-    Expected<void>
-    draw(const shading::View& view, int width, int height, const SurfaceLayout& layout = {}) const;
+    // Draws into the bound framebuffer (viewport width x height, an RGBA32F colour target): XYZ
+    // (cd/m^2) and, in alpha, E_geo (lux on the panel plane, every pixel: pass 2's flare term).
+    // The eye-independent part (eq. 1 and 2, E_geo) is kept in a cache of the viewport's size and
+    // recomputed only when the light, the size, the layout or its pose differs from the cached
+    // one (exactly), or after invalidateCache(); its pose is cachePose when given (a pose held
+    // against sensor noise: booth_scene_pass.h), else view.panel. Every draw then adds the
+    // specular term for view.eye and view.panel. A frame drawn from the cache is bit-identical
+    // to one that recomputes it.
+    Expected<void> draw(const shading::View& view,
+                        int width,
+                        int height,
+                        const SurfaceLayout& layout = {},
+                        const shading::PanelPose* cachePose = nullptr) const;
+
+    // Forces the next draw to recompute the cached part (e.g. after the channel encoding of the
+    // scene's textures changed under the pass).
+    void invalidateCache() const { cacheValid_ = false; }
+    // How many draws recomputed the cached part so far.
+    long cacheRefreshes() const { return cacheRefreshes_; }
 
     const shading::RenderSettings& settings() const { return settings_; }
 
 private:
     BoothShadingPass() = default;
     Expected<void> init(const shading::PreparedScene& scene);
+    Expected<void> ensureCacheTarget(int width, int height) const;
+    void setPose(const shading::PanelPose& panel) const;
 
     shading::RenderSettings settings_;
     const shading::PreparedScene* scene_ = nullptr;
@@ -76,7 +94,22 @@ private:
     GLuint program_ = 0;
     GLuint vao_ = 0;
     GLuint lightsUbo_ = 0;
+    GLuint samplesUbo_ = 0;
     GLuint coeffA_ = 0, coeffB_ = 0, normals_ = 0, horizon_ = 0, lum_ = 0;
+
+    // The cache of the eye-independent part and what it was drawn for.
+    struct CacheKey {
+        shading::Vec3 centre{0.0}, right{0.0}, up{0.0}, normal{0.0};
+        int width = 0, height = 0;
+        glm::dvec2 offset{0.0}, scale{0.0};
+        bool operator==(const CacheKey&) const = default;
+    };
+    mutable CacheKey cacheKey_;
+    mutable bool cacheValid_ = false;
+    mutable long cacheRefreshes_ = 0;
+    mutable GLuint cacheTexture_ = 0;
+    mutable GLuint cacheFbo_ = 0;
+    mutable int cacheWidth_ = 0, cacheHeight_ = 0;
 };
 
 // An RGBA32F render target with read-back into an XyzFrame (rows top-down, like the CPU model):

@@ -36,6 +36,7 @@ uniform int uDispLightCount;
 uniform vec4 uDispLights[256];  // xyz: position (m); w: intensity (cd)
 uniform vec3 uDispLightNormal;
 uniform vec3 uDispFlarePerLux;  // rho_d / pi times the light's XYZ with Y = 1; 0 when off
+uniform int uDispIlluminanceInAlpha; // 1: E (lux) is the XYZ texel's alpha (pass 1 wrote it)
 )";
 
 // Flare first (the reflection reaches the eye whatever the panel emits), then the viewing-angle
@@ -45,9 +46,12 @@ const vec3 kFalseColour[4] = vec3[4](vec3(0.0), vec3(1.0, 0.0, 1.0), vec3(0.0, 1
                                      vec3(0.0, 0.3, 1.0));
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec3 xyz = texelFetch(uXyz, px, 0).xyz;
+    vec4 texel = texelFetch(uXyz, px, 0);
+    vec3 xyz = texel.xyz;
     vec3 p = uDispPanelOrigin + vUv.x * uDispPanelRight + vUv.y * uDispPanelUp;
-    if (any(notEqual(uDispFlarePerLux, vec3(0.0)))) {
+    if (uDispIlluminanceInAlpha != 0) {
+        xyz -= texel.w * uDispFlarePerLux;
+    } else if (any(notEqual(uDispFlarePerLux, vec3(0.0)))) {
         float e = 0.0;
         for (int i = 0; i < uDispLightCount; ++i) {
             vec3 d = uDispLights[i].xyz - p;
@@ -268,7 +272,8 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     setVec3(program_, "uDispPanelUp", frame.pose.upM);
     setVec3(program_, "uDispPanelNormal", frame.pose.normal);
     setVec3(program_, "uDispLightNormal", frame.lightNormal);
-    const int lights = frame.lights != nullptr ? frame.lightCount : 0;
+    setInt(program_, "uDispIlluminanceInAlpha", frame.illuminanceInAlpha ? 1 : 0);
+    const int lights = frame.lights != nullptr && !frame.illuminanceInAlpha ? frame.lightCount : 0;
     setInt(program_, "uDispLightCount", lights);
     if (lights > 0) {
         glUniform4fv(glGetUniformLocation(program_, "uDispLights"), lights, frame.lights->data());

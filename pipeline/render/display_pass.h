@@ -43,6 +43,9 @@ struct DisplayPassFrame {
     int lightCount = 0;
     glm::dvec3 lightNormal{0.0, -1.0, 0.0};
     glm::dvec3 lightXyzUnitY{0.0}; // the booth light's colour, Y = 1
+    // Take the illuminance on the panel (lux) from the XYZ texture's alpha, where pass 1 wrote
+    // it, instead of summing 'lights' again per pixel.
+    bool illuminanceInAlpha = false;
 };
 
 class DisplayPass

@@ -153,19 +153,25 @@ public:
     {
         const int w = setup_.width;
         const int h = setup_.height;
-        // The panel pose and the uniform grid of lights: pass 1 of the flat image and pass 2's
-        // flare estimate use them.
+        // The panel pose and, for the flat image, the uniform grid of lights: its pass 1 and
+        // pass 2's flare estimate use them. The booth pass writes the illuminance on the panel
+        // itself (the XYZ target's alpha), from the booth model's lights.
         const scene::PanelPose pose = scene::panelPose(setup_.stand, state.tiltRad);
-        const auto lights = scene::uniformGridLights(
-                setup_.booth.emitter, state.emitterLuminanceCdM2, setup_.lightsU, setup_.lightsV);
-        const int count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
         std::vector<float> packed;
-        packed.reserve(static_cast<std::size_t>(count) * 4);
-        for (int i = 0; i < count; ++i) {
-            const auto& l = lights[static_cast<std::size_t>(i)];
-            packed.insert(packed.end(),
-                          {static_cast<float>(l.positionM.x), static_cast<float>(l.positionM.y),
-                           static_cast<float>(l.positionM.z), static_cast<float>(l.intensityCd)});
+        int count = 0;
+        if (!setup_.boothScene) {
+            const auto lights =
+                    scene::uniformGridLights(setup_.booth.emitter, state.emitterLuminanceCdM2,
+                                             setup_.lightsU, setup_.lightsV);
+            count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
+            packed.reserve(static_cast<std::size_t>(count) * 4);
+            for (int i = 0; i < count; ++i) {
+                const auto& l = lights[static_cast<std::size_t>(i)];
+                packed.insert(packed.end(),
+                              {static_cast<float>(l.positionM.x), static_cast<float>(l.positionM.y),
+                               static_cast<float>(l.positionM.z),
+                               static_cast<float>(l.intensityCd)});
+            }
         }
         glViewport(0, 0, w, h);
 
@@ -188,6 +194,7 @@ public:
         df.lights = &packed;
         df.lightCount = count;
         df.lightNormal = setup_.booth.emitter.normal;
+        df.illuminanceInAlpha = setup_.boothScene != nullptr;
         const colour::Xyz lightXyz = colour::spectrumToXyz(setup_.observer, state.illuminant);
         df.lightXyzUnitY = lightXyz.y > 0.0 ? lightXyz / lightXyz.y : glm::dvec3(0.0);
         auto gamut = displayPass_.draw(xyzTarget_, df);

@@ -1,8 +1,10 @@
 // The shipped booth and its simplest point-light decomposition.
 #include <filesystem>
 
+#include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/scene/booth.h>
 
@@ -29,6 +31,30 @@ Expected<Booth> loadDefaultBooth(const std::string& dataDir)
         }
         lamp.spectrum = *s;
     }
+    // One geometry for the whole appliance: the ceiling of the booth model (data/booth), which
+    // the booth renderer lights the surface with.
+    const auto boothDir = std::filesystem::path(dataDir) / "booth";
+    auto model = booth::loadBooth(boothDir);
+    if (!model) {
+        return tl::unexpected(model.error());
+    }
+    if (model->lights.empty()) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: the booth model has no lights", boothDir.string()));
+    }
+    const booth::BoothLight& first = model->lights.front();
+    for (const auto& l : model->lights) {
+        if (l.centre != first.centre || l.edgeU != first.edgeU || l.edgeV != first.edgeV) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: light '{}' has another ceiling than '{}'; the "
+                                         "appliance's booth has one emitter for all its lamps",
+                                         (boothDir / "booth.json").string(), l.name, first.name));
+        }
+    }
+    booth.emitter.centreM = first.centre;
+    booth.emitter.edgeUM = first.edgeU;
+    booth.emitter.edgeVM = first.edgeV;
+    booth.emitter.normal = first.normal();
     return booth;
 }
 

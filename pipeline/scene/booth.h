@@ -13,10 +13,11 @@ namespace replica::pipeline::scene {
 
 // Booth frame: right-handed, metres; origin on the booth floor at its centre, x to the right, y up,
 // z out of the booth towards the viewer.
+// The defaults are the shipped booth model's ceiling; loadDefaultBooth reads them from it.
 struct Emitter {
-    glm::dvec3 centreM{0.0, 0.90, -0.10};
+    glm::dvec3 centreM{0.0, 0.62, -0.05};
     glm::dvec3 edgeUM{1.00, 0.0, 0.0}; // full edge vectors: the emitter spans centre +- edge/2
-    glm::dvec3 edgeVM{0.0, 0.0, 0.60};
+    glm::dvec3 edgeVM{0.0, 0.0, 0.50};
     glm::dvec3 normal{0.0, -1.0, 0.0}; // emits downwards into the booth
 };
 
@@ -35,7 +36,10 @@ struct Booth {
 };
 
 // The booth the appliance ships with: tungsten (CIE A), D50 fluorescent simulator (CIE F8) and D65
-// fluorescent simulator (CIE F7) behind one diffuser. Spectra are read from dataDir/spectra.
+// fluorescent simulator (CIE F7) behind one diffuser. Spectra are read from dataDir/spectra; the
+// emitter's geometry is the booth model's ceiling (dataDir/booth/booth.json), so that the flat
+// renderer, pass 2 and the booth renderer share one booth. Fails when the model's lights do not
+// share one ceiling.
 Expected<Booth> loadDefaultBooth(const std::string& dataDir);
 
 // A point light standing for part of the emitter (paper eq. 1): its position, and L * a (cd), the

@@ -24,7 +24,7 @@ enum class ChannelRep {
 
 struct RenderSettings {
     int lights = 32;
-    int specularSamples = 16;
+    int specularSamples = 48;
     int horizonDirections = 8;
     ChannelRep channels = ChannelRep::Basis6;
     bool diffusePass = true;

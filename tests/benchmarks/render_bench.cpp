@@ -3,12 +3,15 @@
 // samples 1-64, horizon directions, channel representation), ms per 1920x1200 frame measured on
 // the GPU path and CIEDE2000 mean / 95th / max against the exact reference on an error frame;
 // the planner's choice and its saving; a Pareto-front PNG.
-// Usage: replica_bench_render [OUT_DIR] [WIDTHxHEIGHT of the error frame, default 64x40] [SCENE]
-// (SCENE: only that shipped scene, e.g. metamer; default all three)
+// Usage: replica_bench_render [OUT_DIR] [WIDTHxHEIGHT of the error frame, default 64x40]
+//        [--defaults-only [SPECULAR_SAMPLES]: the default setting (or it with that many specular
+//        samples) under every scene and light; no sweep, no planner, no plot]
+//        [--scene NAME: only that shipped scene, e.g. metamer (last, after the options above)]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -153,6 +156,8 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "error frame: expected WIDTHxHEIGHT\n");
         return 2;
     }
+    const bool defaultsOnly = argc > 3 && std::string(argv[3]) == "--defaults-only";
+    const int defaultSamples = defaultsOnly && argc > 4 ? std::atoi(argv[4]) : 0;
     std::filesystem::create_directories(outDir);
     auto output = platform::createHeadlessOutput();
     auto obs = colour::loadCie1931(dataDir());
@@ -175,7 +180,12 @@ int main(int argc, char** argv)
                 "|\n|---|---|---|---|---|---|---|\n");
     std::vector<Point> pareto;
     std::vector<std::string> planLines;
-    const std::string only = argc > 3 ? argv[3] : "";
+    std::string only;
+    for (int a = 3; a + 1 < argc; ++a) {
+        if (std::string(argv[a]) == "--scene") {
+            only = argv[a + 1];
+        }
+    }
     for (const char* sceneName : {"colorchecker", "metamer", "painting"}) {
         if (!only.empty() && only != sceneName) {
             continue;
@@ -191,11 +201,14 @@ int main(int argc, char** argv)
             view.pixelsX = fw;
             view.pixelsY = fh;
             const auto ref = reference::renderReference(*scene, light, view, *obs);
-            const shading::RenderSettings def;
+            shading::RenderSettings def;
+            if (defaultSamples > 0) {
+                def.specularSamples = defaultSamples;
+            }
             std::vector<std::pair<std::string, shading::RenderSettings>> configs;
             configs.emplace_back("default (" + describe(def, *scene) + ")", def);
             // The whole sweep under the hardest light (tubes); the default alone under the others.
-            const bool sweep = light.name == "d65-fluorescent";
+            const bool sweep = !defaultsOnly && light.name == "d65-fluorescent";
             for (int n : sweep ? std::vector<int>{8, 128, 256} : std::vector<int>{}) {
                 auto s = def;
                 s.lights = n;
@@ -311,6 +324,9 @@ int main(int argc, char** argv)
                 }
             }
         }
+    }
+    if (defaultsOnly) {
+        return 0;
     }
     std::printf("\n## planner (budget dE00 p95 <= 1, max <= 3)\n\n| scene | light | chosen | "
                 "skipped | candidates tried | ms 1920x1200 | default ms | saving x | fps 960x600 "

@@ -1,0 +1,243 @@
+// The booth pass's cache of its eye-independent part: a frame drawn from the cache equals one that
+// recomputes it, the cache follows light, pose and size, a held tilt costs a bounded ΔE00, and
+// pass 1's illuminance in alpha is E_geo on every pixel of the panel.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <numbers>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/reference/frame_error.h>
+#include <pipeline/render/booth_scene_pass.h>
+#include <platform/output/output.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::pipeline::render {
+namespace {
+
+constexpr int kW = 60, kH = 36;
+
+// Every float of the RGBA32F target (alpha included), rows as GL has them.
+std::vector<float> readAll(const XyzTarget& t)
+{
+    std::vector<float> px(static_cast<std::size_t>(t.width()) * t.height() * 4);
+    t.bind();
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, t.width(), t.height(), GL_RGBA, GL_FLOAT, px.data());
+    return px;
+}
+
+class BoothCacheTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        auto out = platform::createHeadlessOutput();
+        if (!out) {
+            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        }
+        output_ = std::move(*out);
+        setup_.booth = *booth::loadBooth(dataDir() / "booth");
+        setup_.lamps = {"tungsten", "d50-fluorescent", "d65-fluorescent"};
+        setup_.scene = *surface::loadScene(dataDir() / "scenes" / "colorchecker"); // glossy
+        setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
+        setup_.observer = *colour::loadCie1931(dataDir());
+        setup_.settings.lights = 16;
+        setup_.settings.specularSamples = 8;
+        setup_.settings.subtractFlare = false; // as in the appliance: pass 2 subtracts it
+        auto t = XyzTarget::create(kW, kH);
+        ASSERT_TRUE(t);
+        target_ = std::move(*t);
+    }
+
+    std::vector<float> draw(BoothScenePass& pass, const scene::SceneState& st)
+    {
+        target_->bind();
+        auto ok = pass.draw(st, kW, kH);
+        EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
+        return readAll(*target_);
+    }
+
+    static scene::SceneState state(double tiltRad, glm::dvec3 eye, int lamp = 2)
+    {
+        scene::SceneState st;
+        st.lampIndex = lamp;
+        st.tiltRad = tiltRad;
+        st.eyeBoothM = eye;
+        return st;
+    }
+
+    std::unique_ptr<platform::Output> output_;
+    std::unique_ptr<XyzTarget> target_;
+    BoothSceneSetup setup_;
+};
+
+TEST_F(BoothCacheTest, AFrameFromTheCacheEqualsOneThatRecomputesIt)
+{
+    auto a = BoothScenePass::create(setup_);
+    auto b = BoothScenePass::create(setup_);
+    ASSERT_TRUE(a && b);
+    const glm::dvec3 eye1{-0.15, 0.45, 0.60};
+    const glm::dvec3 eye2{0.20, 0.40, 0.55};
+    const auto first = draw(**a, state(0.35, eye1));
+    const auto cached = draw(**a, state(0.35, eye2)); // the eye moved: only the specular term
+    EXPECT_EQ((*a)->cacheRefreshes(), 1);
+    const auto fresh = draw(**b, state(0.35, eye2));
+    EXPECT_EQ((*b)->cacheRefreshes(), 1);
+    ASSERT_EQ(cached.size(), fresh.size());
+    long differ = 0;
+    for (std::size_t i = 0; i < cached.size(); ++i) {
+        ASSERT_EQ(cached[i], fresh[i]) << "float " << i; // bit for bit, alpha too
+        differ += cached[i] != first[i] ? 1 : 0;
+    }
+    // The glossy surface does change with the eye (the cache is not hiding the specular term).
+    EXPECT_GT(differ, kW * kH / 10);
+}
+
+TEST_F(BoothCacheTest, TiltNoiseIsHeldAndLightPoseAndInvalidationRefresh)
+{
+    auto pass = BoothScenePass::create(setup_);
+    ASSERT_TRUE(pass);
+    const glm::dvec3 eye{0.0, 0.45, 0.60};
+    const double deg = std::numbers::pi / 180.0;
+    const double tilt0 = 0.35;
+    draw(**pass, state(tilt0, eye));
+    EXPECT_EQ((*pass)->cacheRefreshes(), 1);
+    EXPECT_EQ((*pass)->heldTiltRad(), tilt0);
+    // Sensor noise of +-0.25 degrees (twice the accelerometer's): the mean stays within the hold.
+    std::vector<float> held;
+    for (int i = 0; i < 24; ++i) {
+        held = draw(**pass, state(tilt0 + (i % 2 == 0 ? 0.25 : -0.25) * deg, eye));
+    }
+    EXPECT_EQ((*pass)->cacheRefreshes(), 1);
+    EXPECT_EQ((*pass)->heldTiltRad(), tilt0);
+    // The held frame's cached part (alpha: E_geo) is that of the held tilt, whatever the sensed
+    // one was; its specular part follows the sensed tilt.
+    auto fresh = BoothScenePass::create(setup_);
+    ASSERT_TRUE(fresh);
+    const auto want = draw(**fresh, state(tilt0, eye));
+    ASSERT_EQ(want.size(), held.size());
+    for (std::size_t i = 3; i < want.size(); i += 4) {
+        ASSERT_EQ(want[i], held[i]) << "pixel " << i / 4;
+    }
+    // A real move of 1 degree: recomputed, and held within the hold of the new tilt.
+    for (int i = 0; i < 24; ++i) {
+        draw(**pass, state(tilt0 + 1.0 * deg, eye));
+    }
+    const long afterMove = (*pass)->cacheRefreshes();
+    EXPECT_GE(afterMove, 2);
+    EXPECT_LE(std::abs((*pass)->heldTiltRad() - (tilt0 + 1.0 * deg)), kTiltHoldRad);
+    // A non-finite tilt changes nothing.
+    draw(**pass, state(std::nan(""), eye));
+    EXPECT_EQ((*pass)->cacheRefreshes(), afterMove);
+    // A lamp change recomputes.
+    draw(**pass, state(tilt0 + 1.0 * deg, eye, 0));
+    EXPECT_EQ((*pass)->cacheRefreshes(), afterMove + 1);
+    // An explicit invalidation (a new channel encoding) recomputes.
+    (*pass)->invalidateCache();
+    draw(**pass, state(tilt0 + 1.0 * deg, eye, 0));
+    EXPECT_EQ((*pass)->cacheRefreshes(), afterMove + 2);
+}
+
+TEST_F(BoothCacheTest, TheHeldTiltIsADeterministicFunctionOfTheStates)
+{
+    // What replay relies on: two passes fed the same states draw the same frames.
+    auto a = BoothScenePass::create(setup_);
+    auto b = BoothScenePass::create(setup_);
+    ASSERT_TRUE(a && b);
+    std::uint32_t x = 12345u;
+    for (int i = 0; i < 40; ++i) {
+        x = x * 1664525u + 1013904223u; // a fixed pseudo-random walk of tilt and eye
+        const double jitter = (static_cast<double>(x >> 8) / 16777216.0 - 0.5) * 0.02;
+        const scene::SceneState st = state(0.3 + 0.004 * i + jitter, {0.01 * i, 0.45, 0.6});
+        const auto fa = draw(**a, st);
+        const auto fb = draw(**b, st);
+        ASSERT_EQ(fa, fb) << "frame " << i;
+    }
+    EXPECT_EQ((*a)->cacheRefreshes(), (*b)->cacheRefreshes());
+    EXPECT_GT((*a)->cacheRefreshes(), 1);
+    EXPECT_LT((*a)->cacheRefreshes(), 40);
+}
+
+TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
+{
+    auto pass = BoothScenePass::create(setup_);
+    ASSERT_TRUE(pass);
+    const scene::SceneState st = state(0.35, {0.0, 0.45, 0.60});
+    const auto px = draw(**pass, st);
+    // Independent value: eq. (1) with the macro normal over the same median-cut lights, in
+    // double, at the pixel centre on the panel plane (around the surface too).
+    const auto light = shading::prepareLight(*setup_.booth.find("d65-fluorescent"), setup_.observer,
+                                             setup_.settings.lights, setup_.basis);
+    const auto panel = shading::panelPoseFromTilt(setup_.stand, 0.35 * 180.0 / std::numbers::pi);
+    const SurfaceLayout layout = layoutOnPanel(setup_.scene, setup_.stand);
+    const booth::BoothLight& bl = *light.light;
+    double worst = 0.0;
+    int outside = 0;
+    for (int y = 0; y < kH; y += 5) {
+        for (int x = 0; x < kW; x += 7) {
+            const double u = layout.offset.x + layout.scale.x * (x + 0.5) / kW;
+            const double v = layout.offset.y + layout.scale.y * (1.0 - (y + 0.5) / kH);
+            outside += (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) ? 1 : 0;
+            const shading::Vec3 p = panel.centre + panel.right * ((u - 0.5) * setup_.scene.widthM) +
+                                    panel.up * ((0.5 - v) * setup_.scene.heightM);
+            const double e = shading::pointLightIrradiance(
+                    light.points, bl.normal(), bl.texelAreaM2(), p, panel.normal, panel.normal,
+                    nullptr, 0, 0, panel.right, panel.up, 0.0);
+            const float got = px[(static_cast<std::size_t>(y) * kW + x) * 4 + 3];
+            ASSERT_GT(e, 0.0);
+            worst = std::max(worst, std::abs(got - e) / e);
+        }
+    }
+    EXPECT_GT(outside, 0); // the check covered pixels around the surface
+    EXPECT_LT(worst, 1e-4);
+}
+
+// The hold's price: the diffuse term (what the cache holds; the specular term follows the sensed
+// tilt) rendered at a tilt kTiltHoldRad away from the true one, against the same term at the true
+// tilt (CPU model, every shipped scene and light, over the sim's tilt range).
+TEST(TiltHold, CostsTheDiffuseTermAFifthOfADeltaE00AtMost)
+{
+    const auto obs = *colour::loadCie1931(dataDir());
+    const auto boothModel = *booth::loadBooth(dataDir() / "booth");
+    const auto basis = *colour::loadDefaultChannelBasis(dataDir());
+    shading::RenderSettings settings;
+    settings.specularPass = false;
+    double worstP95 = 0.0, worstP95Upright = 0.0, worstMax = 0.0;
+    for (const char* name : {"colorchecker", "metamer", "painting"}) {
+        const auto scene = *surface::loadScene(dataDir() / "scenes" / name);
+        const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, basis);
+        for (const auto& l : boothModel.lights) {
+            const auto pl = shading::prepareLight(l, obs, settings.lights, basis);
+            for (const double tiltDeg : {5.0, 20.0, 35.0}) {
+                shading::View truth;
+                truth.pixelsX = 32;
+                truth.pixelsY = 20;
+                truth.panel = shading::panelPoseFromTilt(tiltDeg);
+                shading::View held = truth;
+                held.panel = shading::panelPoseFromTilt(tiltDeg +
+                                                        kTiltHoldRad * 180.0 / std::numbers::pi);
+                const auto a = shading::renderRealtime(ps, pl, truth, obs, settings);
+                const auto b = shading::renderRealtime(ps, pl, held, obs, settings);
+                const auto e = reference::compareFrames(a, b);
+                worstP95 = std::max(worstP95, e.p95);
+                worstMax = std::max(worstMax, e.max);
+                if (tiltDeg >= 20.0) {
+                    worstP95Upright = std::max(worstP95Upright, e.p95);
+                }
+            }
+        }
+    }
+    std::printf("tilt hold %.2f deg: diffuse dE00 p95 <= %.3f (5-35 deg), <= %.3f (20-35 deg); "
+                "max %.3f\n",
+                kTiltHoldRad * 180.0 / std::numbers::pi, worstP95, worstP95Upright, worstMax);
+    // Measured 0.248 and 0.108 (docs/rendering.md); the max (1.13) is the painting's relief at 5
+    // degrees, where a facet's horizon shadow edge moves.
+    EXPECT_LT(worstP95, 0.25);
+    EXPECT_LT(worstP95Upright, 0.125);
+    EXPECT_GT(worstP95, 0.0); // the pose does matter
+}
+
+} // namespace
+} // namespace replica::pipeline::render

@@ -1,0 +1,66 @@
+// The appliance's booth (scene::Booth) and the booth model (data/booth) are one booth: the same
+// ceiling for the flat renderer, pass 2's flare and the booth renderer.
+#include <filesystem>
+
+#include <glm/geometric.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/booth/booth_generator.h>
+#include <pipeline/booth/booth_model.h>
+#include <pipeline/scene/booth.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::pipeline::scene {
+namespace {
+
+TEST(DefaultBooth, HasTheBoothModelsCeiling)
+{
+    auto b = loadDefaultBooth(dataDir().string());
+    ASSERT_TRUE(b) << b.error().message;
+    auto model = booth::loadBooth(dataDir() / "booth");
+    ASSERT_TRUE(model) << model.error().message;
+    ASSERT_FALSE(model->lights.empty());
+    for (const auto& l : model->lights) {
+        EXPECT_EQ(b->emitter.centreM, l.centre) << l.name;
+        EXPECT_EQ(b->emitter.edgeUM, l.edgeU) << l.name;
+        EXPECT_EQ(b->emitter.edgeVM, l.edgeV) << l.name;
+        EXPECT_EQ(b->emitter.normal, l.normal()) << l.name;
+        // Every lamp of the appliance has its light in the model.
+    }
+    for (const auto& lamp : b->lamps) {
+        EXPECT_NE(model->find(lamp.name), nullptr) << lamp.name;
+    }
+    // The generator that made data/booth and the built-in default agree too.
+    const booth::CeilingGeometry g;
+    const Emitter e;
+    EXPECT_EQ(e.centreM, g.centre);
+    EXPECT_DOUBLE_EQ(glm::length(e.edgeUM), g.widthM);
+    EXPECT_DOUBLE_EQ(glm::length(e.edgeVM), g.depthM);
+    EXPECT_EQ(e.centreM, b->emitter.centreM);
+    EXPECT_EQ(e.edgeUM, b->emitter.edgeUM);
+    EXPECT_EQ(e.edgeVM, b->emitter.edgeVM);
+    // Emits downwards into the booth.
+    EXPECT_DOUBLE_EQ(b->emitter.normal.y, -1.0);
+}
+
+TEST(DefaultBooth, RefusesAModelWhoseLightsHaveTwoCeilings)
+{
+    const auto dir = std::filesystem::temp_directory_path() / "replica_two_ceilings";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy(dataDir() / "spectra", dir / "spectra");
+    auto model = booth::loadBooth(dataDir() / "booth");
+    ASSERT_TRUE(model);
+    model->lights.back().centre.y += 0.1;
+    ASSERT_TRUE(booth::saveBooth(dir / "booth", *model));
+    auto b = loadDefaultBooth(dir.string());
+    ASSERT_FALSE(b);
+    EXPECT_NE(b.error().message.find("booth.json: light 'd65-fluorescent' has another ceiling"),
+              std::string::npos)
+            << b.error().message;
+    std::filesystem::remove_all(dir);
+}
+
+} // namespace
+} // namespace replica::pipeline::scene
