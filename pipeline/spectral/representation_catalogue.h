@@ -12,12 +12,16 @@
 
 namespace replica::pipeline::spectral {
 
-// "rgb3" (1), "paper6" (2), "replica_k6" (3, the appliance's default), "adaptive_k6" (3 re-encoded
-// for each light, adaptive_encoding.h), "spectral36" (4), and for comparison "general_k6"
-// (light-aware, all training lights equal), "pca6" (principal components, light-independent) and
-// "box6" (six box bands).
+// "rgb3" (1), "paper6" (2), "replica_k6" (3 with one basis fitted for all lights, shipped in
+// data/channels/), "adaptive_k6" (3 re-encoded for each light, adaptive_encoding.h; the
+// appliance's default), "spectral36" (4), and for comparison "general_k6" (light-aware, all
+// training lights equal), "pca6" (principal components, light-independent) and "box6" (six box
+// bands).
 std::vector<std::string> representationNames();
+// The fixed basis 'replica spectral fit' derives and ships (data/channels/replica_k6.csv).
 constexpr const char* kDefaultRepresentation = "replica_k6";
+// What the appliance renders with and 'replica spectral eval' reports unless told otherwise.
+constexpr const char* kApplianceRepresentation = "adaptive_k6";
 
 Expected<std::unique_ptr<Representation>> makeRepresentation(const std::filesystem::path& dataDir,
                                                              const Observer& obs,

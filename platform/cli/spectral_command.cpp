@@ -33,7 +33,7 @@ namespace spectral = pipeline::spectral;
 struct EvalOptions {
     std::string illuminant;
     std::string reflectances;
-    std::string representation = spectral::kDefaultRepresentation;
+    std::string representation = spectral::kApplianceRepresentation;
     std::string encodedFor; // adaptive representations: the light the surfaces were encoded for
     bool json = false;
 };
