@@ -70,21 +70,8 @@ LampSelectorReader::LampSelectorReader(std::unique_ptr<GpioLines> lines,
                                        const Clock& clock,
                                        std::int64_t debounceNs)
     : lines_(std::move(lines)), lineCount_(static_cast<std::uint32_t>(lineCount)),
-      mask_(lineCount >= 32 ? 0xffffffffu : ((1u << lineCount) - 1u)), clock_(clock),
-      debouncer_(debounceNs)
+      mask_(lineMask(lineCount)), clock_(clock), debouncer_(debounceNs)
 {}
-
-LampSample
-LampSelectorReader::sample(std::uint32_t levels, std::int64_t tNs, std::uint32_t sequence) const
-{
-    LampSample s;
-    s.timestampNs = tNs;
-    s.sequence = sequence;
-    s.lineLevels = levels & mask_;
-    s.lineCount = lineCount_;
-    s.lamp = decodeOneHot(s.lineLevels);
-    return s;
-}
 
 Expected<LampSample> LampSelectorReader::start(std::uint32_t sequence)
 {
@@ -93,7 +80,7 @@ Expected<LampSample> LampSelectorReader::start(std::uint32_t sequence)
         return tl::unexpected(levels.error());
     }
     const auto settled = debouncer_.start(*levels & mask_, clock_.nowNs());
-    return sample(settled.levels, settled.settledNs, sequence);
+    return settledSample(settled, lineCount_, sequence);
 }
 
 Expected<std::optional<LampSample>> LampSelectorReader::step(std::int64_t maxWaitNs,
@@ -117,7 +104,7 @@ Expected<std::optional<LampSample>> LampSelectorReader::step(std::int64_t maxWai
         debouncer_.observe(*levels & mask_, clock_.nowNs());
     }
     if (const auto settled = debouncer_.settle(clock_.nowNs())) {
-        return std::optional<LampSample>(sample(settled->levels, settled->settledNs, sequence));
+        return std::optional<LampSample>(settledSample(*settled, lineCount_, sequence));
     }
     return std::optional<LampSample>();
 }

@@ -35,8 +35,6 @@ public:
     const GpioLines& lines() const { return *lines_; }
 
 private:
-    LampSample sample(std::uint32_t levels, std::int64_t tNs, std::uint32_t sequence) const;
-
     std::unique_ptr<GpioLines> lines_;
     std::uint32_t lineCount_;
     std::uint32_t mask_;

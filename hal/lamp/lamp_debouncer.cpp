@@ -17,6 +17,23 @@ int decodeOneHot(std::uint32_t levels)
     return std::countr_zero(levels);
 }
 
+std::uint32_t lineMask(std::size_t lineCount)
+{
+    return lineCount >= 32 ? 0xffffffffu : ((1u << lineCount) - 1u);
+}
+
+LampSample
+settledSample(const SettledLevels& settled, std::uint32_t lineCount, std::uint32_t sequence)
+{
+    LampSample s;
+    s.timestampNs = settled.settledNs;
+    s.sequence = sequence;
+    s.lineLevels = settled.levels & lineMask(lineCount);
+    s.lineCount = lineCount;
+    s.lamp = decodeOneHot(s.lineLevels);
+    return s;
+}
+
 LampDebouncer::LampDebouncer(std::int64_t debounceNs) : debounceNs_(debounceNs > 0 ? debounceNs : 0)
 {}
 

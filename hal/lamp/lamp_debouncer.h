@@ -3,8 +3,11 @@
 // and the simulator share it and tests can feed it exact edge times.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
+
+#include <hal/samples.h>
 
 namespace replica::hal::lamp {
 
@@ -20,6 +23,14 @@ struct SettledLevels {
     std::uint32_t levels = 0;
     std::int64_t settledNs = 0; // when they became stable plus the debounce time
 };
+
+// The bits of a switch's lineCount lines (all 32 from 32 up).
+std::uint32_t lineMask(std::size_t lineCount);
+
+// The sample a settled position gives on a switch of lineCount lines (levels beyond them
+// ignored): what the live driver and the simulator both report.
+LampSample
+settledSample(const SettledLevels& settled, std::uint32_t lineCount, std::uint32_t sequence);
 
 class LampDebouncer
 {

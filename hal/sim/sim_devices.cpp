@@ -249,13 +249,7 @@ private:
 
     LampSample make(const lamp::SettledLevels& s)
     {
-        LampSample out;
-        out.timestampNs = s.settledNs;
-        out.sequence = sequence_++;
-        out.lineLevels = s.levels;
-        out.lineCount = static_cast<std::uint32_t>(lineCount_);
-        out.lamp = lamp::decodeOneHot(s.levels);
-        return out;
+        return lamp::settledSample(s, static_cast<std::uint32_t>(lineCount_), sequence_++);
     }
 
     // The edges of turn k at tNs, from its own noise stream so that they do not depend on how the
