@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/image/exr.h>
@@ -24,7 +25,12 @@ struct CliResult {
 
 CliResult run(const std::string& args)
 {
-    const auto errFile = std::filesystem::temp_directory_path() / "replica_render_cli_err.txt";
+    // One file per process and call: ctest runs this binary's tests side by side, and a shared
+    // name let one test read another's (or a truncated) stderr.
+    static int calls = 0;
+    const auto errFile = std::filesystem::temp_directory_path() /
+                         ("replica_render_cli_err_" + std::to_string(::getpid()) + "_" +
+                          std::to_string(calls++) + ".txt");
     const std::string cmd =
             std::string(REPLICA_BINARY) + " " + args + " >/dev/null 2>" + errFile.string();
     const int status = std::system(cmd.c_str());
@@ -34,6 +40,7 @@ CliResult run(const std::string& args)
     std::stringstream ss;
     ss << in.rdbuf();
     r.err = ss.str();
+    std::filesystem::remove(errFile);
     return r;
 }
 
