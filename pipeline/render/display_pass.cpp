@@ -88,15 +88,17 @@ void main() {
 }
 )";
 
-// One invocation per pixel; only out-of-gamut pixels touch the counters.
+// One invocation per pixel of the rectangle [uOrigin, uEnd); only out-of-gamut pixels touch the
+// counters.
 const char* const kCountShader = R"(#version 310 es
 layout(local_size_x = 16, local_size_y = 16) in;
 uniform highp sampler2D uClass;
-uniform ivec2 uSize;
+uniform ivec2 uOrigin;
+uniform ivec2 uEnd;
 layout(std430, binding = 0) buffer Counts { uint counts[4]; };
 void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x >= uSize.x || p.y >= uSize.y) {
+    ivec2 p = uOrigin + ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= uEnd.x || p.y >= uEnd.y) {
         return;
     }
     int cls = int(texelFetch(uClass, p, 0).r * 255.0 + 0.5);
@@ -209,6 +211,29 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
 
+    // The black surround's output, in float as the shader forms it: a pixel below black gets the
+    // counts at r = 0 (the tone LUT's first entry; on the 3-D LUT path the lattice's first node),
+    // then floor(counts + dither). Constant only if no dither entry moves it.
+    surroundConstant_ = params.blackY > 0.0f && !setup.falseColour &&
+                        (setup.method == InverseMethod::Lut3d ||
+                         setup.gamut == display::GamutMode::HueKeeping) &&
+                        params.lutSize >= 2;
+    for (int c = 0; c < 3 && surroundConstant_; ++c) {
+        const float counts = setup.method == InverseMethod::Lut3d
+                                     ? lattice[static_cast<std::size_t>(c)]
+                                     : params.lut[static_cast<std::size_t>(c * params.lutSize)] *
+                                               params.maxCount;
+        const auto quantise = [&](float t) {
+            return std::clamp(std::floor(counts + t), 0.0f, params.maxCount);
+        };
+        const float q = quantise(params.dither[0]);
+        for (const float t : params.dither) {
+            surroundConstant_ = surroundConstant_ && quantise(t) == q;
+        }
+        surroundRgba_[static_cast<std::size_t>(c)] = q / params.maxCount;
+    }
+    surroundRgba_[3] = 1.0f;
+
     glGenBuffers(1, &counts_);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
     glBufferData(GL_SHADER_STORAGE_BUFFER, 4 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
@@ -252,7 +277,6 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     setInt(program_, "uDispLut3d", 3);
     glUseProgram(countProgram_);
     setInt(countProgram_, "uClass", 0);
-    glUniform2i(glGetUniformLocation(countProgram_, "uSize"), width, height);
     glUseProgram(0);
     if (GLenum err = glGetError(); err != GL_NO_ERROR) {
         return makeError(ErrorCode::Unsupported,
@@ -287,7 +311,23 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glBindTexture(GL_TEXTURE_2D, dither_);
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_3D, lut3d_);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    PixelRect shade{0, 0, width_, height_};
+    if (frame.blackOutside && surroundConstant_) {
+        shade.x = std::clamp(frame.inside.x, 0, width_);
+        shade.y = std::clamp(frame.inside.y, 0, height_);
+        shade.width = std::clamp(frame.inside.width, 0, width_ - shade.x);
+        shade.height = std::clamp(frame.inside.height, 0, height_ - shade.y);
+        // The surround: its constant counts, gamut class 3 (below black).
+        const std::array<float, 4> belowBlack{3.0f / 255.0f, 0.0f, 0.0f, 0.0f};
+        glClearBufferfv(GL_COLOR, 0, surroundRgba_.data());
+        glClearBufferfv(GL_COLOR, 1, belowBlack.data());
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(shade.x, shade.y, shade.width, shade.height);
+    }
+    if (shade.width > 0 && shade.height > 0) {
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    glDisable(GL_SCISSOR_TEST);
 
     // Count the classes on the GPU: 16 bytes come back instead of the class image.
     const std::array<GLuint, 4> zero{};
@@ -297,8 +337,13 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glUseProgram(countProgram_);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, classTarget_);
-    glDispatchCompute(static_cast<GLuint>((width_ + 15) / 16),
-                      static_cast<GLuint>((height_ + 15) / 16), 1);
+    glUniform2i(glGetUniformLocation(countProgram_, "uOrigin"), shade.x, shade.y);
+    glUniform2i(glGetUniformLocation(countProgram_, "uEnd"), shade.x + shade.width,
+                shade.y + shade.height);
+    if (shade.width > 0 && shade.height > 0) {
+        glDispatchCompute(static_cast<GLuint>((shade.width + 15) / 16),
+                          static_cast<GLuint>((shade.height + 15) / 16), 1);
+    }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     display::GamutCounters counters;
     const void* mapped =
@@ -312,7 +357,9 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     counters.pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
     counters.chroma = c[1];
     counters.overPeak = c[2];
-    counters.belowBlack = c[3];
+    // The cleared surround is below black, pixel for pixel.
+    counters.belowBlack = c[3] + (static_cast<std::uint64_t>(width_) * height_ -
+                                  static_cast<std::uint64_t>(shade.width) * shade.height);
     glUseProgram(0);
     return counters;
 }

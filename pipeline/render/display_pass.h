@@ -16,6 +16,7 @@
 #include <pipeline/base/expected.h>
 #include <pipeline/display/display_model.h>
 #include <pipeline/display/gamut_map.h>
+#include <pipeline/render/pixel_rect.h>
 #include <pipeline/scene/stand.h>
 
 namespace replica::pipeline::render {
@@ -46,6 +47,13 @@ struct DisplayPassFrame {
     // Take the illuminance on the panel (lux) from the XYZ texture's alpha, where pass 1 wrote
     // it, instead of summing 'lights' again per pixel.
     bool illuminanceInAlpha = false;
+    // Pass 1 wrote XYZ (0, 0, 0) outside this rectangle (the black panel around a booth surface).
+    // There, whatever the flare and the eye, every pixel is below black and gets the counts of
+    // XYZ 0; when those counts survive the dither unchanged (DisplayPass::surroundConstant) the
+    // pass clears the surround to them and shades only the rectangle: the same pixels and gamut
+    // counts, for the surface's share of the work. Whole frame when not set.
+    bool blackOutside = false;
+    PixelRect inside;
 };
 
 class DisplayPass
@@ -63,6 +71,11 @@ public:
     Expected<display::GamutCounters> draw(GLuint xyzTexture, const DisplayPassFrame& frame);
     // The RGBA8 display target (counts / 255; alpha 1).
     GLuint framebuffer() const { return fbo_; }
+    // Whether a frame's black surround can be cleared instead of shaded (see blackOutside): the
+    // profile has a black above 0 (so XYZ 0 minus any flare is below it), the gamut mapping keeps
+    // hue (clipping would map each pixel's flare-lowered XYZ differently), no false colour, and
+    // the counts of XYZ 0 are the same after every entry of the dither matrix.
+    bool surroundConstant() const { return surroundConstant_; }
 
 private:
     DisplayPassSetup setup_;
@@ -78,6 +91,8 @@ private:
     GLuint lut3d_ = 0;
     GLuint counts_ = 0; // SSBO of 4 uints, one per gamut class
     float flarePerLux_ = 0.0f;
+    bool surroundConstant_ = false;
+    std::array<float, 4> surroundRgba_{}; // the surround's output, as the shader writes it
     glm::dvec3 white_{0.0};
 };
 
