@@ -46,6 +46,7 @@ std::string RunConfig::toJson() const
                      {"scene_digest", sceneDigest},
                      {"booth_lights", boothLights},
                      {"specular_samples", specularSamples},
+                     {"specular_grid", specularGrid},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
                      {"display_inverse", displayInverse},
@@ -79,6 +80,8 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.sceneDigest = j.value("scene_digest", std::string());
         c.boothLights = j.value("booth_lights", c.boothLights);
         c.specularSamples = j.value("specular_samples", c.specularSamples);
+        // Absent before the specular grid: those recordings were shaded per pixel.
+        c.specularGrid = j.value("specular_grid", 0);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
         // Recordings made before display profiles had none of these: the plain pass 2 they had
         // was on-axis, without flare subtraction.
@@ -94,10 +97,11 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
     if (c.width <= 0 || c.height <= 0 || c.width > 16384 || c.height > 16384 || !(c.rateHz > 0.0) ||
         c.rateHz > 1000.0 || c.lightsU <= 0 || c.lightsV <= 0 || c.lightsU * c.lightsV > 256 ||
         c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < 0 ||
-        c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32) {
+        c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
+        c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256) {
         return makeError(ErrorCode::InvalidArgument, "run configuration: size, rate, light count, "
-                                                     "specular samples or horizon directions out "
-                                                     "of range");
+                                                     "specular samples, specular grid or horizon "
+                                                     "directions out of range");
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -193,6 +197,10 @@ makeBoothScene(RunConfig& config,
     setup.observer = observer;
     setup.settings.lights = config.boothLights;
     setup.settings.specularSamples = config.specularSamples;
+    if (config.specularGrid == kAutoSpecularGrid) {
+        config.specularGrid = pipeline::shading::defaultSpecularGrid(setup.scene); // recorded
+    }
+    setup.settings.specularGrid = config.specularGrid;
     setup.settings.horizonDirections = config.horizonDirections;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     setup.settings.subtractFlare = !config.flareSubtraction;

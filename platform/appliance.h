@@ -20,6 +20,8 @@ namespace replica::platform {
 
 // Everything that decides what a frame looks like, apart from the samples. Recorded in the session
 // so that replay rebuilds the identical renderer.
+constexpr int kAutoSpecularGrid = -1;
+
 struct RunConfig {
     int width = 960;
     int height = 600;
@@ -34,6 +36,11 @@ struct RunConfig {
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
     int boothLights = 32;    // median-cut point lights
     int specularSamples = 48;
+    // Texels between the specular grid's nodes (shading::RenderSettings::specularGrid); 0: per
+    // pixel; kAutoSpecularGrid: shading::defaultSpecularGrid for the scene, chosen when the
+    // appliance is built and recorded as chosen.
+    // Recordings made before the grid have none: they replay per pixel.
+    int specularGrid = -1;
     int horizonDirections = 8;
     // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
     // light; recordings made with replica_k6 or box6 replay as such.

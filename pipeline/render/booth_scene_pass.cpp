@@ -164,4 +164,9 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
     return pass_->draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand), &held);
 }
 
+PixelRect BoothScenePass::surfaceRect(int width, int height) const
+{
+    return render::surfaceRect(layoutOnPanel(setup_.scene, setup_.stand), width, height);
+}
+
 } // namespace replica::pipeline::render

@@ -57,6 +57,10 @@ public:
     // state's tilt and eye.
     Expected<void> draw(const scene::SceneState& state, int width, int height);
 
+    // The pixels of a width x height frame that can show the surface; draw() writes XYZ (0, 0, 0)
+    // everywhere else (render::surfaceRect).
+    PixelRect surfaceRect(int width, int height) const;
+
     // The tilt of the cached diffuse term: the mean of the last kTiltWindow sensed tilts as it
     // was at the last light change or the last time that mean moved more than kTiltHoldRad away
     // from it. A deterministic function of the states drawn so far, so replay renders the same

@@ -4,7 +4,7 @@
 
 namespace replica::pipeline::render {
 
-const char* const kBoothXyzShader = R"(#version 310 es
+const char* const kBoothXyzShader = R"(
 precision highp float;
 precision highp int;
 precision highp sampler2D;
@@ -28,7 +28,7 @@ uniform sampler2D uCoeffA;      // channels 0..2 per texel (row 0 = top row of t
 uniform sampler2D uCoeffB;      // channels 3..5
 uniform sampler2D uNormals;     // tangent-space normal per texel
 uniform sampler2DArray uHorizon; // sin(horizon elevation), 4 directions per layer
-uniform bool uRelief;
+const bool uRelief = BOOTH_RELIEF != 0; // normal map and horizons (fixed for the pass's life)
 uniform int uHorizonDirs;       // 0: no horizon shadowing
 uniform float uSoftness;
 
@@ -43,9 +43,17 @@ uniform vec3 uChannelXyz[6];    // M_k of the light (Y = 1 light)
 uniform vec3 uWhite;            // XYZ of the light scaled to Y = 1
 uniform float uFlareRho;
 // 0: the eye-independent part into the cache (diffuse XYZ, E_geo in alpha); 1: compose the frame
-// from the cache plus the eye-dependent specular term (booth_shading_pass.cpp says when each runs).
-uniform int uMode;
+// from the cache plus the eye-dependent specular term; 2: the specular term (rho_s = 1) at the
+// nodes of the specular grid, one fragment per node (booth_shading_pass.cpp says when each runs).
+// A constant: each mode is its own program, so that it carries none of the others' code (llvmpipe
+// runs both sides of a branch under a mask; a mode that only composes would pay for the rest).
+const int uMode = BOOTH_MODE;
 uniform sampler2D uCache;       // RGBA32F, the viewport's size: what mode 0 wrote
+// The specular grid (shading::specularGridNodes): node (i, j) at surface (u, v) =
+// (i / (nodes.x - 1), j / (nodes.y - 1)); (0, 0): the specular term per pixel.
+uniform ivec2 uGridNodes;
+const bool kGrid = BOOTH_GRID != 0;     // whether the compose reads the grid (fixed likewise)
+uniform sampler2D uSpecGrid;    // R32F, uGridNodes: what mode 2 wrote this frame
 
 uniform int uSpecSamples;       // 0: no specular pass
 // brdf::sampleWardHalfVectorLocal for sample k (u1 = (k + 1/2) / N, u2 = radicalInverse2(k)),
@@ -207,10 +215,33 @@ vec3 bilinearNormal(float x, float y) {
     return len > 1e-12 ? n / len : vec3(0.0, 0.0, 1.0);
 }
 
+// realtime_model.cpp gridSpecular: bilinear between the four nodes around (u, v).
+float gridSpecular(float u, float v) {
+    vec2 last = vec2(uGridNodes - 1);
+    vec2 f = clamp(vec2(u, v), 0.0, 1.0) * last;
+    vec2 f0 = min(floor(f), last - 1.0);
+    vec2 a = f - f0;
+    ivec2 c = ivec2(f0);
+    float s00 = texelFetch(uSpecGrid, c, 0).r;
+    float s10 = texelFetch(uSpecGrid, c + ivec2(1, 0), 0).r;
+    float s01 = texelFetch(uSpecGrid, c + ivec2(0, 1), 0).r;
+    float s11 = texelFetch(uSpecGrid, c + ivec2(1, 1), 0).r;
+    return (1.0 - a.y) * ((1.0 - a.x) * s00 + a.x * s10) + a.y * ((1.0 - a.x) * s01 + a.x * s11);
+}
+
 void main() {
-    vec2 frag = gl_FragCoord.xy / uViewport;
-    float u = uSurfOffset.x + uSurfScale.x * frag.x;
-    float v = uSurfOffset.y + uSurfScale.y * (1.0 - frag.y);
+    float u;
+    float v;
+    if (uMode == 2) {
+        // A node of the specular grid (row j = v, down the surface, like the textures' rows).
+        vec2 node = floor(gl_FragCoord.xy);
+        u = node.x / float(uGridNodes.x - 1);
+        v = node.y / float(uGridNodes.y - 1);
+    } else {
+        vec2 frag = gl_FragCoord.xy / uViewport;
+        u = uSurfOffset.x + uSurfScale.x * frag.x;
+        v = uSurfOffset.y + uSurfScale.y * (1.0 - frag.y);
+    }
     bool inside = u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0;
     // On the panel plane also around the surface: the flare term needs E_geo on every pixel.
     vec3 p = uCentre + uRight * ((u - 0.5) * uSizeM.x) + uUp * ((0.5 - v) * uSizeM.y);
@@ -218,7 +249,9 @@ void main() {
     float texY = v * float(uTexels.y);
     ivec2 tc = clamp(ivec2(int(texX), int(texY)), ivec2(0), uTexels - 1);
     vec3 nShade = uNormal;
-    if (inside && uRelief && (uMode == 0 || uSpecSamples > 0)) {
+    // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
+    bool facets = uMode == 0 || (uSpecSamples > 0 && (uMode == 2 || !kGrid));
+    if (inside && uRelief && facets) {
         vec3 nl = bilinearNormal(texX, texY);
         nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
         int layers = (uHorizonDirs + 3) / 4;
@@ -231,6 +264,17 @@ void main() {
         }
     }
 
+    if (uMode == 2) {
+        float spec = 0.0;
+        vec3 toEye = uEye - p;
+        float eyeDist = length(toEye);
+        toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;
+        if (dot(toEye, uNormal) > 0.0) {
+            spec = filteredSpecular(p, uNormal, nShade, toEye);
+        }
+        outXyz = vec4((isnan(spec) || isinf(spec)) ? 0.0 : spec, 0.0, 0.0, 0.0);
+        return;
+    }
     if (uMode == 0 && !inside) {
         // Around the surface only E_geo (pass 2's flare): eq. (1) with the macro normal, the
         // cosines clamped instead of tested: the same sum, and on llvmpipe about half the cost of
@@ -309,7 +353,11 @@ void main() {
     vec4 cached = texelFetch(uCache, ivec2(gl_FragCoord.xy), 0);
     vec3 xyz = cached.rgb;
     float eGeo = cached.a;
-    if (inside && uSpecSamples > 0) {
+    if (kGrid) {
+        if (inside) {
+            xyz += uSpecXyz * gridSpecular(u, v);
+        }
+    } else if (inside && uSpecSamples > 0) {
         vec3 toEye = uEye - p;
         float eyeDist = length(toEye);
         toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;

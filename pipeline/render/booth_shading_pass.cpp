@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include <fmt/format.h>
@@ -22,7 +23,8 @@ enum TextureUnit : GLint {
     kUnitNormals,
     kUnitHorizon,
     kUnitLum,
-    kUnitCache
+    kUnitCache,
+    kUnitSpecGrid
 };
 
 // Float textures are read with texelFetch only: nearest sampling keeps them complete without the
@@ -52,17 +54,6 @@ GLuint texture2d(GLenum internalFormat, GLenum format, int w, int h, const float
 glm::vec3 f3(const glm::dvec3& v)
 {
     return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
-}
-
-GLint loc(GLuint program, const char* name)
-{
-    return glGetUniformLocation(program, name);
-}
-
-void set3(GLuint program, const char* name, const glm::dvec3& v)
-{
-    const glm::vec3 f = f3(v);
-    glUniform3f(loc(program, name), f.x, f.y, f.z);
 }
 
 int wardModelIndex(brdf::WardModel m)
@@ -121,6 +112,23 @@ SurfaceLayout layoutOnPanel(const surface::SurfaceScene& scene, const scene::Sta
     return l;
 }
 
+PixelRect surfaceRect(const SurfaceLayout& layout, int width, int height)
+{
+    if (!(layout.scale.x > 0.0) || !(layout.scale.y > 0.0)) {
+        return {0, 0, width, height};
+    }
+    const auto span = [](double offset, double scale, int n) {
+        const double a = (0.0 - offset) / scale * n;
+        const double b = (1.0 - offset) / scale * n;
+        const int lo = std::clamp(static_cast<int>(std::floor(std::min(a, b))) - 1, 0, n);
+        const int hi = std::clamp(static_cast<int>(std::ceil(std::max(a, b))) + 1, 0, n);
+        return std::pair<int, int>(lo, hi);
+    };
+    const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
+    const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
+    return {x0, height - r1, x1 - x0, r1 - r0};
+}
+
 Expected<std::unique_ptr<BoothShadingPass>>
 BoothShadingPass::create(const shading::PreparedScene& scene,
                          const shading::RenderSettings& settings,
@@ -149,11 +157,24 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                          fmt::format("render: {} horizon directions; the GL pass holds at most {}",
                                      horizonDirs_, kBoothMaxHorizonDirections));
     }
-    auto program = linkProgram(kFullscreenVertexShader, kBoothXyzShader, "booth XYZ");
-    if (!program) {
-        return tl::unexpected(program.error());
+    // Which passes run is fixed for the pass's life: compiled into each program, so that none
+    // carries code it never runs (llvmpipe executes both sides of a branch under a mask).
+    const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
+    gridNodes_ =
+            specular ? shading::specularGridNodes(s, settings_.specularGrid) : shading::GridNodes{};
+    for (int mode = 0; mode < 3; ++mode) {
+        const std::string source =
+                fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
+                            "#define BOOTH_GRID {}\n",
+                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0) +
+                kBoothXyzShader;
+        auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
+                                   fmt::format("booth XYZ mode {}", mode).c_str());
+        if (!program) {
+            return tl::unexpected(program.error());
+        }
+        programs_[static_cast<std::size_t>(mode)] = *program;
     }
-    program_ = *program;
     glGenVertexArrays(1, &vao_);
 
     const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
@@ -199,14 +220,15 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     glGenBuffers(1, &lightsUbo_);
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
     glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 4 * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
-    const GLuint block = glGetUniformBlockIndex(program_, "BoothLights");
-    if (block == GL_INVALID_INDEX) {
-        return makeError(ErrorCode::Unsupported, "render: the booth shader has no light block");
+    // Blocks a mode does not use are gone from its program: bound where present.
+    for (const GLuint p : programs_) {
+        if (const GLuint block = glGetUniformBlockIndex(p, "BoothLights");
+            block != GL_INVALID_INDEX) {
+            glUniformBlockBinding(p, block, 0);
+        }
     }
-    glUniformBlockBinding(program_, block, 0);
 
     // The specular samples' half vectors depend only on alpha and N: once here, in double.
-    const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
     const int samples = specular ? settings_.specularSamples : 0;
     if (samples > kBoothMaxSpecularSamples) {
         return makeError(ErrorCode::InvalidArgument,
@@ -231,43 +253,66 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     glBindBuffer(GL_UNIFORM_BUFFER, samplesUbo_);
     glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(table.size() * sizeof(float)),
                  table.data(), GL_STATIC_DRAW);
-    const GLuint samplesBlock = glGetUniformBlockIndex(program_, "BoothSpecSamples");
-    if (samplesBlock == GL_INVALID_INDEX) {
-        return makeError(ErrorCode::Unsupported,
-                         "render: the booth shader has no specular sample block");
+    for (const GLuint p : programs_) {
+        if (const GLuint block = glGetUniformBlockIndex(p, "BoothSpecSamples");
+            block != GL_INVALID_INDEX) {
+            glUniformBlockBinding(p, block, 1);
+        }
     }
-    glUniformBlockBinding(program_, samplesBlock, 1);
 
-    glUseProgram(program_);
-    glUniform1i(loc(program_, "uCoeffA"), kUnitCoeffA);
-    glUniform1i(loc(program_, "uCoeffB"), kUnitCoeffB);
-    glUniform1i(loc(program_, "uNormals"), kUnitNormals);
-    glUniform1i(loc(program_, "uHorizon"), kUnitHorizon);
-    glUniform1i(loc(program_, "uLum"), kUnitLum);
-    glUniform1i(loc(program_, "uCache"), kUnitCache);
-    glUniform2i(loc(program_, "uTexels"), s.width, s.height);
-    glUniform2f(loc(program_, "uSizeM"), static_cast<float>(s.widthM),
-                static_cast<float>(s.heightM));
-    glUniform1i(loc(program_, "uRelief"), relief_ ? 1 : 0);
-    glUniform1i(loc(program_, "uHorizonDirs"), horizonDirs_);
-    glUniform1f(loc(program_, "uSoftness"), static_cast<float>(settings_.horizonSoftness));
-    glUniform1i(loc(program_, "uDiffuse"), settings_.diffusePass ? 1 : 0);
-    glUniform1f(loc(program_, "uFlareRho"),
-                static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));
-    glUniform1i(loc(program_, "uSpecSamples"), samples);
-    glUniform1i(loc(program_, "uWardModel"), wardModelIndex(s.model));
+    // The specular grid's target: one R32F texel per node, shaded every frame (mode 2).
+    if (gridNodes_.x > 0) {
+        glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);
+        gridTexture_ = texture2d(GL_R32F, GL_RED, gridNodes_.x, gridNodes_.y, nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE0);
+        glGenFramebuffers(1, &gridFbo_);
+        glBindFramebuffer(GL_FRAMEBUFFER, gridFbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, gridTexture_,
+                               0);
+        const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        if (!complete) {
+            return makeError(ErrorCode::Unsupported,
+                             "render: the booth pass's R32F specular grid is not renderable on "
+                             "this GL; run with a specular grid of 0 (per pixel)");
+        }
+    }
+
+    uniformAll(glProgramUniform1i, "uCoeffA", kUnitCoeffA);
+    uniformAll(glProgramUniform1i, "uCoeffB", kUnitCoeffB);
+    uniformAll(glProgramUniform1i, "uNormals", kUnitNormals);
+    uniformAll(glProgramUniform1i, "uHorizon", kUnitHorizon);
+    uniformAll(glProgramUniform1i, "uLum", kUnitLum);
+    uniformAll(glProgramUniform1i, "uCache", kUnitCache);
+    uniformAll(glProgramUniform1i, "uSpecGrid", kUnitSpecGrid);
+    uniformAll(glProgramUniform2i, "uGridNodes", gridNodes_.x, gridNodes_.y);
+    uniformAll(glProgramUniform2i, "uTexels", s.width, s.height);
+    uniformAll(glProgramUniform2f, "uSizeM", static_cast<float>(s.widthM),
+               static_cast<float>(s.heightM));
+    uniformAll(glProgramUniform1i, "uHorizonDirs", horizonDirs_);
+    uniformAll(glProgramUniform1f, "uSoftness", static_cast<float>(settings_.horizonSoftness));
+    uniformAll(glProgramUniform1i, "uDiffuse", settings_.diffusePass ? 1 : 0);
+    uniformAll(glProgramUniform1f, "uFlareRho",
+               static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));
+    uniformAll(glProgramUniform1i, "uSpecSamples", samples);
+    uniformAll(glProgramUniform1i, "uWardModel", wardModelIndex(s.model));
     return glCheck("uploading the scene");
 }
 
 BoothShadingPass::~BoothShadingPass()
 {
-    const std::array<GLuint, 6> textures{coeffA_, coeffB_, normals_, horizon_, lum_, cacheTexture_};
+    const std::array<GLuint, 7> textures{coeffA_, coeffB_,       normals_,    horizon_,
+                                         lum_,    cacheTexture_, gridTexture_};
     glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     glDeleteFramebuffers(1, &cacheFbo_);
+    glDeleteFramebuffers(1, &gridFbo_);
     glDeleteBuffers(1, &lightsUbo_);
     glDeleteBuffers(1, &samplesUbo_);
     glDeleteVertexArrays(1, &vao_);
-    glDeleteProgram(program_);
+    for (const GLuint p : programs_) {
+        glDeleteProgram(p);
+    }
 }
 
 Expected<void> BoothShadingPass::setChannels(const shading::PreparedScene& ps)
@@ -338,39 +383,45 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
 
     const surface::SurfaceScene& s = *scene_->scene;
     specXyz_ = colour::spectrumToXyz(*observer_, s.rhoS * pl.unitSpd);
-    glUseProgram(program_);
-    glUniform1i(loc(program_, "uLightCount"), lightCount_);
-    set3(program_, "uLightNormal", bl.normal());
-    glUniform1f(loc(program_, "uTexelArea"), static_cast<float>(a));
+    uniformAll(glProgramUniform1i, "uLightCount", lightCount_);
+    set3All("uLightNormal", bl.normal());
+    uniformAll(glProgramUniform1f, "uTexelArea", static_cast<float>(a));
     std::array<float, colour::kChannels * 3> m{};
     for (std::size_t k = 0; k < colour::kChannels; ++k) {
         for (int c = 0; c < 3; ++c) {
             m[k * 3 + static_cast<std::size_t>(c)] = static_cast<float>(pl.channelXyz[k][c]);
         }
     }
-    glUniform3fv(loc(program_, "uChannelXyz"), static_cast<GLsizei>(colour::kChannels), m.data());
-    set3(program_, "uWhite", pl.white);
-    set3(program_, "uSpecXyz", specXyz_);
-    set3(program_, "uLightCentre", bl.centre);
-    set3(program_, "uEdgeU", bl.edgeU);
-    set3(program_, "uEdgeV", bl.edgeV);
+    uniformAll(glProgramUniform3fv, "uChannelXyz", static_cast<GLsizei>(colour::kChannels),
+               m.data());
+    set3All("uWhite", pl.white);
+    set3All("uSpecXyz", specXyz_);
+    set3All("uLightCentre", bl.centre);
+    set3All("uEdgeU", bl.edgeU);
+    set3All("uEdgeV", bl.edgeV);
     const double u2 = glm::dot(bl.edgeU, bl.edgeU);
     const double v2 = glm::dot(bl.edgeV, bl.edgeV);
-    glUniform2f(loc(program_, "uInvEdge2"), static_cast<float>(u2 > 0.0 ? 1.0 / u2 : 0.0),
-                static_cast<float>(v2 > 0.0 ? 1.0 / v2 : 0.0));
-    glUniform1i(loc(program_, "uLumMaxLevel"), lumMaxLevel_);
-    glUniform2i(loc(program_, "uLumSize"), levels[0].width, levels[0].height);
-    glUniform2f(loc(program_, "uLumUsed"), static_cast<float>(pl.mips.usedU),
-                static_cast<float>(pl.mips.usedV));
+    uniformAll(glProgramUniform2f, "uInvEdge2", static_cast<float>(u2 > 0.0 ? 1.0 / u2 : 0.0),
+               static_cast<float>(v2 > 0.0 ? 1.0 / v2 : 0.0));
+    uniformAll(glProgramUniform1i, "uLumMaxLevel", lumMaxLevel_);
+    uniformAll(glProgramUniform2i, "uLumSize", levels[0].width, levels[0].height);
+    uniformAll(glProgramUniform2f, "uLumUsed", static_cast<float>(pl.mips.usedU),
+               static_cast<float>(pl.mips.usedV));
     return glCheck("uploading the light");
+}
+
+void BoothShadingPass::set3All(const char* name, const glm::dvec3& v) const
+{
+    const glm::vec3 f = f3(v);
+    uniformAll(glProgramUniform3f, name, f.x, f.y, f.z);
 }
 
 void BoothShadingPass::setPose(const shading::PanelPose& panel) const
 {
-    set3(program_, "uCentre", panel.centre);
-    set3(program_, "uRight", panel.right);
-    set3(program_, "uUp", panel.up);
-    set3(program_, "uNormal", panel.normal);
+    set3All("uCentre", panel.centre);
+    set3All("uRight", panel.right);
+    set3All("uUp", panel.up);
+    set3All("uNormal", panel.normal);
 }
 
 Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
@@ -419,13 +470,13 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     }
     glViewport(0, 0, width, height);
     glBindVertexArray(vao_);
-    glUseProgram(program_);
-    glUniform2f(loc(program_, "uViewport"), static_cast<float>(width), static_cast<float>(height));
-    glUniform2f(loc(program_, "uSurfOffset"), static_cast<float>(layout.offset.x),
-                static_cast<float>(layout.offset.y));
-    glUniform2f(loc(program_, "uSurfScale"), static_cast<float>(layout.scale.x),
-                static_cast<float>(layout.scale.y));
-    set3(program_, "uEye", view.eye);
+    uniformAll(glProgramUniform2f, "uViewport", static_cast<float>(width),
+               static_cast<float>(height));
+    uniformAll(glProgramUniform2f, "uSurfOffset", static_cast<float>(layout.offset.x),
+               static_cast<float>(layout.offset.y));
+    uniformAll(glProgramUniform2f, "uSurfScale", static_cast<float>(layout.scale.x),
+               static_cast<float>(layout.scale.y));
+    set3All("uEye", view.eye);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightsUbo_);
     glBindBufferBase(GL_UNIFORM_BUFFER, 1, samplesUbo_);
     glActiveTexture(GL_TEXTURE0 + kUnitCoeffA);
@@ -454,11 +505,22 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare).
         glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
         setPose(diffusePose);
-        glUniform1i(loc(program_, "uMode"), 0);
+        glUseProgram(programs_[0]);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         cacheKey_ = key;
         cacheValid_ = true;
         ++cacheRefreshes_;
+    }
+    const bool specular =
+            settings_.specularPass && scene_->scene->glossy() && settings_.specularSamples > 0;
+    if (specular && gridNodes_.x > 0) {
+        // This eye's specular term at the grid's nodes, for the compose to interpolate.
+        glBindFramebuffer(GL_FRAMEBUFFER, gridFbo_);
+        glViewport(0, 0, gridNodes_.x, gridNodes_.y);
+        setPose(view.panel);
+        glUseProgram(programs_[2]);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glViewport(0, 0, width, height);
     }
     // The frame is the cache around the surface ((0, 0, 0) and E_geo) and, without a specular
     // term or flare to add, on it too: copy it. Then compose the surface's rectangle (widened by a
@@ -468,27 +530,21 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     restore();
-    const bool specular =
-            settings_.specularPass && scene_->scene->glossy() && settings_.specularSamples > 0;
     if (specular || settings_.subtractFlare) {
-        const auto span = [](double offset, double scale, int n) {
-            const double a = (0.0 - offset) / scale * n;
-            const double b = (1.0 - offset) / scale * n;
-            const int lo = std::clamp(static_cast<int>(std::floor(std::min(a, b))) - 1, 0, n);
-            const int hi = std::clamp(static_cast<int>(std::ceil(std::max(a, b))) + 1, 0, n);
-            return std::pair<int, int>(lo, hi);
-        };
         const bool scissor = layout.scale.x > 0.0 && layout.scale.y > 0.0;
         if (scissor) {
-            const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
-            const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
+            const PixelRect r = surfaceRect(layout, width, height);
             glEnable(GL_SCISSOR_TEST);
-            glScissor(x0, height - r1, x1 - x0, r1 - r0);
+            glScissor(r.x, r.y, r.width, r.height);
         }
         setPose(view.panel);
-        glUniform1i(loc(program_, "uMode"), 1);
+        glUseProgram(programs_[1]);
         glBindTexture(GL_TEXTURE_2D, cacheTexture_); // unit kUnitCache is active
+        glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);
+        glBindTexture(GL_TEXTURE_2D, gridTexture_);
         glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE0 + kUnitCache);
         glBindTexture(GL_TEXTURE_2D, 0);
         if (scissor) {
             glDisable(GL_SCISSOR_TEST);

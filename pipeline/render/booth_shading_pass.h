@@ -3,6 +3,7 @@
 // Needs a current GLES 3.1 context on the calling thread for every call, including destruction.
 #pragma once
 
+#include <array>
 #include <memory>
 
 #include <GLES3/gl31.h>
@@ -10,6 +11,7 @@
 
 #include <pipeline/base/expected.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/render/pixel_rect.h>
 #include <pipeline/scene/stand.h>
 #include <pipeline/shading/frame.h>
 #include <pipeline/shading/realtime_model.h>
@@ -24,6 +26,11 @@ struct SurfaceLayout {
     glm::dvec2 offset{0.0, 0.0};
     glm::dvec2 scale{1.0, 1.0};
 };
+
+// The pixels of a width x height frame that can show the surface, widened by one pixel so that
+// the shader's own bounds test decides every edge pixel: outside it the booth pass writes XYZ
+// (0, 0, 0), the black panel around the surface. The whole frame for a layout that does not scale.
+PixelRect surfaceRect(const SurfaceLayout& layout, int width, int height);
 
 // The surface at its physical size, centred on the panel's active area (the appliance's frame
 // covers the whole panel). The matching View's panel centre is the active area's centre.
@@ -91,7 +98,17 @@ private:
     int lightCount_ = 0;
     int lumMaxLevel_ = 0;
     colour::Xyz specXyz_{0.0};
-    GLuint program_ = 0;
+    // One program per shader mode (booth_shaders.h): 0 cache, 1 compose, 2 specular grid.
+    std::array<GLuint, 3> programs_{};
+    // Sets a uniform in every mode's program (where that mode still has it).
+    template <typename Fn, typename... Args>
+    void uniformAll(Fn fn, const char* name, Args... args) const
+    {
+        for (const GLuint p : programs_) {
+            fn(p, glGetUniformLocation(p, name), args...);
+        }
+    }
+    void set3All(const char* name, const glm::dvec3& v) const;
     GLuint vao_ = 0;
     GLuint lightsUbo_ = 0;
     GLuint samplesUbo_ = 0;
@@ -110,6 +127,11 @@ private:
     mutable GLuint cacheTexture_ = 0;
     mutable GLuint cacheFbo_ = 0;
     mutable int cacheWidth_ = 0, cacheHeight_ = 0;
+
+    // The specular grid (settings.specularGrid > 0 on a glossy scene): its nodes and target.
+    shading::GridNodes gridNodes_;
+    GLuint gridTexture_ = 0;
+    GLuint gridFbo_ = 0;
 };
 
 // An RGBA32F render target with read-back into an XyzFrame (rows top-down, like the CPU model):

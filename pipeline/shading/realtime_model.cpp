@@ -161,6 +161,40 @@ double filteredSpecular(const PreparedLight& light,
     return samples > 0 ? sum / samples : 0.0;
 }
 
+GridNodes specularGridNodes(const surface::SurfaceScene& scene, int spacingTexels)
+{
+    if (spacingTexels <= 0 || scene.width <= 0 || scene.height <= 0) {
+        return {};
+    }
+    return {(scene.width + spacingTexels - 1) / spacingTexels + 1,
+            (scene.height + spacingTexels - 1) / spacingTexels + 1};
+}
+
+int defaultSpecularGrid(const surface::SurfaceScene& scene)
+{
+    return scene.flat() ? kFlatSpecularGrid : 0;
+}
+
+double gridSpecular(const std::vector<double>& values, GridNodes nodes, double u, double v)
+{
+    const double lastX = nodes.x - 1;
+    const double lastY = nodes.y - 1;
+    const double fx = std::clamp(u, 0.0, 1.0) * lastX;
+    const double fy = std::clamp(v, 0.0, 1.0) * lastY;
+    const double x0 = std::min(std::floor(fx), lastX - 1.0);
+    const double y0 = std::min(std::floor(fy), lastY - 1.0);
+    const double ax = fx - x0;
+    const double ay = fy - y0;
+    const auto at = [&](int x, int y) {
+        return values[static_cast<std::size_t>(y) * static_cast<std::size_t>(nodes.x) +
+                      static_cast<std::size_t>(x)];
+    };
+    const int ix = static_cast<int>(x0);
+    const int iy = static_cast<int>(y0);
+    return (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
+           ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
+}
+
 XyzFrame renderRealtime(const PreparedScene& ps,
                         const PreparedLight& light,
                         const View& view,
@@ -183,6 +217,41 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     const Vec3 nl = bl.normal();
     const double a = bl.texelAreaM2();
     const colour::Xyz specXyz = colour::spectrumToXyz(obs, scene.rhoS * light.unitSpd);
+    const int threads = std::clamp(settings.threads, 1, std::max(frame.height, 1));
+
+    // The specular grid, when used: every node first (as the GL pass's mode 2 does).
+    const GridNodes nodes =
+            specular ? specularGridNodes(scene, settings.specularGrid) : GridNodes{};
+    std::vector<double> grid(static_cast<std::size_t>(nodes.x) * static_cast<std::size_t>(nodes.y));
+    const auto gridRows = [&](int j0, int j1) {
+        for (int j = j0; j < j1; ++j) {
+            for (int i = 0; i < nodes.x; ++i) {
+                const ShadingPoint sp =
+                        shadingPointAt(view, scene, normals, static_cast<double>(i) / (nodes.x - 1),
+                                       static_cast<double>(j) / (nodes.y - 1));
+                Vec3 toEye = view.eye - sp.p;
+                const double eyeDist = glm::length(toEye);
+                toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
+                double s = 0.0;
+                if (glm::dot(toEye, sp.nGeo) > 0.0) {
+                    s = filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model,
+                                         scene.alpha, settings.specularSamples, horizon, sp.tx,
+                                         sp.ty, sp.right, sp.up, settings.horizonSoftness);
+                }
+                grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(nodes.x) +
+                     static_cast<std::size_t>(i)] = std::isfinite(s) ? s : 0.0;
+            }
+        }
+    };
+    if (nodes.x > 0) {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t) {
+            pool.emplace_back(gridRows, nodes.y * t / threads, nodes.y * (t + 1) / threads);
+        }
+        for (auto& th : pool) {
+            th.join();
+        }
+    }
 
     struct Counts {
         long flare = 0, behind = 0, bad = 0;
@@ -220,7 +289,11 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                                                 scene.reflectance(sp.tx, sp.ty) * light.unitSpd) *
                           (e / std::numbers::pi);
                 }
-                if (specular && !behind) {
+                if (specular && nodes.x > 0) {
+                    const double u = (px + 0.5) / view.pixelsX;
+                    const double v = (py + 0.5) / view.pixelsY;
+                    xyz += specXyz * gridSpecular(grid, nodes, u, v);
+                } else if (specular && !behind) {
                     const double s =
                             filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model,
                                              scene.alpha, settings.specularSamples, horizon, sp.tx,
@@ -237,7 +310,6 @@ XyzFrame renderRealtime(const PreparedScene& ps,
             }
         }
     };
-    const int threads = std::clamp(settings.threads, 1, std::max(frame.height, 1));
     std::vector<Counts> counts(static_cast<std::size_t>(threads));
     std::vector<std::thread> pool;
     for (int t = 0; t < threads; ++t) {

@@ -52,9 +52,17 @@ ShadingPoint shadingPoint(const View& view,
                           int px,
                           int py)
 {
+    return shadingPointAt(view, scene, normals, (px + 0.5) / view.pixelsX,
+                          (py + 0.5) / view.pixelsY);
+}
+
+ShadingPoint shadingPointAt(const View& view,
+                            const surface::SurfaceScene& scene,
+                            const std::vector<Vec3>& normals,
+                            double u,
+                            double v)
+{
     ShadingPoint s;
-    const double u = (px + 0.5) / view.pixelsX;
-    const double v = (py + 0.5) / view.pixelsY;
     const PanelPose& pose = view.panel;
     s.p = pose.centre + pose.right * ((u - 0.5) * scene.widthM) +
           pose.up * ((0.5 - v) * scene.heightM);

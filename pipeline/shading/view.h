@@ -52,6 +52,13 @@ ShadingPoint shadingPoint(const View& view,
                           const std::vector<Vec3>& normals,
                           int px,
                           int py);
+// The same at surface coordinates (u, v) in [0, 1]^2 (v down the surface): what a pixel centre
+// maps to, or a node of the specular grid.
+ShadingPoint shadingPointAt(const View& view,
+                            const surface::SurfaceScene& scene,
+                            const std::vector<Vec3>& normals,
+                            double u,
+                            double v);
 
 // Bilinear interpolation of a normal map at fractional texel coordinates, renormalised (never zero:
 // every stored normal has z > 0).

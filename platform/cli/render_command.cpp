@@ -33,7 +33,8 @@ struct RenderArgs {
     bool plan = false;
     bool gl = false;
     int lights = 32;
-    int samples = 16;
+    int samples = pipeline::shading::RenderSettings{}.specularSamples; // the appliance's default
+    int specularGrid = -1; // -1: as the appliance chooses (flat: 8 texels; relief: per pixel)
     int horizonDirections = 8;
     std::string basis = "adaptive_k6";
     std::string out;
@@ -133,6 +134,8 @@ int runRender(const RenderArgs& a)
     settings.lights = a.lights;
     settings.specularSamples = a.samples;
     settings.horizonDirections = a.horizonDirections;
+    settings.specularGrid =
+            a.specularGrid >= 0 ? a.specularGrid : shading::defaultSpecularGrid(*scene);
     std::string mode = "realtime-cpu";
     shading::Plan plan;
     if (a.reference) {
@@ -208,6 +211,7 @@ int runRender(const RenderArgs& a)
         j["basis"] = basis->name;
         j["specular_samples"] =
                 scene->glossy() && settings.specularPass ? settings.specularSamples : 0;
+        j["specular_grid"] = scene->glossy() && settings.specularPass ? settings.specularGrid : 0;
         j["horizon_directions"] =
                 !scene->flat() && settings.reliefPass ? settings.horizonDirections : 0;
         if (a.plan) {
@@ -258,6 +262,12 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--samples", args->samples, "specular FIS samples per pixel")
             ->capture_default_str()
             ->check(CLI::Range(1, 1024));
+    cmd->add_option("--specular-grid", args->specularGrid,
+                    "texels between the nodes the specular term is shaded at, then interpolated; "
+                    "0: per pixel; -1: as the appliance chooses (8 on a flat surface, per pixel "
+                    "on relief)")
+            ->capture_default_str()
+            ->check(CLI::Range(-1, 256));
     cmd->add_option("--horizon-directions", args->horizonDirections, "horizon map azimuths")
             ->capture_default_str()
             ->check(CLI::Range(1, 64));

@@ -7,6 +7,7 @@
 //        [--defaults-only [SPECULAR_SAMPLES]: the default setting (or it with that many specular
 //        samples) under every scene and light; no sweep, no planner, no plot]
 //        [--scene NAME: only that shipped scene, e.g. metamer (last, after the options above)]
+//        [--grid N: the default setting with a specular grid of N texels (after the above)]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -87,7 +88,10 @@ std::string describe(const shading::RenderSettings& s, const surface::SurfaceSce
 {
     return std::to_string(s.lights) + " lights, " +
            std::to_string(scene.glossy() && s.specularPass ? s.specularSamples : 0) + " spec, " +
-           std::to_string(scene.flat() || !s.reliefPass ? 0 : s.horizonDirections) + " horizon";
+           std::to_string(scene.flat() || !s.reliefPass ? 0 : s.horizonDirections) + " horizon" +
+           (scene.glossy() && s.specularPass && s.specularGrid > 0
+                    ? ", specular grid " + std::to_string(s.specularGrid)
+                    : std::string());
 }
 
 void writePareto(const std::filesystem::path& file, const std::vector<Point>& pts)
@@ -181,9 +185,13 @@ int main(int argc, char** argv)
     std::vector<Point> pareto;
     std::vector<std::string> planLines;
     std::string only;
+    int grid = 0;
     for (int a = 3; a + 1 < argc; ++a) {
         if (std::string(argv[a]) == "--scene") {
             only = argv[a + 1];
+        }
+        if (std::string(argv[a]) == "--grid") {
+            grid = std::atoi(argv[a + 1]);
         }
     }
     for (const char* sceneName : {"colorchecker", "metamer", "painting"}) {
@@ -205,6 +213,9 @@ int main(int argc, char** argv)
             if (defaultSamples > 0) {
                 def.specularSamples = defaultSamples;
             }
+            if (grid > 0) {
+                def.specularGrid = grid;
+            }
             std::vector<std::pair<std::string, shading::RenderSettings>> configs;
             configs.emplace_back("default (" + describe(def, *scene) + ")", def);
             // The whole sweep under the hardest light (tubes); the default alone under the others.
@@ -219,6 +230,11 @@ int main(int argc, char** argv)
                     auto s = def;
                     s.specularSamples = n;
                     configs.emplace_back(std::to_string(n) + " spec samples", s);
+                }
+                for (int g : {1, 2, 4, 8}) {
+                    auto s = def;
+                    s.specularGrid = g;
+                    configs.emplace_back("specular grid " + std::to_string(g) + " texels", s);
                 }
             }
             if (!scene->flat() && sweep) {
