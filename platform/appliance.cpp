@@ -47,6 +47,7 @@ std::string RunConfig::toJson() const
                      {"booth_lights", boothLights},
                      {"specular_samples", specularSamples},
                      {"specular_grid", specularGrid},
+                     {"hardware_filter", hardwareFilter},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
                      {"display_inverse", displayInverse},
@@ -82,6 +83,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularSamples = j.value("specular_samples", c.specularSamples);
         // Absent before the specular grid: those recordings were shaded per pixel.
         c.specularGrid = j.value("specular_grid", 0);
+        c.hardwareFilter = j.value("hardware_filter", false);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
         // Recordings made before display profiles had none of these: the plain pass 2 they had
         // was on-axis, without flare subtraction.
@@ -201,6 +203,7 @@ makeBoothScene(RunConfig& config,
         config.specularGrid = pipeline::shading::defaultSpecularGrid(setup.scene); // recorded
     }
     setup.settings.specularGrid = config.specularGrid;
+    setup.settings.hardwareFilter = config.hardwareFilter;
     setup.settings.horizonDirections = config.horizonDirections;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     setup.settings.subtractFlare = !config.flareSubtraction;

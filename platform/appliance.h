@@ -42,6 +42,10 @@ struct RunConfig {
     // Recordings made before the grid have none: they replay per pixel.
     int specularGrid = -1;
     int horizonDirections = 8;
+    // shading::RenderSettings::hardwareFilter: the sampler filters the luminance mip chain (same
+    // rule, other float rounding). Recordings made before it have none and replay with the
+    // shader's own filter, bit for bit.
+    bool hardwareFilter = true;
     // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
     // light; recordings made with replica_k6 or box6 replay as such.
     std::string basis = "adaptive_k6";

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -69,6 +70,20 @@ int wardModelIndex(brdf::WardModel m)
         return 3;
     }
     return 2;
+}
+
+bool hasExtension(const char* name)
+{
+    GLint n = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (GLint i = 0; i < n; ++i) {
+        const auto* e =
+                reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, static_cast<GLuint>(i)));
+        if (e != nullptr && std::strcmp(e, name) == 0) {
+            return true;
+        }
+    }
+    return false;
 }
 
 Expected<void> glCheck(const char* what)
@@ -157,6 +172,12 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                          fmt::format("render: {} horizon directions; the GL pass holds at most {}",
                                      horizonDirs_, kBoothMaxHorizonDirections));
     }
+    // The luminance chain is filtered by the sampler where the GL can filter float textures and
+    // clamp to a border (GLES 3.2 has both's core equivalents only for the border); otherwise the
+    // shader filters by hand with texelFetch, the same rule.
+    hwFilter_ = settings_.hardwareFilter && hasExtension("GL_OES_texture_float_linear") &&
+                (hasExtension("GL_EXT_texture_border_clamp") ||
+                 hasExtension("GL_OES_texture_border_clamp"));
     // Which passes run is fixed for the pass's life: compiled into each program, so that none
     // carries code it never runs (llvmpipe executes both sides of a branch under a mask).
     const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
@@ -165,8 +186,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     for (int mode = 0; mode < 3; ++mode) {
         const std::string source =
                 fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
-                            "#define BOOTH_GRID {}\n",
-                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0) +
+                            "#define BOOTH_GRID {}\n#define BOOTH_HW_FILTER {}\n",
+                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -380,6 +401,14 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, lumMaxLevel_);
     nearest(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+    if (hwFilter_) {
+        // booth::MipChain::sample's rule (booth_shaders.cpp lumSample); border colour 0.
+        constexpr GLenum kClampToBorder = 0x812D; // GL_CLAMP_TO_BORDER_EXT / _OES
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, kClampToBorder);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, kClampToBorder);
+    }
 
     const surface::SurfaceScene& s = *scene_->scene;
     specXyz_ = colour::spectrumToXyz(*observer_, s.rhoS * pl.unitSpd);

@@ -82,6 +82,9 @@ public:
     long cacheRefreshes() const { return cacheRefreshes_; }
 
     const shading::RenderSettings& settings() const { return settings_; }
+    // Whether the luminance chain is filtered by the sampler (settings.hardwareFilter and the
+    // GL's float-filtering and border-clamp extensions) or by hand in the shader.
+    bool hardwareFilter() const { return hwFilter_; }
 
 private:
     BoothShadingPass() = default;
@@ -94,6 +97,7 @@ private:
     const shading::PreparedLight* light_ = nullptr;
     const colour::Observer* observer_ = nullptr;
     bool relief_ = false;
+    bool hwFilter_ = false;
     int horizonDirs_ = 0;
     int lightCount_ = 0;
     int lumMaxLevel_ = 0;

@@ -40,6 +40,9 @@ struct RenderSettings {
     // smoothly over the surface, and shading it at grid nodes and interpolating costs a fraction
     // of shading it per pixel (specularGridNodes; the planner measures the error it adds).
     int specularGrid = 0;
+    // The GL pass only: let the sampler filter the luminance mip chain where the GL can (same
+    // rule as booth::MipChain::sample); off, or without the extensions, the shader filters by hand.
+    bool hardwareFilter = true;
     int threads = 2;
 };
 

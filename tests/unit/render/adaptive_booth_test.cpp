@@ -266,6 +266,9 @@ TEST(AdaptiveAppliance, SimRunReencodesAtEachConfirmedLampChange)
         GTEST_SKIP() << app.error().message;
     }
     ASSERT_TRUE((*app)->boothScene);
+    // The shipped ColorChecker is flat: the appliance chose the flat specular grid and recorded it.
+    EXPECT_EQ((*app)->config.specularGrid, shading::kFlatSpecularGrid);
+    EXPECT_NE((*app)->config.toJson().find("\"specular_grid\":8"), std::string::npos);
     auto sources = platform::makeSimSources(**app);
     ASSERT_TRUE(sources) << sources.error().message;
     const auto plan = platform::fixedRatePlan((*app)->config.periodNs(), 50); // 5 s

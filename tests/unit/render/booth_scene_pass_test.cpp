@@ -139,6 +139,19 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     auto o = platform::RunConfig::fromJson(old);
     ASSERT_TRUE(o) << o.error().message;
     EXPECT_EQ(o->renderer, "flat");
+    // Made before the specular grid and the sampler's filter: per pixel, the shader's filter.
+    EXPECT_EQ(o->specularGrid, 0);
+    EXPECT_FALSE(o->hardwareFilter);
+    // A new run chooses (the grid per scene when the appliance is built) and records both.
+    EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
+    EXPECT_TRUE(c.hardwareFilter);
+    c.specularGrid = 8;
+    auto round = platform::RunConfig::fromJson(c.toJson());
+    ASSERT_TRUE(round);
+    EXPECT_EQ(round->specularGrid, 8);
+    EXPECT_TRUE(round->hardwareFilter);
+    c.specularGrid = -2;
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
 
     const auto shipped = platform::resolveSceneDir("scenes/metamer");
     auto d1 = platform::sceneDigest(shipped);
