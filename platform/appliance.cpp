@@ -1,4 +1,5 @@
 // Assembling the appliance.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
 #include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/spectral/representation_catalogue.h>
 #include <platform/appliance.h>
 #include <platform/loop/frame_digest.h>
 
@@ -283,15 +285,15 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     // the first recordings used) or one fitted by 'replica spectral fit' under data/channels/
     // (docs/accuracy.md).
     const bool adaptive = config.basis == kAdaptiveBasis;
-    const bool knownBasis = adaptive || config.basis == "box6" || config.basis == "replica_k6" ||
-                            config.basis == "general_k6" || config.basis == "pca6";
+    const std::vector<std::string> bases = pipeline::spectral::channelBasisNames();
+    const bool knownBasis = std::find(bases.begin(), bases.end(), config.basis) != bases.end();
     const bool knownScene = config.renderer == "booth" || config.scene == "colorchecker";
     if (config.booth != "replica-booth-1" || !knownScene || !knownBasis) {
         return makeError(ErrorCode::NotFound,
                          fmt::format("unknown booth '{}', scene '{}' or basis '{}' (this build has "
-                                     "replica-booth-1, colorchecker, and bases adaptive_k6, "
-                                     "replica_k6, general_k6, pca6, box6)",
-                                     config.booth, config.scene, config.basis));
+                                     "replica-booth-1, colorchecker, and bases {})",
+                                     config.booth, config.scene, config.basis,
+                                     fmt::join(bases, ", ")));
     }
     if (adaptive && config.renderer != "booth") {
         return makeError(ErrorCode::InvalidArgument,

@@ -90,6 +90,12 @@ Vec3 sampleWardHalfVectorLocal(double alpha, double u1, double u2)
     return Vec3(sinT * std::cos(phi), sinT * std::sin(phi), cosT);
 }
 
+double wardSolidAngleWithoutOh(double alpha, double hz, double u1, int sampleCount)
+{
+    const double u = std::clamp(u1, kMinU1, 1.0);
+    return 4.0 * kPi * alpha * alpha * hz * hz * hz / (static_cast<double>(sampleCount) * u);
+}
+
 WardSample sampleWard(WardModel model,
                       double alpha,
                       const Vec3& n,
@@ -131,8 +137,7 @@ WardSample sampleWard(WardModel model,
         s.weight = ci / (oh * hz);
         break;
     }
-    const double u = std::clamp(u1, kMinU1, 1.0);
-    s.solidAngle = 4.0 * kPi * alpha * alpha * oh * hz3 / (static_cast<double>(sampleCount) * u);
+    s.solidAngle = wardSolidAngleWithoutOh(alpha, hz, u1, sampleCount) * oh;
     s.valid = true;
     return s;
 }

@@ -42,6 +42,11 @@ struct Frame {
 // phi = 2 pi u2; trig-free for theta. u1 is clamped to [2^-24, 1].
 Vec3 sampleWardHalfVectorLocal(double alpha, double u1, double u2);
 
+// A sample's solid angle 1 / (N pdf) without its o.h factor: 4 pi alpha^2 cos^3(theta_h) / (N u1),
+// u1 clamped as sampleWardHalfVectorLocal clamps it. View-independent, so the GL pass tabulates it
+// once per (alpha, N); sampleWard multiplies it by o.h.
+double wardSolidAngleWithoutOh(double alpha, double hz, double u1, int sampleCount);
+
 struct WardSample {
     Vec3 i{0.0};             // sampled light direction (world); meaningful only if valid
     double weight = 0.0;     // f * cos_i / pdf, closed form, for rho_s = 1

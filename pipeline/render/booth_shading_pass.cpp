@@ -261,9 +261,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
         const double u1 = (k + 0.5) / samples;
         const shading::Vec3 hl = brdf::sampleWardHalfVectorLocal(
                 s.alpha, u1, shading::radicalInverse2(static_cast<unsigned>(k)));
-        const double u = std::clamp(u1, brdf::kMinU1, 1.0);
-        const double w = 4.0 * std::numbers::pi * s.alpha * s.alpha * hl.z * hl.z * hl.z /
-                         (static_cast<double>(samples) * u);
+        const double w = brdf::wardSolidAngleWithoutOh(s.alpha, hl.z, u1, samples);
         const auto i = static_cast<std::size_t>(k) * 4;
         table[i] = static_cast<float>(hl.x);
         table[i + 1] = static_cast<float>(hl.y);

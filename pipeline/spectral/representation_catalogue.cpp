@@ -13,6 +13,11 @@ std::vector<std::string> representationNames()
             "spectral36", "general_k6", "pca6",       "box6"};
 }
 
+std::vector<std::string> channelBasisNames()
+{
+    return {"adaptive_k6", "replica_k6", "general_k6", "pca6", "box6"};
+}
+
 Expected<std::unique_ptr<Representation>> makeRepresentation(const std::filesystem::path& dataDir,
                                                              const Observer& obs,
                                                              const Spectrum& d65,

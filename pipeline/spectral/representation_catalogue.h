@@ -18,6 +18,9 @@ namespace replica::pipeline::spectral {
 // training lights equal), "pca6" (principal components, light-independent) and "box6" (six box
 // bands).
 std::vector<std::string> representationNames();
+// The K = 6 channel bases among them: what the GL renderer's two RGB coefficient textures hold, so
+// what 'replica run' and 'replica render' accept (adaptive_k6 first: the default).
+std::vector<std::string> channelBasisNames();
 // The fixed basis 'replica spectral fit' derives and ships (data/channels/replica_k6.csv).
 constexpr const char* kDefaultRepresentation = "replica_k6";
 // What the appliance renders with and 'replica spectral eval' reports unless told otherwise.

@@ -15,6 +15,7 @@
 #include <pipeline/shading/planner.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/surface/scene.h>
 #include <platform/cli/commands.h>
 #include <platform/output/output.h>
@@ -274,7 +275,7 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--basis", args->basis,
                     "channel basis: adaptive_k6 (encoded for the light: the appliance's default), "
                     "replica_k6, general_k6, pca6, box6 (docs/accuracy.md)")
-            ->check(CLI::IsMember({"adaptive_k6", "replica_k6", "general_k6", "pca6", "box6"}))
+            ->check(CLI::IsMember(pipeline::spectral::channelBasisNames()))
             ->capture_default_str();
     cmd->add_option("--out", args->out, "output .exr")->required();
     cmd->add_flag("--json", args->json, "print the summary as JSON");

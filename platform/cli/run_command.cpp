@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/spectral/representation_catalogue.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/frame_outputs.h>
@@ -248,10 +249,11 @@ int runMain(const RunOptions& o)
                   sources->lampSelector->info().model, sources->lampSelector->info().serial,
                   (*appliance)->updater->lampArbiter().overruled());
     }
-    log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}; late frames {}; "
-              "out of gamut: mean {:.4f}, max {:.4f} of pixels",
+    log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}, lamp selector "
+              "{}; late frames {}; out of gamut: mean {:.4f}, max {:.4f} of pixels",
               stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
-              stats->lateFrames, stats->meanOutOfGamutFraction(), stats->maxOutOfGamutFraction);
+              stats->droppedLamp, stats->lateFrames, stats->meanOutOfGamutFraction(),
+              stats->maxOutOfGamutFraction);
     return code;
 }
 
@@ -323,7 +325,7 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                     "channel basis: adaptive_k6 (re-encoded for each light, exact for the light "
                     "present; the default, booth renderer only), replica_k6 (fixed; the flat "
                     "renderer's default), general_k6, pca6, box6 (docs/accuracy.md)")
-            ->check(CLI::IsMember({"adaptive_k6", "replica_k6", "general_k6", "pca6", "box6"}));
+            ->check(CLI::IsMember(pipeline::spectral::channelBasisNames()));
     cmd->add_flag("--fast", opts->fast,
                   "do not wait for each tick's wall-clock time (same frames, rendered as fast as "
                   "possible)");
