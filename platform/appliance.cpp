@@ -50,6 +50,7 @@ std::string RunConfig::toJson() const
                      {"specular_samples", specularSamples},
                      {"specular_grid", specularGrid},
                      {"hardware_filter", hardwareFilter},
+                     {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
                      {"display_inverse", displayInverse},
@@ -86,6 +87,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         // Absent before the specular grid: those recordings were shaded per pixel.
         c.specularGrid = j.value("specular_grid", 0);
         c.hardwareFilter = j.value("hardware_filter", false);
+        c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
         // Recordings made before display profiles had none of these: the plain pass 2 they had
         // was on-axis, without flare subtraction.
@@ -359,6 +361,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     setup.display = std::move(*display);
     setup.lightsU = config.lightsU;
     setup.lightsV = config.lightsV;
+    setup.surroundIlluminance = config.surroundIlluminance;
     if (config.renderer == "booth") {
         auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer, encoder);
         if (!boothScene) {

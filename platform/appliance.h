@@ -46,6 +46,10 @@ struct RunConfig {
     // rule, other float rounding). Recordings made before it have none and replay with the
     // shader's own filter, bit for bit.
     bool hardwareFilter = true;
+    // Whether pass 1 also shades the illuminance around the surface when the display pass clears
+    // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
+    // Recordings made before have none and replay with it, so their XYZ digests stand.
+    bool surroundIlluminance = false;
     // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
     // light; recordings made with replica_k6 or box6 replay as such.
     std::string basis = "adaptive_k6";

@@ -70,6 +70,9 @@ public:
     // recomputed, and a way to force it (e.g. after the channel encoding changed).
     long cacheRefreshes() const { return pass_->cacheRefreshes(); }
     void invalidateCache() { pass_->invalidateCache(); }
+    // BoothShadingPass::setSurroundIlluminance.
+    void setSurroundIlluminance(bool on) { pass_->setSurroundIlluminance(on); }
+    bool surroundIlluminance() const { return pass_->surroundIlluminance(); }
 
     std::string description() const;
 

@@ -437,6 +437,14 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     return glCheck("uploading the light");
 }
 
+void BoothShadingPass::setSurroundIlluminance(bool on) const
+{
+    if (on != surroundIlluminance_) {
+        surroundIlluminance_ = on;
+        cacheValid_ = false;
+    }
+}
+
 void BoothShadingPass::set3All(const char* name, const glm::dvec3& v) const
 {
     const glm::vec3 f = f3(v);
@@ -529,11 +537,21 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                        layout.offset,
                        layout.scale};
     if (!cacheValid_ || !(key == cacheKey_)) {
-        // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare).
+        // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare); or,
+        // without the surround's illuminance, the surface's rectangle and zero around it.
         glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
+        const bool rectOnly = !surroundIlluminance_ && layout.scale.x > 0.0 && layout.scale.y > 0.0;
+        if (rectOnly) {
+            const std::array<float, 4> zero{};
+            glClearBufferfv(GL_COLOR, 0, zero.data());
+            const PixelRect r = surfaceRect(layout, width, height);
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(r.x, r.y, r.width, r.height);
+        }
         setPose(diffusePose);
         glUseProgram(programs_[0]);
         glDrawArrays(GL_TRIANGLES, 0, 3);
+        glDisable(GL_SCISSOR_TEST);
         cacheKey_ = key;
         cacheValid_ = true;
         ++cacheRefreshes_;

@@ -78,6 +78,13 @@ public:
     // Forces the next draw to recompute the cached part (e.g. after the channel encoding of the
     // scene's textures changed under the pass).
     void invalidateCache() const { cacheValid_ = false; }
+    // Whether the cache (and so every frame) carries E_geo around the surface, what a display pass
+    // that shades the whole panel needs for its flare (the default). Off, the pass shades only the
+    // surface's rectangle (surfaceRect) and the frame is (0, 0, 0, 0) around it: for a display pass
+    // that clears that surround anyway (DisplayPass::surroundConstant). Inside the rectangle the
+    // frame is the same either way.
+    void setSurroundIlluminance(bool on) const;
+    bool surroundIlluminance() const { return surroundIlluminance_; }
     // How many draws recomputed the cached part so far.
     long cacheRefreshes() const { return cacheRefreshes_; }
 
@@ -127,6 +134,7 @@ private:
     };
     mutable CacheKey cacheKey_;
     mutable bool cacheValid_ = false;
+    mutable bool surroundIlluminance_ = true;
     mutable long cacheRefreshes_ = 0;
     mutable GLuint cacheTexture_ = 0;
     mutable GLuint cacheFbo_ = 0;

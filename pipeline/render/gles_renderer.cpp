@@ -103,6 +103,10 @@ public:
             return tl::unexpected(display.error());
         }
         glGenVertexArrays(1, &vao_);
+        if (setup_.boothScene) {
+            setup_.boothScene->setSurroundIlluminance(setup_.surroundIlluminance ||
+                                                      !displayPass_.surroundConstant());
+        }
 
         const auto& s = setup_.surface;
         const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);

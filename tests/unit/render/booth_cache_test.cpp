@@ -239,5 +239,50 @@ TEST(TiltHold, CostsTheDiffuseTermAFifthOfADeltaE00AtMost)
     EXPECT_GT(worstP95, 0.0); // the pose does matter
 }
 
+TEST_F(BoothCacheTest, WithoutTheSurroundOnlyTheSurfaceRectangleIsShaded)
+{
+    auto with = BoothScenePass::create(setup_);
+    auto without = BoothScenePass::create(setup_);
+    ASSERT_TRUE(with && without);
+    EXPECT_TRUE((*with)->surroundIlluminance()); // the default
+    (*without)->setSurroundIlluminance(false);
+    const PixelRect r = (*with)->surfaceRect(kW, kH);
+    ASSERT_GT(r.width, 0);
+    ASSERT_LT(r.width * r.height, kW * kH); // the surface does not fill the panel
+    for (const double tilt : {0.35, 0.6}) { // the second recomputes the cache
+        const auto st = state(tilt, {0.1, 0.5, 0.5});
+        const auto a = draw(**with, st);
+        const auto b = draw(**without, st);
+        long inside = 0, outsideLit = 0;
+        for (int y = 0; y < kH; ++y) {
+            for (int x = 0; x < kW; ++x) {
+                const std::size_t i = (static_cast<std::size_t>(y) * kW + x) * 4;
+                const bool in = x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height;
+                if (in) {
+                    ++inside;
+                    for (int c = 0; c < 4; ++c) {
+                        ASSERT_EQ(a[i + c], b[i + c]) << x << ", " << y << " channel " << c;
+                    }
+                } else {
+                    for (int c = 0; c < 3; ++c) {
+                        ASSERT_EQ(a[i + c], 0.0f); // the black panel either way
+                        ASSERT_EQ(b[i + c], 0.0f);
+                    }
+                    ASSERT_EQ(b[i + 3], 0.0f); // no illuminance where nothing reads it
+                    outsideLit += a[i + 3] > 0.0f ? 1 : 0;
+                }
+            }
+        }
+        EXPECT_EQ(inside, static_cast<long>(r.width) * r.height);
+        EXPECT_GT(outsideLit, 0); // with it, E_geo is there around the surface
+    }
+    EXPECT_EQ((*without)->cacheRefreshes(), 2);
+    // Turning it back on recomputes the cache (it was drawn without the surround).
+    (*without)->setSurroundIlluminance(true);
+    const auto st = state(0.6, {0.1, 0.5, 0.5});
+    EXPECT_EQ(draw(**with, st), draw(**without, st));
+    EXPECT_EQ((*without)->cacheRefreshes(), 3);
+}
+
 } // namespace
 } // namespace replica::pipeline::render

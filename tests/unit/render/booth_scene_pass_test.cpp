@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/render/booth_scene_pass.h>
@@ -142,6 +143,7 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // Made before the specular grid and the sampler's filter: per pixel, the shader's filter.
     EXPECT_EQ(o->specularGrid, 0);
     EXPECT_FALSE(o->hardwareFilter);
+    EXPECT_TRUE(o->surroundIlluminance);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
     EXPECT_TRUE(c.hardwareFilter);
@@ -175,6 +177,82 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
 
 namespace replica::platform {
 namespace {
+
+// One frame of a freshly built appliance (one GL context at a time: built, drawn, destroyed).
+struct SurroundFrame {
+    pipeline::render::RenderedFrame frame;
+    pipeline::render::PixelRect rect;
+    bool surround = true;
+};
+std::optional<SurroundFrame> surroundFrame(RunConfig c)
+{
+    auto app = buildAppliance(c);
+    if (!app) {
+        return std::nullopt;
+    }
+    pipeline::scene::SceneState st;
+    st.lampIndex = 0;
+    st.illuminant = (*app)->booth.lamps[0].spectrum;
+    st.emitterLuminanceCdM2 = (*app)->booth.lamps[0].luminanceCdM2;
+    st.tiltRad = 0.3;
+    st.eyeBoothM = {0.1, 0.5, 0.45};
+    SurroundFrame f;
+    EXPECT_TRUE((*app)->renderer->render(st, f.frame, pipeline::render::Readback::DisplayAndXyz));
+    f.rect = (*app)->boothScene->surfaceRect(c.width, c.height);
+    f.surround = (*app)->boothScene->surroundIlluminance();
+    return f;
+}
+
+TEST(ApplianceBoothScene, TheClearedSurroundIsNotShadedAndNoPixelChanges)
+{
+    RunConfig c;
+    c.width = 96;
+    c.height = 60;
+    ASSERT_FALSE(c.surroundIlluminance); // new runs leave it out
+    const auto without = surroundFrame(c);
+    if (!without) {
+        GTEST_SKIP() << "no EGL/GLES context";
+    }
+    c.surroundIlluminance = true; // as recordings made before it replay
+    const auto with = surroundFrame(c);
+    ASSERT_TRUE(with);
+    EXPECT_FALSE(without->surround);
+    EXPECT_TRUE(with->surround);
+    // What the panel shows, and the gamut counts, are the same.
+    EXPECT_EQ(without->frame.rgba, with->frame.rgba);
+    EXPECT_EQ(without->frame.gamut.belowBlack, with->frame.gamut.belowBlack);
+    EXPECT_EQ(without->frame.gamut.chroma, with->frame.gamut.chroma);
+    EXPECT_EQ(without->frame.gamut.overPeak, with->frame.gamut.overPeak);
+    // The XYZ frame differs only in the surround's alpha, which nothing reads.
+    const auto& a = without->frame.xyz;
+    const auto& b = with->frame.xyz;
+    ASSERT_EQ(a.size(), b.size());
+    long alphaDiffers = 0;
+    for (int y = 0; y < c.height; ++y) {
+        for (int x = 0; x < c.width; ++x) {
+            const std::size_t i = (static_cast<std::size_t>(y) * c.width + x) * 4;
+            const auto& r = with->rect;
+            const bool in = x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height;
+            for (int k = 0; k < 3; ++k) {
+                ASSERT_EQ(a[i + k], b[i + k]) << x << ", " << y;
+            }
+            if (in) {
+                ASSERT_EQ(a[i + 3], b[i + 3]) << x << ", " << y;
+            } else {
+                alphaDiffers += a[i + 3] != b[i + 3] ? 1 : 0;
+            }
+        }
+    }
+    EXPECT_GT(alphaDiffers, 0);
+
+    // A display pass that shades the surround (per-channel clipping) gets its illuminance
+    // whatever the configuration says.
+    c.surroundIlluminance = false;
+    c.gamutMapping = "clip";
+    const auto clip = surroundFrame(c);
+    ASSERT_TRUE(clip);
+    EXPECT_TRUE(clip->surround);
+}
 
 TEST(ApplianceBoothScene, RecordsTheSceneAndRefusesAChangedOne)
 {
