@@ -18,10 +18,11 @@
 
 namespace replica::platform {
 
-// Everything that decides what a frame looks like, apart from the samples. Recorded in the session
-// so that replay rebuilds the identical renderer.
+// RunConfig::specularGrid: chosen for the scene when the appliance is built.
 constexpr int kAutoSpecularGrid = -1;
 
+// Everything that decides what a frame looks like, apart from the samples. Recorded in the session
+// so that replay rebuilds the identical renderer.
 struct RunConfig {
     int width = 960;
     int height = 600;
@@ -40,7 +41,7 @@ struct RunConfig {
     // pixel; kAutoSpecularGrid: shading::defaultSpecularGrid for the scene, chosen when the
     // appliance is built and recorded as chosen.
     // Recordings made before the grid have none: they replay per pixel.
-    int specularGrid = -1;
+    int specularGrid = kAutoSpecularGrid;
     int horizonDirections = 8;
     // shading::RenderSettings::hardwareFilter: the sampler filters the luminance mip chain (same
     // rule, other float rounding). Recordings made before it have none and replay with the

@@ -180,9 +180,9 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                  hasExtension("GL_OES_texture_border_clamp"));
     // Which passes run is fixed for the pass's life: compiled into each program, so that none
     // carries code it never runs (llvmpipe executes both sides of a branch under a mask).
-    const bool specular = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
-    gridNodes_ =
-            specular ? shading::specularGridNodes(s, settings_.specularGrid) : shading::GridNodes{};
+    specular_ = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
+    gridNodes_ = specular_ ? shading::specularGridNodes(s, settings_.specularGrid)
+                           : shading::GridNodes{};
     for (int mode = 0; mode < 3; ++mode) {
         const std::string source =
                 fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
@@ -250,7 +250,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     }
 
     // The specular samples' half vectors depend only on alpha and N: once here, in double.
-    const int samples = specular ? settings_.specularSamples : 0;
+    const int samples = specular_ ? settings_.specularSamples : 0;
     if (samples > kBoothMaxSpecularSamples) {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("render: {} specular samples; the GL pass takes at most {}",
@@ -451,12 +451,18 @@ void BoothShadingPass::set3All(const char* name, const glm::dvec3& v) const
     uniformAll(glProgramUniform3f, name, f.x, f.y, f.z);
 }
 
-void BoothShadingPass::setPose(const shading::PanelPose& panel) const
+void BoothShadingPass::usePose(int mode, const shading::PanelPose& panel) const
 {
-    set3All("uCentre", panel.centre);
-    set3All("uRight", panel.right);
-    set3All("uUp", panel.up);
-    set3All("uNormal", panel.normal);
+    const GLuint p = programs_[static_cast<std::size_t>(mode)];
+    const auto set = [p](const char* name, const shading::Vec3& v) {
+        const glm::vec3 f = f3(v);
+        glProgramUniform3f(p, glGetUniformLocation(p, name), f.x, f.y, f.z);
+    };
+    set("uCentre", panel.centre);
+    set("uRight", panel.right);
+    set("uUp", panel.up);
+    set("uNormal", panel.normal);
+    glUseProgram(p);
 }
 
 Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
@@ -528,6 +534,9 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     glBindTexture(GL_TEXTURE_2D, 0); // not sampled while it is the render target
 
     const shading::PanelPose& diffusePose = cachePose != nullptr ? *cachePose : view.panel;
+    // What the surface can light (the whole viewport for a layout that does not scale): what the
+    // compose draws, and all the cache holds without the surround's illuminance.
+    const PixelRect rect = surfaceRect(layout, width, height);
     const CacheKey key{diffusePose.centre,
                        diffusePose.right,
                        diffusePose.up,
@@ -540,30 +549,24 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare); or,
         // without the surround's illuminance, the surface's rectangle and zero around it.
         glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
-        const bool rectOnly = !surroundIlluminance_ && layout.scale.x > 0.0 && layout.scale.y > 0.0;
-        if (rectOnly) {
+        if (!surroundIlluminance_) {
             const std::array<float, 4> zero{};
             glClearBufferfv(GL_COLOR, 0, zero.data());
-            const PixelRect r = surfaceRect(layout, width, height);
             glEnable(GL_SCISSOR_TEST);
-            glScissor(r.x, r.y, r.width, r.height);
+            glScissor(rect.x, rect.y, rect.width, rect.height);
         }
-        setPose(diffusePose);
-        glUseProgram(programs_[0]);
+        usePose(0, diffusePose);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glDisable(GL_SCISSOR_TEST);
         cacheKey_ = key;
         cacheValid_ = true;
         ++cacheRefreshes_;
     }
-    const bool specular =
-            settings_.specularPass && scene_->scene->glossy() && settings_.specularSamples > 0;
-    if (specular && gridNodes_.x > 0) {
+    if (gridNodes_.x > 0) {
         // This eye's specular term at the grid's nodes, for the compose to interpolate.
         glBindFramebuffer(GL_FRAMEBUFFER, gridFbo_);
         glViewport(0, 0, gridNodes_.x, gridNodes_.y);
-        setPose(view.panel);
-        glUseProgram(programs_[2]);
+        usePose(2, view.panel);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glViewport(0, 0, width, height);
     }
@@ -575,15 +578,10 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     restore();
-    if (specular || settings_.subtractFlare) {
-        const bool scissor = layout.scale.x > 0.0 && layout.scale.y > 0.0;
-        if (scissor) {
-            const PixelRect r = surfaceRect(layout, width, height);
-            glEnable(GL_SCISSOR_TEST);
-            glScissor(r.x, r.y, r.width, r.height);
-        }
-        setPose(view.panel);
-        glUseProgram(programs_[1]);
+    if (specular_ || settings_.subtractFlare) {
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(rect.x, rect.y, rect.width, rect.height);
+        usePose(1, view.panel);
         glBindTexture(GL_TEXTURE_2D, cacheTexture_); // unit kUnitCache is active
         glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);
         glBindTexture(GL_TEXTURE_2D, gridTexture_);
@@ -591,9 +589,7 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         glBindTexture(GL_TEXTURE_2D, 0);
         glActiveTexture(GL_TEXTURE0 + kUnitCache);
         glBindTexture(GL_TEXTURE_2D, 0);
-        if (scissor) {
-            glDisable(GL_SCISSOR_TEST);
-        }
+        glDisable(GL_SCISSOR_TEST);
     }
     glActiveTexture(GL_TEXTURE0);
     return glCheck("drawing the booth pass");

@@ -97,13 +97,16 @@ private:
     BoothShadingPass() = default;
     Expected<void> init(const shading::PreparedScene& scene);
     Expected<void> ensureCacheTarget(int width, int height) const;
-    void setPose(const shading::PanelPose& panel) const;
+    // Sets the panel pose in one mode's program and makes that program current: each mode draws
+    // at its own pose (the cache at the held one).
+    void usePose(int mode, const shading::PanelPose& panel) const;
 
     shading::RenderSettings settings_;
     const shading::PreparedScene* scene_ = nullptr;
     const shading::PreparedLight* light_ = nullptr;
     const colour::Observer* observer_ = nullptr;
     bool relief_ = false;
+    bool specular_ = false; // a specular term to shade: glossy scene, pass and samples on
     bool hwFilter_ = false;
     int horizonDirs_ = 0;
     int lightCount_ = 0;

@@ -313,10 +313,11 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glBindTexture(GL_TEXTURE_3D, lut3d_);
     PixelRect shade{0, 0, width_, height_};
     if (frame.blackOutside && surroundConstant_) {
-        shade.x = std::clamp(frame.inside.x, 0, width_);
-        shade.y = std::clamp(frame.inside.y, 0, height_);
-        shade.width = std::clamp(frame.inside.width, 0, width_ - shade.x);
-        shade.height = std::clamp(frame.inside.height, 0, height_ - shade.y);
+        const PixelRect& inside = *frame.blackOutside;
+        shade.x = std::clamp(inside.x, 0, width_);
+        shade.y = std::clamp(inside.y, 0, height_);
+        shade.width = std::clamp(inside.width, 0, width_ - shade.x);
+        shade.height = std::clamp(inside.height, 0, height_ - shade.y);
         // The surround: its constant counts, gamut class 3 (below black).
         const std::array<float, 4> belowBlack{3.0f / 255.0f, 0.0f, 0.0f, 0.0f};
         glClearBufferfv(GL_COLOR, 0, surroundRgba_.data());

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <GLES3/gl31.h>
@@ -47,13 +48,12 @@ struct DisplayPassFrame {
     // Take the illuminance on the panel (lux) from the XYZ texture's alpha, where pass 1 wrote
     // it, instead of summing 'lights' again per pixel.
     bool illuminanceInAlpha = false;
-    // Pass 1 wrote XYZ (0, 0, 0) outside this rectangle (the black panel around a booth surface).
-    // There, whatever the flare and the eye, every pixel is below black and gets the counts of
-    // XYZ 0; when those counts survive the dither unchanged (DisplayPass::surroundConstant) the
-    // pass clears the surround to them and shades only the rectangle: the same pixels and gamut
-    // counts, for the surface's share of the work. Whole frame when not set.
-    bool blackOutside = false;
-    PixelRect inside;
+    // When set, pass 1 wrote XYZ (0, 0, 0) outside this rectangle (the black panel around a booth
+    // surface). There, whatever the flare and the eye, every pixel is below black and gets the
+    // counts of XYZ 0; when those counts survive the dither unchanged (DisplayPass::
+    // surroundConstant) the pass clears the surround to them and shades only the rectangle: the
+    // same pixels and gamut counts, for the surface's share of the work. Unset: the whole frame.
+    std::optional<PixelRect> blackOutside;
 };
 
 class DisplayPass

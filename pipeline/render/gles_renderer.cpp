@@ -200,8 +200,7 @@ public:
         df.lightNormal = setup_.booth.emitter.normal;
         df.illuminanceInAlpha = setup_.boothScene != nullptr;
         if (setup_.boothScene) {
-            df.blackOutside = true;
-            df.inside = setup_.boothScene->surfaceRect(w, h);
+            df.blackOutside = setup_.boothScene->surfaceRect(w, h);
         }
         const colour::Xyz lightXyz = colour::spectrumToXyz(setup_.observer, state.illuminant);
         df.lightXyzUnitY = lightXyz.y > 0.0 ? lightXyz / lightXyz.y : glm::dvec3(0.0);

@@ -218,39 +218,47 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     const double a = bl.texelAreaM2();
     const colour::Xyz specXyz = colour::spectrumToXyz(obs, scene.rhoS * light.unitSpd);
     const int threads = std::clamp(settings.threads, 1, std::max(frame.height, 1));
+    // Rows [0, rows) split over the threads: f(thread, first row, end row).
+    const auto inParallel = [threads](int rows, const auto& f) {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t) {
+            pool.emplace_back(f, t, rows * t / threads, rows * (t + 1) / threads);
+        }
+        for (auto& th : pool) {
+            th.join();
+        }
+    };
+    // The unit vector from a shading point to the eye (the macro normal with the eye on it), and
+    // the specular term (rho_s = 1) seen along it: what a pixel and a grid node both shade.
+    const auto towardEye = [&](const ShadingPoint& sp) {
+        const Vec3 toEye = view.eye - sp.p;
+        const double eyeDist = glm::length(toEye);
+        return eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
+    };
+    const auto specularAt = [&](const ShadingPoint& sp, const Vec3& toEye) {
+        return filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model, scene.alpha,
+                                settings.specularSamples, horizon, sp.tx, sp.ty, sp.right, sp.up,
+                                settings.horizonSoftness);
+    };
 
     // The specular grid, when used: every node first (as the GL pass's mode 2 does).
     const GridNodes nodes =
             specular ? specularGridNodes(scene, settings.specularGrid) : GridNodes{};
     std::vector<double> grid(static_cast<std::size_t>(nodes.x) * static_cast<std::size_t>(nodes.y));
-    const auto gridRows = [&](int j0, int j1) {
-        for (int j = j0; j < j1; ++j) {
-            for (int i = 0; i < nodes.x; ++i) {
-                const ShadingPoint sp =
-                        shadingPointAt(view, scene, normals, static_cast<double>(i) / (nodes.x - 1),
-                                       static_cast<double>(j) / (nodes.y - 1));
-                Vec3 toEye = view.eye - sp.p;
-                const double eyeDist = glm::length(toEye);
-                toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
-                double s = 0.0;
-                if (glm::dot(toEye, sp.nGeo) > 0.0) {
-                    s = filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model,
-                                         scene.alpha, settings.specularSamples, horizon, sp.tx,
-                                         sp.ty, sp.right, sp.up, settings.horizonSoftness);
-                }
-                grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(nodes.x) +
-                     static_cast<std::size_t>(i)] = std::isfinite(s) ? s : 0.0;
-            }
-        }
-    };
     if (nodes.x > 0) {
-        std::vector<std::thread> pool;
-        for (int t = 0; t < threads; ++t) {
-            pool.emplace_back(gridRows, nodes.y * t / threads, nodes.y * (t + 1) / threads);
-        }
-        for (auto& th : pool) {
-            th.join();
-        }
+        inParallel(nodes.y, [&](int, int j0, int j1) {
+            for (int j = j0; j < j1; ++j) {
+                for (int i = 0; i < nodes.x; ++i) {
+                    const ShadingPoint sp = shadingPointAt(view, scene, normals,
+                                                           static_cast<double>(i) / (nodes.x - 1),
+                                                           static_cast<double>(j) / (nodes.y - 1));
+                    const Vec3 toEye = towardEye(sp);
+                    const double s = glm::dot(toEye, sp.nGeo) > 0.0 ? specularAt(sp, toEye) : 0.0;
+                    grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(nodes.x) +
+                         static_cast<std::size_t>(i)] = std::isfinite(s) ? s : 0.0;
+                }
+            }
+        });
     }
 
     struct Counts {
@@ -260,9 +268,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
         for (int py = y0; py < y1; ++py) {
             for (int px = 0; px < frame.width; ++px) {
                 const ShadingPoint sp = shadingPoint(view, scene, normals, px, py);
-                Vec3 toEye = view.eye - sp.p;
-                const double eyeDist = glm::length(toEye);
-                toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
+                const Vec3 toEye = towardEye(sp);
                 const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
                 c.behind += behind ? 1 : 0;
                 const double eGeo =
@@ -294,11 +300,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                     const double v = (py + 0.5) / view.pixelsY;
                     xyz += specXyz * gridSpecular(grid, nodes, u, v);
                 } else if (specular && !behind) {
-                    const double s =
-                            filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model,
-                                             scene.alpha, settings.specularSamples, horizon, sp.tx,
-                                             sp.ty, sp.right, sp.up, settings.horizonSoftness);
-                    xyz += specXyz * s;
+                    xyz += specXyz * specularAt(sp, toEye);
                 }
                 const colour::Xyz flare = light.white * (kScreenFlareRho * eGeo / std::numbers::pi);
                 colour::Xyz out = subtractFlare(xyz, flare, c.flare);
@@ -311,14 +313,9 @@ XyzFrame renderRealtime(const PreparedScene& ps,
         }
     };
     std::vector<Counts> counts(static_cast<std::size_t>(threads));
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) {
-        pool.emplace_back(renderRows, frame.height * t / threads, frame.height * (t + 1) / threads,
-                          std::ref(counts[static_cast<std::size_t>(t)]));
-    }
-    for (auto& th : pool) {
-        th.join();
-    }
+    inParallel(frame.height, [&](int t, int y0, int y1) {
+        renderRows(y0, y1, counts[static_cast<std::size_t>(t)]);
+    });
     for (const auto& c : counts) {
         frame.flareClamped += c.flare;
         frame.eyeBehindPixels += c.behind;

@@ -17,6 +17,7 @@
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/surface/scene.h>
+#include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/output/output.h>
 
@@ -35,7 +36,7 @@ struct RenderArgs {
     bool gl = false;
     int lights = 32;
     int samples = pipeline::shading::RenderSettings{}.specularSamples; // the appliance's default
-    int specularGrid = -1; // -1: as the appliance chooses (flat: 8 texels; relief: per pixel)
+    int specularGrid = kAutoSpecularGrid; // as the appliance chooses it for the scene
     int horizonDirections = 8;
     std::string basis = "adaptive_k6";
     std::string out;
@@ -268,7 +269,7 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                     "0: per pixel; -1: as the appliance chooses (8 on a flat surface, per pixel "
                     "on relief)")
             ->capture_default_str()
-            ->check(CLI::Range(-1, 256));
+            ->check(CLI::Range(kAutoSpecularGrid, 256));
     cmd->add_option("--horizon-directions", args->horizonDirections, "horizon map azimuths")
             ->capture_default_str()
             ->check(CLI::Range(1, 64));

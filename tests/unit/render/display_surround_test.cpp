@@ -82,8 +82,9 @@ protected:
         f.eyeM = {0.2, 0.5, 0.4};
         f.lightXyzUnitY = {0.96, 1.0, 0.82};
         f.illuminanceInAlpha = true;
-        f.blackOutside = blackOutside;
-        f.inside = kInside;
+        if (blackOutside) {
+            f.blackOutside = kInside;
+        }
         auto counts = pass.draw(xyz_, f);
         EXPECT_TRUE(counts) << counts.error().message;
         Drawn d;
