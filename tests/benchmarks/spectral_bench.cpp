@@ -3,6 +3,8 @@
 // per-pixel shading of each representation in float, as a shader would run it.
 #include <algorithm>
 #include <cstdio>
+#include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -73,18 +75,40 @@ void printAccuracyTable()
     std::printf("\n");
 }
 
-// adaptive_k6 encoded for one light and rendered under another: what the appliance shows between a
-// light change and the end of the re-encode, and the general basis it starts from.
-void printAdaptiveTransitions()
+// What the adaptive_k6 studies below evaluate with: the observer, D65 (the representations'
+// reference white), the ColorChecker and the adaptive representation.
+struct AdaptiveStudy {
+    pipeline::colour::Observer obs;
+    Spectrum d65;
+    NamedSpectra colorchecker;
+    std::unique_ptr<Representation> rep;
+};
+
+std::optional<AdaptiveStudy> loadAdaptiveStudy()
 {
     auto obs = pipeline::colour::loadCie1931(dataDir());
     auto d65 = loadCieIlluminant(dataDir(), "D65");
     auto set = loadReflectanceSet(dataDir(), "colorchecker");
+    if (!obs || !d65 || !set) {
+        return std::nullopt;
+    }
     auto rep = makeRepresentation(dataDir(), *obs, *d65, "adaptive_k6");
-    if (!obs || !d65 || !set || !rep) {
+    if (!rep) {
+        return std::nullopt;
+    }
+    return AdaptiveStudy{std::move(*obs), *d65, std::move(*set), std::move(*rep)};
+}
+
+// adaptive_k6 encoded for one light and rendered under another: what the appliance shows between a
+// light change and the end of the re-encode, and the general basis it starts from.
+void printAdaptiveTransitions()
+{
+    auto study = loadAdaptiveStudy();
+    if (!study) {
         std::fprintf(stderr, "cannot load the adaptive representation\n");
         return;
     }
+    const auto& [obs, d65, set, rep] = *study;
     const auto lights = evaluationLightNames();
     // Largest error encoded for the light itself, beyond the 3 decimals of the table.
     double worst = 0.0;
@@ -92,7 +116,7 @@ void printAdaptiveTransitions()
         auto s = loadReflectanceSet(dataDir(), setName);
         for (const auto& l : lights) {
             auto light = loadCieIlluminant(dataDir(), l);
-            auto res = evaluateRepresentation(*obs, *d65, **rep, *light, *s);
+            auto res = evaluateRepresentation(obs, d65, *rep, *light, *s);
             worst = res ? std::max(worst, res->stats.max) : 1e9;
         }
     }
@@ -115,7 +139,7 @@ void printAdaptiveTransitions()
         std::unique_ptr<Representation> fixed;
         if (row[0] != '(') {
             auto encodedFor = loadCieIlluminant(dataDir(), row);
-            auto a = (*rep)->adaptedTo(*encodedFor);
+            auto a = rep->adaptedTo(*encodedFor);
             if (!a) {
                 continue;
             }
@@ -125,14 +149,14 @@ void printAdaptiveTransitions()
         for (const auto& l : lights) {
             auto light = loadCieIlluminant(dataDir(), l);
             // The general basis is (*rep) itself before adaptation; a fixed one is not adaptive.
-            auto res = fixed ? evaluateRepresentation(*obs, *d65, *fixed, *light, *set)
+            auto res = fixed ? evaluateRepresentation(obs, d65, *fixed, *light, set)
                              : Expected<AccuracyReport>(makeError(ErrorCode::InvalidArgument, ""));
             if (!fixed) {
-                auto general = makeBasisRepresentation(*obs, [&] {
+                auto general = makeBasisRepresentation(obs, [&] {
                     auto enc = AdaptiveEncoder::createDefault(dataDir());
                     return enc->generalBasis();
                 }());
-                res = evaluateRepresentation(*obs, *d65, *general, *light, *set);
+                res = evaluateRepresentation(obs, d65, *general, *light, set);
             }
             if (!res) {
                 std::printf(" error |");
@@ -333,14 +357,12 @@ void reencodeTexels(benchmark::State& state)
 // re-encodes: what kAdaptiveReencodeDistance trades.
 void printDirectSensorDrift()
 {
-    auto obs = pipeline::colour::loadCie1931(dataDir());
-    auto d65 = loadCieIlluminant(dataDir(), "D65");
-    auto set = loadReflectanceSet(dataDir(), "colorchecker");
-    auto rep = makeRepresentation(dataDir(), *obs, *d65, "adaptive_k6");
-    if (!obs || !d65 || !set || !rep) {
+    auto study = loadAdaptiveStudy();
+    if (!study) {
         std::fprintf(stderr, "cannot load the adaptive representation\n");
         return;
     }
+    const auto& [obs, d65, set, rep] = *study;
     const auto names = evaluationLightNames();
     std::printf(
             "adaptive_k6 encoded for each of the eight lights, rendered under it moved by shape "
@@ -355,11 +377,11 @@ void printDirectSensorDrift()
         int n = 0;
         for (const auto& from : names) {
             auto l = loadCieIlluminant(dataDir(), from);
-            auto encoded = (*rep)->adaptedTo(*l);
+            auto encoded = rep->adaptedTo(*l);
             std::vector<Spectrum> moved;
             for (const auto& to : names) {
                 auto m = loadCieIlluminant(dataDir(), to);
-                if (auto s = shiftedLight(*obs, *l, *m, d); to != from && s) {
+                if (auto s = shiftedLight(obs, *l, *m, d); to != from && s) {
                     moved.push_back(*s);
                 }
             }
@@ -368,12 +390,12 @@ void printDirectSensorDrift()
                 for (std::size_t b = 0; b < pipeline::colour::kBands; ++b) {
                     noise[b] = (*l)[b] * (1.0 + 0.1 * gauss(rng));
                 }
-                if (auto s = shiftedLight(*obs, *l, noise, d)) {
+                if (auto s = shiftedLight(obs, *l, noise, d)) {
                     moved.push_back(*s);
                 }
             }
             for (const auto& m : moved) {
-                auto r = evaluateRepresentation(*obs, *d65, **encoded, m, *set);
+                auto r = evaluateRepresentation(obs, d65, **encoded, m, set);
                 if (r) {
                     worstMean = std::max(worstMean, r->stats.mean);
                     worstMax = std::max(worstMax, r->stats.max);
