@@ -78,11 +78,8 @@ const float kMinCosView = 1e-3;
 
 float hz[32];
 
-// surface::HorizonMap::sinHorizon + realtime_model.cpp horizonVisibility.
-float visibility(vec3 l) {
-    if (uHorizonDirs <= 0) {
-        return 1.0;
-    }
+// surface::HorizonMap::sinHorizon: the horizon sine at the azimuth of l (tangent frame).
+float horizonSine(vec3 l) {
     float phi = (abs(l.x) > 0.0 || abs(l.y) > 0.0) ? atan(l.y, l.x) : 0.0;
     if (phi < 0.0) {
         phi += 2.0 * kPi;
@@ -91,14 +88,26 @@ float visibility(vec3 l) {
     int k0 = int(floor(f)) % uHorizonDirs;
     int k1 = (k0 + 1) % uHorizonDirs;
     float t = f - floor(f);
-    float sinB = (1.0 - t) * hz[k0] + t * hz[k1];
+    return (1.0 - t) * hz[k0] + t * hz[k1];
+}
+
+// realtime_model.cpp elevationVisibility: a direction at elevation sin = lz against sinB.
+float elevationVisibility(float sinB, float lz) {
     if (sinB <= 0.0) {
         return 1.0;
     }
     float e0 = sinB - uSoftness;
     float e1 = sinB + uSoftness;
-    float s = clamp((l.z - e0) / max(e1 - e0, 1e-12), 0.0, 1.0);
+    float s = clamp((lz - e0) / max(e1 - e0, 1e-12), 0.0, 1.0);
     return s * s * (3.0 - 2.0 * s);
+}
+
+// realtime_model.cpp horizonVisibility.
+float visibility(vec3 l) {
+    if (uHorizonDirs <= 0) {
+        return 1.0;
+    }
+    return elevationVisibility(horizonSine(l), l.z);
 }
 
 #if BOOTH_HW_FILTER
@@ -159,6 +168,12 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
     float fb = n.x * n.y * fa;
     vec3 ft = vec3(1.0 + sgn * n.x * n.x * fa, sgn * fb, -sgn * n.x);
     vec3 fbt = vec3(fb, sgn + n.y * n.y * fa, -n.y);
+    // The lobe's horizon sine, at the mirror direction's azimuth (realtime_model.cpp).
+    float lobeSinB = 0.0;
+    if (uHorizonDirs > 0) {
+        vec3 mirror = 2.0 * co * n - o;
+        lobeSinB = horizonSine(vec3(dot(mirror, uRight), dot(mirror, uUp), 0.0));
+    }
     float sum = 0.0;
     float nf = float(uSpecSamples);
     for (int k = 0; k < uSpecSamples; ++k) {
@@ -203,8 +218,7 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
         }
         float ratio = solidAngle * t * t / (uTexelArea * -denom);
         float lod = 0.5 * log2(max(ratio, 1e-20)) + 1.0;
-        vec3 lt = vec3(dot(i, uRight), dot(i, uUp), cosG);
-        sum += lumSample(lu, lv, lod) * w * visibility(lt);
+        sum += lumSample(lu, lv, lod) * w * elevationVisibility(lobeSinB, cosG);
     }
     return sum / nf;
 }

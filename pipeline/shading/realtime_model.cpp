@@ -11,21 +11,26 @@
 namespace replica::pipeline::shading {
 namespace {
 
-double horizonVisibility(
-        const surface::HorizonMap* horizon, int tx, int ty, const Vec3& l, double softness)
+// Soft horizon test of a direction at elevation sin = lz against the horizon sine sinB.
+double elevationVisibility(double sinB, double lz, double softness)
 {
-    if (horizon == nullptr || horizon->directions <= 0) {
-        return 1.0;
-    }
-    const double sinB = horizon->sinHorizon(tx, ty, l);
     if (sinB <= 0.0) {
         return 1.0; // flat horizon: the geometric test already decided (keeps flat frames
                     // identical)
     }
     const double e0 = sinB - softness;
     const double e1 = sinB + softness;
-    const double t = std::clamp((l.z - e0) / std::max(e1 - e0, 1e-12), 0.0, 1.0);
+    const double t = std::clamp((lz - e0) / std::max(e1 - e0, 1e-12), 0.0, 1.0);
     return t * t * (3.0 - 2.0 * t);
+}
+
+double horizonVisibility(
+        const surface::HorizonMap* horizon, int tx, int ty, const Vec3& l, double softness)
+{
+    if (horizon == nullptr || horizon->directions <= 0) {
+        return 1.0;
+    }
+    return elevationVisibility(horizon->sinHorizon(tx, ty, l), l.z, softness);
 }
 
 } // namespace
@@ -128,6 +133,17 @@ double filteredSpecular(const PreparedLight& light,
     const double a = bl.texelAreaM2();
     const double invU2 = 1.0 / glm::dot(bl.edgeU, bl.edgeU);
     const double invV2 = 1.0 / glm::dot(bl.edgeV, bl.edgeV);
+    // One horizon sine for the whole lobe, read at the azimuth of the mirror direction; each
+    // sample is tested against it at its own elevation. The lobe's samples share that azimuth
+    // wherever the horizon can shadow them (near the horizon; near the normal the azimuth spreads
+    // but the elevation clears any horizon), and the per-sample azimuth and horizon lookup were a
+    // third of the painting's frame on llvmpipe (docs/rendering.md has the error it costs).
+    double lobeSinB = 0.0;
+    if (horizon != nullptr && horizon->directions > 0) {
+        const Vec3 mirror = 2.0 * glm::dot(nShade, toEye) * nShade - toEye;
+        lobeSinB = horizon->sinHorizon(tx, ty,
+                                       Vec3(glm::dot(mirror, right), glm::dot(mirror, up), 0.0));
+    }
     double sum = 0.0;
     for (int k = 0; k < samples; ++k) {
         const double u1 = (k + 0.5) / samples;
@@ -154,9 +170,8 @@ double filteredSpecular(const PreparedLight& light,
         const double cosL = -denom;
         const double ratio = s.solidAngle * t * t / (a * cosL);
         const double lod = 0.5 * std::log2(std::max(ratio, 1e-20)) + 1.0;
-        const Vec3 lt(glm::dot(s.i, right), glm::dot(s.i, up), cosG);
         sum += light.mips.sample(u, v, lod) * s.weight *
-               horizonVisibility(horizon, tx, ty, lt, softness);
+               elevationVisibility(lobeSinB, cosG, softness);
     }
     return samples > 0 ? sum / samples : 0.0;
 }

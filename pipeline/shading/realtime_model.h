@@ -115,6 +115,8 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             double softness);
 
 // Specular radiance (cd/m^2, rho_s = 1) by FIS with N Hammersley samples (u1 = (k + 1/2) / N).
+// The horizon shadows the lobe with one sine, read at the mirror direction's azimuth; each sample
+// is tested against it at its own elevation.
 double filteredSpecular(const PreparedLight& light,
                         const Vec3& p,
                         const Vec3& nGeo,
