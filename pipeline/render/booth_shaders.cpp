@@ -29,7 +29,12 @@ uniform sampler2D uCoeffB;      // channels 3..5
 uniform sampler2D uNormals;     // tangent-space normal per texel
 uniform sampler2DArray uHorizon; // sin(horizon elevation), 4 directions per layer
 const bool uRelief = BOOTH_RELIEF != 0; // normal map and horizons (fixed for the pass's life)
-uniform int uHorizonDirs;       // 0: no horizon shadowing
+// Horizon directions (0: no horizon shadowing), specular samples (0: no specular pass) and the
+// Ward model (0 Ward 1992, 1 Ward-Duer, 2 Ward-Duer guarded, 3 GMD) are fixed for the pass's life
+// and compiled in: the loops over them get constant bounds, the horizon sines constant indices
+// and the Ward weight one branch (llvmpipe paid for the dynamic array indexing and the untaken
+// branches on every sample).
+const int uHorizonDirs = BOOTH_HORIZON_DIRS;
 uniform float uSoftness;
 
 layout(std140) uniform BoothLights {
@@ -55,14 +60,14 @@ uniform ivec2 uGridNodes;
 const bool kGrid = BOOTH_GRID != 0;     // whether the compose reads the grid (fixed likewise)
 uniform sampler2D uSpecGrid;    // R32F, uGridNodes: what mode 2 wrote this frame
 
-uniform int uSpecSamples;       // 0: no specular pass
+const int uSpecSamples = BOOTH_SPEC_SAMPLES;
 // brdf::sampleWardHalfVectorLocal for sample k (u1 = (k + 1/2) / N, u2 = radicalInverse2(k)),
 // computed once on the CPU in double: xyz the half vector in the local frame, w the sample's
 // solid angle without its o.h factor, 4 pi alpha^2 cos^3 / (N u1).
 layout(std140) uniform BoothSpecSamples {
     vec4 uSpecSample[256];
 };
-uniform int uWardModel;         // 0 Ward 1992, 1 Ward-Duer, 2 Ward-Duer guarded, 3 GMD
+const int uWardModel = BOOTH_WARD_MODEL;
 uniform vec3 uSpecXyz;          // XYZ of rho_s times the unit-luminance light
 uniform vec3 uLightCentre;
 uniform vec3 uEdgeU;
@@ -76,7 +81,7 @@ uniform vec2 uLumUsed;          // the light's share of the padded texture
 const float kPi = 3.14159265358979;
 const float kMinCosView = 1e-3;
 
-float hz[32];
+float hz[BOOTH_HORIZON_SLOTS];  // 4 a layer, at least one layer
 
 // surface::HorizonMap::sinHorizon: the horizon sine at the azimuth of l (tangent frame).
 float horizonSine(vec3 l) {
@@ -84,11 +89,16 @@ float horizonSine(vec3 l) {
     if (phi < 0.0) {
         phi += 2.0 * kPi;
     }
+    // Linear between the two directions around phi (wrapping): written as a tent weight over
+    // all k so that every index is a constant (the same sum as indexing hz[k0] and hz[k1]).
     float f = phi / (2.0 * kPi) * float(uHorizonDirs);
-    int k0 = int(floor(f)) % uHorizonDirs;
-    int k1 = (k0 + 1) % uHorizonDirs;
-    float t = f - floor(f);
-    return (1.0 - t) * hz[k0] + t * hz[k1];
+    float sinB = 0.0;
+    for (int k = 0; k < uHorizonDirs; ++k) {
+        float d = abs(f - float(k));
+        d = min(d, float(uHorizonDirs) - d);
+        sinB += max(1.0 - d, 0.0) * hz[k];
+    }
+    return sinB;
 }
 
 // realtime_model.cpp elevationVisibility: a direction at elevation sin = lz against sinB.

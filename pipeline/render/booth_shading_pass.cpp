@@ -183,11 +183,22 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     specular_ = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
     gridNodes_ = specular_ ? shading::specularGridNodes(s, settings_.specularGrid)
                            : shading::GridNodes{};
+    // The specular samples' half vectors depend only on alpha and N: once here, in double.
+    const int samples = specular_ ? settings_.specularSamples : 0;
+    if (samples > kBoothMaxSpecularSamples) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: {} specular samples; the GL pass takes at most {}",
+                                     samples, kBoothMaxSpecularSamples));
+    }
+    const int layers = std::max((horizonDirs_ + 3) / 4, 1);
     for (int mode = 0; mode < 3; ++mode) {
         const std::string source =
                 fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
-                            "#define BOOTH_GRID {}\n#define BOOTH_HW_FILTER {}\n",
-                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0) +
+                            "#define BOOTH_GRID {}\n#define BOOTH_HW_FILTER {}\n"
+                            "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
+                            "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n",
+                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0,
+                            horizonDirs_, 4 * layers, samples, wardModelIndex(s.model)) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -218,7 +229,6 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                        : texture2d(GL_RGB32F, GL_RGB, 1, 1, n.data());
 
     // Horizon map: four directions per layer of an RGBA32F array.
-    const int layers = std::max((horizonDirs_ + 3) / 4, 1);
     const int hw = horizonDirs_ > 0 ? s.width : 1;
     const int hh = horizonDirs_ > 0 ? s.height : 1;
     std::vector<float> hz(static_cast<std::size_t>(hw) * hh * 4 * layers, 0.0f);
@@ -249,13 +259,6 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
         }
     }
 
-    // The specular samples' half vectors depend only on alpha and N: once here, in double.
-    const int samples = specular_ ? settings_.specularSamples : 0;
-    if (samples > kBoothMaxSpecularSamples) {
-        return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("render: {} specular samples; the GL pass takes at most {}",
-                                     samples, kBoothMaxSpecularSamples));
-    }
     std::vector<float> table(static_cast<std::size_t>(kBoothMaxSpecularSamples) * 4, 0.0f);
     for (int k = 0; k < samples; ++k) {
         const double u1 = (k + 0.5) / samples;
@@ -309,13 +312,10 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     uniformAll(glProgramUniform2i, "uTexels", s.width, s.height);
     uniformAll(glProgramUniform2f, "uSizeM", static_cast<float>(s.widthM),
                static_cast<float>(s.heightM));
-    uniformAll(glProgramUniform1i, "uHorizonDirs", horizonDirs_);
     uniformAll(glProgramUniform1f, "uSoftness", static_cast<float>(settings_.horizonSoftness));
     uniformAll(glProgramUniform1i, "uDiffuse", settings_.diffusePass ? 1 : 0);
     uniformAll(glProgramUniform1f, "uFlareRho",
                static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));
-    uniformAll(glProgramUniform1i, "uSpecSamples", samples);
-    uniformAll(glProgramUniform1i, "uWardModel", wardModelIndex(s.model));
     return glCheck("uploading the scene");
 }
 
