@@ -50,6 +50,7 @@ std::string RunConfig::toJson() const
                      {"specular_samples", specularSamples},
                      {"specular_grid", specularGrid},
                      {"hardware_filter", hardwareFilter},
+                     {"specular_lod_bias", specularLodBias},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -87,6 +88,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         // Absent before the specular grid: those recordings were shaded per pixel.
         c.specularGrid = j.value("specular_grid", 0);
         c.hardwareFilter = j.value("hardware_filter", false);
+        c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
         // Recordings made before display profiles had none of these: the plain pass 2 they had
@@ -104,10 +106,12 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.rateHz > 1000.0 || c.lightsU <= 0 || c.lightsV <= 0 || c.lightsU * c.lightsV > 256 ||
         c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < 0 ||
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
-        c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256) {
+        c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
+        !(std::abs(c.specularLodBias) <= 8.0)) {
         return makeError(ErrorCode::InvalidArgument, "run configuration: size, rate, light count, "
-                                                     "specular samples, specular grid or horizon "
-                                                     "directions out of range");
+                                                     "specular samples, specular grid, specular "
+                                                     "lod bias or horizon directions out of "
+                                                     "range");
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -208,6 +212,7 @@ makeBoothScene(RunConfig& config,
     }
     setup.settings.specularGrid = config.specularGrid;
     setup.settings.hardwareFilter = config.hardwareFilter;
+    setup.settings.specularLodBias = config.specularLodBias;
     setup.settings.horizonDirections = config.horizonDirections;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     setup.settings.subtractFlare = !config.flareSubtraction;

@@ -47,6 +47,9 @@ struct RunConfig {
     // rule, other float rounding). Recordings made before it have none and replay with the
     // shader's own filter, bit for bit.
     bool hardwareFilter = true;
+    // shading::RenderSettings::specularLodBias. Recordings made before it have none and replay
+    // with the level bias the renderer had then (kLegacySpecularLodBias), bit for bit.
+    double specularLodBias = pipeline::shading::kDefaultSpecularLodBias;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

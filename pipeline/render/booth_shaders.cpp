@@ -77,6 +77,7 @@ uniform sampler2D uLum;         // luminance mip chain (cd/m^2), padded to power
 uniform int uLumMaxLevel;
 uniform ivec2 uLumSize;         // level 0
 uniform vec2 uLumUsed;          // the light's share of the padded texture
+uniform float uLodBias;         // RenderSettings::specularLodBias
 
 const float kPi = 3.14159265358979;
 const float kMinCosView = 1e-3;
@@ -227,7 +228,7 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
             continue;
         }
         float ratio = solidAngle * t * t / (uTexelArea * -denom);
-        float lod = 0.5 * log2(max(ratio, 1e-20)) + 1.0;
+        float lod = 0.5 * log2(max(ratio, 1e-20)) + uLodBias;
         sum += lumSample(lu, lv, lod) * w * elevationVisibility(lobeSinB, cosG);
     }
     return sum / nf;

@@ -313,6 +313,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     uniformAll(glProgramUniform2f, "uSizeM", static_cast<float>(s.widthM),
                static_cast<float>(s.heightM));
     uniformAll(glProgramUniform1f, "uSoftness", static_cast<float>(settings_.horizonSoftness));
+    uniformAll(glProgramUniform1f, "uLodBias", static_cast<float>(settings_.specularLodBias));
     uniformAll(glProgramUniform1i, "uDiffuse", settings_.diffusePass ? 1 : 0);
     uniformAll(glProgramUniform1f, "uFlareRho",
                static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));

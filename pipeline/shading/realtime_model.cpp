@@ -126,7 +126,8 @@ double filteredSpecular(const PreparedLight& light,
                         int ty,
                         const Vec3& right,
                         const Vec3& up,
-                        double softness)
+                        double softness,
+                        double lodBias)
 {
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();
@@ -169,7 +170,7 @@ double filteredSpecular(const PreparedLight& light,
         }
         const double cosL = -denom;
         const double ratio = s.solidAngle * t * t / (a * cosL);
-        const double lod = 0.5 * std::log2(std::max(ratio, 1e-20)) + 1.0;
+        const double lod = 0.5 * std::log2(std::max(ratio, 1e-20)) + lodBias;
         sum += light.mips.sample(u, v, lod) * s.weight *
                elevationVisibility(lobeSinB, cosG, softness);
     }
@@ -253,7 +254,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     const auto specularAt = [&](const ShadingPoint& sp, const Vec3& toEye) {
         return filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model, scene.alpha,
                                 settings.specularSamples, horizon, sp.tx, sp.ty, sp.right, sp.up,
-                                settings.horizonSoftness);
+                                settings.horizonSoftness, settings.specularLodBias);
     };
 
     // The specular grid, when used: every node first (as the GL pass's mode 2 does).

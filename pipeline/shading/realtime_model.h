@@ -22,6 +22,11 @@ enum class ChannelRep {
     Spectral36, // full spectra per texel (what the channels approximate)
 };
 
+// The specular mip level bias the renderer uses unless told otherwise (RenderSettings).
+inline constexpr double kDefaultSpecularLodBias = 0.0;
+// What renderers used before the bias was a setting: recordings without it replay with this.
+inline constexpr double kLegacySpecularLodBias = 1.0;
+
 struct RenderSettings {
     int lights = 32;
     int specularSamples = 48;
@@ -43,6 +48,11 @@ struct RenderSettings {
     // The GL pass only: let the sampler filter the luminance mip chain where the GL can (same
     // rule as booth::MipChain::sample); off, or without the extensions, the shader filters by hand.
     bool hardwareFilter = true;
+    // Added to each specular sample's mip level (Colbert & Krivanek's level, 1/2 log2 of the
+    // sample's footprint over a texel's): more blurs the luminance image under each sample, less
+    // aliases it. Colbert & Krivanek add 1; docs/rendering.md measures 0 as the better choice
+    // against the exact reference at every sample count the appliance uses.
+    double specularLodBias = kDefaultSpecularLodBias;
     int threads = 2;
 };
 
@@ -130,7 +140,8 @@ double filteredSpecular(const PreparedLight& light,
                         int ty,
                         const Vec3& right,
                         const Vec3& up,
-                        double softness);
+                        double softness,
+                        double lodBias);
 
 XyzFrame renderRealtime(const PreparedScene& scene,
                         const PreparedLight& light,

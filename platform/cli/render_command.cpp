@@ -37,6 +37,7 @@ struct RenderArgs {
     int lights = 32;
     int samples = pipeline::shading::RenderSettings{}.specularSamples; // the appliance's default
     int specularGrid = kAutoSpecularGrid; // as the appliance chooses it for the scene
+    double lodBias = pipeline::shading::kDefaultSpecularLodBias;
     int horizonDirections = 8;
     std::string basis = "adaptive_k6";
     std::string out;
@@ -138,6 +139,7 @@ int runRender(const RenderArgs& a)
     settings.horizonDirections = a.horizonDirections;
     settings.specularGrid =
             a.specularGrid >= 0 ? a.specularGrid : shading::defaultSpecularGrid(*scene);
+    settings.specularLodBias = a.lodBias;
     std::string mode = "realtime-cpu";
     shading::Plan plan;
     if (a.reference) {
@@ -214,6 +216,7 @@ int runRender(const RenderArgs& a)
         j["specular_samples"] =
                 scene->glossy() && settings.specularPass ? settings.specularSamples : 0;
         j["specular_grid"] = scene->glossy() && settings.specularPass ? settings.specularGrid : 0;
+        j["specular_lod_bias"] = settings.specularLodBias;
         j["horizon_directions"] =
                 !scene->flat() && settings.reliefPass ? settings.horizonDirections : 0;
         if (a.plan) {
@@ -270,6 +273,11 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                     "on relief)")
             ->capture_default_str()
             ->check(CLI::Range(kAutoSpecularGrid, 256));
+    cmd->add_option("--specular-lod-bias", args->lodBias,
+                    "added to each specular sample's mip level: more blurs the light under each "
+                    "sample, less aliases it (docs/rendering.md measures the choice)")
+            ->capture_default_str()
+            ->check(CLI::Range(-8.0, 8.0));
     cmd->add_option("--horizon-directions", args->horizonDirections, "horizon map azimuths")
             ->capture_default_str()
             ->check(CLI::Range(1, 64));

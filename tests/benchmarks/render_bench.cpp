@@ -8,6 +8,7 @@
 //        samples) under every scene and light; no sweep, no planner, no plot]
 //        [--scene NAME: only that shipped scene, e.g. metamer (last, after the options above)]
 //        [--grid N: the default setting with a specular grid of N texels (after the above)]
+//        [--lod-bias B: the default setting with specular mip level bias B (after the above)]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -89,6 +90,10 @@ std::string describe(const shading::RenderSettings& s, const surface::SurfaceSce
     return std::to_string(s.lights) + " lights, " +
            std::to_string(scene.glossy() && s.specularPass ? s.specularSamples : 0) + " spec, " +
            std::to_string(scene.flat() || !s.reliefPass ? 0 : s.horizonDirections) + " horizon" +
+           (scene.glossy() && s.specularPass &&
+                            s.specularLodBias != shading::kDefaultSpecularLodBias
+                    ? ", lod bias " + std::to_string(s.specularLodBias).substr(0, 4)
+                    : std::string()) +
            (scene.glossy() && s.specularPass && s.specularGrid > 0
                     ? ", specular grid " + std::to_string(s.specularGrid)
                     : std::string());
@@ -186,7 +191,11 @@ int main(int argc, char** argv)
     std::vector<std::string> planLines;
     std::string only;
     int grid = 0;
+    double lodBias = shading::kDefaultSpecularLodBias;
     for (int a = 3; a + 1 < argc; ++a) {
+        if (std::string(argv[a]) == "--lod-bias") {
+            lodBias = std::atof(argv[a + 1]);
+        }
         if (std::string(argv[a]) == "--scene") {
             only = argv[a + 1];
         }
@@ -216,6 +225,7 @@ int main(int argc, char** argv)
             if (grid > 0) {
                 def.specularGrid = grid;
             }
+            def.specularLodBias = lodBias;
             std::vector<std::pair<std::string, shading::RenderSettings>> configs;
             configs.emplace_back("default (" + describe(def, *scene) + ")", def);
             // The whole sweep under the hardest light (tubes); the default alone under the others.
@@ -230,6 +240,11 @@ int main(int argc, char** argv)
                     auto s = def;
                     s.specularSamples = n;
                     configs.emplace_back(std::to_string(n) + " spec samples", s);
+                }
+                for (double b : {0.5, 1.0}) {
+                    auto s = def;
+                    s.specularLodBias = b;
+                    configs.emplace_back("specular lod bias " + std::to_string(b).substr(0, 3), s);
                 }
                 for (int g : {1, 2, 4, 8}) {
                     auto s = def;

@@ -144,14 +144,22 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_EQ(o->specularGrid, 0);
     EXPECT_FALSE(o->hardwareFilter);
     EXPECT_TRUE(o->surroundIlluminance);
+    // And before the specular mip level bias was a setting: the renderer's bias of then.
+    EXPECT_EQ(o->specularLodBias, shading::kLegacySpecularLodBias);
+    EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
     EXPECT_TRUE(c.hardwareFilter);
     c.specularGrid = 8;
+    c.specularLodBias = 0.25;
     auto round = platform::RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(round);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_TRUE(round->hardwareFilter);
+    EXPECT_EQ(round->specularLodBias, 0.25);
+    c.specularLodBias = 1e9; // a corrupt value is refused, not rendered
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
+    c.specularLodBias = 0.0;
     c.specularGrid = -2;
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
 

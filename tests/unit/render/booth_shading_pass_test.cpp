@@ -221,7 +221,7 @@ TEST_F(BoothPassTest, PlannedSettingMeetsTheErrorBudgetAgainstTheReference)
         const char* scene;
         int lights, samples, dirs;
     };
-    for (const Case c : {Case{"colorchecker", 16, 32, 0}, Case{"painting", 32, 8, 8}}) {
+    for (const Case c : {Case{"colorchecker", 32, 8, 0}, Case{"painting", 32, 4, 8}}) {
         const auto& scene = scenes_.at(c.scene);
         const auto& light = booth_->lights[2]; // d65-fluorescent: tubes, the hardest image
         shading::RenderSettings settings;

@@ -226,7 +226,8 @@ TEST(RealtimeModel, SpecularLobeIsShadowedByTheHorizonAtItsMirrorAzimuth)
     map.directions = 8;
     const auto specular = [&](const surface::HorizonMap* h) {
         return shading::filteredSpecular(pl, p, n, n, toEye, brdf::WardModel::WardDurGuarded, 0.1,
-                                         48, h, 0, 0, right, up, 0.02);
+                                         48, h, 0, 0, right, up, 0.02,
+                                         shading::kDefaultSpecularLodBias);
     };
     const double unshadowed = specular(nullptr);
     ASSERT_GT(unshadowed, 0.0);
