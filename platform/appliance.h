@@ -36,7 +36,7 @@ struct RunConfig {
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
     int boothLights = 32;    // median-cut point lights
-    int specularSamples = 48;
+    int specularSamples = 16;
     // Texels between the specular grid's nodes (shading::RenderSettings::specularGrid); 0: per
     // pixel; kAutoSpecularGrid: shading::defaultSpecularGrid for the scene, chosen when the
     // appliance is built and recorded as chosen.
