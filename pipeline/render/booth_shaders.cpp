@@ -185,6 +185,20 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
         vec3 mirror = 2.0 * co * n - o;
         lobeSinB = horizonSine(vec3(dot(mirror, uRight), dot(mirror, uUp), 0.0));
     }
+    // What the loop below needs of the pixel alone, once (the compiler does not hoist it): the
+    // ceiling's plane and axes from p, and the horizon's smoothstep (an open horizon: always 1).
+    vec3 pc = p - uLightCentre;
+    float planeDist = -dot(pc, uLightNormal);
+    vec3 eu = uEdgeU * uInvEdge2.x;
+    vec3 ev = uEdgeV * uInvEdge2.y;
+    float lu0 = dot(pc, eu) + 0.5;
+    float lv0 = dot(pc, ev) + 0.5;
+    float visFrom = -2.0;
+    float visScale = 1.0;
+    if (lobeSinB > 0.0) {
+        visFrom = lobeSinB - uSoftness;
+        visScale = 1.0 / max(2.0 * uSoftness, 1e-12);
+    }
     float sum = 0.0;
     float nf = float(uSpecSamples);
     for (int k = 0; k < uSpecSamples; ++k) {
@@ -217,19 +231,19 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
         if (!(cosG > 0.0) || !(denom < 0.0)) {
             continue;
         }
-        float t = dot(uLightCentre - p, uLightNormal) / denom;
+        float t = planeDist / denom;
         if (!(t > 0.0) || isinf(t)) {
             continue;
         }
-        vec3 hit = p + i * t - uLightCentre;
-        float lu = dot(hit, uEdgeU) * uInvEdge2.x + 0.5;
-        float lv = dot(hit, uEdgeV) * uInvEdge2.y + 0.5;
+        float lu = lu0 + t * dot(i, eu);
+        float lv = lv0 + t * dot(i, ev);
         if (!(lu >= 0.0 && lu <= 1.0 && lv >= 0.0 && lv <= 1.0)) {
             continue;
         }
         float ratio = solidAngle * t * t / (uTexelArea * -denom);
         float lod = 0.5 * log2(max(ratio, 1e-20)) + uLodBias;
-        sum += lumSample(lu, lv, lod) * w * elevationVisibility(lobeSinB, cosG);
+        float vis = clamp((cosG - visFrom) * visScale, 0.0, 1.0);
+        sum += lumSample(lu, lv, lod) * w * (vis * vis * (3.0 - 2.0 * vis));
     }
     return sum / nf;
 }

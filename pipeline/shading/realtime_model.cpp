@@ -145,6 +145,13 @@ double filteredSpecular(const PreparedLight& light,
         lobeSinB = horizon->sinHorizon(tx, ty,
                                        Vec3(glm::dot(mirror, right), glm::dot(mirror, up), 0.0));
     }
+    // The ceiling's plane and axes from p, once (the shader hoists them out of its loop too).
+    const Vec3 pc = p - bl.centre;
+    const double planeDist = -glm::dot(pc, nl);
+    const Vec3 eu = bl.edgeU * invU2;
+    const Vec3 ev = bl.edgeV * invV2;
+    const double u0 = glm::dot(pc, eu) + 0.5;
+    const double v0 = glm::dot(pc, ev) + 0.5;
     double sum = 0.0;
     for (int k = 0; k < samples; ++k) {
         const double u1 = (k + 0.5) / samples;
@@ -158,13 +165,12 @@ double filteredSpecular(const PreparedLight& light,
         if (!(cosG > 0.0) || !(denom < 0.0)) {
             continue; // below the macro surface, or heading away from the emitting side
         }
-        const double t = glm::dot(bl.centre - p, nl) / denom;
+        const double t = planeDist / denom;
         if (!(t > 0.0) || !std::isfinite(t)) {
             continue;
         }
-        const Vec3 hit = p + s.i * t - bl.centre;
-        const double u = glm::dot(hit, bl.edgeU) * invU2 + 0.5;
-        const double v = glm::dot(hit, bl.edgeV) * invV2 + 0.5;
+        const double u = u0 + t * glm::dot(s.i, eu); // the hit p + t i, in the ceiling's axes
+        const double v = v0 + t * glm::dot(s.i, ev);
         if (!(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0)) {
             continue; // the dark booth
         }
