@@ -15,7 +15,7 @@
 namespace replica::pipeline::render {
 namespace {
 
-const char* const kFragmentHead = R"(#version 310 es
+const char* const kFragmentHead = R"(
 precision highp float;
 precision highp int;
 precision highp sampler3D;
@@ -23,10 +23,13 @@ in vec2 vUv;
 layout(location = 0) out vec4 outRgba;
 layout(location = 1) out float outClass;
 uniform highp sampler2D uXyz;
-uniform int uDispMethod;        // 0 analytic, 1 3-D LUT
-uniform int uDispGamutMode;     // 0 hue-keeping, 1 per-channel clip
-uniform int uDispViewingOn;
-uniform int uDispFalseColour;
+// Fixed for the pass's life and compiled in (DisplayPass::init), so that the program carries
+// only the inverse, gamut mode and overlays it runs: llvmpipe executes an untaken branch under a
+// mask, and the 3-D LUT path cost every analytic frame its tetrahedral fetches.
+const int uDispMethod = DISP_METHOD;         // 0 analytic, 1 3-D LUT
+const int uDispGamutMode = DISP_GAMUT_MODE;  // 0 hue-keeping, 1 per-channel clip
+const int uDispViewingOn = DISP_VIEWING;
+const int uDispFalseColour = DISP_FALSE_COLOUR;
 uniform vec3 uDispEye;
 uniform vec3 uDispPanelOrigin;
 uniform vec3 uDispPanelRight;
@@ -168,7 +171,12 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     flarePerLux_ = setup.flareSubtraction ? params.flarePerLux : 0.0f;
 
     const std::string fragment =
-            std::string(kFragmentHead) + display::kDisplayInverseGlsl + kFragmentMain;
+            fmt::format("#version 310 es\n#define DISP_METHOD {}\n#define DISP_GAMUT_MODE {}\n"
+                        "#define DISP_VIEWING {}\n#define DISP_FALSE_COLOUR {}\n",
+                        setup.method == InverseMethod::Lut3d ? 1 : 0,
+                        setup.gamut == display::GamutMode::Clip ? 1 : 0,
+                        setup.viewingCompensation ? 1 : 0, setup.falseColour ? 1 : 0) +
+            kFragmentHead + display::kDisplayInverseGlsl + kFragmentMain;
     auto program = linkProgram(kFullscreenVertexShader, fragment.c_str(), "display");
     if (!program) {
         return tl::unexpected(program.error());
@@ -265,10 +273,6 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
         glUniform4fv(glGetUniformLocation(program_, "uDispViewing"), params.viewingRows,
                      params.viewing.data());
     }
-    setInt(program_, "uDispMethod", setup.method == InverseMethod::Lut3d ? 1 : 0);
-    setInt(program_, "uDispGamutMode", setup.gamut == display::GamutMode::Clip ? 1 : 0);
-    setInt(program_, "uDispViewingOn", setup.viewingCompensation ? 1 : 0);
-    setInt(program_, "uDispFalseColour", setup.falseColour ? 1 : 0);
     setInt(program_, "uDispLut3dSize", n);
     setVec3(program_, "uDispLut3dScale", latticeScale);
     setInt(program_, "uXyz", 0);
