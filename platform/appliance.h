@@ -34,9 +34,9 @@ struct RunConfig {
     // recordings made before the booth renderer hold (a configuration without "renderer").
     std::string renderer = "booth";
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
-    std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
-    int boothLights = 32;    // median-cut point lights
-    int specularSamples = 16;
+    std::string sceneDigest;  // FNV-1a 64 of the scene's files; replay refuses a changed scene
+    int boothLights = 32;     // median-cut point lights
+    int specularSamples = 12; // shading::RenderSettings' default
     // Texels between the specular grid's nodes (shading::RenderSettings::specularGrid); 0: per
     // pixel; kAutoSpecularGrid: shading::defaultSpecularGrid for the scene, chosen when the
     // appliance is built and recorded as chosen.
