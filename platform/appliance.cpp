@@ -51,6 +51,7 @@ std::string RunConfig::toJson() const
                      {"specular_grid", specularGrid},
                      {"hardware_filter", hardwareFilter},
                      {"specular_lod_bias", specularLodBias},
+                     {"specular_nearest_level", specularNearestLevel},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -88,6 +89,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         // Absent before the specular grid: those recordings were shaded per pixel.
         c.specularGrid = j.value("specular_grid", 0);
         c.hardwareFilter = j.value("hardware_filter", false);
+        c.specularNearestLevel = j.value("specular_nearest_level", false);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
@@ -213,6 +215,7 @@ makeBoothScene(RunConfig& config,
     setup.settings.specularGrid = config.specularGrid;
     setup.settings.hardwareFilter = config.hardwareFilter;
     setup.settings.specularLodBias = config.specularLodBias;
+    setup.settings.specularNearestLevel = config.specularNearestLevel;
     setup.settings.horizonDirections = config.horizonDirections;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     setup.settings.subtractFlare = !config.flareSubtraction;

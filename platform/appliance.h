@@ -50,6 +50,8 @@ struct RunConfig {
     // shading::RenderSettings::specularLodBias. Recordings made before it have none and replay
     // with the level bias the renderer had then (kLegacySpecularLodBias), bit for bit.
     double specularLodBias = pipeline::shading::kDefaultSpecularLodBias;
+    // shading::RenderSettings::specularNearestLevel; recordings made before it replay trilinear.
+    bool specularNearestLevel = true;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

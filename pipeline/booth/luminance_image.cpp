@@ -147,4 +147,15 @@ double MipChain::sample(double u, double v, double level) const
     return (1.0 - t) * a + t * bilinear(levels[static_cast<std::size_t>(l1)], tu, tv);
 }
 
+double MipChain::sampleNearestLevel(double u, double v, double level) const
+{
+    if (!(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0)) {
+        return 0.0;
+    }
+    const double l =
+            std::clamp(std::isfinite(level) ? level : 0.0, 0.0, static_cast<double>(maxLevel()));
+    const int d = l <= 0.5 ? 0 : std::min(static_cast<int>(std::ceil(l + 0.5)) - 1, maxLevel());
+    return bilinear(levels[static_cast<std::size_t>(d)], u * usedU, v * usedV);
+}
+
 } // namespace replica::pipeline::booth

@@ -38,6 +38,9 @@ struct MipChain {
     // [0,1]^2; zero outside (the dark booth), the same rule as a CLAMP_TO_BORDER texture with
     // border 0.
     double sample(double u, double v, double level) const;
+    // Bilinear within the one level nearest 'level', GL_LINEAR_MIPMAP_NEAREST's rule: level 0 up
+    // to 1/2, then ceil(level + 1/2) - 1, clamped to the chain; half the fetches of sample().
+    double sampleNearestLevel(double u, double v, double level) const;
     int maxLevel() const { return static_cast<int>(levels.size()) - 1; }
 };
 

@@ -122,7 +122,8 @@ float visibility(vec3 l) {
 }
 
 #if BOOTH_HW_FILTER
-// booth::MipChain::sample by the sampler itself: GL_LINEAR_MIPMAP_LINEAR is its rule (bilinear
+// booth::MipChain::sample (or sampleNearestLevel: GL_LINEAR_MIPMAP_NEAREST, set by the pass) by
+// the sampler itself: GL_LINEAR_MIPMAP_LINEAR is its rule (bilinear
 // within a level with texel centres at (x + 0.5) / w, linear between levels, the level clamped to
 // the chain) and GL_CLAMP_TO_BORDER with border 0 its dark booth outside the image. One textureLod
 // instead of eight texelFetch and their bounds tests: about 1.7x faster per specular sample on
@@ -153,6 +154,14 @@ float lumBilinear(float u, float v, int level) {
     return (1.0 - ay) * ((1.0 - ax) * lumTexel(c, level, size) + ax * lumTexel(c + ivec2(1, 0), level, size))
          + ay * ((1.0 - ax) * lumTexel(c + ivec2(0, 1), level, size) + ax * lumTexel(c + ivec2(1, 1), level, size));
 }
+#if BOOTH_NEAREST_LEVEL
+// booth::MipChain::sampleNearestLevel.
+float lumSample(float u, float v, float level) {
+    float l = clamp(level, 0.0, float(uLumMaxLevel));
+    int d = l <= 0.5 ? 0 : min(int(ceil(l + 0.5)) - 1, uLumMaxLevel);
+    return lumBilinear(u * uLumUsed.x, v * uLumUsed.y, d);
+}
+#else
 // booth::MipChain::sample.
 float lumSample(float u, float v, float level) {
     float l = clamp(level, 0.0, float(uLumMaxLevel));
@@ -165,6 +174,7 @@ float lumSample(float u, float v, float level) {
     }
     return (1.0 - t) * a + t * lumBilinear(u * uLumUsed.x, v * uLumUsed.y, l1);
 }
+#endif
 #endif
 
 // realtime_model.cpp filteredSpecular with brdf::sampleWard inlined (rho_s = 1).

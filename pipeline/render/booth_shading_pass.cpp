@@ -196,9 +196,11 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                 fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
                             "#define BOOTH_GRID {}\n#define BOOTH_HW_FILTER {}\n"
                             "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
-                            "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n",
+                            "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n"
+                            "#define BOOTH_NEAREST_LEVEL {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0,
-                            horizonDirs_, 4 * layers, samples, wardModelIndex(s.model)) +
+                            horizonDirs_, 4 * layers, samples, wardModelIndex(s.model),
+                            settings_.specularNearestLevel ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -403,7 +405,9 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     if (hwFilter_) {
         // booth::MipChain::sample's rule (booth_shaders.cpp lumSample); border colour 0.
         constexpr GLenum kClampToBorder = 0x812D; // GL_CLAMP_TO_BORDER_EXT / _OES
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                        settings_.specularNearestLevel ? GL_LINEAR_MIPMAP_NEAREST
+                                                       : GL_LINEAR_MIPMAP_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, kClampToBorder);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, kClampToBorder);

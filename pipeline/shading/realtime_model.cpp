@@ -127,7 +127,8 @@ double filteredSpecular(const PreparedLight& light,
                         const Vec3& right,
                         const Vec3& up,
                         double softness,
-                        double lodBias)
+                        double lodBias,
+                        bool nearestLevel)
 {
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();
@@ -177,8 +178,9 @@ double filteredSpecular(const PreparedLight& light,
         const double cosL = -denom;
         const double ratio = s.solidAngle * t * t / (a * cosL);
         const double lod = 0.5 * std::log2(std::max(ratio, 1e-20)) + lodBias;
-        sum += light.mips.sample(u, v, lod) * s.weight *
-               elevationVisibility(lobeSinB, cosG, softness);
+        const double lum = nearestLevel ? light.mips.sampleNearestLevel(u, v, lod)
+                                        : light.mips.sample(u, v, lod);
+        sum += lum * s.weight * elevationVisibility(lobeSinB, cosG, softness);
     }
     return samples > 0 ? sum / samples : 0.0;
 }
@@ -260,7 +262,8 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     const auto specularAt = [&](const ShadingPoint& sp, const Vec3& toEye) {
         return filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model, scene.alpha,
                                 settings.specularSamples, horizon, sp.tx, sp.ty, sp.right, sp.up,
-                                settings.horizonSoftness, settings.specularLodBias);
+                                settings.horizonSoftness, settings.specularLodBias,
+                                settings.specularNearestLevel);
     };
 
     // The specular grid, when used: every node first (as the GL pass's mode 2 does).

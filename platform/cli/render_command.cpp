@@ -38,6 +38,7 @@ struct RenderArgs {
     int samples = pipeline::shading::RenderSettings{}.specularSamples; // the appliance's default
     int specularGrid = kAutoSpecularGrid; // as the appliance chooses it for the scene
     double lodBias = pipeline::shading::kDefaultSpecularLodBias;
+    bool trilinear = false;
     int horizonDirections = 8;
     std::string basis = "adaptive_k6";
     std::string out;
@@ -140,6 +141,7 @@ int runRender(const RenderArgs& a)
     settings.specularGrid =
             a.specularGrid >= 0 ? a.specularGrid : shading::defaultSpecularGrid(*scene);
     settings.specularLodBias = a.lodBias;
+    settings.specularNearestLevel = !a.trilinear;
     std::string mode = "realtime-cpu";
     shading::Plan plan;
     if (a.reference) {
@@ -217,6 +219,7 @@ int runRender(const RenderArgs& a)
                 scene->glossy() && settings.specularPass ? settings.specularSamples : 0;
         j["specular_grid"] = scene->glossy() && settings.specularPass ? settings.specularGrid : 0;
         j["specular_lod_bias"] = settings.specularLodBias;
+        j["specular_nearest_level"] = settings.specularNearestLevel;
         j["horizon_directions"] =
                 !scene->flat() && settings.reliefPass ? settings.horizonDirections : 0;
         if (a.plan) {
@@ -273,6 +276,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                     "on relief)")
             ->capture_default_str()
             ->check(CLI::Range(kAutoSpecularGrid, 256));
+    cmd->add_flag("--specular-trilinear", args->trilinear,
+                  "read each specular sample between the two mip levels around its own instead "
+                  "of from the nearest one (slower; the default before 2026-12-01)");
     cmd->add_option("--specular-lod-bias", args->lodBias,
                     "added to each specular sample's mip level: more blurs the light under each "
                     "sample, less aliases it (docs/rendering.md measures the choice)")

@@ -241,6 +241,13 @@ int main(int argc, char** argv)
                     s.specularSamples = n;
                     configs.emplace_back(std::to_string(n) + " spec samples", s);
                 }
+                {
+                    auto s = def;
+                    s.specularNearestLevel = !def.specularNearestLevel;
+                    configs.emplace_back(s.specularNearestLevel ? "nearest mip level"
+                                                                : "trilinear mip levels",
+                                         s);
+                }
                 for (double b : {0.5, 1.0}) {
                     auto s = def;
                     s.specularLodBias = b;

@@ -192,6 +192,33 @@ TEST(MipChain, AveragesExactlyAndConservesPowerForOddSizes)
     EXPECT_TRUE(std::isfinite(chain.sample(0.5, 0.5, -INFINITY)));
 }
 
+TEST(MipChain, NearestLevelFollowsGlsLinearMipmapNearestRule)
+{
+    // A 64x64 image whose levels are told apart by value: each level's texels hold a constant,
+    // so a lookup anywhere names the level it read.
+    const MipChain chain = buildMipChain(LuminanceImage::filled(64, 64, 1.0));
+    MipChain marked = chain;
+    for (std::size_t d = 0; d < marked.levels.size(); ++d) {
+        for (auto& t : marked.levels[d].cdM2) {
+            t = static_cast<double>(d + 1);
+        }
+    }
+    const auto levelRead = [&](double lod) {
+        return marked.sampleNearestLevel(0.5, 0.5, lod) - 1.0;
+    };
+    // GL: level 0 for lod <= 1/2, then ceil(lod + 1/2) - 1, clamped to the last level.
+    EXPECT_EQ(levelRead(-3.0), 0.0);
+    EXPECT_EQ(levelRead(0.5), 0.0);
+    EXPECT_EQ(levelRead(0.51), 1.0);
+    EXPECT_EQ(levelRead(1.5), 1.0);
+    EXPECT_EQ(levelRead(1.51), 2.0);
+    EXPECT_EQ(levelRead(100.0), static_cast<double>(marked.maxLevel()));
+    EXPECT_EQ(levelRead(std::nan("")), 0.0);
+    // On a whole level it is the trilinear lookup; outside the light, zero.
+    EXPECT_EQ(chain.sampleNearestLevel(0.3, 0.7, 2.0), chain.sample(0.3, 0.7, 2.0));
+    EXPECT_EQ(chain.sampleNearestLevel(1.2, 0.5, 0.0), 0.0);
+}
+
 TEST(LuminanceCheck, NamesTheFirstBadTexel)
 {
     LuminanceImage img = LuminanceImage::filled(8, 4, 1.0);

@@ -146,6 +146,8 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_TRUE(o->surroundIlluminance);
     // And before the specular mip level bias was a setting: the renderer's bias of then.
     EXPECT_EQ(o->specularLodBias, shading::kLegacySpecularLodBias);
+    EXPECT_FALSE(o->specularNearestLevel);
+    EXPECT_TRUE(c.specularNearestLevel);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);

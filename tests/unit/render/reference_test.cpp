@@ -227,7 +227,7 @@ TEST(RealtimeModel, SpecularLobeIsShadowedByTheHorizonAtItsMirrorAzimuth)
     const auto specular = [&](const surface::HorizonMap* h) {
         return shading::filteredSpecular(pl, p, n, n, toEye, brdf::WardModel::WardDurGuarded, 0.1,
                                          48, h, 0, 0, right, up, 0.02,
-                                         shading::kDefaultSpecularLodBias);
+                                         shading::kDefaultSpecularLodBias, true);
     };
     const double unshadowed = specular(nullptr);
     ASSERT_GT(unshadowed, 0.0);
