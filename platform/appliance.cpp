@@ -109,7 +109,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < 0 ||
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
-        !(std::abs(c.specularLodBias) <= 8.0)) {
+        !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias)) {
         return makeError(ErrorCode::InvalidArgument, "run configuration: size, rate, light count, "
                                                      "specular samples, specular grid, specular "
                                                      "lod bias or horizon directions out of "

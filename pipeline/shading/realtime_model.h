@@ -26,12 +26,15 @@ enum class ChannelRep {
 inline constexpr double kDefaultSpecularLodBias = 0.0;
 // What renderers used before the bias was a setting: recordings without it replay with this.
 inline constexpr double kLegacySpecularLodBias = 1.0;
+// The largest |bias| a command line or a recorded configuration may ask for (8 levels: a 256x
+// sharper or blurrier footprint, far past any useful setting).
+inline constexpr double kMaxSpecularLodBias = 8.0;
 
 struct RenderSettings {
     int lights = 32;
     // The fewest of 8/12/16/24/48 inside the error budget with margin on every shipped glossy
-    // scene and light at lod bias 0 (docs/rendering.md: worst p95 0.50, max 1.21; 8 leaves the
-    // ColorChecker's p95 at 0.98).
+    // scene and light at lod bias 0 (docs/rendering.md: worst p95 / max 0.57 / 1.64 at the
+    // nearest mip level, 0.52 / 1.13 trilinear; 8 leaves the ColorChecker's p95 at 0.98).
     int specularSamples = 12;
     int horizonDirections = 8;
     ChannelRep channels = ChannelRep::Basis6;
@@ -58,7 +61,7 @@ struct RenderSettings {
     double specularLodBias = kDefaultSpecularLodBias;
     // Read each specular sample from the one mip level nearest its own (MipChain::
     // sampleNearestLevel) instead of between the two around it: half the texel fetches, about
-    // 15% of the painting's frame on llvmpipe, for p95 0.57 / max 1.64 at worst against 0.46 /
+    // 15% of the painting's frame on llvmpipe, for p95 0.57 / max 1.64 at worst against 0.52 /
     // 1.13 (docs/rendering.md). Recordings made before it replay trilinear.
     bool specularNearestLevel = true;
     int threads = 2;

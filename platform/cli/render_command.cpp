@@ -283,7 +283,8 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                     "added to each specular sample's mip level: more blurs the light under each "
                     "sample, less aliases it (docs/rendering.md measures the choice)")
             ->capture_default_str()
-            ->check(CLI::Range(-8.0, 8.0));
+            ->check(CLI::Range(-pipeline::shading::kMaxSpecularLodBias,
+                               pipeline::shading::kMaxSpecularLodBias));
     cmd->add_option("--horizon-directions", args->horizonDirections, "horizon map azimuths")
             ->capture_default_str()
             ->check(CLI::Range(1, 64));

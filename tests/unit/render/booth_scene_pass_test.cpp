@@ -160,7 +160,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_TRUE(round->hardwareFilter);
     EXPECT_EQ(round->specularLodBias, 0.25);
     c.specularLodBias = 1e9; // a corrupt value is refused, not rendered
-    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
+    const auto corrupt = platform::RunConfig::fromJson(c.toJson());
+    ASSERT_FALSE(corrupt);
+    EXPECT_NE(corrupt.error().message.find("specular lod bias"), std::string::npos)
+            << corrupt.error().message;
     c.specularLodBias = 0.0;
     c.specularGrid = -2;
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));

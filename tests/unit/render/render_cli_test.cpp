@@ -63,6 +63,10 @@ TEST(RenderCli, RejectsBadArgumentsWithOneLine)
             << r.err;
     r = run("render --scene " + kScenes + "/metamer --light d65 --size 0x5 --out /tmp/x.exr");
     EXPECT_EQ(r.code, 2);
+    r = run("render --scene " + kScenes +
+            "/painting --light d65 --specular-lod-bias 9 --out /tmp/x.exr");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--specular-lod-bias"), std::string::npos) << r.err;
     r = run("scene generate --kind teapot --out /tmp/replica_teapot");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("unknown scene kind 'teapot'"), std::string::npos) << r.err;
