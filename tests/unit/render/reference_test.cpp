@@ -127,6 +127,28 @@ Case setup(bool bumpy, bool glossy, double tiltDeg, int px = 24, int py = 16)
     return s;
 }
 
+// A case rendered by the exact reference and by the model at 'settings' (128 point lights unless
+// the caller says otherwise), with what the model was prepared from, for renders with a knob
+// changed. 's' must outlive it (the prepared scene and light point into it).
+struct Compared {
+    shading::XyzFrame ref;
+    shading::PreparedScene ps;
+    shading::PreparedLight pl;
+    shading::XyzFrame fast;
+    reference::FrameError err;
+};
+
+Compared renderBoth(const Case& s, int horizonDirections, const shading::RenderSettings& settings)
+{
+    Compared c;
+    c.ref = reference::renderReference(s.scene, s.light, s.view, test::observer());
+    c.ps = shading::prepareScene(s.scene, horizonDirections);
+    c.pl = shading::prepareLight(s.light, test::observer(), settings.lights);
+    c.fast = shading::renderRealtime(c.ps, c.pl, s.view, test::observer(), settings);
+    c.err = reference::compareFrames(c.ref, c.fast);
+    return c;
+}
+
 void expectAllFinite(const shading::XyzFrame& f)
 {
     EXPECT_EQ(f.nonFinite, 0);
@@ -139,16 +161,12 @@ void expectAllFinite(const shading::XyzFrame& f)
 TEST(RealtimeModel, FlatGlossySceneIsCloseToTheReference)
 {
     Case s = setup(false, true, 40.0);
-    const auto ref = reference::renderReference(s.scene, s.light, s.view, test::observer());
-    const auto ps = shading::prepareScene(s.scene, 8);
     shading::RenderSettings settings;
     settings.lights = 128;
     settings.specularSamples = 32;
-    const auto pl = shading::prepareLight(s.light, test::observer(), settings.lights);
-    const auto fast = shading::renderRealtime(ps, pl, s.view, test::observer(), settings);
+    const auto [ref, ps, pl, fast, err] = renderBoth(s, 8, settings);
     expectAllFinite(ref);
     expectAllFinite(fast);
-    const auto err = reference::compareFrames(ref, fast);
     EXPECT_LT(err.p95, 1.0);
     EXPECT_LT(err.max, 3.0);
     // A specular highlight exists at this tilt: the frame is not just the diffuse term.
@@ -167,14 +185,10 @@ TEST(RealtimeModel, FlatGlossySceneIsCloseToTheReference)
 TEST(RealtimeModel, BumpySceneWithShadowsIsCloseToTheReference)
 {
     Case s = setup(true, false, 30.0);
-    const auto ref = reference::renderReference(s.scene, s.light, s.view, test::observer());
-    const auto ps = shading::prepareScene(s.scene, 16);
     shading::RenderSettings settings;
     settings.lights = 128;
-    const auto pl = shading::prepareLight(s.light, test::observer(), settings.lights);
-    const auto fast = shading::renderRealtime(ps, pl, s.view, test::observer(), settings);
+    const auto [ref, ps, pl, fast, err] = renderBoth(s, 16, settings);
     expectAllFinite(fast);
-    const auto err = reference::compareFrames(ref, fast);
     EXPECT_LT(err.mean, 1.0);
     // And the relief matters: ignoring it is clearly worse.
     settings.reliefPass = false;
@@ -192,14 +206,10 @@ TEST(RealtimeModel, BumpyGlossySceneWithShadowsIsCloseToTheReference)
     for (double& h : s.scene.relief.m) {
         h *= 4.0;
     }
-    const auto ref = reference::renderReference(s.scene, s.light, s.view, test::observer());
-    const auto ps = shading::prepareScene(s.scene, 8);
     shading::RenderSettings settings;
     settings.lights = 128;
-    const auto pl = shading::prepareLight(s.light, test::observer(), settings.lights);
-    const auto fast = shading::renderRealtime(ps, pl, s.view, test::observer(), settings);
+    const auto [ref, ps, pl, fast, err] = renderBoth(s, 8, settings);
     expectAllFinite(fast);
-    const auto err = reference::compareFrames(ref, fast);
     EXPECT_LT(err.p95, 1.0); // measured 0.44
     EXPECT_LT(err.max, 3.0); // measured 0.83
     // The horizons shadow here: taking them away only adds light (Y summed over the frame).
