@@ -57,7 +57,6 @@ uniform float uDispMaxCount;
 uniform int uDispLutSize;
 uniform highp sampler2D uDispToneLut;  // lutSize x 3, R32F, texelFetch only
 uniform highp sampler2D uDispDither;   // 16 x 16, R32F
-uniform int uDispViewingRows;
 uniform vec4 uDispViewing[16];         // angle deg, gain X, Y, Z
 
 // Linear interpolation in u = cbrt(r), done by hand so no float-filtering extension is needed.
@@ -86,14 +85,17 @@ vec4 displayInverse(vec3 xyzIn, int mode) {
     }
     vec3 r = uDispXyzToLinear * (xyz - uDispBlackXyz);
     float span = uDispWhiteY - uDispBlackY;
-    if (!(xyz.y - uDispBlackY >= 0.0)) {
-        vec3 rc = mode == 1 ? clamp(r, 0.0, 1.0) : vec3(0.0);
-        return vec4(displayToneLut(0, rc.r), displayToneLut(1, rc.g), displayToneLut(2, rc.b), 3.0);
-    }
+    // Below black: class 3, and the channels clipped (mode 1) or black (mode 0). One tone-curve
+    // lookup below serves both cases (llvmpipe runs both sides of a branch, so a second set of
+    // lookups here cost every pixel six more texel fetches and cube roots).
+    bool below = !(xyz.y - uDispBlackY >= 0.0);
     // float rounding in M^-1 must not flag in-gamut colours: a small tolerance, then clamp.
     const float tol = 1e-5;
     bool inside = all(greaterThanEqual(r, vec3(-tol))) && all(lessThanEqual(r, vec3(1.0 + tol)));
-    if (!inside && mode == 0) {
+    if (below) {
+        r = mode == 1 ? r : vec3(0.0);
+        cls = 3.0;
+    } else if (!inside && mode == 0) {
         // As mapToGamut: towards the same-luminance neutral until no channel is negative, then
         // scale down until none exceeds 1.
         float s = clamp((xyz.y - uDispBlackY) / span, 0.0, 1.0);
@@ -116,23 +118,25 @@ vec4 displayInverse(vec3 xyzIn, int mode) {
     return vec4(displayToneLut(0, r.r), displayToneLut(1, r.g), displayToneLut(2, r.b), cls);
 }
 
+// The row count is compiled in (DISP_VIEWING_ROWS, from the profile): with a constant bound and
+// no return inside the loop, llvmpipe runs the rows once each instead of looping under a mask.
+// Walking down and keeping the last row whose upper angle is above a gives the first such row,
+// which is what a search up the table returns.
 vec3 displayViewingGain(float angleDeg) {
-    if (uDispViewingRows <= 0) {
-        return vec3(1.0);
-    }
+#if DISP_VIEWING_ROWS <= 0
+    return vec3(1.0);
+#else
     float a = clamp(angleDeg, 0.0, 90.0);
-    vec4 last = uDispViewing[uDispViewingRows - 1];
-    if (a >= last.x) {
-        return last.yzw;
-    }
-    for (int i = 0; i + 1 < uDispViewingRows; ++i) {
+    vec3 gain = uDispViewing[DISP_VIEWING_ROWS - 1].yzw;
+    for (int i = DISP_VIEWING_ROWS - 2; i >= 0; --i) {
         vec4 lo = uDispViewing[i];
         vec4 hi = uDispViewing[i + 1];
         if (a < hi.x) {
-            return mix(lo.yzw, hi.yzw, (a - lo.x) / (hi.x - lo.x));
+            gain = mix(lo.yzw, hi.yzw, (a - lo.x) / (hi.x - lo.x));
         }
     }
-    return last.yzw;
+    return gain;
+#endif
 }
 
 // The 3-D LUT path (DisplayLut3d::counts): lattice over u = cbrt(XYZ / white), tetrahedral.

@@ -37,8 +37,8 @@ struct DisplayShaderParams {
 
 DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse);
 
-// GLSL ES 3.10 declarations and functions (no #version, no main): uniforms uDisp*, samplers
-// uDispToneLut and uDispDither, and
+// GLSL ES 3.10 declarations and functions (no #version, no main; the includer defines
+// DISP_VIEWING_ROWS as viewingRows): uniforms uDisp*, samplers uDispToneLut and uDispDither, and
 //   vec4 displayInverse(vec3 xyz, int mode)  // counts (real) in .xyz, gamut class in .w
 //   vec3 displayViewingGain(float angleDeg)
 //   vec3 displayQuantise(vec3 counts, ivec2 pixel) // integer counts as floats

@@ -172,10 +172,12 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
 
     const std::string fragment =
             fmt::format("#version 310 es\n#define DISP_METHOD {}\n#define DISP_GAMUT_MODE {}\n"
-                        "#define DISP_VIEWING {}\n#define DISP_FALSE_COLOUR {}\n",
+                        "#define DISP_VIEWING {}\n#define DISP_FALSE_COLOUR {}\n"
+                        "#define DISP_VIEWING_ROWS {}\n",
                         setup.method == InverseMethod::Lut3d ? 1 : 0,
                         setup.gamut == display::GamutMode::Clip ? 1 : 0,
-                        setup.viewingCompensation ? 1 : 0, setup.falseColour ? 1 : 0) +
+                        setup.viewingCompensation ? 1 : 0, setup.falseColour ? 1 : 0,
+                        params.viewingRows) +
             kFragmentHead + display::kDisplayInverseGlsl + kFragmentMain;
     auto program = linkProgram(kFullscreenVertexShader, fragment.c_str(), "display");
     if (!program) {
@@ -268,7 +270,6 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     glUniform1f(glGetUniformLocation(program_, "uDispWhiteY"), params.whiteY);
     glUniform1f(glGetUniformLocation(program_, "uDispMaxCount"), params.maxCount);
     setInt(program_, "uDispLutSize", params.lutSize);
-    setInt(program_, "uDispViewingRows", params.viewingRows);
     if (params.viewingRows > 0) {
         glUniform4fv(glGetUniformLocation(program_, "uDispViewing"), params.viewingRows,
                      params.viewing.data());
