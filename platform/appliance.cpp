@@ -106,7 +106,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
     }
     if (c.width <= 0 || c.height <= 0 || c.width > 16384 || c.height > 16384 || !(c.rateHz > 0.0) ||
         c.rateHz > 1000.0 || c.lightsU <= 0 || c.lightsV <= 0 || c.lightsU * c.lightsV > 256 ||
-        c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < 0 ||
+        c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < kAutoSpecularSamples ||
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
         !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias)) {
@@ -208,6 +208,9 @@ makeBoothScene(RunConfig& config,
     setup.adaptive = std::move(adaptive);
     setup.observer = observer;
     setup.settings.lights = config.boothLights;
+    if (config.specularSamples == kAutoSpecularSamples) {
+        config.specularSamples = pipeline::shading::defaultSpecularSamples(setup.scene); // recorded
+    }
     setup.settings.specularSamples = config.specularSamples;
     if (config.specularGrid == kAutoSpecularGrid) {
         config.specularGrid = pipeline::shading::defaultSpecularGrid(setup.scene); // recorded

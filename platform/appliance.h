@@ -18,8 +18,9 @@
 
 namespace replica::platform {
 
-// RunConfig::specularGrid: chosen for the scene when the appliance is built.
+// RunConfig::specularGrid and specularSamples: chosen for the scene when the appliance is built.
 constexpr int kAutoSpecularGrid = -1;
+constexpr int kAutoSpecularSamples = -1;
 
 // Everything that decides what a frame looks like, apart from the samples. Recorded in the session
 // so that replay rebuilds the identical renderer.
@@ -34,9 +35,12 @@ struct RunConfig {
     // recordings made before the booth renderer hold (a configuration without "renderer").
     std::string renderer = "booth";
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
-    std::string sceneDigest;  // FNV-1a 64 of the scene's files; replay refuses a changed scene
-    int boothLights = 32;     // median-cut point lights
-    int specularSamples = 12; // shading::RenderSettings' default
+    std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
+    int boothLights = 32;    // median-cut point lights
+    // Specular samples per pixel or grid node; kAutoSpecularSamples: shading::
+    // defaultSpecularSamples for the scene (8 on relief, 12 on a flat surface), chosen when the
+    // appliance is built and recorded as chosen. Recordings made before hold the count they used.
+    int specularSamples = kAutoSpecularSamples;
     // Texels between the specular grid's nodes (shading::RenderSettings::specularGrid); 0: per
     // pixel; kAutoSpecularGrid: shading::defaultSpecularGrid for the scene, chosen when the
     // appliance is built and recorded as chosen.

@@ -199,6 +199,11 @@ int defaultSpecularGrid(const surface::SurfaceScene& scene)
     return scene.flat() ? kFlatSpecularGrid : 0;
 }
 
+int defaultSpecularSamples(const surface::SurfaceScene& scene)
+{
+    return scene.flat() ? kFlatSpecularSamples : kReliefSpecularSamples;
+}
+
 double gridSpecular(const std::vector<double>& values, GridNodes nodes, double u, double v)
 {
     const double lastX = nodes.x - 1;

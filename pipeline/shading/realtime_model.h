@@ -30,12 +30,22 @@ inline constexpr double kLegacySpecularLodBias = 1.0;
 // sharper or blurrier footprint, far past any useful setting).
 inline constexpr double kMaxSpecularLodBias = 8.0;
 
+// Specular samples per pixel (or per grid node) the appliance and 'replica render' use unless
+// told. Relief is shaded per pixel, so each sample costs the whole surface a texture read (about
+// 1.4 ms of the painting's 960x600 frame on 2-core llvmpipe) and 8 of them meet the budget there
+// (worst light p95 / max 0.63 / 2.09 on the 128x80 error frame); a flat surface is shaded at the
+// grid's nodes, where samples cost next to nothing and the ColorChecker needs 12 (8 leave its p95
+// at 0.98). docs/rendering.md has the sweep.
+constexpr int kReliefSpecularSamples = 8;
+constexpr int kFlatSpecularSamples = 12;
+
 struct RenderSettings {
     int lights = 32;
     // The fewest of 8/12/16/24/48 inside the error budget with margin on every shipped glossy
     // scene and light at lod bias 0 (docs/rendering.md: worst p95 / max 0.57 / 1.64 at the
-    // nearest mip level, 0.52 / 1.13 trilinear; 8 leaves the ColorChecker's p95 at 0.98).
-    int specularSamples = 12;
+    // nearest mip level, 0.52 / 1.13 trilinear; 8 leaves the ColorChecker's p95 at 0.98). The
+    // appliance and 'replica render' take defaultSpecularSamples for the scene instead.
+    int specularSamples = kFlatSpecularSamples;
     int horizonDirections = 8;
     ChannelRep channels = ChannelRep::Basis6;
     bool diffusePass = true;
@@ -85,6 +95,10 @@ constexpr int kFlatSpecularGrid = 8;
 // The spacing the appliance and 'replica render' use unless told: kFlatSpecularGrid on a flat
 // surface, 0 (per pixel) on relief.
 int defaultSpecularGrid(const surface::SurfaceScene& scene);
+
+// The specular sample count the appliance and 'replica render' use unless told
+// (kReliefSpecularSamples or kFlatSpecularSamples).
+int defaultSpecularSamples(const surface::SurfaceScene& scene);
 
 // The grid's specular term at (u, v): bilinear between the four nodes around it (values row by
 // row, nodes.x per row).

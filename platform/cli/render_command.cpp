@@ -35,7 +35,7 @@ struct RenderArgs {
     bool plan = false;
     bool gl = false;
     int lights = 32;
-    int samples = pipeline::shading::RenderSettings{}.specularSamples; // the appliance's default
+    int samples = kAutoSpecularSamples;   // as the appliance chooses it for the scene
     int specularGrid = kAutoSpecularGrid; // as the appliance chooses it for the scene
     double lodBias = pipeline::shading::kDefaultSpecularLodBias;
     bool trilinear = false;
@@ -136,7 +136,7 @@ int runRender(const RenderArgs& a)
     shading::XyzFrame frame;
     shading::RenderSettings settings;
     settings.lights = a.lights;
-    settings.specularSamples = a.samples;
+    settings.specularSamples = a.samples > 0 ? a.samples : shading::defaultSpecularSamples(*scene);
     settings.horizonDirections = a.horizonDirections;
     settings.specularGrid =
             a.specularGrid >= 0 ? a.specularGrid : shading::defaultSpecularGrid(*scene);
@@ -267,9 +267,11 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--lights", args->lights, "median-cut point lights")
             ->capture_default_str()
             ->check(CLI::Range(1, 4096));
-    cmd->add_option("--samples", args->samples, "specular FIS samples per pixel")
+    cmd->add_option("--samples", args->samples,
+                    "specular FIS samples per pixel (or grid node); -1: as the appliance chooses "
+                    "(8 on relief, 12 on a flat surface)")
             ->capture_default_str()
-            ->check(CLI::Range(1, 1024));
+            ->check(CLI::Range(kAutoSpecularSamples, 1024) & !CLI::IsMember({0}));
     cmd->add_option("--specular-grid", args->specularGrid,
                     "texels between the nodes the specular term is shaded at, then interpolated; "
                     "0: per pixel; -1: as the appliance chooses (8 on a flat surface, per pixel "

@@ -219,9 +219,9 @@ int main(int argc, char** argv)
             view.pixelsY = fh;
             const auto ref = reference::renderReference(*scene, light, view, *obs);
             shading::RenderSettings def;
-            if (defaultSamples > 0) {
-                def.specularSamples = defaultSamples;
-            }
+            // As the appliance and 'replica render' choose it for the scene, unless told.
+            def.specularSamples =
+                    defaultSamples > 0 ? defaultSamples : shading::defaultSpecularSamples(*scene);
             if (grid > 0) {
                 def.specularGrid = grid;
             }

@@ -267,6 +267,45 @@ TEST(ApplianceBoothScene, TheClearedSurroundIsNotShadedAndNoPixelChanges)
     EXPECT_TRUE(clip->surround);
 }
 
+TEST(ApplianceBoothScene, ChoosesTheSpecularSampleCountForTheSceneAndRecordsIt)
+{
+    RunConfig c;
+    EXPECT_EQ(c.specularSamples, kAutoSpecularSamples);
+    c.width = 32;
+    c.height = 20;
+    c.sceneDir = "scenes/painting";
+    auto app = buildAppliance(c);
+    if (!app && app.error().message.find("EGL") != std::string::npos) {
+        GTEST_SKIP() << app.error().message;
+    }
+    ASSERT_TRUE(app) << app.error().message;
+    // Relief, shaded per pixel: the relief's count, recorded as chosen.
+    EXPECT_EQ((*app)->config.specularSamples, pipeline::shading::kReliefSpecularSamples);
+    EXPECT_NE((*app)->config.toJson().find("\"specular_samples\":8"), std::string::npos);
+    EXPECT_NE((*app)->renderer->description().find(", 8 specular samples"), std::string::npos)
+            << (*app)->renderer->description();
+    const std::string json = (*app)->config.toJson();
+    app->reset();
+
+    // A recording holds the count it ran with, and replays with it whatever the default.
+    auto recorded = RunConfig::fromJson(json);
+    ASSERT_TRUE(recorded);
+    recorded->specularSamples = 12;
+    auto replayed = RunConfig::fromJson(recorded->toJson());
+    ASSERT_TRUE(replayed);
+    auto again = buildAppliance(*replayed);
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_EQ((*again)->config.specularSamples, 12);
+    EXPECT_NE((*again)->renderer->description().find(", 12 specular samples"), std::string::npos)
+            << (*again)->renderer->description();
+
+    // A count out of range is refused by name.
+    recorded->specularSamples = -2;
+    auto bad = RunConfig::fromJson(recorded->toJson());
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("specular samples"), std::string::npos);
+}
+
 TEST(ApplianceBoothScene, RecordsTheSceneAndRefusesAChangedOne)
 {
     RunConfig c;

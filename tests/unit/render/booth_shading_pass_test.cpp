@@ -207,6 +207,32 @@ TEST_F(BoothPassTest, FlatSpecularGridMeetsTheErrorBudgetAgainstTheReference)
     }
 }
 
+TEST_F(BoothPassTest, ReliefDefaultSampleCountMeetsTheErrorBudgetAgainstTheReference)
+{
+    // What the appliance runs on the painting: per pixel, with the relief's default sample count
+    // (fewer than a flat surface's, since each sample costs every pixel), against the exact
+    // reference under every light.
+    const shading::View v = view(24, 15);
+    const auto& scene = scenes_.at("painting");
+    ASSERT_EQ(shading::defaultSpecularSamples(scene), shading::kReliefSpecularSamples);
+    ASSERT_EQ(shading::defaultSpecularSamples(scenes_.at("colorchecker")),
+              shading::kFlatSpecularSamples);
+    ASSERT_LT(shading::kReliefSpecularSamples, shading::kFlatSpecularSamples);
+    shading::RenderSettings settings;
+    settings.specularSamples = shading::defaultSpecularSamples(scene);
+    settings.specularGrid = shading::defaultSpecularGrid(scene);
+    const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, *basis_);
+    auto pass = BoothShadingPass::create(ps, settings, *obs_);
+    ASSERT_TRUE(pass) << pass.error().message;
+    for (const auto& light : booth_->lights) {
+        const auto pl = shading::prepareLight(light, *obs_, settings.lights, *basis_);
+        ASSERT_TRUE((*pass)->setLight(pl));
+        const auto e = errorAgainstReference(**pass, pl, scene, light, v);
+        EXPECT_LE(e.p95, 1.0) << light.name;
+        EXPECT_LE(e.max, 3.0) << light.name;
+    }
+}
+
 TEST_F(BoothPassTest, PlannedSettingMeetsTheErrorBudgetAgainstTheReference)
 {
     // The budget: dE00 95th <= 1, max <= 3. The settings are what shading::planRender
