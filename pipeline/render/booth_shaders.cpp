@@ -59,6 +59,13 @@ uniform sampler2D uCache;       // RGBA32F, the viewport's size: what mode 0 wro
 uniform ivec2 uGridNodes;
 const bool kGrid = BOOTH_GRID != 0;     // whether the compose reads the grid (fixed likewise)
 uniform sampler2D uSpecGrid;    // R32F, uGridNodes: what mode 2 wrote this frame
+// BOOTH_FACET_CACHE (relief with a per-pixel specular term): mode 0 also writes each pixel's
+// facet normal (tangent frame, bilinearNormal's) beside the cache, and the compose reads it there:
+// one texel a frame instead of four and a normalisation.
+#if BOOTH_FACET_CACHE && BOOTH_MODE == 0
+layout(location = 1) out vec4 outFacet;
+#endif
+uniform sampler2D uFacetCache;  // RGBA32F, the viewport's size: what mode 0 wrote
 
 const int uSpecSamples = BOOTH_SPEC_SAMPLES;
 // brdf::sampleWardHalfVectorLocal for sample k (u1 = (k + 1/2) / N, u2 = radicalInverse2(k)),
@@ -313,7 +320,14 @@ void main() {
     // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
     bool facets = uMode == 0 || (uSpecSamples > 0 && (uMode == 2 || !kGrid));
     if (inside && uRelief && facets) {
+#if BOOTH_FACET_CACHE && BOOTH_MODE == 1
+        vec3 nl = texelFetch(uFacetCache, ivec2(gl_FragCoord.xy), 0).xyz;
+#else
         vec3 nl = bilinearNormal(texX, texY);
+#endif
+#if BOOTH_FACET_CACHE && BOOTH_MODE == 0
+        outFacet = vec4(nl, 0.0);
+#endif
         nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
         int layers = (uHorizonDirs + 3) / 4;
         for (int j = 0; j < layers; ++j) {

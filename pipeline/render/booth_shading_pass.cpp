@@ -25,7 +25,8 @@ enum TextureUnit : GLint {
     kUnitHorizon,
     kUnitLum,
     kUnitCache,
-    kUnitSpecGrid
+    kUnitSpecGrid,
+    kUnitFacet
 };
 
 // Float textures are read with texelFetch only: nearest sampling keeps them complete without the
@@ -183,6 +184,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     specular_ = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
     gridNodes_ = specular_ ? shading::specularGridNodes(s, settings_.specularGrid)
                            : shading::GridNodes{};
+    facetCache_ = relief_ && specular_ && gridNodes_.x == 0;
     // The specular samples' half vectors depend only on alpha and N: once here, in double.
     const int samples = specular_ ? settings_.specularSamples : 0;
     if (samples > kBoothMaxSpecularSamples) {
@@ -197,10 +199,10 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             "#define BOOTH_GRID {}\n#define BOOTH_HW_FILTER {}\n"
                             "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
                             "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n"
-                            "#define BOOTH_NEAREST_LEVEL {}\n",
+                            "#define BOOTH_NEAREST_LEVEL {}\n#define BOOTH_FACET_CACHE {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0,
                             horizonDirs_, 4 * layers, samples, wardModelIndex(s.model),
-                            settings_.specularNearestLevel ? 1 : 0) +
+                            settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -310,6 +312,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     uniformAll(glProgramUniform1i, "uLum", kUnitLum);
     uniformAll(glProgramUniform1i, "uCache", kUnitCache);
     uniformAll(glProgramUniform1i, "uSpecGrid", kUnitSpecGrid);
+    uniformAll(glProgramUniform1i, "uFacetCache", kUnitFacet);
     uniformAll(glProgramUniform2i, "uGridNodes", gridNodes_.x, gridNodes_.y);
     uniformAll(glProgramUniform2i, "uTexels", s.width, s.height);
     uniformAll(glProgramUniform2f, "uSizeM", static_cast<float>(s.widthM),
@@ -324,8 +327,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
 
 BoothShadingPass::~BoothShadingPass()
 {
-    const std::array<GLuint, 7> textures{coeffA_, coeffB_,       normals_,    horizon_,
-                                         lum_,    cacheTexture_, gridTexture_};
+    const std::array<GLuint, 8> textures{coeffA_, coeffB_,       normals_,      horizon_,
+                                         lum_,    cacheTexture_, facetTexture_, gridTexture_};
     glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     glDeleteFramebuffers(1, &cacheFbo_);
     glDeleteFramebuffers(1, &gridFbo_);
@@ -477,12 +480,25 @@ Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
     }
     glDeleteFramebuffers(1, &cacheFbo_);
     glDeleteTextures(1, &cacheTexture_);
+    glDeleteTextures(1, &facetTexture_);
+    facetTexture_ = 0;
     glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
     cacheTexture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
+    if (facetCache_) {
+        facetTexture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
+    }
     glBindTexture(GL_TEXTURE_2D, 0);
     glGenFramebuffers(1, &cacheFbo_);
     glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, cacheTexture_, 0);
+    if (facetCache_) {
+        // Mode 0 writes the facet normal beside the cached terms; the blit reads attachment 0.
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, facetTexture_,
+                               0);
+        const std::array<GLenum, 2> buffers{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        glDrawBuffers(2, buffers.data());
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+    }
     const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     cacheWidth_ = width;
     cacheHeight_ = height;
@@ -588,9 +604,13 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         glScissor(rect.x, rect.y, rect.width, rect.height);
         usePose(1, view.panel);
         glBindTexture(GL_TEXTURE_2D, cacheTexture_); // unit kUnitCache is active
+        glActiveTexture(GL_TEXTURE0 + kUnitFacet);
+        glBindTexture(GL_TEXTURE_2D, facetTexture_);
         glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);
         glBindTexture(GL_TEXTURE_2D, gridTexture_);
         glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE0 + kUnitFacet);
         glBindTexture(GL_TEXTURE_2D, 0);
         glActiveTexture(GL_TEXTURE0 + kUnitCache);
         glBindTexture(GL_TEXTURE_2D, 0);

@@ -141,6 +141,11 @@ private:
     mutable long cacheRefreshes_ = 0;
     mutable GLuint cacheTexture_ = 0;
     mutable GLuint cacheFbo_ = 0;
+    // With relief and a per-pixel specular term the cache also keeps each pixel's facet normal
+    // (tangent frame, what bilinearNormal gives; RGBA32F), so that the compose reads one texel
+    // instead of four and their normalisation every frame.
+    bool facetCache_ = false;
+    mutable GLuint facetTexture_ = 0;
     mutable int cacheWidth_ = 0, cacheHeight_ = 0;
 
     // The specular grid (settings.specularGrid > 0 on a glossy scene): its nodes and target.
