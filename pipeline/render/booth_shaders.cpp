@@ -184,6 +184,54 @@ float lumSample(float u, float v, float level) {
 #endif
 #endif
 
+// Sample k of filteredSpecular's loop (brdf::sampleWard inlined, rho_s = 1): its weighted
+// luminance, 0 where the sample leaves the lobe, the surface or the ceiling.
+float specSample(int k, vec3 n, vec3 o, float co, vec3 ft, vec3 fbt, vec3 nGeo, float planeDist,
+                 vec3 eu, vec3 ev, float lu0, float lv0, float visFrom, float visScale) {
+    vec4 sk = uSpecSample[k];
+    vec3 hl = sk.xyz;
+    vec3 h = ft * hl.x + fbt * hl.y + n * hl.z;
+    float oh = dot(o, h);
+    if (!(oh > 0.0)) {
+        return 0.0;
+    }
+    vec3 i = 2.0 * oh * h - o;
+    float ci = dot(n, i);
+    if (!(ci > 0.0)) {
+        return 0.0;
+    }
+    float hz3 = hl.z * hl.z * hl.z;
+    float w;
+    if (uWardModel == 0) {
+        w = ci * oh * hz3 / sqrt(max(ci, kMinCosView) * max(co, kMinCosView));
+    } else if (uWardModel == 1) {
+        w = (ci / max(ci, kMinCosView)) * oh * hz3 / max(co, kMinCosView);
+    } else if (uWardModel == 2) {
+        w = ci * oh * hz3 / max(ci * co, oh * oh * hz3 * hl.z);
+    } else {
+        w = ci / (oh * hl.z);
+    }
+    float solidAngle = sk.w * oh;
+    float cosG = dot(nGeo, i);
+    float denom = dot(i, uLightNormal);
+    if (!(cosG > 0.0) || !(denom < 0.0)) {
+        return 0.0;
+    }
+    float t = planeDist / denom;
+    if (!(t > 0.0) || isinf(t)) {
+        return 0.0;
+    }
+    float lu = lu0 + t * dot(i, eu);
+    float lv = lv0 + t * dot(i, ev);
+    if (!(lu >= 0.0 && lu <= 1.0 && lv >= 0.0 && lv <= 1.0)) {
+        return 0.0;
+    }
+    float ratio = solidAngle * t * t / (uTexelArea * -denom);
+    float lod = 0.5 * log2(max(ratio, 1e-20)) + uLodBias;
+    float vis = clamp((cosG - visFrom) * visScale, 0.0, 1.0);
+    return lumSample(lu, lv, lod) * w * (vis * vis * (3.0 - 2.0 * vis));
+}
+
 // realtime_model.cpp filteredSpecular with brdf::sampleWard inlined (rho_s = 1).
 float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
     float co = dot(n, o);
@@ -219,50 +267,35 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
     float sum = 0.0;
     float nf = float(uSpecSamples);
     for (int k = 0; k < uSpecSamples; ++k) {
-        vec4 sk = uSpecSample[k];
-        vec3 hl = sk.xyz;
-        vec3 h = ft * hl.x + fbt * hl.y + n * hl.z;
-        float oh = dot(o, h);
-        if (!(oh > 0.0)) {
-            continue;
-        }
-        vec3 i = 2.0 * oh * h - o;
-        float ci = dot(n, i);
-        if (!(ci > 0.0)) {
-            continue;
-        }
-        float hz3 = hl.z * hl.z * hl.z;
-        float w;
-        if (uWardModel == 0) {
-            w = ci * oh * hz3 / sqrt(max(ci, kMinCosView) * max(co, kMinCosView));
-        } else if (uWardModel == 1) {
-            w = (ci / max(ci, kMinCosView)) * oh * hz3 / max(co, kMinCosView);
-        } else if (uWardModel == 2) {
-            w = ci * oh * hz3 / max(ci * co, oh * oh * hz3 * hl.z);
-        } else {
-            w = ci / (oh * hl.z);
-        }
-        float solidAngle = sk.w * oh;
-        float cosG = dot(nGeo, i);
-        float denom = dot(i, uLightNormal);
-        if (!(cosG > 0.0) || !(denom < 0.0)) {
-            continue;
-        }
-        float t = planeDist / denom;
-        if (!(t > 0.0) || isinf(t)) {
-            continue;
-        }
-        float lu = lu0 + t * dot(i, eu);
-        float lv = lv0 + t * dot(i, ev);
-        if (!(lu >= 0.0 && lu <= 1.0 && lv >= 0.0 && lv <= 1.0)) {
-            continue;
-        }
-        float ratio = solidAngle * t * t / (uTexelArea * -denom);
-        float lod = 0.5 * log2(max(ratio, 1e-20)) + uLodBias;
-        float vis = clamp((cosG - visFrom) * visScale, 0.0, 1.0);
-        sum += lumSample(lu, lv, lod) * w * (vis * vis * (3.0 - 2.0 * vis));
+        sum += specSample(k, n, o, co, ft, fbt, nGeo, planeDist, eu, ev, lu0, lv0, visFrom,
+                          visScale);
     }
     return sum / nf;
+}
+
+// Light i's share of eq. (1): to eGeo with the macro normal, to e with the facet normal and the
+// horizon (relief only).
+void diffuseLight(int i, vec3 p, vec3 nShade, bool relief, inout float eGeo, inout float e) {
+    vec4 l = uLight[i];
+    vec3 d = l.xyz - p;
+    float d2 = dot(d, d);
+    if (!(d2 > 0.0) || !(l.w > 0.0)) {
+        return;
+    }
+    d *= inversesqrt(d2);
+    float cosL = -dot(uLightNormal, d);
+    float cosG = dot(uNormal, d);
+    if (!(cosL > 0.0) || !(cosG > 0.0)) {
+        return;
+    }
+    float g = l.w * cosL / max(d2, uTexelArea);
+    eGeo += g * cosG;
+    if (relief) {
+        float cosS = dot(nShade, d);
+        if (cosS > 0.0) {
+            e += g * cosS * visibility(vec3(dot(d, uRight), dot(d, uUp), cosG));
+        }
+    }
 }
 
 vec3 bilinearNormal(float x, float y) {
@@ -372,27 +405,15 @@ void main() {
         bool relief = inside && uRelief;
         float eGeo = 0.0;
         float e = 0.0;
-        for (int i = 0; i < uLightCount; ++i) {
-            vec4 l = uLight[i];
-            vec3 d = l.xyz - p;
-            float d2 = dot(d, d);
-            if (!(d2 > 0.0) || !(l.w > 0.0)) {
-                continue;
-            }
-            d *= inversesqrt(d2);
-            float cosL = -dot(uLightNormal, d);
-            float cosG = dot(uNormal, d);
-            if (!(cosL > 0.0) || !(cosG > 0.0)) {
-                continue;
-            }
-            float g = l.w * cosL / max(d2, uTexelArea);
-            eGeo += g * cosG;
-            if (relief) {
-                float cosS = dot(nShade, d);
-                if (cosS > 0.0) {
-                    e += g * cosS * visibility(vec3(dot(d, uRight), dot(d, uUp), cosG));
-                }
-            }
+        // The first BOOTH_UNROLLED_LIGHTS lights one after another at constant indices
+        // (BOOTH_LIGHT_CALLS, written out by the pass: LIGHT_AT(0) LIGHT_AT(1) ...; llvmpipe
+        // reads a uniform array at a loop counter as a gather per pixel, at a constant index as
+        // one load), then any beyond them in a loop. Same lights in the same order.
+#define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, nShade, relief, eGeo, e); }
+        BOOTH_LIGHT_CALLS
+#undef LIGHT_AT
+        for (int i = BOOTH_UNROLLED_LIGHTS; i < uLightCount; ++i) {
+            diffuseLight(i, p, nShade, relief, eGeo, e);
         }
         if (!relief) {
             e = eGeo;

@@ -193,16 +193,28 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                                      samples, kBoothMaxSpecularSamples));
     }
     const int layers = std::max((horizonDirs_ + 3) / 4, 1);
+    // booth_shaders.cpp eq. (1) on a flat surface: one LIGHT_AT per light up to
+    // kBoothUnrolledLights, a loop for any beyond. Not on relief: there each light's horizon test
+    // is large, and 32 copies of it took LLVM seconds to compile (a test's pass 2 -> 16 s) for no
+    // measurable gain in the frame.
+    const int unrolledLights = relief_ ? 0 : std::clamp(settings_.lights, 0, kBoothUnrolledLights);
+    std::string lightCalls;
+    for (int i = 0; i < unrolledLights; ++i) {
+        lightCalls += fmt::format(" LIGHT_AT({})", i);
+    }
     for (int mode = 0; mode < 3; ++mode) {
         const std::string source =
                 fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
                             "#define BOOTH_GRID {}\n#define BOOTH_HW_FILTER {}\n"
                             "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
                             "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n"
-                            "#define BOOTH_NEAREST_LEVEL {}\n#define BOOTH_FACET_CACHE {}\n",
+                            "#define BOOTH_NEAREST_LEVEL {}\n#define BOOTH_FACET_CACHE {}\n"
+                            "#define BOOTH_LIGHT_CALLS{}\n"
+                            "#define BOOTH_UNROLLED_LIGHTS {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0,
                             horizonDirs_, 4 * layers, samples, wardModelIndex(s.model),
-                            settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0) +
+                            settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0, lightCalls,
+                            unrolledLights) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
