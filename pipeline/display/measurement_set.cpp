@@ -6,50 +6,10 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/display/csv_cells.h>
 #include <pipeline/display/measurement_set.h>
 
 namespace replica::pipeline::display {
-namespace {
-
-std::string trim(const std::string& s)
-{
-    const auto b = s.find_first_not_of(" \t\r");
-    if (b == std::string::npos) {
-        return {};
-    }
-    const auto e = s.find_last_not_of(" \t\r");
-    return s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> splitComma(const std::string& line)
-{
-    std::vector<std::string> out;
-    std::string cell;
-    std::istringstream in(line);
-    while (std::getline(in, cell, ',')) {
-        out.push_back(trim(cell));
-    }
-    if (!line.empty() && line.back() == ',') {
-        out.emplace_back();
-    }
-    return out;
-}
-
-bool parseNumber(const std::string& s, double& v)
-{
-    if (s.empty()) {
-        return false;
-    }
-    std::size_t used = 0;
-    try {
-        v = std::stod(s, &used);
-    } catch (const std::exception&) {
-        return false;
-    }
-    return used == s.size() && std::isfinite(v);
-}
-
-} // namespace
 
 Expected<MeasurementSet>
 parseMeasurementCsv(const std::string& text, const std::string& source, int bitDepth)
@@ -63,11 +23,11 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
     double maxSeen = 0.0;
     while (std::getline(in, raw)) {
         ++lineNo;
-        const std::string line = trim(raw);
+        const std::string line = trimCell(raw);
         if (line.empty() || line[0] == '#') {
             continue;
         }
-        const auto cells = splitComma(line);
+        const auto cells = splitCsvRow(line);
         if (!header) {
             const std::vector<std::string> want{"R", "G", "B", "X", "Y", "Z"};
             if (cells != want) {
@@ -87,7 +47,7 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
         m.line = lineNo;
         for (int i = 0; i < 6; ++i) {
             double v = 0.0;
-            if (!parseNumber(cells[static_cast<std::size_t>(i)], v)) {
+            if (!parseFiniteNumber(cells[static_cast<std::size_t>(i)], v)) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: '{}' in column {} is not a finite number",
                                              source, lineNo, cells[static_cast<std::size_t>(i)],

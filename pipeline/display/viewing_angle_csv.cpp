@@ -6,33 +6,10 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/display/csv_cells.h>
 #include <pipeline/display/viewing_angle_csv.h>
 
 namespace replica::pipeline::display {
-namespace {
-
-std::string trim(const std::string& s)
-{
-    const auto b = s.find_first_not_of(" \t\r");
-    if (b == std::string::npos) {
-        return {};
-    }
-    const auto e = s.find_last_not_of(" \t\r");
-    return s.substr(b, e - b + 1);
-}
-
-bool parseNumber(const std::string& s, double& v)
-{
-    std::size_t used = 0;
-    try {
-        v = std::stod(s, &used);
-    } catch (const std::exception&) {
-        return false;
-    }
-    return !s.empty() && used == s.size() && std::isfinite(v);
-}
-
-} // namespace
 
 Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const std::string& source)
 {
@@ -46,15 +23,11 @@ Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const 
     double lum0 = 0.0;
     while (std::getline(in, raw)) {
         ++lineNo;
-        const std::string line = trim(raw);
+        const std::string line = trimCell(raw);
         if (line.empty() || line[0] == '#') {
             continue;
         }
-        std::vector<std::string> cells;
-        std::istringstream row(line);
-        for (std::string cell; std::getline(row, cell, ',');) {
-            cells.push_back(trim(cell));
-        }
+        const auto cells = splitCsvRow(line);
         if (!header) {
             if (cells != std::vector<std::string>{"angle_deg", "X", "Y", "Z"}) {
                 return makeError(ErrorCode::Corrupt,
@@ -71,7 +44,7 @@ Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const 
                                                              source, lineNo, cells.size()));
         }
         for (std::size_t i = 0; i < 4; ++i) {
-            if (!parseNumber(cells[i], v[i])) {
+            if (!parseFiniteNumber(cells[i], v[i])) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: '{}' is not a finite number", source, lineNo,
                                              cells[i]));

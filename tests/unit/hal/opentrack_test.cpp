@@ -17,6 +17,8 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/eventually.h"
+
 namespace replica::tests {
 namespace {
 
@@ -81,18 +83,6 @@ void sendTo(std::uint16_t port, const std::vector<std::uint8_t>& bytes)
                        sizeof addr),
               static_cast<ssize_t>(bytes.size()));
     ::close(fd);
-}
-
-template <typename F>
-bool eventually(F f)
-{
-    for (int i = 0; i < 500; ++i) {
-        if (f()) {
-            return true;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return false;
 }
 
 TEST(OpentrackSource, ReceivesPosesDropsBadOnesAndGoesStale)

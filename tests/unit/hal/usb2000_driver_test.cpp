@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/eventually.h"
 #include "fake_usb2000.h"
 
 namespace replica::tests {
@@ -220,19 +221,6 @@ TEST(Usb2000Device, UnpluggingIsNotFound)
     ASSERT_FALSE(s);
     EXPECT_EQ(s.error().code, ErrorCode::NotFound);
     EXPECT_NE(s.error().message.find("unplugged"), std::string::npos);
-}
-
-// Waits (up to 5 s) for a condition the reader thread brings about.
-template <typename F>
-bool eventually(F f)
-{
-    for (int i = 0; i < 500; ++i) {
-        if (f()) {
-            return true;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return false;
 }
 
 TEST(Usb2000Source, DeliversStampedSpectraFollowsAutoIntegrationAndSurvivesUnplugging)

@@ -19,6 +19,8 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/files.h"
+
 namespace replica::recordings {
 namespace {
 
@@ -41,11 +43,7 @@ std::vector<std::uint16_t> noisyCounts(std::uint32_t seed)
     return counts;
 }
 
-std::filesystem::path tempPath(const std::string& name)
-{
-    return std::filesystem::temp_directory_path() /
-           (name + "-" + std::to_string(::getpid()) + ".mcap");
-}
+using tests::tempRecordingPath;
 
 // The child: records sim-like samples (tracker 120 Hz, accel 100 Hz, a spectrum every 200 ms)
 // stamped with CLOCK_MONOTONIC until it is killed. Never returns.
@@ -99,7 +97,7 @@ TEST(CrashSafety, SigkillAtRandomMomentsLosesAtMostTheFlushInterval)
     std::vector<Child> children;
     const auto start = monotonicNs();
     for (int k = 0; k < kKills; ++k) {
-        const auto path = tempPath("sigkill-" + std::to_string(k));
+        const auto path = tempRecordingPath("sigkill-" + std::to_string(k));
         const pid_t pid = ::fork();
         ASSERT_GE(pid, 0);
         if (pid == 0) {
@@ -120,7 +118,7 @@ TEST(CrashSafety, SigkillAtRandomMomentsLosesAtMostTheFlushInterval)
     }
     for (const auto& c : children) {
         SCOPED_TRACE(c.path.string());
-        const auto out = tempPath("sigkill-recovered");
+        const auto out = tempRecordingPath("sigkill-recovered");
         auto report = recoverRecording(c.path, out);
         ASSERT_TRUE(report) << report.error().message;
         auto rec = readRecording(out);
@@ -145,7 +143,7 @@ TEST(CrashSafety, SigkillAtRandomMomentsLosesAtMostTheFlushInterval)
 
 TEST(CrashSafety, DiskFullGivesOneErrorKeepsRunningAndKeepsWhatWasWritten)
 {
-    const auto path = tempPath("fsize");
+    const auto path = tempRecordingPath("fsize");
     const pid_t pid = ::fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {
@@ -188,7 +186,7 @@ TEST(CrashSafety, DiskFullGivesOneErrorKeepsRunningAndKeepsWhatWasWritten)
     auto damaged = readRecording(path);
     ASSERT_FALSE(damaged);
     EXPECT_NE(damaged.error().message.find("replica recover"), std::string::npos);
-    const auto out = tempPath("fsize-recovered");
+    const auto out = tempRecordingPath("fsize-recovered");
     auto report = recoverRecording(path, out);
     ASSERT_TRUE(report) << report.error().message;
     auto rec = readRecording(out);
@@ -229,7 +227,7 @@ TEST(CrashSafety, UnwritableDirectoryIsOneClearErrorAtCreate)
 
 TEST(CrashSafety, DeletedFileIsOneClearError)
 {
-    const auto path = tempPath("deleted");
+    const auto path = tempRecordingPath("deleted");
     int errors = 0;
     std::string message;
     WriterOptions options;

@@ -14,25 +14,17 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/files.h"
+
 namespace replica::recordings {
 namespace {
 
+using tests::slurp;
+using tests::spit;
+
 std::filesystem::path tempPath(const std::string& name)
 {
-    return std::filesystem::temp_directory_path() /
-           ("damage-" + name + "-" + std::to_string(::getpid()) + ".mcap");
-}
-
-std::string slurp(const std::filesystem::path& p)
-{
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void spit(const std::filesystem::path& p, std::string_view bytes)
-{
-    std::ofstream out(p, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    return tests::tempRecordingPath("damage-" + name);
 }
 
 // A recording of every stream with small chunks, so that there are many chunk boundaries.

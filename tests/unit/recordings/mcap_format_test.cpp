@@ -14,17 +14,15 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/files.h"
+
 namespace replica::recordings {
 namespace {
 
 using mcap::ByteReader;
 using mcap::Op;
 
-std::string slurp(const std::filesystem::path& p)
-{
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using tests::slurp;
 
 struct Rec {
     Op op;
