@@ -49,6 +49,7 @@ std::string RunConfig::toJson() const
                      {"booth_lights", boothLights},
                      {"specular_samples", specularSamples},
                      {"specular_grid", specularGrid},
+                     {"diffuse_grid", diffuseGrid},
                      {"hardware_filter", hardwareFilter},
                      {"specular_lod_bias", specularLodBias},
                      {"specular_nearest_level", specularNearestLevel},
@@ -88,6 +89,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularSamples = j.value("specular_samples", c.specularSamples);
         // Absent before the specular grid: those recordings were shaded per pixel.
         c.specularGrid = j.value("specular_grid", 0);
+        c.diffuseGrid = j.value("diffuse_grid", 0);
         c.hardwareFilter = j.value("hardware_filter", false);
         c.specularNearestLevel = j.value("specular_nearest_level", false);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
@@ -109,11 +111,11 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < kAutoSpecularSamples ||
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
+        c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 ||
         !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias)) {
-        return makeError(ErrorCode::InvalidArgument, "run configuration: size, rate, light count, "
-                                                     "specular samples, specular grid, specular "
-                                                     "lod bias or horizon directions out of "
-                                                     "range");
+        return makeError(ErrorCode::InvalidArgument,
+                         "run configuration: size, rate, light count, specular samples, specular "
+                         "or diffuse grid, specular lod bias or horizon directions out of range");
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -216,6 +218,10 @@ makeBoothScene(RunConfig& config,
         config.specularGrid = pipeline::shading::defaultSpecularGrid(setup.scene); // recorded
     }
     setup.settings.specularGrid = config.specularGrid;
+    if (config.diffuseGrid == kAutoDiffuseGrid) {
+        config.diffuseGrid = pipeline::shading::defaultDiffuseGrid(setup.scene); // recorded
+    }
+    setup.settings.diffuseGrid = config.diffuseGrid;
     setup.settings.hardwareFilter = config.hardwareFilter;
     setup.settings.specularLodBias = config.specularLodBias;
     setup.settings.specularNearestLevel = config.specularNearestLevel;

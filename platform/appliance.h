@@ -18,8 +18,10 @@
 
 namespace replica::platform {
 
-// RunConfig::specularGrid and specularSamples: chosen for the scene when the appliance is built.
+// RunConfig::specularGrid, diffuseGrid and specularSamples: chosen for the scene when the
+// appliance is built.
 constexpr int kAutoSpecularGrid = -1;
+constexpr int kAutoDiffuseGrid = -1;
 constexpr int kAutoSpecularSamples = -1;
 
 // Everything that decides what a frame looks like, apart from the samples. Recorded in the session
@@ -46,6 +48,11 @@ struct RunConfig {
     // appliance is built and recorded as chosen.
     // Recordings made before the grid have none: they replay per pixel.
     int specularGrid = kAutoSpecularGrid;
+    // Texels between the diffuse grid's nodes (shading::RenderSettings::diffuseGrid; flat
+    // surfaces only); 0: per pixel; kAutoDiffuseGrid: shading::defaultDiffuseGrid for the scene,
+    // chosen when the appliance is built and recorded as chosen. Recordings made before the grid
+    // have none: they replay per pixel.
+    int diffuseGrid = kAutoDiffuseGrid;
     int horizonDirections = 8;
     // shading::RenderSettings::hardwareFilter: the sampler filters the luminance mip chain (same
     // rule, other float rounding). Recordings made before it have none and replay with the

@@ -53,10 +53,17 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
 std::string BoothScenePass::description() const
 {
     const auto& s = setup_.settings;
+    const bool glossy = setup_.scene.glossy();
+    const bool flat = setup_.scene.flat();
+    const std::string grids =
+            (glossy && s.specularGrid > 0 ? fmt::format(", specular grid {} texels", s.specularGrid)
+                                          : std::string()) +
+            (flat && s.diffuseGrid > 0 ? fmt::format(", diffuse grid {} texels", s.diffuseGrid)
+                                       : std::string());
     return fmt::format("gles-booth (scene {}, {} median-cut lights, {} specular samples, {} "
-                       "horizon directions, basis {}{})",
-                       setup_.scene.name, s.lights, setup_.scene.glossy() ? s.specularSamples : 0,
-                       setup_.scene.flat() ? 0 : s.horizonDirections, setup_.basis.name,
+                       "horizon directions{}, basis {}{})",
+                       setup_.scene.name, s.lights, glossy ? s.specularSamples : 0,
+                       flat ? 0 : s.horizonDirections, grids, setup_.basis.name,
                        setup_.adaptive ? ", re-encoded for each new light" : "");
 }
 

@@ -49,7 +49,8 @@ uniform vec3 uWhite;            // XYZ of the light scaled to Y = 1
 uniform float uFlareRho;
 // 0: the eye-independent part into the cache (diffuse XYZ, E_geo in alpha); 1: compose the frame
 // from the cache plus the eye-dependent specular term; 2: the specular term (rho_s = 1) at the
-// nodes of the specular grid, one fragment per node (booth_shading_pass.cpp says when each runs).
+// nodes of the specular grid, one fragment per node; 3: E_geo at the nodes of the diffuse grid,
+// for mode 0 to interpolate (booth_shading_pass.cpp says when each runs).
 // A constant: each mode is its own program, so that it carries none of the others' code (llvmpipe
 // runs both sides of a branch under a mask; a mode that only composes would pay for the rest).
 const int uMode = BOOTH_MODE;
@@ -59,6 +60,11 @@ uniform sampler2D uCache;       // RGBA32F, the viewport's size: what mode 0 wro
 uniform ivec2 uGridNodes;
 const bool kGrid = BOOTH_GRID != 0;     // whether the compose reads the grid (fixed likewise)
 uniform sampler2D uSpecGrid;    // R32F, uGridNodes: what mode 2 wrote this frame
+// The diffuse grid (RenderSettings::diffuseGrid, flat surfaces only), laid out like the specular
+// one: mode 0 interpolates E_geo between its nodes instead of summing eq. (1) per pixel.
+uniform ivec2 uDiffNodes;
+const bool kDiffuseGrid = BOOTH_DIFFUSE_GRID != 0;
+uniform sampler2D uDiffGrid;    // R32F, uDiffNodes: what mode 3 wrote with the cache
 // BOOTH_FACET_CACHE (relief with a per-pixel specular term): mode 0 also writes each pixel's
 // facet normal (tangent frame, bilinearNormal's) beside the cache, and the compose reads it there:
 // one texel a frame instead of four and a normalisation.
@@ -317,27 +323,32 @@ vec3 bilinearNormal(float x, float y) {
 }
 
 // realtime_model.cpp gridSpecular: bilinear between the four nodes around (u, v).
-float gridSpecular(float u, float v) {
-    vec2 last = vec2(uGridNodes - 1);
+float gridValue(sampler2D grid, ivec2 nodes, float u, float v) {
+    vec2 last = vec2(nodes - 1);
     vec2 f = clamp(vec2(u, v), 0.0, 1.0) * last;
     vec2 f0 = min(floor(f), last - 1.0);
     vec2 a = f - f0;
     ivec2 c = ivec2(f0);
-    float s00 = texelFetch(uSpecGrid, c, 0).r;
-    float s10 = texelFetch(uSpecGrid, c + ivec2(1, 0), 0).r;
-    float s01 = texelFetch(uSpecGrid, c + ivec2(0, 1), 0).r;
-    float s11 = texelFetch(uSpecGrid, c + ivec2(1, 1), 0).r;
+    float s00 = texelFetch(grid, c, 0).r;
+    float s10 = texelFetch(grid, c + ivec2(1, 0), 0).r;
+    float s01 = texelFetch(grid, c + ivec2(0, 1), 0).r;
+    float s11 = texelFetch(grid, c + ivec2(1, 1), 0).r;
     return (1.0 - a.y) * ((1.0 - a.x) * s00 + a.x * s10) + a.y * ((1.0 - a.x) * s01 + a.x * s11);
+}
+float gridSpecular(float u, float v) {
+    return gridValue(uSpecGrid, uGridNodes, u, v);
 }
 
 void main() {
     float u;
     float v;
-    if (uMode == 2) {
-        // A node of the specular grid (row j = v, down the surface, like the textures' rows).
+    if (uMode == 2 || uMode == 3) {
+        // A node of the specular or the diffuse grid (row j = v, down the surface, like the
+        // textures' rows).
         vec2 node = floor(gl_FragCoord.xy);
-        u = node.x / float(uGridNodes.x - 1);
-        v = node.y / float(uGridNodes.y - 1);
+        ivec2 nodes = uMode == 2 ? uGridNodes : uDiffNodes;
+        u = node.x / float(nodes.x - 1);
+        v = node.y / float(nodes.y - 1);
     } else {
         vec2 frag = gl_FragCoord.xy / uViewport;
         u = uSurfOffset.x + uSurfScale.x * frag.x;
@@ -383,6 +394,19 @@ void main() {
         outXyz = vec4((isnan(spec) || isinf(spec)) ? 0.0 : spec, 0.0, 0.0, 0.0);
         return;
     }
+    if (uMode == 3) {
+        // realtime_model.cpp's diffuse grid: eq. (1) with the macro normal at this node.
+        float eg = 0.0;
+        float unused = 0.0;
+#define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, uNormal, false, eg, unused); }
+        BOOTH_LIGHT_CALLS
+#undef LIGHT_AT
+        for (int i = BOOTH_UNROLLED_LIGHTS; i < uLightCount; ++i) {
+            diffuseLight(i, p, uNormal, false, eg, unused);
+        }
+        outXyz = vec4((isnan(eg) || isinf(eg)) ? 0.0 : eg, 0.0, 0.0, 0.0);
+        return;
+    }
     if (uMode == 0 && !inside) {
         // Around the surface only E_geo (pass 2's flare): eq. (1) with the macro normal, the
         // cosines clamped instead of tested: the same sum, and on llvmpipe about half the cost of
@@ -409,12 +433,17 @@ void main() {
         // (BOOTH_LIGHT_CALLS, written out by the pass: LIGHT_AT(0) LIGHT_AT(1) ...; llvmpipe
         // reads a uniform array at a loop counter as a gather per pixel, at a constant index as
         // one load), then any beyond them in a loop. Same lights in the same order.
+#if BOOTH_DIFFUSE_GRID
+        // Flat, and inside the surface here: E_geo between the diffuse grid's nodes.
+        eGeo = gridValue(uDiffGrid, uDiffNodes, u, v);
+#else
 #define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, nShade, relief, eGeo, e); }
         BOOTH_LIGHT_CALLS
 #undef LIGHT_AT
         for (int i = BOOTH_UNROLLED_LIGHTS; i < uLightCount; ++i) {
             diffuseLight(i, p, nShade, relief, eGeo, e);
         }
+#endif
         if (!relief) {
             e = eGeo;
         }

@@ -26,7 +26,8 @@ enum TextureUnit : GLint {
     kUnitLum,
     kUnitCache,
     kUnitSpecGrid,
-    kUnitFacet
+    kUnitFacet,
+    kUnitDiffGrid
 };
 
 // Float textures are read with texelFetch only: nearest sampling keeps them complete without the
@@ -185,6 +186,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     gridNodes_ = specular_ ? shading::specularGridNodes(s, settings_.specularGrid)
                            : shading::GridNodes{};
     facetCache_ = relief_ && specular_ && gridNodes_.x == 0;
+    diffuseNodes_ =
+            relief_ ? shading::GridNodes{} : shading::specularGridNodes(s, settings_.diffuseGrid);
     // The specular samples' half vectors depend only on alpha and N: once here, in double.
     const int samples = specular_ ? settings_.specularSamples : 0;
     if (samples > kBoothMaxSpecularSamples) {
@@ -202,17 +205,20 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     for (int i = 0; i < unrolledLights; ++i) {
         lightCalls += fmt::format(" LIGHT_AT({})", i);
     }
-    for (int mode = 0; mode < 3; ++mode) {
+    const int modes = diffuseNodes_.x > 0 ? 4 : 3;
+    for (int mode = 0; mode < modes; ++mode) {
         const std::string source =
                 fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
-                            "#define BOOTH_GRID {}\n#define BOOTH_HW_FILTER {}\n"
+                            "#define BOOTH_GRID {}\n#define BOOTH_DIFFUSE_GRID {}\n"
+                            "#define BOOTH_HW_FILTER {}\n"
                             "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
                             "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n"
                             "#define BOOTH_NEAREST_LEVEL {}\n#define BOOTH_FACET_CACHE {}\n"
                             "#define BOOTH_LIGHT_CALLS{}\n"
                             "#define BOOTH_UNROLLED_LIGHTS {}\n",
-                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0,
-                            horizonDirs_, 4 * layers, samples, wardModelIndex(s.model),
+                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
+                            diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
+                            4 * layers, samples, wardModelIndex(s.model),
                             settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0, lightCalls,
                             unrolledLights) +
                 kBoothXyzShader;
@@ -269,7 +275,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 4 * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
     // Blocks a mode does not use are gone from its program: bound where present.
     for (const GLuint p : programs_) {
-        if (const GLuint block = glGetUniformBlockIndex(p, "BoothLights");
+        if (const GLuint block =
+                    p != 0 ? glGetUniformBlockIndex(p, "BoothLights") : GL_INVALID_INDEX;
             block != GL_INVALID_INDEX) {
             glUniformBlockBinding(p, block, 0);
         }
@@ -292,7 +299,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(table.size() * sizeof(float)),
                  table.data(), GL_STATIC_DRAW);
     for (const GLuint p : programs_) {
-        if (const GLuint block = glGetUniformBlockIndex(p, "BoothSpecSamples");
+        if (const GLuint block =
+                    p != 0 ? glGetUniformBlockIndex(p, "BoothSpecSamples") : GL_INVALID_INDEX;
             block != GL_INVALID_INDEX) {
             glUniformBlockBinding(p, block, 1);
         }
@@ -317,6 +325,25 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
         }
     }
 
+    // The diffuse grid's target: one R32F texel per node, drawn whenever the cache is (mode 3).
+    if (diffuseNodes_.x > 0) {
+        glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
+        diffuseTexture_ = texture2d(GL_R32F, GL_RED, diffuseNodes_.x, diffuseNodes_.y, nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE0);
+        glGenFramebuffers(1, &diffuseFbo_);
+        glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, diffuseTexture_,
+                               0);
+        const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        if (!complete) {
+            return makeError(ErrorCode::Unsupported,
+                             "render: the booth pass's R32F diffuse grid is not renderable on "
+                             "this GL; run with a diffuse grid of 0 (per pixel)");
+        }
+    }
+
     uniformAll(glProgramUniform1i, "uCoeffA", kUnitCoeffA);
     uniformAll(glProgramUniform1i, "uCoeffB", kUnitCoeffB);
     uniformAll(glProgramUniform1i, "uNormals", kUnitNormals);
@@ -326,6 +353,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     uniformAll(glProgramUniform1i, "uSpecGrid", kUnitSpecGrid);
     uniformAll(glProgramUniform1i, "uFacetCache", kUnitFacet);
     uniformAll(glProgramUniform2i, "uGridNodes", gridNodes_.x, gridNodes_.y);
+    uniformAll(glProgramUniform1i, "uDiffGrid", kUnitDiffGrid);
+    uniformAll(glProgramUniform2i, "uDiffNodes", diffuseNodes_.x, diffuseNodes_.y);
     uniformAll(glProgramUniform2i, "uTexels", s.width, s.height);
     uniformAll(glProgramUniform2f, "uSizeM", static_cast<float>(s.widthM),
                static_cast<float>(s.heightM));
@@ -339,16 +368,18 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
 
 BoothShadingPass::~BoothShadingPass()
 {
-    const std::array<GLuint, 8> textures{coeffA_, coeffB_,       normals_,      horizon_,
-                                         lum_,    cacheTexture_, facetTexture_, gridTexture_};
+    const std::array<GLuint, 9> textures{coeffA_,       coeffB_,      normals_,
+                                         horizon_,      lum_,         cacheTexture_,
+                                         facetTexture_, gridTexture_, diffuseTexture_};
     glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     glDeleteFramebuffers(1, &cacheFbo_);
     glDeleteFramebuffers(1, &gridFbo_);
+    glDeleteFramebuffers(1, &diffuseFbo_);
     glDeleteBuffers(1, &lightsUbo_);
     glDeleteBuffers(1, &samplesUbo_);
     glDeleteVertexArrays(1, &vao_);
     for (const GLuint p : programs_) {
-        glDeleteProgram(p);
+        glDeleteProgram(p); // 0 is ignored
     }
 }
 
@@ -579,6 +610,17 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                        layout.offset,
                        layout.scale};
     if (!cacheValid_ || !(key == cacheKey_)) {
+        if (diffuseNodes_.x > 0) {
+            // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface.
+            glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_);
+            glViewport(0, 0, diffuseNodes_.x, diffuseNodes_.y);
+            usePose(3, diffusePose);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+            glViewport(0, 0, width, height);
+            glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
+            glBindTexture(GL_TEXTURE_2D, diffuseTexture_);
+            glActiveTexture(GL_TEXTURE0);
+        }
         // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare); or,
         // without the surround's illuminance, the surface's rectangle and zero around it.
         glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
@@ -591,6 +633,11 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         usePose(0, diffusePose);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glDisable(GL_SCISSOR_TEST);
+        if (diffuseNodes_.x > 0) {
+            glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
+            glBindTexture(GL_TEXTURE_2D, 0); // not sampled while mode 3 draws into it
+            glActiveTexture(GL_TEXTURE0);
+        }
         cacheKey_ = key;
         cacheValid_ = true;
         ++cacheRefreshes_;
@@ -615,7 +662,8 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         glEnable(GL_SCISSOR_TEST);
         glScissor(rect.x, rect.y, rect.width, rect.height);
         usePose(1, view.panel);
-        glBindTexture(GL_TEXTURE_2D, cacheTexture_); // unit kUnitCache is active
+        glActiveTexture(GL_TEXTURE0 + kUnitCache);
+        glBindTexture(GL_TEXTURE_2D, cacheTexture_);
         glActiveTexture(GL_TEXTURE0 + kUnitFacet);
         glBindTexture(GL_TEXTURE_2D, facetTexture_);
         glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);

@@ -112,14 +112,17 @@ private:
     int lightCount_ = 0;
     int lumMaxLevel_ = 0;
     colour::Xyz specXyz_{0.0};
-    // One program per shader mode (booth_shaders.h): 0 cache, 1 compose, 2 specular grid.
-    std::array<GLuint, 3> programs_{};
+    // One program per shader mode (booth_shaders.h): 0 cache, 1 compose, 2 specular grid,
+    // 3 diffuse grid (0 where the pass has no diffuse grid).
+    std::array<GLuint, 4> programs_{};
     // Sets a uniform in every mode's program (where that mode still has it).
     template <typename Fn, typename... Args>
     void uniformAll(Fn fn, const char* name, Args... args) const
     {
         for (const GLuint p : programs_) {
-            fn(p, glGetUniformLocation(p, name), args...);
+            if (p != 0) {
+                fn(p, glGetUniformLocation(p, name), args...);
+            }
         }
     }
     void set3All(const char* name, const glm::dvec3& v) const;
@@ -152,6 +155,10 @@ private:
     shading::GridNodes gridNodes_;
     GLuint gridTexture_ = 0;
     GLuint gridFbo_ = 0;
+    // The diffuse grid (settings.diffuseGrid > 0 on a flat surface): drawn with the cache.
+    shading::GridNodes diffuseNodes_;
+    GLuint diffuseTexture_ = 0;
+    GLuint diffuseFbo_ = 0;
 };
 
 // An RGBA32F render target with read-back into an XyzFrame (rows top-down, like the CPU model):

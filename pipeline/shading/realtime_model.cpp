@@ -199,6 +199,11 @@ int defaultSpecularGrid(const surface::SurfaceScene& scene)
     return scene.flat() ? kFlatSpecularGrid : 0;
 }
 
+int defaultDiffuseGrid(const surface::SurfaceScene& scene)
+{
+    return scene.flat() ? kFlatDiffuseGrid : 0;
+}
+
 int defaultSpecularSamples(const surface::SurfaceScene& scene)
 {
     return scene.flat() ? kFlatSpecularSamples : kReliefSpecularSamples;
@@ -291,6 +296,30 @@ XyzFrame renderRealtime(const PreparedScene& ps,
         });
     }
 
+    // The diffuse grid, when used (flat surfaces only): eq. (1) with the macro normal at every
+    // node first, as the GL pass's mode 3 does when it recomputes its cache.
+    const GridNodes diffuseNodes =
+            relief ? GridNodes{} : specularGridNodes(scene, settings.diffuseGrid);
+    std::vector<double> diffuseGrid(static_cast<std::size_t>(diffuseNodes.x) *
+                                    static_cast<std::size_t>(diffuseNodes.y));
+    if (diffuseNodes.x > 0) {
+        inParallel(diffuseNodes.y, [&](int, int j0, int j1) {
+            for (int j = j0; j < j1; ++j) {
+                for (int i = 0; i < diffuseNodes.x; ++i) {
+                    const ShadingPoint sp = shadingPointAt(
+                            view, scene, normals, static_cast<double>(i) / (diffuseNodes.x - 1),
+                            static_cast<double>(j) / (diffuseNodes.y - 1));
+                    const double e =
+                            pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo,
+                                                 nullptr, 0, 0, sp.right, sp.up, 0.0);
+                    diffuseGrid[static_cast<std::size_t>(j) *
+                                        static_cast<std::size_t>(diffuseNodes.x) +
+                                static_cast<std::size_t>(i)] = std::isfinite(e) ? e : 0.0;
+                }
+            }
+        });
+    }
+
     struct Counts {
         long flare = 0, behind = 0, bad = 0;
     };
@@ -302,8 +331,11 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                 const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
                 c.behind += behind ? 1 : 0;
                 const double eGeo =
-                        pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr,
-                                             0, 0, sp.right, sp.up, 0.0);
+                        diffuseNodes.x > 0
+                                ? gridSpecular(diffuseGrid, diffuseNodes, (px + 0.5) / view.pixelsX,
+                                               (py + 0.5) / view.pixelsY)
+                                : pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo,
+                                                       nullptr, 0, 0, sp.right, sp.up, 0.0);
                 double e = eGeo;
                 if (relief) {
                     e = pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon,

@@ -61,6 +61,12 @@ struct RenderSettings {
     // smoothly over the surface, and shading it at grid nodes and interpolating costs a fraction
     // of shading it per pixel (specularGridNodes; the planner measures the error it adds).
     int specularGrid = 0;
+    // Texels between the nodes of the diffuse grid; 0: eq. (1) per pixel. Ignored on relief,
+    // whose facets and horizons change from texel to texel. On a flat surface the illuminance from
+    // the booth's lights varies over centimetres, not texels: summed at the grid's nodes
+    // (specularGridNodes' layout) and interpolated, it costs a frame that recomputes the cache
+    // (the panel being tilted) a few hundred sums instead of one per pixel.
+    int diffuseGrid = 0;
     // The GL pass only: let the sampler filter the luminance mip chain where the GL can (same
     // rule as booth::MipChain::sample); off, or without the extensions, the shader filters by hand.
     bool hardwareFilter = true;
@@ -96,12 +102,20 @@ constexpr int kFlatSpecularGrid = 8;
 // surface, 0 (per pixel) on relief.
 int defaultSpecularGrid(const surface::SurfaceScene& scene);
 
+// On a flat surface the diffuse term (eq. 1 with the macro normal) is summed every 8 texels and
+// interpolated: the shipped flat scenes move by ΔE00 0.01 at most against per pixel (docs/
+// rendering.md). 0 (per pixel) on relief.
+constexpr int kFlatDiffuseGrid = 8;
+// The spacing the appliance and 'replica render' use unless told: kFlatDiffuseGrid on a flat
+// surface, 0 on relief.
+int defaultDiffuseGrid(const surface::SurfaceScene& scene);
+
 // The specular sample count the appliance and 'replica render' use unless told
 // (kReliefSpecularSamples or kFlatSpecularSamples).
 int defaultSpecularSamples(const surface::SurfaceScene& scene);
 
-// The grid's specular term at (u, v): bilinear between the four nodes around it (values row by
-// row, nodes.x per row).
+// A grid's value at (u, v): bilinear between the four nodes around it (values row by row, nodes.x
+// per row); the specular grid's term and the diffuse grid's illuminance alike.
 double gridSpecular(const std::vector<double>& values, GridNodes nodes, double u, double v);
 
 // Per-light precomputation: median cut, mip chain, spectra. Rebuilt only when the light or N

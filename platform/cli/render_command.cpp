@@ -37,6 +37,7 @@ struct RenderArgs {
     int lights = 32;
     int samples = kAutoSpecularSamples;   // as the appliance chooses it for the scene
     int specularGrid = kAutoSpecularGrid; // as the appliance chooses it for the scene
+    int diffuseGrid = kAutoDiffuseGrid;   // likewise
     double lodBias = pipeline::shading::kDefaultSpecularLodBias;
     bool trilinear = false;
     int horizonDirections = 8;
@@ -140,6 +141,7 @@ int runRender(const RenderArgs& a)
     settings.horizonDirections = a.horizonDirections;
     settings.specularGrid =
             a.specularGrid >= 0 ? a.specularGrid : shading::defaultSpecularGrid(*scene);
+    settings.diffuseGrid = a.diffuseGrid >= 0 ? a.diffuseGrid : shading::defaultDiffuseGrid(*scene);
     settings.specularLodBias = a.lodBias;
     settings.specularNearestLevel = !a.trilinear;
     std::string mode = "realtime-cpu";
@@ -218,6 +220,7 @@ int runRender(const RenderArgs& a)
         j["specular_samples"] =
                 scene->glossy() && settings.specularPass ? settings.specularSamples : 0;
         j["specular_grid"] = scene->glossy() && settings.specularPass ? settings.specularGrid : 0;
+        j["diffuse_grid"] = scene->flat() || !settings.reliefPass ? settings.diffuseGrid : 0;
         j["specular_lod_bias"] = settings.specularLodBias;
         j["specular_nearest_level"] = settings.specularNearestLevel;
         j["horizon_directions"] =
@@ -278,6 +281,12 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                     "on relief)")
             ->capture_default_str()
             ->check(CLI::Range(kAutoSpecularGrid, 256));
+    cmd->add_option("--diffuse-grid", args->diffuseGrid,
+                    "texels between the nodes eq. (1) is summed at on a flat surface, then "
+                    "interpolated; 0: per pixel; -1: as the appliance chooses (8 on a flat "
+                    "surface; relief is always per pixel)")
+            ->capture_default_str()
+            ->check(CLI::Range(kAutoDiffuseGrid, 256));
     cmd->add_flag("--specular-trilinear", args->trilinear,
                   "read each specular sample between the two mip levels around its own instead "
                   "of from the nearest one (slower; the default before 2026-12-01)");

@@ -142,6 +142,7 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_EQ(o->renderer, "flat");
     // Made before the specular grid and the sampler's filter: per pixel, the shader's filter.
     EXPECT_EQ(o->specularGrid, 0);
+    EXPECT_EQ(o->diffuseGrid, 0); // and before the diffuse grid: eq. (1) per pixel
     EXPECT_FALSE(o->hardwareFilter);
     EXPECT_TRUE(o->surroundIlluminance);
     // And before the specular mip level bias was a setting: the renderer's bias of then.
@@ -151,12 +152,15 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
+    EXPECT_EQ(c.diffuseGrid, platform::kAutoDiffuseGrid);
     EXPECT_TRUE(c.hardwareFilter);
     c.specularGrid = 8;
+    c.diffuseGrid = 5;
     c.specularLodBias = 0.25;
     auto round = platform::RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(round);
     EXPECT_EQ(round->specularGrid, 8);
+    EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);
     EXPECT_EQ(round->specularLodBias, 0.25);
     c.specularLodBias = 1e9; // a corrupt value is refused, not rendered
@@ -167,6 +171,11 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     c.specularLodBias = 0.0;
     c.specularGrid = -2;
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
+    c.specularGrid = 8;
+    c.diffuseGrid = 257;
+    const auto badGrid = platform::RunConfig::fromJson(c.toJson());
+    ASSERT_FALSE(badGrid);
+    EXPECT_NE(badGrid.error().message.find("diffuse grid"), std::string::npos);
 
     const auto shipped = platform::resolveSceneDir("scenes/metamer");
     auto d1 = platform::sceneDigest(shipped);
@@ -284,6 +293,8 @@ TEST(ApplianceBoothScene, ChoosesTheSpecularSampleCountForTheSceneAndRecordsIt)
     EXPECT_NE((*app)->config.toJson().find("\"specular_samples\":8"), std::string::npos);
     EXPECT_NE((*app)->renderer->description().find(", 8 specular samples"), std::string::npos)
             << (*app)->renderer->description();
+    // Relief sums eq. (1) per pixel: recorded as 0.
+    EXPECT_EQ((*app)->config.diffuseGrid, 0);
     app->reset();
 
     // A recording holds the count it ran with and replays with it, whatever the scene's default
@@ -298,6 +309,12 @@ TEST(ApplianceBoothScene, ChoosesTheSpecularSampleCountForTheSceneAndRecordsIt)
     auto replayed = buildAppliance(*recorded);
     ASSERT_TRUE(replayed) << replayed.error().message;
     EXPECT_EQ((*replayed)->config.specularSamples, 5);
+    // The flat ColorChecker's diffuse grid, chosen when the appliance is built and recorded.
+    EXPECT_EQ((*replayed)->config.diffuseGrid, pipeline::shading::kFlatDiffuseGrid);
+    EXPECT_NE((*replayed)->config.toJson().find("\"diffuse_grid\":8"), std::string::npos);
+    EXPECT_NE((*replayed)->renderer->description().find(", diffuse grid 8 texels"),
+              std::string::npos)
+            << (*replayed)->renderer->description();
     EXPECT_NE((*replayed)->renderer->description().find(", 5 specular samples"), std::string::npos)
             << (*replayed)->renderer->description();
 
