@@ -525,6 +525,7 @@ Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
     glDeleteTextures(1, &cacheTexture_);
     glDeleteTextures(1, &facetTexture_);
     facetTexture_ = 0;
+    zeroAround_.reset();                       // a new texture holds nothing yet
     glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
     cacheTexture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
     if (facetCache_) {
@@ -625,10 +626,19 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         // without the surround's illuminance, the surface's rectangle and zero around it.
         glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
         if (!surroundIlluminance_) {
-            const std::array<float, 4> zero{};
-            glClearBufferfv(GL_COLOR, 0, zero.data());
+            // Mode 0 writes only the rectangle, so zero around it stays zero from one refresh to
+            // the next: cleared only when the cache was not already zero there (a new target, a
+            // new rectangle, or the surround's illuminance drawn). On llvmpipe a clear of the
+            // RGBA32F cache is a pass over 9 MB at 960x600, a good part of a tilting frame.
+            if (!(zeroAround_ && *zeroAround_ == rect)) {
+                const std::array<float, 4> zero{};
+                glClearBufferfv(GL_COLOR, 0, zero.data());
+                zeroAround_ = rect;
+            }
             glEnable(GL_SCISSOR_TEST);
             glScissor(rect.x, rect.y, rect.width, rect.height);
+        } else {
+            zeroAround_.reset();
         }
         usePose(0, diffusePose);
         glDrawArrays(GL_TRIANGLES, 0, 3);

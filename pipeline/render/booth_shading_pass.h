@@ -5,6 +5,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 
 #include <GLES3/gl31.h>
 #include <glm/vec2.hpp>
@@ -143,6 +144,9 @@ private:
     mutable bool surroundIlluminance_ = true;
     mutable long cacheRefreshes_ = 0;
     mutable GLuint cacheTexture_ = 0;
+    // The rectangle outside which the cache is known to hold zero (cleared for it, and mode 0
+    // writes only inside it); none after a new texture or a draw with the surround's illuminance.
+    mutable std::optional<PixelRect> zeroAround_;
     mutable GLuint cacheFbo_ = 0;
     // With relief and a per-pixel specular term the cache also keeps each pixel's facet normal
     // (tangent frame, what bilinearNormal gives; RGBA32F), so that the compose reads one texel

@@ -282,6 +282,19 @@ TEST_F(BoothCacheTest, WithoutTheSurroundOnlyTheSurfaceRectangleIsShaded)
     const auto st = state(0.6, {0.1, 0.5, 0.5});
     EXPECT_EQ(draw(**with, st), draw(**without, st));
     EXPECT_EQ((*without)->cacheRefreshes(), 3);
+    // And off again: the cache held E_geo around the surface, so it is cleared there once more
+    // (between refreshes without the surround it is not cleared: mode 0 never writes there).
+    (*without)->setSurroundIlluminance(false);
+    const auto off = draw(**without, st);
+    EXPECT_EQ((*without)->cacheRefreshes(), 4);
+    for (int y = 0; y < kH; ++y) {
+        for (int x = 0; x < kW; ++x) {
+            if (!(x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height)) {
+                ASSERT_EQ(off[(static_cast<std::size_t>(y) * kW + x) * 4 + 3], 0.0f)
+                        << x << ", " << y;
+            }
+        }
+    }
 }
 
 } // namespace
