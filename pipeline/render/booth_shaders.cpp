@@ -62,8 +62,8 @@ const bool kGrid = BOOTH_GRID != 0;     // whether the compose reads the grid (f
 uniform sampler2D uSpecGrid;    // R32F, uGridNodes: what mode 2 wrote this frame
 // The diffuse grid (RenderSettings::diffuseGrid, flat surfaces only), laid out like the specular
 // one: mode 0 interpolates E_geo between its nodes instead of summing eq. (1) per pixel.
+// BOOTH_DIFFUSE_GRID says whether mode 0 reads it (fixed for the pass's life like the rest).
 uniform ivec2 uDiffNodes;
-const bool kDiffuseGrid = BOOTH_DIFFUSE_GRID != 0;
 uniform sampler2D uDiffGrid;    // R32F, uDiffNodes: what mode 3 wrote with the cache
 // BOOTH_FACET_CACHE (relief with a per-pixel specular term): mode 0 also writes each pixel's
 // facet normal (tangent frame, bilinearNormal's) beside the cache, and the compose reads it there:
