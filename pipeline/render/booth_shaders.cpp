@@ -55,7 +55,7 @@ uniform float uFlareRho;
 // runs both sides of a branch under a mask; a mode that only composes would pay for the rest).
 const int uMode = BOOTH_MODE;
 uniform sampler2D uCache;       // RGBA32F, the viewport's size: what mode 0 wrote
-// The specular grid (shading::specularGridNodes): node (i, j) at surface (u, v) =
+// The specular grid (shading::gridNodes): node (i, j) at surface (u, v) =
 // (i / (nodes.x - 1), j / (nodes.y - 1)); (0, 0): the specular term per pixel.
 uniform ivec2 uGridNodes;
 const bool kGrid = BOOTH_GRID != 0;     // whether the compose reads the grid (fixed likewise)
@@ -322,7 +322,7 @@ vec3 bilinearNormal(float x, float y) {
     return len > 1e-12 ? n / len : vec3(0.0, 0.0, 1.0);
 }
 
-// realtime_model.cpp gridSpecular: bilinear between the four nodes around (u, v).
+// realtime_model.cpp gridValue: bilinear between the four nodes around (u, v).
 float gridValue(sampler2D grid, ivec2 nodes, float u, float v) {
     vec2 last = vec2(nodes - 1);
     vec2 f = clamp(vec2(u, v), 0.0, 1.0) * last;

@@ -54,6 +54,29 @@ GLuint texture2d(GLenum internalFormat, GLenum format, int w, int h, const float
     return tex;
 }
 
+// A grid's target: one R32F texel per node (made on 'unit', so that creating it binds over no
+// other input) and a framebuffer that draws into it.
+Expected<void>
+nodeTarget(shading::GridNodes nodes, GLint unit, const char* grid, GLuint& texture, GLuint& fbo)
+{
+    glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
+    texture = texture2d(GL_R32F, GL_RED, nodes.x, nodes.y, nullptr);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+    const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!complete) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("render: the booth pass's R32F {0} grid is not renderable on "
+                                     "this GL; run with a {0} grid of 0 (per pixel)",
+                                     grid));
+    }
+    return {};
+}
+
 glm::vec3 f3(const glm::dvec3& v)
 {
     return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
@@ -183,11 +206,9 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     // Which passes run is fixed for the pass's life: compiled into each program, so that none
     // carries code it never runs (llvmpipe executes both sides of a branch under a mask).
     specular_ = settings_.specularPass && s.glossy() && settings_.specularSamples > 0;
-    gridNodes_ = specular_ ? shading::specularGridNodes(s, settings_.specularGrid)
-                           : shading::GridNodes{};
+    gridNodes_ = specular_ ? shading::gridNodes(s, settings_.specularGrid) : shading::GridNodes{};
     facetCache_ = relief_ && specular_ && gridNodes_.x == 0;
-    diffuseNodes_ =
-            relief_ ? shading::GridNodes{} : shading::specularGridNodes(s, settings_.diffuseGrid);
+    diffuseNodes_ = relief_ ? shading::GridNodes{} : shading::gridNodes(s, settings_.diffuseGrid);
     // The specular samples' half vectors depend only on alpha and N: once here, in double.
     const int samples = specular_ ? settings_.specularSamples : 0;
     if (samples > kBoothMaxSpecularSamples) {
@@ -306,41 +327,19 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
         }
     }
 
-    // The specular grid's target: one R32F texel per node, shaded every frame (mode 2).
+    // The grids' targets: the specular one shaded every frame (mode 2), the diffuse one drawn
+    // whenever the cache is (mode 3).
     if (gridNodes_.x > 0) {
-        glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);
-        gridTexture_ = texture2d(GL_R32F, GL_RED, gridNodes_.x, gridNodes_.y, nullptr);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        glActiveTexture(GL_TEXTURE0);
-        glGenFramebuffers(1, &gridFbo_);
-        glBindFramebuffer(GL_FRAMEBUFFER, gridFbo_);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, gridTexture_,
-                               0);
-        const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        if (!complete) {
-            return makeError(ErrorCode::Unsupported,
-                             "render: the booth pass's R32F specular grid is not renderable on "
-                             "this GL; run with a specular grid of 0 (per pixel)");
+        if (auto ok = nodeTarget(gridNodes_, kUnitSpecGrid, "specular", gridTexture_, gridFbo_);
+            !ok) {
+            return ok;
         }
     }
-
-    // The diffuse grid's target: one R32F texel per node, drawn whenever the cache is (mode 3).
     if (diffuseNodes_.x > 0) {
-        glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
-        diffuseTexture_ = texture2d(GL_R32F, GL_RED, diffuseNodes_.x, diffuseNodes_.y, nullptr);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        glActiveTexture(GL_TEXTURE0);
-        glGenFramebuffers(1, &diffuseFbo_);
-        glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, diffuseTexture_,
-                               0);
-        const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        if (!complete) {
-            return makeError(ErrorCode::Unsupported,
-                             "render: the booth pass's R32F diffuse grid is not renderable on "
-                             "this GL; run with a diffuse grid of 0 (per pixel)");
+        if (auto ok = nodeTarget(diffuseNodes_, kUnitDiffGrid, "diffuse", diffuseTexture_,
+                                 diffuseFbo_);
+            !ok) {
+            return ok;
         }
     }
 

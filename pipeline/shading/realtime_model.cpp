@@ -185,7 +185,7 @@ double filteredSpecular(const PreparedLight& light,
     return samples > 0 ? sum / samples : 0.0;
 }
 
-GridNodes specularGridNodes(const surface::SurfaceScene& scene, int spacingTexels)
+GridNodes gridNodes(const surface::SurfaceScene& scene, int spacingTexels)
 {
     if (spacingTexels <= 0 || scene.width <= 0 || scene.height <= 0) {
         return {};
@@ -209,7 +209,7 @@ int defaultSpecularSamples(const surface::SurfaceScene& scene)
     return scene.flat() ? kFlatSpecularSamples : kReliefSpecularSamples;
 }
 
-double gridSpecular(const std::vector<double>& values, GridNodes nodes, double u, double v)
+double gridValue(const std::vector<double>& values, GridNodes nodes, double u, double v)
 {
     const double lastX = nodes.x - 1;
     const double lastY = nodes.y - 1;
@@ -277,8 +277,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     };
 
     // The specular grid, when used: every node first (as the GL pass's mode 2 does).
-    const GridNodes nodes =
-            specular ? specularGridNodes(scene, settings.specularGrid) : GridNodes{};
+    const GridNodes nodes = specular ? gridNodes(scene, settings.specularGrid) : GridNodes{};
     std::vector<double> grid(static_cast<std::size_t>(nodes.x) * static_cast<std::size_t>(nodes.y));
     if (nodes.x > 0) {
         inParallel(nodes.y, [&](int, int j0, int j1) {
@@ -298,8 +297,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
 
     // The diffuse grid, when used (flat surfaces only): eq. (1) with the macro normal at every
     // node first, as the GL pass's mode 3 does when it recomputes its cache.
-    const GridNodes diffuseNodes =
-            relief ? GridNodes{} : specularGridNodes(scene, settings.diffuseGrid);
+    const GridNodes diffuseNodes = relief ? GridNodes{} : gridNodes(scene, settings.diffuseGrid);
     std::vector<double> diffuseGrid(static_cast<std::size_t>(diffuseNodes.x) *
                                     static_cast<std::size_t>(diffuseNodes.y));
     if (diffuseNodes.x > 0) {
@@ -332,8 +330,8 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                 c.behind += behind ? 1 : 0;
                 const double eGeo =
                         diffuseNodes.x > 0
-                                ? gridSpecular(diffuseGrid, diffuseNodes, (px + 0.5) / view.pixelsX,
-                                               (py + 0.5) / view.pixelsY)
+                                ? gridValue(diffuseGrid, diffuseNodes, (px + 0.5) / view.pixelsX,
+                                            (py + 0.5) / view.pixelsY)
                                 : pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo,
                                                        nullptr, 0, 0, sp.right, sp.up, 0.0);
                 double e = eGeo;
@@ -360,7 +358,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                 if (specular && nodes.x > 0) {
                     const double u = (px + 0.5) / view.pixelsX;
                     const double v = (py + 0.5) / view.pixelsY;
-                    xyz += specXyz * gridSpecular(grid, nodes, u, v);
+                    xyz += specXyz * gridValue(grid, nodes, u, v);
                 } else if (specular && !behind) {
                     xyz += specXyz * specularAt(sp, toEye);
                 }

@@ -59,12 +59,12 @@ struct RenderSettings {
     // Texels between the nodes of the specular grid; 0: the specular term per pixel. The
     // specular term follows the eye, so it is shaded every frame; on a flat surface it varies
     // smoothly over the surface, and shading it at grid nodes and interpolating costs a fraction
-    // of shading it per pixel (specularGridNodes; the planner measures the error it adds).
+    // of shading it per pixel (gridNodes; the planner measures the error it adds).
     int specularGrid = 0;
     // Texels between the nodes of the diffuse grid; 0: eq. (1) per pixel. Ignored on relief,
     // whose facets and horizons change from texel to texel. On a flat surface the illuminance from
     // the booth's lights varies over centimetres, not texels: summed at the grid's nodes
-    // (specularGridNodes' layout) and interpolated, it costs a frame that recomputes the cache
+    // (gridNodes' layout) and interpolated, it costs a frame that recomputes the cache
     // (the panel being tilted) a few hundred sums instead of one per pixel.
     int diffuseGrid = 0;
     // The GL pass only: let the sampler filter the luminance mip chain where the GL can (same
@@ -83,14 +83,14 @@ struct RenderSettings {
     int threads = 2;
 };
 
-// Nodes of the specular grid for a spacing in texels: (ceil(width / s) + 1) x (ceil(height / s) +
-// 1), spread evenly over the surface with its corners included, node (i, j) at (u, v) = (i / (x -
-// 1), j / (y - 1)). {0, 0} for s <= 0 (per pixel).
+// Nodes of a grid (specular or diffuse) for a spacing in texels: (ceil(width / s) + 1) x
+// (ceil(height / s) + 1), spread evenly over the surface with its corners included, node (i, j) at
+// (u, v) = (i / (x - 1), j / (y - 1)). {0, 0} for s <= 0 (per pixel).
 struct GridNodes {
     int x = 0;
     int y = 0;
 };
-GridNodes specularGridNodes(const surface::SurfaceScene& scene, int spacingTexels);
+GridNodes gridNodes(const surface::SurfaceScene& scene, int spacingTexels);
 
 // On a flat surface the specular term varies smoothly: shaded every 8 texels and interpolated,
 // the shipped ColorChecker stays inside the ΔE00 budget (p95 0.67 / max 0.86 against 0.66 / 0.89
@@ -116,7 +116,7 @@ int defaultSpecularSamples(const surface::SurfaceScene& scene);
 
 // A grid's value at (u, v): bilinear between the four nodes around it (values row by row, nodes.x
 // per row); the specular grid's term and the diffuse grid's illuminance alike.
-double gridSpecular(const std::vector<double>& values, GridNodes nodes, double u, double v);
+double gridValue(const std::vector<double>& values, GridNodes nodes, double u, double v);
 
 // Per-light precomputation: median cut, mip chain, spectra. Rebuilt only when the light or N
 // changes.

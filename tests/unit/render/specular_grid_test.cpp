@@ -1,4 +1,4 @@
-// The specular grid of the CPU model (shading::specularGridNodes, gridSpecular): node layout,
+// The specular grid of the CPU model (shading::gridNodes, gridValue): node layout,
 // interpolation that is exact for bilinear functions, and what the grid costs the ColorChecker
 // against shading the specular term per pixel.
 #include <cmath>
@@ -18,20 +18,20 @@ TEST(SpecularGrid, NodesCoverTheSurfaceCornersIncluded)
     surface::SurfaceScene s;
     s.width = 275;
     s.height = 185;
-    const GridNodes g8 = specularGridNodes(s, 8);
+    const GridNodes g8 = gridNodes(s, 8);
     EXPECT_EQ(g8.x, 36); // ceil(275 / 8) + 1
     EXPECT_EQ(g8.y, 25); // ceil(185 / 8) + 1
-    const GridNodes g1 = specularGridNodes(s, 1);
+    const GridNodes g1 = gridNodes(s, 1);
     EXPECT_EQ(g1.x, 276);
     EXPECT_EQ(g1.y, 186);
     // Coarser than the surface: still two nodes a side (the corners).
-    const GridNodes big = specularGridNodes(s, 1000);
+    const GridNodes big = gridNodes(s, 1000);
     EXPECT_EQ(big.x, 2);
     EXPECT_EQ(big.y, 2);
-    EXPECT_EQ(specularGridNodes(s, 0).x, 0);
-    EXPECT_EQ(specularGridNodes(s, -3).y, 0);
+    EXPECT_EQ(gridNodes(s, 0).x, 0);
+    EXPECT_EQ(gridNodes(s, -3).y, 0);
     surface::SurfaceScene empty;
-    EXPECT_EQ(specularGridNodes(empty, 8).x, 0);
+    EXPECT_EQ(gridNodes(empty, 8).x, 0);
 }
 
 TEST(SpecularGrid, InterpolationIsExactForBilinearFunctionsAndHitsTheNodes)
@@ -47,13 +47,13 @@ TEST(SpecularGrid, InterpolationIsExactForBilinearFunctionsAndHitsTheNodes)
     }
     for (double u : {0.0, 0.013, 0.5, 0.77, 1.0}) {
         for (double v : {0.0, 0.25, 0.333, 0.99, 1.0}) {
-            EXPECT_NEAR(gridSpecular(values, g, u, v), f(u, v), 1e-12) << u << ", " << v;
+            EXPECT_NEAR(gridValue(values, g, u, v), f(u, v), 1e-12) << u << ", " << v;
         }
     }
     // At a node: its own value, not a blend.
-    EXPECT_DOUBLE_EQ(gridSpecular(values, g, 2.0 / 6.0, 1.0 / 3.0), values[1 * 7 + 2]);
+    EXPECT_DOUBLE_EQ(gridValue(values, g, 2.0 / 6.0, 1.0 / 3.0), values[1 * 7 + 2]);
     // Outside [0, 1]^2: clamped to the edge, never read out of bounds.
-    EXPECT_NEAR(gridSpecular(values, g, -0.5, 1.5), f(0.0, 1.0), 1e-12);
+    EXPECT_NEAR(gridValue(values, g, -0.5, 1.5), f(0.0, 1.0), 1e-12);
 }
 
 TEST(SpecularGrid, CostsTheFlatColorCheckerLittleAgainstPerPixelShading)
