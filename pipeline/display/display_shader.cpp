@@ -23,10 +23,12 @@ DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse)
     p.whiteY = static_cast<float>(g.whiteY);
     p.maxCount = static_cast<float>(m.maxCount());
     p.lutSize = inverse.lutSize();
-    p.lut.reserve(static_cast<std::size_t>(p.lutSize) * 3);
+    p.lut.reserve(static_cast<std::size_t>(p.lutSize - 1) * 3 * 2);
     for (int c = 0; c < 3; ++c) {
-        for (double v : inverse.lut(c)) {
-            p.lut.push_back(static_cast<float>(v));
+        const std::vector<double>& lut = inverse.lut(c);
+        for (std::size_t j = 0; j + 1 < lut.size(); ++j) {
+            p.lut.push_back(static_cast<float>(lut[j]));
+            p.lut.push_back(static_cast<float>(lut[j + 1]));
         }
     }
     p.dither = ditherPattern();
@@ -55,7 +57,7 @@ uniform float uDispBlackY;
 uniform float uDispWhiteY;
 uniform float uDispMaxCount;
 uniform int uDispLutSize;
-uniform highp sampler2D uDispToneLut;  // lutSize x 3, R32F, texelFetch only
+uniform highp sampler2D uDispToneLut;  // (lutSize - 1) x 3, RG32F, texelFetch only
 uniform highp sampler2D uDispDither;   // 16 x 16, R32F
 uniform vec4 uDispViewing[16];         // angle deg, gain X, Y, Z
 
@@ -64,9 +66,9 @@ float displayToneLut(int channel, float r) {
     float pos = pow(clamp(r, 0.0, 1.0), 1.0 / 3.0) * float(uDispLutSize - 1);
     int j = clamp(int(floor(pos)), 0, uDispLutSize - 2);
     float f = pos - float(j);
-    float a = texelFetch(uDispToneLut, ivec2(j, channel), 0).r;
-    float b = texelFetch(uDispToneLut, ivec2(j + 1, channel), 0).r;
-    return mix(a, b, f) * uDispMaxCount;
+    // Texel j holds entries j and j + 1: one fetch where two were (each a gather on llvmpipe).
+    vec2 ab = texelFetch(uDispToneLut, ivec2(j, channel), 0).rg;
+    return mix(ab.x, ab.y, f) * uDispMaxCount;
 }
 
 // Gamut classes: 0 in gamut, 1 chroma, 2 over peak, 3 below black (see gamut_map.h).
@@ -118,24 +120,28 @@ vec4 displayInverse(vec3 xyzIn, int mode) {
     return vec4(displayToneLut(0, r.r), displayToneLut(1, r.g), displayToneLut(2, r.b), cls);
 }
 
-// The row count is compiled in (DISP_VIEWING_ROWS, from the profile): with a constant bound and
-// no return inside the loop, llvmpipe runs the rows once each instead of looping under a mask.
-// Walking down and keeping the last row whose upper angle is above a gives the first such row,
-// which is what a search up the table returns.
+// The row count is compiled in (DISP_VIEWING_ROWS, from the profile). The segment is the first
+// row i whose next angle is above a (what a search up the table returns): with the angles rising,
+// i counts the inner rows at or below a. Counting costs a compare a row; only that segment is
+// interpolated (llvmpipe ran all eleven divisions and mixes when each row interpolated under its
+// own test). At or past the last angle, and for a NaN, the last row's gain.
 vec3 displayViewingGain(float angleDeg) {
 #if DISP_VIEWING_ROWS <= 0
     return vec3(1.0);
+#elif DISP_VIEWING_ROWS == 1
+    return uDispViewing[0].yzw;
 #else
     float a = clamp(angleDeg, 0.0, 90.0);
-    vec3 gain = uDispViewing[DISP_VIEWING_ROWS - 1].yzw;
-    for (int i = DISP_VIEWING_ROWS - 2; i >= 0; --i) {
-        vec4 lo = uDispViewing[i];
-        vec4 hi = uDispViewing[i + 1];
-        if (a < hi.x) {
-            gain = mix(lo.yzw, hi.yzw, (a - lo.x) / (hi.x - lo.x));
-        }
+    if (!(a < uDispViewing[DISP_VIEWING_ROWS - 1].x)) {
+        return uDispViewing[DISP_VIEWING_ROWS - 1].yzw;
     }
-    return gain;
+    int i = 0;
+    for (int k = 1; k < DISP_VIEWING_ROWS - 1; ++k) {
+        i += a >= uDispViewing[k].x ? 1 : 0;
+    }
+    vec4 lo = uDispViewing[i];
+    vec4 hi = uDispViewing[i + 1];
+    return mix(lo.yzw, hi.yzw, (a - lo.x) / (hi.x - lo.x));
 #endif
 }
 

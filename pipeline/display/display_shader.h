@@ -20,8 +20,9 @@ struct DisplayShaderParams {
     float blackY = 0.0f;
     float whiteY = 1.0f;
     float maxCount = 255.0f;
-    // Inverse tone LUTs: a lutSize x 3 R32F texture, row c = channel c, texel j = counts / maxCount
-    // at r = (j / (lutSize - 1))^3 (the cube-root domain keeps near-black precision).
+    // Inverse tone LUTs: entry j = counts / maxCount at r = (j / (lutSize - 1))^3 (the cube-root
+    // domain keeps near-black precision), as a (lutSize - 1) x 3 RG32F texture: row c = channel c,
+    // texel j = entries j and j + 1 (the pair one interpolation reads).
     int lutSize = 0;
     std::vector<float> lut;
     // 16 x 16 R32F texture of ordered-dither thresholds in (0, 1), indexed by pixel modulo 16.

@@ -196,7 +196,7 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
 
     rgbaTarget_ = texture2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height, nullptr);
     classTarget_ = texture2d(GL_R8, GL_RED, GL_UNSIGNED_BYTE, width, height, nullptr);
-    toneLut_ = texture2d(GL_R32F, GL_RED, GL_FLOAT, params.lutSize, 3, params.lut.data());
+    toneLut_ = texture2d(GL_RG32F, GL_RG, GL_FLOAT, params.lutSize - 1, 3, params.lut.data());
     dither_ = texture2d(GL_R32F, GL_RED, GL_FLOAT, display::kDitherSize, display::kDitherSize,
                         params.dither.data());
     // A 3-D texture always exists (a 2^3 dummy on the analytic path) so that the sampler is valid.
@@ -229,10 +229,11 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
                          setup.gamut == display::GamutMode::HueKeeping) &&
                         params.lutSize >= 2;
     for (int c = 0; c < 3 && surroundConstant_; ++c) {
-        const float counts = setup.method == InverseMethod::Lut3d
-                                     ? lattice[static_cast<std::size_t>(c)]
-                                     : params.lut[static_cast<std::size_t>(c * params.lutSize)] *
-                                               params.maxCount;
+        const float counts =
+                setup.method == InverseMethod::Lut3d
+                        ? lattice[static_cast<std::size_t>(c)]
+                        : params.lut[static_cast<std::size_t>(c * 2 * (params.lutSize - 1))] *
+                                  params.maxCount;
         const auto quantise = [&](float t) {
             return std::clamp(std::floor(counts + t), 0.0f, params.maxCount);
         };
