@@ -1,5 +1,7 @@
 // The display pass's cleared surround: shading only the rectangle pass 1 can light, and clearing
 // the black panel around it, must give the very pixels and gamut counts of shading the whole frame.
+// Every draw also checks the gamut counts against its class image, counted here.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -93,6 +95,21 @@ protected:
         glBindFramebuffer(GL_FRAMEBUFFER, pass.framebuffer());
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
         glReadPixels(0, 0, kW, kH, GL_RGBA, GL_UNSIGNED_BYTE, d.rgba.data());
+        // The counters are the class image counted: read it back (attachment 1, class / 255 in
+        // red) and count it here, pixel by pixel.
+        std::vector<std::uint8_t> classes(static_cast<std::size_t>(kW) * kH * 4);
+        glReadBuffer(GL_COLOR_ATTACHMENT1);
+        glReadPixels(0, 0, kW, kH, GL_RGBA, GL_UNSIGNED_BYTE, classes.data());
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+        std::array<std::uint64_t, 4> tally{};
+        for (std::size_t i = 0; i < classes.size(); i += 4) {
+            EXPECT_LT(classes[i], 4) << "pixel " << i / 4;
+            ++tally[std::min<std::size_t>(classes[i], 3)];
+        }
+        EXPECT_EQ(d.counts.pixels, static_cast<std::uint64_t>(kW) * kH);
+        EXPECT_EQ(d.counts.chroma, tally[1]);
+        EXPECT_EQ(d.counts.overPeak, tally[2]);
+        EXPECT_EQ(d.counts.belowBlack, tally[3]);
         return d;
     }
 
