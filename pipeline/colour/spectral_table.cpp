@@ -1,5 +1,4 @@
 // Spectral CSV parsing with file:line error messages.
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -7,47 +6,10 @@
 #include <fmt/format.h>
 
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/csv/csv_cells.h>
 
 namespace replica::pipeline::colour {
-namespace {
-
-std::vector<std::string> splitCsvLine(const std::string& line)
-{
-    std::vector<std::string> cells;
-    std::string cell;
-    std::istringstream in(line);
-    while (std::getline(in, cell, ',')) {
-        while (!cell.empty() &&
-               (cell.back() == '\r' || cell.back() == ' ' || cell.back() == '\t')) {
-            cell.pop_back();
-        }
-        std::size_t start = 0;
-        while (start < cell.size() && (cell[start] == ' ' || cell[start] == '\t')) {
-            ++start;
-        }
-        cells.push_back(cell.substr(start));
-    }
-    if (!line.empty() && line.back() == ',') {
-        cells.emplace_back();
-    }
-    return cells;
-}
-
-bool parseDouble(const std::string& cell, double& out)
-{
-    if (cell.empty()) {
-        return false;
-    }
-    const char* first = cell.data();
-    const char* last = cell.data() + cell.size();
-    if (*first == '+') {
-        ++first;
-    }
-    auto [ptr, ec] = std::from_chars(first, last, out);
-    return ec == std::errc() && ptr == last && std::isfinite(out);
-}
-
-} // namespace
+namespace {} // namespace
 
 Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::string& source)
 {
@@ -65,7 +27,7 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
         if (line.empty() || line[0] == '#') {
             continue;
         }
-        auto cells = splitCsvLine(line);
+        auto cells = csv::splitCsvRow(line);
         if (!haveHeader) {
             if (cells.size() < 2 || cells[0] != "wavelength_nm") {
                 return makeError(ErrorCode::InvalidArgument,
@@ -92,7 +54,7 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
                                 table.columns.size()));
         }
         double wl = 0.0;
-        if (!parseDouble(cells[0], wl)) {
+        if (!csv::parseFiniteNumber(cells[0], wl)) {
             return makeError(ErrorCode::InvalidArgument,
                              fmt::format("{}:{}: wavelength '{}' is not a number", source, lineNo,
                                          cells[0]));
@@ -105,7 +67,7 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
         }
         std::vector<double> row(table.columns.size());
         for (std::size_t c = 0; c < row.size(); ++c) {
-            if (!parseDouble(cells[c + 1], row[c])) {
+            if (!csv::parseFiniteNumber(cells[c + 1], row[c])) {
                 return makeError(ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: column '{}' value '{}' is not a finite number",
                                              source, lineNo, table.columns[c], cells[c + 1]));

@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include <pipeline/display/csv_cells.h>
+#include <pipeline/csv/csv_cells.h>
 #include <pipeline/display/measurement_set.h>
 
 namespace replica::pipeline::display {
@@ -23,11 +23,11 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
     double maxSeen = 0.0;
     while (std::getline(in, raw)) {
         ++lineNo;
-        const std::string line = trimCell(raw);
+        const std::string line = csv::trimCell(raw);
         if (line.empty() || line[0] == '#') {
             continue;
         }
-        const auto cells = splitCsvRow(line);
+        const auto cells = csv::splitCsvRow(line);
         if (!header) {
             const std::vector<std::string> want{"R", "G", "B", "X", "Y", "Z"};
             if (cells != want) {
@@ -47,7 +47,7 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
         m.line = lineNo;
         for (int i = 0; i < 6; ++i) {
             double v = 0.0;
-            if (!parseFiniteNumber(cells[static_cast<std::size_t>(i)], v)) {
+            if (!csv::parseFiniteNumber(cells[static_cast<std::size_t>(i)], v)) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: '{}' in column {} is not a finite number",
                                              source, lineNo, cells[static_cast<std::size_t>(i)],

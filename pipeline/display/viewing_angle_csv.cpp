@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include <pipeline/display/csv_cells.h>
+#include <pipeline/csv/csv_cells.h>
 #include <pipeline/display/viewing_angle_csv.h>
 
 namespace replica::pipeline::display {
@@ -23,11 +23,11 @@ Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const 
     double lum0 = 0.0;
     while (std::getline(in, raw)) {
         ++lineNo;
-        const std::string line = trimCell(raw);
+        const std::string line = csv::trimCell(raw);
         if (line.empty() || line[0] == '#') {
             continue;
         }
-        const auto cells = splitCsvRow(line);
+        const auto cells = csv::splitCsvRow(line);
         if (!header) {
             if (cells != std::vector<std::string>{"angle_deg", "X", "Y", "Z"}) {
                 return makeError(ErrorCode::Corrupt,
@@ -44,7 +44,7 @@ Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const 
                                                              source, lineNo, cells.size()));
         }
         for (std::size_t i = 0; i < 4; ++i) {
-            if (!parseFiniteNumber(cells[i], v[i])) {
+            if (!csv::parseFiniteNumber(cells[i], v[i])) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: '{}' is not a finite number", source, lineNo,
                                              cells[i]));

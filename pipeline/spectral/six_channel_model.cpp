@@ -1,5 +1,4 @@
 // Fitting, applying and storing the paper's six-channel representation.
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -7,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/csv/csv_cells.h>
 #include <pipeline/spectral/dense_matrix.h>
 #include <pipeline/spectral/fit_metric.h>
 #include <pipeline/spectral/six_channel_model.h>
@@ -282,15 +282,6 @@ std::filesystem::path toXyzPath(const std::filesystem::path& csvPath)
     return p;
 }
 
-bool parseNumber(const std::string& cell, double& out)
-{
-    if (cell.empty()) {
-        return false;
-    }
-    auto [ptr, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), out);
-    return ec == std::errc() && ptr == cell.data() + cell.size() && std::isfinite(out);
-}
-
 } // namespace
 
 Expected<SixChannelModel> loadSixChannelModel(const std::filesystem::path& csvPath)
@@ -343,12 +334,7 @@ Expected<SixChannelModel> loadSixChannelModel(const std::filesystem::path& csvPa
             header = true;
             continue;
         }
-        std::vector<std::string> cells;
-        std::stringstream in(line);
-        std::string cell;
-        while (std::getline(in, cell, ',')) {
-            cells.push_back(cell);
-        }
+        const std::vector<std::string> cells = csv::splitCsvRow(line);
         double v[4] = {};
         if (cells.size() != 4) {
             return makeError(ErrorCode::InvalidArgument,
@@ -356,7 +342,7 @@ Expected<SixChannelModel> loadSixChannelModel(const std::filesystem::path& csvPa
                                          xyzPath.string(), lineNo, cells.size()));
         }
         for (std::size_t i = 0; i < 4; ++i) {
-            if (!parseNumber(cells[i], v[i])) {
+            if (!csv::parseFiniteNumber(cells[i], v[i])) {
                 return makeError(ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: '{}' is not a finite number", xyzPath.string(),
                                              lineNo, cells[i]));

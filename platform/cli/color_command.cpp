@@ -1,6 +1,5 @@
 // 'replica color de2000 PAIRS.csv': CIEDE2000 of each CIELAB pair in a CSV file.
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -15,6 +14,7 @@
 
 #include <pipeline/base/expected.h>
 #include <pipeline/colour/ciede2000.h>
+#include <pipeline/csv/csv_cells.h>
 #include <platform/cli/commands.h>
 
 namespace replica::platform {
@@ -33,32 +33,6 @@ struct PairFile {
     std::string header;
     std::vector<PairRow> rows;
 };
-
-std::vector<std::string> splitCells(const std::string& line)
-{
-    std::vector<std::string> cells;
-    std::stringstream in(line);
-    std::string cell;
-    while (std::getline(in, cell, ',')) {
-        const auto first = cell.find_first_not_of(" \t");
-        const auto last = cell.find_last_not_of(" \t");
-        cells.push_back(first == std::string::npos ? "" : cell.substr(first, last - first + 1));
-    }
-    if (!line.empty() && line.back() == ',') {
-        cells.emplace_back();
-    }
-    return cells;
-}
-
-bool parseNumber(const std::string& cell, double& out)
-{
-    if (cell.empty()) {
-        return false;
-    }
-    const char* first = cell.data() + (cell[0] == '+' ? 1 : 0);
-    auto [ptr, ec] = std::from_chars(first, cell.data() + cell.size(), out);
-    return ec == std::errc() && ptr == cell.data() + cell.size() && std::isfinite(out);
-}
 
 Expected<PairFile> readPairs(const std::string& path)
 {
@@ -82,7 +56,7 @@ Expected<PairFile> readPairs(const std::string& path)
         if (line.empty() || line[0] == '#') {
             continue;
         }
-        const auto cells = splitCells(line);
+        const auto cells = pipeline::csv::splitCsvRow(line);
         if (!haveHeader) {
             for (std::size_t c = 0; c < 6; ++c) {
                 const auto it = std::find(cells.begin(), cells.end(), kColumns[c]);
@@ -107,7 +81,7 @@ Expected<PairFile> readPairs(const std::string& path)
         }
         double v[6] = {};
         for (std::size_t c = 0; c < 6; ++c) {
-            if (!parseNumber(cells[columnIndex[c]], v[c])) {
+            if (!pipeline::csv::parseFiniteNumber(cells[columnIndex[c]], v[c])) {
                 return makeError(ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: column '{}' value '{}' is not a finite number",
                                              path, lineNo, kColumns[c], cells[columnIndex[c]]));

@@ -1,32 +1,12 @@
-// The cell rules shared by the display layer's CSV readers, and the viewing-angle reader on them:
-// errors name source:line, and a row with a missing or non-finite value is refused, not shortened.
-#include <pipeline/display/csv_cells.h>
+// The display layer's CSV readers on the shared cell rules (pipeline/csv/csv_cells.h, tested in
+// tests/unit/csv): errors name source:line, and a row with a missing or non-finite value is
+// refused, not shortened.
 #include <pipeline/display/viewing_angle_csv.h>
 
 #include <gtest/gtest.h>
 
 namespace replica::pipeline::display {
 namespace {
-
-TEST(CsvCells, TrimsSplitsAndCountsATrailingEmptyCell)
-{
-    EXPECT_EQ(trimCell(" \t12.5\r"), "12.5");
-    EXPECT_EQ(trimCell(" \t\r"), "");
-    EXPECT_EQ(splitCsvRow("a, b ,c"), (std::vector<std::string>{"a", "b", "c"}));
-    EXPECT_EQ(splitCsvRow("1,2,"), (std::vector<std::string>{"1", "2", ""}));
-}
-
-TEST(CsvCells, ReadsOnlyWholeFiniteNumbers)
-{
-    double v = 0.0;
-    EXPECT_TRUE(parseFiniteNumber("-1.25e2", v));
-    EXPECT_DOUBLE_EQ(v, -125.0);
-    EXPECT_FALSE(parseFiniteNumber("", v));
-    EXPECT_FALSE(parseFiniteNumber("3x", v));
-    EXPECT_FALSE(parseFiniteNumber("nan", v));
-    EXPECT_FALSE(parseFiniteNumber("inf", v));
-    EXPECT_FALSE(parseFiniteNumber("1e999", v));
-}
 
 TEST(ViewingAngleCsv, ReadsRatiosAndShiftsRelativeToTheOnAxisRow)
 {

@@ -320,6 +320,24 @@ TEST_F(CliFiles, SixChannelModelRoundTripsAndNamesItsMatrixFile)
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error().message,
               (dir_ / "m_to_xyz.csv").string() + ":3: 3 cells, expected 4 (channel,X,Y,Z)");
+    // A row with a trailing comma has a fifth, empty cell: refused, where it was once read as
+    // the four before it.
+    std::ofstream(dir_ / "m_to_xyz.csv") << "channel,X,Y,Z\n1,1,2,3,\n";
+    bad = loadSixChannelModel(path);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().message,
+              (dir_ / "m_to_xyz.csv").string() + ":2: 5 cells, expected 4 (channel,X,Y,Z)");
+    // Blanks around a cell are trimmed as in every other CSV the project reads.
+    std::ofstream(dir_ / "m_to_xyz.csv") << "channel,X,Y,Z\n";
+    for (int k = 0; k < 6; ++k) {
+        std::ofstream(dir_ / "m_to_xyz.csv", std::ios::app)
+                << k + 1 << ", " << model->toXyz[static_cast<std::size_t>(k)].x << " ,"
+                << model->toXyz[static_cast<std::size_t>(k)].y << ",\t"
+                << model->toXyz[static_cast<std::size_t>(k)].z << "\n";
+    }
+    auto spaced = loadSixChannelModel(path);
+    ASSERT_TRUE(spaced) << spaced.error().message;
+    EXPECT_NEAR(spaced->toXyz[5].z, model->toXyz[5].z, 1e-5 * std::abs(model->toXyz[5].z));
 }
 
 } // namespace

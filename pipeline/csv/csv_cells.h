@@ -1,0 +1,27 @@
+// The cell-level rules every CSV reader of the project shares (spectral tables, display
+// measurements and viewing-angle tables, the colour CLI's pairs): trimming, splitting a row at
+// commas, and reading a cell as a finite number. One set of rules, so that a file one command
+// accepts is not refused by another for the spelling of a number.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace replica::pipeline::csv {
+
+// s without leading and trailing spaces, tabs and carriage returns.
+std::string trimCell(std::string_view s);
+
+// The trimmed cells of one row; a trailing comma gives a trailing empty cell, so that a row with
+// a missing last value is counted as such rather than silently shortened. An empty line is one
+// empty cell.
+std::vector<std::string> splitCsvRow(std::string_view line);
+
+// True when the whole cell is one finite decimal number: an optional sign ('+' or '-'), digits
+// with an optional '.', an optional exponent. Read with std::from_chars, so the C locale's
+// decimal separator does not matter (a process running under a comma-decimal locale reads the
+// same files), and hexadecimal, "inf" and "nan" are refused. 'v' is written only on success.
+bool parseFiniteNumber(std::string_view cell, double& v);
+
+} // namespace replica::pipeline::csv
