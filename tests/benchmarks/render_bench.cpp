@@ -9,6 +9,7 @@
 //        [--scene NAME: only that shipped scene, e.g. metamer (last, after the options above)]
 //        [--grid N: the default setting with a specular grid of N texels (after the above)]
 //        [--lod-bias B: the default setting with specular mip level bias B (after the above)]
+//        [--views: the appliance's default from nine views (three eyes, three tilts) instead]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -158,6 +159,102 @@ void writePareto(const std::filesystem::path& file, const std::vector<Point>& pt
     }
 }
 
+// What --views renders: the appliance's default setting with any of these changed, and which of
+// the views (empty or negative: all).
+struct ViewsOptions {
+    std::string scene;
+    std::string light;
+    int samples = 0;        // > 0: specular samples instead of the scene's default
+    int lights = 0;         // > 0: median-cut lights instead of 32
+    double softness = -1.0; // >= 0: horizon softness instead of the default
+    double tilt = -1.0;     // >= 0: only this tilt
+    int eye = -1;           // >= 0: only this eye (0 centre, 1 left, 2 high right)
+    int horizon = 0;        // > 0: horizon directions instead of 8
+};
+
+// The appliance's default setting (adaptive_k6, the scene's own sample count and grids) against
+// the reference from several views: three eyes (the bench's own, off to the left, high and to the
+// right) at three tilts (10, 30 and 50 degrees). The sweep measures one view; a colour scientist
+// asks whether the budget holds wherever the viewer stands and however the panel leans. Prints a
+// row per view and the worst p95 and max per scene.
+int runViews(const ViewsOptions& o,
+             int fw,
+             int fh,
+             const colour::Observer& obs,
+             const booth::BoothModel& booth,
+             const spectral::AdaptiveEncoder& encoder)
+{
+    const std::vector<std::pair<const char*, shading::Vec3>> eyes{
+            {"centre (0, 0.45, 0.60)", {0.0, 0.45, 0.60}},
+            {"left (-0.30, 0.40, 0.55)", {-0.30, 0.40, 0.55}},
+            {"high right (0.25, 0.65, 0.45)", {0.25, 0.65, 0.45}}};
+    std::printf("| scene | light | tilt | eye | setting | dE00 mean | p95 | max "
+                "|\n|---|---|---|---|---|---|---|---|\n");
+    for (const char* sceneName : {"colorchecker", "metamer", "painting"}) {
+        if (!o.scene.empty() && o.scene != sceneName) {
+            continue;
+        }
+        auto scene = surface::loadScene(dataDir() / "scenes" / sceneName);
+        if (!scene) {
+            std::fprintf(stderr, "%s\n", scene.error().message.c_str());
+            return 1;
+        }
+        shading::RenderSettings def;
+        def.specularSamples = o.samples > 0 ? o.samples : shading::defaultSpecularSamples(*scene);
+        def.specularGrid = shading::defaultSpecularGrid(*scene);
+        def.diffuseGrid = shading::defaultDiffuseGrid(*scene);
+        if (o.lights > 0) {
+            def.lights = o.lights;
+        }
+        if (o.softness >= 0.0) {
+            def.horizonSoftness = o.softness;
+        }
+        if (o.horizon > 0) {
+            def.horizonDirections = o.horizon;
+        }
+        const std::string setting = describe(def, *scene);
+        double worstP95 = 0.0;
+        double worstMax = 0.0;
+        for (const auto& light : booth.lights) {
+            if (!o.light.empty() && o.light != light.name) {
+                continue;
+            }
+            auto basis = encoder.basisFor(light.spd);
+            if (!basis) {
+                std::fprintf(stderr, "%s\n", basis.error().message.c_str());
+                return 1;
+            }
+            for (const double tilt : {10.0, 30.0, 50.0}) {
+                if (o.tilt >= 0.0 && o.tilt != tilt) {
+                    continue;
+                }
+                for (std::size_t e = 0; e < eyes.size(); ++e) {
+                    if (o.eye >= 0 && static_cast<std::size_t>(o.eye) != e) {
+                        continue;
+                    }
+                    const auto& [label, eye] = eyes[e];
+                    shading::View view;
+                    view.panel = shading::panelPoseFromTilt(tilt);
+                    view.eye = eye;
+                    view.pixelsX = fw;
+                    view.pixelsY = fh;
+                    const auto ref = reference::renderReference(*scene, light, view, obs);
+                    const Result r = measure(*scene, light, obs, *basis, def, view, ref, fw, fh);
+                    worstP95 = std::max(worstP95, r.error.p95);
+                    worstMax = std::max(worstMax, r.error.max);
+                    std::printf("| %s | %s | %.0f | %s | %s | %.3f | %.3f | %.3f |\n", sceneName,
+                                light.name.c_str(), tilt, label, setting.c_str(), r.error.mean,
+                                r.error.p95, r.error.max);
+                    std::fflush(stdout);
+                }
+            }
+        }
+        std::printf("| %s | worst of all | | | | | **%.3f** | **%.3f** |\n", sceneName, worstP95,
+                    worstMax);
+    }
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -167,7 +264,8 @@ int main(int argc, char** argv)
         if (arg == "--help" || arg == "-h") {
             std::printf(
                     "usage: %s [OUT_DIR [WxH [--defaults-only [SAMPLES]] [--scene NAME] "
-                    "[--grid TEXELS] [--lod-bias B]]]\n"
+                    "[--grid TEXELS] [--lod-bias B] [--views [--light NAME] [--tilt DEG] "
+                    "[--eye I] [--lights N] [--horizon N] [--softness S]]]]\n"
                     "Sweeps the booth renderer's knobs on every shipped scene and light: ms per "
                     "1920x1200 frame of the GL pass and dE00 mean / p95 / max on a WxH frame "
                     "(default 64x40) against the exact reference, then the planner's choices and "
@@ -178,7 +276,18 @@ int main(int argc, char** argv)
                     "samples instead of the scene's default)\n"
                     "  --scene NAME               one scene: colorchecker, metamer or painting\n"
                     "  --grid TEXELS              the default setting's specular grid\n"
-                    "  --lod-bias B               the default setting's specular mip level bias\n",
+                    "  --lod-bias B               the default setting's specular mip level bias\n"
+                    "  --views                    the appliance's default setting (with "
+                    "--defaults-only SAMPLES: that many samples) from nine views, three eyes at "
+                    "tilts 10, 30 and 50 degrees, and the worst p95 and max per scene; with it:\n"
+                    "    --light NAME             one booth light\n"
+                    "    --tilt DEG               one of the three tilts\n"
+                    "    --eye I                  one of the three eyes (0 centre, 1 left, 2 "
+                    "high right)\n"
+                    "    --horizon N              N horizon directions instead of 8\n"
+                    "    --lights N               N median-cut lights instead of 32\n"
+                    "    --softness S             horizon softness S (sin of elevation) instead "
+                    "of the default\n",
                     argv[0]);
             return 0;
         }
@@ -200,6 +309,33 @@ int main(int argc, char** argv)
     if (!output || !obs || !booth || !basis || !encoder) {
         std::fprintf(stderr, "cannot set up: no GL context or data missing\n");
         return 1;
+    }
+    bool views = false;
+    for (int a = 3; a < argc; ++a) {
+        views = views || std::string(argv[a]) == "--views";
+    }
+    if (views) {
+        ViewsOptions o;
+        o.samples = defaultSamples;
+        for (int a = 3; a + 1 < argc; ++a) {
+            const std::string arg = argv[a];
+            if (arg == "--scene") {
+                o.scene = argv[a + 1];
+            } else if (arg == "--light") {
+                o.light = argv[a + 1];
+            } else if (arg == "--lights") {
+                o.lights = std::atoi(argv[a + 1]);
+            } else if (arg == "--softness") {
+                o.softness = std::atof(argv[a + 1]);
+            } else if (arg == "--tilt") {
+                o.tilt = std::atof(argv[a + 1]);
+            } else if (arg == "--eye") {
+                o.eye = std::atoi(argv[a + 1]);
+            } else if (arg == "--horizon") {
+                o.horizon = std::atoi(argv[a + 1]);
+            }
+        }
+        return runViews(o, fw, fh, *obs, *booth, *encoder);
     }
     const int tw = 1920, th = 1200;
     const double tilt = 30.0;
