@@ -50,8 +50,28 @@ std::vector<PointLight> pointLights(const BoothLight& light,
 {
     std::vector<PointLight> out;
     out.reserve(regions.size());
+    const LuminanceImage& img = light.luminance;
+    const Vec3 uHat = glm::normalize(light.edgeU);
+    const Vec3 vHat = glm::normalize(light.edgeV);
     for (const RegionLight& r : regions) {
-        out.push_back(PointLight{light.pointAtTexel(r.centroidX, r.centroidY), r.sumCdM2});
+        // Second moments about the centroid, each texel a uniform square (its own spread 1/12).
+        double sum = 0.0, sxx = 0.0, syy = 0.0;
+        for (int y = r.y0; y < r.y1; ++y) {
+            for (int x = r.x0; x < r.x1; ++x) {
+                const double l = img.at(x, y);
+                const double dx = x + 0.5 - r.centroidX;
+                const double dy = y + 0.5 - r.centroidY;
+                sum += l;
+                sxx += l * (dx * dx + 1.0 / 12.0);
+                syy += l * (dy * dy + 1.0 / 12.0);
+            }
+        }
+        PointLight p{light.pointAtTexel(r.centroidX, r.centroidY), r.sumCdM2};
+        if (sum > 0.0) {
+            p.spreadU = uHat * (std::sqrt(sxx / sum) * light.texelWidthM());
+            p.spreadV = vHat * (std::sqrt(syy / sum) * light.texelHeightM());
+        }
+        out.push_back(p);
     }
     return out;
 }

@@ -44,6 +44,10 @@ colour::Spectrum unitLuminanceSpd(const colour::Observer& obs, const colour::Spe
 struct PointLight {
     Vec3 position{0.0};
     double sumCdM2 = 0.0;
+    // The region's luminance-weighted standard deviation about 'position' along edgeU and edgeV,
+    // as vectors in metres: how far the light the point stands for spreads over the ceiling.
+    Vec3 spreadU{0.0};
+    Vec3 spreadV{0.0};
 };
 
 std::vector<PointLight> pointLights(const BoothLight& light,

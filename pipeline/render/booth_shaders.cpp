@@ -39,6 +39,8 @@ uniform float uSoftness;
 
 layout(std140) uniform BoothLights {
     vec4 uLight[256];           // xyz: position (m); w: summed luminance * texel area (cd)
+    vec4 uLightSpreadU[256];    // xyz: booth::PointLight::spreadU (m)
+    vec4 uLightSpreadV[256];    // xyz: booth::PointLight::spreadV (m)
 };
 uniform int uLightCount;
 uniform vec3 uLightNormal;      // emitting side of the ceiling
@@ -116,22 +118,35 @@ float horizonSine(vec3 l) {
 }
 
 // realtime_model.cpp elevationVisibility: a direction at elevation sin = lz against sinB.
-float elevationVisibility(float sinB, float lz) {
+float elevationVisibility(float sinB, float lz, float softness) {
     if (sinB <= 0.0) {
         return 1.0;
     }
-    float e0 = sinB - uSoftness;
-    float e1 = sinB + uSoftness;
+    float e0 = sinB - softness;
+    float e1 = sinB + softness;
     float s = clamp((lz - e0) / max(e1 - e0, 1e-12), 0.0, 1.0);
     return s * s * (3.0 - 2.0 * s);
 }
 
 // realtime_model.cpp horizonVisibility.
-float visibility(vec3 l) {
+float visibility(vec3 l, float softness) {
     if (uHorizonDirs <= 0) {
         return 1.0;
     }
-    return elevationVisibility(horizonSine(l), l.z);
+    return elevationVisibility(horizonSine(l), l.z, softness);
+}
+
+// realtime_model.cpp lightSoftness: the horizon's softness for light i seen along the unit
+// direction d, cosG = d.n, d2 its squared distance: at least uSoftness, and sqrt(3) times the
+// spread of the light's elevation sine over the ceiling region it stands for (the distance
+// floored at a texel, as in eq. 1).
+float lightSoftness(int i, vec3 d, float cosG, float d2) {
+    float invDist = inversesqrt(max(d2, uTexelArea));
+    vec3 su3 = uLightSpreadU[i].xyz;
+    vec3 sv3 = uLightSpreadV[i].xyz;
+    float su = (dot(su3, uNormal) - cosG * dot(d, su3)) * invDist;
+    float sv = (dot(sv3, uNormal) - cosG * dot(d, sv3)) * invDist;
+    return max(uSoftness, sqrt(3.0 * (su * su + sv * sv)));
 }
 
 #if BOOTH_HW_FILTER
@@ -299,7 +314,9 @@ void diffuseLight(int i, vec3 p, vec3 nShade, bool relief, inout float eGeo, ino
     if (relief) {
         float cosS = dot(nShade, d);
         if (cosS > 0.0) {
-            e += g * cosS * visibility(vec3(dot(d, uRight), dot(d, uUp), cosG));
+            e += g * cosS *
+                 visibility(vec3(dot(d, uRight), dot(d, uUp), cosG),
+                            lightSoftness(i, d, cosG, d2));
         }
     }
 }

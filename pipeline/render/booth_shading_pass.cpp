@@ -293,7 +293,9 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
 
     glGenBuffers(1, &lightsUbo_);
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
-    glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 4 * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
+    // Per light: position and intensity, then the two spread vectors (booth_shaders.cpp).
+    glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 3 * 4 * sizeof(float), nullptr,
+                 GL_DYNAMIC_DRAW);
     // Blocks a mode does not use are gone from its program: bound where present.
     for (const GLuint p : programs_) {
         if (const GLuint block =
@@ -415,14 +417,20 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     const booth::BoothLight& bl = *pl.light;
     const double a = bl.texelAreaM2();
     lightCount_ = static_cast<int>(std::min<std::size_t>(pl.points.size(), kBoothMaxLights));
-    std::vector<float> packed(static_cast<std::size_t>(kBoothMaxLights) * 4, 0.0f);
+    // The block's three arrays one after another: uLight, uLightSpreadU, uLightSpreadV.
+    const std::size_t block = static_cast<std::size_t>(kBoothMaxLights) * 4;
+    std::vector<float> packed(block * 3, 0.0f);
     for (int i = 0; i < lightCount_; ++i) {
         const booth::PointLight& p = pl.points[static_cast<std::size_t>(i)];
-        const glm::vec3 pos = f3(p.position);
         const std::size_t k = static_cast<std::size_t>(i) * 4;
-        packed[k] = pos.x;
-        packed[k + 1] = pos.y;
-        packed[k + 2] = pos.z;
+        const glm::vec3 pos = f3(p.position);
+        const glm::vec3 su = f3(p.spreadU);
+        const glm::vec3 sv = f3(p.spreadV);
+        for (int c = 0; c < 3; ++c) {
+            packed[k + static_cast<std::size_t>(c)] = pos[c];
+            packed[block + k + static_cast<std::size_t>(c)] = su[c];
+            packed[2 * block + k + static_cast<std::size_t>(c)] = sv[c];
+        }
         packed[k + 3] = static_cast<float>(p.sumCdM2 * a);
     }
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);

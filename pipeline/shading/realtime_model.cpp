@@ -24,6 +24,27 @@ double elevationVisibility(double sinB, double lz, double softness)
     return t * t * (3.0 - 2.0 * t);
 }
 
+// The horizon's softness for one point light: at least 'softness', and wide enough to cover the
+// spread of the ceiling it stands for. Moving the light point by s along the ceiling moves its
+// elevation sine (d.n, d the unit direction) by (s.n - (d.n)(d.s)) / |d|; over the region's
+// spread (its standard deviation along each edge) that is sigma, and a uniform box of standard
+// deviation sigma reaches sqrt(3) sigma either side. With one sharp step per point, a region
+// straddling the relief's horizon went all dark or all lit where the reference sees part of it.
+double lightSoftness(const booth::PointLight& l,
+                     const Vec3& d,
+                     const Vec3& n,
+                     double cosG,
+                     double d2,
+                     double texelAreaM2,
+                     double softness)
+{
+    // The distance floored at a texel, as in eq. (1): a light touching the surface stays finite.
+    const double invDist = 1.0 / std::sqrt(std::max(d2, texelAreaM2));
+    const double su = (glm::dot(l.spreadU, n) - cosG * glm::dot(d, l.spreadU)) * invDist;
+    const double sv = (glm::dot(l.spreadV, n) - cosG * glm::dot(d, l.spreadV)) * invDist;
+    return std::max(softness, std::sqrt(3.0 * (su * su + sv * sv)));
+}
+
 double horizonVisibility(
         const surface::HorizonMap* horizon, int tx, int ty, const Vec3& l, double softness)
 {
@@ -107,7 +128,8 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
             continue;
         }
         const Vec3 lt(glm::dot(d, right), glm::dot(d, up), cosG);
-        const double v = horizonVisibility(horizon, tx, ty, lt, softness);
+        const double v = horizonVisibility(
+                horizon, tx, ty, lt, lightSoftness(l, d, nGeo, cosG, d2, texelAreaM2, softness));
         e += l.sumCdM2 * cosS * cosL / std::max(d2, texelAreaM2) * v;
     }
     return e * texelAreaM2;

@@ -4,9 +4,12 @@
 
 #include <glm/geometric.hpp>
 
+#include <pipeline/base/data_dir.h>
+#include <pipeline/booth/booth_model.h>
 #include <pipeline/reference/frame_error.h>
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/shading/realtime_model.h>
+#include <pipeline/surface/scene.h>
 
 #include <gtest/gtest.h>
 
@@ -80,6 +83,30 @@ TEST(PointLights, HotTexelEqualsThePointSourceFormula)
                                                 brdf::WardModel::WardDur, 0.1, false, nullptr,
                                                 Vec3(1, 0, 0), Vec3(0, 0, -1));
     EXPECT_NEAR(ref.irradiance, expected, 1e-9 * expected);
+}
+
+TEST(PointLights, SpreadIsTheRegionsStandardDeviationAlongEachEdge)
+{
+    // One region over a uniform 12 x 6 image of a 1.0 x 0.5 m ceiling: a uniform box of width W
+    // has standard deviation W / sqrt(12), along edgeU and edgeV.
+    booth::BoothLight light = test::ceilingLight(12, 6, 500.0);
+    const booth::RegionLight all{500.0 * 72, 6.0, 3.0, 0, 0, 12, 6};
+    auto points = booth::pointLights(light, {all});
+    ASSERT_EQ(points.size(), 1u);
+    EXPECT_NEAR(points[0].spreadU.x, 1.0 / std::sqrt(12.0), 1e-12);
+    EXPECT_NEAR(points[0].spreadV.z, 0.5 / std::sqrt(12.0), 1e-12);
+    EXPECT_EQ(points[0].spreadU.y, 0.0);
+    EXPECT_EQ(points[0].spreadV.x, 0.0);
+    // A hot texel inside a dark region: the spread of that texel alone, wherever the region ends.
+    light.luminance = booth::LuminanceImage::filled(12, 6, 0.0);
+    light.luminance.at(7, 2) = 1e6;
+    points = booth::pointLights(light, {booth::RegionLight{1e6, 7.5, 2.5, 4, 0, 12, 6}});
+    EXPECT_NEAR(glm::length(points[0].spreadU), (1.0 / 12) / std::sqrt(12.0), 1e-12);
+    EXPECT_NEAR(glm::length(points[0].spreadV), (0.5 / 6) / std::sqrt(12.0), 1e-12);
+    // A dark region has no spread (and no light).
+    points = booth::pointLights(light, {booth::RegionLight{0.0, 1.0, 4.0, 0, 3, 2, 6}});
+    EXPECT_EQ(glm::length(points[0].spreadU), 0.0);
+    EXPECT_EQ(glm::length(points[0].spreadV), 0.0);
 }
 
 TEST(PointLights, ThirtyTwoLightsAreWithinTheMeasuredErrorOfTheReference)
@@ -194,6 +221,46 @@ TEST(RealtimeModel, BumpySceneWithShadowsIsCloseToTheReference)
     settings.reliefPass = false;
     const auto noRelief = shading::renderRealtime(ps, pl, s.view, test::observer(), settings);
     EXPECT_GT(reference::compareFrames(ref, noRelief).mean, err.mean);
+}
+
+TEST(RealtimeModel, GrazingCeilingSpreadsEachLightsHorizonOverItsRegion)
+{
+    // The shipped painting at a 10-degree tilt: the ceiling grazes the panel and the relief's
+    // horizons cut through the regions the 32 point lights stand for. A sharp horizon test per
+    // point turns a region all dark or all lit where the reference sees part of it; each light's
+    // horizon spread over its region's extent (booth::PointLight::spreadU/V) must do better.
+    auto scene = surface::loadScene(dataDir() / "scenes" / "painting");
+    auto booth = booth::loadBooth(dataDir() / "booth");
+    ASSERT_TRUE(scene && booth);
+    const booth::BoothLight* light = nullptr;
+    for (const auto& l : booth->lights) {
+        light = l.name == "d50-fluorescent" ? &l : light;
+    }
+    ASSERT_NE(light, nullptr);
+    shading::View view;
+    view.panel = shading::panelPoseFromTilt(10.0);
+    view.pixelsX = 32;
+    view.pixelsY = 20;
+    const auto ref = reference::renderReference(*scene, *light, view, test::observer());
+    shading::RenderSettings settings;
+    settings.specularSamples = shading::defaultSpecularSamples(*scene);
+    const auto ps = shading::prepareScene(*scene, settings.horizonDirections);
+    auto pl = shading::prepareLight(*light, test::observer(), settings.lights);
+    const auto spread = shading::renderRealtime(ps, pl, view, test::observer(), settings);
+    for (auto& p : pl.points) {
+        EXPECT_GT(glm::length(p.spreadU) + glm::length(p.spreadV), 0.0);
+        p.spreadU = Vec3(0.0);
+        p.spreadV = Vec3(0.0);
+    }
+    const auto sharp = shading::renderRealtime(ps, pl, view, test::observer(), settings);
+    const auto withSpread = reference::compareFrames(ref, spread);
+    const auto withoutSpread = reference::compareFrames(ref, sharp);
+    // Measured: max 4.63 -> 4.41 on this 32 x 20 frame (on 64 x 40, 4.72 -> 3.07: the worst
+    // pixels there are the ones a region straddling the horizon darkened); p95 and mean no worse.
+    EXPECT_LT(withSpread.max, withoutSpread.max - 0.1)
+            << "max " << withSpread.max << " against " << withoutSpread.max;
+    EXPECT_LE(withSpread.p95, withoutSpread.p95);
+    EXPECT_LE(withSpread.mean, withoutSpread.mean);
 }
 
 TEST(RealtimeModel, BumpyGlossySceneWithShadowsIsCloseToTheReference)
