@@ -40,7 +40,7 @@ struct RunConfig {
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
     int boothLights = 32;    // median-cut point lights
     // Specular samples per pixel or grid node; kAutoSpecularSamples: shading::
-    // defaultSpecularSamples for the scene (8 on relief, 12 on a flat surface), chosen when the
+    // defaultSpecularSamples for the scene (8 on relief, 24 on a flat surface), chosen when the
     // appliance is built and recorded as chosen. Recordings made before hold the count they used.
     int specularSamples = kAutoSpecularSamples;
     // Texels between the specular grid's nodes (shading::RenderSettings::specularGrid); 0: per

@@ -272,7 +272,7 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
             ->check(CLI::Range(1, 4096));
     cmd->add_option("--samples", args->samples,
                     "specular FIS samples per pixel (or grid node); -1: as the appliance chooses "
-                    "(8 on relief, 12 on a flat surface)")
+                    "(8 on relief, 24 on a flat surface)")
             ->capture_default_str()
             ->check(CLI::Range(kAutoSpecularSamples, 1024) & !CLI::IsMember({0}));
     cmd->add_option("--specular-grid", args->specularGrid,

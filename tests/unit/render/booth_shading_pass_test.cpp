@@ -274,6 +274,36 @@ TEST_F(BoothPassTest, ReliefDefaultSampleCountMeetsTheErrorBudgetAgainstTheRefer
     expectBudgetUnderEveryLight(scene, settings, v);
 }
 
+TEST_F(BoothPassTest, FlatDefaultSampleCountMeetsTheBudgetWhereTheTubesAlias)
+{
+    // The ColorChecker leaning back 50 degrees under the d50 tubes, seen from the centre and
+    // from the left: there the tubes' reflection aliases against the sample pattern, and the
+    // 12 samples that met the budget from the sweep's one view reached p95 1.07-1.09 on the
+    // 64x40 frame (replica_bench_render --views; 16 samples 1.29). The default, on the grid the
+    // appliance shades it on, must meet the budget from both eyes: measured p95 0.63 / 0.75 at
+    // 24 samples on this 32x20 frame, 1.005 / 1.015 at 12.
+    const auto& scene = scenes_.at("colorchecker");
+    const auto& light = booth_->lights[1];
+    ASSERT_EQ(light.name, "d50-fluorescent");
+    shading::RenderSettings settings;
+    settings.specularSamples = shading::defaultSpecularSamples(scene);
+    settings.specularGrid = shading::defaultSpecularGrid(scene);
+    settings.diffuseGrid = shading::defaultDiffuseGrid(scene);
+    const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, *basis_);
+    auto pass = BoothShadingPass::create(ps, settings, *obs_);
+    ASSERT_TRUE(pass) << pass.error().message;
+    const auto pl = shading::prepareLight(light, *obs_, settings.lights, *basis_);
+    ASSERT_TRUE((*pass)->setLight(pl));
+    for (const shading::Vec3 eye :
+         {shading::Vec3(0.0, 0.45, 0.60), shading::Vec3(-0.30, 0.40, 0.55)}) {
+        shading::View v = view(32, 20, 50.0);
+        v.eye = eye;
+        const auto e = errorAgainstReference(**pass, pl, scene, light, v);
+        EXPECT_LE(e.p95, 1.0) << "eye x " << eye.x;
+        EXPECT_LE(e.max, 3.0) << "eye x " << eye.x;
+    }
+}
+
 TEST_F(BoothPassTest, PlannedSettingMeetsTheErrorBudgetAgainstTheReference)
 {
     // The budget: dE00 95th <= 1, max <= 3. The settings are what shading::planRender
