@@ -63,6 +63,9 @@ struct RunConfig {
     double specularLodBias = pipeline::shading::kDefaultSpecularLodBias;
     // shading::RenderSettings::specularNearestLevel; recordings made before it replay trilinear.
     bool specularNearestLevel = true;
+    // shading::RenderSettings::horizonSpread; recordings made before it have none and replay
+    // with one fixed horizon softness, bit for bit.
+    bool horizonSpread = true;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

@@ -424,8 +424,9 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
         const booth::PointLight& p = pl.points[static_cast<std::size_t>(i)];
         const std::size_t k = static_cast<std::size_t>(i) * 4;
         const glm::vec3 pos = f3(p.position);
-        const glm::vec3 su = f3(p.spreadU);
-        const glm::vec3 sv = f3(p.spreadV);
+        // Zero spreads leave every light's softness at uSoftness: the frames before the spread.
+        const glm::vec3 su = settings_.horizonSpread ? f3(p.spreadU) : glm::vec3(0.0f);
+        const glm::vec3 sv = settings_.horizonSpread ? f3(p.spreadV) : glm::vec3(0.0f);
         for (int c = 0; c < 3; ++c) {
             packed[k + static_cast<std::size_t>(c)] = pos[c];
             packed[block + k + static_cast<std::size_t>(c)] = su[c];

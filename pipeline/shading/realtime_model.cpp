@@ -272,6 +272,16 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();
     const double a = bl.texelAreaM2();
+    // Without the horizon spread every light's spread is zero: its softness is horizonSoftness.
+    std::vector<booth::PointLight> sharp;
+    if (!settings.horizonSpread) {
+        sharp = light.points;
+        for (booth::PointLight& p : sharp) {
+            p.spreadU = Vec3(0.0);
+            p.spreadV = Vec3(0.0);
+        }
+    }
+    const std::vector<booth::PointLight>& points = settings.horizonSpread ? light.points : sharp;
     const colour::Xyz specXyz = colour::spectrumToXyz(obs, scene.rhoS * light.unitSpd);
     const int threads = std::clamp(settings.threads, 1, std::max(frame.height, 1));
     // Rows [0, rows) split over the threads: f(thread, first row, end row).
@@ -329,9 +339,8 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                     const ShadingPoint sp = shadingPointAt(
                             view, scene, normals, static_cast<double>(i) / (diffuseNodes.x - 1),
                             static_cast<double>(j) / (diffuseNodes.y - 1));
-                    const double e =
-                            pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo,
-                                                 nullptr, 0, 0, sp.right, sp.up, 0.0);
+                    const double e = pointLightIrradiance(points, nl, a, sp.p, sp.nGeo, sp.nGeo,
+                                                          nullptr, 0, 0, sp.right, sp.up, 0.0);
                     diffuseGrid[static_cast<std::size_t>(j) *
                                         static_cast<std::size_t>(diffuseNodes.x) +
                                 static_cast<std::size_t>(i)] = std::isfinite(e) ? e : 0.0;
@@ -354,11 +363,11 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                         diffuseNodes.x > 0
                                 ? gridValue(diffuseGrid, diffuseNodes, (px + 0.5) / view.pixelsX,
                                             (py + 0.5) / view.pixelsY)
-                                : pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nGeo,
+                                : pointLightIrradiance(points, nl, a, sp.p, sp.nGeo, sp.nGeo,
                                                        nullptr, 0, 0, sp.right, sp.up, 0.0);
                 double e = eGeo;
                 if (relief) {
-                    e = pointLightIrradiance(light.points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon,
+                    e = pointLightIrradiance(points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon,
                                              sp.tx, sp.ty, sp.right, sp.up,
                                              settings.horizonSoftness);
                 }

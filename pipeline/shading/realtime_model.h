@@ -53,6 +53,10 @@ struct RenderSettings {
     bool specularPass = true;      // ignored (skipped) for a matte scene
     bool reliefPass = true;        // normal map + horizon; ignored for a flat scene
     double horizonSoftness = 0.02; // half-width of the smoothstep in sin(elevation)
+    // Widen each point light's horizon smoothstep to the spread of its ceiling region
+    // (booth::PointLight::spreadU/V; pointLightIrradiance). Off: every light uses
+    // horizonSoftness alone, as before 2026-12-02 (recordings made before replay so).
+    bool horizonSpread = true;
     // Subtract the screen's front-surface flare here (the GL pass only: the CPU model always does).
     // The appliance turns it off when its display pass subtracts the flare instead, so that the
     // reflection is never subtracted twice.

@@ -149,6 +149,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_EQ(o->specularLodBias, shading::kLegacySpecularLodBias);
     EXPECT_FALSE(o->specularNearestLevel);
     EXPECT_TRUE(c.specularNearestLevel);
+    // And before each light's horizon was spread over its region: one fixed softness.
+    EXPECT_FALSE(o->horizonSpread);
+    EXPECT_TRUE(c.horizonSpread);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -157,8 +160,12 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     c.specularGrid = 8;
     c.diffuseGrid = 5;
     c.specularLodBias = 0.25;
+    c.horizonSpread = false;
     auto round = platform::RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(round);
+    EXPECT_FALSE(round->horizonSpread);
+    c.horizonSpread = true;
+    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonSpread);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);

@@ -240,6 +240,21 @@ TEST_F(BoothPassTest, DiffuseGridMatchesTheCpuModel)
     }
 }
 
+TEST_F(BoothPassTest, HorizonSpreadOnAndOffMatchesTheCpuModel)
+{
+    // Each light's horizon spread over its region (on: the appliance; off: what recordings made
+    // before it replay with) in the GL pass against the CPU model, on the painting at a
+    // 10-degree tilt, where the ceiling grazes the panel and the spread matters most.
+    const shading::View v = view(64, 40, 10.0);
+    for (const bool spread : {true, false}) {
+        shading::RenderSettings settings;
+        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        settings.horizonSpread = spread;
+        expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
+                                 spread ? "spread" : "no spread");
+    }
+}
+
 TEST_F(BoothPassTest, FlatSpecularGridMeetsTheErrorBudgetAgainstTheReference)
 {
     // What the appliance runs on the ColorChecker: the default setting with the specular term
