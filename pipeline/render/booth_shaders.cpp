@@ -352,9 +352,6 @@ float gridValue(sampler2D grid, ivec2 nodes, float u, float v) {
     float s11 = texelFetch(grid, c + ivec2(1, 1), 0).r;
     return (1.0 - a.y) * ((1.0 - a.x) * s00 + a.x * s10) + a.y * ((1.0 - a.x) * s01 + a.x * s11);
 }
-float gridSpecular(float u, float v) {
-    return gridValue(uSpecGrid, uGridNodes, u, v);
-}
 
 void main() {
     float u;
@@ -497,7 +494,7 @@ void main() {
     float eGeo = cached.a;
     if (kGrid) {
         if (inside) {
-            xyz += uSpecXyz * gridSpecular(u, v);
+            xyz += uSpecXyz * gridValue(uSpecGrid, uGridNodes, u, v);
         }
     } else if (inside && uSpecSamples > 0) {
         vec3 toEye = uEye - p;

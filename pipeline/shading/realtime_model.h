@@ -155,8 +155,8 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
 
 // Diffuse illuminance from point lights (eq. 1): both cosines clamped at 0, 1/d^2 clamped at one
 // texel area; vis(light direction) in [0, 1] multiplies each light: a smoothstep across the
-// relief's horizon, half as wide as 'softness' or as sqrt(3) times the spread of the light's
-// elevation over its ceiling region (booth::PointLight::spreadU/V), whichever is wider.
+// relief's horizon whose half-width is 'softness' or sqrt(3) times the spread of the light's
+// elevation sine over its ceiling region (booth::PointLight::spreadU/V), whichever is wider.
 double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             const Vec3& lightNormal,
                             double texelAreaM2,
