@@ -66,6 +66,9 @@ struct RunConfig {
     // shading::RenderSettings::horizonSpread; recordings made before it have none and replay
     // with one fixed horizon softness, bit for bit.
     bool horizonSpread = true;
+    // shading::RenderSettings::horizonHalf; recordings made before it have none and replay with
+    // float horizon sines, bit for bit.
+    bool horizonHalf = true;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

@@ -27,7 +27,13 @@ uniform vec3 uEye;
 uniform sampler2D uCoeffA;      // channels 0..2 per texel (row 0 = top row of the scene)
 uniform sampler2D uCoeffB;      // channels 3..5
 uniform sampler2D uNormals;     // tangent-space normal per texel
-uniform sampler2DArray uHorizon; // sin(horizon elevation), 4 directions per layer
+// sin(horizon elevation): 4 directions a layer, or with BOOTH_HORIZON_HALF 8 a layer as half
+// floats, two a word (booth_shading_pass.cpp horizonTexture; RenderSettings::horizonHalf).
+#if BOOTH_HORIZON_HALF
+uniform highp usampler2DArray uHorizon;
+#else
+uniform sampler2DArray uHorizon;
+#endif
 const bool uRelief = BOOTH_RELIEF != 0; // normal map and horizons (fixed for the pass's life)
 // Horizon directions (0: no horizon shadowing), specular samples (0: no specular pass) and the
 // Ward model (0 Ward 1992, 1 Ward-Duer, 2 Ward-Duer guarded, 3 GMD) are fixed for the pass's life
@@ -97,7 +103,7 @@ uniform float uLodBias;         // RenderSettings::specularLodBias
 const float kPi = 3.14159265358979;
 const float kMinCosView = 1e-3;
 
-float hz[BOOTH_HORIZON_SLOTS];  // 4 a layer, at least one layer
+float hz[BOOTH_HORIZON_SLOTS];  // a whole number of layers, at least one
 
 // surface::HorizonMap::sinHorizon: the horizon sine at the azimuth of l (tangent frame).
 float horizonSine(vec3 l) {
@@ -387,14 +393,24 @@ void main() {
         outFacet = vec4(nl, 0.0);
 #endif
         nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
-        int layers = (uHorizonDirs + 3) / 4;
-        for (int j = 0; j < layers; ++j) {
+#if BOOTH_HORIZON_HALF
+        for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {
+            uvec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
+            for (int w = 0; w < 4; ++w) {
+                vec2 pair = unpackHalf2x16(b[w]);
+                hz[8 * j + 2 * w] = pair.x;
+                hz[8 * j + 2 * w + 1] = pair.y;
+            }
+        }
+#else
+        for (int j = 0; j < (uHorizonDirs + 3) / 4; ++j) {
             vec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
             hz[4 * j] = b.x;
             hz[4 * j + 1] = b.y;
             hz[4 * j + 2] = b.z;
             hz[4 * j + 3] = b.w;
         }
+#endif
     }
 
     if (uMode == 2) {

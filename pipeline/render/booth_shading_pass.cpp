@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <numbers>
 #include <string>
@@ -9,6 +10,7 @@
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
+#include <glm/gtc/packing.hpp>
 
 #include <pipeline/brdf/ward.h>
 #include <pipeline/render/booth_shaders.h>
@@ -75,6 +77,47 @@ nodeTarget(shading::GridNodes nodes, GLint unit, const char* grid, GLuint& textu
                                      grid));
     }
     return {};
+}
+
+// The horizon map as a 2-D array texture: directions [4j, 4j + 4) in layer j of an RGBA32F array,
+// or with 'half' [8j, 8j + 8) as half floats in layer j of an RGBA32UI array (packHalf2x16's
+// layout: direction 2i in the low 16 bits of word i). 'dirs' 0: one empty texel.
+GLuint horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
+{
+    const int perLayer = half ? 8 : 4;
+    const int layers = std::max((dirs + perLayer - 1) / perLayer, 1);
+    const int w = dirs > 0 ? map.width : 1;
+    const int h = dirs > 0 ? map.height : 1;
+    const auto texels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+    const auto k = static_cast<std::size_t>(dirs);
+    std::vector<float> sines(texels * 4 * static_cast<std::size_t>(layers), 0.0f);
+    std::vector<std::uint32_t> words(half ? sines.size() : 0, 0u);
+    for (std::size_t i = 0; i < texels && k > 0; ++i) {
+        for (std::size_t d = 0; d < k; ++d) {
+            const float sinB = map.sinBeta[i * k + d];
+            if (half) {
+                const std::size_t word = ((d / 8) * texels + i) * 4 + (d % 8) / 2;
+                words[word] |= static_cast<std::uint32_t>(glm::packHalf1x16(sinB))
+                               << (d % 2 == 0 ? 0 : 16);
+            } else {
+                sines[((d / 4) * texels + i) * 4 + d % 4] = sinB;
+            }
+        }
+    }
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, half ? GL_RGBA32UI : GL_RGBA32F, w, h, layers);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    if (half) {
+        glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, layers, GL_RGBA_INTEGER,
+                        GL_UNSIGNED_INT, words.data());
+    } else {
+        glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, layers, GL_RGBA, GL_FLOAT,
+                        sines.data());
+    }
+    nearest(GL_TEXTURE_2D_ARRAY);
+    return tex;
 }
 
 glm::vec3 f3(const glm::dvec3& v)
@@ -216,7 +259,9 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                          fmt::format("render: {} specular samples; the GL pass takes at most {}",
                                      samples, kBoothMaxSpecularSamples));
     }
-    const int layers = std::max((horizonDirs_ + 3) / 4, 1);
+    // Horizon sines a layer of the horizon texture (horizonTexture) and layers.
+    const int perLayer = settings_.horizonHalf ? 8 : 4;
+    const int layers = std::max((horizonDirs_ + perLayer - 1) / perLayer, 1);
     // booth_shaders.cpp eq. (1) on a flat surface: one LIGHT_AT per light up to
     // kBoothUnrolledLights, a loop for any beyond. Not on relief: there each light's horizon test
     // is large, and 32 copies of it took LLVM seconds to compile (a test's pass 2 -> 16 s) for no
@@ -236,12 +281,12 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n"
                             "#define BOOTH_NEAREST_LEVEL {}\n#define BOOTH_FACET_CACHE {}\n"
                             "#define BOOTH_LIGHT_CALLS{}\n"
-                            "#define BOOTH_UNROLLED_LIGHTS {}\n",
+                            "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_HORIZON_HALF {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
                             diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
-                            4 * layers, samples, wardModelIndex(s.model),
+                            perLayer * layers, samples, wardModelIndex(s.model),
                             settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0, lightCalls,
-                            unrolledLights) +
+                            unrolledLights, settings_.horizonHalf ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -271,25 +316,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     normals_ = relief_ ? texture2d(GL_RGB32F, GL_RGB, s.width, s.height, n.data())
                        : texture2d(GL_RGB32F, GL_RGB, 1, 1, n.data());
 
-    // Horizon map: four directions per layer of an RGBA32F array.
-    const int hw = horizonDirs_ > 0 ? s.width : 1;
-    const int hh = horizonDirs_ > 0 ? s.height : 1;
-    std::vector<float> hz(static_cast<std::size_t>(hw) * hh * 4 * layers, 0.0f);
-    if (horizonDirs_ > 0) {
-        const auto k = static_cast<std::size_t>(horizonDirs_);
-        for (std::size_t i = 0; i < texels; ++i) {
-            for (std::size_t d = 0; d < k; ++d) {
-                const std::size_t layer = d / 4;
-                hz[(layer * texels + i) * 4 + d % 4] = ps.horizon.sinBeta[i * k + d];
-            }
-        }
-    }
-    glGenTextures(1, &horizon_);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, horizon_);
-    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, hw, hh, layers);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, hw, hh, layers, GL_RGBA, GL_FLOAT, hz.data());
-    nearest(GL_TEXTURE_2D_ARRAY);
+    horizon_ = horizonTexture(ps.horizon, horizonDirs_, settings_.horizonHalf);
 
     glGenBuffers(1, &lightsUbo_);
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);

@@ -267,8 +267,14 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     const bool specular = settings.specularPass && scene.glossy();
     const std::vector<Vec3> none;
     const std::vector<Vec3>& normals = relief ? ps.normals : none;
-    const surface::HorizonMap* horizon =
-            relief && settings.horizonDirections > 0 ? &ps.horizon : nullptr;
+    // The GL pass's half-float horizons (RenderSettings::horizonHalf): the same rounded sines here.
+    const surface::HorizonMap half = relief && settings.horizonHalf
+                                             ? surface::halfPrecision(ps.horizon)
+                                             : surface::HorizonMap{};
+    const surface::HorizonMap* horizon = nullptr;
+    if (relief && settings.horizonDirections > 0) {
+        horizon = settings.horizonHalf ? &half : &ps.horizon;
+    }
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();
     const double a = bl.texelAreaM2();

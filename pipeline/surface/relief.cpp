@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <glm/gtc/packing.hpp>
+
 #include <pipeline/surface/relief.h>
 
 namespace replica::pipeline::surface {
@@ -100,6 +102,15 @@ HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM)
         }
     }
     return map;
+}
+
+HorizonMap halfPrecision(const HorizonMap& map)
+{
+    HorizonMap half = map;
+    for (float& s : half.sinBeta) {
+        s = glm::unpackHalf1x16(glm::packHalf1x16(s));
+    }
+    return half;
 }
 
 double HorizonMap::sinHorizon(int x, int y, const Vec3& l) const

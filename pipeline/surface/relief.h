@@ -43,6 +43,11 @@ struct HorizonMap {
 
 HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM);
 
+// The map with every sine rounded to the nearest half float (IEEE binary16, ties away from zero):
+// within 2^-12 of the float, and exactly what the GL pass stores when it packs eight directions
+// into one texel (shading::RenderSettings::horizonHalf), so that the CPU model reads the same.
+HorizonMap halfPrecision(const HorizonMap& map);
+
 // The exact horizon at a fractional texel position and azimuth, by marching the bilinear height
 // field in steps of half a pitch: what the reference uses.
 double exactSinHorizon(const HeightField& h, double x, double y, double phi, double maxDistanceM);

@@ -152,6 +152,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // And before each light's horizon was spread over its region: one fixed softness.
     EXPECT_FALSE(o->horizonSpread);
     EXPECT_TRUE(c.horizonSpread);
+    // And before the horizon sines were stored as half floats: floats.
+    EXPECT_FALSE(o->horizonHalf);
+    EXPECT_TRUE(c.horizonHalf);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -166,6 +169,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_FALSE(round->horizonSpread);
     c.horizonSpread = true;
     EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonSpread);
+    c.horizonHalf = false;
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->horizonHalf);
+    c.horizonHalf = true;
+    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonHalf);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);

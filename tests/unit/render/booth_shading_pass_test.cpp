@@ -262,6 +262,21 @@ TEST_F(BoothPassTest, HorizonSpreadOnAndOffMatchesTheCpuModel)
     }
 }
 
+TEST_F(BoothPassTest, HalfAndFloatHorizonsMatchTheCpuModel)
+{
+    // The horizon sines packed as half floats, eight a texel (the appliance), and as floats, four
+    // a texel (what recordings made before replay with), in the GL pass against the CPU model
+    // with the same setting; on the painting at a 10-degree tilt, where the horizons shadow most.
+    const shading::View v = view(64, 40, 10.0);
+    for (const bool half : {true, false}) {
+        shading::RenderSettings settings;
+        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        settings.horizonHalf = half;
+        expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
+                                 half ? "half horizons" : "float horizons");
+    }
+}
+
 TEST_F(BoothPassTest, FlatSpecularGridMeetsTheErrorBudgetAgainstTheReference)
 {
     // What the appliance runs on the ColorChecker: the default setting with the specular term

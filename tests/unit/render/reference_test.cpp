@@ -271,6 +271,41 @@ TEST(RealtimeModel, GrazingCeilingSpreadsEachLightsHorizonOverItsRegion)
     EXPECT_LE(withSpread.mean, withoutSpread.mean);
 }
 
+TEST(RealtimeModel, HalfHorizonsAreTheRoundedMapAndMoveTheFrameByLittle)
+{
+    // RenderSettings::horizonHalf reads the horizon map rounded to half floats: exactly the
+    // frame of a float map rounded beforehand, and within a hundredth of ΔE00 of the float frame
+    // (a sine moves by 2^-12 at most, against a smoothstep 0.04 wide; measured: max 0.0008).
+    auto scene = surface::loadScene(dataDir() / "scenes" / "painting");
+    auto booth = booth::loadBooth(dataDir() / "booth");
+    ASSERT_TRUE(scene && booth);
+    const booth::BoothLight& light = booth->lights.front();
+    shading::View view;
+    view.panel = shading::panelPoseFromTilt(10.0);
+    view.pixelsX = 32;
+    view.pixelsY = 20;
+    shading::RenderSettings settings;
+    settings.specularSamples = shading::defaultSpecularSamples(*scene);
+    auto ps = shading::prepareScene(*scene, settings.horizonDirections);
+    const auto pl = shading::prepareLight(light, test::observer(), settings.lights);
+    settings.horizonHalf = false;
+    const auto full = shading::renderRealtime(ps, pl, view, test::observer(), settings);
+    settings.horizonHalf = true;
+    const auto half = shading::renderRealtime(ps, pl, view, test::observer(), settings);
+    ps.horizon = surface::halfPrecision(ps.horizon);
+    settings.horizonHalf = false;
+    const auto rounded = shading::renderRealtime(ps, pl, view, test::observer(), settings);
+    ASSERT_EQ(half.xyz.size(), rounded.xyz.size());
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < half.xyz.size(); ++i) {
+        ASSERT_EQ(half.xyz[i], rounded.xyz[i]) << "pixel " << i;
+        moved += half.xyz[i] != full.xyz[i] ? 1 : 0;
+    }
+    EXPECT_GT(moved, 0u); // the rounding reaches the frame: the setting is not a no-op
+    const auto e = reference::compareFrames(full, half);
+    EXPECT_LT(e.max, 0.01) << "mean " << e.mean << " p95 " << e.p95;
+}
+
 TEST(RealtimeModel, BumpyGlossySceneWithShadowsIsCloseToTheReference)
 {
     // The reference tests every texel's direction against the horizon; the model shadows each

@@ -65,6 +65,29 @@ TEST(HorizonMap, FlatFieldHasZeroHorizonsEverywhere)
     }
 }
 
+TEST(HorizonMap, HalfPrecisionRoundsEachSineToTheNearestHalfFloat)
+{
+    HorizonMap m;
+    m.width = 2;
+    m.height = 1;
+    m.directions = 4;
+    // 0.1: binary16 0x2E66 = 1638 / 16384; 0.5 and 0 are exact; 0.999: nearest 2046 / 2048;
+    // 1/3: 0x3555 = 1365 / 4096; 1e-5: a subnormal half, 168 / 2^24.
+    m.sinBeta = {0.1f, 0.5f, 0.0f, 0.999f, 1.0f / 3.0f, 1e-5f, 0.75f, 0.2f};
+    const HorizonMap h = halfPrecision(m);
+    ASSERT_EQ(h.sinBeta.size(), m.sinBeta.size());
+    EXPECT_EQ(h.directions, 4);
+    EXPECT_EQ(h.sinBeta[0], 1638.0f / 16384.0f);
+    EXPECT_EQ(h.sinBeta[1], 0.5f);
+    EXPECT_EQ(h.sinBeta[2], 0.0f);
+    EXPECT_EQ(h.sinBeta[3], 2046.0f / 2048.0f);
+    EXPECT_EQ(h.sinBeta[4], 1365.0f / 4096.0f);
+    EXPECT_EQ(h.sinBeta[5], 168.0f / 16777216.0f);
+    for (std::size_t i = 0; i < m.sinBeta.size(); ++i) {
+        EXPECT_LE(std::abs(h.sinBeta[i] - m.sinBeta[i]), 1.0f / 4096.0f) << i;
+    }
+}
+
 TEST(HorizonMap, WallGivesItsElevationInItsDirectionOnly)
 {
     // A 2 mm wall 5 mm to the right (+x) of the texel: sin(atan(2/5)) towards +x, nothing towards
