@@ -37,6 +37,7 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
     mcap::ScanOptions options;
     options.resync = true;
     options.maxDamageReports = 50;
+    options.chunkedOnly = true; // the writer chunks every record that carries samples
     // Replica's channel ids are fixed per format version: a file whose first chunk (the channel
     // definitions) was lost can still have its samples recovered.
     // Format 3 only added channel 7, so its definitions serve format 2 files as well.

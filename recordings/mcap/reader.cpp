@@ -116,6 +116,18 @@ public:
             case Op::Schema:
             case Op::Channel:
             case Op::Message:
+                if (o_.chunkedOnly) {
+                    // Damage, not a sample (so not counted as a dropped message); its bounds
+                    // looked sane: skip it whole and go on.
+                    problem(fmt::format("{} record at byte {} outside every chunk, where no CRC "
+                                        "covers it: skipped",
+                                        op == static_cast<std::uint8_t>(Op::Message)  ? "Message"
+                                        : op == static_cast<std::uint8_t>(Op::Schema) ? "Schema"
+                                                                                      : "Channel",
+                                        at));
+                    s_.bytesSkipped += next - at;
+                    break;
+                }
                 ok = inner(static_cast<Op>(op), content, at);
                 break;
             case Op::Chunk:

@@ -22,6 +22,12 @@ struct ScanOptions {
     // when the chunk that defined them was lost (recover knows each format's fixed channels).
     std::map<std::uint16_t, Channel> fallbackChannels;
     std::map<std::uint16_t, Schema> fallbackSchemas;
+    // Trust Schema, Channel and Message records only inside a chunk, where a CRC covers them
+    // (recover: Replica's writer puts every one in a chunk). A record of those kinds in the data
+    // section itself is reported and skipped: one flipped bit turns a Message Index (opcode 0x07)
+    // into a Message (0x05) whose payload is the index's bytes, and nothing checks it before the
+    // Data End record's CRC, which covers the whole section and so cannot say which record broke.
+    bool chunkedOnly = false;
 };
 
 struct ChunkSpan {
