@@ -55,6 +55,7 @@ std::string RunConfig::toJson() const
                      {"specular_nearest_level", specularNearestLevel},
                      {"horizon_spread", horizonSpread},
                      {"horizon_half", horizonHalf},
+                     {"horizon_bilinear", horizonBilinear},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -96,6 +97,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularNearestLevel = j.value("specular_nearest_level", false);
         c.horizonSpread = j.value("horizon_spread", false);
         c.horizonHalf = j.value("horizon_half", false);
+        c.horizonBilinear = j.value("horizon_bilinear", false);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
@@ -232,6 +234,7 @@ makeBoothScene(RunConfig& config,
     setup.settings.horizonDirections = config.horizonDirections;
     setup.settings.horizonSpread = config.horizonSpread;
     setup.settings.horizonHalf = config.horizonHalf;
+    setup.settings.horizonBilinear = config.horizonBilinear;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     setup.settings.subtractFlare = !config.flareSubtraction;
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));

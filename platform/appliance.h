@@ -69,6 +69,9 @@ struct RunConfig {
     // shading::RenderSettings::horizonHalf; recordings made before it have none and replay with
     // float horizon sines, bit for bit.
     bool horizonHalf = true;
+    // shading::RenderSettings::horizonBilinear; recordings made before it have none and replay
+    // with each texel's own horizon, bit for bit.
+    bool horizonBilinear = true;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

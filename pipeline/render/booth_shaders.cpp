@@ -105,6 +105,50 @@ const float kMinCosView = 1e-3;
 
 float hz[BOOTH_HORIZON_SLOTS];  // a whole number of layers, at least one
 
+#if BOOTH_HORIZON_BILINEAR && BOOTH_MODE == 0
+// Adds w times texel t's horizon sines to hz (horizonTexture's layout).
+void addHorizons(ivec2 t, float w) {
+#if BOOTH_HORIZON_HALF
+    for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {
+        uvec4 b = texelFetch(uHorizon, ivec3(t, j), 0);
+        for (int q = 0; q < 4; ++q) {
+            vec2 pair = unpackHalf2x16(b[q]);
+            hz[8 * j + 2 * q] += w * pair.x;
+            hz[8 * j + 2 * q + 1] += w * pair.y;
+        }
+    }
+#else
+    for (int j = 0; j < (uHorizonDirs + 3) / 4; ++j) {
+        vec4 b = texelFetch(uHorizon, ivec3(t, j), 0);
+        hz[4 * j] += w * b.x;
+        hz[4 * j + 1] += w * b.y;
+        hz[4 * j + 2] += w * b.z;
+        hz[4 * j + 3] += w * b.w;
+    }
+#endif
+}
+
+// surface::HorizonMap::sinHorizonBilinear's four texels and weights at texel position (x, y),
+// summed into hz (the azimuth interpolation after it is linear too: the same sine).
+void bilinearHorizons(float x, float y) {
+    for (int k = 0; k < BOOTH_HORIZON_SLOTS; ++k) {
+        hz[k] = 0.0;
+    }
+    float fx = x - 0.5;
+    float fy = y - 0.5;
+    float x0 = floor(fx);
+    float y0 = floor(fy);
+    float ax = fx - x0;
+    float ay = fy - y0;
+    ivec2 c = ivec2(int(x0), int(y0));
+    ivec2 hi = uTexels - 1;
+    addHorizons(clamp(c, ivec2(0), hi), (1.0 - ax) * (1.0 - ay));
+    addHorizons(clamp(c + ivec2(1, 0), ivec2(0), hi), ax * (1.0 - ay));
+    addHorizons(clamp(c + ivec2(0, 1), ivec2(0), hi), (1.0 - ax) * ay);
+    addHorizons(clamp(c + ivec2(1, 1), ivec2(0), hi), ax * ay);
+}
+#endif
+
 // surface::HorizonMap::sinHorizon: the horizon sine at the azimuth of l (tangent frame).
 float horizonSine(vec3 l) {
     float phi = (abs(l.x) > 0.0 || abs(l.y) > 0.0) ? atan(l.y, l.x) : 0.0;
@@ -393,7 +437,11 @@ void main() {
         outFacet = vec4(nl, 0.0);
 #endif
         nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
-#if BOOTH_HORIZON_HALF
+#if BOOTH_HORIZON_BILINEAR && BOOTH_MODE == 0
+        // Eq. (1)'s horizons at this point (RenderSettings::horizonBilinear); the compose's lobe
+        // reads the texel's below.
+        bilinearHorizons(texX, texY);
+#elif BOOTH_HORIZON_HALF
         for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {
             uvec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
             for (int w = 0; w < 4; ++w) {

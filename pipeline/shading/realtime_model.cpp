@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <thread>
 
 #include <glm/geometric.hpp>
@@ -45,13 +46,19 @@ double lightSoftness(const booth::PointLight& l,
     return std::max(softness, std::sqrt(3.0 * (su * su + sv * sv)));
 }
 
-double horizonVisibility(
-        const surface::HorizonMap* horizon, int tx, int ty, const Vec3& l, double softness)
+double horizonVisibility(const surface::HorizonMap* horizon,
+                         int tx,
+                         int ty,
+                         const std::optional<glm::dvec2>& at,
+                         const Vec3& l,
+                         double softness)
 {
     if (horizon == nullptr || horizon->directions <= 0) {
         return 1.0;
     }
-    return elevationVisibility(horizon->sinHorizon(tx, ty, l), l.z, softness);
+    const double sinB =
+            at ? horizon->sinHorizonBilinear(at->x, at->y, l) : horizon->sinHorizon(tx, ty, l);
+    return elevationVisibility(sinB, l.z, softness);
 }
 
 } // namespace
@@ -111,7 +118,8 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             int ty,
                             const Vec3& right,
                             const Vec3& up,
-                            double softness)
+                            double softness,
+                            const std::optional<glm::dvec2>& bilinearAt)
 {
     double e = 0.0;
     for (const booth::PointLight& l : lights) {
@@ -128,8 +136,9 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
             continue;
         }
         const Vec3 lt(glm::dot(d, right), glm::dot(d, up), cosG);
-        const double v = horizonVisibility(
-                horizon, tx, ty, lt, lightSoftness(l, d, nGeo, cosG, d2, texelAreaM2, softness));
+        const double v =
+                horizonVisibility(horizon, tx, ty, bilinearAt, lt,
+                                  lightSoftness(l, d, nGeo, cosG, d2, texelAreaM2, softness));
         e += l.sumCdM2 * cosS * cosL / std::max(d2, texelAreaM2) * v;
     }
     return e * texelAreaM2;
@@ -373,9 +382,11 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                                                        nullptr, 0, 0, sp.right, sp.up, 0.0);
                 double e = eGeo;
                 if (relief) {
-                    e = pointLightIrradiance(points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon,
-                                             sp.tx, sp.ty, sp.right, sp.up,
-                                             settings.horizonSoftness);
+                    e = pointLightIrradiance(
+                            points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon, sp.tx, sp.ty,
+                            sp.right, sp.up, settings.horizonSoftness,
+                            settings.horizonBilinear ? std::optional<glm::dvec2>({sp.texX, sp.texY})
+                                                     : std::nullopt);
                 }
                 if (!settings.diffusePass) {
                     e = 0.0;

@@ -5,7 +5,10 @@
 // sweep measures against the reference.
 #pragma once
 
+#include <optional>
 #include <vector>
+
+#include <glm/vec2.hpp>
 
 #include <pipeline/booth/booth_light.h>
 #include <pipeline/booth/luminance_image.h>
@@ -62,6 +65,13 @@ struct RenderSettings {
     // read a pixel fewer (2-3 ms of the painting's 960x600 frame on llvmpipe). Off: float sines,
     // as before 2026-12-02 (recordings made before replay so).
     bool horizonHalf = true;
+    // Read the horizons for eq. (1) bilinearly at the pixel's point on the surface
+    // (HorizonMap::sinHorizonBilinear) instead of at the texel holding it. At a 10-degree tilt the
+    // ceiling grazes the panel and a light's visibility turns within a texel: the nearest texel's
+    // horizon took the painting's max ΔE00 to 3.07, the bilinear one to 1.5 (docs/rendering.md).
+    // It costs four horizon reads a pixel where one was, only when the cache is recomputed; the
+    // specular lobe keeps the nearest texel's. Off: as before 2026-12-02 (recordings made before).
+    bool horizonBilinear = true;
     // Subtract the screen's front-surface flare here (the GL pass only: the CPU model always does).
     // The appliance turns it off when its display pass subtracts the flare instead, so that the
     // reflection is never subtracted twice.
@@ -162,6 +172,8 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
 // texel area; vis(light direction) in [0, 1] multiplies each light: a smoothstep across the
 // relief's horizon whose half-width is 'softness' or sqrt(3) times the spread of the light's
 // elevation sine over its ceiling region (booth::PointLight::spreadU/V), whichever is wider.
+// The horizon is the texel (tx, ty)'s, or with bilinearAt the bilinear one at that fractional
+// texel position (RenderSettings::horizonBilinear).
 double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             const Vec3& lightNormal,
                             double texelAreaM2,
@@ -173,7 +185,8 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             int ty,
                             const Vec3& right,
                             const Vec3& up,
-                            double softness);
+                            double softness,
+                            const std::optional<glm::dvec2>& bilinearAt = std::nullopt);
 
 // Specular radiance (cd/m^2, rho_s = 1) by FIS with N Hammersley samples (u1 = (k + 1/2) / N).
 // The horizon shadows the lobe with one sine, read at the mirror direction's azimuth; each sample

@@ -39,6 +39,9 @@ struct HorizonMap {
 
     // Interpolated linearly in azimuth; l is a tangent-space unit direction.
     double sinHorizon(int x, int y, const Vec3& l) const;
+    // At a fractional texel position (texel centres at x + 0.5): bilinear between the four texels
+    // around it (clamped to the edge, as the normal map is read), each interpolated in azimuth.
+    double sinHorizonBilinear(double x, double y, const Vec3& l) const;
 };
 
 HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM);

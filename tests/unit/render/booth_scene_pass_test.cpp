@@ -155,6 +155,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // And before the horizon sines were stored as half floats: floats.
     EXPECT_FALSE(o->horizonHalf);
     EXPECT_TRUE(c.horizonHalf);
+    // And before eq. (1)'s horizon was read bilinearly: each texel's own.
+    EXPECT_FALSE(o->horizonBilinear);
+    EXPECT_TRUE(c.horizonBilinear);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -173,6 +176,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->horizonHalf);
     c.horizonHalf = true;
     EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonHalf);
+    c.horizonBilinear = false;
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->horizonBilinear);
+    c.horizonBilinear = true;
+    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonBilinear);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);

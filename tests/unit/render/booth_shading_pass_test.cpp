@@ -262,18 +262,23 @@ TEST_F(BoothPassTest, HorizonSpreadOnAndOffMatchesTheCpuModel)
     }
 }
 
-TEST_F(BoothPassTest, HalfAndFloatHorizonsMatchTheCpuModel)
+TEST_F(BoothPassTest, HorizonEncodingsAndLookupsMatchTheCpuModel)
 {
-    // The horizon sines packed as half floats, eight a texel (the appliance), and as floats, four
-    // a texel (what recordings made before replay with), in the GL pass against the CPU model
-    // with the same setting; on the painting at a 10-degree tilt, where the horizons shadow most.
+    // The horizon sines as half floats, eight a texel, or floats, four a texel; eq. (1)'s horizon
+    // read bilinearly at the pixel's point or at its texel (the appliance: half and bilinear;
+    // recordings made before either replay without it). The GL pass against the CPU model with
+    // the same settings, on the painting at a 10-degree tilt, where the horizons shadow most.
     const shading::View v = view(64, 40, 10.0);
     for (const bool half : {true, false}) {
-        shading::RenderSettings settings;
-        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
-        settings.horizonHalf = half;
-        expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
-                                 half ? "half horizons" : "float horizons");
+        for (const bool bilinear : {true, false}) {
+            shading::RenderSettings settings;
+            settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+            settings.horizonHalf = half;
+            settings.horizonBilinear = bilinear;
+            expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
+                                     std::string(half ? "half" : "float") + " horizons, " +
+                                             (bilinear ? "bilinear" : "nearest texel"));
+        }
     }
 }
 

@@ -9,6 +9,7 @@
 #include <pipeline/reference/frame_error.h>
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/shading/realtime_model.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/surface/scene.h>
 
 #include <gtest/gtest.h>
@@ -244,6 +245,9 @@ TEST(RealtimeModel, GrazingCeilingSpreadsEachLightsHorizonOverItsRegion)
     const auto ref = reference::renderReference(*scene, *light, view, test::observer());
     shading::RenderSettings settings;
     settings.specularSamples = shading::defaultSpecularSamples(*scene);
+    // Each texel's own horizon, as when the spread was measured (the bilinear horizon has its
+    // own test below: with it the spread no longer moves this frame's max).
+    settings.horizonBilinear = false;
     const auto ps = shading::prepareScene(*scene, settings.horizonDirections);
     auto pl = shading::prepareLight(*light, test::observer(), settings.lights);
     const auto spread = shading::renderRealtime(ps, pl, view, test::observer(), settings);
@@ -269,6 +273,45 @@ TEST(RealtimeModel, GrazingCeilingSpreadsEachLightsHorizonOverItsRegion)
             << "max " << withSpread.max << " against " << withoutSpread.max;
     EXPECT_LE(withSpread.p95, withoutSpread.p95);
     EXPECT_LE(withSpread.mean, withoutSpread.mean);
+}
+
+TEST(RealtimeModel, BilinearHorizonsKeepTheGrazingPaintingWithinBudget)
+{
+    // The shipped painting at a 10-degree tilt in the appliance's adaptive channels: with each
+    // texel's own horizon the worst pixels were far off (a light's visibility turns within a
+    // texel when the ceiling grazes the panel); read bilinearly at the pixel's point, as the
+    // reference marches from that point, they are within the budget. Measured on this 32 x 20
+    // frame: max 2.42 -> 0.95 (64 x 40: 3.07 -> 1.51; 96 x 60: 3.35 -> 1.58).
+    auto scene = surface::loadScene(dataDir() / "scenes" / "painting");
+    auto booth = booth::loadBooth(dataDir() / "booth");
+    auto encoder = spectral::AdaptiveEncoder::createDefault(dataDir());
+    ASSERT_TRUE(scene && booth && encoder);
+    const booth::BoothLight* light = nullptr;
+    for (const auto& l : booth->lights) {
+        light = l.name == "d50-fluorescent" ? &l : light;
+    }
+    ASSERT_NE(light, nullptr);
+    auto basis = encoder->basisFor(light->spd);
+    ASSERT_TRUE(basis) << basis.error().message;
+    shading::View view;
+    view.panel = shading::panelPoseFromTilt(10.0);
+    view.pixelsX = 32;
+    view.pixelsY = 20;
+    const auto ref = reference::renderReference(*scene, *light, view, test::observer());
+    shading::RenderSettings settings;
+    settings.specularSamples = shading::defaultSpecularSamples(*scene);
+    ASSERT_TRUE(settings.horizonBilinear); // the default
+    const auto ps = shading::prepareScene(*scene, settings.horizonDirections, 0.01, *basis);
+    const auto pl = shading::prepareLight(*light, test::observer(), settings.lights, *basis);
+    const auto bilinear = reference::compareFrames(
+            ref, shading::renderRealtime(ps, pl, view, test::observer(), settings));
+    settings.horizonBilinear = false;
+    const auto nearest = reference::compareFrames(
+            ref, shading::renderRealtime(ps, pl, view, test::observer(), settings));
+    EXPECT_GT(nearest.max, 2.0) << "the case no longer shows the nearest texel's error";
+    EXPECT_LT(bilinear.max, 1.5) << "nearest " << nearest.max;
+    EXPECT_LE(bilinear.p95, nearest.p95);
+    EXPECT_LE(bilinear.mean, nearest.mean);
 }
 
 TEST(RealtimeModel, HalfHorizonsAreTheRoundedMapAndMoveTheFrameByLittle)
@@ -320,17 +363,22 @@ TEST(RealtimeModel, BumpyGlossySceneWithShadowsIsCloseToTheReference)
     settings.lights = 128;
     const auto [ref, ps, pl, fast, err] = renderBoth(s, 8, settings);
     expectAllFinite(fast);
-    EXPECT_LT(err.p95, 1.0); // measured 0.44
-    EXPECT_LT(err.max, 3.0); // measured 0.83
-    // The horizons shadow here: taking them away only adds light (Y summed over the frame).
+    EXPECT_LT(err.p95, 1.0); // measured 0.34 (0.42 with each texel's own horizon)
+    EXPECT_LT(err.max, 3.0); // measured 0.63 (0.94)
+    // The horizons shadow here, as much as the reference's do: taking them away adds light, and
+    // the frame's Y summed is much nearer the reference's with them than without (measured:
+    // 72216 and 72283 against 72207; each texel's own horizon, 72091, overshot the other way).
     settings.horizonDirections = 0;
     const auto open = shading::renderRealtime(ps, pl, s.view, test::observer(), settings);
-    double shadowedY = 0.0, openY = 0.0;
+    double shadowedY = 0.0, openY = 0.0, refY = 0.0;
     for (std::size_t k = 0; k < fast.xyz.size(); ++k) {
         shadowedY += fast.xyz[k].y;
         openY += open.xyz[k].y;
+        refY += ref.xyz[k].y;
     }
-    EXPECT_LT(shadowedY, 0.999 * openY);
+    EXPECT_LT(shadowedY, openY);
+    EXPECT_LT(std::abs(shadowedY - refY), 0.25 * std::abs(openY - refY))
+            << "shadowed " << shadowedY << ", open " << openY << ", reference " << refY;
 }
 
 TEST(RealtimeModel, SpecularLobeIsShadowedByTheHorizonAtItsMirrorAzimuth)

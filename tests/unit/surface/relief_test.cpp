@@ -109,6 +109,17 @@ TEST(HorizonMap, WallGivesItsElevationInItsDirectionOnly)
     EXPECT_NEAR(m.sinHorizon(x, y, Vec3(1.0, 0.0, 0.5)), b[0], 1e-6);
     const Vec3 halfway(std::cos(M_PI / 8), std::sin(M_PI / 8), 0.3);
     EXPECT_NEAR(m.sinHorizon(x, y, halfway), 0.5 * (b[0] + b[1]), 1e-6);
+    // Bilinear between texel centres: a centre gives the texel's own, halfway to the next
+    // column the mean of the two, and past the last centre the edge texel's (clamped).
+    const Vec3 east(1.0, 0.0, 0.5);
+    EXPECT_DOUBLE_EQ(m.sinHorizonBilinear(x + 0.5, y + 0.5, east), m.sinHorizon(x, y, east));
+    EXPECT_NEAR(m.sinHorizonBilinear(x + 1.0, y + 0.5, east),
+                0.5 * (m.sinHorizon(x, y, east) + m.sinHorizon(x + 1, y, east)), 1e-12);
+    EXPECT_NEAR(m.sinHorizonBilinear(x + 0.75, y + 1.0, east),
+                0.25 * 0.5 * (m.sinHorizon(x + 1, y, east) + m.sinHorizon(x + 1, y + 1, east)) +
+                        0.75 * 0.5 * (m.sinHorizon(x, y, east) + m.sinHorizon(x, y + 1, east)),
+                1e-12);
+    EXPECT_DOUBLE_EQ(m.sinHorizonBilinear(40.0, 0.0, east), m.sinHorizon(39, 0, east));
     // A cliff face: horizons approach 90 degrees but stay finite.
     HeightField cliff = field(10, 3, 1e-4);
     for (int y2 = 0; y2 < 3; ++y2) {
