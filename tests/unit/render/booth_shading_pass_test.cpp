@@ -280,6 +280,14 @@ TEST_F(BoothPassTest, HorizonEncodingsAndLookupsMatchTheCpuModel)
                                              (bilinear ? "bilinear" : "nearest texel"));
         }
     }
+    // Direction counts that fill a layer partly (4 and 12 of 8 a layer) or span several (20).
+    for (const int dirs : {4, 12, 20}) {
+        shading::RenderSettings settings;
+        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        settings.horizonDirections = dirs;
+        expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
+                                 "half horizons, " + std::to_string(dirs) + " directions");
+    }
 }
 
 TEST_F(BoothPassTest, FlatSpecularGridMeetsTheErrorBudgetAgainstTheReference)
