@@ -105,6 +105,17 @@ const float kMinCosView = 1e-3;
 
 float hz[BOOTH_HORIZON_SLOTS];  // a whole number of layers, at least one
 
+// surface::bilinearAtTexel's rule at texel position (x, y) (texel centres at + 0.5): the texel
+// below and left of it in c (not clamped) and the weights of the texels after it in x and y.
+vec2 bilinearTexel(float x, float y, out ivec2 c) {
+    float fx = x - 0.5;
+    float fy = y - 0.5;
+    float x0 = floor(fx);
+    float y0 = floor(fy);
+    c = ivec2(int(x0), int(y0));
+    return vec2(fx - x0, fy - y0);
+}
+
 #if BOOTH_HORIZON_BILINEAR && BOOTH_MODE == 0
 // Adds w times texel t's horizon sines to hz (horizonTexture's layout).
 void addHorizons(ivec2 t, float w) {
@@ -134,13 +145,10 @@ void bilinearHorizons(float x, float y) {
     for (int k = 0; k < BOOTH_HORIZON_SLOTS; ++k) {
         hz[k] = 0.0;
     }
-    float fx = x - 0.5;
-    float fy = y - 0.5;
-    float x0 = floor(fx);
-    float y0 = floor(fy);
-    float ax = fx - x0;
-    float ay = fy - y0;
-    ivec2 c = ivec2(int(x0), int(y0));
+    ivec2 c;
+    vec2 a = bilinearTexel(x, y, c);
+    float ax = a.x;
+    float ay = a.y;
     ivec2 hi = uTexels - 1;
     addHorizons(clamp(c, ivec2(0), hi), (1.0 - ax) * (1.0 - ay));
     addHorizons(clamp(c + ivec2(1, 0), ivec2(0), hi), ax * (1.0 - ay));
@@ -372,13 +380,10 @@ void diffuseLight(int i, vec3 p, vec3 nShade, bool relief, inout float eGeo, ino
 }
 
 vec3 bilinearNormal(float x, float y) {
-    float fx = x - 0.5;
-    float fy = y - 0.5;
-    float x0 = floor(fx);
-    float y0 = floor(fy);
-    float ax = fx - x0;
-    float ay = fy - y0;
-    ivec2 c = ivec2(int(x0), int(y0));
+    ivec2 c;
+    vec2 a = bilinearTexel(x, y, c);
+    float ax = a.x;
+    float ay = a.y;
     ivec2 hi = uTexels - 1;
     vec3 n00 = texelFetch(uNormals, clamp(c, ivec2(0), hi), 0).xyz;
     vec3 n10 = texelFetch(uNormals, clamp(c + ivec2(1, 0), ivec2(0), hi), 0).xyz;

@@ -27,21 +27,11 @@ PanelPose panelPoseFromTilt(double tiltDeg)
 
 Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, double y)
 {
-    const double fx = x - 0.5;
-    const double fy = y - 0.5;
-    const double x0 = std::floor(fx);
-    const double y0 = std::floor(fy);
-    const double ax = fx - x0;
-    const double ay = fy - y0;
-    const auto at = [&](int ix, int iy) {
+    const Vec3 n = surface::bilinearAtTexel(x, y, [&](int ix, int iy) {
         ix = std::clamp(ix, 0, w - 1);
         iy = std::clamp(iy, 0, h - 1);
         return normals[static_cast<std::size_t>(iy) * w + ix];
-    };
-    const int ix = static_cast<int>(x0);
-    const int iy = static_cast<int>(y0);
-    const Vec3 n = (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
-                   ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
+    });
     const double len = glm::length(n);
     return len > 1e-12 ? n / len : Vec3(0.0, 0.0, 1.0);
 }

@@ -18,16 +18,7 @@ double HeightField::at(int x, int y) const
 
 double HeightField::sample(double x, double y) const
 {
-    const double fx = x - 0.5;
-    const double fy = y - 0.5;
-    const double x0 = std::floor(fx);
-    const double y0 = std::floor(fy);
-    const double ax = fx - x0;
-    const double ay = fy - y0;
-    const int ix = static_cast<int>(x0);
-    const int iy = static_cast<int>(y0);
-    return (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
-           ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
+    return bilinearAtTexel(x, y, [this](int ix, int iy) { return at(ix, iy); });
 }
 
 bool HeightField::flat() const
@@ -134,17 +125,8 @@ double HorizonMap::sinHorizon(int x, int y, const Vec3& l) const
 
 double HorizonMap::sinHorizonBilinear(double x, double y, const Vec3& l) const
 {
-    const double fx = x - 0.5;
-    const double fy = y - 0.5;
-    const double x0 = std::floor(fx);
-    const double y0 = std::floor(fy);
-    const double ax = fx - x0;
-    const double ay = fy - y0;
-    const int ix = static_cast<int>(x0);
-    const int iy = static_cast<int>(y0);
     // sinHorizon clamps each texel to the map.
-    return (1.0 - ay) * ((1.0 - ax) * sinHorizon(ix, iy, l) + ax * sinHorizon(ix + 1, iy, l)) +
-           ay * ((1.0 - ax) * sinHorizon(ix, iy + 1, l) + ax * sinHorizon(ix + 1, iy + 1, l));
+    return bilinearAtTexel(x, y, [&](int ix, int iy) { return sinHorizon(ix, iy, l); });
 }
 
 } // namespace replica::pipeline::surface
