@@ -21,6 +21,39 @@ namespace {
 
 using reference::Vec3;
 
+// The shipped painting and booth, and the view where the ceiling grazes the panel (10-degree
+// tilt, 32 x 20): what the relief-horizon tests below share, loaded once.
+struct GrazingPainting {
+    surface::SurfaceScene scene;
+    booth::BoothModel booth;
+    shading::View view;
+    const booth::BoothLight& light(const std::string& name) const
+    {
+        for (const auto& l : booth.lights) {
+            if (l.name == name) {
+                return l;
+            }
+        }
+        ADD_FAILURE() << "no booth light named " << name;
+        return booth.lights.front();
+    }
+};
+
+const GrazingPainting& grazingPainting()
+{
+    static const GrazingPainting g = [] {
+        auto scene = surface::loadScene(dataDir() / "scenes" / "painting");
+        auto booth = booth::loadBooth(dataDir() / "booth");
+        EXPECT_TRUE(scene && booth);
+        GrazingPainting out{*scene, *booth, {}};
+        out.view.panel = shading::panelPoseFromTilt(10.0);
+        out.view.pixelsX = 32;
+        out.view.pixelsY = 20;
+        return out;
+    }();
+    return g;
+}
+
 std::vector<Vec3> corners(const booth::BoothLight& l)
 {
     return {l.pointAtTexel(0, 0), l.pointAtTexel(l.luminance.width, 0),
@@ -230,18 +263,10 @@ TEST(RealtimeModel, GrazingCeilingSpreadsEachLightsHorizonOverItsRegion)
     // horizons cut through the regions the 32 point lights stand for. A sharp horizon test per
     // point turns a region all dark or all lit where the reference sees part of it; each light's
     // horizon spread over its region's extent (booth::PointLight::spreadU/V) must do better.
-    auto scene = surface::loadScene(dataDir() / "scenes" / "painting");
-    auto booth = booth::loadBooth(dataDir() / "booth");
-    ASSERT_TRUE(scene && booth);
-    const booth::BoothLight* light = nullptr;
-    for (const auto& l : booth->lights) {
-        light = l.name == "d50-fluorescent" ? &l : light;
-    }
-    ASSERT_NE(light, nullptr);
-    shading::View view;
-    view.panel = shading::panelPoseFromTilt(10.0);
-    view.pixelsX = 32;
-    view.pixelsY = 20;
+    const GrazingPainting& g = grazingPainting();
+    const surface::SurfaceScene* scene = &g.scene;
+    const booth::BoothLight* light = &g.light("d50-fluorescent");
+    const shading::View& view = g.view;
     const auto ref = reference::renderReference(*scene, *light, view, test::observer());
     shading::RenderSettings settings;
     settings.specularSamples = shading::defaultSpecularSamples(*scene);
@@ -282,21 +307,14 @@ TEST(RealtimeModel, BilinearHorizonsKeepTheGrazingPaintingWithinBudget)
     // texel when the ceiling grazes the panel); read bilinearly at the pixel's point, as the
     // reference marches from that point, they are within the budget. Measured on this 32 x 20
     // frame: max 2.42 -> 0.95 (64 x 40: 3.07 -> 1.51; 96 x 60: 3.35 -> 1.58).
-    auto scene = surface::loadScene(dataDir() / "scenes" / "painting");
-    auto booth = booth::loadBooth(dataDir() / "booth");
+    const GrazingPainting& g = grazingPainting();
+    const surface::SurfaceScene* scene = &g.scene;
+    const booth::BoothLight* light = &g.light("d50-fluorescent");
+    const shading::View& view = g.view;
     auto encoder = spectral::AdaptiveEncoder::createDefault(dataDir());
-    ASSERT_TRUE(scene && booth && encoder);
-    const booth::BoothLight* light = nullptr;
-    for (const auto& l : booth->lights) {
-        light = l.name == "d50-fluorescent" ? &l : light;
-    }
-    ASSERT_NE(light, nullptr);
+    ASSERT_TRUE(encoder);
     auto basis = encoder->basisFor(light->spd);
     ASSERT_TRUE(basis) << basis.error().message;
-    shading::View view;
-    view.panel = shading::panelPoseFromTilt(10.0);
-    view.pixelsX = 32;
-    view.pixelsY = 20;
     const auto ref = reference::renderReference(*scene, *light, view, test::observer());
     shading::RenderSettings settings;
     settings.specularSamples = shading::defaultSpecularSamples(*scene);
@@ -319,14 +337,10 @@ TEST(RealtimeModel, HalfHorizonsAreTheRoundedMapAndMoveTheFrameByLittle)
     // RenderSettings::horizonHalf reads the horizon map rounded to half floats: exactly the
     // frame of a float map rounded beforehand, and within a hundredth of ΔE00 of the float frame
     // (a sine moves by 2^-12 at most, against a smoothstep 0.04 wide; measured: max 0.0008).
-    auto scene = surface::loadScene(dataDir() / "scenes" / "painting");
-    auto booth = booth::loadBooth(dataDir() / "booth");
-    ASSERT_TRUE(scene && booth);
-    const booth::BoothLight& light = booth->lights.front();
-    shading::View view;
-    view.panel = shading::panelPoseFromTilt(10.0);
-    view.pixelsX = 32;
-    view.pixelsY = 20;
+    const GrazingPainting& g = grazingPainting();
+    const surface::SurfaceScene* scene = &g.scene;
+    const booth::BoothLight& light = g.booth.lights.front();
+    const shading::View& view = g.view;
     shading::RenderSettings settings;
     settings.specularSamples = shading::defaultSpecularSamples(*scene);
     auto ps = shading::prepareScene(*scene, settings.horizonDirections);
