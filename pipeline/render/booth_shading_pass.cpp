@@ -90,8 +90,9 @@ GLuint horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
     const int h = dirs > 0 ? map.height : 1;
     const auto texels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
     const auto k = static_cast<std::size_t>(dirs);
-    std::vector<float> sines(texels * 4 * static_cast<std::size_t>(layers), 0.0f);
-    std::vector<std::uint32_t> words(half ? sines.size() : 0, 0u);
+    const std::size_t components = texels * 4 * static_cast<std::size_t>(layers);
+    std::vector<float> sines(half ? 0 : components, 0.0f);
+    std::vector<std::uint32_t> words(half ? components : 0, 0u);
     for (std::size_t i = 0; i < texels && k > 0; ++i) {
         for (std::size_t d = 0; d < k; ++d) {
             const float sinB = map.sinBeta[i * k + d];
