@@ -20,5 +20,6 @@ constexpr int kBoothMaxLights = 256;           // std140 uniform block of vec4: 
 constexpr int kBoothUnrolledLights = 64;       // eq. (1) written out light by light up to here
 constexpr int kBoothMaxHorizonDirections = 32; // local array in the shader
 constexpr int kBoothMaxSpecularSamples = 256;  // std140 uniform block of vec4: 4 KiB
+constexpr int kBoothUnrolledSpecSamples = 32;  // the specular loop written out up to here
 
 } // namespace replica::pipeline::render
