@@ -56,6 +56,7 @@ std::string RunConfig::toJson() const
                      {"horizon_spread", horizonSpread},
                      {"horizon_half", horizonHalf},
                      {"horizon_bilinear", horizonBilinear},
+                     {"specular_branch_free", specularBranchFree},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -98,6 +99,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.horizonSpread = j.value("horizon_spread", false);
         c.horizonHalf = j.value("horizon_half", false);
         c.horizonBilinear = j.value("horizon_bilinear", false);
+        c.specularBranchFree = j.value("specular_branch_free", false);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
@@ -235,6 +237,7 @@ makeBoothScene(RunConfig& config,
     setup.settings.horizonSpread = config.horizonSpread;
     setup.settings.horizonHalf = config.horizonHalf;
     setup.settings.horizonBilinear = config.horizonBilinear;
+    setup.settings.specularBranchFree = config.specularBranchFree;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     setup.settings.subtractFlare = !config.flareSubtraction;
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));

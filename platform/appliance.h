@@ -72,6 +72,9 @@ struct RunConfig {
     // shading::RenderSettings::horizonBilinear; recordings made before it have none and replay
     // with each texel's own horizon, bit for bit.
     bool horizonBilinear = true;
+    // shading::RenderSettings::specularBranchFree; recordings made before it have none and replay
+    // with the early returns, bit for bit.
+    bool specularBranchFree = true;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

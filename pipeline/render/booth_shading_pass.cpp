@@ -292,13 +292,14 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             "#define BOOTH_LIGHT_CALLS{}\n"
                             "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_HORIZON_HALF {}\n"
                             "#define BOOTH_HORIZON_BILINEAR {}\n#define BOOTH_SPEC_CALLS{}\n"
-                            "#define BOOTH_UNROLLED_SPEC {}\n",
+                            "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
                             diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
                             perLayer * layers, samples, wardModelIndex(s.model),
                             settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0, lightCalls,
                             unrolledLights, settings_.horizonHalf ? 1 : 0,
-                            settings_.horizonBilinear ? 1 : 0, specCalls, unrolledSpec) +
+                            settings_.horizonBilinear ? 1 : 0, specCalls, unrolledSpec,
+                            settings_.specularBranchFree ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());

@@ -158,6 +158,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // And before eq. (1)'s horizon was read bilinearly: each texel's own.
     EXPECT_FALSE(o->horizonBilinear);
     EXPECT_TRUE(c.horizonBilinear);
+    // And before the specular samples were branch-free: the early returns.
+    EXPECT_FALSE(o->specularBranchFree);
+    EXPECT_TRUE(c.specularBranchFree);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -180,6 +183,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->horizonBilinear);
     c.horizonBilinear = true;
     EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonBilinear);
+    c.specularBranchFree = false;
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->specularBranchFree);
+    c.specularBranchFree = true;
+    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->specularBranchFree);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);
