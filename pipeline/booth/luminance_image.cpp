@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/bilinear.h>
 #include <pipeline/booth/luminance_image.h>
 
 namespace replica::pipeline::booth {
@@ -71,22 +72,12 @@ int nextPow2(int v)
 double bilinear(const LuminanceImage& img, double u, double v)
 {
     // Texel centres at (x + 0.5) / w; outside the texture the border value 0 is used.
-    const double fx = u * img.width - 0.5;
-    const double fy = v * img.height - 0.5;
-    const double x0f = std::floor(fx);
-    const double y0f = std::floor(fy);
-    const double ax = fx - x0f;
-    const double ay = fy - y0f;
-    const int x0 = static_cast<int>(x0f);
-    const int y0 = static_cast<int>(y0f);
-    auto tex = [&](int x, int y) {
+    return bilinearAtTexel(u * img.width, v * img.height, [&](int x, int y) {
         if (x < 0 || y < 0 || x >= img.width || y >= img.height) {
             return 0.0;
         }
         return img.at(x, y);
-    };
-    return (1.0 - ay) * ((1.0 - ax) * tex(x0, y0) + ax * tex(x0 + 1, y0)) +
-           ay * ((1.0 - ax) * tex(x0, y0 + 1) + ax * tex(x0 + 1, y0 + 1));
+    });
 }
 
 } // namespace

@@ -105,8 +105,9 @@ const float kMinCosView = 1e-3;
 
 float hz[BOOTH_HORIZON_SLOTS];  // a whole number of layers, at least one
 
-// surface::bilinearAtTexel's rule at texel position (x, y) (texel centres at + 0.5): the texel
-// below and left of it in c (not clamped) and the weights of the texels after it in x and y.
+// bilinearAtTexel's rule (pipeline/base/bilinear.h) at texel position (x, y) (texel centres at
+// + 0.5): the texel below and left of it in c (not clamped) and the weights of the texels after
+// it in x and y.
 vec2 bilinearTexel(float x, float y, out ivec2 c) {
     float fx = x - 0.5;
     float fy = y - 0.5;

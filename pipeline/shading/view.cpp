@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <pipeline/base/bilinear.h>
 #include <pipeline/shading/view.h>
 
 namespace replica::pipeline::shading {
@@ -27,7 +28,7 @@ PanelPose panelPoseFromTilt(double tiltDeg)
 
 Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, double y)
 {
-    const Vec3 n = surface::bilinearAtTexel(x, y, [&](int ix, int iy) {
+    const Vec3 n = bilinearAtTexel(x, y, [&](int ix, int iy) {
         ix = std::clamp(ix, 0, w - 1);
         iy = std::clamp(iy, 0, h - 1);
         return normals[static_cast<std::size_t>(iy) * w + ix];

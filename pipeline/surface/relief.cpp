@@ -5,6 +5,7 @@
 
 #include <glm/gtc/packing.hpp>
 
+#include <pipeline/base/bilinear.h>
 #include <pipeline/surface/relief.h>
 
 namespace replica::pipeline::surface {

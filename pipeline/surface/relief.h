@@ -2,7 +2,6 @@
 // horizon map.
 #pragma once
 
-#include <cmath>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -10,24 +9,6 @@
 namespace replica::pipeline::surface {
 
 using Vec3 = glm::dvec3;
-
-// Bilinear interpolation at a fractional texel position (texel centres at x + 0.5) of the values
-// at(ix, iy) returns for the four texels around it (at clamps, or not, as its map needs): the one
-// rule the height field, the normal map and the horizon map are read with.
-template <typename At>
-auto bilinearAtTexel(double x, double y, const At& at)
-{
-    const double fx = x - 0.5;
-    const double fy = y - 0.5;
-    const double x0 = std::floor(fx);
-    const double y0 = std::floor(fy);
-    const double ax = fx - x0;
-    const double ay = fy - y0;
-    const int ix = static_cast<int>(x0);
-    const int iy = static_cast<int>(y0);
-    return (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
-           ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
-}
 
 // Tangent frame of the surface: +x along image columns, +y up the image (against row order), +z out
 // of the surface towards the viewer. Heights are in metres, texel pitch in metres.
