@@ -100,6 +100,7 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
     if (!scene.flat()) {
         p.normals = surface::normalMap(scene.relief);
         p.horizon = surface::horizonMap(scene.relief, horizonDirections, horizonDistanceM);
+        p.horizonHalf = surface::halfPrecision(p.horizon);
     }
     for (const auto& s : scene.palette) {
         p.paletteCoeffs.push_back(colour::projectReflectance(basis, s));
@@ -277,12 +278,9 @@ XyzFrame renderRealtime(const PreparedScene& ps,
     const std::vector<Vec3> none;
     const std::vector<Vec3>& normals = relief ? ps.normals : none;
     // The GL pass's half-float horizons (RenderSettings::horizonHalf): the same rounded sines here.
-    const surface::HorizonMap half = relief && settings.horizonHalf
-                                             ? surface::halfPrecision(ps.horizon)
-                                             : surface::HorizonMap{};
     const surface::HorizonMap* horizon = nullptr;
     if (relief && settings.horizonDirections > 0) {
-        horizon = settings.horizonHalf ? &half : &ps.horizon;
+        horizon = settings.horizonHalf ? &ps.horizonHalf : &ps.horizon;
     }
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();

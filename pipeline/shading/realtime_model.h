@@ -166,6 +166,10 @@ struct PreparedScene {
     const surface::SurfaceScene* scene = nullptr;
     std::vector<Vec3> normals; // empty when flat
     surface::HorizonMap horizon;
+    // surface::halfPrecision(horizon), rounded once here for RenderSettings::horizonHalf (the
+    // planner renders one prepared scene dozens of times). Whoever replaces 'horizon' rounds it
+    // again.
+    surface::HorizonMap horizonHalf;
     std::vector<colour::ChannelCoeffs> paletteCoeffs;
 };
 

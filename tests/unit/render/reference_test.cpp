@@ -350,6 +350,7 @@ TEST(RealtimeModel, HalfHorizonsAreTheRoundedMapAndMoveTheFrameByLittle)
     settings.horizonHalf = true;
     const auto half = shading::renderRealtime(ps, pl, view, test::observer(), settings);
     ps.horizon = surface::halfPrecision(ps.horizon);
+    ps.horizonHalf = surface::halfPrecision(ps.horizon); // as prepareScene keeps it
     settings.horizonHalf = false;
     const auto rounded = shading::renderRealtime(ps, pl, view, test::observer(), settings);
     ASSERT_EQ(half.xyz.size(), rounded.xyz.size());
