@@ -58,7 +58,6 @@ uniform float uDispWhiteY;
 uniform float uDispMaxCount;
 uniform int uDispLutSize;
 uniform highp sampler2D uDispToneLut;  // (lutSize - 1) x 3, RG32F, texelFetch only
-uniform highp sampler2D uDispDither;   // 16 x 16, R32F
 uniform vec4 uDispViewing[16];         // angle deg, gain X, Y, Z
 
 // Linear interpolation in u = cbrt(r), done by hand so no float-filtering extension is needed.
@@ -197,8 +196,21 @@ float displayGamutClass(vec3 xyz) {
     return inside ? 0.0 : 1.0;
 }
 
+// ditherPattern()'s threshold at the pixel, computed by the same bit interleaving: a dozen
+// integer operations where a texel read was a gather per pixel on llvmpipe (3.5 M instructions
+// of the painting's frame). The same floats: v + 0.5 and the division by 256 are exact.
+float displayDitherThreshold(ivec2 pixel) {
+    int y = pixel.y & 15;
+    int xy = (pixel.x & 15) ^ y;
+    int v = 0;
+    for (int bit = 0; bit < 4; ++bit) {
+        v = (v << 2) | (((xy >> bit) & 1) << 1) | ((y >> bit) & 1);
+    }
+    return (float(v) + 0.5) / 256.0;
+}
+
 vec3 displayQuantise(vec3 counts, ivec2 pixel) {
-    float t = texelFetch(uDispDither, pixel & ivec2(15), 0).r;
+    float t = displayDitherThreshold(pixel);
     return clamp(floor(counts + vec3(t)), vec3(0.0), vec3(uDispMaxCount));
 }
 )";

@@ -25,7 +25,8 @@ struct DisplayShaderParams {
     // texel j = entries j and j + 1 (the pair one interpolation reads).
     int lutSize = 0;
     std::vector<float> lut;
-    // 16 x 16 R32F texture of ordered-dither thresholds in (0, 1), indexed by pixel modulo 16.
+    // Ordered-dither thresholds in (0, 1), indexed by pixel modulo 16 (the CPU's checks of the
+    // surround; the shader computes the same thresholds).
     std::array<float, kDitherSize * kDitherSize> dither{};
     // Viewing-angle gains at the table rows: (angle deg, gain X, gain Y, gain Z); rows beyond
     // kMaxViewingRows are dropped (the shipped table has 12).
@@ -39,7 +40,7 @@ struct DisplayShaderParams {
 DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse);
 
 // GLSL ES 3.10 declarations and functions (no #version, no main; the includer defines
-// DISP_VIEWING_ROWS as viewingRows): uniforms uDisp*, samplers uDispToneLut and uDispDither, and
+// DISP_VIEWING_ROWS as viewingRows): uniforms uDisp*, sampler uDispToneLut, and
 //   vec4 displayInverse(vec3 xyz, int mode)  // counts (real) in .xyz, gamut class in .w
 //   vec3 displayViewingGain(float angleDeg)
 //   vec3 displayQuantise(vec3 counts, ivec2 pixel) // integer counts as floats

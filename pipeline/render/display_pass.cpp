@@ -171,7 +171,7 @@ void setInt(GLuint program, const char* name, int v)
 
 DisplayPass::~DisplayPass()
 {
-    const std::array<GLuint, 5> textures{rgbaTarget_, classTarget_, toneLut_, dither_, lut3d_};
+    const std::array<GLuint, 4> textures{rgbaTarget_, classTarget_, toneLut_, lut3d_};
     glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     glDeleteBuffers(1, &counts_);
     glDeleteFramebuffers(1, &fbo_);
@@ -227,8 +227,6 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     rgbaTarget_ = texture2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height, nullptr);
     classTarget_ = texture2d(GL_R8, GL_RED, GL_UNSIGNED_BYTE, width, height, nullptr);
     toneLut_ = texture2d(GL_RG32F, GL_RG, GL_FLOAT, params.lutSize - 1, 3, params.lut.data());
-    dither_ = texture2d(GL_R32F, GL_RED, GL_FLOAT, display::kDitherSize, display::kDitherSize,
-                        params.dither.data());
     // A 3-D texture always exists (a 2^3 dummy on the analytic path) so that the sampler is valid.
     const int n = setup.method == InverseMethod::Lut3d ? std::max(setup.lut3dSize, 2) : 2;
     std::vector<float> lattice(static_cast<std::size_t>(n * n * n) * 4, 0.0f);
@@ -309,8 +307,7 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     setVec3(program_, "uDispLut3dScale", latticeScale);
     setInt(program_, "uXyz", 0);
     setInt(program_, "uDispToneLut", 1);
-    setInt(program_, "uDispDither", 2);
-    setInt(program_, "uDispLut3d", 3);
+    setInt(program_, "uDispLut3d", 2);
     glUseProgram(countProgram_);
     setInt(countProgram_, "uClass", 0);
     glUseProgram(0);
@@ -344,8 +341,6 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, toneLut_);
     glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D, dither_);
-    glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_3D, lut3d_);
     PixelRect shade{0, 0, width_, height_};
     if (frame.blackOutside && surroundConstant_) {

@@ -87,7 +87,6 @@ private:
     GLuint rgbaTarget_ = 0;
     GLuint classTarget_ = 0;
     GLuint toneLut_ = 0;
-    GLuint dither_ = 0;
     GLuint lut3d_ = 0;
     GLuint counts_ = 0; // SSBO of 4 uints, one per gamut class
     float flarePerLux_ = 0.0f;
