@@ -57,6 +57,7 @@ std::string RunConfig::toJson() const
                      {"horizon_half", horizonHalf},
                      {"horizon_bilinear", horizonBilinear},
                      {"specular_branch_free", specularBranchFree},
+                     {"specular_exact_level", specularExactLevel},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -100,6 +101,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.horizonHalf = j.value("horizon_half", false);
         c.horizonBilinear = j.value("horizon_bilinear", false);
         c.specularBranchFree = j.value("specular_branch_free", false);
+        c.specularExactLevel = j.value("specular_exact_level", false);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
@@ -177,6 +179,27 @@ std::string displayProfileId(const RunConfig& config, const std::string& profile
     return fmt::format("{} ({}, fnv1a64 {})", profileName, config.display, config.displayDigest);
 }
 
+pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
+{
+    pipeline::shading::RenderSettings s;
+    s.lights = config.boothLights;
+    s.specularSamples = config.specularSamples;
+    s.specularGrid = config.specularGrid;
+    s.diffuseGrid = config.diffuseGrid;
+    s.hardwareFilter = config.hardwareFilter;
+    s.specularLodBias = config.specularLodBias;
+    s.specularNearestLevel = config.specularNearestLevel;
+    s.horizonDirections = config.horizonDirections;
+    s.horizonSpread = config.horizonSpread;
+    s.horizonHalf = config.horizonHalf;
+    s.horizonBilinear = config.horizonBilinear;
+    s.specularBranchFree = config.specularBranchFree;
+    s.specularExactLevel = config.specularExactLevel;
+    // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
+    s.subtractFlare = !config.flareSubtraction;
+    return s;
+}
+
 namespace {
 
 // The booth renderer's pass 1: the booth model, the scene folder, the settings.
@@ -217,29 +240,17 @@ makeBoothScene(RunConfig& config,
     setup.basis = basis;
     setup.adaptive = std::move(adaptive);
     setup.observer = observer;
-    setup.settings.lights = config.boothLights;
+    // The counts chosen for the scene, recorded.
     if (config.specularSamples == kAutoSpecularSamples) {
-        config.specularSamples = pipeline::shading::defaultSpecularSamples(setup.scene); // recorded
+        config.specularSamples = pipeline::shading::defaultSpecularSamples(setup.scene);
     }
-    setup.settings.specularSamples = config.specularSamples;
     if (config.specularGrid == kAutoSpecularGrid) {
-        config.specularGrid = pipeline::shading::defaultSpecularGrid(setup.scene); // recorded
+        config.specularGrid = pipeline::shading::defaultSpecularGrid(setup.scene);
     }
-    setup.settings.specularGrid = config.specularGrid;
     if (config.diffuseGrid == kAutoDiffuseGrid) {
-        config.diffuseGrid = pipeline::shading::defaultDiffuseGrid(setup.scene); // recorded
+        config.diffuseGrid = pipeline::shading::defaultDiffuseGrid(setup.scene);
     }
-    setup.settings.diffuseGrid = config.diffuseGrid;
-    setup.settings.hardwareFilter = config.hardwareFilter;
-    setup.settings.specularLodBias = config.specularLodBias;
-    setup.settings.specularNearestLevel = config.specularNearestLevel;
-    setup.settings.horizonDirections = config.horizonDirections;
-    setup.settings.horizonSpread = config.horizonSpread;
-    setup.settings.horizonHalf = config.horizonHalf;
-    setup.settings.horizonBilinear = config.horizonBilinear;
-    setup.settings.specularBranchFree = config.specularBranchFree;
-    // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
-    setup.settings.subtractFlare = !config.flareSubtraction;
+    setup.settings = boothRenderSettings(config);
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
     if (!pass) {
         return tl::unexpected(pass.error());

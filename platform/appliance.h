@@ -75,6 +75,9 @@ struct RunConfig {
     // shading::RenderSettings::specularBranchFree; recordings made before it have none and replay
     // with the early returns, bit for bit.
     bool specularBranchFree = true;
+    // shading::RenderSettings::specularExactLevel; recordings made before it have none and
+    // replay with log2, bit for bit.
+    bool specularExactLevel = true;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.
@@ -143,6 +146,11 @@ struct Appliance {
 // files that make the scene (scene.json, channels.exr, height.exr, material.exr).
 std::filesystem::path resolveSceneDir(const std::string& sceneDir);
 Expected<std::string> sceneDigest(const std::filesystem::path& dir);
+
+// The booth renderer's settings as the configuration records them. The scene's counts must
+// already be chosen (specular samples and the two grids not kAuto*: makeBoothScene chooses and
+// records them); a replay gets the settings its recording ran with.
+pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config);
 
 // Where frames go; not part of RunConfig because it never changes what a frame looks like.
 struct OutputChoice {

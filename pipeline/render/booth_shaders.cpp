@@ -99,6 +99,7 @@ uniform int uLumMaxLevel;
 uniform ivec2 uLumSize;         // level 0
 uniform vec2 uLumUsed;          // the light's share of the padded texture
 uniform float uLodBias;         // RenderSettings::specularLodBias
+uniform float uLodScale;        // 4^uLodBias, exact (BOOTH_EXACT_LEVEL only)
 
 const float kPi = 3.14159265358979;
 const float kMinCosView = 1e-3;
@@ -322,7 +323,17 @@ float specSample(int k, vec3 n, vec3 o, float co, vec3 ft, vec3 fbt, vec3 nGeo, 
     }
 #endif
     float ratio = solidAngle * t * t / (uTexelArea * -denom);
+#if BOOTH_EXACT_LEVEL
+    // RenderSettings::specularExactLevel: sampleNearestLevel's level d = ceil(l + 0.5) - 1 for
+    // l = 0.5 log2(r) + bias > 0.5, else 0, is ceil(log2(r 4^bias)) halved and rounded down, and
+    // for a normal float r ceil(log2 r) is its exponent plus one unless the mantissa is zero:
+    // adding the largest mantissa carries into the exponent exactly then. (llvmpipe's log2 is a
+    // polynomial.) The ratio is kept within normal floats; d < 0 clamps to level 0 below.
+    float r = clamp(ratio, 1e-20, 1e30) * uLodScale;
+    float lod = float((((floatBitsToInt(r) + 0x7fffff) >> 23) - 127) >> 1);
+#else
     float lod = 0.5 * log2(max(ratio, 1e-20)) + uLodBias;
+#endif
     float vis = clamp((cosG - visFrom) * visScale, 0.0, 1.0);
     float value = lumSample(lu, lv, lod) * w * (vis * vis * (3.0 - 2.0 * vis));
 #if BOOTH_SPEC_BRANCH_FREE

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -124,6 +125,19 @@ GLuint horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
 glm::vec3 f3(const glm::dvec3& v)
 {
     return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+}
+
+// 2 x the specular mip level bias when RenderSettings::specularExactLevel applies (the nearest
+// level and a bias of whole half levels; within kMaxSpecularLodBias, 4^bias keeps the shader's
+// clamped ratio, 1e-20 to 1e30, a normal float), else nothing: the shader then takes log2.
+std::optional<int> exactLevelTwiceBias(const shading::RenderSettings& s)
+{
+    const double twice = 2.0 * s.specularLodBias;
+    if (!s.specularExactLevel || !s.specularNearestLevel ||
+        !(std::abs(twice) <= 2.0 * shading::kMaxSpecularLodBias) || twice != std::round(twice)) {
+        return std::nullopt;
+    }
+    return static_cast<int>(twice);
 }
 
 int wardModelIndex(brdf::WardModel m)
@@ -292,14 +306,16 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             "#define BOOTH_LIGHT_CALLS{}\n"
                             "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_HORIZON_HALF {}\n"
                             "#define BOOTH_HORIZON_BILINEAR {}\n#define BOOTH_SPEC_CALLS{}\n"
-                            "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n",
+                            "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n"
+                            "#define BOOTH_EXACT_LEVEL {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
                             diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
                             perLayer * layers, samples, wardModelIndex(s.model),
                             settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0, lightCalls,
                             unrolledLights, settings_.horizonHalf ? 1 : 0,
                             settings_.horizonBilinear ? 1 : 0, specCalls, unrolledSpec,
-                            settings_.specularBranchFree ? 1 : 0) +
+                            settings_.specularBranchFree ? 1 : 0,
+                            exactLevelTwiceBias(settings_) ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -401,6 +417,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                static_cast<float>(s.heightM));
     uniformAll(glProgramUniform1f, "uSoftness", static_cast<float>(settings_.horizonSoftness));
     uniformAll(glProgramUniform1f, "uLodBias", static_cast<float>(settings_.specularLodBias));
+    uniformAll(glProgramUniform1f, "uLodScale",
+               std::ldexp(1.0f, exactLevelTwiceBias(settings_).value_or(0)));
     uniformAll(glProgramUniform1i, "uDiffuse", settings_.diffusePass ? 1 : 0);
     uniformAll(glProgramUniform1f, "uFlareRho",
                static_cast<float>(settings_.subtractFlare ? shading::kScreenFlareRho : 0.0));

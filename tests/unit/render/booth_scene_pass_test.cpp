@@ -161,6 +161,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // And before the specular samples were branch-free: the early returns.
     EXPECT_FALSE(o->specularBranchFree);
     EXPECT_TRUE(c.specularBranchFree);
+    // And before the nearest mip level came from the ratio's exponent: log2.
+    EXPECT_FALSE(o->specularExactLevel);
+    EXPECT_TRUE(c.specularExactLevel);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -187,6 +190,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->specularBranchFree);
     c.specularBranchFree = true;
     EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->specularBranchFree);
+    c.specularExactLevel = false;
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->specularExactLevel);
+    c.specularExactLevel = true;
+    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->specularExactLevel);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);
@@ -302,6 +309,46 @@ TEST(ApplianceBoothScene, TheClearedSurroundIsNotShadedAndNoPixelChanges)
     const auto clip = surroundFrame(c);
     ASSERT_TRUE(clip);
     EXPECT_TRUE(clip->surround);
+}
+
+TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
+{
+    // What a recording holds is what its replay renders with: each key, set both ways, arrives
+    // in the booth renderer's settings (a key dropped on the way renders every replay with the
+    // default, which the committed goldens only catch where the default changes their frames).
+    platform::RunConfig c;
+    c.boothLights = 17;
+    c.specularSamples = 5;
+    c.specularGrid = 3;
+    c.diffuseGrid = 2;
+    c.horizonDirections = 12;
+    c.specularLodBias = 0.75;
+    for (const bool on : {false, true}) {
+        c.hardwareFilter = on;
+        c.specularNearestLevel = !on;
+        c.horizonSpread = on;
+        c.horizonHalf = !on;
+        c.horizonBilinear = on;
+        c.specularBranchFree = !on;
+        c.specularExactLevel = on;
+        c.flareSubtraction = !on;
+        const pipeline::shading::RenderSettings s = platform::boothRenderSettings(c);
+        EXPECT_EQ(s.lights, 17);
+        EXPECT_EQ(s.specularSamples, 5);
+        EXPECT_EQ(s.specularGrid, 3);
+        EXPECT_EQ(s.diffuseGrid, 2);
+        EXPECT_EQ(s.horizonDirections, 12);
+        EXPECT_EQ(s.specularLodBias, 0.75);
+        EXPECT_EQ(s.hardwareFilter, on);
+        EXPECT_EQ(s.specularNearestLevel, !on);
+        EXPECT_EQ(s.horizonSpread, on);
+        EXPECT_EQ(s.horizonHalf, !on);
+        EXPECT_EQ(s.horizonBilinear, on);
+        EXPECT_EQ(s.specularBranchFree, !on);
+        EXPECT_EQ(s.specularExactLevel, on);
+        // Flare subtracted by the display pass: never a second time in pass 1.
+        EXPECT_EQ(s.subtractFlare, on);
+    }
 }
 
 TEST(ApplianceBoothScene, ChoosesTheSpecularSampleCountForTheSceneAndRecordsIt)

@@ -1,9 +1,11 @@
 // The GLES booth pass on the real headless EGL path against the CPU model it follows
 // (shading::renderRealtime) and against the exact reference, on every shipped scene.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
+#include <fmt/format.h>
 #include <glm/geometric.hpp>
 
 #include <pipeline/base/data_dir.h>
@@ -358,6 +360,46 @@ TEST_F(BoothPassTest, BranchFreeSpecularSamplesMatchTheEarlyReturns)
                 }
                 EXPECT_LE(worst, 1e-5) << name << ", light " << f;
             }
+        }
+    }
+}
+
+TEST_F(BoothPassTest, ExactMipLevelMatchesTheCpuModel)
+{
+    // RenderSettings::specularExactLevel (the appliance's default; recordings made before it
+    // replay with log2): each sample's nearest mip level from the footprint ratio's float
+    // exponent. Against the CPU model, whose level comes from log2 in double, at biases of whole
+    // half levels, where it applies (the ratio scaled by 4^bias); at a quarter-level bias it does
+    // not apply, and the frames are log2's, bit for bit.
+    const shading::View v = view(64, 40, 30.0);
+    for (const char* name : {"colorchecker", "painting"}) {
+        const auto& scene = scenes_.at(name);
+        shading::RenderSettings settings;
+        settings.specularSamples = shading::defaultSpecularSamples(scene);
+        ASSERT_TRUE(settings.specularExactLevel);
+        ASSERT_TRUE(settings.specularNearestLevel);
+        for (const double bias : {0.0, 0.5, -1.0}) {
+            settings.specularLodBias = bias;
+            expectMatchesTheCpuModel(scene, settings, v,
+                                     fmt::format("{}, exact level, bias {}", name, bias));
+        }
+        settings.specularLodBias = 0.25;
+        std::array<std::vector<shading::XyzFrame>, 2> frames; // log2, exact asked for
+        for (const bool exact : {false, true}) {
+            settings.specularExactLevel = exact;
+            expectMatchesTheCpuModel(scene, settings, v,
+                                     fmt::format("{}, bias 0.25, exact level {}", name, exact),
+                                     false, nullptr, &frames[exact ? 1 : 0]);
+        }
+        ASSERT_EQ(frames[0].size(), 2u);
+        ASSERT_EQ(frames[1].size(), 2u);
+        for (std::size_t f = 0; f < 2; ++f) {
+            ASSERT_EQ(frames[0][f].xyz.size(), frames[1][f].xyz.size());
+            std::size_t differ = 0;
+            for (std::size_t i = 0; i < frames[0][f].xyz.size(); ++i) {
+                differ += frames[0][f].xyz[i] != frames[1][f].xyz[i] ? 1 : 0;
+            }
+            EXPECT_EQ(differ, 0u) << name << ", light " << f;
         }
     }
 }
