@@ -58,6 +58,7 @@ std::string RunConfig::toJson() const
                      {"horizon_bilinear", horizonBilinear},
                      {"specular_branch_free", specularBranchFree},
                      {"specular_exact_level", specularExactLevel},
+                     {"texel_exact_ties", texelExactTies},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -102,6 +103,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.horizonBilinear = j.value("horizon_bilinear", false);
         c.specularBranchFree = j.value("specular_branch_free", false);
         c.specularExactLevel = j.value("specular_exact_level", false);
+        c.texelExactTies = j.value("texel_exact_ties", false);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
@@ -195,6 +197,7 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.horizonBilinear = config.horizonBilinear;
     s.specularBranchFree = config.specularBranchFree;
     s.specularExactLevel = config.specularExactLevel;
+    s.texelExactTies = config.texelExactTies;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     s.subtractFlare = !config.flareSubtraction;
     return s;

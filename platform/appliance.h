@@ -78,6 +78,9 @@ struct RunConfig {
     // shading::RenderSettings::specularExactLevel; recordings made before it have none and
     // replay with log2, bit for bit.
     bool specularExactLevel = true;
+    // shading::RenderSettings::texelExactTies; recordings made before it have none and replay
+    // with u * texels, bit for bit.
+    bool texelExactTies = true;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

@@ -15,6 +15,9 @@ out vec4 outXyz;
 uniform vec2 uViewport;
 uniform vec2 uSurfOffset;
 uniform vec2 uSurfScale;
+// The surface's pixel rectangle in window coordinates (BOOTH_EXACT_TIES): left edge x, top edge y
+// (window y runs up), width and height in pixels; from uSurfOffset, uSurfScale and uViewport.
+uniform vec4 uSurfPixels;
 // The surface in the booth frame (metres): centre, unit axes, physical size; texels.
 uniform vec3 uCentre;
 uniform vec3 uRight;
@@ -472,7 +475,23 @@ void main() {
     vec3 p = uCentre + uRight * ((u - 0.5) * uSizeM.x) + uUp * ((0.5 - v) * uSizeM.y);
     float texX = u * float(uTexels.x);
     float texY = v * float(uTexels.y);
+#if BOOTH_EXACT_TIES
+    // RenderSettings::texelExactTies (view.cpp shadingPoint's rule): the pixel's texel position
+    // from its offset into the surface's pixels times the texels, divided last. For the
+    // whole-pixel rectangles the CPU model renders the product is exact, and a correctly rounded
+    // division (llvmpipe's) of it lands exactly on a texel edge where the pixel centre does, so
+    // float takes the texel after the edge as double does. u * texels rounded such a centre
+    // either way: at 48x30 a pixel row in thirty read the texel row before the CPU model's.
+    if (uMode == 0 || uMode == 1) {
+        vec2 along = vec2(gl_FragCoord.x - uSurfPixels.x, uSurfPixels.y - gl_FragCoord.y) *
+                     vec2(uTexels);
+        texX = along.x / uSurfPixels.z;
+        texY = along.y / uSurfPixels.w;
+    }
+    ivec2 tc = clamp(ivec2(floor(vec2(texX, texY))), ivec2(0), uTexels - 1);
+#else
     ivec2 tc = clamp(ivec2(int(texX), int(texY)), ivec2(0), uTexels - 1);
+#endif
     vec3 nShade = uNormal;
     // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
     bool facets = uMode == 0 || (uSpecSamples > 0 && (uMode == 2 || !kGrid));

@@ -307,7 +307,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_HORIZON_HALF {}\n"
                             "#define BOOTH_HORIZON_BILINEAR {}\n#define BOOTH_SPEC_CALLS{}\n"
                             "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n"
-                            "#define BOOTH_EXACT_LEVEL {}\n",
+                            "#define BOOTH_EXACT_LEVEL {}\n#define BOOTH_EXACT_TIES {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
                             diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
                             perLayer * layers, samples, wardModelIndex(s.model),
@@ -315,7 +315,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             unrolledLights, settings_.horizonHalf ? 1 : 0,
                             settings_.horizonBilinear ? 1 : 0, specCalls, unrolledSpec,
                             settings_.specularBranchFree ? 1 : 0,
-                            exactLevelTwiceBias(settings_) ? 1 : 0) +
+                            exactLevelTwiceBias(settings_) ? 1 : 0,
+                            settings_.texelExactTies ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -648,6 +649,13 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                static_cast<float>(layout.offset.y));
     uniformAll(glProgramUniform2f, "uSurfScale", static_cast<float>(layout.scale.x),
                static_cast<float>(layout.scale.y));
+    // The same rectangle in window pixels (u = 0 to 1 left to right, v = 0 to 1 top to bottom):
+    // the default layout's are whole numbers, (0, height, width, height).
+    const glm::dvec2 sx = glm::max(layout.scale, glm::dvec2(1e-9));
+    uniformAll(glProgramUniform4f, "uSurfPixels",
+               static_cast<float>(-layout.offset.x * width / sx.x),
+               static_cast<float>(height * (1.0 + layout.offset.y / sx.y)),
+               static_cast<float>(width / sx.x), static_cast<float>(height / sx.y));
     set3All("uEye", view.eye);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightsUbo_);
     glBindBufferBase(GL_UNIFORM_BUFFER, 1, samplesUbo_);

@@ -43,15 +43,21 @@ ShadingPoint shadingPoint(const View& view,
                           int px,
                           int py)
 {
+    // The texel position with the division last: exact wherever the pixel centre lies on a
+    // texel edge, which then takes the texel after it (the GL pass's rule with
+    // RenderSettings::texelExactTies). u * texels rounded such a centre either way.
+    const glm::dvec2 texel((px + 0.5) * scene.width / view.pixelsX,
+                           (py + 0.5) * scene.height / view.pixelsY);
     return shadingPointAt(view, scene, normals, (px + 0.5) / view.pixelsX,
-                          (py + 0.5) / view.pixelsY);
+                          (py + 0.5) / view.pixelsY, texel);
 }
 
 ShadingPoint shadingPointAt(const View& view,
                             const surface::SurfaceScene& scene,
                             const std::vector<Vec3>& normals,
                             double u,
-                            double v)
+                            double v,
+                            const std::optional<glm::dvec2>& texel)
 {
     ShadingPoint s;
     const PanelPose& pose = view.panel;
@@ -60,8 +66,8 @@ ShadingPoint shadingPointAt(const View& view,
     s.nGeo = pose.normal;
     s.right = pose.right;
     s.up = pose.up;
-    s.texX = u * scene.width;
-    s.texY = v * scene.height;
+    s.texX = texel ? texel->x : u * scene.width;
+    s.texY = texel ? texel->y : v * scene.height;
     s.tx = std::clamp(static_cast<int>(s.texX), 0, scene.width - 1);
     s.ty = std::clamp(static_cast<int>(s.texY), 0, scene.height - 1);
     if (normals.empty()) {

@@ -2,6 +2,9 @@
 // per-pixel shading point (position, geometric and normal-mapped normals) on the virtual surface.
 #pragma once
 
+#include <optional>
+
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include <pipeline/brdf/ward.h>
@@ -53,12 +56,14 @@ ShadingPoint shadingPoint(const View& view,
                           int px,
                           int py);
 // The same at surface coordinates (u, v) in [0, 1]^2 (v down the surface): what a pixel centre
-// maps to, or a node of the specular grid.
+// maps to, or a node of the specular grid. The texel position is 'texel' when given, else
+// (u, v) times the texels.
 ShadingPoint shadingPointAt(const View& view,
                             const surface::SurfaceScene& scene,
                             const std::vector<Vec3>& normals,
                             double u,
-                            double v);
+                            double v,
+                            const std::optional<glm::dvec2>& texel = std::nullopt);
 
 // Bilinear interpolation of a normal map at fractional texel coordinates, renormalised (never zero:
 // every stored normal has z > 0).

@@ -164,6 +164,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // And before the nearest mip level came from the ratio's exponent: log2.
     EXPECT_FALSE(o->specularExactLevel);
     EXPECT_TRUE(c.specularExactLevel);
+    // And before a pixel's texel was picked with the exact tie rule: u * texels.
+    EXPECT_FALSE(o->texelExactTies);
+    EXPECT_TRUE(c.texelExactTies);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -194,6 +197,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->specularExactLevel);
     c.specularExactLevel = true;
     EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->specularExactLevel);
+    c.texelExactTies = false;
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->texelExactTies);
+    c.texelExactTies = true;
+    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->texelExactTies);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);
@@ -331,6 +338,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         c.horizonBilinear = on;
         c.specularBranchFree = !on;
         c.specularExactLevel = on;
+        c.texelExactTies = !on;
         c.flareSubtraction = !on;
         const pipeline::shading::RenderSettings s = platform::boothRenderSettings(c);
         EXPECT_EQ(s.lights, 17);
@@ -346,6 +354,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         EXPECT_EQ(s.horizonBilinear, on);
         EXPECT_EQ(s.specularBranchFree, !on);
         EXPECT_EQ(s.specularExactLevel, on);
+        EXPECT_EQ(s.texelExactTies, !on);
         // Flare subtracted by the display pass: never a second time in pass 1.
         EXPECT_EQ(s.subtractFlare, on);
     }

@@ -404,6 +404,87 @@ TEST_F(BoothPassTest, ExactMipLevelMatchesTheCpuModel)
     }
 }
 
+TEST_F(BoothPassTest, PixelCentresOnTexelEdgesTakeTheCpuModelsTexel)
+{
+    // RenderSettings::texelExactTies (the appliance's default; recordings made before it replay
+    // with u * texels). At 48x30 and 96x60 a pixel row in about thirty has its centres exactly on
+    // a texel edge of the painting. With the tie rule the GL pass picks the CPU model's texel
+    // there; without it, float rounding picked the texel before on some of those rows, a whole
+    // pigment away at an edge (this is what the comparison catches, so the sizes do hold ties).
+    const auto& scene = scenes_.at("painting");
+    shading::RenderSettings settings;
+    settings.specularSamples = shading::defaultSpecularSamples(scene);
+    ASSERT_TRUE(settings.texelExactTies);
+    const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, *basis_);
+    const auto pl = shading::prepareLight(booth_->lights[2], *obs_, settings.lights, *basis_);
+    for (const auto& [w, h] : {std::pair{48, 30}, std::pair{96, 60}}) {
+        const shading::View v = view(w, h, 30.0);
+        const auto cpu = shading::renderRealtime(ps, pl, v, *obs_, settings);
+        for (const bool exact : {true, false}) {
+            shading::RenderSettings s = settings;
+            s.texelExactTies = exact;
+            auto pass = BoothShadingPass::create(ps, s, *obs_);
+            ASSERT_TRUE(pass) << pass.error().message;
+            ASSERT_TRUE((*pass)->setLight(pl));
+            const auto gl = renderBoothFrame(**pass, pl, v);
+            ASSERT_TRUE(gl) << gl.error().message;
+            const Agreement a = agree(cpu, *gl);
+            if (exact) {
+                EXPECT_LE(a.fracOverTol, 0.002) << w << "x" << h << " max rel " << a.maxRelY;
+                EXPECT_LE(a.de.max, 0.01) << w << "x" << h;
+            } else {
+                EXPECT_GT(a.de.max, 0.5) << w << "x" << h << ": no tie showed";
+            }
+        }
+    }
+}
+
+TEST_F(BoothPassTest, AnOffsetLayoutTakesTheCpuModelsTexelsToo)
+{
+    // The appliance draws the surface into part of its frame (SurfaceLayout), and the tie rule
+    // reads the surface's pixel rectangle from the layout. Here the surface fills pixels 12 to 108
+    // across and 8 to 68 down of a 120x76 viewport: those pixels are the CPU model's 96x60 frame,
+    // ties included (without the rule they differ, so the layout does hold ties).
+    const auto& scene = scenes_.at("painting");
+    shading::RenderSettings settings;
+    settings.specularSamples = shading::defaultSpecularSamples(scene);
+    const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, *basis_);
+    const auto pl = shading::prepareLight(booth_->lights[2], *obs_, settings.lights, *basis_);
+    const int w = 120, h = 76, x0 = 12, y0 = 8, pw = 96, ph = 60;
+    SurfaceLayout layout;
+    layout.scale = glm::dvec2(double(w) / pw, double(h) / ph);
+    layout.offset = glm::dvec2(-layout.scale.x * x0 / w, -layout.scale.y * y0 / h);
+    const shading::View cpuView = view(pw, ph, 30.0);
+    const auto cpu = shading::renderRealtime(ps, pl, cpuView, *obs_, settings);
+    for (const bool exact : {true, false}) {
+        shading::RenderSettings s = settings;
+        s.texelExactTies = exact;
+        auto pass = BoothShadingPass::create(ps, s, *obs_);
+        ASSERT_TRUE(pass) << pass.error().message;
+        ASSERT_TRUE((*pass)->setLight(pl));
+        auto target = XyzTarget::create(w, h);
+        ASSERT_TRUE(target);
+        (*target)->bind();
+        const shading::View glView = view(w, h, 30.0);
+        ASSERT_TRUE((*pass)->draw(glView, w, h, layout));
+        const auto full = (*target)->read(pl, glView);
+        shading::XyzFrame inner = cpu;
+        for (int y = 0; y < ph; ++y) {
+            for (int x = 0; x < pw; ++x) {
+                inner.xyz[static_cast<std::size_t>(y * pw + x)] =
+                        full.xyz[static_cast<std::size_t>((y0 + y) * w + x0 + x)];
+            }
+        }
+        const Agreement a = agree(cpu, inner);
+        if (exact) {
+            EXPECT_LE(a.fracOverTol, 0.002) << "max rel " << a.maxRelY;
+            EXPECT_LE(a.de.max, 0.01);
+        } else {
+            EXPECT_GT(a.de.max, 0.5) << "no tie showed";
+        }
+    }
+}
+
 TEST_F(BoothPassTest, FlatSpecularGridMeetsTheErrorBudgetAgainstTheReference)
 {
     // What the appliance runs on the ColorChecker: the default setting with the specular term
