@@ -65,6 +65,7 @@ std::string RunConfig::toJson() const
                      {"display_inverse", displayInverse},
                      {"gamut_mapping", gamutMapping},
                      {"viewing_compensation", viewingCompensation},
+                     {"viewing_filtered", viewingFiltered},
                      {"flare_subtraction", flareSubtraction},
                      {"false_colour", falseColour}};
     return j.dump();
@@ -113,6 +114,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.displayInverse = j.value("display_inverse", std::string("analytic"));
         c.gamutMapping = j.value("gamut_mapping", std::string("hue"));
         c.viewingCompensation = j.value("viewing_compensation", false);
+        c.viewingFiltered = j.value("viewing_filtered", false);
         c.flareSubtraction = j.value("flare_subtraction", false);
         c.falseColour = j.value("false_colour", false);
     } catch (const std::exception& e) {
@@ -306,6 +308,7 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
                                                 : pipeline::render::InverseMethod::Analytic;
     d.gamut = config.gamutMapping == "clip" ? pd::GamutMode::Clip : pd::GamutMode::HueKeeping;
     d.viewingCompensation = config.viewingCompensation;
+    d.viewingFiltered = config.viewingFiltered;
     d.flareSubtraction = config.flareSubtraction;
     d.falseColour = config.falseColour;
     id = displayProfileId(config, d.model.name);

@@ -101,6 +101,9 @@ struct RunConfig {
     std::string displayInverse = "analytic"; // or "lut3d" (docs/display.md compares them)
     std::string gamutMapping = "hue";        // or "clip" (per channel, for comparison only)
     bool viewingCompensation = true;
+    // render::DisplayPassSetup::viewingFiltered; recordings made before it have none and replay
+    // with the table's rows, bit for bit.
+    bool viewingFiltered = true;
     bool flareSubtraction = true;
     bool falseColour = false;
 

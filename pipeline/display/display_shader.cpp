@@ -4,6 +4,7 @@
 #include <glm/matrix.hpp>
 
 #include <pipeline/display/display_shader.h>
+#include <pipeline/display/viewing_angle.h>
 
 namespace replica::pipeline::display {
 
@@ -43,6 +44,15 @@ DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse)
         p.viewing[row * 4 + 2] = static_cast<float>(gain.y);
         p.viewing[row * 4 + 3] = static_cast<float>(gain.z);
     }
+    if (p.viewingRows >= 2) {
+        p.viewingGrid.reserve(4 * kViewingGridNodes);
+        for (int k = 0; k < kViewingGridNodes; ++k) {
+            const glm::dvec3 gain = viewingGain(m.viewing, white, k * kViewingGridStepDeg);
+            p.viewingGrid.insert(p.viewingGrid.end(),
+                                 {static_cast<float>(gain.x), static_cast<float>(gain.y),
+                                  static_cast<float>(gain.z), 0.0f});
+        }
+    }
     p.flarePerLux =
             m.condition == MeasurementCondition::LitBooth
                     ? 0.0f
@@ -59,6 +69,7 @@ uniform float uDispMaxCount;
 uniform int uDispLutSize;
 uniform highp sampler2D uDispToneLut;  // (lutSize - 1) x 3, RG32F, texelFetch only
 uniform vec4 uDispViewing[16];         // angle deg, gain X, Y, Z
+uniform highp sampler2D uDispViewingGrid; // kViewingGridNodes x 1, RGBA32F, GL_LINEAR
 
 // Linear interpolation in u = cbrt(r), done by hand so no float-filtering extension is needed.
 float displayToneLut(int channel, float r) {
@@ -129,6 +140,15 @@ vec3 displayViewingGain(float angleDeg) {
     return vec3(1.0);
 #elif DISP_VIEWING_ROWS == 1
     return uDispViewing[0].yzw;
+#elif DISP_VIEWING_FILTERED
+    // DisplayPassSetup::viewingFiltered: the gain every half degree, interpolated by the sampler.
+    // One filtered read where the row count, two indexed uniform reads (a gather per component
+    // on llvmpipe) and a division were: 6 % of the painting's frame. NaN and 90 degrees or more
+    // take the last node, the last row's gain.
+    float a = angleDeg < 90.0 ? max(angleDeg, 0.0) : 90.0;
+    return texture(uDispViewingGrid,
+                   vec2((a * float(DISP_VIEWING_GRID_PER_DEG) + 0.5) / float(DISP_VIEWING_GRID_NODES),
+                        0.5)).rgb;
 #else
     float a = clamp(angleDeg, 0.0, 90.0);
     if (!(a < uDispViewing[DISP_VIEWING_ROWS - 1].x)) {

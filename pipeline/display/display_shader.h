@@ -13,6 +13,11 @@
 namespace replica::pipeline::display {
 
 constexpr int kMaxViewingRows = 16;
+// The viewing-angle gain sampled every half degree from 0 to 90 (DisplayPassSetup::
+// viewingFiltered): the same piecewise-linear function as the rows wherever every row's angle is
+// a multiple of the step (the shipped table's are multiples of 5 degrees).
+constexpr double kViewingGridStepDeg = 0.5;
+constexpr int kViewingGridNodes = 181;
 
 struct DisplayShaderParams {
     std::array<float, 9> xyzToLinear{}; // M^-1, column-major (glUniformMatrix3fv, transpose false)
@@ -32,6 +37,9 @@ struct DisplayShaderParams {
     // kMaxViewingRows are dropped (the shipped table has 12).
     int viewingRows = 0;
     std::array<float, 4 * kMaxViewingRows> viewing{};
+    // The gain at each of kViewingGridNodes angles, RGBA (gain X, Y, Z, 0); empty for fewer than
+    // two rows (no interpolation to do).
+    std::vector<float> viewingGrid;
     // Front-surface flare per lux of illuminance, before the light's colour: rho_d / pi; 0 when the
     // profile was measured in the lit booth (its black already holds the reflection).
     float flarePerLux = 0.0f;
@@ -40,7 +48,9 @@ struct DisplayShaderParams {
 DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse);
 
 // GLSL ES 3.10 declarations and functions (no #version, no main; the includer defines
-// DISP_VIEWING_ROWS as viewingRows): uniforms uDisp*, sampler uDispToneLut, and
+// DISP_VIEWING_ROWS as viewingRows, DISP_VIEWING_FILTERED 0 or 1, DISP_VIEWING_GRID_PER_DEG and
+// DISP_VIEWING_GRID_NODES from the constants above): uniforms uDisp*, samplers uDispToneLut and
+// uDispViewingGrid (read only when filtered), and
 //   vec4 displayInverse(vec3 xyz, int mode)  // counts (real) in .xyz, gamut class in .w
 //   vec3 displayViewingGain(float angleDeg)
 //   vec3 displayQuantise(vec3 counts, ivec2 pixel) // integer counts as floats

@@ -155,20 +155,6 @@ int wardModelIndex(brdf::WardModel m)
     return 2;
 }
 
-bool hasExtension(const char* name)
-{
-    GLint n = 0;
-    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
-    for (GLint i = 0; i < n; ++i) {
-        const auto* e =
-                reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, static_cast<GLuint>(i)));
-        if (e != nullptr && std::strcmp(e, name) == 0) {
-            return true;
-        }
-    }
-    return false;
-}
-
 Expected<void> glCheck(const char* what)
 {
     if (GLenum err = glGetError(); err != GL_NO_ERROR) {

@@ -171,7 +171,7 @@ void setInt(GLuint program, const char* name, int v)
 
 DisplayPass::~DisplayPass()
 {
-    const std::array<GLuint, 4> textures{rgbaTarget_, classTarget_, toneLut_, lut3d_};
+    const std::array<GLuint, 5> textures{rgbaTarget_, classTarget_, toneLut_, lut3d_, viewingGrid_};
     glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     glDeleteBuffers(1, &counts_);
     glDeleteFramebuffers(1, &fbo_);
@@ -198,14 +198,20 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     white_ = setup.model.whiteXyz();
     flarePerLux_ = setup.flareSubtraction ? params.flarePerLux : 0.0f;
 
+    const bool filtered = setup.viewingCompensation && setup.viewingFiltered &&
+                          !params.viewingGrid.empty() &&
+                          hasExtension("GL_OES_texture_float_linear");
     const std::string fragment =
             fmt::format("#version 310 es\n#define DISP_METHOD {}\n#define DISP_GAMUT_MODE {}\n"
                         "#define DISP_VIEWING {}\n#define DISP_FALSE_COLOUR {}\n"
-                        "#define DISP_VIEWING_ROWS {}\n",
+                        "#define DISP_VIEWING_ROWS {}\n#define DISP_VIEWING_FILTERED {}\n"
+                        "#define DISP_VIEWING_GRID_PER_DEG {:.17g}\n"
+                        "#define DISP_VIEWING_GRID_NODES {}\n",
                         setup.method == InverseMethod::Lut3d ? 1 : 0,
                         setup.gamut == display::GamutMode::Clip ? 1 : 0,
                         setup.viewingCompensation ? 1 : 0, setup.falseColour ? 1 : 0,
-                        params.viewingRows) +
+                        params.viewingRows, filtered ? 1 : 0, 1.0 / display::kViewingGridStepDeg,
+                        display::kViewingGridNodes) +
             kFragmentHead + display::kDisplayInverseGlsl + kFragmentMain;
     auto program = linkProgram(kFullscreenVertexShader, fragment.c_str(), "display");
     if (!program) {
@@ -227,6 +233,12 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     rgbaTarget_ = texture2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height, nullptr);
     classTarget_ = texture2d(GL_R8, GL_RED, GL_UNSIGNED_BYTE, width, height, nullptr);
     toneLut_ = texture2d(GL_RG32F, GL_RG, GL_FLOAT, params.lutSize - 1, 3, params.lut.data());
+    if (filtered) {
+        viewingGrid_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, display::kViewingGridNodes, 1,
+                                 params.viewingGrid.data());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    }
     // A 3-D texture always exists (a 2^3 dummy on the analytic path) so that the sampler is valid.
     const int n = setup.method == InverseMethod::Lut3d ? std::max(setup.lut3dSize, 2) : 2;
     std::vector<float> lattice(static_cast<std::size_t>(n * n * n) * 4, 0.0f);
@@ -308,6 +320,7 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     setInt(program_, "uXyz", 0);
     setInt(program_, "uDispToneLut", 1);
     setInt(program_, "uDispLut3d", 2);
+    setInt(program_, "uDispViewingGrid", 3);
     glUseProgram(countProgram_);
     setInt(countProgram_, "uClass", 0);
     glUseProgram(0);
@@ -342,6 +355,8 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glBindTexture(GL_TEXTURE_2D, toneLut_);
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_3D, lut3d_);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, viewingGrid_);
     PixelRect shade{0, 0, width_, height_};
     if (frame.blackOutside && surroundConstant_) {
         const PixelRect& inside = *frame.blackOutside;

@@ -33,8 +33,14 @@ struct DisplayPassSetup {
     InverseMethod method = InverseMethod::Analytic;
     int lut3dSize = 33;
     bool viewingCompensation = true; // from the profile's table and the tracked eye; off: on-axis
-    bool flareSubtraction = true;    // rho_d E / pi per pixel; never for a lit-booth profile
-    bool falseColour = false;        // field-staff overlay: out-of-gamut pixels striped in colour
+    // The gain read from the table resampled every half degree (display::kViewingGridStepDeg) with
+    // the sampler's linear filter, where the GL filters float textures (GL_OES_texture_float_
+    // linear): the same function as the rows to float rounding when the rows lie on the half
+    // degrees, 6 % of the painting's frame less on llvmpipe. Off, or without the extension: the
+    // rows themselves, as before 2026-12-02 (recordings made before replay so, bit for bit).
+    bool viewingFiltered = true;
+    bool flareSubtraction = true; // rho_d E / pi per pixel; never for a lit-booth profile
+    bool falseColour = false;     // field-staff overlay: out-of-gamut pixels striped in colour
 };
 
 // What changes per frame. 'lights' is the renderer's packed list (x, y, z in m, intensity in cd).
@@ -67,6 +73,9 @@ public:
     // Fails when the profile does not validate, is not 8-bit (the output target in this build), or
     // the GL lacks what the pass needs.
     Expected<void> init(const DisplayPassSetup& setup, int width, int height);
+    // Whether init found the viewing gain filtered (DisplayPassSetup::viewingFiltered and the
+    // extension it needs).
+    bool viewingFiltered() const { return viewingGrid_ != 0; }
     // Reads xyzTexture (RGBA32F, texelFetch), draws into framebuffer(), counts the gamut classes.
     Expected<display::GamutCounters> draw(GLuint xyzTexture, const DisplayPassFrame& frame);
     // The RGBA8 display target (counts / 255; alpha 1).
@@ -87,6 +96,7 @@ private:
     GLuint rgbaTarget_ = 0;
     GLuint classTarget_ = 0;
     GLuint toneLut_ = 0;
+    GLuint viewingGrid_ = 0; // 0 unless the gain is filtered (DisplayPassSetup::viewingFiltered)
     GLuint lut3d_ = 0;
     GLuint counts_ = 0; // SSBO of 4 uints, one per gamut class
     float flarePerLux_ = 0.0f;

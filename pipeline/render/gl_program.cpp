@@ -1,5 +1,6 @@
 // GLES program compilation with the info log in the error.
 #include <array>
+#include <cstring>
 
 #include <fmt/format.h>
 
@@ -71,6 +72,20 @@ Expected<GLuint> linkShaders(std::initializer_list<GLuint> shaders, const char* 
                          fmt::format("render: {} program does not link: {}", what, log.data()));
     }
     return program;
+}
+
+bool hasExtension(const char* name)
+{
+    GLint n = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (GLint i = 0; i < n; ++i) {
+        const auto* e =
+                reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, static_cast<GLuint>(i)));
+        if (e != nullptr && std::strcmp(e, name) == 0) {
+            return true;
+        }
+    }
+    return false;
 }
 
 Expected<GLuint> linkProgram(const char* vertexSource, const char* fragmentSource, const char* what)

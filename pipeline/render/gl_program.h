@@ -23,4 +23,7 @@ Expected<GLuint> linkShaders(std::initializer_list<GLuint> shaders, const char* 
 Expected<GLuint>
 linkProgram(const char* vertexSource, const char* fragmentSource, const char* what);
 
+// Whether the current context lists the extension (e.g. "GL_OES_texture_float_linear").
+bool hasExtension(const char* name);
+
 } // namespace replica::pipeline::render

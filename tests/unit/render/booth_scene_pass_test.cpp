@@ -167,6 +167,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // And before a pixel's texel was picked with the exact tie rule: u * texels.
     EXPECT_FALSE(o->texelExactTies);
     EXPECT_TRUE(c.texelExactTies);
+    // And before the viewing gain was filtered from a half-degree grid: the table's rows.
+    EXPECT_FALSE(o->viewingFiltered);
+    EXPECT_TRUE(c.viewingFiltered);
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -201,6 +204,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->texelExactTies);
     c.texelExactTies = true;
     EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->texelExactTies);
+    c.viewingFiltered = false;
+    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->viewingFiltered);
+    c.viewingFiltered = true;
+    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->viewingFiltered);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);

@@ -1,13 +1,18 @@
 // The GPU display pass against the CPU display model, with the shipped profile: flare subtraction
 // and viewing-angle compensation per pixel, both inverse methods, and the per-frame gamut counts.
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
+#include <pipeline/render/display_pass.h>
+#include <pipeline/render/gl_program.h>
 #include <pipeline/render/gles_renderer.h>
 #include <platform/output/output.h>
 
@@ -159,6 +164,66 @@ TEST_F(DisplayPassTest, CompensationChangesWhatIsDrivenInTheRightDirection)
         }
     }
     EXPECT_GT(sumOn, sumOff);
+}
+
+TEST_F(DisplayPassTest, FilteredViewingGainDrivesWhatTheTableRowsDo)
+{
+    // DisplayPassSetup::viewingFiltered (the default; recordings made before it replay with the
+    // rows): the gain resampled every half degree and interpolated by the sampler. The shipped
+    // table's rows lie on whole degrees, so it is the rows' function to float rounding. An eye
+    // 3 cm in front of the panel near its lower-left corner sees the pixels at 0 to about 86
+    // degrees; a mid grey is driven within one count of the rows' pass everywhere, and the same
+    // on nearly every pixel.
+    if (!hasExtension("GL_OES_texture_float_linear")) {
+        GTEST_SKIP() << "this GL does not filter float textures: the pass keeps the rows";
+    }
+    const int w = 96, h = 60;
+    const scene::PanelPose pose = scene::panelPose(scene::StandModel{}, 0.3);
+    DisplayPassFrame frame;
+    frame.pose = pose;
+    frame.eyeM = pose.originM + 0.1 * pose.rightM + 0.1 * pose.upM + 0.03 * pose.normal;
+    const glm::dvec3 grey = 0.1 * profile_.whiteXyz(); // in gamut at every angle
+    std::vector<float> xyz;
+    for (int i = 0; i < w * h; ++i) {
+        xyz.insert(xyz.end(), {static_cast<float>(grey.x), static_cast<float>(grey.y),
+                               static_cast<float>(grey.z), 0.0f});
+    }
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, w, h);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, xyz.data());
+    std::array<std::vector<std::uint8_t>, 2> out; // rows, filtered
+    for (const bool filtered : {false, true}) {
+        DisplayPassSetup setup;
+        setup.model = profile_;
+        setup.flareSubtraction = false;
+        setup.viewingFiltered = filtered;
+        DisplayPass pass;
+        ASSERT_TRUE(pass.init(setup, w, h));
+        EXPECT_EQ(pass.viewingFiltered(), filtered);
+        ASSERT_TRUE(pass.draw(tex, frame));
+        auto& o = out[filtered ? 1 : 0];
+        o.assign(static_cast<std::size_t>(w * h * 4), 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, pass.framebuffer());
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, o.data());
+    }
+    glDeleteTextures(1, &tex);
+    std::size_t same = 0;
+    int worst = 0;
+    for (std::size_t i = 0; i < out[0].size(); ++i) {
+        const int d = std::abs(int(out[0][i]) - int(out[1][i]));
+        worst = std::max(worst, d);
+        same += d == 0 ? 1 : 0;
+    }
+    EXPECT_LE(worst, 1);
+    EXPECT_GE(same, out[0].size() * 99 / 100);
+    // The compensation is at work across the frame: the far corner is driven harder than the
+    // pixel under the eye (green, in the first and last pixel rows read back).
+    const std::size_t nearEye = static_cast<std::size_t>((h / 6) * w + w / 5) * 4 + 1;
+    const std::size_t far = static_cast<std::size_t>((h - 1) * w + w - 1) * 4 + 1;
+    EXPECT_GT(int(out[1][far]), int(out[1][nearEye]) + 10);
 }
 
 TEST_F(DisplayPassTest, LutPassAgreesWithTheAnalyticPass)
