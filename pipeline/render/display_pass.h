@@ -36,8 +36,9 @@ struct DisplayPassSetup {
     // The gain read from the table resampled every half degree (display::kViewingGridStepDeg) with
     // the sampler's linear filter, where the GL filters float textures (GL_OES_texture_float_
     // linear): the same function as the rows to float rounding when the rows lie on the half
-    // degrees, 6 % of the painting's frame less on llvmpipe. Off, or without the extension: the
-    // rows themselves, as before 2026-12-02 (recordings made before replay so, bit for bit).
+    // degrees, 4 % fewer instructions in the painting's frame on llvmpipe. Off, or without the
+    // extension: the rows themselves, as before 2026-12-02 (recordings made before replay so, bit
+    // for bit).
     bool viewingFiltered = true;
     bool flareSubtraction = true; // rho_d E / pi per pixel; never for a lit-booth profile
     bool falseColour = false;     // field-staff overlay: out-of-gamut pixels striped in colour

@@ -81,7 +81,7 @@ struct RenderSettings {
     // The GL pass only: each specular sample's nearest mip level taken from the footprint
     // ratio's float exponent, ceil(log2 r) / 2 rounded down (exactly the level
     // booth::MipChain::sampleNearestLevel picks from 0.5 log2 r), instead of through log2, which
-    // llvmpipe computes with a polynomial: 3 % of the painting's instructions. It applies with
+    // llvmpipe computes with a polynomial: 2 % of the painting's instructions. It applies with
     // specularNearestLevel and a specularLodBias that is a multiple of 0.5 (the default 0; the
     // ratio is then scaled by 4^bias exactly); otherwise log2 as before. Frames differ where the
     // polynomial's rounding put a sample on the other side of a level boundary. Off: log2, as
