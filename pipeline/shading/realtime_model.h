@@ -89,11 +89,12 @@ struct RenderSettings {
     bool specularExactLevel = true;
     // The GL pass only (the CPU model and the reference always do this, shading::shadingPoint):
     // a pixel's texel position is its offset into the surface's pixels times the texels,
-    // divided last, and the texel holding it is confirmed with products, so that a pixel centre
-    // exactly on a texel edge takes the texel after it in float as in double. u * texels, as
-    // before, rounds such a centre either way: at 48x30 and 96x60 one pixel row in thirty read
-    // the texel row before the CPU model's (ΔE00 up to 56 at a pigment edge). Off: u * texels,
-    // as before 2026-12-02 (recordings made before replay so, bit for bit).
+    // divided last (exact on a texel edge with a correctly rounded division, as llvmpipe's), so
+    // that a pixel centre exactly on a texel edge takes the texel after it in float as in
+    // double. u * texels, as before, rounds such a centre either way: at 48x30 and 96x60 one
+    // pixel row in thirty read the texel row before the CPU model's (ΔE00 up to 56 at a pigment
+    // edge). Off: u * texels, as before 2026-12-02 (recordings made before replay so, bit for
+    // bit).
     bool texelExactTies = true;
     // Subtract the screen's front-surface flare here (the GL pass only: the CPU model always does).
     // The appliance turns it off when its display pass subtracts the flare instead, so that the
