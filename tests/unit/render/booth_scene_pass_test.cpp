@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <utility>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/render/booth_scene_pass.h>
@@ -147,29 +148,34 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_TRUE(o->surroundIlluminance);
     // And before the specular mip level bias was a setting: the renderer's bias of then.
     EXPECT_EQ(o->specularLodBias, shading::kLegacySpecularLodBias);
-    EXPECT_FALSE(o->specularNearestLevel);
-    EXPECT_TRUE(c.specularNearestLevel);
-    // And before each light's horizon was spread over its region: one fixed softness.
-    EXPECT_FALSE(o->horizonSpread);
-    EXPECT_TRUE(c.horizonSpread);
-    // And before the horizon sines were stored as half floats: floats.
-    EXPECT_FALSE(o->horizonHalf);
-    EXPECT_TRUE(c.horizonHalf);
-    // And before eq. (1)'s horizon was read bilinearly: each texel's own.
-    EXPECT_FALSE(o->horizonBilinear);
-    EXPECT_TRUE(c.horizonBilinear);
-    // And before the specular samples were branch-free: the early returns.
-    EXPECT_FALSE(o->specularBranchFree);
-    EXPECT_TRUE(c.specularBranchFree);
-    // And before the nearest mip level came from the ratio's exponent: log2.
-    EXPECT_FALSE(o->specularExactLevel);
-    EXPECT_TRUE(c.specularExactLevel);
-    // And before a pixel's texel was picked with the exact tie rule: u * texels.
-    EXPECT_FALSE(o->texelExactTies);
-    EXPECT_TRUE(c.texelExactTies);
-    // And before the viewing gain was filtered from a half-degree grid: the table's rows.
-    EXPECT_FALSE(o->viewingFiltered);
-    EXPECT_TRUE(c.viewingFiltered);
+    // And before each of these was a recorded setting: off (the rule of then), and on for a new
+    // run; each is recorded both ways.
+    const std::pair<const char*, bool platform::RunConfig::*> recordedSwitches[] = {
+            {"the nearest mip level (else trilinear)", &platform::RunConfig::specularNearestLevel},
+            {"each light's horizon spread over its region (else one fixed softness)",
+             &platform::RunConfig::horizonSpread},
+            {"horizon sines as half floats (else floats)", &platform::RunConfig::horizonHalf},
+            {"eq. (1)'s horizon read bilinearly (else each texel's own)",
+             &platform::RunConfig::horizonBilinear},
+            {"branch-free specular samples (else the early returns)",
+             &platform::RunConfig::specularBranchFree},
+            {"the nearest mip level from the ratio's exponent (else log2)",
+             &platform::RunConfig::specularExactLevel},
+            {"the exact texel tie rule (else u * texels)", &platform::RunConfig::texelExactTies},
+            {"the viewing gain filtered from a half-degree grid (else the table's rows)",
+             &platform::RunConfig::viewingFiltered},
+    };
+    for (const auto& [what, key] : recordedSwitches) {
+        EXPECT_FALSE((*o).*key) << what;
+        EXPECT_TRUE(c.*key) << what;
+        platform::RunConfig flipped = c;
+        flipped.*key = false;
+        const auto off = platform::RunConfig::fromJson(flipped.toJson());
+        const auto on = platform::RunConfig::fromJson(c.toJson());
+        ASSERT_TRUE(off && on) << what;
+        EXPECT_FALSE((*off).*key) << what;
+        EXPECT_TRUE((*on).*key) << what;
+    }
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -178,36 +184,8 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     c.specularGrid = 8;
     c.diffuseGrid = 5;
     c.specularLodBias = 0.25;
-    c.horizonSpread = false;
     auto round = platform::RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(round);
-    EXPECT_FALSE(round->horizonSpread);
-    c.horizonSpread = true;
-    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonSpread);
-    c.horizonHalf = false;
-    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->horizonHalf);
-    c.horizonHalf = true;
-    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonHalf);
-    c.horizonBilinear = false;
-    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->horizonBilinear);
-    c.horizonBilinear = true;
-    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->horizonBilinear);
-    c.specularBranchFree = false;
-    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->specularBranchFree);
-    c.specularBranchFree = true;
-    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->specularBranchFree);
-    c.specularExactLevel = false;
-    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->specularExactLevel);
-    c.specularExactLevel = true;
-    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->specularExactLevel);
-    c.texelExactTies = false;
-    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->texelExactTies);
-    c.texelExactTies = true;
-    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->texelExactTies);
-    c.viewingFiltered = false;
-    EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson())->viewingFiltered);
-    c.viewingFiltered = true;
-    EXPECT_TRUE(platform::RunConfig::fromJson(c.toJson())->viewingFiltered);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
     EXPECT_TRUE(round->hardwareFilter);
