@@ -59,6 +59,7 @@ std::string RunConfig::toJson() const
                      {"specular_branch_free", specularBranchFree},
                      {"specular_exact_level", specularExactLevel},
                      {"texel_exact_ties", texelExactTies},
+                     {"cache_slices", cacheSlices},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -105,6 +106,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularBranchFree = j.value("specular_branch_free", false);
         c.specularExactLevel = j.value("specular_exact_level", false);
         c.texelExactTies = j.value("texel_exact_ties", false);
+        c.cacheSlices = j.value("cache_slices", 1);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
@@ -126,10 +128,12 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
         c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 ||
-        !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias)) {
+        !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias) ||
+        c.cacheSlices < 1 || c.cacheSlices > kMaxCacheSlices) {
         return makeError(ErrorCode::InvalidArgument,
                          "run configuration: size, rate, light count, specular samples, specular "
-                         "or diffuse grid, specular lod bias or horizon directions out of range");
+                         "or diffuse grid, specular lod bias, horizon directions or cache slices "
+                         "out of range");
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -200,6 +204,7 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.specularBranchFree = config.specularBranchFree;
     s.specularExactLevel = config.specularExactLevel;
     s.texelExactTies = config.texelExactTies;
+    s.cacheSlices = config.cacheSlices;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     s.subtractFlare = !config.flareSubtraction;
     return s;

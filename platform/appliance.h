@@ -23,6 +23,10 @@ namespace replica::platform {
 constexpr int kAutoSpecularGrid = -1;
 constexpr int kAutoDiffuseGrid = -1;
 constexpr int kAutoSpecularSamples = -1;
+// RunConfig::cacheSlices for new runs (docs/rendering.md measures the choice), and the most a
+// configuration may ask for.
+constexpr int kDefaultCacheSlices = 3;
+constexpr int kMaxCacheSlices = 16;
 
 // Everything that decides what a frame looks like, apart from the samples. Recorded in the session
 // so that replay rebuilds the identical renderer.
@@ -81,6 +85,10 @@ struct RunConfig {
     // shading::RenderSettings::texelExactTies; recordings made before it have none and replay
     // with u * texels, bit for bit.
     bool texelExactTies = true;
+    // shading::RenderSettings::cacheSlices: a tilt recomputes the cached diffuse term in this many
+    // bands over as many frames. Recordings made before it have none and replay with 1 (whole at
+    // once), frame for frame.
+    int cacheSlices = kDefaultCacheSlices;
     // Whether pass 1 also shades the illuminance around the surface when the display pass clears
     // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
     // Recordings made before have none and replay with it, so their XYZ digests stand.

@@ -59,7 +59,9 @@ std::string BoothScenePass::description() const
             (glossy && s.specularGrid > 0 ? fmt::format(", specular grid {} texels", s.specularGrid)
                                           : std::string()) +
             (flat && s.diffuseGrid > 0 ? fmt::format(", diffuse grid {} texels", s.diffuseGrid)
-                                       : std::string());
+                                       : std::string()) +
+            (s.cacheSlices > 1 ? fmt::format(", a tilt recomputed over {} frames", s.cacheSlices)
+                               : std::string());
     return fmt::format("gles-booth (scene {}, {} median-cut lights, {} specular samples, {} "
                        "horizon directions{}, basis {}{})",
                        setup_.scene.name, s.lights, glossy ? s.specularSamples : 0,

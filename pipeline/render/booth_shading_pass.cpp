@@ -413,11 +413,20 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
 
 BoothShadingPass::~BoothShadingPass()
 {
-    const std::array<GLuint, 9> textures{coeffA_,       coeffB_,      normals_,
-                                         horizon_,      lum_,         cacheTexture_,
-                                         facetTexture_, gridTexture_, diffuseTexture_};
+    const std::array<GLuint, 10> textures{coeffA_,
+                                          coeffB_,
+                                          normals_,
+                                          horizon_,
+                                          lum_,
+                                          caches_[0].texture,
+                                          caches_[1].texture,
+                                          facetTexture_,
+                                          gridTexture_,
+                                          diffuseTexture_};
     glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
-    glDeleteFramebuffers(1, &cacheFbo_);
+    for (const CacheBuffer& c : caches_) {
+        glDeleteFramebuffers(1, &c.fbo);
+    }
     glDeleteFramebuffers(1, &gridFbo_);
     glDeleteFramebuffers(1, &diffuseFbo_);
     glDeleteBuffers(1, &lightsUbo_);
@@ -570,32 +579,43 @@ void BoothShadingPass::usePose(int mode, const shading::PanelPose& panel) const
 
 Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
 {
-    if (cacheTexture_ != 0 && cacheWidth_ == width && cacheHeight_ == height) {
+    if (caches_[0].texture != 0 && cacheWidth_ == width && cacheHeight_ == height) {
         return {};
     }
-    glDeleteFramebuffers(1, &cacheFbo_);
-    glDeleteTextures(1, &cacheTexture_);
+    for (CacheBuffer& c : caches_) {
+        glDeleteFramebuffers(1, &c.fbo);
+        glDeleteTextures(1, &c.texture);
+        c = CacheBuffer{}; // a new texture holds nothing yet
+    }
     glDeleteTextures(1, &facetTexture_);
     facetTexture_ = 0;
-    zeroAround_.reset();                       // a new texture holds nothing yet
+    front_ = 0;
+    pending_.reset();
     glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
-    cacheTexture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
     if (facetCache_) {
         facetTexture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
     }
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glGenFramebuffers(1, &cacheFbo_);
-    glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, cacheTexture_, 0);
-    if (facetCache_) {
-        // Mode 0 writes the facet normal beside the cached terms; the blit reads attachment 0.
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, facetTexture_,
-                               0);
-        const std::array<GLenum, 2> buffers{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-        glDrawBuffers(2, buffers.data());
-        glReadBuffer(GL_COLOR_ATTACHMENT0);
+    // The back cache only where refreshes are sliced: 9 MB at 960x600 that nothing else reads.
+    const int buffers = settings_.cacheSlices > 1 ? 2 : 1;
+    bool complete = true;
+    for (int b = 0; b < buffers; ++b) {
+        CacheBuffer& c = caches_[static_cast<std::size_t>(b)];
+        glActiveTexture(GL_TEXTURE0 + kUnitCache);
+        c.texture = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glGenFramebuffers(1, &c.fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, c.fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, c.texture, 0);
+        if (facetCache_) {
+            // Mode 0 writes the facet normal beside the cached terms; the blit reads attachment 0.
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D,
+                                   facetTexture_, 0);
+            const std::array<GLenum, 2> attachments{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+            glDrawBuffers(2, attachments.data());
+            glReadBuffer(GL_COLOR_ATTACHMENT0);
+        }
+        complete = complete && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     }
-    const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     cacheWidth_ = width;
     cacheHeight_ = height;
     cacheValid_ = false;
@@ -604,6 +624,70 @@ Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
                          "render: the booth pass's RGBA32F cache is not renderable on this GL");
     }
     return glCheck("creating the booth pass's cache");
+}
+
+void BoothShadingPass::drawCacheSlice(int buffer,
+                                      const shading::PanelPose& pose,
+                                      int slice,
+                                      int slices,
+                                      const PixelRect& rect,
+                                      int width,
+                                      int height) const
+{
+    CacheBuffer& c = caches_[static_cast<std::size_t>(buffer)];
+    if (slice == 0 && diffuseNodes_.x > 0) {
+        // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface (it stays
+        // for the refresh's later bands: nothing else draws into it).
+        glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_);
+        glViewport(0, 0, diffuseNodes_.x, diffuseNodes_.y);
+        usePose(3, pose);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glViewport(0, 0, width, height);
+    }
+    if (diffuseNodes_.x > 0) {
+        glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
+        glBindTexture(GL_TEXTURE_2D, diffuseTexture_);
+        glActiveTexture(GL_TEXTURE0);
+    }
+    // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare); or,
+    // without the surround's illuminance, the surface's rectangle and zero around it.
+    glBindFramebuffer(GL_FRAMEBUFFER, c.fbo);
+    PixelRect region{0, 0, width, height};
+    if (!surroundIlluminance_) {
+        // Mode 0 writes only the rectangle, so zero around it stays zero from one refresh to
+        // the next: cleared only when the cache was not already zero there (a new target, a
+        // new rectangle, or the surround's illuminance drawn). On llvmpipe a clear of the
+        // RGBA32F cache is a pass over 9 MB at 960x600, a good part of a tilting frame.
+        if (slice == 0 && !(c.zeroAround && *c.zeroAround == rect)) {
+            const std::array<float, 4> zero{};
+            glClearBufferfv(GL_COLOR, 0, zero.data());
+            c.zeroAround = rect;
+        }
+        region = rect;
+    } else {
+        c.zeroAround.reset();
+    }
+    // Band 'slice' of the region's rows: the surface's rows split evenly (they carry nearly all
+    // the cost), the rows below it with the first band and those above with the last.
+    int y0 = region.y;
+    int y1 = region.y + region.height;
+    if (slices > 1) {
+        const auto edge = [&](int k) {
+            return rect.y + static_cast<int>(static_cast<long>(rect.height) * k / slices);
+        };
+        y0 = slice == 0 ? region.y : edge(slice);
+        y1 = slice == slices - 1 ? region.y + region.height : edge(slice + 1);
+    }
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(region.x, y0, region.width, std::max(y1 - y0, 0));
+    usePose(0, pose);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisable(GL_SCISSOR_TEST);
+    if (diffuseNodes_.x > 0) {
+        glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
+        glBindTexture(GL_TEXTURE_2D, 0); // not sampled while mode 3 draws into it
+        glActiveTexture(GL_TEXTURE0);
+    }
 }
 
 Expected<void> BoothShadingPass::draw(const shading::View& view,
@@ -669,47 +753,30 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                        height,
                        layout.offset,
                        layout.scale};
-    if (!cacheValid_ || !(key == cacheKey_)) {
-        if (diffuseNodes_.x > 0) {
-            // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface.
-            glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_);
-            glViewport(0, 0, diffuseNodes_.x, diffuseNodes_.y);
-            usePose(3, diffusePose);
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-            glViewport(0, 0, width, height);
-            glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
-            glBindTexture(GL_TEXTURE_2D, diffuseTexture_);
-            glActiveTexture(GL_TEXTURE0);
-        }
-        // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare); or,
-        // without the surround's illuminance, the surface's rectangle and zero around it.
-        glBindFramebuffer(GL_FRAMEBUFFER, cacheFbo_);
-        if (!surroundIlluminance_) {
-            // Mode 0 writes only the rectangle, so zero around it stays zero from one refresh to
-            // the next: cleared only when the cache was not already zero there (a new target, a
-            // new rectangle, or the surround's illuminance drawn). On llvmpipe a clear of the
-            // RGBA32F cache is a pass over 9 MB at 960x600, a good part of a tilting frame.
-            if (!(zeroAround_ && *zeroAround_ == rect)) {
-                const std::array<float, 4> zero{};
-                glClearBufferfv(GL_COLOR, 0, zero.data());
-                zeroAround_ = rect;
-            }
-            glEnable(GL_SCISSOR_TEST);
-            glScissor(rect.x, rect.y, rect.width, rect.height);
-        } else {
-            zeroAround_.reset();
-        }
-        usePose(0, diffusePose);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        glDisable(GL_SCISSOR_TEST);
-        if (diffuseNodes_.x > 0) {
-            glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
-            glBindTexture(GL_TEXTURE_2D, 0); // not sampled while mode 3 draws into it
-            glActiveTexture(GL_TEXTURE0);
-        }
+    const int slices = std::max(settings_.cacheSlices, 1);
+    if (!cacheValid_ || (slices == 1 && !(key == cacheKey_))) {
+        // Drawn whole: the first cache, a new light, size, layout, channels or surround (nothing
+        // of the old cache would do), or any change with unsliced refreshes.
+        pending_.reset();
+        drawCacheSlice(front_, diffusePose, 0, 1, rect, width, height);
         cacheKey_ = key;
         cacheValid_ = true;
         ++cacheRefreshes_;
+    } else {
+        if (!pending_ && !(key == cacheKey_)) {
+            pending_ = PendingRefresh{key, diffusePose, 0};
+        }
+        if (pending_) {
+            // One band of the refresh into the back cache; the last one makes it the front.
+            const int back = 1 - front_;
+            drawCacheSlice(back, pending_->pose, pending_->nextSlice, slices, rect, width, height);
+            if (++pending_->nextSlice == slices) {
+                front_ = back;
+                cacheKey_ = pending_->key;
+                pending_.reset();
+                ++cacheRefreshes_;
+            }
+        }
     }
     if (gridNodes_.x > 0) {
         // This eye's specular term at the grid's nodes, for the compose to interpolate.
@@ -723,7 +790,8 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     // term or flare to add, on it too: copy it. Then compose the surface's rectangle (widened by a
     // pixel so that the shader's own bounds test decides every edge pixel): the cached part, the
     // specular term for this frame's pose and eye, minus the flare.
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, cacheFbo_);
+    const CacheBuffer& front = caches_[static_cast<std::size_t>(front_)];
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, front.fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     restore();
@@ -732,7 +800,7 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         glScissor(rect.x, rect.y, rect.width, rect.height);
         usePose(1, view.panel);
         glActiveTexture(GL_TEXTURE0 + kUnitCache);
-        glBindTexture(GL_TEXTURE_2D, cacheTexture_);
+        glBindTexture(GL_TEXTURE_2D, front.texture);
         glActiveTexture(GL_TEXTURE0 + kUnitFacet);
         glBindTexture(GL_TEXTURE_2D, facetTexture_);
         glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);

@@ -70,6 +70,13 @@ public:
     // against sensor noise: booth_scene_pass.h), else view.panel. Every draw then adds the
     // specular term for view.eye and view.panel. A frame drawn from the cache is bit-identical
     // to one that recomputes it.
+    // With settings.cacheSlices = K > 1 a pose change (the panel tilted) recomputes the cache in
+    // K bands of rows over K draws into a second cache, while the draws compose from the complete
+    // cache they have; the K-th draw swaps the two and composes from the new one. A pose change
+    // during those K draws waits for them (the bands all belong to one pose), so the diffuse term
+    // shown is always one whole cache, at most 2K - 2 draws behind the pose asked for. A first
+    // cache, and any change of light, size, layout, channels or surround, is drawn whole at once as
+    // with K = 1. Once the pose holds still the frames are those of K = 1, bit for bit.
     Expected<void> draw(const shading::View& view,
                         int width,
                         int height,
@@ -86,8 +93,11 @@ public:
     // frame is the same either way.
     void setSurroundIlluminance(bool on) const;
     bool surroundIlluminance() const { return surroundIlluminance_; }
-    // How many draws recomputed the cached part so far.
+    // How many times the cached part was recomputed so far (a sliced refresh counts once, at the
+    // draw that completes it).
     long cacheRefreshes() const { return cacheRefreshes_; }
+    // Whether a sliced refresh is under way (some of its bands drawn, the cache shown the old one).
+    bool cacheRefreshPending() const { return pending_.has_value(); }
 
     const shading::RenderSettings& settings() const { return settings_; }
     // Whether the luminance chain is filtered by the sampler (settings.hardwareFilter and the
@@ -98,6 +108,15 @@ private:
     BoothShadingPass() = default;
     Expected<void> init(const shading::PreparedScene& scene);
     Expected<void> ensureCacheTarget(int width, int height) const;
+    // Draws the cache's eye-independent part at 'pose' into caches_[buffer]: band 'slice' of
+    // 'slices' (slice 0 also draws the diffuse grid and clears what needs clearing).
+    void drawCacheSlice(int buffer,
+                        const shading::PanelPose& pose,
+                        int slice,
+                        int slices,
+                        const PixelRect& rect,
+                        int width,
+                        int height) const;
     // Sets the panel pose in one mode's program and makes that program current: each mode draws
     // at its own pose (the cache at the held one).
     void usePose(int mode, const shading::PanelPose& panel) const;
@@ -139,18 +158,35 @@ private:
         glm::dvec2 offset{0.0}, scale{0.0};
         bool operator==(const CacheKey&) const = default;
     };
+    // cacheKey_: what the front cache (caches_[front_]) holds when cacheValid_.
     mutable CacheKey cacheKey_;
     mutable bool cacheValid_ = false;
     mutable bool surroundIlluminance_ = true;
     mutable long cacheRefreshes_ = 0;
-    mutable GLuint cacheTexture_ = 0;
-    // The rectangle outside which the cache is known to hold zero (cleared for it, and mode 0
-    // writes only inside it); none after a new texture or a draw with the surround's illuminance.
-    mutable std::optional<PixelRect> zeroAround_;
-    mutable GLuint cacheFbo_ = 0;
+    struct CacheBuffer {
+        GLuint texture = 0; // RGBA32F: diffuse XYZ, E_geo in alpha
+        GLuint fbo = 0;
+        // The rectangle outside which this buffer is known to hold zero (cleared for it, and mode
+        // 0 writes only inside it); none after a new texture or a draw with the surround's
+        // illuminance.
+        std::optional<PixelRect> zeroAround;
+    };
+    // The front cache the frames compose from, and (settings.cacheSlices > 1 only) the back one
+    // a sliced refresh draws into.
+    mutable std::array<CacheBuffer, 2> caches_{};
+    mutable int front_ = 0;
+    // A sliced refresh under way: the key and pose it draws, and its next band.
+    struct PendingRefresh {
+        CacheKey key;
+        shading::PanelPose pose;
+        int nextSlice = 0;
+    };
+    mutable std::optional<PendingRefresh> pending_;
     // With relief and a per-pixel specular term the cache also keeps each pixel's facet normal
     // (tangent frame, what bilinearNormal gives; RGBA32F), so that the compose reads one texel
-    // instead of four and their normalisation every frame.
+    // instead of four and their normalisation every frame. One texture behind both caches: a
+    // facet normal depends on the layout and size alone, and a change of either redraws the
+    // cache whole, so a band drawn into the back cache writes there what it already holds.
     bool facetCache_ = false;
     mutable GLuint facetTexture_ = 0;
     mutable int cacheWidth_ = 0, cacheHeight_ = 0;

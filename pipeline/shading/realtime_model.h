@@ -96,6 +96,15 @@ struct RenderSettings {
     // edge). Off: u * texels, as before 2026-12-02 (recordings made before replay so, bit for
     // bit).
     bool texelExactTies = true;
+    // The GL pass only, and only across frames (one frame is the same either way): when the
+    // panel's pose changes, the cached eye-independent part (eq. 1 and 2, the frame's costly part
+    // on relief) is recomputed in this many bands of rows over as many frames, into a second
+    // cache, while the frames go on composing from the last complete one
+    // (render::BoothShadingPass::draw). A tilting frame then pays a band instead of the whole,
+    // and the diffuse term lags the tilt by a few frames while it moves; once the panel stops,
+    // the frames are those of 1 (recompute whole at once), bit for bit. 1 for a one-off render;
+    // the appliance sets its own (platform::RunConfig::cacheSlices).
+    int cacheSlices = 1;
     // Subtract the screen's front-surface flare here (the GL pass only: the CPU model always does).
     // The appliance turns it off when its display pass subtracts the flare instead, so that the
     // reflection is never subtracted twice.

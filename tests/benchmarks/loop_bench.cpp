@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <tuple>
 
 #include <benchmark/benchmark.h>
 
@@ -25,11 +26,12 @@ using namespace replica;
 
 const char* const kScenes[] = {"colorchecker", "metamer", "painting"};
 
-// One appliance per scene and specular sample count, built once (the GL context lives in it).
-platform::Appliance* appliance(int scene, int specularSamples)
+// One appliance per scene, specular sample count and cache slices, built once (the GL context
+// lives in it).
+platform::Appliance* appliance(int scene, int specularSamples, int cacheSlices)
 {
-    static std::map<std::pair<int, int>, std::unique_ptr<platform::Appliance>> built;
-    const std::pair<int, int> key{scene, specularSamples};
+    static std::map<std::tuple<int, int, int>, std::unique_ptr<platform::Appliance>> built;
+    const std::tuple<int, int, int> key{scene, specularSamples, cacheSlices};
     auto it = built.find(key);
     if (it != built.end()) {
         return it->second.get();
@@ -40,6 +42,7 @@ platform::Appliance* appliance(int scene, int specularSamples)
     c.height = 600;
     c.sceneDir = std::string("scenes/") + kScenes[scene];
     c.specularSamples = specularSamples;
+    c.cacheSlices = cacheSlices;
     auto app = platform::buildAppliance(c);
     if (!app) {
         std::fprintf(stderr, "appliance: %s\n", app.error().message.c_str());
@@ -49,10 +52,12 @@ platform::Appliance* appliance(int scene, int specularSamples)
 }
 
 // Arg 0: scene; arg 1: 0 = eye moving, tilt still; 1 = tilt moving 1 degree a frame (pass 1
-// recomputes its cached part on nearly every frame); arg 2: specular samples.
+// recomputes its cached part on nearly every frame); arg 2: specular samples; arg 3: the bands a
+// tilt's recompute is spread over (RunConfig::cacheSlices).
 void BM_ApplianceFrame(benchmark::State& st)
 {
-    auto* app = appliance(static_cast<int>(st.range(0)), static_cast<int>(st.range(2)));
+    auto* app = appliance(static_cast<int>(st.range(0)), static_cast<int>(st.range(2)),
+                          static_cast<int>(st.range(3)));
     if (app == nullptr) {
         st.SkipWithError("no EGL/GLES context or appliance");
         return;
@@ -61,7 +66,12 @@ void BM_ApplianceFrame(benchmark::State& st)
     st.SetLabel(std::string(kScenes[st.range(0)]) +
                 (tiltMoves ? ", tilt moving (recompute)" : ", eye moving, tilt still") + ", " +
                 std::to_string(app->config.specularSamples) + " specular samples" +
-                (st.range(2) == platform::kAutoSpecularSamples ? " (the default)" : ""));
+                (st.range(2) == platform::kAutoSpecularSamples ? " (the default)" : "") +
+                (tiltMoves
+                         ? ", cache in " + std::to_string(app->config.cacheSlices) + " slices" +
+                                   (st.range(3) == platform::kDefaultCacheSlices ? " (the default)"
+                                                                                 : "")
+                         : std::string()));
     pipeline::scene::SceneState state;
     state.lampIndex = 2; // d65-fluorescent
     state.illuminant = app->booth.lamps[2].spectrum;
@@ -91,11 +101,22 @@ void BM_ApplianceFrame(benchmark::State& st)
             benchmark::Counter(static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ApplianceFrame)
-        ->ArgsProduct({{0, 1, 2}, {0, 1}, {platform::kAutoSpecularSamples}}) // the defaults
-        ->Args({0, 0, 48}) // the default before the lod bias was 0
-        ->Args({2, 0, 48})
-        ->Args({2, 0, 16})
-        ->Args({2, 0, 12}) // the painting's default before it took 8 (2026-12-01)
+        ->ArgsProduct({{0, 1, 2},
+                       {0, 1},
+                       {platform::kAutoSpecularSamples},
+                       {platform::kDefaultCacheSlices}}) // the defaults
+        ->Apply([](benchmark::internal::Benchmark* b) {
+            // The painting tilting with its recompute in 1 to 4 bands (the default is above).
+            for (const int slices : {1, 2, 3, 4}) {
+                if (slices != platform::kDefaultCacheSlices) {
+                    b->Args({2, 1, platform::kAutoSpecularSamples, slices});
+                }
+            }
+        })
+        ->Args({0, 0, 48, platform::kDefaultCacheSlices}) // the default before the lod bias was 0
+        ->Args({2, 0, 48, platform::kDefaultCacheSlices})
+        ->Args({2, 0, 16, platform::kDefaultCacheSlices})
+        ->Args({2, 0, 12, platform::kDefaultCacheSlices}) // the painting's default before 8
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
 

@@ -177,6 +177,24 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
         EXPECT_TRUE((*on).*key) << what;
     }
     EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
+    // Made before sliced cache refreshes: recomputed whole at once, as then; a new run slices.
+    EXPECT_EQ(o->cacheSlices, 1);
+    EXPECT_EQ(c.cacheSlices, platform::kDefaultCacheSlices);
+    EXPECT_GT(c.cacheSlices, 1);
+    for (const int slices : {1, 4, platform::kMaxCacheSlices}) {
+        platform::RunConfig k = c;
+        k.cacheSlices = slices;
+        const auto back = platform::RunConfig::fromJson(k.toJson());
+        ASSERT_TRUE(back) << slices;
+        EXPECT_EQ(back->cacheSlices, slices);
+    }
+    for (const int slices : {0, -3, platform::kMaxCacheSlices + 1}) {
+        platform::RunConfig k = c;
+        k.cacheSlices = slices;
+        const auto bad = platform::RunConfig::fromJson(k.toJson());
+        ASSERT_FALSE(bad) << slices;
+        EXPECT_NE(bad.error().message.find("cache slices"), std::string::npos);
+    }
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
     EXPECT_EQ(c.diffuseGrid, platform::kAutoDiffuseGrid);
@@ -324,6 +342,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         c.specularBranchFree = !on;
         c.specularExactLevel = on;
         c.texelExactTies = !on;
+        c.cacheSlices = on ? 3 : 1;
         c.flareSubtraction = !on;
         const pipeline::shading::RenderSettings s = platform::boothRenderSettings(c);
         EXPECT_EQ(s.lights, 17);
@@ -340,6 +359,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         EXPECT_EQ(s.specularBranchFree, !on);
         EXPECT_EQ(s.specularExactLevel, on);
         EXPECT_EQ(s.texelExactTies, !on);
+        EXPECT_EQ(s.cacheSlices, on ? 3 : 1);
         // Flare subtracted by the display pass: never a second time in pass 1.
         EXPECT_EQ(s.subtractFlare, on);
     }
