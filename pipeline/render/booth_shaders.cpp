@@ -168,15 +168,33 @@ float horizonSine(vec3 l) {
     if (phi < 0.0) {
         phi += 2.0 * kPi;
     }
+    float f = phi / (2.0 * kPi) * float(uHorizonDirs);
+#if BOOTH_HORIZON_PICK
+    // RenderSettings::horizonPick: the two directions around phi picked by comparisons, each
+    // direction past the first replacing the pair when f has reached it (every index a
+    // constant: a compare and two selects a direction, where the tent weights below take seven
+    // operations), then sinHorizon's (1 - t) lo + t hi. f = K (phi rounded up to 2 pi) is
+    // direction 0 again, as on the CPU.
+    f = f >= float(uHorizonDirs) ? f - float(uHorizonDirs) : f;
+    float lo = hz[0];
+    float hi = hz[uHorizonDirs > 1 ? 1 : 0];
+    for (int k = 1; k < uHorizonDirs; ++k) {
+        bool past = f >= float(k);
+        lo = past ? hz[k] : lo;
+        hi = past ? hz[(k + 1) % uHorizonDirs] : hi;
+    }
+    float t = f - floor(f);
+    float sinB = (1.0 - t) * lo + t * hi;
+#else
     // Linear between the two directions around phi (wrapping): written as a tent weight over
     // all k so that every index is a constant (the same sum as indexing hz[k0] and hz[k1]).
-    float f = phi / (2.0 * kPi) * float(uHorizonDirs);
     float sinB = 0.0;
     for (int k = 0; k < uHorizonDirs; ++k) {
         float d = abs(f - float(k));
         d = min(d, float(uHorizonDirs) - d);
         sinB += max(1.0 - d, 0.0) * hz[k];
     }
+#endif
     return sinB;
 }
 

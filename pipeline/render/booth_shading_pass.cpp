@@ -292,7 +292,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_HORIZON_HALF {}\n"
                             "#define BOOTH_HORIZON_BILINEAR {}\n#define BOOTH_SPEC_CALLS{}\n"
                             "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n"
-                            "#define BOOTH_EXACT_LEVEL {}\n#define BOOTH_EXACT_TIES {}\n",
+                            "#define BOOTH_EXACT_LEVEL {}\n#define BOOTH_EXACT_TIES {}\n"
+                            "#define BOOTH_HORIZON_PICK {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
                             diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
                             perLayer * layers, samples, wardModelIndex(s.model),
@@ -301,7 +302,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             settings_.horizonBilinear ? 1 : 0, specCalls, unrolledSpec,
                             settings_.specularBranchFree ? 1 : 0,
                             exactLevelTwiceBias(settings_) ? 1 : 0,
-                            settings_.texelExactTies ? 1 : 0) +
+                            settings_.texelExactTies ? 1 : 0, settings_.horizonPick ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());

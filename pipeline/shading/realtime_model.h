@@ -96,6 +96,12 @@ struct RenderSettings {
     // edge). Off: u * texels, as before 2026-12-02 (recordings made before replay so, bit for
     // bit).
     bool texelExactTies = true;
+    // The GL pass only: the two horizon directions around a light's azimuth picked by
+    // comparisons (HorizonMap::sinHorizon's (1 - t) lo + t hi), instead of a tent weight on
+    // every direction: about half the operations per light and direction on relief, and the
+    // CPU model's sum rather than another, so other float rounding. Off: the tent weights, as
+    // before 2026-12-02 (recordings made before replay so, bit for bit).
+    bool horizonPick = true;
     // The GL pass only, and only across frames (one frame is the same either way): when the
     // panel's pose changes, the cached eye-independent part (eq. 1 and 2, the frame's costly part
     // on relief) is recomputed in this many bands of rows over as many frames, into a second

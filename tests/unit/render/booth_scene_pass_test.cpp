@@ -162,6 +162,8 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
             {"the nearest mip level from the ratio's exponent (else log2)",
              &platform::RunConfig::specularExactLevel},
             {"the exact texel tie rule (else u * texels)", &platform::RunConfig::texelExactTies},
+            {"the horizon directions picked (else tent-weighted)",
+             &platform::RunConfig::horizonPick},
             {"the viewing gain filtered from a half-degree grid (else the table's rows)",
              &platform::RunConfig::viewingFiltered},
     };
@@ -342,6 +344,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         c.specularBranchFree = !on;
         c.specularExactLevel = on;
         c.texelExactTies = !on;
+        c.horizonPick = on;
         c.cacheSlices = on ? 3 : 1;
         c.flareSubtraction = !on;
         const pipeline::shading::RenderSettings s = platform::boothRenderSettings(c);
@@ -359,6 +362,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         EXPECT_EQ(s.specularBranchFree, !on);
         EXPECT_EQ(s.specularExactLevel, on);
         EXPECT_EQ(s.texelExactTies, !on);
+        EXPECT_EQ(s.horizonPick, on);
         EXPECT_EQ(s.cacheSlices, on ? 3 : 1);
         // Flare subtracted by the display pass: never a second time in pass 1.
         EXPECT_EQ(s.subtractFlare, on);
