@@ -53,8 +53,9 @@ public:
     // Draws the state's frame into the bound RGBA32F framebuffer (viewport width x height, the
     // whole panel; the surface at its physical size in the middle, black around it; alpha: the
     // illuminance on the panel, lux). The cached diffuse term is drawn at heldTiltRad(), so that
-    // sensor noise on the tilt does not recompute it every frame; the specular term at the
-    // state's tilt and eye.
+    // sensor noise on the tilt does not recompute it every frame (with settings.cacheSlices = K >
+    // 1 a new held tilt shows once its K bands are drawn, K - 1 to 2K - 2 draws later:
+    // BoothShadingPass::draw); the specular term at the state's tilt and eye.
     Expected<void> draw(const scene::SceneState& state, int width, int height);
 
     // The pixels of a width x height frame that can show the surface; draw() writes XYZ (0, 0, 0)
