@@ -755,7 +755,12 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                        layout.offset,
                        layout.scale};
     const int slices = std::max(settings_.cacheSlices, 1);
-    if (!cacheValid_ || (slices == 1 && !(key == cacheKey_))) {
+    // Only a new pose is drawn in bands: the compose places the surface by this draw's layout,
+    // and the facet normals (one texture behind both caches) follow the layout too, so a cache
+    // of another layout or size is no frame to show meanwhile.
+    const bool samePlacement = key.width == cacheKey_.width && key.height == cacheKey_.height &&
+                               key.offset == cacheKey_.offset && key.scale == cacheKey_.scale;
+    if (!cacheValid_ || (!(key == cacheKey_) && (slices == 1 || !samePlacement))) {
         // Drawn whole: the first cache, a new light, size, layout, channels or surround (nothing
         // of the old cache would do), or any change with unsliced refreshes.
         pending_.reset();

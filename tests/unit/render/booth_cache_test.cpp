@@ -314,7 +314,7 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
             (*pass)->setSurroundIlluminance(c.surround);
             ASSERT_TRUE((*pass)->setLight(d65));
         }
-        const SurfaceLayout layout = layoutOnPanel(scene, setup_.stand);
+        SurfaceLayout layout = layoutOnPanel(scene, setup_.stand);
         shading::View view; // the specular term's pose and eye stay put: only the cache moves
         view.panel = shading::panelPoseFromTilt(setup_.stand, 20.0);
         view.eye = {0.05, 0.45, 0.6};
@@ -362,6 +362,15 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         EXPECT_TRUE(sameFrame(frame(s, 23.0), t23));
         EXPECT_FALSE(s.cacheRefreshPending());
         EXPECT_FALSE(sameFrame(t23, w23));
+        // A new layout in the middle of a refresh: drawn whole at once too (the compose places
+        // the surface by the new one, and the facet normals follow it).
+        EXPECT_TRUE(sameFrame(frame(s, 27.0), t23));
+        EXPECT_TRUE(s.cacheRefreshPending());
+        layout.offset.x += 0.125;
+        const auto moved27 = frame(**whole, 27.0);
+        EXPECT_TRUE(sameFrame(frame(s, 27.0), moved27));
+        EXPECT_FALSE(s.cacheRefreshPending());
+        EXPECT_FALSE(sameFrame(moved27, frame(**whole, 23.0)));
     }
 }
 
