@@ -254,6 +254,12 @@ int runMain(const RunOptions& o)
               stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
               stats->droppedLamp, stats->lateFrames, stats->meanOutOfGamutFraction(),
               stats->maxOutOfGamutFraction);
+    const FrameTimes& t = stats->frameTimes;
+    const double periodMs = 1000.0 / o.rateHz;
+    log->info("frame time: mean {:.1f} ms ({:.0f} frames/s), 95th percentile {:.1f}, max {:.1f}; "
+              "{} of {} frames took the whole {:.1f} ms period or more",
+              t.meanMs(), t.meanMs() > 0.0 ? 1000.0 / t.meanMs() : 0.0, t.percentileMs(0.95),
+              t.maxMs(), t.atLeast(periodMs), t.count(), periodMs);
     return code;
 }
 

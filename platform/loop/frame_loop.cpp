@@ -172,6 +172,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             }
         }
 
+        const auto workStart = std::chrono::steady_clock::now();
         freshSpectra.clear();
         freshPoses.clear();
         freshAccel.clear();
@@ -245,6 +246,11 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         if (onFrame) {
             onFrame(record, state, image);
         }
+        const double workMs = std::chrono::duration<double, std::milli>(
+                                      std::chrono::steady_clock::now() - workStart)
+                                      .count();
+        stats.frameTimes.add(workMs);
+        log->debug("frame {}: {:.1f} ms", tick.frameIndex, workMs);
         ++stats.frames;
     }
     if (stats.replayMismatches > 0) {

@@ -11,6 +11,7 @@
 #include <pipeline/base/expected.h>
 #include <pipeline/render/renderer.h>
 #include <platform/appliance.h>
+#include <platform/loop/frame_times.h>
 #include <recordings/recording.h>
 
 namespace replica::platform {
@@ -41,6 +42,9 @@ struct LoopStats {
     std::uint64_t droppedLamp = 0;
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
     std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
+    // Each frame's work on the wall clock, from polling the sources to handing the frame on
+    // (not the wait for its tick): what says whether the machine keeps the rate.
+    FrameTimes frameTimes;
     double sumOutOfGamutFraction = 0.0; // over frames: the display pass's per-frame count
     double maxOutOfGamutFraction = 0.0;
     double meanOutOfGamutFraction() const

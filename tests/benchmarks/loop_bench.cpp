@@ -120,6 +120,33 @@ BENCHMARK(BM_ApplianceFrame)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
 
+// A lamp change in every frame at 960x600 (the appliance's defaults; arg: scene), the tilt still:
+// the hiccup a new lamp costs the running appliance (a new light, the surface re-encoded for it,
+// the cache recomputed whole).
+void BM_ApplianceLampChange(benchmark::State& st)
+{
+    auto* app = appliance(static_cast<int>(st.range(0)), platform::kAutoSpecularSamples,
+                          platform::kDefaultCacheSlices);
+    if (app == nullptr) {
+        st.SkipWithError("no EGL/GLES context or appliance");
+        return;
+    }
+    st.SetLabel(std::string(kScenes[st.range(0)]) + ", tungsten and d65-fluorescent in turn");
+    pipeline::scene::SceneState state;
+    state.tiltRad = 0.35;
+    pipeline::render::RenderedFrame frame;
+    int lamp = 0;
+    for (auto _ : st) {
+        lamp = lamp == 0 ? 2 : 0;
+        state.lampIndex = lamp;
+        state.illuminant = app->booth.lamps[static_cast<std::size_t>(lamp)].spectrum;
+        state.emitterLuminanceCdM2 = app->booth.lamps[static_cast<std::size_t>(lamp)].luminanceCdM2;
+        auto ok = app->renderer->render(state, frame, pipeline::render::Readback::Display);
+        benchmark::DoNotOptimize(ok);
+    }
+}
+BENCHMARK(BM_ApplianceLampChange)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 struct FlatFixture {
     std::unique_ptr<platform::Output> output;
     std::unique_ptr<pipeline::render::Renderer> renderer;

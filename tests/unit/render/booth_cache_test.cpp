@@ -16,7 +16,7 @@
 namespace replica::pipeline::render {
 namespace {
 
-constexpr int kW = 60, kH = 36;
+constexpr int kCacheW = 60, kCacheH = 36;
 
 // Every float of the RGBA32F target (alpha included), rows as GL has them.
 std::vector<float> readAll(const XyzTarget& t)
@@ -62,7 +62,7 @@ protected:
         setup_.settings.lights = 16;
         setup_.settings.specularSamples = 8;
         setup_.settings.subtractFlare = false; // as in the appliance: pass 2 subtracts it
-        auto t = XyzTarget::create(kW, kH);
+        auto t = XyzTarget::create(kCacheW, kCacheH);
         ASSERT_TRUE(t);
         target_ = std::move(*t);
     }
@@ -70,7 +70,7 @@ protected:
     std::vector<float> draw(BoothScenePass& pass, const scene::SceneState& st)
     {
         target_->bind();
-        auto ok = pass.draw(st, kW, kH);
+        auto ok = pass.draw(st, kCacheW, kCacheH);
         EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
         return readAll(*target_);
     }
@@ -108,7 +108,7 @@ TEST_F(BoothCacheTest, AFrameFromTheCacheEqualsOneThatRecomputesIt)
         differ += cached[i] != first[i] ? 1 : 0;
     }
     // The glossy surface does change with the eye (the cache is not hiding the specular term).
-    EXPECT_GT(differ, kW * kH / 10);
+    EXPECT_GT(differ, kCacheW * kCacheH / 10);
 }
 
 TEST_F(BoothCacheTest, TiltNoiseIsHeldAndLightPoseAndInvalidationRefresh)
@@ -195,17 +195,17 @@ TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
     const booth::BoothLight& bl = *light.light;
     double worst = 0.0;
     int outside = 0;
-    for (int y = 0; y < kH; y += 5) {
-        for (int x = 0; x < kW; x += 7) {
-            const double u = layout.offset.x + layout.scale.x * (x + 0.5) / kW;
-            const double v = layout.offset.y + layout.scale.y * (1.0 - (y + 0.5) / kH);
+    for (int y = 0; y < kCacheH; y += 5) {
+        for (int x = 0; x < kCacheW; x += 7) {
+            const double u = layout.offset.x + layout.scale.x * (x + 0.5) / kCacheW;
+            const double v = layout.offset.y + layout.scale.y * (1.0 - (y + 0.5) / kCacheH);
             outside += (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) ? 1 : 0;
             const shading::Vec3 p = panel.centre + panel.right * ((u - 0.5) * setup_.scene.widthM) +
                                     panel.up * ((0.5 - v) * setup_.scene.heightM);
             const double e = shading::pointLightIrradiance(
                     light.points, bl.normal(), bl.texelAreaM2(), p, panel.normal, panel.normal,
                     nullptr, 0, 0, panel.right, panel.up, 0.0);
-            const float got = px[(static_cast<std::size_t>(y) * kW + x) * 4 + 3];
+            const float got = px[(static_cast<std::size_t>(y) * kCacheW + x) * 4 + 3];
             ASSERT_GT(e, 0.0);
             worst = std::max(worst, std::abs(got - e) / e);
         }
@@ -318,13 +318,13 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         shading::View view; // the specular term's pose and eye stay put: only the cache moves
         view.panel = shading::panelPoseFromTilt(setup_.stand, 20.0);
         view.eye = {0.05, 0.45, 0.6};
-        view.pixelsX = kW;
-        view.pixelsY = kH;
+        view.pixelsX = kCacheW;
+        view.pixelsY = kCacheH;
         const auto frame = [&](const BoothShadingPass& pass, double cacheTiltDeg) {
             const shading::PanelPose cachePose =
                     shading::panelPoseFromTilt(setup_.stand, cacheTiltDeg);
             target_->bind();
-            auto ok = pass.draw(view, kW, kH, layout, &cachePose);
+            auto ok = pass.draw(view, kCacheW, kCacheH, layout, &cachePose);
             EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
             return readAll(*target_);
         };
@@ -336,7 +336,7 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         for (std::size_t i = 0; i < w20.size(); ++i) {
             moved += w20[i] != w23[i] ? 1 : 0;
         }
-        EXPECT_GT(moved, kW * kH / 2); // the cache's pose shows in the frame
+        EXPECT_GT(moved, kCacheW * kCacheH / 2); // the cache's pose shows in the frame
         BoothShadingPass& s = **sliced;
         EXPECT_TRUE(sameFrame(frame(s, 20.0), w20)); // the first cache is drawn whole
         EXPECT_EQ(s.cacheRefreshes(), 1);
@@ -381,17 +381,17 @@ TEST_F(BoothCacheTest, WithoutTheSurroundOnlyTheSurfaceRectangleIsShaded)
     ASSERT_TRUE(with && without);
     EXPECT_TRUE((*with)->surroundIlluminance()); // the default
     (*without)->setSurroundIlluminance(false);
-    const PixelRect r = (*with)->surfaceRect(kW, kH);
+    const PixelRect r = (*with)->surfaceRect(kCacheW, kCacheH);
     ASSERT_GT(r.width, 0);
-    ASSERT_LT(r.width * r.height, kW * kH); // the surface does not fill the panel
-    for (const double tilt : {0.35, 0.6}) { // the second recomputes the cache
+    ASSERT_LT(r.width * r.height, kCacheW * kCacheH); // the surface does not fill the panel
+    for (const double tilt : {0.35, 0.6}) {           // the second recomputes the cache
         const auto st = state(tilt, {0.1, 0.5, 0.5});
         const auto a = draw(**with, st);
         const auto b = draw(**without, st);
         long inside = 0, outsideLit = 0;
-        for (int y = 0; y < kH; ++y) {
-            for (int x = 0; x < kW; ++x) {
-                const std::size_t i = (static_cast<std::size_t>(y) * kW + x) * 4;
+        for (int y = 0; y < kCacheH; ++y) {
+            for (int x = 0; x < kCacheW; ++x) {
+                const std::size_t i = (static_cast<std::size_t>(y) * kCacheW + x) * 4;
                 const bool in = x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height;
                 if (in) {
                     ++inside;
@@ -422,10 +422,10 @@ TEST_F(BoothCacheTest, WithoutTheSurroundOnlyTheSurfaceRectangleIsShaded)
     (*without)->setSurroundIlluminance(false);
     const auto off = draw(**without, st);
     EXPECT_EQ((*without)->cacheRefreshes(), 4);
-    for (int y = 0; y < kH; ++y) {
-        for (int x = 0; x < kW; ++x) {
+    for (int y = 0; y < kCacheH; ++y) {
+        for (int x = 0; x < kCacheW; ++x) {
             if (!(x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height)) {
-                ASSERT_EQ(off[(static_cast<std::size_t>(y) * kW + x) * 4 + 3], 0.0f)
+                ASSERT_EQ(off[(static_cast<std::size_t>(y) * kCacheW + x) * 4 + 3], 0.0f)
                         << x << ", " << y;
             }
         }
