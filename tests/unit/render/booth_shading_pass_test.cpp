@@ -80,6 +80,15 @@ protected:
         output_ = std::move(*out);
     }
 
+    // The default settings with the painting's specular sample count: what the horizon tests
+    // below vary one setting of.
+    static shading::RenderSettings paintingSettings()
+    {
+        shading::RenderSettings settings;
+        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        return settings;
+    }
+
     static shading::View view(int w, int h, double tiltDeg = 30.0)
     {
         shading::View v;
@@ -261,8 +270,7 @@ TEST_F(BoothPassTest, HorizonSpreadOnAndOffMatchesTheCpuModel)
     // 10-degree tilt, where the ceiling grazes the panel and the spread matters most.
     const shading::View v = view(64, 40, 10.0);
     for (const bool spread : {true, false}) {
-        shading::RenderSettings settings;
-        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        shading::RenderSettings settings = paintingSettings();
         settings.horizonSpread = spread;
         expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
                                  spread ? "spread" : "no spread");
@@ -278,8 +286,7 @@ TEST_F(BoothPassTest, HorizonEncodingsAndLookupsMatchTheCpuModel)
     const shading::View v = view(64, 40, 10.0);
     for (const bool half : {true, false}) {
         for (const bool bilinear : {true, false}) {
-            shading::RenderSettings settings;
-            settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+            shading::RenderSettings settings = paintingSettings();
             settings.horizonHalf = half;
             settings.horizonBilinear = bilinear;
             expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
@@ -289,8 +296,7 @@ TEST_F(BoothPassTest, HorizonEncodingsAndLookupsMatchTheCpuModel)
     }
     // Direction counts that fill a layer partly (4 and 12 of 8 a layer) or span several (20).
     for (const int dirs : {4, 12, 20}) {
-        shading::RenderSettings settings;
-        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        shading::RenderSettings settings = paintingSettings();
         settings.horizonDirections = dirs;
         expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
                                  "half horizons, " + std::to_string(dirs) + " directions");
@@ -305,15 +311,13 @@ TEST_F(BoothPassTest, HorizonPickAndTentWeightsBothMatchTheCpuModel)
     // or an odd number.
     const shading::View v = view(64, 40, 10.0);
     for (const bool pick : {true, false}) {
-        shading::RenderSettings settings;
-        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        shading::RenderSettings settings = paintingSettings();
         settings.horizonPick = pick;
         expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
                                  pick ? "picked directions" : "tent weights");
     }
     for (const int dirs : {1, 3}) {
-        shading::RenderSettings settings;
-        settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
+        shading::RenderSettings settings = paintingSettings();
         settings.horizonDirections = dirs;
         expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
                                  "picked from " + std::to_string(dirs) + " directions");
@@ -324,21 +328,24 @@ TEST_F(BoothPassTest, HorizonPickAndTentWeightsBothMatchTheCpuModel)
     // llvmpipe 15); recorded as a setting all the same, so that a compiler that fuses otherwise
     // cannot change an old recording's frames. Tilts that put lights on every side of a facet's
     // azimuth, direction 0 (the wrap) included.
+    const auto ps = shading::prepareScene(scenes_.at("painting"),
+                                          paintingSettings().horizonDirections, 0.01, *basis_);
+    const auto pl =
+            shading::prepareLight(booth_->lights[0], *obs_, paintingSettings().lights, *basis_);
+    std::vector<std::unique_ptr<BoothShadingPass>> passes; // the pick, then the tent weights
+    for (const bool pick : {true, false}) {
+        shading::RenderSettings settings = paintingSettings();
+        settings.horizonPick = pick;
+        auto pass = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_TRUE(pass) << pass.error().message;
+        ASSERT_TRUE((*pass)->setLight(pl));
+        passes.push_back(std::move(*pass));
+    }
     long pixels = 0, exact = 0;
     for (const double tilt : {10.0, 40.0, 110.0}) {
         std::vector<shading::XyzFrame> frames;
-        for (const bool pick : {true, false}) {
-            shading::RenderSettings settings;
-            settings.specularSamples = shading::defaultSpecularSamples(scenes_.at("painting"));
-            settings.horizonPick = pick;
-            const auto ps = shading::prepareScene(scenes_.at("painting"),
-                                                  settings.horizonDirections, 0.01, *basis_);
-            auto pass = BoothShadingPass::create(ps, settings, *obs_);
-            ASSERT_TRUE(pass) << pass.error().message;
-            const auto pl =
-                    shading::prepareLight(booth_->lights[0], *obs_, settings.lights, *basis_);
-            ASSERT_TRUE((*pass)->setLight(pl));
-            auto gl = renderBoothFrame(**pass, pl, view(160, 100, tilt));
+        for (const auto& pass : passes) {
+            auto gl = renderBoothFrame(*pass, pl, view(160, 100, tilt));
             ASSERT_TRUE(gl) << gl.error().message;
             frames.push_back(std::move(*gl));
         }
