@@ -31,7 +31,7 @@ public:
 
 private:
     static constexpr std::size_t kBins = static_cast<std::size_t>(kTopMs / kBinMs);
-    std::array<std::uint32_t, kBins> bins_{};
+    std::array<std::uint64_t, kBins> bins_{}; // 64-bit: a bin never wraps, however long the run
     std::uint64_t count_ = 0;
     double sumMs_ = 0.0;
     double maxMs_ = 0.0;
