@@ -601,7 +601,6 @@ Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
     bool complete = true;
     for (int b = 0; b < buffers; ++b) {
         CacheBuffer& c = caches_[static_cast<std::size_t>(b)];
-        glActiveTexture(GL_TEXTURE0 + kUnitCache);
         c.texture = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
         glBindTexture(GL_TEXTURE_2D, 0);
         glGenFramebuffers(1, &c.fbo);
