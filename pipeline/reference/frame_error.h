@@ -1,21 +1,11 @@
-// CIELAB / CIEDE2000 and the per-frame error statistics the sweep reports against the reference.
+// The per-frame CIEDE2000 error statistics the sweep reports against the reference. CIELAB and
+// CIEDE2000 themselves are colour::xyzToLab and colour::ciede2000 (pipeline/colour/).
 #pragma once
 
 #include <pipeline/colour/xyz.h>
 #include <pipeline/shading/frame.h>
 
 namespace replica::pipeline::reference {
-
-struct Lab {
-    double l = 0.0, a = 0.0, b = 0.0;
-};
-
-// CIELAB with the cube-root branch at (6/29)^3 = 216/24389; white must have Y > 0 (else black).
-Lab xyzToLab(const colour::Xyz& xyz, const colour::Xyz& white);
-
-// CIEDE2000 (Sharma, Wu & Dalal 2005 formulation), kL = kC = kH = 1; handles zero chroma and the
-// hue wrap-around.
-double ciede2000(const Lab& a, const Lab& b);
 
 struct FrameError {
     double mean = 0.0;

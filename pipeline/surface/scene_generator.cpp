@@ -7,8 +7,9 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/colour/ciede2000.h>
+#include <pipeline/colour/cielab.h>
 #include <pipeline/colour/spectral_table.h>
-#include <pipeline/reference/frame_error.h>
 #include <pipeline/surface/scene_generator.h>
 
 namespace replica::pipeline::surface {
@@ -164,9 +165,9 @@ Expected<SurfaceScene> metamerTarget(const std::filesystem::path& dataDir)
                     }
                 }
                 const colour::Spectrum r2 = r1 + black * (0.9 * std::max(scale, 0.0));
-                const double de = reference::ciede2000(
-                        reference::xyzToLab(colour::reflectanceToXyz(*obs, a, r1), whiteA),
-                        reference::xyzToLab(colour::reflectanceToXyz(*obs, a, r2), whiteA));
+                const double de = colour::ciede2000(
+                        colour::xyzToLab(colour::reflectanceToXyz(*obs, a, r1), whiteA),
+                        colour::xyzToLab(colour::reflectanceToXyz(*obs, a, r2), whiteA));
                 if (de > bestDe) {
                     bestDe = de;
                     bestR2 = r2;

@@ -12,11 +12,11 @@
 #include <pipeline/image/exr.h>
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/render/booth_shading_pass.h>
-#include <pipeline/shading/planner.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/surface/scene.h>
+#include <pipeline/tuning/planner.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/output/output.h>

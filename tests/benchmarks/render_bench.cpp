@@ -26,9 +26,9 @@
 #include <pipeline/reference/frame_error.h>
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/render/booth_shading_pass.h>
-#include <pipeline/shading/planner.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/tuning/planner.h>
 #include <platform/image/png_writer.h>
 #include <platform/output/output.h>
 

@@ -25,6 +25,13 @@ TEST(Cielab, ExactConstants)
     EXPECT_NEAR(onLine.L, 8.0, 1e-12);
 }
 
+TEST(Cielab, LinearBranchBelowEpsilonIsKappaTimesY)
+{
+    // Y/Yn = 0.001 < 216/24389: L* = (24389/27) * Y/Yn on the straight line, not the cube root.
+    const Xyz white{95.047, 100.0, 108.883};
+    EXPECT_NEAR(xyzToLab(white * 0.001, white).L, 903.2962962962963 * 0.001, 1e-9);
+}
+
 TEST(Cielab, PublishedExampleAgainstD65)
 {
     // colour-science 0.4 documentation example (XYZ_to_Lab and XYZ_to_xyY of the same colour).

@@ -10,8 +10,9 @@
 #include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/colour/ciede2000.h>
+#include <pipeline/colour/cielab.h>
 #include <pipeline/image/exr.h>
-#include <pipeline/reference/frame_error.h>
 
 #include <gtest/gtest.h>
 
@@ -103,8 +104,8 @@ TEST(RenderCli, AdaptiveBasisIsTheDefaultAndCloserToTheReferenceOnTheMetamer)
         EXPECT_TRUE(a);
         double sum = 0.0;
         for (std::size_t k = 0; a && k < a->planes[1].size(); ++k) {
-            sum += pipeline::reference::ciede2000(pipeline::reference::xyzToLab(xyz(*a, k), white),
-                                                  pipeline::reference::xyzToLab(xyz(*b, k), white));
+            sum += pipeline::colour::ciede2000(pipeline::colour::xyzToLab(xyz(*a, k), white),
+                                               pipeline::colour::xyzToLab(xyz(*b, k), white));
         }
         return a ? sum / static_cast<double>(a->planes[1].size()) : 1e9;
     };

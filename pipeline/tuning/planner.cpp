@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include <pipeline/reference/reference_integrator.h>
-#include <pipeline/shading/planner.h>
+#include <pipeline/tuning/planner.h>
 
 namespace replica::pipeline::shading {
 
