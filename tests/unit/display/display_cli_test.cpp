@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/display/cgats.h>
 
 #include <gtest/gtest.h>
 
@@ -195,6 +196,48 @@ TEST_F(DisplayCli, FitFailsClearlyOnDegenerateSets)
     EXPECT_EQ(header.exitCode, 1);
     EXPECT_NE(header.err.find("h.csv:1: header must be R,G,B,X,Y,Z"), std::string::npos)
             << header.err;
+}
+
+TEST_F(DisplayCli, FitsArgyllReadingsAndWritesAnIccProfile)
+{
+    // The shipped set as dispread would have written it: the same fit as from the CSV.
+    auto set = loadMeasurementCsv(shippedMeasurements());
+    ASSERT_TRUE(set.has_value());
+    const std::string ti3 = write("m.ti3", ti3Text(set->rows, 8, "test"));
+    const std::string fromTi3 = (dir_ / "a.json").string();
+    const std::string fromCsv = (dir_ / "b.json").string();
+    const std::string icc = (dir_ / "a.icc").string();
+    const auto a = run("display fit " + ti3 + " --out " + fromTi3 + " --icc " + icc);
+    ASSERT_EQ(a.exitCode, 0) << a.err;
+    // The shipped panel has 0.5 % channel interaction, which the check now tells from noise.
+    EXPECT_NE(a.out.find("NOT additive: channel interaction beyond the noise"), std::string::npos)
+            << a.out;
+    EXPECT_NE(a.out.find("meter noise (from the ramps' residuals)"), std::string::npos) << a.out;
+    const auto b = run("display fit " + shippedMeasurements() + " --out " + fromCsv + " --json");
+    ASSERT_EQ(b.exitCode, 0) << b.err;
+    const auto j = nlohmann::json::parse(b.out);
+    EXPECT_TRUE(j.at("additive_within_noise").is_boolean());
+    EXPECT_GT(j.at("noise_percent").get<double>(), 0.1);
+    EXPECT_LT(j.at("noise_percent").get<double>(), 0.4);
+    const auto fa = run("display forward " + fromTi3 + " --rgb 120,80,200 --json");
+    const auto fb = run("display forward " + fromCsv + " --rgb 120,80,200 --json");
+    ASSERT_EQ(fa.exitCode, 0) << fa.err;
+    const auto xa = nlohmann::json::parse(fa.out).at("xyz");
+    const auto xb = nlohmann::json::parse(fb.out).at("xyz");
+    for (int k = 0; k < 3; ++k) {
+        // The .ti3 carries XYZ to 8 significant digits, the CSV to 6 decimals.
+        EXPECT_NEAR(xa[k].get<double>(), xb[k].get<double>(), 1e-4 * xb[k].get<double>());
+    }
+    EXPECT_TRUE(std::filesystem::exists(icc));
+    EXPECT_GT(std::filesystem::file_size(icc), 1000u);
+
+    // A cut-short .ti3 names its line.
+    std::string text = ti3Text(set->rows, 8, "test");
+    text.resize(text.find("END_DATA\n"));
+    const auto bad = run("display fit " + write("cut.ti3", text) + " --out " + fromTi3);
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("cut.ti3:"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("BEGIN_DATA without END_DATA"), std::string::npos) << bad.err;
 }
 
 TEST_F(DisplayCli, StudyNamesThePapersOutOfGamutPatchesUnderTungsten)
