@@ -22,6 +22,7 @@
 #include <pipeline/display/synthetic_display.h>
 #include <pipeline/display/viewing_angle_csv.h>
 #include <platform/cli/commands.h>
+#include <platform/cli/display_patches.h>
 #include <platform/logging.h>
 
 namespace replica::platform {
@@ -610,6 +611,33 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
                      "ColorChecker colours");
     addStudyOptions(flareCmd, *flare);
     flareCmd->callback([flare, &exitCode] { exitCode = flareMain(*flare); });
+
+    auto pat = std::make_shared<PatchesOptions>();
+    auto* patCmd = display->add_subcommand(
+            "patches", "show a patch set (.ti1) patch by patch and collect one reading each, from "
+                       "ArgyllCMS spotread or typed X Y Z, into a .ti3 (resumed when it exists)");
+    patCmd->add_option("set", pat->set, "patch set, ArgyllCMS .ti1 (targen's, or --make-set's)");
+    patCmd->add_option("--out", pat->out, "readings to write, .ti3 (rewritten after each)");
+    patCmd->add_option("--show-dir", pat->showDir,
+                       "headless display: the patch on show as DIR/patch.png and DIR/patch.txt");
+    patCmd->add_option("--spotread", pat->spotread,
+                       "meter command, e.g. 'spotread -e -x' (one key press per reading, parsed "
+                       "from its 'Result is XYZ:' line); without it X Y Z are read from stdin");
+    patCmd->add_option("--settle-ms", pat->settleMs, "wait after showing each patch (ms)")
+            ->capture_default_str();
+    patCmd->add_option("--bits", pat->bits, "panel bit depth")
+            ->check(CLI::Range(1, 16))
+            ->capture_default_str();
+    patCmd->add_option("--make-set", pat->makeSet,
+                       "write the default set (3 blacks, R, G, B ramps every --step counts, 2 "
+                       "whites, --colours random colours) to this .ti1 and stop");
+    patCmd->add_option("--step", pat->step, "ramp step for --make-set")
+            ->check(CLI::Range(1, 64))
+            ->capture_default_str();
+    patCmd->add_option("--colours", pat->colours, "random colours for --make-set")
+            ->check(CLI::Range(6, 10000))
+            ->capture_default_str();
+    patCmd->callback([pat, &exitCode] { exitCode = patchesMain(*pat); });
 
     auto syn = std::make_shared<DisplayOptions>();
     auto* synCmd = display->add_subcommand(
