@@ -2,6 +2,12 @@
 // rows, tone curves re-derived from the R, G and B ramps for each candidate matrix, and the matrix
 // chosen to minimise the mean CIEDE2000 over half of the off-ramp colours; the other half is held
 // out for the reported accuracy. Degenerate sets fail with a message saying what to measure.
+//
+// The tone curves average the meter's noise (pipeline/display/tone_fit.h: GOG, GOGO, or GOGO plus a
+// smoothing spline, chosen per channel by cross-validation) and the primaries' directions come from
+// every ramp reading above a fifth of full drive, not from the one full-drive reading. The
+// interpolating fit of the first profiles (every ramp reading interpolated; the shipped synthetic
+// profile) stays as ToneMethod::Interpolate.
 #pragma once
 
 #include <string>
@@ -11,6 +17,11 @@
 #include <pipeline/display/measurement_set.h>
 
 namespace replica::pipeline::display {
+
+enum class ToneMethod {
+    Robust,      // noise-averaging tone curves, primaries from the whole ramps
+    Interpolate, // monotone interpolation through every ramp reading, primaries at full drive
+};
 
 struct FitOptions {
     std::string name = "display";
@@ -22,6 +33,11 @@ struct FitOptions {
     double monotonicTolerance = 0.02;   // a ramp may dip by this fraction of its range (noise)
     double deadChannelFraction = 0.005; // X+Y+Z of a primary below this share of all three: dead
     int maxEvaluations = 4000; // Nelder-Mead evaluations of the matrix; 0 keeps direct primaries
+    ToneMethod toneMethod = ToneMethod::Robust;
+    // Robust: reading weights 1 / (v^2 + (floor v_full)^2), a relative noise with an absolute
+    // floor at this share of full drive.
+    double noiseFloor = 0.002;
+    int bootstrapReplicates = 24; // for the inverse's expected error in counts
 };
 
 Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& options);

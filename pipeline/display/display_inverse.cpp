@@ -54,7 +54,9 @@ double DisplayInverse::countsFromLinear(int channel, double r, ToneInverse tone)
     const auto j = static_cast<std::size_t>(
             std::clamp(std::floor(pos), 0.0, static_cast<double>(lutSize_ - 2)));
     const double f = pos - static_cast<double>(j);
-    return (lut[j] + f * (lut[j + 1] - lut[j])) * model_.maxCount();
+    // lut[j] + 1 * (lut[j + 1] - lut[j]) can round past lut[j + 1] at the table's top.
+    return std::clamp((lut[j] + f * (lut[j + 1] - lut[j])) * model_.maxCount(), 0.0,
+                      model_.maxCount());
 }
 
 InverseResult DisplayInverse::invert(const glm::dvec3& xyz, GamutMode mode, ToneInverse tone) const

@@ -32,6 +32,18 @@ struct FitReport {
     std::array<double, 3> chromaticityDrift{};   // max |dxy| of each primary along its ramp
     int monotonicCorrections = 0;                // ramp points moved by pool-adjacent-violators
     int optimiserEvaluations = 0;
+    // The noise-robust fit (absent, -1 / empty, for the interpolating fit of format 1 profiles):
+    double noisePercent =
+            -1.0; // meter noise per XYZ component, % of the reading, from ramp residuals
+    std::array<std::string, 3> toneShape{};   // per channel: gog, gogo or gogo+spline
+    std::array<double, 3> toneSmoothing{};    // the spline's cross-validated penalty (relative)
+    std::array<double, 3> inverseCountsRms{}; // expected inverse error (1 sigma) in counts, rms
+                                              // over the counts where r >= 0.1 % of full
+    std::array<double, 3> inverseCountsMax{}; // and its maximum (where r >= 0.1 % of full)
+    double heldOutNoiseMeanDe00 = -1.0;       // mean dE00 the held-out readings' noise alone gives
+    double additivityLuminanceSigmaPercent = -1.0; // 1 sigma of the luminance check from the noise
+    double additivityNoiseDe00 = -1.0; // 99th percentile of the dE00 the noise alone gives
+    bool additiveWithinNoise = false;
 };
 
 struct DisplayModel {

@@ -65,6 +65,19 @@ std::string profileToJson(const DisplayModel& m)
                 {"chromaticity_drift", f.chromaticityDrift},
                 {"monotonic_corrections", f.monotonicCorrections},
                 {"optimiser_evaluations", f.optimiserEvaluations}};
+    if (f.noisePercent >= 0.0) {
+        // The noise-robust fit's report (absent from profiles made by the interpolating fit).
+        auto& jf = j["fit"];
+        jf["noise_percent"] = f.noisePercent;
+        jf["tone_shape"] = f.toneShape;
+        jf["tone_smoothing"] = f.toneSmoothing;
+        jf["inverse_counts_rms"] = f.inverseCountsRms;
+        jf["inverse_counts_max"] = f.inverseCountsMax;
+        jf["held_out_noise_mean_de00"] = f.heldOutNoiseMeanDe00;
+        jf["additivity_luminance_sigma_percent"] = f.additivityLuminanceSigmaPercent;
+        jf["additivity_noise_de00"] = f.additivityNoiseDe00;
+        jf["additive_within_noise"] = f.additiveWithinNoise;
+    }
     return j.dump(2) + "\n";
 }
 
@@ -139,6 +152,18 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
             }
             m.fit.monotonicCorrections = f.value("monotonic_corrections", 0);
             m.fit.optimiserEvaluations = f.value("optimiser_evaluations", 0);
+            if (f.contains("noise_percent")) {
+                m.fit.noisePercent = f.at("noise_percent").get<double>();
+                m.fit.toneShape = f.at("tone_shape").get<std::array<std::string, 3>>();
+                m.fit.toneSmoothing = f.at("tone_smoothing").get<std::array<double, 3>>();
+                m.fit.inverseCountsRms = f.at("inverse_counts_rms").get<std::array<double, 3>>();
+                m.fit.inverseCountsMax = f.at("inverse_counts_max").get<std::array<double, 3>>();
+                m.fit.heldOutNoiseMeanDe00 = f.value("held_out_noise_mean_de00", -1.0);
+                m.fit.additivityLuminanceSigmaPercent =
+                        f.value("additivity_luminance_sigma_percent", -1.0);
+                m.fit.additivityNoiseDe00 = f.value("additivity_noise_de00", -1.0);
+                m.fit.additiveWithinNoise = f.value("additive_within_noise", false);
+            }
         }
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("{}: {}", source, e.what()));

@@ -41,6 +41,15 @@ double SyntheticDisplay::toneResponse(int channel, double counts) const
     const auto c = static_cast<std::size_t>(channel);
     const double maxCount = std::ldexp(1.0, bitDepth) - 1.0;
     const double x = std::clamp(counts / maxCount, 0.0, 1.0);
+    if (tone == SyntheticTone::Gog) {
+        const double u = gogGain[c] * x + (1.0 - gogGain[c]);
+        return u > 0.0 ? std::pow(u, gamma[c]) : 0.0;
+    }
+    if (tone == SyntheticTone::Srgb) {
+        // Continuous at the break: the toe's slope matches the power segment's value there.
+        const double knee = std::pow((0.04045 + 0.055) / 1.055, gamma[c]);
+        return x <= 0.04045 ? x * knee / 0.04045 : std::pow((x + 0.055) / 1.055, gamma[c]);
+    }
     const double shaped = x + sShape[c] * x * (1.0 - x) * (x - 0.5);
     return std::pow(std::max(shaped, 0.0), gamma[c]);
 }
@@ -128,6 +137,58 @@ syntheticMeasurements(const SyntheticDisplay& display, const MeterNoise& noise, 
     // The fit alternates off-ramp colours between training and held-out, so both halves sample
     // the grid and the random colours.
     for (const auto& p : colours) {
+        patches.push_back(p);
+    }
+    std::vector<Measurement> out;
+    out.reserve(patches.size());
+    for (const auto& p : patches) {
+        Measurement m;
+        m.counts = p;
+        const glm::dvec3 truth = display.forward(p);
+        for (int c = 0; c < 3; ++c) {
+            const double sigma = noise.relative * std::abs(truth[c]) + noise.absoluteCdM2;
+            m.xyz[c] = truth[c] + sigma * gaussian(rng);
+        }
+        out.push_back(m);
+    }
+    return out;
+}
+
+std::vector<Measurement> syntheticSession(const SyntheticDisplay& display,
+                                          const MeterNoise& noise,
+                                          const SessionPlan& plan,
+                                          std::uint64_t seed)
+{
+    std::mt19937_64 rng(seed);
+    const double maxCount = std::ldexp(1.0, display.bitDepth) - 1.0;
+    std::vector<glm::dvec3> patches;
+    for (int i = 0; i < plan.blackRepeats; ++i) {
+        patches.emplace_back(0.0);
+    }
+    std::vector<double> levels;
+    for (double v = plan.rampStep; v < maxCount; v += plan.rampStep) {
+        levels.push_back(v);
+    }
+    levels.push_back(maxCount);
+    for (int c = 0; c < (plan.greyRamp ? 4 : 3); ++c) {
+        for (double v : levels) {
+            glm::dvec3 p(0.0);
+            if (c == 3) {
+                p = glm::dvec3(v);
+            } else {
+                p[c] = v;
+            }
+            patches.push_back(p);
+        }
+    }
+    for (int i = plan.greyRamp ? 1 : 0; i < plan.whiteRepeats; ++i) {
+        patches.emplace_back(maxCount);
+    }
+    for (int i = 0; i < plan.randomColours; ++i) {
+        glm::dvec3 p;
+        for (int c = 0; c < 3; ++c) {
+            p[c] = std::floor(static_cast<double>(rng() >> 11) * 0x1.0p-53 * (maxCount + 1.0));
+        }
         patches.push_back(p);
     }
     std::vector<Measurement> out;

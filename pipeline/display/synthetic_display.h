@@ -14,11 +14,20 @@
 
 namespace replica::pipeline::display {
 
+// How a synthetic channel's tone response is shaped.
+enum class SyntheticTone {
+    Power, // (x + s x (1 - x)(x - 0.5))^gamma: a power law, S-shaped for s > 0
+    Gog,   // (gain x + 1 - gain)^gamma, zero below: Berns's gain-offset-gamma
+    Srgb,  // linear toe to 0.04045 then ((x + 0.055) / 1.055)^gamma: the sRGB shape
+};
+
 struct SyntheticDisplay {
     int bitDepth = 8;
-    std::array<glm::dvec2, 3> primaryXy{}; // chromaticities of R, G, B
-    glm::dvec2 whiteXy{0.3127, 0.3290};    // at full drive
-    double whiteCdM2 = 900.0;              // above black
+    SyntheticTone tone = SyntheticTone::Power;
+    std::array<double, 3> gogGain{1.0, 1.0, 1.0}; // SyntheticTone::Gog
+    std::array<glm::dvec2, 3> primaryXy{};        // chromaticities of R, G, B
+    glm::dvec2 whiteXy{0.3127, 0.3290};           // at full drive
+    double whiteCdM2 = 900.0;                     // above black
     glm::dvec3 blackXyz{0.0};
     std::array<double, 3> gamma{2.2, 2.2, 2.2};
     std::array<double, 3> sShape{0.0, 0.0, 0.0}; // x + s x (1 - x)(x - 0.5) before the power
@@ -48,5 +57,20 @@ struct MeterNoise {
 // seed).
 std::vector<Measurement>
 syntheticMeasurements(const SyntheticDisplay& display, const MeterNoise& noise, std::uint64_t seed);
+
+// A measurement session of another plan: black 'blackRepeats' times, R, G and B ramps every
+// 'rampStep' counts and full drive, white 'whiteRepeats' times, a grey ramp when asked, and
+// 'randomColours' pseudo-random colours, each read once through the meter noise.
+struct SessionPlan {
+    int rampStep = 5;
+    int blackRepeats = 5;
+    int whiteRepeats = 1;
+    bool greyRamp = false;
+    int randomColours = 60;
+};
+std::vector<Measurement> syntheticSession(const SyntheticDisplay& display,
+                                          const MeterNoise& noise,
+                                          const SessionPlan& plan,
+                                          std::uint64_t seed);
 
 } // namespace replica::pipeline::display

@@ -13,13 +13,16 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/channel_basis.h>
+#include <pipeline/display/cgats.h>
 #include <pipeline/display/colorchecker_study.h>
 #include <pipeline/display/display_fit.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
+#include <pipeline/display/icc_profile.h>
 #include <pipeline/display/synthetic_display.h>
 #include <pipeline/display/viewing_angle_csv.h>
 #include <platform/cli/commands.h>
+#include <platform/cli/display_patches.h>
 #include <platform/logging.h>
 
 namespace replica::platform {
@@ -44,6 +47,8 @@ struct DisplayOptions {
     std::string flare = "subtract";
     std::string panel = "model";
     std::string basis = "replica_k6";
+    std::string tone = "robust";
+    std::string icc;
 };
 
 // The shipped profile, where a command takes the profile as an option.
@@ -88,7 +93,7 @@ int fitMain(const DisplayOptions& o)
         log->error("--measured-in {}: expected 'dark' or 'lit-booth'", o.measuredIn);
         return kExitUsage;
     }
-    auto set = pd::loadMeasurementCsv(o.measurements, o.bits);
+    auto set = pd::loadMeasurements(o.measurements, o.bits);
     if (!set) {
         log->error("{}", set.error().message);
         return kExitFailure;
@@ -96,6 +101,7 @@ int fitMain(const DisplayOptions& o)
     pd::FitOptions fo;
     fo.name = o.name.empty() ? std::filesystem::path(o.out).stem().string() : o.name;
     fo.synthetic = o.synthetic;
+    fo.toneMethod = o.tone == "interpolate" ? pd::ToneMethod::Interpolate : pd::ToneMethod::Robust;
     fo.condition = o.measuredIn == "dark" ? pd::MeasurementCondition::Dark
                                           : pd::MeasurementCondition::LitBooth;
     fo.description = fmt::format("fitted by 'replica display fit' from {} ({} rows, {}-bit){}",
@@ -122,25 +128,70 @@ int fitMain(const DisplayOptions& o)
         log->error("{}", ok.error().message);
         return kExitFailure;
     }
+    if (!o.icc.empty()) {
+        auto icc = pd::writeIccProfile(*model, o.icc);
+        if (!icc) {
+            log->error("{}", icc.error().message);
+            return kExitFailure;
+        }
+        if (icc->blackClipped) {
+            log->warn("{}: black lies outside the primaries' triangle; the ICC profile's black is "
+                      "the nearest the matrix/TRC form holds",
+                      o.icc);
+        }
+    }
     const auto& f = model->fit;
     if (o.json) {
-        fmt::print("{}\n", nlohmann::json{{"profile", o.out},
-                                          {"held_out_colours", f.heldOutColours},
-                                          {"held_out_mean_de00", f.heldOutMeanDe00},
-                                          {"held_out_p90_de00", f.heldOutP90De00},
-                                          {"held_out_max_de00", f.heldOutMaxDe00},
-                                          {"additivity_de00", f.additivityDe00}}
-                                   .dump());
+        fmt::print("{}\n",
+                   nlohmann::json{{"profile", o.out},
+                                  {"held_out_colours", f.heldOutColours},
+                                  {"held_out_mean_de00", f.heldOutMeanDe00},
+                                  {"held_out_p90_de00", f.heldOutP90De00},
+                                  {"held_out_max_de00", f.heldOutMaxDe00},
+                                  {"additivity_de00", f.additivityDe00},
+                                  {"additivity_luminance_percent", f.additivityLuminancePercent},
+                                  {"additivity_noise_de00", f.additivityNoiseDe00},
+                                  {"additivity_luminance_sigma_percent",
+                                   f.additivityLuminanceSigmaPercent},
+                                  {"additive_within_noise", f.additiveWithinNoise},
+                                  {"noise_percent", f.noisePercent},
+                                  {"held_out_noise_mean_de00", f.heldOutNoiseMeanDe00},
+                                  {"tone_shape", f.toneShape},
+                                  {"inverse_counts_rms", f.inverseCountsRms},
+                                  {"inverse_counts_max", f.inverseCountsMax}}
+                           .dump());
     } else {
         const glm::dvec3 w = model->whiteXyz();
-        fmt::print("profile: {}\n", o.out);
+        fmt::print("profile: {}{}\n", o.out,
+                   o.icc.empty() ? std::string() : fmt::format(" (and ICC v4: {})", o.icc));
         fmt::print("white {:.1f} cd/m^2, black {:.3f} cd/m^2, {}-bit\n", w.y, model->blackXyz.y,
                    model->bitDepth);
         fmt::print("held-out dE00 over {} colours: mean {:.3f}, 90th {:.3f}, max {:.3f} "
                    "(direct primaries: mean {:.3f}; training mean {:.3f})\n",
                    f.heldOutColours, f.heldOutMeanDe00, f.heldOutP90De00, f.heldOutMaxDe00,
                    f.directPrimariesHeldOutMeanDe00, f.trainingMeanDe00);
-        if (f.additivityDe00 >= 0.0) {
+        if (f.noisePercent >= 0.0) {
+            fmt::print(
+                    "meter noise (from the ramps' residuals): {:.3f}% per XYZ component; held-out "
+                    "readings' own noise alone gives mean dE00 {:.3f}\n",
+                    f.noisePercent, f.heldOutNoiseMeanDe00);
+            fmt::print("tone curves (cross-validated): R {} G {} B {}; inverse's expected error "
+                       "(1 sigma) in counts: rms {:.2f} {:.2f} {:.2f}, max {:.2f} {:.2f} {:.2f} "
+                       "(where the light is at least 0.1% of full drive)\n",
+                       f.toneShape[0], f.toneShape[1], f.toneShape[2], f.inverseCountsRms[0],
+                       f.inverseCountsRms[1], f.inverseCountsRms[2], f.inverseCountsMax[0],
+                       f.inverseCountsMax[1], f.inverseCountsMax[2]);
+        }
+        if (f.additivityDe00 >= 0.0 && f.additivityNoiseDe00 >= 0.0) {
+            fmt::print("additivity: white vs black + R + G + B dE00 {:.3f} (the noise alone gives "
+                       "up to {:.3f}, 99th percentile), luminance {:+.2f}% +- {:.2f}% (1 sigma): "
+                       "{}\n",
+                       f.additivityDe00, f.additivityNoiseDe00, f.additivityLuminancePercent,
+                       f.additivityLuminanceSigmaPercent,
+                       f.additiveWithinNoise
+                               ? "additive within the noise"
+                               : "NOT additive: channel interaction beyond the noise");
+        } else if (f.additivityDe00 >= 0.0) {
             fmt::print("additivity: white vs R+G+B dE00 {:.3f}, luminance {:+.2f}%\n",
                        f.additivityDe00, f.additivityLuminancePercent);
         }
@@ -475,12 +526,15 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
 
     auto fit = std::make_shared<DisplayOptions>();
     auto* fitCmd = display->add_subcommand(
-            "fit", "fit a display profile to measurements MEAS.csv (columns R,G,B,X,Y,Z: counts "
-                   "at the panel's bit depth, XYZ in cd/m^2)");
-    fitCmd->add_option("measurements", fit->measurements, "measurement CSV")->required();
+            "fit", "fit a display profile to measurements: MEAS.csv (columns R,G,B,X,Y,Z: counts "
+                   "at the panel's bit depth, XYZ in cd/m^2) or an ArgyllCMS MEAS.ti3");
+    fitCmd->add_option("measurements", fit->measurements,
+                       "measurements: CSV R,G,B,X,Y,Z, or an ArgyllCMS .ti3 (dispread's readings)")
+            ->required();
     fitCmd->add_option("--out", fit->out, "profile to write (JSON)")->required();
     fitCmd->add_option("--name", fit->name, "profile name (default: the output file's stem)");
-    fitCmd->add_option("--bits", fit->bits, "panel bit depth (default: from the largest count)")
+    fitCmd->add_option("--bits", fit->bits,
+                       "panel bit depth (default: from the largest count; 8 for a .ti3)")
             ->check(CLI::Range(1, 16));
     fitCmd->add_option("--measured-in", fit->measuredIn,
                        "dark, or lit-booth (the black then already holds the screen's reflection "
@@ -492,6 +546,15 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
     fitCmd->add_option("--viewing-table", fit->viewingTable,
                        "full white measured off axis: CSV angle_deg,X,Y,Z (first row 0 deg); "
                        "without it the profile has no viewing-angle compensation");
+    fitCmd->add_option("--tone", fit->tone,
+                       "tone curves: robust (average the meter's noise: GOG, GOGO or a smoothing "
+                       "spline, chosen by cross-validation) or interpolate (through every ramp "
+                       "reading; the shipped synthetic profile)")
+            ->check(CLI::IsMember({"robust", "interpolate"}))
+            ->capture_default_str();
+    fitCmd->add_option("--icc", fit->icc,
+                       "also write the profile as an ICC v4 display profile (matrix/TRC, D50 PCS, "
+                       "white's luminance in the lumi tag)");
     fitCmd->add_flag("--json", fit->json, "print the fit report as JSON");
     fitCmd->callback([fit, &exitCode] { exitCode = fitMain(*fit); });
 
@@ -548,6 +611,33 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
                      "ColorChecker colours");
     addStudyOptions(flareCmd, *flare);
     flareCmd->callback([flare, &exitCode] { exitCode = flareMain(*flare); });
+
+    auto pat = std::make_shared<PatchesOptions>();
+    auto* patCmd = display->add_subcommand(
+            "patches", "show a patch set (.ti1) patch by patch and collect one reading each, from "
+                       "ArgyllCMS spotread or typed X Y Z, into a .ti3 (resumed when it exists)");
+    patCmd->add_option("set", pat->set, "patch set, ArgyllCMS .ti1 (targen's, or --make-set's)");
+    patCmd->add_option("--out", pat->out, "readings to write, .ti3 (rewritten after each)");
+    patCmd->add_option("--show-dir", pat->showDir,
+                       "headless display: the patch on show as DIR/patch.png and DIR/patch.txt");
+    patCmd->add_option("--spotread", pat->spotread,
+                       "meter command, e.g. 'spotread -e -x' (one key press per reading, parsed "
+                       "from its 'Result is XYZ:' line); without it X Y Z are read from stdin");
+    patCmd->add_option("--settle-ms", pat->settleMs, "wait after showing each patch (ms)")
+            ->capture_default_str();
+    patCmd->add_option("--bits", pat->bits, "panel bit depth")
+            ->check(CLI::Range(1, 16))
+            ->capture_default_str();
+    patCmd->add_option("--make-set", pat->makeSet,
+                       "write the default set (3 blacks, R, G, B ramps every --step counts, 2 "
+                       "whites, --colours random colours) to this .ti1 and stop");
+    patCmd->add_option("--step", pat->step, "ramp step for --make-set")
+            ->check(CLI::Range(1, 64))
+            ->capture_default_str();
+    patCmd->add_option("--colours", pat->colours, "random colours for --make-set")
+            ->check(CLI::Range(6, 10000))
+            ->capture_default_str();
+    patCmd->callback([pat, &exitCode] { exitCode = patchesMain(*pat); });
 
     auto syn = std::make_shared<DisplayOptions>();
     auto* synCmd = display->add_subcommand(

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/display/cgats.h>
 
 #include <gtest/gtest.h>
 
@@ -195,6 +196,117 @@ TEST_F(DisplayCli, FitFailsClearlyOnDegenerateSets)
     EXPECT_EQ(header.exitCode, 1);
     EXPECT_NE(header.err.find("h.csv:1: header must be R,G,B,X,Y,Z"), std::string::npos)
             << header.err;
+}
+
+TEST_F(DisplayCli, FitsArgyllReadingsAndWritesAnIccProfile)
+{
+    // The shipped set as dispread would have written it: the same fit as from the CSV.
+    auto set = loadMeasurementCsv(shippedMeasurements());
+    ASSERT_TRUE(set.has_value());
+    const std::string ti3 = write("m.ti3", ti3Text(set->rows, 8, "test"));
+    const std::string fromTi3 = (dir_ / "a.json").string();
+    const std::string fromCsv = (dir_ / "b.json").string();
+    const std::string icc = (dir_ / "a.icc").string();
+    const auto a = run("display fit " + ti3 + " --out " + fromTi3 + " --icc " + icc);
+    ASSERT_EQ(a.exitCode, 0) << a.err;
+    // The shipped panel has 0.5 % channel interaction, which the check now tells from noise.
+    EXPECT_NE(a.out.find("NOT additive: channel interaction beyond the noise"), std::string::npos)
+            << a.out;
+    EXPECT_NE(a.out.find("meter noise (from the ramps' residuals)"), std::string::npos) << a.out;
+    const auto b = run("display fit " + shippedMeasurements() + " --out " + fromCsv + " --json");
+    ASSERT_EQ(b.exitCode, 0) << b.err;
+    const auto j = nlohmann::json::parse(b.out);
+    EXPECT_TRUE(j.at("additive_within_noise").is_boolean());
+    EXPECT_GT(j.at("noise_percent").get<double>(), 0.1);
+    EXPECT_LT(j.at("noise_percent").get<double>(), 0.4);
+    const auto fa = run("display forward " + fromTi3 + " --rgb 120,80,200 --json");
+    const auto fb = run("display forward " + fromCsv + " --rgb 120,80,200 --json");
+    ASSERT_EQ(fa.exitCode, 0) << fa.err;
+    const auto xa = nlohmann::json::parse(fa.out).at("xyz");
+    const auto xb = nlohmann::json::parse(fb.out).at("xyz");
+    for (int k = 0; k < 3; ++k) {
+        // The .ti3 carries XYZ to 8 significant digits, the CSV to 6 decimals.
+        EXPECT_NEAR(xa[k].get<double>(), xb[k].get<double>(), 1e-4 * xb[k].get<double>());
+    }
+    EXPECT_TRUE(std::filesystem::exists(icc));
+    EXPECT_GT(std::filesystem::file_size(icc), 1000u);
+
+    // A cut-short .ti3 names its line.
+    std::string text = ti3Text(set->rows, 8, "test");
+    text.resize(text.find("END_DATA\n"));
+    const auto bad = run("display fit " + write("cut.ti3", text) + " --out " + fromTi3);
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("cut.ti3:"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("BEGIN_DATA without END_DATA"), std::string::npos) << bad.err;
+}
+
+// A stand-in for ArgyllCMS spotread: its prompt, and for each key press a " Result is XYZ: X Y Z,
+// Yxy: ..." line (the format of spotread 2.3's emissive readings), of a linear panel reading the
+// counts the headless display shows; FAKE_STOP ends it after that many readings, as a pulled cable.
+constexpr const char* kFakeSpotread = R"(#!/bin/bash
+echo "Place instrument on spot to be measured,"
+printf "Hit ESC or Q to exit, instrument switch or any other key to take a reading: "
+n=0
+while IFS= read -r -n1 key; do
+  case "$key" in q|Q) echo; exit 0;; esac
+  n=$((n+1))
+  if [ -n "$FAKE_STOP" ] && [ "$n" -gt "$FAKE_STOP" ]; then exit 3; fi
+  read -r r g b < "$SHOW_DIR/patch.txt"
+  awk -v r="$r" -v g="$g" -v b="$b" 'BEGIN { x = 0.5 + 1.6*r + 1.4*g + 0.7*b; y = 0.6 + 0.8*r + 2.8*g + 0.3*b; z = 0.8 + 0.05*r + 0.4*g + 3.5*b; printf "\n Result is XYZ: %.6f %.6f %.6f, Yxy: %.6f 0.3 0.3\n\n", x, y, z, y }'
+  echo "Place instrument on spot to be measured,"
+  printf "Hit ESC or Q to exit, instrument switch or any other key to take a reading: "
+done
+)";
+
+TEST_F(DisplayCli, PatchesDriveSpotreadAndResumeAfterAnInterruption)
+{
+    const std::string set = (dir_ / "set.ti1").string();
+    const std::string out = (dir_ / "r.ti3").string();
+    const std::string show = (dir_ / "show").string();
+    const std::string fake = write("spotread.sh", kFakeSpotread);
+    const auto made = run("display patches --make-set " + set + " --step 32 --colours 6");
+    ASSERT_EQ(made.exitCode, 0) << made.err;
+    EXPECT_NE(made.out.find("35 patches"), std::string::npos) << made.out; // 3 + 3 x 8 + 2 + 6
+    const auto stopped = run("display patches " + set + " --out " + out + " --show-dir " + show +
+                             " --spotread 'FAKE_STOP=5 SHOW_DIR=" + show + " bash " + fake + "'");
+    EXPECT_EQ(stopped.exitCode, 1);
+    EXPECT_NE(stopped.err.find("the meter ended before reading patch 6 of 35"), std::string::npos)
+            << stopped.err;
+    auto partial = loadMeasurements(out);
+    ASSERT_TRUE(partial.has_value()) << partial.error().message;
+    EXPECT_EQ(partial->rows.size(), 5u);
+    const auto resumed = run("display patches " + set + " --out " + out + " --show-dir " + show +
+                             " --spotread 'SHOW_DIR=" + show + " bash " + fake + "'");
+    ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+    EXPECT_NE(resumed.out.find("resuming at patch 6 of 35"), std::string::npos) << resumed.out;
+    auto all = loadMeasurements(out);
+    ASSERT_TRUE(all.has_value()) << all.error().message;
+    ASSERT_EQ(all->rows.size(), 35u);
+    for (const auto& m : all->rows) {
+        const glm::dvec3 c = m.counts;
+        const glm::dvec3 want{0.5 + 1.6 * c.x + 1.4 * c.y + 0.7 * c.z,
+                              0.6 + 0.8 * c.x + 2.8 * c.y + 0.3 * c.z,
+                              0.8 + 0.05 * c.x + 0.4 * c.y + 3.5 * c.z};
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_NEAR(m.xyz[k], want[k], 1e-5 * want[k]) << m.line;
+        }
+    }
+    // The readings of a linear panel fit exactly.
+    const auto fit = run("display fit " + out + " --out " + (dir_ / "p.json").string() + " --json");
+    ASSERT_EQ(fit.exitCode, 0) << fit.err;
+    EXPECT_LT(nlohmann::json::parse(fit.out).at("held_out_max_de00").get<double>(), 1e-3);
+
+    // Typed readings: two, then end of input (resumable), then a malformed line.
+    std::filesystem::remove(out);
+    const auto typed = run("display patches " + set + " --out " + out + " --show-dir " + show +
+                           " < " + write("in.txt", "0.5 0.6 0.8\n0.5 0.6 0.8\n"));
+    EXPECT_EQ(typed.exitCode, 0) << typed.err;
+    EXPECT_NE(typed.out.find("stopped: 2 of 35 readings"), std::string::npos) << typed.out;
+    const auto bad = run("display patches " + set + " --out " + out + " --show-dir " + show +
+                         " < " + write("bad.txt", "1 2 x\n"));
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("patch 3: '1 2 x' is not three numbers X Y Z"), std::string::npos)
+            << bad.err;
 }
 
 TEST_F(DisplayCli, StudyNamesThePapersOutOfGamutPatchesUnderTungsten)

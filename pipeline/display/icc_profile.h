@@ -1,0 +1,44 @@
+// The display model as an ICC v4 display profile (written with Little CMS 2): matrix/TRC, the
+// black offset folded into the tone curves. The model is additive, XYZ = XYZ_k + M r(d); with
+// b = M^-1 XYZ_k (the black in channel units, all >= 0 when black's chromaticity lies inside the
+// primaries' triangle) it is XYZ = M diag(1 + b) TRC(d) with TRC_c = (r_c + b_c) / (1 + b_c), which
+// a matrix/TRC profile holds exactly. The colorants are adapted to the D50 PCS with Bradford (a
+// chad tag records it) and white's absolute luminance goes in the lumi tag.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/display/display_model.h>
+
+namespace replica::pipeline::display {
+
+struct IccWriteReport {
+    glm::dvec3 blackChannels{0.0}; // b = M^-1 XYZ_k
+    bool blackClipped = false;     // some b_c < 0 was set to 0 (black outside the triangle)
+};
+
+Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
+                                         const std::filesystem::path& path);
+
+// Bradford adaptation matrix from 'white' (any scale) to D50 (X 0.9642, Y 1, Z 0.8249).
+glm::dmat3 bradfordToD50(const glm::dvec3& white);
+
+// What Little CMS reads back from a profile's header and tags.
+struct IccInfo {
+    double version = 0.0; // e.g. 4.3
+    bool displayClass = false;
+    bool rgbToXyz = false; // colour space RGB, PCS XYZ
+    double luminanceCdM2 = 0.0;
+    std::string description;
+};
+Expected<IccInfo> readIccInfo(const std::filesystem::path& path);
+
+// Relative colorimetric RGB -> PCS XYZ (D50, white Y = 1) of a profile read back with Little CMS,
+// for counts at 'bitDepth': the check that the file says what the model says.
+Expected<std::vector<glm::dvec3>>
+iccForward(const std::filesystem::path& path, const std::vector<glm::dvec3>& counts, int bitDepth);
+
+} // namespace replica::pipeline::display

@@ -1,0 +1,284 @@
+// Measuring a panel patch by patch.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <pipeline/display/cgats.h>
+#include <platform/cli/commands.h>
+#include <platform/cli/display_patches.h>
+#include <platform/image/png_writer.h>
+#include <platform/logging.h>
+
+namespace replica::platform {
+namespace {
+
+namespace pd = pipeline::display;
+
+bool writeAtomically(const std::filesystem::path& path, const std::string& text)
+{
+    const auto tmp = path.string() + ".tmp";
+    {
+        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+        f << text;
+        if (!f) {
+            return false;
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    return !ec;
+}
+
+// The default set: black three times, R, G and B ramps every 'step' counts and full drive, white
+// twice, and pseudo-random colours: what 'display fit' needs, in the order it is shown.
+std::vector<glm::dvec3> defaultSet(int bits, int step, int colours, std::uint64_t seed)
+{
+    const double maxCount = std::ldexp(1.0, bits) - 1.0;
+    std::vector<glm::dvec3> p(3, glm::dvec3(0.0));
+    for (int c = 0; c < 3; ++c) {
+        for (double v = step; v < maxCount + step; v += step) {
+            glm::dvec3 q(0.0);
+            q[c] = std::min(v, maxCount);
+            p.push_back(q);
+        }
+    }
+    p.emplace_back(maxCount);
+    p.emplace_back(maxCount);
+    std::mt19937_64 rng(seed);
+    for (int i = 0; i < colours; ++i) {
+        glm::dvec3 q;
+        for (int c = 0; c < 3; ++c) {
+            q[c] = std::floor(static_cast<double>(rng() >> 11) * 0x1.0p-53 * (maxCount + 1.0));
+        }
+        p.push_back(q);
+    }
+    return p;
+}
+
+// A subprocess with its stdin and stdout piped to us.
+class Meter
+{
+public:
+    static std::optional<Meter> start(const std::string& command)
+    {
+        // A meter that exits mid-run must not take us with it: a write to its closed stdin then
+        // fails with EPIPE and is reported as the meter having ended.
+        ::signal(SIGPIPE, SIG_IGN);
+        int in[2];
+        int out[2];
+        if (::pipe(in) != 0 || ::pipe(out) != 0) {
+            return std::nullopt;
+        }
+        const pid_t pid = ::fork();
+        if (pid < 0) {
+            return std::nullopt;
+        }
+        if (pid == 0) {
+            ::dup2(in[0], 0);
+            ::dup2(out[1], 1);
+            ::close(in[1]);
+            ::close(out[0]);
+            ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+            ::_exit(127);
+        }
+        ::close(in[0]);
+        ::close(out[1]);
+        Meter m;
+        m.pid_ = pid;
+        m.toMeter_ = in[1];
+        m.fromMeter_ = ::fdopen(out[0], "r");
+        return m;
+    }
+
+    // Asks for one reading (a key press, as spotread takes it) and returns the XYZ of its
+    // " Result is XYZ: X Y Z, ..." line; nullopt when the meter ends first (lastLine says what it
+    // printed last).
+    std::optional<glm::dvec3> read(std::string& lastLine)
+    {
+        if (::write(toMeter_, " ", 1) != 1) {
+            return std::nullopt;
+        }
+        char buf[1024];
+        while (std::fgets(buf, sizeof buf, fromMeter_) != nullptr) {
+            std::string line(buf);
+            while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) {
+                line.pop_back();
+            }
+            if (!line.empty()) {
+                lastLine = line;
+            }
+            const auto at = line.find("Result is XYZ:");
+            double x = 0.0;
+            double y = 0.0;
+            double z = 0.0;
+            if (at != std::string::npos &&
+                std::sscanf(line.c_str() + at + 14, " %lf %lf %lf", &x, &y, &z) == 3) {
+                return glm::dvec3(x, y, z);
+            }
+        }
+        return std::nullopt;
+    }
+
+    void stop()
+    {
+        if (pid_ > 0) {
+            [[maybe_unused]] const auto n = ::write(toMeter_, "q", 1);
+            ::close(toMeter_);
+            std::fclose(fromMeter_);
+            int status = 0;
+            ::waitpid(pid_, &status, 0);
+            pid_ = -1;
+        }
+    }
+
+private:
+    pid_t pid_ = -1;
+    int toMeter_ = -1;
+    std::FILE* fromMeter_ = nullptr;
+};
+
+} // namespace
+
+int patchesMain(const PatchesOptions& o)
+{
+    auto log = logger("replica");
+    if (!o.makeSet.empty()) {
+        const auto set = defaultSet(o.bits, o.step, o.colours, o.seed);
+        if (!writeAtomically(o.makeSet, pd::ti1Text(set, o.bits, "Replica display patches"))) {
+            log->error("{}: cannot write the patch set", o.makeSet);
+            return kExitFailure;
+        }
+        fmt::print("patch set: {} ({} patches)\n", o.makeSet, set.size());
+        return kExitOk;
+    }
+    if (o.set.empty() || o.out.empty() || o.showDir.empty()) {
+        log->error("display patches: give SET.ti1, --out READINGS.ti3 and --show-dir DIR (or "
+                   "--make-set SET.ti1)");
+        return kExitUsage;
+    }
+    std::ifstream sf(o.set, std::ios::binary);
+    if (!sf) {
+        log->error("{}: cannot open the patch set", o.set);
+        return kExitFailure;
+    }
+    std::ostringstream ss;
+    ss << sf.rdbuf();
+    auto set = pd::parseTi1(ss.str(), o.set, o.bits);
+    if (!set) {
+        log->error("{}", set.error().message);
+        return kExitFailure;
+    }
+    // Resume: the readings already taken must be of the set's first patches, in order.
+    std::vector<pd::Measurement> readings;
+    if (std::filesystem::exists(o.out)) {
+        auto done = pd::loadMeasurements(o.out, o.bits);
+        if (!done) {
+            log->error("{} (delete it to start again)", done.error().message);
+            return kExitFailure;
+        }
+        for (std::size_t i = 0; i < done->rows.size(); ++i) {
+            if (i >= set->size() || done->rows[i].counts != (*set)[i]) {
+                log->error("{}:{}: reading {} is not of patch {} of {}: a different set? (delete "
+                           "it to start again)",
+                           o.out, done->rows[i].line, i + 1, i + 1, o.set);
+                return kExitFailure;
+            }
+        }
+        readings = done->rows;
+        fmt::print("resuming at patch {} of {} ({} readings in {})\n", readings.size() + 1,
+                   set->size(), readings.size(), o.out);
+    }
+    std::filesystem::create_directories(o.showDir);
+    std::optional<Meter> meter;
+    if (!o.spotread.empty()) {
+        meter = Meter::start(o.spotread);
+        if (!meter) {
+            log->error("cannot start the meter '{}'", o.spotread);
+            return kExitFailure;
+        }
+    }
+    const double maxCount = std::ldexp(1.0, o.bits) - 1.0;
+    for (std::size_t i = readings.size(); i < set->size(); ++i) {
+        const glm::dvec3 c = (*set)[i];
+        // Show: a full-frame PNG of the patch (8-bit) and its counts, for the headless display.
+        std::vector<std::uint8_t> rgba;
+        constexpr int kSide = 64;
+        for (int p = 0; p < kSide * kSide; ++p) {
+            for (int k = 0; k < 3; ++k) {
+                rgba.push_back(static_cast<std::uint8_t>(std::lround(c[k] / maxCount * 255.0)));
+            }
+            rgba.push_back(255);
+        }
+        const auto dir = std::filesystem::path(o.showDir);
+        if (auto ok = writePng(dir / "patch.png", kSide, kSide, rgba);
+            !ok || !writeAtomically(dir / "patch.txt", fmt::format("{} {} {}\n", c.x, c.y, c.z))) {
+            log->error("{}: cannot show the patch", o.showDir);
+            return kExitFailure;
+        }
+        if (o.settleMs > 0) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(o.settleMs));
+        }
+        std::optional<glm::dvec3> xyz;
+        if (meter) {
+            std::string last;
+            xyz = meter->read(last);
+            if (!xyz) {
+                meter->stop();
+                log->error("the meter ended before reading patch {} of {} ({}): {} readings kept "
+                           "in {}; run again to resume",
+                           i + 1, set->size(), last.empty() ? "no output" : last, readings.size(),
+                           o.out);
+                return kExitFailure;
+            }
+        } else {
+            fmt::print("patch {}/{} {},{},{}: X Y Z (cd/m^2)? ", i + 1, set->size(), c.x, c.y, c.z);
+            std::fflush(stdout);
+            std::string line;
+            if (!std::getline(std::cin, line)) {
+                fmt::print("\nstopped: {} of {} readings in {}; run again to resume\n",
+                           readings.size(), set->size(), o.out);
+                return kExitOk;
+            }
+            double x = 0.0;
+            double y = 0.0;
+            double z = 0.0;
+            char extra = 0;
+            if (std::sscanf(line.c_str(), " %lf %lf %lf %c", &x, &y, &z, &extra) != 3 ||
+                !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+                log->error("patch {}: '{}' is not three numbers X Y Z; {} readings kept in {}",
+                           i + 1, line, readings.size(), o.out);
+                return kExitFailure;
+            }
+            xyz = glm::dvec3(x, y, z);
+        }
+        pd::Measurement m;
+        m.counts = c;
+        m.xyz = *xyz;
+        readings.push_back(m);
+        if (!writeAtomically(o.out, pd::ti3Text(readings, o.bits, "Replica display patches"))) {
+            log->error("{}: cannot write the readings", o.out);
+            return kExitFailure;
+        }
+        fmt::print("[{}/{}] {},{},{} -> XYZ {:.4f} {:.4f} {:.4f}\n", i + 1, set->size(), c.x, c.y,
+                   c.z, xyz->x, xyz->y, xyz->z);
+    }
+    if (meter) {
+        meter->stop();
+    }
+    fmt::print("readings: {} ({} patches); fit with 'replica display fit {} --out PROFILE'\n",
+               o.out, readings.size(), o.out);
+    return kExitOk;
+}
+
+} // namespace replica::platform

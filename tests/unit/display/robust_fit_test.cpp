@@ -1,0 +1,266 @@
+// The noise-robust fit on synthetic panels of known truth: several tone-curve shapes (GOG,
+// sRGB-like piecewise, S-shaped), channel crosstalk, a black offset, meter noise 0 to 1 %. Every
+// figure is the fitted model against the panel's own forward model, on colours and counts that
+// were never measured, so nothing here compares the fit with itself.
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <pipeline/display/display_fit.h>
+#include <pipeline/display/display_inverse.h>
+#include <pipeline/display/synthetic_display.h>
+#include <pipeline/display/tone_fit.h>
+#include <pipeline/display/xyz_difference.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::pipeline::display {
+namespace {
+
+// The panel: three GOG tone curves, a black offset, sRGB-like primaries.
+SyntheticDisplay gogPanel()
+{
+    SyntheticDisplay d = wideIpsGroundTruth();
+    d.tone = SyntheticTone::Gog;
+    d.gamma = {2.35, 2.2, 2.05};
+    d.gogGain = {1.03, 1.0, 1.06};
+    d.blackXyz = {0.45, 0.48, 0.70};
+    d.interaction = 0.0;
+    return d;
+}
+
+SyntheticDisplay srgbPanel()
+{
+    SyntheticDisplay d = gogPanel();
+    d.tone = SyntheticTone::Srgb;
+    d.gamma = {2.4, 2.4, 2.3};
+    return d;
+}
+
+SyntheticDisplay sShapedPanel()
+{
+    SyntheticDisplay d = wideIpsGroundTruth(); // S-shaped power curves, 0.5 % crosstalk
+    d.interaction = 0.0;
+    return d;
+}
+
+SyntheticDisplay crosstalkPanel()
+{
+    return wideIpsGroundTruth(); // as above with its 0.5 % channel interaction
+}
+
+MeasurementSet measure(const SyntheticDisplay& d, double noise, std::uint64_t seed)
+{
+    MeasurementSet s;
+    s.source = "synthetic";
+    s.bitDepth = d.bitDepth;
+    MeterNoise n;
+    n.relative = noise;
+    n.absoluteCdM2 = noise * 1.25; // 0.0025 cd/m^2 at 0.2 %: a colorimeter's floor
+    s.rows = syntheticSession(d, n, SessionPlan{}, seed);
+    for (std::size_t i = 0; i < s.rows.size(); ++i) {
+        s.rows[i].line = static_cast<int>(i) + 2;
+    }
+    return s;
+}
+
+struct Figures {
+    double truthMean = 0.0; // model vs panel, dE00, 400 unmeasured colours
+    double truthMax = 0.0;
+    double rampInverseMax = 0.0;   // counts, R, G, B and grey ramps at every count
+    double colourInverseP95 = 0.0; // counts, the 400 colours (in gamut), per-channel
+    double colourInverseMax = 0.0;
+    int rampWorstChannel = 0;
+    int rampWorstCount = 0;
+};
+
+Figures evaluate(const DisplayModel& model, const SyntheticDisplay& truth)
+{
+    Figures f;
+    const glm::dvec3 white = truth.forward(glm::dvec3(255.0));
+    auto inv = DisplayInverse::build(model);
+    EXPECT_TRUE(inv.has_value());
+    std::mt19937_64 rng(4242);
+    std::vector<double> colourErr;
+    for (int i = 0; i < 400; ++i) {
+        glm::dvec3 c;
+        for (int k = 0; k < 3; ++k) {
+            c[k] = static_cast<double>(rng() % 25501) / 100.0;
+        }
+        const double de = deltaE2000Xyz(model.forward(c), truth.forward(c), white);
+        f.truthMean += de / 400.0;
+        f.truthMax = std::max(f.truthMax, de);
+        const auto r = inv->invert(truth.forward(c), GamutMode::HueKeeping, ToneInverse::Exact);
+        if (r.inGamut()) {
+            for (int k = 0; k < 3; ++k) {
+                if (truth.toneResponse(k, c[k]) >= 1e-3) {
+                    colourErr.push_back(std::abs(r.counts[k] - c[k]));
+                }
+            }
+        }
+    }
+    std::sort(colourErr.begin(), colourErr.end());
+    if (!colourErr.empty()) {
+        f.colourInverseP95 = colourErr[colourErr.size() * 95 / 100];
+        f.colourInverseMax = colourErr.back();
+    }
+    for (int ch = 0; ch < 4; ++ch) {
+        for (int v = 1; v <= 255; ++v) {
+            glm::dvec3 c(0.0);
+            if (ch == 3) {
+                c = glm::dvec3(v);
+            } else {
+                c[ch] = v;
+            }
+            const auto r = inv->invert(truth.forward(c), GamutMode::HueKeeping, ToneInverse::Exact);
+            for (int k = 0; k < 3; ++k) {
+                if ((ch == 3 || k == ch) && truth.toneResponse(k, v) >= 1e-3) {
+                    const double e = std::abs(r.counts[k] - c[k]);
+                    if (e > f.rampInverseMax) {
+                        f.rampInverseMax = e;
+                        f.rampWorstChannel = ch;
+                        f.rampWorstCount = v;
+                    }
+                }
+            }
+        }
+    }
+    return f;
+}
+
+// The figures of docs/display.md: every panel at 0, 0.2, 0.5 and 1 % noise, robust fit, the same
+// without the matrix refinement, and the interpolating fit. About 30 s; run with
+// --gtest_also_run_disabled_tests --gtest_filter=RobustFit.DISABLED_Table.
+TEST(RobustFit, DISABLED_Table)
+{
+    const std::vector<std::pair<const char*, SyntheticDisplay>> panels{
+            {"gog", gogPanel()},
+            {"srgb", srgbPanel()},
+            {"s-shaped", sShapedPanel()},
+            {"crosstalk", crosstalkPanel()}};
+    for (const auto& [name, panel] : panels) {
+        for (double noise : {0.0, 0.002, 0.005, 0.01}) {
+            for (int method = 0; method < 3; ++method) {
+                FitOptions o;
+                o.toneMethod = method != 1 ? ToneMethod::Robust : ToneMethod::Interpolate;
+                o.maxEvaluations = method == 2 ? 0 : o.maxEvaluations;
+                auto m = fitDisplay(measure(panel, noise, 17), o);
+                ASSERT_TRUE(m.has_value()) << m.error().message;
+                const Figures f = evaluate(*m, panel);
+                std::printf(
+                        "%-10s %5.1f%% %-5s truth dE mean %.3f max %.3f | inverse ramps max "
+                        "%.2f (%d@%d) colours p95 %.2f max %.2f | heldout %.3f/%.3f noiseDe %.3f "
+                        "noise %.3f%% shapes %s %s %s expInv %.2f %.2f %.2f add %.3f (p99 "
+                        "%.3f) %+.3f%% +- %.3f %s\n",
+                        name, 100 * noise,
+                        method == 0   ? "rob"
+                        : method == 1 ? "old"
+                                      : "noNM",
+                        f.truthMean, f.truthMax, f.rampInverseMax, f.rampWorstChannel,
+                        f.rampWorstCount, f.colourInverseP95, f.colourInverseMax,
+                        m->fit.heldOutMeanDe00, m->fit.heldOutMaxDe00, m->fit.heldOutNoiseMeanDe00,
+                        m->fit.noisePercent, m->fit.toneShape[0].c_str(),
+                        m->fit.toneShape[1].c_str(), m->fit.toneShape[2].c_str(),
+                        m->fit.inverseCountsMax[0], m->fit.inverseCountsMax[1],
+                        m->fit.inverseCountsMax[2], m->fit.additivityDe00,
+                        m->fit.additivityNoiseDe00, m->fit.additivityLuminancePercent,
+                        m->fit.additivityLuminanceSigmaPercent,
+                        m->fit.additiveWithinNoise ? "additive" : "NOT");
+            }
+        }
+    }
+}
+
+DisplayModel fit(const SyntheticDisplay& panel,
+                 double noise,
+                 std::uint64_t seed,
+                 ToneMethod method = ToneMethod::Robust)
+{
+    FitOptions o;
+    o.toneMethod = method;
+    auto m = fitDisplay(measure(panel, noise, seed), o);
+    EXPECT_TRUE(m.has_value()) << m.error().message;
+    return m ? *m : DisplayModel{};
+}
+
+TEST(RobustFit, NoiseFreeMeasurementsFitExactly)
+{
+    // GOG curves are in the model family: exact to rounding. The others are interpolated.
+    const Figures gog = evaluate(fit(gogPanel(), 0.0, 3), gogPanel());
+    EXPECT_LT(gog.truthMax, 1e-3);
+    EXPECT_LT(gog.rampInverseMax, 1e-3);
+    for (const auto& panel : {srgbPanel(), sShapedPanel()}) {
+        const DisplayModel m = fit(panel, 0.0, 3);
+        const Figures f = evaluate(m, panel);
+        EXPECT_LT(f.truthMax, 0.02);
+        EXPECT_LT(f.rampInverseMax, 0.1);
+        EXPECT_LT(m.fit.noisePercent, 1e-5);
+        EXPECT_LT(m.fit.heldOutMaxDe00, 0.02);
+    }
+}
+
+TEST(RobustFit, AveragesAColorimetersNoise)
+{
+    // 0.2 % per XYZ component (plus 0.0025 cd/m^2): the goal is held-out dE00 max <= 0.5
+    // and the inverse within 0.5 counts. Against the truth on 400 unmeasured colours, and every
+    // count of the R, G, B and grey ramps where the light is at least 0.1 % of full drive.
+    for (const auto& [panel, inverseLimit] :
+         {std::pair{gogPanel(), 0.5}, std::pair{srgbPanel(), 0.5},
+          std::pair{sShapedPanel(), 0.75}}) { // the S-shape's top end: 0.60 (docs/display.md)
+        const Figures robust = evaluate(fit(panel, 0.002, 17), panel);
+        const Figures old = evaluate(fit(panel, 0.002, 17, ToneMethod::Interpolate), panel);
+        EXPECT_LE(robust.truthMax, 0.5);
+        EXPECT_LT(robust.truthMean, 0.05);
+        EXPECT_LE(robust.rampInverseMax, inverseLimit);
+        EXPECT_LE(robust.colourInverseP95, 0.5);
+        // And better than interpolating through the noise.
+        EXPECT_LT(robust.truthMean, 0.7 * old.truthMean);
+        EXPECT_LT(robust.truthMax, old.truthMax);
+    }
+}
+
+TEST(RobustFit, EstimatesTheMetersNoise)
+{
+    for (double noise : {0.002, 0.01}) {
+        const DisplayModel m = fit(srgbPanel(), noise, 5);
+        EXPECT_NEAR(m.fit.noisePercent, 100.0 * noise, 15.0 * noise) << noise;
+        // The held-out readings' own noise is of the order of the held-out error (30 held-out
+        // colours, one draw each: this seed's draws come out a third below the expectation).
+        EXPECT_GT(m.fit.heldOutNoiseMeanDe00, 0.5 * m.fit.heldOutMeanDe00);
+        EXPECT_LT(m.fit.heldOutNoiseMeanDe00, 2.0 * m.fit.heldOutMeanDe00);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_GT(m.fit.inverseCountsRms[static_cast<std::size_t>(c)], 0.0);
+            EXPECT_EQ(m.fit.toneShape[static_cast<std::size_t>(c)].empty(), false);
+        }
+    }
+}
+
+TEST(RobustFit, AdditivityIsJudgedAgainstTheNoise)
+{
+    // Noise-free and additive, with a large black: white = black + R + G + B exactly, so the
+    // check reads 0 only if black is counted once.
+    SyntheticDisplay bright = gogPanel();
+    bright.blackXyz = {4.5, 5.0, 6.0};
+    const DisplayModel exact = fit(bright, 0.0, 1);
+    EXPECT_LT(exact.fit.additivityDe00, 1e-3);
+    EXPECT_LT(std::abs(exact.fit.additivityLuminancePercent), 1e-3);
+    // Additive with 0.2 % noise: additive within the noise, whatever the draw.
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        const DisplayModel m = fit(gogPanel(), 0.002, seed);
+        EXPECT_TRUE(m.fit.additiveWithinNoise)
+                << seed << ": dE00 " << m.fit.additivityDe00 << " vs " << m.fit.additivityNoiseDe00
+                << ", " << m.fit.additivityLuminancePercent << " % +- "
+                << m.fit.additivityLuminanceSigmaPercent;
+        EXPECT_GT(m.fit.additivityLuminanceSigmaPercent, 0.1);
+        EXPECT_LT(m.fit.additivityLuminanceSigmaPercent, 0.4);
+    }
+    // White 2 % darker than the channels' sum: seen, and not put down to noise.
+    SyntheticDisplay cross = gogPanel();
+    cross.interaction = 0.02;
+    const DisplayModel m = fit(cross, 0.002, 3);
+    EXPECT_FALSE(m.fit.additiveWithinNoise);
+    EXPECT_NEAR(m.fit.additivityLuminancePercent, -2.0, 0.5);
+}
+
+} // namespace
+} // namespace replica::pipeline::display
