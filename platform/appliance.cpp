@@ -60,6 +60,7 @@ std::string RunConfig::toJson() const
                      {"specular_exact_level", specularExactLevel},
                      {"texel_exact_ties", texelExactTies},
                      {"horizon_pick", horizonPick},
+                     {"area_lights", areaLights},
                      {"cache_slices", cacheSlices},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
@@ -108,6 +109,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularExactLevel = j.value("specular_exact_level", false);
         c.texelExactTies = j.value("texel_exact_ties", false);
         c.horizonPick = j.value("horizon_pick", false);
+        c.areaLights = j.value("area_lights", false);
         c.cacheSlices = j.value("cache_slices", 1);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
@@ -207,6 +209,7 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.specularExactLevel = config.specularExactLevel;
     s.texelExactTies = config.texelExactTies;
     s.horizonPick = config.horizonPick;
+    s.areaLights = config.areaLights;
     s.cacheSlices = config.cacheSlices;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     s.subtractFlare = !config.flareSubtraction;

@@ -88,6 +88,9 @@ struct RunConfig {
     // shading::RenderSettings::horizonPick; recordings made before it have none and replay with
     // the tent weights (the same frames where measured, but not by construction).
     bool horizonPick = true;
+    // shading::RenderSettings::areaLights: eq. (1) from the median-cut regions' areas. Recordings
+    // made before it have none and replay with point lights, bit for bit.
+    bool areaLights = true;
     // shading::RenderSettings::cacheSlices: a tilt recomputes the cached diffuse term in this many
     // bands over as many frames. Recordings made before it have none and replay with 1 (whole at
     // once), frame for frame.

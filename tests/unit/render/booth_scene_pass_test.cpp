@@ -164,6 +164,8 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
             {"the exact texel tie rule (else u * texels)", &platform::RunConfig::texelExactTies},
             {"the horizon directions picked (else tent-weighted)",
              &platform::RunConfig::horizonPick},
+            {"eq. (1) from the regions' areas (else point lights)",
+             &platform::RunConfig::areaLights},
             {"the viewing gain filtered from a half-degree grid (else the table's rows)",
              &platform::RunConfig::viewingFiltered},
     };
@@ -345,6 +347,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         c.specularExactLevel = on;
         c.texelExactTies = !on;
         c.horizonPick = on;
+        c.areaLights = !on;
         c.cacheSlices = on ? 3 : 1;
         c.flareSubtraction = !on;
         const pipeline::shading::RenderSettings s = platform::boothRenderSettings(c);
@@ -363,6 +366,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         EXPECT_EQ(s.specularExactLevel, on);
         EXPECT_EQ(s.texelExactTies, !on);
         EXPECT_EQ(s.horizonPick, on);
+        EXPECT_EQ(s.areaLights, !on);
         EXPECT_EQ(s.cacheSlices, on ? 3 : 1);
         // Flare subtracted by the display pass: never a second time in pass 1.
         EXPECT_EQ(s.subtractFlare, on);
