@@ -421,19 +421,21 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
 }
 
 #if BOOTH_AREA_LIGHTS
-// RenderSettings::areaLights: each region the uniform rectangle it covers, its irradiance by
+// RenderSettings::areaLights: each region the uniform rectangle of its power, centroid and spread
+// (booth::PointLight::region*), its irradiance by
 // Lambert's contour integral over the part above the horizon. realtime_model.cpp clips the
 // polygon whole (clipToHorizon, Sutherland-Hodgman) and sums its edges; here each edge is clipped
 // on its own, with constant indices (llvmpipe spills a local array indexed by a counter), and the
 // edge the clip adds along the horizon is the one from where the boundary leaves the half-space to
 // where it comes back: the same polygon, its edges summed in another order.
 
-// realtime_model.cpp edgeTerm: the angle a -> b subtends times n . normalize(a x b); 0 for an edge
-// of zero length or in line with the point.
-float edgeTerm(vec3 a, vec3 b, vec3 n) {
+// realtime_model.cpp edgeTerm without the normal: the angle a -> b subtends times
+// normalize(a x b) (the edge's share of the polygon's vector irradiance, to be dotted with a
+// normal); 0 for an edge of zero length or in line with the point.
+vec3 edgeVector(vec3 a, vec3 b) {
     vec3 c = cross(a, b);
     float len = length(c);
-    return len > 0.0 ? atan(len, dot(a, b)) * (dot(n, c) / len) : 0.0;
+    return len > 0.0 ? c * (atan(len, dot(a, b)) / len) : vec3(0.0);
 }
 
 // Edge a -> b (keep: whether it is part of the polygon) clipped to the horizon n . v >= 0: keep
@@ -480,24 +482,39 @@ void diffuseLight(int i, vec3 p, vec3 nShade, bool relief, inout float eGeo, ino
     clipEdge(a1, b1, k1, uNormal, a4, b4, k4);
     clipEdge(a2, b2, k2, uNormal, a4, b4, k4);
     clipEdge(a3, b3, k3, uNormal, a4, b4, k4);
-    float sum = (k0 ? edgeTerm(a0, b0, uNormal) : 0.0) + (k1 ? edgeTerm(a1, b1, uNormal) : 0.0)
-              + (k2 ? edgeTerm(a2, b2, uNormal) : 0.0) + (k3 ? edgeTerm(a3, b3, uNormal) : 0.0)
-              + (k4 ? edgeTerm(a4, b4, uNormal) : 0.0);
-    float eg = 0.5 * lum * abs(sum);
+    vec3 phi = (k0 ? edgeVector(a0, b0) : vec3(0.0)) + (k1 ? edgeVector(a1, b1) : vec3(0.0))
+             + (k2 ? edgeVector(a2, b2) : vec3(0.0)) + (k3 ? edgeVector(a3, b3) : vec3(0.0))
+             + (k4 ? edgeVector(a4, b4) : vec3(0.0));
+    float eg = 0.5 * lum * abs(dot(uNormal, phi));
     eGeo += eg;
     if (relief && eg > 0.0) {
-        // The same five edges clipped to the facet's horizon, and the edge that adds (e5).
-        vec3 a5 = vec3(0.0), b5 = vec3(0.0);
-        bool k5 = false;
-        clipEdge(a0, b0, k0, nShade, a5, b5, k5);
-        clipEdge(a1, b1, k1, nShade, a5, b5, k5);
-        clipEdge(a2, b2, k2, nShade, a5, b5, k5);
-        clipEdge(a3, b3, k3, nShade, a5, b5, k5);
-        clipEdge(a4, b4, k4, nShade, a5, b5, k5);
-        float s = (k0 ? edgeTerm(a0, b0, nShade) : 0.0) + (k1 ? edgeTerm(a1, b1, nShade) : 0.0)
-                + (k2 ? edgeTerm(a2, b2, nShade) : 0.0) + (k3 ? edgeTerm(a3, b3, nShade) : 0.0)
-                + (k4 ? edgeTerm(a4, b4, nShade) : 0.0) + (k5 ? edgeTerm(a5, b5, nShade) : 0.0);
-        float es = 0.5 * lum * abs(s);
+        // With every corner of that polygon above the facet's horizon too, its vector irradiance
+        // serves the facet as it is (the edges' angles once, not twice); otherwise the five
+        // edges are clipped to the facet's horizon and the edge that adds (e5) summed anew.
+        bool below = (k0 && (dot(nShade, a0) < 0.0 || dot(nShade, b0) < 0.0))
+                  || (k1 && (dot(nShade, a1) < 0.0 || dot(nShade, b1) < 0.0))
+                  || (k2 && (dot(nShade, a2) < 0.0 || dot(nShade, b2) < 0.0))
+                  || (k3 && (dot(nShade, a3) < 0.0 || dot(nShade, b3) < 0.0))
+                  || (k4 && (dot(nShade, a4) < 0.0 || dot(nShade, b4) < 0.0));
+        float es;
+        if (below) {
+            vec3 a5 = vec3(0.0), b5 = vec3(0.0);
+            bool k5 = false;
+            clipEdge(a0, b0, k0, nShade, a5, b5, k5);
+            clipEdge(a1, b1, k1, nShade, a5, b5, k5);
+            clipEdge(a2, b2, k2, nShade, a5, b5, k5);
+            clipEdge(a3, b3, k3, nShade, a5, b5, k5);
+            clipEdge(a4, b4, k4, nShade, a5, b5, k5);
+            vec3 phiS = (k0 ? edgeVector(a0, b0) : vec3(0.0))
+                      + (k1 ? edgeVector(a1, b1) : vec3(0.0))
+                      + (k2 ? edgeVector(a2, b2) : vec3(0.0))
+                      + (k3 ? edgeVector(a3, b3) : vec3(0.0))
+                      + (k4 ? edgeVector(a4, b4) : vec3(0.0))
+                      + (k5 ? edgeVector(a5, b5) : vec3(0.0));
+            es = 0.5 * lum * abs(dot(nShade, phiS));
+        } else {
+            es = 0.5 * lum * abs(dot(nShade, phi));
+        }
         if (es > 0.0) {
             // One horizon test, along the region's centroid (areaLightIrradiance).
             vec3 d = uLight[i].xyz - p;

@@ -354,6 +354,11 @@ int defaultDiffuseGrid(const surface::SurfaceScene& scene)
     return scene.flat() ? kFlatDiffuseGrid : 0;
 }
 
+bool defaultAreaLights(const surface::SurfaceScene& scene)
+{
+    return scene.flat();
+}
+
 int defaultSpecularSamples(const surface::SurfaceScene& scene)
 {
     return scene.flat() ? kFlatSpecularSamples : kReliefSpecularSamples;

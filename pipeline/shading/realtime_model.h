@@ -177,6 +177,13 @@ constexpr int kFlatDiffuseGrid = 8;
 // surface, 0 on relief.
 int defaultDiffuseGrid(const surface::SurfaceScene& scene);
 
+// Whether the appliance lights eq. (1) from areas unless told (RenderSettings::areaLights): on a
+// flat surface, where the diffuse grid sums it at a few hundred nodes and areas cost next to
+// nothing; not on relief, where it is summed per pixel and areas made the painting's whole
+// recompute 3.1x as long on llvmpipe (53 -> 165 ms, docs/performance.md) while point lights keep
+// it within the budget (docs/rendering.md). 'replica render' uses areas everywhere.
+bool defaultAreaLights(const surface::SurfaceScene& scene);
+
 // The specular sample count the appliance and 'replica render' use unless told
 // (kReliefSpecularSamples or kFlatSpecularSamples).
 int defaultSpecularSamples(const surface::SurfaceScene& scene);

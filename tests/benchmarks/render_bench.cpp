@@ -171,6 +171,7 @@ struct ViewsOptions {
     int eye = -1;             // >= 0: only this eye (0 centre, 1 left, 2 high right)
     int horizon = 0;          // > 0: horizon directions instead of 8
     bool pointLights = false; // eq. (1) from point lights (RenderSettings::areaLights off)
+    bool areaLights = false;  // eq. (1) from areas on every scene (the default: flat ones only)
 };
 
 // The appliance's default setting (adaptive_k6, the scene's own sample count and grids) against
@@ -213,7 +214,7 @@ int runViews(const ViewsOptions& o,
         if (o.horizon > 0) {
             def.horizonDirections = o.horizon;
         }
-        def.areaLights = !o.pointLights;
+        def.areaLights = !o.pointLights && (o.areaLights || shading::defaultAreaLights(*scene));
         const std::string setting = describe(def, *scene);
         double worstP95 = 0.0;
         double worstMax = 0.0;
@@ -267,7 +268,8 @@ int main(int argc, char** argv)
             std::printf(
                     "usage: %s [OUT_DIR [WxH [--defaults-only [SAMPLES]] [--scene NAME] "
                     "[--grid TEXELS] [--lod-bias B] [--views [--light NAME] [--tilt DEG] "
-                    "[--eye I] [--lights N] [--horizon N] [--softness S] [--point-lights]]]]\n"
+                    "[--eye I] [--lights N] [--horizon N] [--softness S] [--point-lights | "
+                    "--area-lights]]]]\n"
                     "Sweeps the booth renderer's knobs on every shipped scene and light: ms per "
                     "1920x1200 frame of the GL pass and dE00 mean / p95 / max on a WxH frame "
                     "(default 64x40) against the exact reference, then the planner's choices and "
@@ -291,7 +293,9 @@ int main(int argc, char** argv)
                     "    --softness S             horizon softness S (sin of elevation) instead "
                     "of the default\n"
                     "    --point-lights           eq. (1) from each region's centroid as a point "
-                    "light instead of from its area\n",
+                    "light on every scene (the default: areas on flat scenes, points on relief)\n"
+                    "    --area-lights            eq. (1) from each region's area on every "
+                    "scene\n",
                     argv[0]);
             return 0;
         }
@@ -323,6 +327,7 @@ int main(int argc, char** argv)
         o.samples = defaultSamples;
         for (int a = 3; a < argc; ++a) {
             o.pointLights = o.pointLights || std::string(argv[a]) == "--point-lights";
+            o.areaLights = o.areaLights || std::string(argv[a]) == "--area-lights";
         }
         for (int a = 3; a + 1 < argc; ++a) {
             const std::string arg = argv[a];
