@@ -60,6 +60,7 @@ std::string RunConfig::toJson() const
                      {"specular_exact_level", specularExactLevel},
                      {"texel_exact_ties", texelExactTies},
                      {"horizon_pick", horizonPick},
+                     {"area_lights", areaLights},
                      {"cache_slices", cacheSlices},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
@@ -108,6 +109,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularExactLevel = j.value("specular_exact_level", false);
         c.texelExactTies = j.value("texel_exact_ties", false);
         c.horizonPick = j.value("horizon_pick", false);
+        c.areaLights = j.value("area_lights", 0);
         c.cacheSlices = j.value("cache_slices", 1);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
@@ -131,11 +133,12 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
         c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 ||
         !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias) ||
-        c.cacheSlices < 1 || c.cacheSlices > kMaxCacheSlices) {
+        c.cacheSlices < 1 || c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights ||
+        c.areaLights > 1) {
         return makeError(ErrorCode::InvalidArgument,
                          "run configuration: size, rate, light count, specular samples, specular "
-                         "or diffuse grid, specular lod bias, horizon directions or cache slices "
-                         "out of range");
+                         "or diffuse grid, specular lod bias, horizon directions, cache slices or "
+                         "area lights out of range");
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -207,6 +210,7 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.specularExactLevel = config.specularExactLevel;
     s.texelExactTies = config.texelExactTies;
     s.horizonPick = config.horizonPick;
+    s.areaLights = config.areaLights != 0;
     s.cacheSlices = config.cacheSlices;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     s.subtractFlare = !config.flareSubtraction;
@@ -262,6 +266,9 @@ makeBoothScene(RunConfig& config,
     }
     if (config.diffuseGrid == kAutoDiffuseGrid) {
         config.diffuseGrid = pipeline::shading::defaultDiffuseGrid(setup.scene);
+    }
+    if (config.areaLights == kAutoAreaLights) {
+        config.areaLights = pipeline::shading::defaultAreaLights(setup.scene) ? 1 : 0;
     }
     setup.settings = boothRenderSettings(config);
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));

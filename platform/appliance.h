@@ -23,6 +23,7 @@ namespace replica::platform {
 constexpr int kAutoSpecularGrid = -1;
 constexpr int kAutoDiffuseGrid = -1;
 constexpr int kAutoSpecularSamples = -1;
+constexpr int kAutoAreaLights = -1;
 // RunConfig::cacheSlices for new runs (docs/rendering.md measures the choice), and the most a
 // configuration may ask for.
 constexpr int kDefaultCacheSlices = 3;
@@ -88,6 +89,11 @@ struct RunConfig {
     // shading::RenderSettings::horizonPick; recordings made before it have none and replay with
     // the tent weights (the same frames where measured, but not by construction).
     bool horizonPick = true;
+    // shading::RenderSettings::areaLights: 1 eq. (1) from the median-cut regions' areas, 0 from
+    // point lights; kAutoAreaLights: shading::defaultAreaLights for the scene (areas on a flat
+    // surface, points on relief), chosen when the appliance is built and recorded as chosen.
+    // Recordings made before it have none and replay with point lights, bit for bit.
+    int areaLights = kAutoAreaLights;
     // shading::RenderSettings::cacheSlices: a tilt recomputes the cached diffuse term in this many
     // bands over as many frames. Recordings made before it have none and replay with 1 (whole at
     // once), frame for frame.

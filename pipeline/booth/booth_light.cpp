@@ -1,4 +1,6 @@
 // Booth light geometry and the mapping of median-cut regions onto the emitter.
+#include <cmath>
+
 #include <glm/geometric.hpp>
 
 #include <pipeline/booth/booth_light.h>
@@ -71,6 +73,19 @@ std::vector<PointLight> pointLights(const BoothLight& light,
             p.spreadU = uHat * (std::sqrt(sxx / sum) * light.texelWidthM());
             p.spreadV = vHat * (std::sqrt(syy / sum) * light.texelHeightM());
         }
+        // The uniform rectangle with the region's power, centroid and spread: centred on the
+        // centroid, sqrt(12) standard deviations wide along each edge (a uniform box of width w
+        // has w / sqrt(12)). A uniform region is its own rectangle exactly; a tube in a dim region
+        // becomes a narrower, brighter rectangle than the region's (whose spread would be too
+        // wide): what is left is in the light's moments past the second, where a point light's
+        // error starts at the second.
+        const double hu = std::sqrt(3.0) * glm::length(p.spreadU);
+        const double hv = std::sqrt(3.0) * glm::length(p.spreadV);
+        p.regionOrigin = p.position - uHat * hu - vHat * hv;
+        p.regionU = uHat * (2.0 * hu);
+        p.regionV = vHat * (2.0 * hv);
+        const double area = 4.0 * hu * hv;
+        p.meanCdM2 = area > 0.0 ? r.sumCdM2 * light.texelAreaM2() / area : 0.0;
         out.push_back(p);
     }
     return out;

@@ -48,6 +48,16 @@ struct PointLight {
     // as vectors in metres: how far the light the point stands for spreads over the ceiling.
     Vec3 spreadU{0.0};
     Vec3 spreadV{0.0};
+    // The uniform rectangle that stands for the region in the area-light diffuse term
+    // (shading::regionIrradiance): centred on 'position', sqrt(12) spreads wide along each edge,
+    // so that its power, centroid and spread are the region's (a uniform region's is the region
+    // itself): regionOrigin + s regionU + t regionV for s, t in [0, 1] (regionU along edgeU,
+    // regionV along edgeV, so cross(regionU, regionV) is the emitting side), of luminance
+    // meanCdM2 = sumCdM2 * texel area / its area (cd/m^2). Zero-sized for a dark region.
+    Vec3 regionOrigin{0.0};
+    Vec3 regionU{0.0};
+    Vec3 regionV{0.0};
+    double meanCdM2 = 0.0;
 };
 
 std::vector<PointLight> pointLights(const BoothLight& light,

@@ -293,7 +293,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             "#define BOOTH_HORIZON_BILINEAR {}\n#define BOOTH_SPEC_CALLS{}\n"
                             "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n"
                             "#define BOOTH_EXACT_LEVEL {}\n#define BOOTH_EXACT_TIES {}\n"
-                            "#define BOOTH_HORIZON_PICK {}\n",
+                            "#define BOOTH_HORIZON_PICK {}\n#define BOOTH_AREA_LIGHTS {}\n",
                             mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
                             diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
                             perLayer * layers, samples, wardModelIndex(s.model),
@@ -302,7 +302,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                             settings_.horizonBilinear ? 1 : 0, specCalls, unrolledSpec,
                             settings_.specularBranchFree ? 1 : 0,
                             exactLevelTwiceBias(settings_) ? 1 : 0,
-                            settings_.texelExactTies ? 1 : 0, settings_.horizonPick ? 1 : 0) +
+                            settings_.texelExactTies ? 1 : 0, settings_.horizonPick ? 1 : 0,
+                            settings_.areaLights ? 1 : 0) +
                 kBoothXyzShader;
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
@@ -336,8 +337,9 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
 
     glGenBuffers(1, &lightsUbo_);
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
-    // Per light: position and intensity, then the two spread vectors (booth_shaders.cpp).
-    glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 3 * 4 * sizeof(float), nullptr,
+    // Per light: position and intensity, the two spread vectors, the region's rectangle
+    // (booth_shaders.cpp): 16 KiB for 256 lights, the least GL_MAX_UNIFORM_BLOCK_SIZE of GLES 3.1.
+    glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 4 * 4 * sizeof(float), nullptr,
                  GL_DYNAMIC_DRAW);
     // Blocks a mode does not use are gone from its program: bound where present.
     for (const GLuint p : programs_) {
@@ -470,10 +472,25 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     cacheValid_ = false;
     const booth::BoothLight& bl = *pl.light;
     const double a = bl.texelAreaM2();
-    lightCount_ = static_cast<int>(std::min<std::size_t>(pl.points.size(), kBoothMaxLights));
-    // The block's three arrays one after another: uLight, uLightSpreadU, uLightSpreadV.
+    if (pl.points.size() > static_cast<std::size_t>(kBoothMaxLights)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: {} lights; the GL pass holds at most {}: prepare the "
+                                     "light with {} or fewer",
+                                     pl.points.size(), kBoothMaxLights, kBoothMaxLights));
+    }
+    lightCount_ = static_cast<int>(pl.points.size());
+    // The block's four arrays one after another: uLight, uLightSpreadU (w: the region's mean
+    // luminance), uLightSpreadV, uLightRect.
     const std::size_t block = static_cast<std::size_t>(kBoothMaxLights) * 4;
-    std::vector<float> packed(block * 3, 0.0f);
+    std::vector<float> packed(block * 4, 0.0f);
+    const double u2 = glm::dot(bl.edgeU, bl.edgeU);
+    const double v2 = glm::dot(bl.edgeV, bl.edgeV);
+    // A region's corner in the ceiling's unit coordinates (s, t in [0, 1]).
+    const auto unit = [&](const shading::Vec3& q) {
+        const shading::Vec3 d = q - (bl.centre - 0.5 * (bl.edgeU + bl.edgeV));
+        return glm::dvec2(u2 > 0.0 ? glm::dot(d, bl.edgeU) / u2 : 0.0,
+                          v2 > 0.0 ? glm::dot(d, bl.edgeV) / v2 : 0.0);
+    };
     for (int i = 0; i < lightCount_; ++i) {
         const booth::PointLight& p = pl.points[static_cast<std::size_t>(i)];
         const std::size_t k = static_cast<std::size_t>(i) * 4;
@@ -487,6 +504,13 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
             packed[2 * block + k + static_cast<std::size_t>(c)] = sv[c];
         }
         packed[k + 3] = static_cast<float>(p.sumCdM2 * a);
+        packed[block + k + 3] = static_cast<float>(p.meanCdM2);
+        const glm::dvec2 lo = unit(p.regionOrigin);
+        const glm::dvec2 hi = unit(p.regionOrigin + p.regionU + p.regionV);
+        const std::array<double, 4> rect{lo.x, lo.y, hi.x, hi.y};
+        for (std::size_t c = 0; c < 4; ++c) {
+            packed[3 * block + k + c] = static_cast<float>(rect[c]);
+        }
     }
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, static_cast<GLsizeiptr>(packed.size() * sizeof(float)),
@@ -539,8 +563,6 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     set3All("uLightCentre", bl.centre);
     set3All("uEdgeU", bl.edgeU);
     set3All("uEdgeV", bl.edgeV);
-    const double u2 = glm::dot(bl.edgeU, bl.edgeU);
-    const double v2 = glm::dot(bl.edgeV, bl.edgeV);
     uniformAll(glProgramUniform2f, "uInvEdge2", static_cast<float>(u2 > 0.0 ? 1.0 / u2 : 0.0),
                static_cast<float>(v2 > 0.0 ? 1.0 / v2 : 0.0));
     uniformAll(glProgramUniform1i, "uLumMaxLevel", lumMaxLevel_);
@@ -857,7 +879,8 @@ void XyzTarget::bind() const
 }
 
 shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
-                                  const shading::View& view) const
+                                  const shading::View& view,
+                                  double flareRho) const
 {
     shading::XyzFrame f;
     f.width = width_;
@@ -872,10 +895,14 @@ shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
         for (int x = 0; x < width_; ++x) {
             const float* p = &px[(src + x) * 4];
             colour::Xyz v(p[0], p[1], p[2]);
+            const double flare = flareRho * static_cast<double>(p[3]) / std::numbers::pi;
             for (int c = 0; c < 3; ++c) {
                 if (!std::isfinite(v[c])) {
                     ++f.nonFinite;
                     v[c] = 0.0;
+                }
+                if (flareRho > 0.0 && v[c] == 0.0 && light.white[c] * flare > 0.0) {
+                    ++f.flareClamped;
                 }
             }
             f.xyz[static_cast<std::size_t>(y) * width_ + x] = v;
@@ -905,7 +932,23 @@ Expected<shading::XyzFrame> renderBoothFrame(const BoothShadingPass& pass,
     if (auto ok = pass.draw(view, view.pixelsX, view.pixelsY); !ok) {
         return tl::unexpected(ok.error());
     }
-    return (*target)->read(light, view);
+    const shading::RenderSettings& s = pass.settings();
+    shading::XyzFrame f =
+            (*target)->read(light, view, s.subtractFlare ? shading::kScreenFlareRho : 0.0);
+    if (light.light != nullptr) {
+        f.whiteY = shading::panelWhiteY(light, view.panel, s.areaLights);
+        f.whiteXyz = light.white * f.whiteY;
+    }
+    // The eye's side of the surface, pixel by pixel as the CPU model tests it.
+    const std::vector<shading::Vec3> flat;
+    for (int py = 0; py < view.pixelsY; ++py) {
+        for (int px = 0; px < view.pixelsX; ++px) {
+            const shading::ShadingPoint sp =
+                    shading::shadingPoint(view, *pass.scene().scene, flat, px, py);
+            f.eyeBehindPixels += shading::eyeBehind(view, sp) ? 1 : 0;
+        }
+    }
+    return f;
 }
 
 } // namespace replica::pipeline::render

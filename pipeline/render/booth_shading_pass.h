@@ -100,6 +100,7 @@ public:
     bool cacheRefreshPending() const { return pending_.has_value(); }
 
     const shading::RenderSettings& settings() const { return settings_; }
+    const shading::PreparedScene& scene() const { return *scene_; }
     // Whether the luminance chain is filtered by the sampler (settings.hardwareFilter and the
     // GL's float-filtering and border-clamp extensions) or by hand in the shader.
     bool hardwareFilter() const { return hwFilter_; }
@@ -214,8 +215,13 @@ public:
     void bind() const;
     // Waits for the frame and reads it back. nonFinite counts components that are NaN or Inf (the
     // shader must never produce one); whiteY/whiteXyz are filled from 'light' at the view's panel
-    // centre exactly as shading::renderRealtime does.
-    shading::XyzFrame read(const shading::PreparedLight& light, const shading::View& view) const;
+    // centre as shading::renderRealtime does with point lights. With flareRho > 0 (the pass
+    // subtracted the screen's flare) flareClamped counts the components the subtraction took to
+    // zero, as shading::subtractFlare counts them: 0 where the flare, light.white * flareRho *
+    // E_geo / pi with E_geo read from alpha, is positive.
+    shading::XyzFrame read(const shading::PreparedLight& light,
+                           const shading::View& view,
+                           double flareRho = 0.0) const;
     int width() const { return width_; }
     int height() const { return height_; }
 
@@ -227,7 +233,10 @@ private:
     GLuint fbo_ = 0;
 };
 
-// One frame of the GPU path into a fresh target: for tests and the benchmark.
+// One frame of the GPU path into a fresh target: for tests, the benchmark and 'replica render'.
+// The frame carries what shading::renderRealtime reports: whiteY from areas or points as the
+// pass's settings say, the pixels with the eye at or behind the surface (exit 3 in 'replica
+// render') and the flare's clamped components.
 Expected<shading::XyzFrame> renderBoothFrame(const BoothShadingPass& pass,
                                              const shading::PreparedLight& light,
                                              const shading::View& view);

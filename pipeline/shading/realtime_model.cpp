@@ -1,5 +1,6 @@
 // CPU model of the real-time renderer.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -145,6 +146,123 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
     return e * texelAreaM2;
 }
 
+int clipToHorizon(const Vec3* v, int count, const Vec3& n, Vec3* out)
+{
+    int m = 0;
+    for (int i = 0; i < count; ++i) {
+        const Vec3& a = v[i];
+        const Vec3& b = v[(i + 1) % count];
+        const double da = glm::dot(n, a);
+        const double db = glm::dot(n, b);
+        if (da >= 0.0) {
+            out[m++] = a;
+        }
+        if ((da >= 0.0) != (db >= 0.0)) {
+            // One end above, one below: da - db is nonzero and t in [0, 1].
+            out[m++] = a + (b - a) * (da / (da - db));
+        }
+    }
+    return m;
+}
+
+double edgeTerm(const Vec3& a, const Vec3& b, const Vec3& n)
+{
+    const Vec3 c = glm::cross(a, b);
+    const double len = glm::length(c);
+    if (!(len > 0.0)) {
+        return 0.0;
+    }
+    return std::atan2(len, glm::dot(a, b)) * (glm::dot(n, c) / len);
+}
+
+double projectedSolidAngle(const Vec3* v, int count, const Vec3& n)
+{
+    double sum = 0.0;
+    for (int i = 0; i < count; ++i) {
+        sum += edgeTerm(v[i], v[(i + 1) % count], n);
+    }
+    return 0.5 * std::abs(sum);
+}
+
+double regionIrradiance(const booth::PointLight& region,
+                        const Vec3& lightNormal,
+                        const Vec3& p,
+                        const Vec3& nGeo,
+                        const Vec3& nShade)
+{
+    const Vec3 o = region.regionOrigin - p;
+    // In front of the emitting side, by more than rounding of the region's size: in (or behind)
+    // its plane the region lights nothing (and an edge could pass through p).
+    const double scale = glm::length(region.regionU) + glm::length(region.regionV);
+    if (!(region.meanCdM2 > 0.0) || !(-glm::dot(o, lightNormal) > 1e-12 * scale)) {
+        return 0.0;
+    }
+    const std::array<Vec3, 4> quad{o, o + region.regionU, o + region.regionU + region.regionV,
+                                   o + region.regionV};
+    std::array<Vec3, kMaxClippedVertices> geo{};
+    const int m = clipToHorizon(quad.data(), 4, nGeo, geo.data());
+    if (m < 3) {
+        return 0.0;
+    }
+    if (nShade == nGeo) {
+        return region.meanCdM2 * projectedSolidAngle(geo.data(), m, nGeo);
+    }
+    std::array<Vec3, kMaxClippedVertices> shade{};
+    const int k = clipToHorizon(geo.data(), m, nShade, shade.data());
+    return k < 3 ? 0.0 : region.meanCdM2 * projectedSolidAngle(shade.data(), k, nShade);
+}
+
+double areaLightIrradiance(const std::vector<booth::PointLight>& lights,
+                           const Vec3& lightNormal,
+                           double texelAreaM2,
+                           const Vec3& p,
+                           const Vec3& nGeo,
+                           const Vec3& nShade,
+                           const surface::HorizonMap* horizon,
+                           int tx,
+                           int ty,
+                           const Vec3& right,
+                           const Vec3& up,
+                           double softness,
+                           const std::optional<glm::dvec2>& bilinearAt)
+{
+    double e = 0.0;
+    for (const booth::PointLight& l : lights) {
+        const double er = regionIrradiance(l, lightNormal, p, nGeo, nShade);
+        if (!(er > 0.0)) {
+            continue;
+        }
+        double v = 1.0;
+        if (horizon != nullptr && horizon->directions > 0) {
+            // One horizon test for the region, along its centroid's direction.
+            Vec3 d = l.position - p;
+            const double d2 = glm::dot(d, d);
+            if (d2 > 0.0) {
+                d /= std::sqrt(d2);
+                const double cosG = glm::dot(nGeo, d);
+                const Vec3 lt(glm::dot(d, right), glm::dot(d, up), cosG);
+                v = horizonVisibility(horizon, tx, ty, bilinearAt, lt,
+                                      lightSoftness(l, d, nGeo, cosG, d2, texelAreaM2, softness));
+            }
+        }
+        e += er * v;
+    }
+    return e;
+}
+
+double panelWhiteY(const PreparedLight& light, const PanelPose& panel, bool areaLights)
+{
+    const booth::BoothLight& bl = *light.light;
+    const Vec3 n = panel.normal;
+    const double e = areaLights ? areaLightIrradiance(light.points, bl.normal(), bl.texelAreaM2(),
+                                                      panel.centre, n, n, nullptr, 0, 0,
+                                                      panel.right, panel.up, 0.0)
+                                : pointLightIrradiance(light.points, bl.normal(), bl.texelAreaM2(),
+                                                       panel.centre, n, n, nullptr, 0, 0,
+                                                       panel.right, panel.up, 0.0);
+    return e / std::numbers::pi;
+}
+
 double filteredSpecular(const PreparedLight& light,
                         const Vec3& p,
                         const Vec3& nGeo,
@@ -236,6 +354,11 @@ int defaultDiffuseGrid(const surface::SurfaceScene& scene)
     return scene.flat() ? kFlatDiffuseGrid : 0;
 }
 
+bool defaultAreaLights(const surface::SurfaceScene& scene)
+{
+    return scene.flat();
+}
+
 int defaultSpecularSamples(const surface::SurfaceScene& scene)
 {
     return scene.flat() ? kFlatSpecularSamples : kReliefSpecularSamples;
@@ -295,6 +418,8 @@ XyzFrame renderRealtime(const PreparedScene& ps,
         }
     }
     const std::vector<booth::PointLight>& points = settings.horizonSpread ? light.points : sharp;
+    // Eq. (1) from the regions' areas or from their centroids (RenderSettings::areaLights).
+    const auto diffuse = settings.areaLights ? areaLightIrradiance : pointLightIrradiance;
     const colour::Xyz specXyz = colour::spectrumToXyz(obs, scene.rhoS * light.unitSpd);
     const int threads = std::clamp(settings.threads, 1, std::max(frame.height, 1));
     // Rows [0, rows) split over the threads: f(thread, first row, end row).
@@ -352,8 +477,8 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                     const ShadingPoint sp = shadingPointAt(
                             view, scene, normals, static_cast<double>(i) / (diffuseNodes.x - 1),
                             static_cast<double>(j) / (diffuseNodes.y - 1));
-                    const double e = pointLightIrradiance(points, nl, a, sp.p, sp.nGeo, sp.nGeo,
-                                                          nullptr, 0, 0, sp.right, sp.up, 0.0);
+                    const double e = diffuse(points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr, 0, 0,
+                                             sp.right, sp.up, 0.0, std::nullopt);
                     diffuseGrid[static_cast<std::size_t>(j) *
                                         static_cast<std::size_t>(diffuseNodes.x) +
                                 static_cast<std::size_t>(i)] = std::isfinite(e) ? e : 0.0;
@@ -376,15 +501,15 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                         diffuseNodes.x > 0
                                 ? gridValue(diffuseGrid, diffuseNodes, (px + 0.5) / view.pixelsX,
                                             (py + 0.5) / view.pixelsY)
-                                : pointLightIrradiance(points, nl, a, sp.p, sp.nGeo, sp.nGeo,
-                                                       nullptr, 0, 0, sp.right, sp.up, 0.0);
+                                : diffuse(points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr, 0, 0,
+                                          sp.right, sp.up, 0.0, std::nullopt);
                 double e = eGeo;
                 if (relief) {
-                    e = pointLightIrradiance(
-                            points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon, sp.tx, sp.ty,
-                            sp.right, sp.up, settings.horizonSoftness,
-                            settings.horizonBilinear ? std::optional<glm::dvec2>({sp.texX, sp.texY})
-                                                     : std::nullopt);
+                    e = diffuse(points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon, sp.tx, sp.ty,
+                                sp.right, sp.up, settings.horizonSoftness,
+                                settings.horizonBilinear
+                                        ? std::optional<glm::dvec2>({sp.texX, sp.texY})
+                                        : std::nullopt);
                 }
                 if (!settings.diffusePass) {
                     e = 0.0;
@@ -427,10 +552,7 @@ XyzFrame renderRealtime(const PreparedScene& ps,
         frame.eyeBehindPixels += c.behind;
         frame.nonFinite += c.bad;
     }
-    const Vec3 n = view.panel.normal;
-    frame.whiteY = pointLightIrradiance(light.points, nl, a, view.panel.centre, n, n, nullptr, 0, 0,
-                                        view.panel.right, view.panel.up, 0.0) /
-                   std::numbers::pi;
+    frame.whiteY = panelWhiteY(light, view.panel, settings.areaLights);
     frame.whiteXyz = light.white * frame.whiteY;
     return frame;
 }

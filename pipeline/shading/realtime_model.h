@@ -60,6 +60,14 @@ struct RenderSettings {
     // (booth::PointLight::spreadU/V; pointLightIrradiance). Off: every light uses
     // horizonSoftness alone, as before 2026-12-02 (recordings made before replay so).
     bool horizonSpread = true;
+    // The diffuse term (eq. 1) from areas, not points: each median-cut region is the uniform
+    // rectangle it covers on the ceiling (its mean luminance), its irradiance Lambert's contour
+    // integral over the region clipped to the surface's horizon (areaLightIrradiance). Point
+    // lights are wrong in the near field: the shipped 1.0 x 0.5 m ceiling cut into 32 regions of
+    // 12.5 cm half a metre away lit a flat matte surface 2-3 % too bright at small tilts. Relief
+    // keeps one horizon test per region, at its centroid's direction. Off: point lights, as
+    // before 2026-12-03 (recordings made before replay so, bit for bit).
+    bool areaLights = true;
     // Store the horizon sines as half floats (surface::halfPrecision, within 2^-12): the GL pass
     // packs eight directions into one RGBA32UI texel instead of two RGBA32F texels, one texture
     // read a pixel fewer (2-3 ms of the painting's 960x600 frame on llvmpipe). Off: float sines,
@@ -169,6 +177,13 @@ constexpr int kFlatDiffuseGrid = 8;
 // surface, 0 on relief.
 int defaultDiffuseGrid(const surface::SurfaceScene& scene);
 
+// Whether the appliance lights eq. (1) from areas unless told (RenderSettings::areaLights): on a
+// flat surface, where the diffuse grid sums it at a few hundred nodes and areas cost next to
+// nothing; not on relief, where it is summed per pixel and areas made the painting's whole
+// recompute 3.1x as long on llvmpipe (53 -> 165 ms, docs/performance.md) while point lights keep
+// it within the budget (docs/rendering.md). 'replica render' uses areas everywhere.
+bool defaultAreaLights(const surface::SurfaceScene& scene);
+
 // The specular sample count the appliance and 'replica render' use unless told
 // (kReliefSpecularSamples or kFlatSpecularSamples).
 int defaultSpecularSamples(const surface::SurfaceScene& scene);
@@ -230,6 +245,59 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             const Vec3& up,
                             double softness,
                             const std::optional<glm::dvec2>& bilinearAt = std::nullopt);
+
+// The area-light diffuse term (RenderSettings::areaLights), one function per equation. Vertices
+// are vectors from the shading point to the polygon's corners, in order.
+
+// The most vertices a rectangle clipped by two planes can have.
+inline constexpr int kMaxClippedVertices = 6;
+
+// Sutherland-Hodgman against the horizon of a surface with normal n at the shading point: the part
+// of the convex polygon v[0, count) with n . v >= 0, into out (kMaxClippedVertices room for a
+// quadrilateral clipped twice). Returns its vertex count, 0 when all of it is below.
+int clipToHorizon(const Vec3* v, int count, const Vec3& n, Vec3* out);
+
+// One edge's term of Lambert's contour integral: the angle the edge a -> b subtends at the point
+// times n . normalize(a x b). The angle is atan2(|a x b|, a . b), the acos of the unit vectors'
+// dot product without its loss of precision near 0 and pi; 0 for an edge of zero length or one in
+// line with the point (a x b = 0).
+double edgeTerm(const Vec3& a, const Vec3& b, const Vec3& n);
+
+// Lambert's formula: the projected solid angle (sr; pi for the whole hemisphere) of a planar
+// polygon above the horizon of n, 1/2 |sum of its edges' terms|.
+double projectedSolidAngle(const Vec3* v, int count, const Vec3& n);
+
+// The irradiance (lux) at p from one median-cut region taken as the uniform rectangle it covers
+// (booth::PointLight::regionOrigin/U/V, meanCdM2): L times the projected solid angle, for the
+// facet normal nShade, of the region clipped to the macro surface's horizon (nGeo) and to the
+// facet's (nShade; skipped when it is nGeo). 0 when p is not in front of the emitting side.
+double regionIrradiance(const booth::PointLight& region,
+                        const Vec3& lightNormal,
+                        const Vec3& p,
+                        const Vec3& nGeo,
+                        const Vec3& nShade);
+
+// Eq. (1) from areas: regionIrradiance summed over the regions, each times the relief's
+// horizonVisibility evaluated once, along the direction of the region's centroid (the point
+// light's position) with pointLightIrradiance's softness. Same arguments as pointLightIrradiance
+// (texelAreaM2 only floors the softness's distance).
+double areaLightIrradiance(const std::vector<booth::PointLight>& lights,
+                           const Vec3& lightNormal,
+                           double texelAreaM2,
+                           const Vec3& p,
+                           const Vec3& nGeo,
+                           const Vec3& nShade,
+                           const surface::HorizonMap* horizon,
+                           int tx,
+                           int ty,
+                           const Vec3& right,
+                           const Vec3& up,
+                           double softness,
+                           const std::optional<glm::dvec2>& bilinearAt = std::nullopt);
+
+// Y of a perfect white diffuser at the panel's centre under the light (XyzFrame::whiteY): eq. (1)
+// from areas or from points as the settings say.
+double panelWhiteY(const PreparedLight& light, const PanelPose& panel, bool areaLights);
 
 // Specular radiance (cd/m^2, rho_s = 1) by FIS with N Hammersley samples (u1 = (k + 1/2) / N).
 // The horizon shadows the lobe with one sine, read at the mirror direction's azimuth; each sample

@@ -79,4 +79,12 @@ ShadingPoint shadingPointAt(const View& view,
     return s;
 }
 
+bool eyeBehind(const View& view, const ShadingPoint& sp)
+{
+    const Vec3 toEye = view.eye - sp.p;
+    const double eyeDist = glm::length(toEye);
+    const Vec3 unit = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
+    return !(glm::dot(unit, sp.nGeo) > 0.0);
+}
+
 } // namespace replica::pipeline::shading

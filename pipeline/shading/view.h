@@ -65,6 +65,10 @@ ShadingPoint shadingPointAt(const View& view,
                             double v,
                             const std::optional<glm::dvec2>& texel = std::nullopt);
 
+// Whether the eye is at or behind the surface's plane at sp, as renderRealtime decides it (its
+// specular term is then 0 and the pixel counted in XyzFrame::eyeBehindPixels).
+bool eyeBehind(const View& view, const ShadingPoint& sp);
+
 // Bilinear interpolation of a normal map at fractional texel coordinates, renormalised (never zero:
 // every stored normal has z > 0).
 Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, double y);

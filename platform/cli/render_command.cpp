@@ -11,6 +11,7 @@
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
 #include <pipeline/reference/reference_integrator.h>
+#include <pipeline/render/booth_shaders.h>
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
@@ -40,6 +41,7 @@ struct RenderArgs {
     int diffuseGrid = kAutoDiffuseGrid;   // likewise
     double lodBias = pipeline::shading::kDefaultSpecularLodBias;
     bool trilinear = false;
+    bool pointLights = false;
     int horizonDirections = 8;
     std::string basis = "adaptive_k6";
     std::string out;
@@ -124,6 +126,12 @@ int runRender(const RenderArgs& a)
     if (!basis) {
         return fail(kExitFailure, basis.error().message);
     }
+    if (a.gl && !a.reference && a.lights > render::kBoothMaxLights) {
+        return fail(kExitUsage,
+                    fmt::format("--lights {}: the GL pass holds at most {} lights; ask "
+                                "for {} or fewer, or render without --gl",
+                                a.lights, render::kBoothMaxLights, render::kBoothMaxLights));
+    }
     std::unique_ptr<platform::Output> output;
     if (a.gl && !a.reference) {
         auto out = platform::createHeadlessOutput();
@@ -144,6 +152,7 @@ int runRender(const RenderArgs& a)
     settings.diffuseGrid = a.diffuseGrid >= 0 ? a.diffuseGrid : shading::defaultDiffuseGrid(*scene);
     settings.specularLodBias = a.lodBias;
     settings.specularNearestLevel = !a.trilinear;
+    settings.areaLights = !a.pointLights;
     std::string mode = "realtime-cpu";
     shading::Plan plan;
     if (a.reference) {
@@ -153,6 +162,7 @@ int runRender(const RenderArgs& a)
         if (a.plan) {
             plan = shading::planRender(*scene, *light, view, *obs, {}, 32, 20, *basis);
             settings = plan.settings;
+            settings.areaLights = !a.pointLights;
         }
         const auto pl = shading::prepareLight(*light, *obs, settings.lights, *basis);
         const auto ps = shading::prepareScene(*scene, std::max(settings.horizonDirections, 1), 0.01,
@@ -223,6 +233,7 @@ int runRender(const RenderArgs& a)
         j["diffuse_grid"] = scene->flat() || !settings.reliefPass ? settings.diffuseGrid : 0;
         j["specular_lod_bias"] = settings.specularLodBias;
         j["specular_nearest_level"] = settings.specularNearestLevel;
+        j["area_lights"] = settings.areaLights;
         j["horizon_directions"] =
                 !scene->flat() && settings.reliefPass ? settings.horizonDirections : 0;
         if (a.plan) {
@@ -267,7 +278,8 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                   "instead of its CPU model");
     cmd->add_flag("--plan", args->plan,
                   "let the planner pick the cheapest setting meeting dE00 p95 <= 1");
-    cmd->add_option("--lights", args->lights, "median-cut point lights")
+    cmd->add_option("--lights", args->lights,
+                    "median-cut regions of the light (at most 256 with --gl)")
             ->capture_default_str()
             ->check(CLI::Range(1, 4096));
     cmd->add_option("--samples", args->samples,
@@ -290,6 +302,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
     cmd->add_flag("--specular-trilinear", args->trilinear,
                   "read each specular sample between the two mip levels around its own instead "
                   "of from the nearest one (slower; the default before 2026-12-01)");
+    cmd->add_flag("--point-lights", args->pointLights,
+                  "light the diffuse term from each median-cut region's centroid as a point light "
+                  "instead of from the region's area (what renderers did before 2026-12-03)");
     cmd->add_option("--specular-lod-bias", args->lodBias,
                     "added to each specular sample's mip level: more blurs the light under each "
                     "sample, less aliases it (docs/rendering.md measures the choice)")

@@ -4,6 +4,8 @@
 // first recordings with each readback choice; hashing a frame for its digest; a booth lamp change
 // with a fixed and the adaptive basis. Prints figures; never fails on timing.
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <tuple>
@@ -43,6 +45,14 @@ platform::Appliance* appliance(int scene, int specularSamples, int cacheSlices)
     c.sceneDir = std::string("scenes/") + kScenes[scene];
     c.specularSamples = specularSamples;
     c.cacheSlices = cacheSlices;
+    // REPLICA_BENCH_POINT_LIGHTS or REPLICA_BENCH_AREA_LIGHTS set: eq. (1) from point lights or
+    // from areas on every scene (for an A/B of the two in one build: tests/benchmarks/ab_loop.sh
+    // with wrappers that set them); neither: as the appliance chooses for the scene.
+    if (std::getenv("REPLICA_BENCH_POINT_LIGHTS") != nullptr) {
+        c.areaLights = 0;
+    } else if (std::getenv("REPLICA_BENCH_AREA_LIGHTS") != nullptr) {
+        c.areaLights = 1;
+    }
     auto app = platform::buildAppliance(c);
     if (!app) {
         std::fprintf(stderr, "appliance: %s\n", app.error().message.c_str());

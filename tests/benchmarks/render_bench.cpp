@@ -88,7 +88,7 @@ Result measure(const surface::SurfaceScene& scene,
 
 std::string describe(const shading::RenderSettings& s, const surface::SurfaceScene& scene)
 {
-    return std::to_string(s.lights) + " lights, " +
+    return std::to_string(s.lights) + (s.areaLights ? " area" : " point") + " lights, " +
            std::to_string(scene.glossy() && s.specularPass ? s.specularSamples : 0) + " spec, " +
            std::to_string(scene.flat() || !s.reliefPass ? 0 : s.horizonDirections) + " horizon" +
            (scene.glossy() && s.specularPass &&
@@ -164,12 +164,14 @@ void writePareto(const std::filesystem::path& file, const std::vector<Point>& pt
 struct ViewsOptions {
     std::string scene;
     std::string light;
-    int samples = 0;        // > 0: specular samples instead of the scene's default
-    int lights = 0;         // > 0: median-cut lights instead of 32
-    double softness = -1.0; // >= 0: horizon softness instead of the default
-    double tilt = -1.0;     // >= 0: only this tilt
-    int eye = -1;           // >= 0: only this eye (0 centre, 1 left, 2 high right)
-    int horizon = 0;        // > 0: horizon directions instead of 8
+    int samples = 0;          // > 0: specular samples instead of the scene's default
+    int lights = 0;           // > 0: median-cut lights instead of 32
+    double softness = -1.0;   // >= 0: horizon softness instead of the default
+    double tilt = -1.0;       // >= 0: only this tilt
+    int eye = -1;             // >= 0: only this eye (0 centre, 1 left, 2 high right)
+    int horizon = 0;          // > 0: horizon directions instead of 8
+    bool pointLights = false; // eq. (1) from point lights (RenderSettings::areaLights off)
+    bool areaLights = false;  // eq. (1) from areas on every scene (the default: flat ones only)
 };
 
 // The appliance's default setting (adaptive_k6, the scene's own sample count and grids) against
@@ -212,6 +214,7 @@ int runViews(const ViewsOptions& o,
         if (o.horizon > 0) {
             def.horizonDirections = o.horizon;
         }
+        def.areaLights = !o.pointLights && (o.areaLights || shading::defaultAreaLights(*scene));
         const std::string setting = describe(def, *scene);
         double worstP95 = 0.0;
         double worstMax = 0.0;
@@ -265,7 +268,8 @@ int main(int argc, char** argv)
             std::printf(
                     "usage: %s [OUT_DIR [WxH [--defaults-only [SAMPLES]] [--scene NAME] "
                     "[--grid TEXELS] [--lod-bias B] [--views [--light NAME] [--tilt DEG] "
-                    "[--eye I] [--lights N] [--horizon N] [--softness S]]]]\n"
+                    "[--eye I] [--lights N] [--horizon N] [--softness S] [--point-lights | "
+                    "--area-lights]]]]\n"
                     "Sweeps the booth renderer's knobs on every shipped scene and light: ms per "
                     "1920x1200 frame of the GL pass and dE00 mean / p95 / max on a WxH frame "
                     "(default 64x40) against the exact reference, then the planner's choices and "
@@ -287,7 +291,11 @@ int main(int argc, char** argv)
                     "    --horizon N              N horizon directions instead of 8\n"
                     "    --lights N               N median-cut lights instead of 32\n"
                     "    --softness S             horizon softness S (sin of elevation) instead "
-                    "of the default\n",
+                    "of the default\n"
+                    "    --point-lights           eq. (1) from each region's centroid as a point "
+                    "light on every scene (the default: areas on flat scenes, points on relief)\n"
+                    "    --area-lights            eq. (1) from each region's area on every "
+                    "scene\n",
                     argv[0]);
             return 0;
         }
@@ -317,6 +325,10 @@ int main(int argc, char** argv)
     if (views) {
         ViewsOptions o;
         o.samples = defaultSamples;
+        for (int a = 3; a < argc; ++a) {
+            o.pointLights = o.pointLights || std::string(argv[a]) == "--point-lights";
+            o.areaLights = o.areaLights || std::string(argv[a]) == "--area-lights";
+        }
         for (int a = 3; a + 1 < argc; ++a) {
             const std::string arg = argv[a];
             if (arg == "--scene") {

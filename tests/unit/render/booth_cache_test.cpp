@@ -202,9 +202,11 @@ TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
             outside += (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) ? 1 : 0;
             const shading::Vec3 p = panel.centre + panel.right * ((u - 0.5) * setup_.scene.widthM) +
                                     panel.up * ((0.5 - v) * setup_.scene.heightM);
-            const double e = shading::pointLightIrradiance(
-                    light.points, bl.normal(), bl.texelAreaM2(), p, panel.normal, panel.normal,
-                    nullptr, 0, 0, panel.right, panel.up, 0.0);
+            const auto irradiance = setup_.settings.areaLights ? shading::areaLightIrradiance
+                                                               : shading::pointLightIrradiance;
+            const double e = irradiance(light.points, bl.normal(), bl.texelAreaM2(), p,
+                                        panel.normal, panel.normal, nullptr, 0, 0, panel.right,
+                                        panel.up, 0.0, std::nullopt);
             const float got = px[(static_cast<std::size_t>(y) * kCacheW + x) * 4 + 3];
             ASSERT_GT(e, 0.0);
             worst = std::max(worst, std::abs(got - e) / e);

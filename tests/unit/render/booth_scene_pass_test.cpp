@@ -148,6 +148,19 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_TRUE(o->surroundIlluminance);
     // And before the specular mip level bias was a setting: the renderer's bias of then.
     EXPECT_EQ(o->specularLodBias, shading::kLegacySpecularLodBias);
+    // And before area lights: point lights; a new run chooses for its scene, recorded as chosen.
+    EXPECT_EQ(o->areaLights, 0);
+    EXPECT_EQ(c.areaLights, platform::kAutoAreaLights);
+    for (const int area : {0, 1}) {
+        platform::RunConfig chosen = c;
+        chosen.areaLights = area;
+        const auto back = platform::RunConfig::fromJson(chosen.toJson());
+        ASSERT_TRUE(back);
+        EXPECT_EQ(back->areaLights, area);
+    }
+    platform::RunConfig badArea = c;
+    badArea.areaLights = 2;
+    EXPECT_FALSE(platform::RunConfig::fromJson(badArea.toJson()));
     // And before each of these was a recorded setting: off (the rule of then), and on for a new
     // run; each is recorded both ways.
     const std::pair<const char*, bool platform::RunConfig::*> recordedSwitches[] = {
@@ -345,6 +358,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         c.specularExactLevel = on;
         c.texelExactTies = !on;
         c.horizonPick = on;
+        c.areaLights = on ? 0 : 1;
         c.cacheSlices = on ? 3 : 1;
         c.flareSubtraction = !on;
         const pipeline::shading::RenderSettings s = platform::boothRenderSettings(c);
@@ -363,6 +377,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         EXPECT_EQ(s.specularExactLevel, on);
         EXPECT_EQ(s.texelExactTies, !on);
         EXPECT_EQ(s.horizonPick, on);
+        EXPECT_EQ(s.areaLights, !on);
         EXPECT_EQ(s.cacheSlices, on ? 3 : 1);
         // Flare subtracted by the display pass: never a second time in pass 1.
         EXPECT_EQ(s.subtractFlare, on);
@@ -386,8 +401,10 @@ TEST(ApplianceBoothScene, ChoosesTheSpecularSampleCountForTheSceneAndRecordsIt)
     EXPECT_NE((*app)->config.toJson().find("\"specular_samples\":8"), std::string::npos);
     EXPECT_NE((*app)->renderer->description().find(", 8 specular samples"), std::string::npos)
             << (*app)->renderer->description();
-    // Relief sums eq. (1) per pixel: recorded as 0.
+    // Relief sums eq. (1) per pixel: recorded as 0; and from point lights, recorded as chosen.
     EXPECT_EQ((*app)->config.diffuseGrid, 0);
+    EXPECT_EQ((*app)->config.areaLights, 0);
+    EXPECT_NE((*app)->config.toJson().find("\"area_lights\":0"), std::string::npos);
     app->reset();
 
     // A recording holds the count it ran with and replays with it, whatever the scene's default
@@ -405,6 +422,7 @@ TEST(ApplianceBoothScene, ChoosesTheSpecularSampleCountForTheSceneAndRecordsIt)
     // The flat ColorChecker's diffuse grid, chosen when the appliance is built and recorded.
     EXPECT_EQ((*replayed)->config.diffuseGrid, pipeline::shading::kFlatDiffuseGrid);
     EXPECT_NE((*replayed)->config.toJson().find("\"diffuse_grid\":8"), std::string::npos);
+    EXPECT_EQ((*replayed)->config.areaLights, 1); // a flat surface: eq. (1) from areas
     EXPECT_NE((*replayed)->renderer->description().find(", diffuse grid 8 texels"),
               std::string::npos)
             << (*replayed)->renderer->description();

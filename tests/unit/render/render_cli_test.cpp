@@ -1,5 +1,6 @@
 // 'replica render', 'replica booth' and 'replica scene' as a person runs them: exit codes, one-line
 // errors, and EXR frames with no NaN/Inf that agree with the reference.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -68,6 +69,13 @@ TEST(RenderCli, RejectsBadArgumentsWithOneLine)
             "/painting --light d65 --specular-lod-bias 9 --out /tmp/x.exr");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--specular-lod-bias"), std::string::npos) << r.err;
+    // More lights than the GL pass holds: refused with one line, not dropped silently.
+    r = run("render --scene " + kScenes +
+            "/metamer --light d65-fluorescent --gl --lights 257 --out /tmp/x.exr");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--lights 257: the GL pass holds at most 256 lights"), std::string::npos)
+            << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     r = run("scene generate --kind teapot --out /tmp/replica_teapot");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("unknown scene kind 'teapot'"), std::string::npos) << r.err;
