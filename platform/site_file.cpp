@@ -162,6 +162,41 @@ std::string standSection(const pipeline::scene::StandFit& fit)
                        fit.rmsM);
 }
 
+Expected<SiteSources> readSiteSources(const std::filesystem::path& file)
+{
+    auto text = readText(file);
+    if (!text) {
+        return tl::unexpected(text.error());
+    }
+    auto t = parse(*text, file);
+    if (!t) {
+        return tl::unexpected(t.error());
+    }
+    SiteSources s;
+    const auto* table = (*t)["sources"].as_table();
+    if (table == nullptr) {
+        return s;
+    }
+    for (const auto& [key, field] :
+         {std::pair<const char*, std::string*>{"spectrometer", &s.spectrometer},
+          {"tracker", &s.tracker},
+          {"accel", &s.accel},
+          {"lamp_selector", &s.lampSelector}}) {
+        const auto& node = (*table)[key];
+        if (!node) {
+            continue;
+        }
+        const auto v = node.value<std::string>();
+        if (!v) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: [sources] {} must be a string, e.g. \"sim\"",
+                                         file.string(), key));
+        }
+        *field = *v;
+    }
+    return s;
+}
+
 Expected<pipeline::scene::RigidTransform> readTrackerTransform(const std::filesystem::path& file)
 {
     auto text = readText(file);

@@ -3,7 +3,9 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <initializer_list>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -105,6 +107,26 @@ Expected<DeviceChoice> chooseDevices(const RunOptions& o)
     c.accel = o.accel.empty() ? o.hal : o.accel;
     c.lampSelector =
             !o.lampSelector.empty() ? o.lampSelector : (o.live.lampGpio.empty() ? "none" : "gpio");
+    auto oneOf = [](const std::string& v, std::initializer_list<const char*> allowed) {
+        for (const char* a : allowed) {
+            if (v == a) {
+                return true;
+            }
+        }
+        return false;
+    };
+    if (!oneOf(c.spectrometer, {"live", "sim", "replay"}) ||
+        !oneOf(c.tracker, {"opentrack", "hid", "sim", "replay"}) ||
+        !oneOf(c.accel, {"live", "sim", "replay"}) ||
+        !oneOf(c.lampSelector, {"none", "gpio", "sim", "sim-miswired", "replay"})) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("sources spectrometer={} tracker={} accel={} lamp_selector={}: "
+                            "expected spectrometer and accel live|sim|replay, tracker "
+                            "opentrack|hid|sim|replay, lamp_selector "
+                            "none|gpio|sim|sim-miswired|replay",
+                            c.spectrometer, c.tracker, c.accel, c.lampSelector));
+    }
     if (c.lampSelector == "gpio" && o.live.lampGpio.empty()) {
         return makeError(ErrorCode::InvalidArgument,
                          "--lamp-selector gpio needs --lamp-gpio CHIP:OFFSET,OFFSET,... (one line "
@@ -207,9 +229,26 @@ makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock
     return out;
 }
 
-int runMain(const RunOptions& o)
+int runMain(const RunOptions& given)
 {
     auto log = logger("replica");
+    RunOptions o = given;
+    if (!o.site.empty()) {
+        // The site file's [sources] fill in what the command line leaves open.
+        auto site = readSiteSources(o.site);
+        if (!site) {
+            log->error("{}", site.error().message);
+            return kExitUsage;
+        }
+        for (auto [cli, fromSite] :
+             {std::pair{&o.spectrometer, &site->spectrometer},
+              std::pair{&o.tracker, &site->tracker}, std::pair{&o.accel, &site->accel},
+              std::pair{&o.lampSelector, &site->lampSelector}}) {
+            if (cli->empty()) {
+                *cli = *fromSite;
+            }
+        }
+    }
     if (auto choice = chooseDevices(o); !choice) { // usage errors before anything is built
         log->error("{}", choice.error().message);
         return kExitUsage;
@@ -461,8 +500,9 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                     "the recording that devices set to 'replay' play back (from its session "
                     "start)");
     cmd->add_option("--site", opts->site,
-                    "site configuration file (e.g. /etc/replica/replica.toml): the calibrated "
-                    "tracker pose [tracker] T_booth_tracker, written by 'replica calibrate "
+                    "site configuration file (e.g. /etc/replica/replica.toml): [sources] "
+                    "spectrometer/tracker/accel/lamp_selector (the command line wins) and the "
+                    "calibrated tracker pose [tracker] T_booth_tracker from 'replica calibrate "
                     "tracker'");
     cmd->add_option(
             "--hid-tracker", opts->live.hidTracker,

@@ -26,6 +26,14 @@ if got != want or j["tracker"]["count"] == 0:
     print(f"FAIL: sources {got}, want {want}; tracker {j['tracker']}", file=sys.stderr)
     sys.exit(1)
 PY
+# The site file's [sources] choose the same, the command line still wins.
+printf '# booth 7\n[sources]\ntracker = "replay"\naccel = "sim"\n' > "$work/site.toml"
+"$replica" run --hal sim --site "$work/site.toml" --replay-from "$work/a.mcap" "${common[@]}" \
+    --record "$work/c.mcap" --digests "$work/c.json" > /dev/null 2> "$work/c.log"
+cmp -s "$work/a.json" "$work/c.json" || { echo "FAIL: [sources] run changed the frames" >&2; exit 1; }
+"$replica" inspect --json "$work/c.mcap" | grep -q '"source": "replay"' \
+    || { echo "FAIL: [sources] tracker = replay not used" >&2; exit 1; }
+printf '[sources]\ntracker = "bogus"\n' > "$work/bad.toml"
 expect() {
     local want="$1" text="$2"
     shift 2
@@ -45,4 +53,5 @@ expect 2 "--fast needs simulated or replayed" --hal sim --accel live --fast
 expect 2 "needs --lamp-gpio" --lamp-selector gpio
 expect 2 "contradict" --lamp-selector sim --lamp-gpio gpiochip0:17,27,22
 expect 2 "tracker" --tracker bogus
+expect 2 "tracker=bogus" --site "$work/bad.toml"
 echo "ok: per-device sources; tracker replayed under simulated devices reproduces the frames"

@@ -69,6 +69,21 @@ TEST_F(SiteFile, TrackerSectionReplacesOnlyItselfAndReadsBack)
     EXPECT_EQ(again.find("[tracker]"), again.rfind("[tracker]"));
 }
 
+TEST_F(SiteFile, SourcesAreReadWhenPresent)
+{
+    const auto file = dir_ / "sources.toml";
+    std::ofstream(file) << "[sources]\ntracker = \"hid\"\nlamp_selector = \"gpio\"\n";
+    auto s = readSiteSources(file);
+    ASSERT_TRUE(s) << s.error().message;
+    EXPECT_EQ(s->tracker, "hid");
+    EXPECT_EQ(s->lampSelector, "gpio");
+    EXPECT_TRUE(s->spectrometer.empty());
+    std::ofstream(file) << "[sources]\ntracker = 3\n";
+    s = readSiteSources(file);
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.error().message.find("[sources] tracker must be a string"), std::string::npos);
+}
+
 TEST_F(SiteFile, BrokenFilesAreRefusedWithTheirLineAndMissingTablesSaidSo)
 {
     const auto file = dir_ / "broken.toml";
