@@ -323,6 +323,10 @@ private:
                 rejectedBefore_ = rejected_.load();
                 reader.reset();
                 state_ = LinkState::Lost;
+                // A device that fails every read must not be reopened in a tight loop.
+                if (!queue_.waitFor(options_.reconnectNs)) {
+                    return;
+                }
                 continue;
             }
             if (!*s) {
