@@ -71,6 +71,16 @@ std::string RunConfig::toJson() const
                      {"viewing_filtered", viewingFiltered},
                      {"flare_subtraction", flareSubtraction},
                      {"false_colour", falseColour}};
+    if (trackerInBooth) {
+        std::vector<double> rotation;
+        for (int i = 0; i < 3; ++i) {
+            for (int k = 0; k < 3; ++k) {
+                rotation.push_back(trackerInBooth->rotation[k][i]); // row-major
+            }
+        }
+        const glm::dvec3& t = trackerInBooth->translation;
+        j["t_booth_tracker"] = {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}};
+    }
     return j.dump();
 }
 
@@ -123,6 +133,20 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.viewingFiltered = j.value("viewing_filtered", false);
         c.flareSubtraction = j.value("flare_subtraction", false);
         c.falseColour = j.value("false_colour", false);
+        if (j.contains("t_booth_tracker")) {
+            const auto r = j.at("t_booth_tracker").at("rotation").get<std::vector<double>>();
+            const auto t = j.at("t_booth_tracker").at("translation").get<std::vector<double>>();
+            if (r.size() != 9 || t.size() != 3) {
+                return makeError(ErrorCode::Corrupt,
+                                 "run configuration: t_booth_tracker needs 9 + 3 numbers");
+            }
+            pipeline::scene::RigidTransform x;
+            for (std::size_t k = 0; k < 9; ++k) {
+                x.rotation[static_cast<int>(k % 3)][static_cast<int>(k / 3)] = r[k];
+            }
+            x.translation = {t[0], t[1], t[2]};
+            c.trackerInBooth = x;
+        }
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
     }
@@ -441,6 +465,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     SceneUpdaterSetup updaterSetup;
     updaterSetup.booth = app->booth;
     updaterSetup.calibration = *calibration;
+    updaterSetup.trackerInBooth = config.trackerInBooth;
     auto updater = SceneUpdater::create(std::move(updaterSetup));
     if (!updater) {
         return tl::unexpected(updater.error());

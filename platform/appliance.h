@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <glm/vec3.hpp>
@@ -12,6 +13,7 @@
 #include <pipeline/base/expected.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/renderer.h>
+#include <pipeline/scene/calibration.h>
 #include <platform/loop/scene_updater.h>
 #include <platform/output/output.h>
 #include <recordings/recording.h>
@@ -123,6 +125,10 @@ struct RunConfig {
     bool viewingFiltered = true;
     bool flareSubtraction = true;
     bool falseColour = false;
+    // The tracker's calibrated pose in the booth ('replica calibrate tracker', read from the site
+    // file by 'replica run --site'). Absent: the fixed mounting, an unrotated tracker at
+    // SceneUpdaterSetup::trackerInBoothM, which recordings made without it replay with.
+    std::optional<pipeline::scene::RigidTransform> trackerInBooth;
 
     std::int64_t periodNs() const;
     std::string toJson() const;

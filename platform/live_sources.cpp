@@ -10,6 +10,8 @@
 #include <hal/lamp/libgpiod_lines.h>
 #include <hal/spectrometer/usb2000_protocol.h>
 #include <hal/spectrometer/usb2000_source.h>
+#include <hal/tracker/hid_tracker_source.h>
+#include <hal/tracker/hidapi_device.h>
 #include <hal/tracker/opentrack_source.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 #include <platform/live_sources.h>
@@ -58,29 +60,51 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
         }
         lampLines = std::move(*spec);
     }
-    hal::tracker::OpentrackSourceOptions trackerOptions;
-    trackerOptions.port = options.trackerPort;
-    trackerOptions.bindAddress = options.trackerBind;
-    auto tracker = hal::tracker::makeOpentrackSource(clock, trackerOptions);
-    if (!tracker) {
-        return tl::unexpected(tracker.error());
-    }
-    hal::spectrometer::Usb2000SourceOptions specOptions;
-    specOptions.nextIntegrationUs = autoIntegration;
-    hal::accel::IioAccelSourceOptions accelOptions;
-    auto mounting = hal::accel::parseAxisMapping(options.accelAxes);
-    if (!mounting) {
-        return tl::unexpected(mounting.error());
-    }
-    accelOptions.mounting = *mounting;
-    accelOptions.root = options.iioRoot;
-    accelOptions.name = options.accelName;
-
     Sources s;
-    s.tracker = std::move(*tracker);
-    s.spectrometer = hal::spectrometer::makeUsb2000Source(hal::spectrometer::libusbUsb2000Opener(),
-                                                          clock, std::move(specOptions));
-    s.accel = hal::accel::makeIioAccelSource(clock, std::move(accelOptions));
+    if (options.tracker == "opentrack") {
+        hal::tracker::OpentrackSourceOptions trackerOptions;
+        trackerOptions.port = options.trackerPort;
+        trackerOptions.bindAddress = options.trackerBind;
+        auto tracker = hal::tracker::makeOpentrackSource(clock, trackerOptions);
+        if (!tracker) {
+            return tl::unexpected(tracker.error());
+        }
+        s.tracker = std::move(*tracker);
+    } else if (options.tracker == "hid") {
+        hal::tracker::HidTrackerOptions hidOptions;
+        auto axes = hal::accel::parseAxisMapping(options.trackerAxes);
+        if (!axes) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("--tracker-axes {}: {}", options.trackerAxes,
+                                         axes.error().message));
+        }
+        hidOptions.axes = *axes;
+        hidOptions.label = options.hidTracker.empty() ? "auto" : options.hidTracker;
+        // Absent at start is not fatal: Lost, one error line, retry every second.
+        s.tracker = hal::tracker::makeHidTrackerSource(hal::hid::hidapiOpener(options.hidTracker),
+                                                       clock, std::move(hidOptions));
+    } else if (!options.tracker.empty()) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("live tracker '{}': expected opentrack or hid", options.tracker));
+    }
+    if (options.spectrometer) {
+        hal::spectrometer::Usb2000SourceOptions specOptions;
+        specOptions.nextIntegrationUs = autoIntegration;
+        s.spectrometer = hal::spectrometer::makeUsb2000Source(
+                hal::spectrometer::libusbUsb2000Opener(), clock, std::move(specOptions));
+    }
+    if (options.accel) {
+        hal::accel::IioAccelSourceOptions accelOptions;
+        auto mounting = hal::accel::parseAxisMapping(options.accelAxes);
+        if (!mounting) {
+            return tl::unexpected(mounting.error());
+        }
+        accelOptions.mounting = *mounting;
+        accelOptions.root = options.iioRoot;
+        accelOptions.name = options.accelName;
+        s.accel = hal::accel::makeIioAccelSource(clock, std::move(accelOptions));
+    }
     if (lampLines) {
         // A chip that cannot be opened is not fatal: the source reports Lost and retries, and
         // the light comes from the spectrometer alone meanwhile.

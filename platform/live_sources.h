@@ -14,6 +14,14 @@
 namespace replica::platform {
 
 struct LiveOptions {
+    // Which implementation each device uses ('replica run --spectrometer/--tracker/--accel/
+    // --lamp-selector'): a site with a missing device runs that one on simulation (or on a
+    // recording) and the rest live. makeLiveSources opens only the devices marked live here.
+    bool spectrometer = true;
+    std::string tracker = "opentrack"; // "opentrack", "hid" or "" (not live)
+    bool accel = true;
+    std::string hidTracker;            // --tracker hid: /dev/hidrawN; empty = the first found
+    std::string trackerAxes = "x,y,z"; // --tracker hid: device axis for x right, y up, z to viewer
     std::uint16_t trackerPort = 4242;
     std::string trackerBind = "127.0.0.1";
     std::filesystem::path iioRoot = "/sys/bus/iio/devices";
@@ -24,6 +32,7 @@ struct LiveOptions {
     std::string lampGpio;
 };
 
+// The devices marked live in 'options' (the others stay null for the caller to fill).
 // Devices that are absent at start are not an error: their sources report Lost, retry in the
 // background, and the loop keeps the last (or default) light, eye and tilt. Only a request that
 // can never work (a tracker port in use, a bad address) fails here.

@@ -34,6 +34,7 @@ int runCli(int argc, char** argv)
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
     registerProbeCommand(app, exitCode);
+    registerCalibrateCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {

@@ -16,6 +16,8 @@
 #include <hal/spectrometer/libusb_transport.h>
 #include <hal/spectrometer/usb2000_device.h>
 #include <hal/spectrometer/usb2000_protocol.h>
+#include <hal/tracker/hid_tracker_source.h>
+#include <hal/tracker/hidapi_device.h>
 #include <hal/tracker/opentrack_source.h>
 #include <pipeline/scene/stand.h>
 #include <platform/cli/commands.h>
@@ -32,6 +34,7 @@ struct ProbeOptions {
     std::string accelAxes = "x,y,z";
     std::string lampGpio; // CHIP:OFFSETS; empty = only list the GPIO chips
     std::string gpioDev = "/dev";
+    std::string hidrawSysfs = "/sys/class/hidraw";
     bool json = false;
 };
 
@@ -146,6 +149,62 @@ nlohmann::json probeTracker(const ProbeOptions& o)
     return j;
 }
 
+// HID eye/head trackers (usage page 0x12): every hidraw node whose report descriptor has one,
+// each opened as 'replica run --tracker hid' would (configured, one report awaited).
+nlohmann::json probeHidTrackers(const ProbeOptions& o)
+{
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& n : hal::hid::listHidTrackers(o.hidrawSysfs, "/dev")) {
+        nlohmann::json j{{"node", n.devNode},
+                         {"name", n.name},
+                         {"id", fmt::format("{:04x}:{:04x}", n.vendor, n.product)}};
+        if (!n.error.empty()) {
+            j["ok"] = false;
+            j["error"] = n.error;
+            list.push_back(j);
+            continue;
+        }
+        j["layout"] = n.layout;
+        hal::SteadyClock clock;
+        auto dev = hal::hid::hidapiOpener(n.devNode, o.hidrawSysfs, "/dev")();
+        if (!dev) {
+            j["ok"] = false;
+            j["error"] = dev.error().message;
+            list.push_back(j);
+            continue;
+        }
+        hal::tracker::HidTrackerOptions options;
+        options.readTimeoutMs = 100;
+        auto reader = hal::tracker::HidTrackerReader::open(std::move(*dev), clock, options);
+        if (!reader) {
+            j["ok"] = false;
+            j["error"] = reader.error().message;
+            list.push_back(j);
+            continue;
+        }
+        const auto& d = reader->description();
+        j["ok"] = true;
+        j["status"] = d.status ? hal::hid::eht::statusName(*d.status) : "not reported";
+        if (d.screenWidthM && d.screenHeightM) {
+            j["calibrated_screen_m"] = {*d.screenWidthM, *d.screenHeightM};
+        }
+        if (d.samplingHz) {
+            j["sampling_hz"] = *d.samplingHz;
+        }
+        j["mode_request"] = d.modeSent;
+        for (int i = 0; i < 10; ++i) {
+            auto s = reader->next();
+            if (s && *s && (*s)->tracked) {
+                const auto& e = (*s)->eyeTrackerM;
+                j["eye_tracker_m"] = {e.x, e.y, e.z};
+                break;
+            }
+        }
+        list.push_back(j);
+    }
+    return list;
+}
+
 // The lamp selector: every GPIO chip this machine has, and with --lamp-gpio the configured lines
 // opened as 'replica run --hal live' would and read once.
 nlohmann::json probeLampSelector(const ProbeOptions& o)
@@ -202,6 +261,7 @@ int runProbe(const ProbeOptions& o)
     nlohmann::json report{{"spectrometer", probeSpectrometer()},
                           {"accelerometer", probeAccel(o)},
                           {"tracker", probeTracker(o)},
+                          {"hid_trackers", probeHidTrackers(o)},
                           {"lamp_selector", probeLampSelector(o)}};
     bool all = true;
     for (const char* k : {"spectrometer", "accelerometer", "tracker"}) {
@@ -245,6 +305,18 @@ int runProbe(const ProbeOptions& o)
                    t["rate_hz"].get<double>(), t["listening"].get<std::string>());
     } else {
         fmt::print("tracker        MISSING: {}\n", t["error"].get<std::string>());
+    }
+    for (const auto& h : report["hid_trackers"]) {
+        if (h.value("ok", false)) {
+            fmt::print("hid tracker    {} {} [{}]: {}; status {}{}\n", h["node"].get<std::string>(),
+                       h["name"].get<std::string>(), h["id"].get<std::string>(),
+                       h["layout"].get<std::string>(), h["status"].get<std::string>(),
+                       h.contains("eye_tracker_m") ? "" : ", no tracked report yet");
+        } else {
+            fmt::print("hid tracker    {} {} [{}]: UNUSABLE: {}\n", h["node"].get<std::string>(),
+                       h["name"].get<std::string>(), h["id"].get<std::string>(),
+                       h["error"].get<std::string>());
+        }
     }
     std::string chipList;
     for (const auto& c : lamp["chips"]) {
@@ -298,6 +370,9 @@ void registerProbeCommand(CLI::App& app, int& exitCode)
                     "the lamp selector's lines, CHIP:OFFSET,OFFSET,... (one per lamp, lamp "
                     "order); without it the GPIO chips are only listed");
     cmd->add_option("--gpio-dev", o->gpioDev, "where GPIO chips are listed")->capture_default_str();
+    cmd->add_option("--hidraw-sysfs", o->hidrawSysfs,
+                    "where hidraw devices are listed (HID eye/head trackers are found there)")
+            ->capture_default_str();
     cmd->add_flag("--json", o->json, "print the report as JSON");
     cmd->callback([o, &exitCode] { exitCode = runProbe(*o); });
 }

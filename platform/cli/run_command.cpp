@@ -3,7 +3,9 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <initializer_list>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -15,13 +17,22 @@
 #include <platform/live_sources.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
+#include <platform/site_file.h>
+#include <recordings/recording.h>
 
 namespace replica::platform {
 namespace {
 
 struct RunOptions {
     std::string hal = "sim";
-    std::string lampSelector = "none"; // sim only: none, sim, sim-miswired
+    // Per device (empty: follow --hal): spectrometer live|sim|replay, tracker opentrack|hid|sim|
+    // replay, accel live|sim|replay, lamp selector none|sim|sim-miswired|gpio|replay.
+    std::string spectrometer;
+    std::string tracker;
+    std::string accel;
+    std::string lampSelector;
+    std::string replayFrom; // the recording that devices set to 'replay' play back
+    std::string site;       // site file: [tracker] T_booth_tracker
     std::string output = "headless";
     std::uint64_t frames = 180;
     std::string size = "960x600";
@@ -58,17 +69,188 @@ std::optional<std::pair<int, int>> parseSize(const std::string& s)
     return std::make_pair(w, h);
 }
 
-int runMain(const RunOptions& o)
+struct DeviceChoice {
+    std::string spectrometer;
+    std::string tracker;
+    std::string accel;
+    std::string lampSelector;
+    bool anyLive() const
+    {
+        return spectrometer == "live" || tracker == "opentrack" || tracker == "hid" ||
+               accel == "live" || lampSelector == "gpio";
+    }
+    bool anyReplay() const
+    {
+        return spectrometer == "replay" || tracker == "replay" || accel == "replay" ||
+               lampSelector == "replay";
+    }
+    bool anySim() const
+    {
+        return spectrometer == "sim" || tracker == "sim" || accel == "sim" ||
+               lampSelector.rfind("sim", 0) == 0;
+    }
+};
+
+// Each device's source: --hal gives the default, --spectrometer/--tracker/--accel/--lamp-selector
+// override it per device. Usage errors come back as InvalidArgument.
+Expected<DeviceChoice> chooseDevices(const RunOptions& o)
+{
+    if (o.hal != "sim" && o.hal != "live") {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("--hal {}: expected 'sim' (built-in simulated sensors) or "
+                                     "'live' (USB2000+, opentrack, IIO accelerometer)",
+                                     o.hal));
+    }
+    DeviceChoice c;
+    c.spectrometer = o.spectrometer.empty() ? o.hal : o.spectrometer;
+    c.tracker = !o.tracker.empty() ? o.tracker : (o.hal == "live" ? "opentrack" : "sim");
+    c.accel = o.accel.empty() ? o.hal : o.accel;
+    c.lampSelector =
+            !o.lampSelector.empty() ? o.lampSelector : (o.live.lampGpio.empty() ? "none" : "gpio");
+    auto oneOf = [](const std::string& v, std::initializer_list<const char*> allowed) {
+        for (const char* a : allowed) {
+            if (v == a) {
+                return true;
+            }
+        }
+        return false;
+    };
+    if (!oneOf(c.spectrometer, {"live", "sim", "replay"}) ||
+        !oneOf(c.tracker, {"opentrack", "hid", "sim", "replay"}) ||
+        !oneOf(c.accel, {"live", "sim", "replay"}) ||
+        !oneOf(c.lampSelector, {"none", "gpio", "sim", "sim-miswired", "replay"})) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("sources spectrometer={} tracker={} accel={} lamp_selector={}: "
+                            "expected spectrometer and accel live|sim|replay, tracker "
+                            "opentrack|hid|sim|replay, lamp_selector "
+                            "none|gpio|sim|sim-miswired|replay",
+                            c.spectrometer, c.tracker, c.accel, c.lampSelector));
+    }
+    if (c.lampSelector == "gpio" && o.live.lampGpio.empty()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "--lamp-selector gpio needs --lamp-gpio CHIP:OFFSET,OFFSET,... (one line "
+                         "per lamp)");
+    }
+    if (!o.live.lampGpio.empty() && c.lampSelector != "gpio") {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("--lamp-gpio {} and --lamp-selector {} contradict each other: "
+                                     "the GPIO switch is --lamp-selector gpio",
+                                     o.live.lampGpio, c.lampSelector));
+    }
+    if (c.anyLive() && o.fast) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "--fast needs simulated or replayed sensors: live sensors run on the "
+                         "wall clock");
+    }
+    if (c.anyReplay() != !o.replayFrom.empty()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         c.anyReplay() ? "a device set to 'replay' needs --replay-from "
+                                         "RECORDING.mcap"
+                                       : "--replay-from is for devices set to 'replay' (e.g. "
+                                         "--tracker replay)");
+    }
+    return c;
+}
+
+Expected<Sources>
+makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock& liveClock)
+{
+    auto choice = chooseDevices(o);
+    if (!choice) {
+        return tl::unexpected(choice.error());
+    }
+    const DeviceChoice& c = *choice;
+    auto log = logger("replica");
+    Sources sim;
+    if (c.anySim()) {
+        const bool simLamp = c.lampSelector == "sim" || c.lampSelector == "sim-miswired";
+        auto made = makeSimSources(appliance, simLamp ? c.lampSelector : std::string("none"));
+        if (!made) {
+            return tl::unexpected(made.error());
+        }
+        sim = std::move(*made);
+    }
+    Sources replayed;
+    if (c.anyReplay()) {
+        auto recording = recordings::readRecording(o.replayFrom);
+        if (!recording) {
+            return tl::unexpected(recording.error());
+        }
+        replayed = makeReplaySources(*recording);
+        if (c.lampSelector == "replay" && !replayed.lampSelector) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("--lamp-selector replay: {} has no lamp selector "
+                                         "channel",
+                                         o.replayFrom));
+        }
+    }
+    Sources live;
+    if (c.anyLive()) {
+        LiveOptions lo = o.live;
+        lo.spectrometer = c.spectrometer == "live";
+        lo.tracker = c.tracker == "opentrack" || c.tracker == "hid" ? c.tracker : std::string();
+        lo.accel = c.accel == "live";
+        if (c.lampSelector != "gpio") {
+            lo.lampGpio.clear();
+        }
+        auto made = makeLiveSources(liveClock, lo, appliance.booth.lamps.size());
+        if (!made) {
+            return tl::unexpected(made.error());
+        }
+        live = std::move(*made);
+    }
+    auto pick = [](const std::string& kind, auto& l, auto& s, auto& r) {
+        return kind == "sim" || kind.rfind("sim-", 0) == 0 ? std::move(s)
+               : kind == "replay"                          ? std::move(r)
+                                                           : std::move(l);
+    };
+    Sources out;
+    out.spectrometer =
+            pick(c.spectrometer, live.spectrometer, sim.spectrometer, replayed.spectrometer);
+    out.tracker = pick(c.tracker, live.tracker, sim.tracker, replayed.tracker);
+    out.accel = pick(c.accel, live.accel, sim.accel, replayed.accel);
+    out.lampSelector = c.lampSelector == "none" ? nullptr
+                                                : pick(c.lampSelector, live.lampSelector,
+                                                       sim.lampSelector, replayed.lampSelector);
+    // Say which devices do not come from the booth, so nobody mistakes a simulated one for it.
+    if (c.anyLive()) {
+        for (const auto& [name, kind] :
+             {std::pair<const char*, const std::string&>{"spectrometer", c.spectrometer},
+              {"tracker", c.tracker},
+              {"accel", c.accel}}) {
+            if (kind == "sim" || kind == "replay") {
+                log->warn("{} is {}: {}; the display follows it, not the booth's {}", name,
+                          kind == "sim" ? "simulated" : "replayed",
+                          kind == "sim" ? "the scripted scenario" : o.replayFrom, name);
+            }
+        }
+    }
+    return out;
+}
+
+int runMain(const RunOptions& given)
 {
     auto log = logger("replica");
-    if (o.hal != "sim" && o.hal != "live") {
-        log->error("--hal {}: expected 'sim' (built-in simulated sensors) or 'live' (USB2000+, "
-                   "opentrack, IIO accelerometer)",
-                   o.hal);
-        return kExitUsage;
+    RunOptions o = given;
+    if (!o.site.empty()) {
+        // The site file's [sources] fill in what the command line leaves open.
+        auto site = readSiteSources(o.site);
+        if (!site) {
+            log->error("{}", site.error().message);
+            return kExitUsage;
+        }
+        for (auto [cli, fromSite] :
+             {std::pair{&o.spectrometer, &site->spectrometer},
+              std::pair{&o.tracker, &site->tracker}, std::pair{&o.accel, &site->accel},
+              std::pair{&o.lampSelector, &site->lampSelector}}) {
+            if (cli->empty()) {
+                *cli = *fromSite;
+            }
+        }
     }
-    if (o.hal == "live" && o.fast) {
-        log->error("--fast needs the simulated sensors: live sensors run on the wall clock");
+    if (auto choice = chooseDevices(o); !choice) { // usage errors before anything is built
+        log->error("{}", choice.error().message);
         return kExitUsage;
     }
     if (o.output != "headless" && o.output != "kms") {
@@ -123,6 +305,19 @@ int runMain(const RunOptions& o)
     config.viewingCompensation = !o.noViewing;
     config.flareSubtraction = !o.noFlare;
     config.falseColour = o.falseColour;
+    if (!o.site.empty()) {
+        auto t = readTrackerTransform(o.site);
+        if (!t && t.error().code != ErrorCode::NotFound) {
+            log->error("{}", t.error().message);
+            return kExitFailure;
+        }
+        if (t) {
+            config.trackerInBooth = *t;
+            log->info("tracker pose in the booth from {} (T_booth_tracker)", o.site);
+        } else {
+            log->warn("{}; using the fixed tracker mounting", t.error().message);
+        }
+    }
 
     OutputChoice outputChoice = o.outputChoice;
     outputChoice.kind = o.output;
@@ -134,23 +329,10 @@ int runMain(const RunOptions& o)
     // Live devices stamp samples on this clock; the loop's ticks start with it (within the few
     // milliseconds between here and the first tick, which only delays samples by that much).
     hal::SteadyClock liveClock;
-    if (o.hal == "live" && o.lampSelector != "none") {
-        log->error("--lamp-selector {} is for --hal sim; a live booth's switch is read with "
-                   "--lamp-gpio CHIP:OFFSETS",
-                   o.lampSelector);
-        return kExitUsage;
-    }
-    if (o.hal == "sim" && !o.live.lampGpio.empty()) {
-        log->error("--lamp-gpio needs --hal live; the simulated booth's switch is "
-                   "--lamp-selector sim");
-        return kExitUsage;
-    }
-    auto sources = o.hal == "live"
-                           ? makeLiveSources(liveClock, o.live, (*appliance)->booth.lamps.size())
-                           : makeSimSources(**appliance, o.lampSelector);
+    auto sources = makeRunSources(o, **appliance, liveClock);
     if (!sources) {
         log->error("{}", sources.error().message);
-        return kExitFailure;
+        return kExitFailure; // usage errors were caught before anything was built
     }
     log->info("hal: spectrometer={} [{} {}], tracker={} [{} {}], accel={} [{} {}]; output={}; "
               "renderer={} on {}; {}x{} at {} Hz; display {}",
@@ -299,9 +481,36 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                     "line per lamp in the booth's lamp order (active low, pull-up), e.g. "
                     "gpiochip0:17,27,22; without it the spectrometer alone decides the light");
     cmd->add_option("--lamp-selector", opts->lampSelector,
-                    "sim: none, sim (a switch that follows the simulated lamps, with contact "
-                    "bounce) or sim-miswired (its lines for lamps 1 and 2 swapped)")
-            ->check(CLI::IsMember({"none", "sim", "sim-miswired"}))
+                    "the booth's lamp switch: none, gpio (the live switch on --lamp-gpio; the "
+                    "default when that is given), sim (follows the simulated lamps, with contact "
+                    "bounce), sim-miswired (its lines for lamps 1 and 2 swapped) or replay")
+            ->check(CLI::IsMember({"none", "gpio", "sim", "sim-miswired", "replay"}));
+    cmd->add_option("--spectrometer", opts->spectrometer,
+                    "the spectrometer's source: live (USB2000+), sim or replay (default: --hal)")
+            ->check(CLI::IsMember({"live", "sim", "replay"}));
+    cmd->add_option("--tracker", opts->tracker,
+                    "the head tracker's source: opentrack (UDP), hid (a USB HID eye/head tracker, "
+                    "usage page 0x12), sim or replay (default: opentrack with --hal live, else "
+                    "sim)")
+            ->check(CLI::IsMember({"opentrack", "hid", "sim", "replay"}));
+    cmd->add_option("--accel", opts->accel,
+                    "the accelerometer's source: live (IIO), sim or replay (default: --hal)")
+            ->check(CLI::IsMember({"live", "sim", "replay"}));
+    cmd->add_option("--replay-from", opts->replayFrom,
+                    "the recording that devices set to 'replay' play back (from its session "
+                    "start)");
+    cmd->add_option("--site", opts->site,
+                    "site configuration file (e.g. /etc/replica/replica.toml): [sources] "
+                    "spectrometer/tracker/accel/lamp_selector (the command line wins) and the "
+                    "calibrated tracker pose [tracker] T_booth_tracker from 'replica calibrate "
+                    "tracker'");
+    cmd->add_option(
+            "--hid-tracker", opts->live.hidTracker,
+            "--tracker hid: the hidraw node, e.g. /dev/hidraw3 (default: the first eye/head "
+            "tracker found; 'replica probe' lists them)");
+    cmd->add_option("--tracker-axes", opts->live.trackerAxes,
+                    "--tracker hid: the device axis for x right, y up, z towards the viewer, e.g. "
+                    "x,-y,z for a tracker whose y points down the screen")
             ->capture_default_str();
     cmd->add_option("--output", opts->output,
                     "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")

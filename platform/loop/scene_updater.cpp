@@ -98,7 +98,8 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
         lastPose_ = pose->sequence;
         const glm::dvec3 e = pose->eyeTrackerM;
         if (pose->tracked && std::isfinite(e.x) && std::isfinite(e.y) && std::isfinite(e.z)) {
-            state.eyeBoothM = e + setup_.trackerInBoothM;
+            state.eyeBoothM = setup_.trackerInBooth ? setup_.trackerInBooth->apply(e)
+                                                    : e + setup_.trackerInBoothM;
         } else {
             ++rejectedPoses_;
         }

@@ -11,6 +11,7 @@
 #include <hal/samples.h>
 #include <pipeline/base/expected.h>
 #include <pipeline/scene/booth.h>
+#include <pipeline/scene/calibration.h>
 #include <pipeline/scene/scene_state.h>
 #include <pipeline/spectral/light_classifier.h>
 #include <pipeline/spectral/spectrometer_chain.h>
@@ -22,6 +23,8 @@ struct SceneUpdaterSetup {
     pipeline::scene::Booth booth;
     pipeline::spectral::SpectrometerCalibration calibration;
     glm::dvec3 trackerInBoothM{0.0, 0.42, 0.05}; // tracker mounted on the stand's base, unrotated
+    // The calibrated T_booth_tracker, which replaces trackerInBoothM when present.
+    std::optional<pipeline::scene::RigidTransform> trackerInBooth;
 };
 
 class SceneUpdater

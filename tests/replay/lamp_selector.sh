@@ -34,8 +34,8 @@ expect() {
     fi
 }
 set +e
-expect 2 "--lamp-gpio needs --hal live" --hal sim --lamp-gpio gpiochip0:17,27,22
-expect 2 "is for --hal sim" --hal live --lamp-selector sim
+expect 2 "contradict each other" --hal sim --lamp-selector sim --lamp-gpio gpiochip0:17,27,22
+expect 2 "needs --lamp-gpio" --hal live --lamp-selector gpio
 expect 2 "lamp-selector" --hal sim --lamp-selector bogus
 expect 1 "2 lines for a booth with 3 lamps" --hal live --lamp-gpio gpiochip0:17,27
 expect 1 "expected CHIP:OFFSET" --hal live --lamp-gpio gpiochip0

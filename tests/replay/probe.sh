@@ -18,6 +18,12 @@ for axis, v in (("x", 0.0), ("y", g * math.cos(math.radians(30))), ("z", g * mat
     open(f"{d}/in_accel_{axis}_raw", "w").write(f"{round(v / scale)}\n")
 open(f"{d}/in_accel_scale", "w").write(f"{scale}\n")
 PY
+# A HID eye tracker's sysfs entry (its report descriptor: Usage Page 0x12, Eye Tracker, head
+# position X, Y, Z) without a device node: listed, and reported as not openable.
+mkdir -p "$work/hidraw/hidraw7/device"
+printf '\x05\x12\x09\x01\xa1\x01\x09\x27\xa1\x00\x09\x21\x09\x22\x09\x23\x75\x10\x95\x03\x81\x02\xc0\xc0' \
+    > "$work/hidraw/hidraw7/device/report_descriptor"
+printf 'HID_ID=0003:00002104:00000127\nHID_NAME=Acme Eye Tracker\n' > "$work/hidraw/hidraw7/device/uevent"
 port=$(python3 -c 'import socket; s=socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 # The sender runs until the probe is done (python can take a second to start on a busy machine,
 # so the probe starts only once the sender is sending).
@@ -39,7 +45,7 @@ for _ in $(seq 1 300); do
     sleep 0.1
 done
 "$replica" probe --json --iio-root "$work/iio" --tracker-port "$port" --tracker-wait 1 \
-    --lamp-gpio replica-no-such-gpiochip:17,27,22 --gpio-dev "$work" \
+    --lamp-gpio replica-no-such-gpiochip:17,27,22 --gpio-dev "$work" --hidraw-sysfs "$work/hidraw" \
     > "$work/probe.json" 2> "$work/probe.log"
 code=$?
 kill "$sender" 2>/dev/null
@@ -66,6 +72,10 @@ l = r["lamp_selector"]
 if (not l["configured"] or l.get("found") or l["chips"] != []
         or "'replica-no-such-gpiochip' not found" not in l.get("error", "")):
     fail.append(f"lamp selector: {l}")
+h = r["hid_trackers"]
+if (len(h) != 1 or h[0]["node"] != "/dev/hidraw7" or h[0]["id"] != "2104:0127"
+        or h[0]["name"] != "Acme Eye Tracker" or h[0]["ok"] or "/dev/hidraw7" not in h[0]["error"]):
+    fail.append(f"hid trackers: {h}")
 if r["all_found"] or code != 1:
     fail.append(f"all_found {r['all_found']} exit {code}")
 if fail:

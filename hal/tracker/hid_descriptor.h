@@ -1,0 +1,97 @@
+// A USB HID report-descriptor parser (HID 1.11 section 6.2.2): short and long items, the global
+// state with Push/Pop, local usages and usage ranges, collections, report IDs, sizes and counts,
+// logical ranges, unit and unit exponent. It flattens every Input, Output and Feature main item
+// into one field per reported value, with its bit position in the report, so that a driver can
+// find the values it wants by usage and read them from raw report bytes. Devices whose descriptor
+// is malformed are refused with the byte offset of the fault.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <pipeline/base/expected.h>
+
+namespace replica::hal::hid {
+
+enum class ReportType { Input, Output, Feature };
+
+const char* toString(ReportType t);
+
+// A usage: page in the high 16 bits, id in the low 16 (HID's "extended usage").
+constexpr std::uint32_t usage(std::uint16_t page, std::uint16_t id)
+{
+    return (static_cast<std::uint32_t>(page) << 16) | id;
+}
+
+// HID unit systems (the low nibble of Unit).
+enum class UnitSystem { None, SiLinear, SiRotation, EnglishLinear, EnglishRotation, Vendor };
+
+struct HidUnit {
+    std::uint32_t raw = 0; // as in the descriptor
+    int exponent = 0;      // Unit Exponent, power of ten
+
+    UnitSystem system() const;
+    // The power of one base dimension (nibble 1 length, 2 mass, 3 time, 4 temperature, 5 current,
+    // 6 luminous intensity), as a signed nibble.
+    int power(int nibble) const;
+    // Metres per logical unit for a pure length (cm or inch, times 10^exponent); 0 otherwise.
+    double metresPerUnit() const;
+    // Seconds per logical unit for a pure time; 0 otherwise.
+    double secondsPerUnit() const;
+};
+
+// One reported value: a single element of a Variable main item (arrays and constants are kept
+// as padding: they take space in the report but have no usage).
+struct HidField {
+    ReportType type = ReportType::Input;
+    std::uint8_t reportId = 0;   // 0: the device does not number its reports
+    std::uint32_t bitOffset = 0; // from the start of the report's data (after the ID byte)
+    std::uint32_t bitSize = 0;   // 1..64
+    std::uint32_t usage = 0;     // page << 16 | id; 0 for padding
+    bool constant = false;       // Constant or Array item: padding for our purposes
+    bool relative = false;       // Relative (rather than Absolute) data
+    bool nullState = false;      // values outside the logical range mean "no value"
+    std::int64_t logicalMin = 0; // signed when logicalMin < 0
+    std::int64_t logicalMax = 0;
+    HidUnit unit;
+    // Usages of the enclosing collections, outermost first.
+    std::vector<std::uint32_t> collections;
+
+    bool isSigned() const { return logicalMin < 0; }
+    bool within(std::uint32_t collectionUsage) const;
+};
+
+struct HidCollection {
+    std::uint32_t usage = 0;
+    std::uint8_t type = 0; // 0 physical, 1 application, 2 logical, ...
+    int depth = 0;
+};
+
+struct ReportDescriptor {
+    std::vector<HidField> fields;
+    std::vector<HidCollection> collections; // in descriptor order
+    bool numberedReports = false;           // any Report ID item: every report starts with its ID
+    // Data bits of each report (without the ID byte), keyed by (type, id).
+    std::map<std::pair<ReportType, std::uint8_t>, std::uint32_t> reportBits;
+
+    // Bytes a report of this type and ID occupies on the wire, with the ID byte when numbered.
+    std::size_t reportBytes(ReportType type, std::uint8_t id) const;
+    const HidField*
+    find(ReportType type, std::uint32_t usage, std::uint32_t withinCollection = 0) const;
+};
+
+// Parses a report descriptor; errors name the byte offset and what is wrong with it.
+Expected<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> bytes);
+
+// Reads a field's raw value from a report's data bytes (without the ID byte); nullopt when the
+// report is too short to hold it. Sign-extended for signed fields.
+std::optional<std::int64_t> extractField(const HidField& f, std::span<const std::uint8_t> data);
+
+// Writes a field's value into a report's data bytes (which must be long enough).
+void insertField(const HidField& f, std::span<std::uint8_t> data, std::int64_t value);
+
+} // namespace replica::hal::hid

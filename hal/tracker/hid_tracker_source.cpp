@@ -1,0 +1,370 @@
+// The HID eye/head tracker: configuration on open, report decoding, and the reader thread.
+#include <algorithm>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <hal/live_queue.h>
+#include <hal/log.h>
+#include <hal/tracker/hid_tracker_source.h>
+
+namespace replica::hal::tracker {
+namespace {
+
+namespace eht = hid::eht;
+
+constexpr std::size_t kFeatureBytes = 256;
+
+Error deviceError(hid::HidStatus s, const std::string& where, const std::string& doing)
+{
+    return Error{s == hid::HidStatus::Gone ? ErrorCode::NotFound : ErrorCode::DeviceFailure,
+                 fmt::format("HID tracker {}: {} failed ({})", where, doing, hid::toString(s))};
+}
+
+glm::dvec3 mapAxes(const glm::dvec3& v, const accel::AxisMapping& m)
+{
+    glm::dvec3 out;
+    for (int i = 0; i < 3; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        out[i] = m.sign[k] * v[m.axis[k]];
+    }
+    return out;
+}
+
+} // namespace
+
+std::optional<glm::dvec3> eyePoint(const eht::TrackingReport& r, const accel::AxisMapping& axes)
+{
+    if (r.leftEyeM && r.rightEyeM) {
+        return mapAxes(0.5 * (*r.leftEyeM + *r.rightEyeM), axes);
+    }
+    if (r.headM) {
+        return mapAxes(*r.headM, axes);
+    }
+    return std::nullopt;
+}
+
+Expected<HidTrackerReader> HidTrackerReader::open(std::unique_ptr<hid::HidDevice> device,
+                                                  const Clock& clock,
+                                                  HidTrackerOptions options)
+{
+    HidTrackerReader r(std::move(device), clock, std::move(options));
+    if (auto ok = r.configure(); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return r;
+}
+
+Expected<void> HidTrackerReader::configure()
+{
+    const std::string where = device_->describe();
+    auto bytes = device_->reportDescriptor();
+    if (!bytes) {
+        return tl::unexpected(bytes.error());
+    }
+    auto descriptor = hid::parseReportDescriptor(*bytes);
+    if (!descriptor) {
+        return makeError(ErrorCode::DeviceFailure, fmt::format("{}: {}; the device cannot be used",
+                                                               where, descriptor.error().message));
+    }
+    auto layout = eht::findLayout(*descriptor);
+    if (!layout) {
+        return makeError(layout.error().code, fmt::format("{}: {}", where, layout.error().message));
+    }
+    description_ = {};
+    description_.layout = *layout;
+    description_.where = where;
+    buffer_.assign(std::max<std::size_t>(layout->inputReportBytes, 1) + 64, 0);
+
+    // Read one feature value; a device that refuses a feature request is still usable.
+    std::vector<std::uint8_t> feature(kFeatureBytes);
+    auto readFeature =
+            [&](const std::optional<hid::HidField>& f) -> Expected<std::optional<double>> {
+        if (!f) {
+            return std::optional<double>();
+        }
+        std::fill(feature.begin(), feature.end(), std::uint8_t{0});
+        const auto got = device_->getFeature(f->reportId, feature);
+        if (got.status == hid::HidStatus::Gone) {
+            return tl::unexpected(deviceError(got.status, where, "a get-feature request"));
+        }
+        if (got.status != hid::HidStatus::Ok || got.bytes == 0) {
+            return std::optional<double>();
+        }
+        return eht::featureValue(*f, {feature.data(), got.bytes});
+    };
+    auto asLength = [](const std::optional<hid::HidField>& f, std::optional<double> v) {
+        // Without a length unit the page's convention, micrometres, applies.
+        if (v && f && f->unit.metresPerUnit() <= 0.0) {
+            *v *= 1e-6;
+        }
+        return v;
+    };
+    auto status = readFeature(layout->configurationStatus);
+    auto quality = readFeature(layout->quality);
+    auto width = readFeature(layout->calibratedWidth);
+    auto height = readFeature(layout->calibratedHeight);
+    auto rate = readFeature(layout->samplingFrequency);
+    for (const auto* e : {&status, &quality, &width, &height, &rate}) {
+        if (!*e) {
+            return tl::unexpected(e->error());
+        }
+    }
+    if (const std::optional<double> v = *status) {
+        description_.status = static_cast<int>(*v);
+    }
+    if (const std::optional<double> v = *quality) {
+        description_.quality = static_cast<int>(*v);
+    }
+    description_.screenWidthM = asLength(layout->calibratedWidth, *width);
+    description_.screenHeightM = asLength(layout->calibratedHeight, *height);
+    description_.samplingHz = *rate;
+
+    // Device Mode Request: read the control report (other values in it stay as they are), set the
+    // streams wanted, write it back.
+    if (layout->modeRequest) {
+        const hid::HidField& f = *layout->modeRequest;
+        const std::size_t n = descriptor->reportBytes(hid::ReportType::Feature, f.reportId) +
+                              (descriptor->numberedReports ? 0 : 1);
+        std::vector<std::uint8_t> report(std::max<std::size_t>(n, 2), 0);
+        std::fill(feature.begin(), feature.end(), std::uint8_t{0});
+        const auto got = device_->getFeature(f.reportId, feature);
+        if (got.status == hid::HidStatus::Gone) {
+            return tl::unexpected(deviceError(got.status, where, "reading the control report"));
+        }
+        if (got.status == hid::HidStatus::Ok) {
+            std::copy_n(feature.begin(), std::min(got.bytes, report.size()), report.begin());
+        }
+        report[0] = f.reportId;
+        const int mode = layout->wantedMode();
+        hid::insertField(f, std::span<std::uint8_t>(report).subspan(1), mode);
+        if (const auto s = device_->sendFeature(report); s != hid::HidStatus::Ok) {
+            return tl::unexpected(
+                    deviceError(s, where, fmt::format("the device mode request ({})", mode)));
+        }
+        description_.modeSent = mode;
+    }
+    offsetNs_.reset();
+    lastNs_ = 0;
+    return {};
+}
+
+std::int64_t HidTrackerReader::sessionTime(std::optional<std::int64_t> deviceNs,
+                                           std::int64_t hostNs)
+{
+    if (!deviceNs) {
+        lastNs_ = std::max(lastNs_, hostNs);
+        return lastNs_;
+    }
+    // The device's clock, anchored so that no report is stamped later than it arrived: the offset
+    // is the smallest (arrival - device time) seen, i.e. the least delayed report. A device clock
+    // that stepped back (reset) or fell far behind (drift, a pause) is re-anchored.
+    const std::int64_t lag = hostNs - *deviceNs;
+    if (!offsetNs_ || *deviceNs < lastDeviceNs_ || lag < *offsetNs_ ||
+        lag - *offsetNs_ > options_.reanchorNs) {
+        offsetNs_ = lag;
+    }
+    lastDeviceNs_ = *deviceNs;
+    lastNs_ = std::max(lastNs_, *deviceNs + *offsetNs_);
+    return lastNs_;
+}
+
+Expected<std::optional<PoseSample>> HidTrackerReader::next()
+{
+    const auto got = device_->readInput(buffer_, options_.readTimeoutMs);
+    if (got.status == hid::HidStatus::Timeout) {
+        return std::optional<PoseSample>();
+    }
+    if (got.status != hid::HidStatus::Ok) {
+        return tl::unexpected(deviceError(got.status, description_.where, "reading a report"));
+    }
+    const std::int64_t host = clock_->nowNs();
+    eht::TrackingReport r;
+    switch (eht::decodeTracking(description_.layout, {buffer_.data(), got.bytes}, r)) {
+    case eht::DecodeResult::OtherReport:
+        return std::optional<PoseSample>();
+    case eht::DecodeResult::Short:
+        if (++rejected_ == 1) {
+            deviceLog("hal.tracker")
+                    ->warn("HID tracker {}: dropped a {}-byte report (the descriptor says {}); "
+                           "further ones are counted",
+                           description_.where, got.bytes, description_.layout.inputReportBytes);
+        }
+        return std::optional<PoseSample>();
+    case eht::DecodeResult::Ok:
+        break;
+    }
+    PoseSample s;
+    s.timestampNs = sessionTime(r.deviceTimeNs, host);
+    const auto eye = eyePoint(r, options_.axes);
+    s.tracked = eye.has_value();
+    if (eye) {
+        s.eyeTrackerM = *eye;
+    }
+    return std::optional<PoseSample>(s);
+}
+
+namespace {
+
+class HidTrackerThread final : public HidTrackerSource
+{
+public:
+    HidTrackerThread(hid::HidOpener opener, const Clock& clock, HidTrackerOptions options)
+        : opener_(std::move(opener)), clock_(clock), options_(std::move(options))
+    {
+        info_.model = "hid-eye-head-tracker";
+        info_.serial = options_.label;
+        info_.kind = SourceKind::Live;
+        thread_ = std::thread([this] { run(); });
+    }
+
+    ~HidTrackerThread() override
+    {
+        queue_.stop();
+        thread_.join();
+    }
+
+    HidTrackerThread(const HidTrackerThread&) = delete;
+    HidTrackerThread& operator=(const HidTrackerThread&) = delete;
+
+    const DeviceInfo& info() const override { return info_; }
+    long rejectedReports() const override { return rejected_.load(); }
+    HidTrackerDescription description() const override
+    {
+        std::lock_guard lock(mutex_);
+        return description_;
+    }
+
+    LinkState state() const override
+    {
+        const LinkState s = state_.load();
+        const std::int64_t last = lastNs_.load();
+        if (s == LinkState::Connected && last >= 0 && clock_.nowNs() - last > options_.staleNs) {
+            return LinkState::Stalled;
+        }
+        return s;
+    }
+
+    void poll(std::int64_t untilNs, std::vector<PoseSample>& out) override
+    {
+        queue_.drain(untilNs, out);
+        std::lock_guard lock(mutex_);
+        // A tracker that went quiet (or away) must not leave the last pose standing as tracked.
+        const std::int64_t last = lastNs_.load();
+        if (last >= 0 && untilNs - last > options_.staleNs && !reportedStale_ &&
+            (out.empty() || out.back().timestampNs < last + options_.staleNs)) {
+            PoseSample s;
+            s.timestampNs = last + options_.staleNs;
+            s.sequence = staleSequence();
+            s.tracked = false;
+            out.push_back(s);
+            reportedStale_ = true;
+        }
+    }
+
+private:
+    std::uint32_t staleSequence() { return sequence_.fetch_add(1); }
+
+    void run()
+    {
+        std::string lastError;
+        std::optional<HidTrackerReader> reader;
+        while (!queue_.stopping()) {
+            if (!reader) {
+                auto dev = opener_();
+                auto r = dev ? HidTrackerReader::open(std::move(*dev), clock_, options_)
+                             : Expected<HidTrackerReader>(tl::unexpected(dev.error()));
+                if (!r) {
+                    state_ = LinkState::Lost;
+                    if (r.error().message != lastError) {
+                        deviceLog("hal.tracker")
+                                ->error("{}; retrying every {} ms", r.error().message,
+                                        options_.reconnectNs / 1'000'000);
+                        lastError = r.error().message;
+                    }
+                    if (!queue_.waitFor(options_.reconnectNs)) {
+                        return;
+                    }
+                    continue;
+                }
+                reader.emplace(std::move(*r));
+                lastError.clear();
+                const auto& d = reader->description();
+                deviceLog("hal.tracker")
+                        ->info("HID tracker {}: {}; status {}, calibrated screen {}, {} Hz, mode "
+                               "request {}",
+                               d.where, d.layout.summary(),
+                               d.status ? hid::eht::statusName(*d.status) : "not reported",
+                               d.screenWidthM && d.screenHeightM
+                                       ? fmt::format("{:.3f} x {:.3f} m", *d.screenWidthM,
+                                                     *d.screenHeightM)
+                                       : std::string("not reported"),
+                               d.samplingHz ? fmt::format("{:g}", *d.samplingHz) : "?", d.modeSent);
+                if (d.status && *d.status != hid::eht::kStatusReady) {
+                    deviceLog("hal.tracker")
+                            ->warn("HID tracker {}: status '{}': run the tracker's own setup "
+                                   "(screen and user calibration) before relying on its poses",
+                                   d.where, hid::eht::statusName(*d.status));
+                }
+                {
+                    std::lock_guard lock(mutex_);
+                    description_ = d;
+                }
+                state_ = LinkState::Connected;
+                lastNs_ = clock_.nowNs();
+            }
+            auto s = reader->next();
+            rejected_ = reader->rejectedReports() + rejectedBefore_;
+            if (!s) {
+                deviceLog("hal.tracker")
+                        ->error("{}; the display keeps the last eye position", s.error().message);
+                rejectedBefore_ = rejected_.load();
+                reader.reset();
+                state_ = LinkState::Lost;
+                // A device that fails every read must not be reopened in a tight loop.
+                if (!queue_.waitFor(options_.reconnectNs)) {
+                    return;
+                }
+                continue;
+            }
+            if (!*s) {
+                continue;
+            }
+            PoseSample p = **s;
+            {
+                std::lock_guard lock(mutex_);
+                p.sequence = staleSequence();
+                reportedStale_ = false;
+            }
+            lastNs_ = p.timestampNs;
+            queue_.push(p);
+        }
+    }
+
+    hid::HidOpener opener_;
+    const Clock& clock_;
+    HidTrackerOptions options_;
+    DeviceInfo info_;
+    mutable std::mutex mutex_;
+    HidTrackerDescription description_; // under mutex_
+    bool reportedStale_ = false;        // under mutex_
+    std::atomic<std::uint32_t> sequence_{0};
+    std::atomic<LinkState> state_{LinkState::Lost};
+    std::atomic<std::int64_t> lastNs_{-1};
+    std::atomic<long> rejected_{0};
+    long rejectedBefore_ = 0; // reader thread only
+    LiveQueue<PoseSample> queue_{1024};
+    std::thread thread_;
+};
+
+} // namespace
+
+std::unique_ptr<HidTrackerSource>
+makeHidTrackerSource(hid::HidOpener opener, const Clock& clock, HidTrackerOptions options)
+{
+    return std::make_unique<HidTrackerThread>(std::move(opener), clock, std::move(options));
+}
+
+} // namespace replica::hal::tracker

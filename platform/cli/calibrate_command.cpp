@@ -1,0 +1,253 @@
+// 'replica calibrate tracker|stand': the site calibration a technician can do with a marker and a
+// tape measure. Readings come from a CSV file (or are typed in when stdin is a terminal); the
+// result is checked (residual, degenerate points) and written into the site TOML file.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <hal/accel/iio_accel.h>
+#include <pipeline/scene/calibration.h>
+#include <platform/cli/commands.h>
+#include <platform/logging.h>
+#include <platform/site_file.h>
+
+namespace replica::platform {
+namespace {
+
+struct CalibrateOptions {
+    std::string points;
+    std::string site = kDefaultSiteFile;
+    double maxRmsMm = 10.0;
+    double panelWidthM = 0.0;
+    double panelHeightM = 0.0;
+    std::string accelAxes = "x,y,z";
+    bool dryRun = false;
+};
+
+// Rows of 'columns' numbers, comma- or space-separated; '#' starts a comment; a first row that is
+// not numeric is a header. Errors name the file and line.
+Expected<std::vector<std::vector<double>>>
+readRows(std::istream& in, const std::string& name, std::size_t columns, bool prompt)
+{
+    std::vector<std::vector<double>> rows;
+    std::string line;
+    int lineNo = 0;
+    while (true) {
+        if (prompt) {
+            fmt::print(stderr, "point {} ({} numbers, empty line to finish): ", rows.size() + 1,
+                       columns);
+        }
+        if (!std::getline(in, line)) {
+            break;
+        }
+        ++lineNo;
+        if (const auto hash = line.find('#'); hash != std::string::npos) {
+            line.resize(hash);
+        }
+        for (auto& c : line) {
+            c = c == ',' || c == ';' || c == '\t' ? ' ' : c;
+        }
+        std::istringstream s(line);
+        s.imbue(std::locale::classic());
+        std::vector<double> row;
+        std::string word;
+        bool numeric = true;
+        while (s >> word) {
+            char* end = nullptr;
+            const double v = std::strtod(word.c_str(), &end);
+            if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
+                numeric = false;
+                break;
+            }
+            row.push_back(v);
+        }
+        if (row.empty() && numeric) {
+            if (prompt) {
+                break;
+            }
+            continue;
+        }
+        if (!numeric && rows.empty() && !prompt) {
+            continue; // header
+        }
+        if (!numeric || row.size() != columns) {
+            const auto e = Error{ErrorCode::InvalidArgument,
+                                 fmt::format("{}:{}: expected {} numbers, got '{}'", name, lineNo,
+                                             columns, line)};
+            if (prompt) {
+                fmt::print(stderr, "{}; type it again\n", e.message);
+                continue;
+            }
+            return tl::unexpected(e);
+        }
+        rows.push_back(std::move(row));
+    }
+    return rows;
+}
+
+Expected<std::vector<std::vector<double>>>
+readingsFrom(const std::string& file, std::size_t columns, const char* what)
+{
+    if (file.empty()) {
+        if (::isatty(STDIN_FILENO) == 0) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("no --points FILE given and stdin is not a terminal: "
+                                         "give the {} as a CSV file",
+                                         what));
+        }
+        fmt::print(stderr, "Type the {}, one per line.\n", what);
+        return readRows(std::cin, "stdin", columns, true);
+    }
+    std::ifstream in(file);
+    if (!in) {
+        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot read it", file));
+    }
+    return readRows(in, file, columns, false);
+}
+
+int finish(const CalibrateOptions& o, const char* section, const std::string& body)
+{
+    if (o.dryRun) {
+        fmt::print("[{}]\n{}", section, body);
+        return kExitOk;
+    }
+    if (auto ok = writeSiteSection(o.site, section, body); !ok) {
+        logger("replica")->error("{}", ok.error().message);
+        return kExitFailure;
+    }
+    fmt::print("wrote [{}] to {}\n", section, o.site);
+    return kExitOk;
+}
+
+int calibrateTracker(const CalibrateOptions& o)
+{
+    auto log = logger("replica");
+    auto rows = readingsFrom(o.points, 6,
+                             "points as booth_x booth_y booth_z tracker_x tracker_y tracker_z "
+                             "(metres; the booth point measured with the tape, the tracker's "
+                             "reading of the marker held there)");
+    if (!rows) {
+        log->error("{}", rows.error().message);
+        return kExitUsage;
+    }
+    std::vector<glm::dvec3> booth;
+    std::vector<glm::dvec3> tracker;
+    for (const auto& r : *rows) {
+        booth.emplace_back(r[0], r[1], r[2]);
+        tracker.emplace_back(r[3], r[4], r[5]);
+    }
+    pipeline::scene::RigidFitOptions fo;
+    fo.maxRmsM = o.maxRmsMm * 1e-3;
+    auto fit = pipeline::scene::fitRigid(tracker, booth, fo);
+    if (!fit) {
+        log->error("{}: {}", o.points.empty() ? "stdin" : o.points, fit.error().message);
+        return kExitFailure;
+    }
+    for (std::size_t i = 0; i < fit->residualsM.size(); ++i) {
+        fmt::print("point {:2}: residual {:6.2f} mm\n", i + 1, fit->residualsM[i] * 1e3);
+    }
+    const auto& t = fit->T_booth_tracker.translation;
+    fmt::print("T_booth_tracker: RMS residual {:.2f} mm over {} points; the tracker's origin sits "
+               "at ({:.3f}, {:.3f}, {:.3f}) m in the booth\n",
+               fit->rmsM * 1e3, rows->size(), t.x, t.y, t.z);
+    return finish(o, "tracker", trackerSection(*fit, rows->size()));
+}
+
+int calibrateStand(const CalibrateOptions& o)
+{
+    auto log = logger("replica");
+    auto mapping = hal::accel::parseAxisMapping(o.accelAxes);
+    if (!mapping) {
+        log->error("--accel-axes {}: {}", o.accelAxes, mapping.error().message);
+        return kExitUsage;
+    }
+    auto rows = readingsFrom(o.points, 5,
+                             "readings as ax ay az top_y top_z (the accelerometer in m/s^2 as "
+                             "'replica probe' prints it; the tape: height of the middle of the "
+                             "panel's top edge above the booth floor and its distance towards the "
+                             "viewer from the booth's centre, metres), one per tilt");
+    if (!rows) {
+        log->error("{}", rows.error().message);
+        return kExitUsage;
+    }
+    std::vector<pipeline::scene::StandReading> readings;
+    for (const auto& r : *rows) {
+        readings.push_back({hal::accel::gravityInPanel({r[0], r[1], r[2]}, *mapping), r[3], r[4]});
+    }
+    pipeline::scene::StandFitOptions fo;
+    fo.maxRmsM = o.maxRmsMm * 1e-3;
+    auto fit = pipeline::scene::fitStand(readings, o.panelWidthM, o.panelHeightM, fo);
+    if (!fit) {
+        log->error("{}: {}", o.points.empty() ? "stdin" : o.points, fit.error().message);
+        return kExitFailure;
+    }
+    constexpr double kDeg = 180.0 / 3.14159265358979323846;
+    for (std::size_t i = 0; i < fit->tiltsRad.size(); ++i) {
+        const auto pose = pipeline::scene::panelPose(fit->stand, fit->tiltsRad[i]);
+        const glm::dvec3 c0 = pose.originM;
+        const glm::dvec3 c1 = pose.originM + pose.rightM;
+        const glm::dvec3 c2 = c1 + pose.upM;
+        const glm::dvec3 c3 = c0 + pose.upM;
+        fmt::print(
+                "tilt {:5.1f} deg: corners (m) ({:.3f}, {:.3f}, {:.3f}) ({:.3f}, {:.3f}, {:.3f}) "
+                "({:.3f}, {:.3f}, {:.3f}) ({:.3f}, {:.3f}, {:.3f})\n",
+                fit->tiltsRad[i] * kDeg, c0.x, c0.y, c0.z, c1.x, c1.y, c1.z, c2.x, c2.y, c2.z, c3.x,
+                c3.y, c3.z);
+    }
+    fmt::print("hinge at y {:.3f} m, z {:.3f} m; panel {:.3f} m above it; tape RMS {:.2f} mm; "
+               "hinge axis {:.2f} deg off the panel's x axis\n",
+               fit->stand.hingeM.y, fit->stand.hingeM.z, fit->stand.hingeToPanelM, fit->rmsM * 1e3,
+               fit->axisAngleRad * kDeg);
+    if (fit->axisAngleRad * kDeg > 3.0) {
+        log->warn("the hinge axis is {:.1f} degrees off the panel's x axis as the accelerometer "
+                  "sees it: check --accel-axes and how the sensor is mounted",
+                  fit->axisAngleRad * kDeg);
+    }
+    return finish(o, "stand", standSection(*fit));
+}
+
+} // namespace
+
+void registerCalibrateCommand(CLI::App& app, int& exitCode)
+{
+    auto* cmd = app.add_subcommand(
+            "calibrate", "site calibration: the tracker's pose in the booth, the stand's hinge");
+    cmd->require_subcommand(1);
+    auto o = std::make_shared<CalibrateOptions>();
+    auto common = [o](CLI::App* sub, const char* what) {
+        sub->add_option("--points", o->points,
+                        fmt::format("CSV of the {} (without it, typed in at the terminal)", what));
+        sub->add_option("--site", o->site, "site configuration file to write the result into")
+                ->capture_default_str();
+        sub->add_option("--max-rms-mm", o->maxRmsMm,
+                        "refuse a fit whose RMS residual is larger (mm)")
+                ->check(CLI::Range(0.1, 1000.0))
+                ->capture_default_str();
+        sub->add_flag("--dry-run", o->dryRun, "print the section instead of writing the file");
+    };
+    auto* tracker = cmd->add_subcommand(
+            "tracker", "fit T_booth_tracker from the tracker's readings of a marker held at 3 or "
+                       "more tape-measured booth points");
+    common(tracker, "points: booth_x,booth_y,booth_z,tracker_x,tracker_y,tracker_z (m)");
+    tracker->callback([o, &exitCode] { exitCode = calibrateTracker(*o); });
+    auto* stand = cmd->add_subcommand(
+            "stand", "fit the hinge and panel offset from accelerometer readings at two or three "
+                     "tilts and the tape-measured top edge");
+    common(stand, "readings: ax,ay,az (m/s^2),top_y,top_z (m)");
+    stand->add_option("--panel-width", o->panelWidthM, "active area width, tape-measured (m)")
+            ->required();
+    stand->add_option("--panel-height", o->panelHeightM, "active area height, tape-measured (m)")
+            ->required();
+    stand->add_option("--accel-axes", o->accelAxes,
+                      "sensor axis for each panel axis, as for 'replica run'")
+            ->capture_default_str();
+    stand->callback([o, &exitCode] { exitCode = calibrateStand(*o); });
+}
+
+} // namespace replica::platform

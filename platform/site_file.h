@@ -1,0 +1,43 @@
+// The site configuration file (TOML, /etc/replica/replica.toml on an appliance): what the
+// calibration steps write into it. A section is replaced as text, so the technician's comments
+// and every other section stay as they were; the file is checked to parse before and after.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/scene/calibration.h>
+
+namespace replica::platform {
+
+constexpr const char* kDefaultSiteFile = "/etc/replica/replica.toml";
+
+// Replaces table [section] (and its [section.*] subtables) in 'file' by 'body' (key = value
+// lines), creating the file if it does not exist; written to a temporary file and renamed.
+// Fails, naming the file and line, when the existing file is not valid TOML.
+Expected<void> writeSiteSection(const std::filesystem::path& file,
+                                const std::string& section,
+                                const std::string& body);
+
+// [tracker] T_booth_tracker = { rotation = [9, row-major], translation = [3] } and the fit's
+// figures, as 'replica calibrate tracker' writes them.
+std::string trackerSection(const pipeline::scene::RigidFit& fit, std::size_t points);
+// [stand] hinge_m, hinge_to_panel_m, panel_width_m, panel_height_m, hinge_axis_panel, fit figures.
+std::string standSection(const pipeline::scene::StandFit& fit);
+
+// [sources]: which implementation each device uses at this site (spectrometer, tracker, accel,
+// lamp_selector; the values of 'replica run --spectrometer' etc.). Absent keys stay empty; a site
+// file without [sources] gives all empty.
+struct SiteSources {
+    std::string spectrometer;
+    std::string tracker;
+    std::string accel;
+    std::string lampSelector;
+};
+Expected<SiteSources> readSiteSources(const std::filesystem::path& file);
+
+// Reads T_booth_tracker back from a site file (nullopt-like NotFound when it has none).
+Expected<pipeline::scene::RigidTransform> readTrackerTransform(const std::filesystem::path& file);
+
+} // namespace replica::platform
