@@ -12,6 +12,7 @@
 #include <hal/replay/replay_source.h>
 #include <hal/sim/sim_devices.h>
 #include <pipeline/base/data_dir.h>
+#include <pipeline/base/input_file.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/display/display_profile.h>
@@ -150,8 +151,10 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
     }
-    if (c.width <= 0 || c.height <= 0 || c.width > 16384 || c.height > 16384 || !(c.rateHz > 0.0) ||
-        c.rateHz > 1000.0 || c.lightsU <= 0 || c.lightsV <= 0 || c.lightsU * c.lightsV > 256 ||
+    if (!frameSizeOk(c.width, c.height) || !(c.rateHz >= 1.0) || c.rateHz > 1000.0 ||
+        c.lightsU <= 0 || c.lightsV <= 0 ||
+        static_cast<long long>(c.lightsU) * static_cast<long long>(c.lightsV) > 256 ||
+        !std::isfinite(c.displayPeakCdM2) || !std::isfinite(c.displayBlackCdM2) ||
         c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < kAutoSpecularSamples ||
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
@@ -159,10 +162,16 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias) ||
         c.cacheSlices < 1 || c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights ||
         c.areaLights > 1) {
-        return makeError(ErrorCode::InvalidArgument,
-                         "run configuration: size, rate, light count, specular samples, specular "
-                         "or diffuse grid, specular lod bias, horizon directions, cache slices or "
-                         "area lights out of range");
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format(
+                        "run configuration: size {}x{} (each side 1-{}, at most "
+                        "{}:1), rate {} Hz (1-1000), lights {}x{} (at most 256), "
+                        "display peak/black, specular samples, specular or diffuse "
+                        "grid, specular lod bias, horizon directions, cache slices or area lights "
+                        "out of range",
+                        c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz, c.lightsU,
+                        c.lightsV));
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -185,10 +194,120 @@ std::filesystem::path resolveSceneDir(const std::string& sceneDir)
     return p.is_relative() ? dataDir() / p : p;
 }
 
+namespace {
+
+// 'p' lies inside 'root' once both are made absolute and '..' and links resolved as far as
+// they exist.
+bool inside(const std::filesystem::path& p, const std::filesystem::path& root)
+{
+    std::error_code ec;
+    const auto a = std::filesystem::weakly_canonical(std::filesystem::absolute(p, ec), ec);
+    if (ec) {
+        return false;
+    }
+    const auto r = std::filesystem::weakly_canonical(std::filesystem::absolute(root, ec), ec);
+    if (ec) {
+        return false;
+    }
+    const auto rel = a.lexically_relative(r);
+    return !rel.empty() && *rel.begin() != ".." && !rel.is_absolute();
+}
+
+Expected<void> checkReference(const std::string& key,
+                              const std::string& value,
+                              const std::vector<std::filesystem::path>& roots)
+{
+    const std::filesystem::path p(value);
+    bool dotdot = false;
+    for (const auto& part : p) {
+        dotdot = dotdot || part == "..";
+    }
+    std::string rootList = dataDir().string();
+    for (const auto& r : roots) {
+        rootList += ", " + r.string();
+    }
+    if (value.empty() || dotdot || value.find('\0') != std::string::npos) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("the recording's {} '{}' is not a name inside the data "
+                                     "folder ('..' or empty); refused",
+                                     key, value.substr(0, 200)));
+    }
+    if (p.is_relative()) {
+        return inside(dataDir() / p, dataDir())
+                       ? Expected<void>{}
+                       : makeError(ErrorCode::InvalidArgument,
+                                   fmt::format("the recording's {} '{}' leads out of the data "
+                                               "folder {} (a link?); refused",
+                                               key, value.substr(0, 200), dataDir().string()));
+    }
+    bool ok = inside(p, dataDir());
+    for (const auto& r : roots) {
+        ok = ok || inside(p, r);
+    }
+    if (!ok) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("the recording's {} is '{}', outside the data folders ({}); "
+                                     "replay opens only files there: copy it under one and pass "
+                                     "that folder with --data-root DIR",
+                                     key, value.substr(0, 200), rootList));
+    }
+    return {};
+}
+
+} // namespace
+
+Expected<void> checkRecordedReferences(const RunConfig& config,
+                                       const std::vector<std::filesystem::path>& roots,
+                                       bool allowUndigested)
+{
+    if (config.renderer == "booth") {
+        if (auto ok = checkReference("scene_dir", config.sceneDir, roots); !ok) {
+            return ok;
+        }
+        if (config.sceneDigest.empty() && !allowUndigested) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("the recording holds no digest of its scene '{}', so "
+                                         "the scene replayed cannot be checked against the one "
+                                         "recorded; pass --allow-undigested to replay it anyway",
+                                         config.sceneDir.substr(0, 200)));
+        }
+    }
+    if (config.display != kUncalibratedDisplay) {
+        if (auto ok = checkReference("display", config.display, roots); !ok) {
+            return ok;
+        }
+        if (config.displayDigest.empty() && !allowUndigested) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("the recording holds no digest of its display profile "
+                                         "'{}'; pass --allow-undigested to replay it anyway",
+                                         config.display.substr(0, 200)));
+        }
+    }
+    if (auto ok = checkReference("spectrometer_calibration", config.spectrometerCalibration, {});
+        !ok) {
+        return ok;
+    }
+    if (std::filesystem::path(config.spectrometerCalibration).is_absolute()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("the recording's spectrometer_calibration '{}' is not a "
+                                     "name inside the data folder; refused",
+                                     config.spectrometerCalibration.substr(0, 200)));
+    }
+    return {};
+}
+
 Expected<std::string> sceneDigest(const std::filesystem::path& dir)
 {
     std::uint64_t h = 14695981039346656037ull;
     for (const char* name : {"scene.json", "channels.exr", "height.exr", "material.exr"}) {
+        // Regular files only: a FIFO would block here and a directory throw from the stream.
+        if (auto ok = checkInputFile(dir / name, kMaxImageBytes, "scene"); !ok) {
+            if (ok.error().code == ErrorCode::NotFound) {
+                return makeError(ErrorCode::NotFound, fmt::format("{}: cannot read the scene file",
+                                                                  (dir / name).string()));
+            }
+            return tl::unexpected(ok.error());
+        }
         std::ifstream in(dir / name, std::ios::binary);
         if (!in) {
             return makeError(ErrorCode::NotFound,
@@ -316,16 +435,18 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
         if (path.is_relative()) {
             path = dataDir() / path;
         }
-        std::ifstream f(path, std::ios::binary);
-        if (!f) {
+        auto read = readInputFile(path, kMaxJsonBytes, "display profile");
+        if (!read) {
+            if (read.error().code != ErrorCode::NotFound) {
+                return tl::unexpected(read.error());
+            }
             return makeError(ErrorCode::NotFound,
                              fmt::format("no display profile at {}: characterise the panel "
                                          "('replica display fit MEAS.csv --out PROFILE') and pass "
                                          "--display-profile PROFILE, or run --uncalibrated",
                                          path.string()));
         }
-        const std::string bytes((std::istreambuf_iterator<char>(f)),
-                                std::istreambuf_iterator<char>());
+        const std::string& bytes = *read;
         const std::string digest = fmt::format(
                 "{:016x}", fnv1a64(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()),
                                              bytes.size())));

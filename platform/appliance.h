@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -30,6 +31,15 @@ constexpr int kAutoAreaLights = -1;
 // configuration may ask for.
 constexpr int kDefaultCacheSlices = 3;
 constexpr int kMaxCacheSlices = 16;
+// Frame sizes a run takes and a recording may hold: each side 1..8192 pixels and at most 16:1
+// (a 16384x1 "frame" is no display).
+constexpr int kMaxFrameSide = 8192;
+constexpr int kMaxFrameAspect = 16;
+inline bool frameSizeOk(long long w, long long h)
+{
+    return w > 0 && h > 0 && w <= kMaxFrameSide && h <= kMaxFrameSide && w <= kMaxFrameAspect * h &&
+           h <= kMaxFrameAspect * w;
+}
 
 // Everything that decides what a frame looks like, apart from the samples. Recorded in the session
 // so that replay rebuilds the identical renderer.
@@ -175,6 +185,15 @@ struct Appliance {
 // files that make the scene (scene.json, channels.exr, height.exr, material.exr).
 std::filesystem::path resolveSceneDir(const std::string& sceneDir);
 Expected<std::string> sceneDigest(const std::filesystem::path& dir);
+
+// A recording is untrusted: before replay builds anything from its configuration, the files it
+// names (scene folder, display profile, spectrometer calibration) must lie inside the data folder
+// or one of 'roots' (relative names without '..', or absolute paths inside a root), and the scene
+// and display digests must be recorded unless 'allowUndigested'. The error names the key and the
+// fix.
+Expected<void> checkRecordedReferences(const RunConfig& config,
+                                       const std::vector<std::filesystem::path>& roots,
+                                       bool allowUndigested);
 
 // The booth renderer's settings as the configuration records them. The scene's counts must
 // already be chosen (specular samples and the two grids not kAuto*: makeBoothScene chooses and

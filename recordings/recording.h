@@ -23,6 +23,13 @@ namespace replica::recordings {
 // session.
 constexpr int kFormatVersion = 3;
 
+// Limits on a recording, which is untrusted input (docs/recordings.md, 'Limits'): its file size,
+// one message's size (a 2048-pixel spectrum is about 12 KiB of JSON), and a spectrum's pixels
+// (the USB2000+ has 2048).
+constexpr std::uint64_t kMaxRecordingBytes = 2ULL << 30;
+constexpr std::size_t kMaxMessageBytes = 1u << 20;
+constexpr std::size_t kMaxSpectrumCounts = 16384;
+
 // For each rendered frame: its tick time and exactly which sample of each device it consumed (by
 // the device's sequence number), so replay never has to guess timing. nullopt: no sample yet.
 struct FrameRecord {
@@ -67,6 +74,9 @@ struct WriterOptions {
     // Called once, from the writer thread, on the first I/O failure (disk full, file deleted, ...).
     // Recording stops there; what was written stays readable.
     std::function<void(const Error&)> onError;
+    // A non-empty regular file at the path is overwritten; false refuses it ('replica run
+    // --record' without --force). A symbolic link there is always refused.
+    bool overwrite = true;
 };
 
 struct WriterStats {

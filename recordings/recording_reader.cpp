@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/input_file.h>
 #include <recordings/mcap/reader.h>
 #include <recordings/recording.h>
 #include <recordings/sample_codec.h>
@@ -14,21 +15,17 @@ namespace {
 
 Expected<std::string> slurp(const std::filesystem::path& path)
 {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: no such recording", path.string()));
+    // A regular file (not a directory, FIFO or /dev/zero) of at most kMaxRecordingBytes, read
+    // whole: the scan below then bounds what it decompresses by the file's size.
+    auto bytes = readInputFile(path, kMaxRecordingBytes, "recording");
+    if (!bytes) {
+        if (bytes.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: no such recording", path.string()));
+        }
+        return tl::unexpected(bytes.error());
     }
-    if (std::filesystem::is_directory(path, ec)) {
-        return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("{}: is a directory, not a recording", path.string()));
-    }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        return makeError(ErrorCode::Io,
-                         fmt::format("{}: cannot open recording (permissions?)", path.string()));
-    }
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (bytes.empty()) {
+    if (bytes->empty()) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: file is empty, not a recording", path.string()));
     }
@@ -63,6 +60,13 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
     bool haveSession = false;
     for (const auto& m : s.messages) {
         const std::string& topic = s.channels.at(m.channelId).topic;
+        if (m.data.size() > kMaxMessageBytes) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: {} message (sequence {}) of {} bytes; Replica's are "
+                                         "at most {} KiB: not a recording Replica wrote",
+                                         name, topic, m.sequence, m.data.size(),
+                                         kMaxMessageBytes >> 10));
+        }
         try {
             const auto j = nlohmann::json::parse(m.data);
             if (topic == kSessionTopic) {

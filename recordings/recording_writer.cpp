@@ -280,9 +280,11 @@ Expected<std::unique_ptr<RecordingWriter>> RecordingWriter::create(
         std::signal(SIGXFSZ, SIG_IGN);
     }
     auto file = mcap::FileWriter::create(
-            path, fmt::format("{} (format {})",
-                              session.softwareVersion.empty() ? "replica" : session.softwareVersion,
-                              kFormatVersion));
+            path,
+            fmt::format("{} (format {})",
+                        session.softwareVersion.empty() ? "replica" : session.softwareVersion,
+                        kFormatVersion),
+            options.overwrite);
     if (!file) {
         return tl::unexpected(file.error());
     }

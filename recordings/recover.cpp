@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/base/input_file.h>
 #include <recordings/mcap/reader.h>
 #include <recordings/mcap/writer.h>
 #include <recordings/recover.h>
@@ -28,12 +29,11 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
                 ErrorCode::InvalidArgument,
                 fmt::format("{}: recover writes a new file; give a different OUT", out.string()));
     }
-    std::ifstream file(in, std::ios::binary);
-    const std::string bytes((std::istreambuf_iterator<char>(file)),
-                            std::istreambuf_iterator<char>());
-    if (!file.good() && !file.eof()) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot read", in.string()));
+    auto read = readInputFile(in, kMaxRecordingBytes, "recording");
+    if (!read) {
+        return tl::unexpected(read.error());
     }
+    const std::string& bytes = *read;
     mcap::ScanOptions options;
     options.resync = true;
     options.maxDamageReports = 50;

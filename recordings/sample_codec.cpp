@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include <recordings/sample_codec.h>
 
 namespace replica::recordings {
@@ -291,6 +293,10 @@ hal::SpectrumSample decodeSpectrum(const json& j)
     s.timestampNs = j.at("t");
     s.sequence = j.at("seq");
     s.integrationTimeUs = j.at("integration_time_us");
+    if (j.at("counts").size() > kMaxSpectrumCounts) {
+        throw std::out_of_range(fmt::format("{} counts; a spectrometer has at most {} pixels",
+                                            j.at("counts").size(), kMaxSpectrumCounts));
+    }
     s.counts = j.at("counts").get<std::vector<std::uint16_t>>();
     s.wavelengthCoeffs = j.at("wavelength_coeffs");
     s.nonlinearityCoeffs = j.at("nonlinearity_coeffs");

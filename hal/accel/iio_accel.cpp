@@ -21,8 +21,14 @@ Expected<double> readSysfsNumber(const fs::path& file)
     if (!in) {
         return makeError(ErrorCode::NotFound, fmt::format("{}: cannot be read", file.string()));
     }
-    std::string text;
-    std::getline(in, text);
+    // A sysfs attribute is a few bytes; read at most 64 so that a wrong path (/dev/zero, a big
+    // file) cannot make us read without end.
+    std::string text(64, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    if (const auto nl = text.find('\n'); nl != std::string::npos) {
+        text.resize(nl);
+    }
     while (!text.empty() && (text.back() == '\n' || text.back() == ' ' || text.back() == '\r')) {
         text.pop_back();
     }
@@ -45,12 +51,13 @@ Expected<double> axisAttribute(const fs::path& dir,
                                const char* what,
                                std::optional<double> fallback)
 {
+    std::error_code ec; // a symlink loop or unreadable directory is "absent", never a throw
     const fs::path perAxis = dir / fmt::format("in_accel_{}_{}", axis, what);
-    if (fs::exists(perAxis)) {
+    if (fs::exists(perAxis, ec)) {
         return readSysfsNumber(perAxis);
     }
     const fs::path shared = dir / fmt::format("in_accel_{}", what);
-    if (fs::exists(shared)) {
+    if (fs::exists(shared, ec)) {
         return readSysfsNumber(shared);
     }
     if (fallback) {
@@ -70,7 +77,8 @@ Expected<IioAccelDevice> IioAccelDevice::open(const fs::path& dir)
     std::ifstream nameFile(dir / "name");
     std::getline(nameFile, d.name_);
     for (int i = 0; i < 3; ++i) {
-        if (!fs::exists(dir / fmt::format("in_accel_{}_raw", kAxes[i]))) {
+        std::error_code ec;
+        if (!fs::exists(dir / fmt::format("in_accel_{}_raw", kAxes[i]), ec)) {
             return makeError(ErrorCode::NotFound,
                              fmt::format("{}: no in_accel_{}_raw; not an accelerometer",
                                          dir.string(), kAxes[i]));
@@ -109,7 +117,7 @@ Expected<IioAccelDevice> IioAccelDevice::find(const fs::path& root, const std::s
     }
     std::sort(dirs.begin(), dirs.end());
     for (const auto& dir : dirs) {
-        if (!fs::exists(dir / "in_accel_x_raw")) {
+        if (!fs::exists(dir / "in_accel_x_raw", ec)) {
             continue;
         }
         auto d = open(dir);
@@ -224,7 +232,8 @@ private:
         std::optional<IioAccelDevice> dev;
         std::string lastError;
         std::uint32_t sequence = 0;
-        for (;;) {
+        bool announced = false;
+        while (!queue_.stopping()) {
             if (!dev) {
                 auto d = IioAccelDevice::find(options_.root, options_.name);
                 if (!d) {
@@ -239,17 +248,35 @@ private:
                     }
                     continue;
                 }
-                deviceLog("hal.accel")->info("'{}' at {}", d->name(), d->dir().string());
+                if (!announced) {
+                    deviceLog("hal.accel")->info("'{}' at {}", d->name(), d->dir().string());
+                    announced = true;
+                }
                 dev = std::move(*d);
-                lastError.clear();
             }
             const std::int64_t started = clock_.nowNs();
             auto a = dev->read();
             if (!a) {
-                deviceLog("hal.accel")->error("{}", a.error().message);
+                // A value file that exists but reads empty, junk or EIO (a glitching I2C sensor)
+                // is handled like an unplugged device: Lost, one line per new error, and a retry
+                // every reconnectNs, never a busy loop.
+                if (a.error().message != lastError) {
+                    deviceLog("hal.accel")
+                            ->error("{}; the display keeps its last tilt and retries every {} ms",
+                                    a.error().message, options_.reconnectNs / 1'000'000);
+                    lastError = a.error().message;
+                }
                 dev.reset();
                 state_ = LinkState::Lost;
+                if (!waitFor(options_.reconnectNs)) {
+                    return;
+                }
                 continue;
+            }
+            if (!lastError.empty()) {
+                deviceLog("hal.accel")
+                        ->info("'{}' at {} reads again", dev->name(), dev->dir().string());
+                lastError.clear();
             }
             state_ = LinkState::Connected;
             AccelSample s;

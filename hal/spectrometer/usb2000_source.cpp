@@ -90,13 +90,22 @@ private:
             if (!raw) {
                 if (raw.error().code == ErrorCode::NotFound) {
                     dropDevice(raw.error());
-                } else {
-                    state_ = LinkState::Stalled;
+                    continue;
+                }
+                // A read that fails fast (a timeout the device answers at once, garbage) must
+                // not spin: one line per new error, and the next try after a period.
+                state_ = LinkState::Stalled;
+                if (raw.error().message != lastError) {
                     deviceLog("hal.spectrometer")->warn("{}", raw.error().message);
+                    lastError = raw.error().message;
+                }
+                if (!waitFor(options_.periodNs > 0 ? options_.periodNs : 1'000'000)) {
+                    return;
                 }
                 continue;
             }
             state_ = LinkState::Connected;
+            lastError.clear();
             SpectrumSample s;
             s.timestampNs = clock_.nowNs();
             s.sequence = sequence_++;

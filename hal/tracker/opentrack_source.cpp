@@ -1,6 +1,7 @@
 // UDP receiver thread for opentrack poses.
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <deque>
 #include <mutex>
@@ -82,6 +83,7 @@ private:
     void run()
     {
         std::vector<std::uint8_t> buf(512);
+        int lastErrno = 0;
         while (!stop_) {
             pollfd p{fd_, POLLIN, 0};
             const int n = ::poll(&p, 1, 50);
@@ -90,13 +92,21 @@ private:
             }
             const ssize_t got = ::recv(fd_, buf.data(), buf.size(), 0);
             if (got < 0) {
-                if (errno != EINTR && errno != EAGAIN) {
-                    deviceLog("hal.tracker")
-                            ->warn("UDP receive on port {} failed: {}", port_,
-                                   std::strerror(errno));
+                const int err = errno;
+                if (err != EINTR && err != EAGAIN) {
+                    // A socket that keeps failing must not spin nor flood the log: one line per
+                    // new error, then a pause as long as the poll timeout.
+                    if (err != lastErrno) {
+                        deviceLog("hal.tracker")
+                                ->warn("UDP receive on port {} failed: {}", port_,
+                                       std::strerror(err));
+                        lastErrno = err;
+                    }
+                    std::this_thread::sleep_for(std::chrono::milliseconds(50));
                 }
                 continue;
             }
+            lastErrno = 0;
             const auto pose = decodeOpentrack({buf.data(), static_cast<std::size_t>(got)});
             if (!pose) {
                 if (++rejected_ == 1) {

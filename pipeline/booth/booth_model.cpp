@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/base/input_file.h>
+#include <pipeline/base/json_schema.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
 
@@ -11,6 +13,25 @@ namespace replica::pipeline::booth {
 namespace {
 
 constexpr const char* kFormat = "replica-booth/1";
+
+// booth.json: positions in metres inside a room-sized box, SPDs per 10 nm band (relative power;
+// negative noise is clipped below, but not a negative lamp).
+const JsonSchema& boothSchema()
+{
+    using namespace json_schema;
+    static const JsonSchema s = object({
+            {"format", string()},
+            {"lights",
+             array(object({{"name", string(128)},
+                           {"luminance", string(128)},
+                           {"centre", array(number(-100.0, 100.0), 3, 3)},
+                           {"edge_u", array(number(-100.0, 100.0), 3, 3)},
+                           {"edge_v", array(number(-100.0, 100.0), 3, 3)},
+                           {"spd", array(number(-1e6, 1e9), colour::kBands, colour::kBands)}}),
+                   1, 64)},
+    });
+    return s;
+}
 
 Expected<Vec3> vec3Field(const nlohmann::json& j, const char* key, const std::string& where)
 {
@@ -68,19 +89,25 @@ std::string BoothModel::names() const
 Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
 {
     const auto file = dir / "booth.json";
-    std::ifstream in(file);
-    if (!in) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open booth model; run 'replica booth build' "
-                                     "or point --booth at a folder with booth.json",
-                                     file.string()));
+    auto text = readInputFile(file, kMaxJsonBytes, "booth model");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open booth model; run 'replica booth build' "
+                                         "or point --booth at a folder with booth.json",
+                                         file.string()));
+        }
+        return tl::unexpected(text.error());
     }
     nlohmann::json j;
     try {
-        j = nlohmann::json::parse(in);
+        j = nlohmann::json::parse(*text);
     } catch (const nlohmann::json::exception& e) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
+    }
+    if (auto ok = validateJson(j, boothSchema(), file.string()); !ok) {
+        return tl::unexpected(ok.error());
     }
     if (!j.contains("format") || j["format"] != kFormat) {
         return makeError(ErrorCode::Corrupt,
@@ -101,6 +128,11 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
                              where + ": needs string fields 'name' and 'luminance'");
         }
         l.name = lj["name"].get<std::string>();
+        // The luminance map is a file next to booth.json, named, never a path elsewhere.
+        if (auto ok = checkPlainName(lj["luminance"].get<std::string>(), where + ".luminance");
+            !ok) {
+            return tl::unexpected(ok.error());
+        }
         auto c = vec3Field(lj, "centre", where);
         auto u = vec3Field(lj, "edge_u", where);
         auto v = vec3Field(lj, "edge_v", where);
@@ -125,6 +157,10 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
             }
             // Negative sensor noise in a measured SPD is clipped: light power cannot be negative.
             l.spd[b] = std::max(lj["spd"][b].get<double>(), 0.0);
+        }
+        if (!(l.spd.sum() > 0.0)) {
+            return makeError(ErrorCode::Corrupt,
+                             where + ": spd has no positive power; a lamp must emit light");
         }
         auto img = image::readExr(dir / lj["luminance"].get<std::string>(), {"Y"});
         if (!img) {
@@ -155,6 +191,10 @@ Expected<void> saveBooth(const std::filesystem::path& dir, const BoothModel& boo
     j["format"] = kFormat;
     j["lights"] = nlohmann::json::array();
     for (const auto& l : booth.lights) {
+        // A light's name becomes a file name in 'dir': never a path that leaves it.
+        if (auto ok = checkPlainName(l.name, (dir / "booth.json").string() + ": light name"); !ok) {
+            return ok;
+        }
         nlohmann::json lj;
         lj["name"] = l.name;
         lj["luminance"] = l.name + ".exr";

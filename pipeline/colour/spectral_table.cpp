@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/input_file.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/csv/csv_cells.h>
 
@@ -91,15 +92,16 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
 
 Expected<SpectralTable> loadSpectralCsv(const std::filesystem::path& path)
 {
-    std::ifstream file(path, std::ios::binary);
-    if (!file) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open spectral table (does the file exist?)",
-                                     path.string()));
+    auto text = readInputFile(path, kMaxCsvBytes, "spectral table");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open spectral table (does the file exist?)",
+                                         path.string()));
+        }
+        return tl::unexpected(text.error());
     }
-    std::ostringstream text;
-    text << file.rdbuf();
-    return parseSpectralCsv(text.str(), path.string());
+    return parseSpectralCsv(*text, path.string());
 }
 
 Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const

@@ -1,4 +1,5 @@
 // CSV cell rules shared by every reader.
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -13,6 +14,12 @@ constexpr std::string_view kBlank = " \t\r";
 
 std::string trimCell(std::string_view s)
 {
+    // A UTF-8 byte order mark (spreadsheet exports start the file with one) is not part of the
+    // first cell.
+    constexpr std::string_view kBom = "\xEF\xBB\xBF";
+    if (s.substr(0, kBom.size()) == kBom) {
+        s.remove_prefix(kBom.size());
+    }
     const auto b = s.find_first_not_of(kBlank);
     if (b == std::string_view::npos) {
         return {};
@@ -23,16 +30,54 @@ std::string trimCell(std::string_view s)
 
 std::vector<std::string> splitCsvRow(std::string_view line)
 {
+    // RFC 4180 quoting: a cell whose first non-blank character is '"' runs to the closing quote,
+    // commas included, with "" for a quote inside; what follows the closing quote up to the next
+    // comma is kept too (and then refused by whoever reads the cell as a number).
     std::vector<std::string> out;
-    std::size_t start = 0;
+    std::size_t p = 0;
     while (true) {
-        const auto comma = line.find(',', start);
+        std::size_t q = p;
+        while (q < line.size() && kBlank.find(line[q]) != std::string_view::npos) {
+            ++q;
+        }
+        constexpr std::string_view kBom = "\xEF\xBB\xBF";
+        if (line.substr(q, kBom.size()) == kBom) {
+            q += kBom.size();
+        }
+        if (q < line.size() && line[q] == '"') {
+            std::string cell;
+            std::size_t i = q + 1;
+            for (; i < line.size(); ++i) {
+                if (line[i] == '"') {
+                    if (i + 1 < line.size() && line[i + 1] == '"') {
+                        cell += '"';
+                        ++i;
+                        continue;
+                    }
+                    break;
+                }
+                cell += line[i];
+            }
+            const auto comma = line.find(',', std::min(i + 1, line.size()));
+            const auto tail = line.substr(std::min(i + 1, line.size()),
+                                          comma == std::string_view::npos
+                                                  ? std::string_view::npos
+                                                  : comma - std::min(i + 1, line.size()));
+            cell += trimCell(tail);
+            out.push_back(trimCell(cell));
+            if (comma == std::string_view::npos) {
+                return out;
+            }
+            p = comma + 1;
+            continue;
+        }
+        const auto comma = line.find(',', p);
         if (comma == std::string_view::npos) {
-            out.push_back(trimCell(line.substr(start)));
+            out.push_back(trimCell(line.substr(p)));
             return out;
         }
-        out.push_back(trimCell(line.substr(start, comma - start)));
-        start = comma + 1;
+        out.push_back(trimCell(line.substr(p, comma - p)));
+        p = comma + 1;
     }
 }
 

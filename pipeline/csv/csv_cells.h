@@ -10,12 +10,14 @@
 
 namespace replica::pipeline::csv {
 
-// s without leading and trailing spaces, tabs and carriage returns.
+// s without leading and trailing spaces, tabs and carriage returns, and without a leading UTF-8
+// byte order mark.
 std::string trimCell(std::string_view s);
 
 // The trimmed cells of one row; a trailing comma gives a trailing empty cell, so that a row with
 // a missing last value is counted as such rather than silently shortened. An empty line is one
 // empty cell.
+// A cell in double quotes (RFC 4180) may hold commas, and "" for a quote.
 std::vector<std::string> splitCsvRow(std::string_view line);
 
 // True when the whole cell is one finite decimal number: an optional sign ('+' or '-'), digits

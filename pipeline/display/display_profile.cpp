@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/base/input_file.h>
+#include <pipeline/base/json_schema.h>
 #include <pipeline/display/display_profile.h>
 
 namespace replica::pipeline::display {
@@ -24,6 +26,37 @@ glm::dvec3 vec3From(const nlohmann::json& j)
         throw std::runtime_error("expected an array of 3 numbers");
     }
     return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
+
+// The profile (docs/display.md): luminances in cd/m^2 of a real panel, tone curves of at most
+// 65536 points (a 16-bit panel's every code).
+const JsonSchema& profileSchema()
+{
+    using namespace json_schema;
+    static const JsonSchema xyz = array(number(-1e5, 1e5), 3, 3);
+    static const JsonSchema curve = object({{"counts", array(number(0.0, 1e6), 2, 65536)},
+                                            {"r", array(number(-1e3, 1e3), 2, 65536)}});
+    static const JsonSchema angles = array(number(-1e6, 1e6), 0, 4096);
+    static const JsonSchema s = object({
+            {"format", string(64)},
+            {"version", integer(0, 1e6)},
+            {"name", string(256)},
+            {"description", string(65536).optional()},
+            {"synthetic", boolean().optional()},
+            {"bit_depth", integer(1, 16)},
+            {"measured_in", string(64)},
+            {"front_surface_reflectance", number(0.0, 1.0)},
+            {"black_xyz_cd_m2", xyz},
+            {"primaries_xyz_cd_m2", object({{"r", xyz}, {"g", xyz}, {"b", xyz}})},
+            {"tone_curves", object({{"r", curve}, {"g", curve}, {"b", curve}})},
+            {"viewing_angle", object({{"angle_deg", angles},
+                                      {"luminance_ratio", angles},
+                                      {"dx", angles},
+                                      {"dy", angles}})
+                                      .optional()},
+            {"fit", map(any(), 256).optional()},
+    });
+    return s;
 }
 
 } // namespace
@@ -86,7 +119,7 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
     DisplayModel m;
     try {
         const auto j = nlohmann::json::parse(text);
-        if (j.value("format", "") != "replica-display-profile") {
+        if (!j.is_object() || j.value("format", "") != "replica-display-profile") {
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: not a Replica display profile (no \"format\": "
                                          "\"replica-display-profile\")",
@@ -96,6 +129,9 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
             return makeError(ErrorCode::Unsupported,
                              fmt::format("{}: profile version {} (this build reads {})", source,
                                          j.at("version").get<int>(), kFormatVersion));
+        }
+        if (auto ok = validateJson(j, profileSchema(), source); !ok) {
+            return tl::unexpected(ok.error());
         }
         m.name = j.at("name").get<std::string>();
         m.description = j.value("description", "");
@@ -176,14 +212,15 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
 
 Expected<DisplayModel> loadProfile(const std::filesystem::path& path)
 {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open the display profile", path.string()));
+    auto text = readInputFile(path, kMaxJsonBytes, "display profile");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open the display profile", path.string()));
+        }
+        return tl::unexpected(text.error());
     }
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return profileFromJson(ss.str(), path.string());
+    return profileFromJson(*text, path.string());
 }
 
 Expected<void> saveProfile(const DisplayModel& model, const std::filesystem::path& path)

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/input_file.h>
 #include <pipeline/csv/csv_cells.h>
 #include <pipeline/display/measurement_set.h>
 
@@ -110,14 +111,15 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
 
 Expected<MeasurementSet> loadMeasurementCsv(const std::filesystem::path& path, int bitDepth)
 {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open the measurement file", path.string()));
+    auto text = readInputFile(path, kMaxCsvBytes, "measurement");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open the measurement file", path.string()));
+        }
+        return tl::unexpected(text.error());
     }
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return parseMeasurementCsv(ss.str(), path.string(), bitDepth);
+    return parseMeasurementCsv(*text, path.string(), bitDepth);
 }
 
 std::string measurementCsv(const std::vector<Measurement>& rows, const std::string& comment)

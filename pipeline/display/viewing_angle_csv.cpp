@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/input_file.h>
 #include <pipeline/csv/csv_cells.h>
 #include <pipeline/display/viewing_angle_csv.h>
 
@@ -88,14 +89,15 @@ Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const 
 
 Expected<ViewingAngleTable> loadViewingAngleCsv(const std::filesystem::path& path)
 {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open the viewing-angle table", path.string()));
+    auto text = readInputFile(path, kMaxCsvBytes, "viewing-angle table");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open the viewing-angle table", path.string()));
+        }
+        return tl::unexpected(text.error());
     }
-    std::ostringstream s;
-    s << f.rdbuf();
-    return parseViewingAngleCsv(s.str(), path.string());
+    return parseViewingAngleCsv(*text, path.string());
 }
 
 } // namespace replica::pipeline::display

@@ -1,5 +1,6 @@
 // OpenEXR wrappers: exceptions from the library stop here and become Error values.
 #include <cmath>
+#include <cstdint>
 #include <exception>
 
 #include <OpenEXR/ImfChannelList.h>
@@ -10,6 +11,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <fmt/format.h>
 
+#include <pipeline/base/input_file.h>
 #include <pipeline/image/exr.h>
 
 namespace replica::pipeline::image {
@@ -26,8 +28,11 @@ const std::vector<float>* ChannelImage::plane(const std::string& name) const
 
 Expected<std::vector<std::string>> exrChannelNames(const std::filesystem::path& path)
 {
-    if (!std::filesystem::exists(path)) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
+    if (auto ok = checkInputFile(path, kMaxImageBytes, "OpenEXR"); !ok) {
+        if (ok.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
+        }
+        return tl::unexpected(ok.error());
     }
     try {
         Imf::InputFile file(path.c_str());
@@ -46,19 +51,31 @@ Expected<std::vector<std::string>> exrChannelNames(const std::filesystem::path& 
 Expected<ChannelImage> readExr(const std::filesystem::path& path,
                                const std::vector<std::string>& names)
 {
-    if (!std::filesystem::exists(path)) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
+    // A regular file of bounded size (not a directory, FIFO or symlink loop), then a bounded
+    // data window, before anything is allocated.
+    if (auto ok = checkInputFile(path, kMaxImageBytes, "OpenEXR"); !ok) {
+        if (ok.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
+        }
+        return tl::unexpected(ok.error());
     }
     ChannelImage img;
     try {
         Imf::InputFile file(path.c_str());
         const Imath::Box2i dw = file.header().dataWindow();
-        img.width = dw.max.x - dw.min.x + 1;
-        img.height = dw.max.y - dw.min.y + 1;
-        if (img.width <= 0 || img.height <= 0) {
+        const std::int64_t w = std::int64_t{dw.max.x} - dw.min.x + 1;
+        const std::int64_t h = std::int64_t{dw.max.y} - dw.min.y + 1;
+        if (w <= 0 || h <= 0) {
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: empty data window", path.string()));
         }
+        if (w > kMaxImageSide || h > kMaxImageSide) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: {}x{} pixels; at most {} per side are read",
+                                         path.string(), w, h, kMaxImageSide));
+        }
+        img.width = static_cast<int>(w);
+        img.height = static_cast<int>(h);
         const auto n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
         Imf::FrameBuffer fb;
         img.names = names;

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/base/input_file.h>
+#include <pipeline/base/json_schema.h>
 #include <pipeline/image/exr.h>
 #include <pipeline/surface/scene.h>
 
@@ -12,6 +14,27 @@ namespace replica::pipeline::surface {
 namespace {
 
 constexpr const char* kFormat = "replica-scene/1";
+
+// scene.json (docs/scenes.md): sizes in metres, reflectances per 10 nm band.
+const JsonSchema& sceneSchema()
+{
+    using namespace json_schema;
+    static const JsonSchema s = object({
+            {"format", string()},
+            {"name", string(256).optional()},
+            {"size_m", array(number(1e-6, 1000.0), 2, 2)},
+            {"palette", array(object({{"name", string(256).optional()},
+                                      {"reflectance",
+                                       array(number(0.0, 1.5), colour::kBands, colour::kBands)}}),
+                              1, 256)},
+            {"ward",
+             object({{"alpha", number(0.0, 5.0).optional()},
+                     {"rho_s", array(number(0.0, 1.0), colour::kBands, colour::kBands).optional()},
+                     {"model", string(64).optional()}})
+                     .optional()},
+    });
+    return s;
+}
 
 Expected<colour::Spectrum>
 spectrumField(const nlohmann::json& j, const std::string& where, double maxValue)
@@ -63,18 +86,25 @@ SurfaceScene::channels(const std::vector<colour::ChannelCoeffs>& pc, int x, int 
 Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
 {
     const auto file = dir / "scene.json";
-    std::ifstream in(file);
-    if (!in) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot open scene manifest; --scene "
-                                                          "must name a folder with scene.json",
-                                                          file.string()));
+    auto text = readInputFile(file, kMaxJsonBytes, "scene manifest");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open scene manifest; --scene must name a "
+                                         "folder with scene.json",
+                                         file.string()));
+        }
+        return tl::unexpected(text.error());
     }
     nlohmann::json j;
     try {
-        j = nlohmann::json::parse(in);
+        j = nlohmann::json::parse(*text);
     } catch (const nlohmann::json::exception& e) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
+    }
+    if (auto ok = validateJson(j, sceneSchema(), file.string()); !ok) {
+        return tl::unexpected(ok.error());
     }
     const std::string f = file.string();
     if (!j.contains("format") || j["format"] != kFormat) {

@@ -9,6 +9,8 @@
 #include <png.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/base/input_file.h>
+#include <pipeline/base/json_schema.h>
 #include <pipeline/booth/booth_generator.h>
 #include <pipeline/booth/hdr_capture.h>
 #include <pipeline/colour/spectral_table.h>
@@ -27,11 +29,24 @@ int fail(const char* cmd, int code, const std::string& msg)
 // Reads an 8-bit PNG as grey (the luminance-like channel mix libpng applies for colour input).
 Expected<pipeline::booth::Exposure> readPngGrey(const std::filesystem::path& path)
 {
+    if (auto ok = checkInputFile(path, kMaxImageBytes, "PNG"); !ok) {
+        return tl::unexpected(ok.error());
+    }
     png_image img{};
     img.version = PNG_IMAGE_VERSION;
     if (png_image_begin_read_from_file(&img, path.c_str()) == 0) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: cannot read PNG ({})", path.string(), img.message));
+    }
+    // The header's size is checked before the pixels are allocated.
+    if (img.width > static_cast<png_uint_32>(kMaxImageSide) ||
+        img.height > static_cast<png_uint_32>(kMaxImageSide)) {
+        const auto w = img.width;
+        const auto h = img.height;
+        png_image_free(&img);
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: {}x{} pixels; at most {} per side are read",
+                                     path.string(), w, h, kMaxImageSide));
     }
     img.format = PNG_FORMAT_GRAY;
     pipeline::booth::Exposure e;
@@ -58,6 +73,42 @@ int runGenerate(const std::string& out)
     return kExitOk;
 }
 
+// capture.json, as below: distances in metres, image positions in pixels, a light map of at most
+// 4096 texels per side, exposures of 1 us to an hour, spectra that are not negative.
+const JsonSchema& captureSchema()
+{
+    using namespace json_schema;
+    static const JsonSchema v3 = array(number(-100.0, 100.0), 3, 3);
+    static const JsonSchema px = number(-1e6, 1e6);
+    static const JsonSchema s = object({
+            {"lights",
+             array(object({
+                           {"name", string(128)},
+                           {"spd_column", string(128).optional()},
+                           {"spd", array(number(0.0, 1e9), pipeline::colour::kBands,
+                                         pipeline::colour::kBands)
+                                           .optional()},
+                           {"centre", v3},
+                           {"edge_u", v3},
+                           {"edge_v", v3},
+                           {"texels", array(integer(1, 4096), 2, 2)},
+                           {"corners", array(array(px, 2, 2), 4, 4)},
+                           {"exposures", array(object({{"file", string(4096)},
+                                                       {"seconds", number(1e-6, 3600.0)}}),
+                                               1, 64)},
+                           {"calibration",
+                            object({{"cdm2_per_unit", number(1e-12, 1e12).optional()},
+                                    {"spot", object({{"x", px},
+                                                     {"y", px},
+                                                     {"radius", number(0.0, 1e6)},
+                                                     {"cdm2", number(1e-9, 1e9)}})
+                                                     .optional()}})},
+                   }),
+                   1, 64)},
+    });
+    return s;
+}
+
 // capture.json: {"lights": [{"name", "spd_column" (CIE table column) | "spd" [36], "centre",
 // "edge_u", "edge_v", "texels": [w, h], "corners": [[x, y] x 4] (image pixels of ceiling uv
 // (0,0),(1,0),(1,1),(0,1)), "exposures": [{"file", "seconds"}], "calibration": {"cdm2_per_unit": k}
@@ -66,15 +117,22 @@ int runBuild(const std::string& input, const std::string& out)
 {
     using namespace pipeline;
     const char* cmd = "booth build";
-    std::ifstream in(input);
-    if (!in) {
-        return fail(cmd, kExitFailure, fmt::format("{}: cannot open", input));
+    auto text = readInputFile(input, kMaxJsonBytes, "capture description");
+    if (!text) {
+        return fail(cmd, kExitFailure, text.error().message);
     }
     nlohmann::json j;
     try {
-        j = nlohmann::json::parse(in);
+        j = nlohmann::json::parse(*text);
     } catch (const nlohmann::json::exception& e) {
         return fail(cmd, kExitFailure, fmt::format("{}: not valid JSON ({})", input, e.what()));
+    }
+    std::vector<std::string> warnings;
+    if (auto ok = validateJson(j, captureSchema(), input, &warnings); !ok) {
+        return fail(cmd, kExitFailure, ok.error().message);
+    }
+    for (const auto& w : warnings) {
+        std::fprintf(stderr, "replica %s: warning: %s\n", cmd, w.c_str());
     }
     const std::filesystem::path base = std::filesystem::path(input).parent_path();
     auto table = colour::loadSpectralCsv(dataDir() / "spectra" /
@@ -89,6 +147,10 @@ int runBuild(const std::string& input, const std::string& out)
             const std::string where = fmt::format("{}: lights[{}]", input, li);
             booth::BoothLight l;
             l.name = lj.at("name").get<std::string>();
+            // The name becomes OUT/NAME.exr: never a path out of --out.
+            if (auto ok = checkPlainName(l.name, where + ".name"); !ok) {
+                return fail(cmd, kExitFailure, ok.error().message);
+            }
             const auto v3 = [&](const char* k) {
                 const auto& a = lj.at(k);
                 return glm::dvec3(a.at(0).get<double>(), a.at(1).get<double>(),

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/base/input_file.h>
 #include <pipeline/colour/ciede2000.h>
 #include <pipeline/csv/csv_cells.h>
 #include <platform/cli/commands.h>
@@ -36,6 +37,12 @@ struct PairFile {
 
 Expected<PairFile> readPairs(const std::string& path)
 {
+    // Regular files only: a directory would throw from the stream, a FIFO block it.
+    if (auto ok = checkInputFile(path, kMaxCsvBytes, "CSV"); !ok) {
+        if (ok.error().code != ErrorCode::NotFound) {
+            return tl::unexpected(ok.error());
+        }
+    }
     std::ifstream file(path, std::ios::binary);
     if (!file) {
         return makeError(ErrorCode::NotFound,

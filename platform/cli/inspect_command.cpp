@@ -2,6 +2,8 @@
 // damage (then it exits non-zero).
 #include <algorithm>
 #include <cstdint>
+#include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -12,6 +14,18 @@
 
 namespace replica::platform {
 namespace {
+
+// Text from a recording is untrusted: control characters (a terminal escape sequence) are shown
+// as \xNN, and a field is cut at 'max' characters.
+std::string shown(std::string_view s, std::size_t max = 200)
+{
+    std::string out;
+    for (const char c : s.substr(0, max)) {
+        const auto u = static_cast<unsigned char>(c);
+        out += u < 0x20 || u == 0x7f ? fmt::format("\\x{:02x}", u) : std::string(1, c);
+    }
+    return s.size() > max ? out + "..." : out;
+}
 
 struct InspectOptions {
     std::string file;
@@ -62,12 +76,12 @@ int reportDamage(const InspectOptions& o,
             j["messages"] = report->messages;
             j["indexed"] = report->indexed;
         }
-        fmt::print("{}\n", j.dump(2));
+        fmt::print("{}\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
     }
     logger("replica")->error("{}", error);
     if (report != nullptr && !o.json) {
         for (const auto& d : report->damage) {
-            fmt::print("  damage: {}\n", d);
+            fmt::print("  damage: {}\n", shown(d, 2000));
         }
         if (report->damageCount > report->damage.size()) {
             fmt::print("  ... and {} more\n", report->damageCount - report->damage.size());
@@ -174,16 +188,16 @@ int inspectMain(const InspectOptions& o)
                            {"tick_ns", rec->frames.back().tickNs}};
     }
     if (o.json) {
-        fmt::print("{}\n", j.dump(2));
+        fmt::print("{}\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
         return kExitOk;
     }
     fmt::print("{}: replica recording, format {}, written by {}\n", o.file, rec->formatVersion,
-               rec->session.softwareVersion);
-    fmt::print("  booth {}, scene {}, display profile {}\n", rec->session.boothModel,
-               rec->session.scene, rec->session.displayProfile);
+               shown(rec->session.softwareVersion));
+    fmt::print("  booth {}, scene {}, display profile {}\n", shown(rec->session.boothModel),
+               shown(rec->session.scene), shown(rec->session.displayProfile));
     auto line = [](const char* name, const hal::DeviceInfo& info, std::size_t count) {
-        fmt::print("  {:<13} {:>7} samples  {} {} ({})\n", name, count, info.model, info.serial,
-                   hal::toString(info.kind));
+        fmt::print("  {:<13} {:>7} samples  {} {} ({})\n", name, count, shown(info.model),
+                   shown(info.serial), hal::toString(info.kind));
     };
     line("spectrometer", rec->session.spectrometer, rec->spectra.size());
     line("tracker", rec->session.tracker, rec->poses.size());
@@ -198,8 +212,8 @@ int inspectMain(const InspectOptions& o)
     fmt::print("  {} bytes, {} messages in {} chunks, {}; no damage found\n", report->fileBytes,
                report->messages, report->chunks, report->indexed ? "indexed" : "not indexed");
     for (const auto& c : report->channels) {
-        fmt::print("  channel {:>2} {:<20} {:>7} messages  {} ({})\n", c.id, c.topic, c.messages,
-                   c.schemaName, c.messageEncoding);
+        fmt::print("  channel {:>2} {:<20} {:>7} messages  {} ({})\n", c.id, shown(c.topic),
+                   c.messages, shown(c.schemaName), shown(c.messageEncoding));
     }
     return kExitOk;
 }

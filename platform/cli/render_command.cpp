@@ -2,6 +2,7 @@
 // OpenEXR.
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -319,7 +320,16 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                     "replica_k6, general_k6, pca6, box6 (docs/accuracy.md)")
             ->check(CLI::IsMember(pipeline::spectral::channelBasisNames()))
             ->capture_default_str();
-    cmd->add_option("--out", args->out, "output .exr")->required();
+    cmd->add_option("--out", args->out, "output .exr")
+            ->required()
+            ->check(CLI::Validator(
+                    [](std::string& s) {
+                        // The image is OpenEXR: a .png (or any other) name would hold EXR bytes.
+                        return std::filesystem::path(s).extension() == ".exr"
+                                       ? std::string()
+                                       : "'" + s + "' must end in .exr (render writes OpenEXR)";
+                    },
+                    "", "FILE.exr"));
     cmd->add_flag("--json", args->json, "print the summary as JSON");
     cmd->callback([args, &exitCode] { exitCode = runRender(*args); });
 }

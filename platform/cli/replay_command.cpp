@@ -1,6 +1,7 @@
 // 'replica replay': feeds a recording back through the replay HAL and renders the same frames.
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -24,6 +25,8 @@ struct ReplayOptions {
     std::string saveFrames;  // write every frame's XYZ here (reference frames for a golden)
     std::string reference;   // reference XYZ frames for --check (default: GOLDEN.frames/)
     std::string mismatchDir; // where --check writes the first differing frame
+    std::vector<std::string> dataRoots; // folders besides data/ a recording may name files in
+    bool allowUndigested = false;       // replay a recording without scene/display digests
 };
 
 std::filesystem::path
@@ -103,6 +106,22 @@ int replayMain(const ReplayOptions& o)
     if (!config) {
         log->error("{}: {}", o.file, config.error().message);
         return kExitFailure;
+    }
+    // The recording is untrusted: it names files only inside the data folders, with digests.
+    const std::vector<std::filesystem::path> roots(o.dataRoots.begin(), o.dataRoots.end());
+    if (auto ok = checkRecordedReferences(*config, roots, o.allowUndigested); !ok) {
+        log->error("{}: {}", o.file, ok.error().message);
+        return kExitFailure;
+    }
+    for (std::size_t i = 0; i < recording->frames.size(); ++i) {
+        const std::int64_t before = i > 0 ? recording->frames[i - 1].tickNs : 0;
+        if (recording->frames[i].tickNs < before) {
+            log->error("{}: frame {} has tick_ns {}, before {} (the session start or the frame "
+                       "ahead of it): the frame channel is corrupt",
+                       o.file, recording->frames[i].frameIndex, recording->frames[i].tickNs,
+                       before);
+            return kExitFailure;
+        }
     }
     auto appliance = buildAppliance(*config);
     if (!appliance) {
@@ -211,11 +230,23 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
             "same frames, bit for bit");
     cmd->add_option("file", opts->file, "recording (.mcap) written by 'replica run --record'")
             ->required();
-    cmd->add_option("--digests", opts->digests, "write one digest per frame to FILE (JSON)");
+    const CLI::Validator nonEmpty(
+            [](std::string& s) { return s.empty() ? std::string("an empty name") : std::string(); },
+            "", "PATH");
+    cmd->add_option("--digests", opts->digests, "write one digest per frame to FILE (JSON)")
+            ->check(nonEmpty);
+    cmd->add_option("--data-root", opts->dataRoots,
+                    "a folder besides the data folder whose files a recording may name (scene "
+                    "folder, display profile); repeatable. Replay opens nothing else a recording "
+                    "names");
+    cmd->add_flag("--allow-undigested", opts->allowUndigested,
+                  "replay a recording that holds no digest of its scene or display profile "
+                  "(nothing then says the files are the ones recorded)");
     cmd->add_option("--check", opts->check,
                     "compare the frame digests with GOLDEN (a digests file); on the first "
                     "difference write that frame (PNG and XYZ), its ΔE00 difference image against "
-                    "the reference frame, print ΔE00 statistics, and exit 1");
+                    "the reference frame, print ΔE00 statistics, and exit 1")
+            ->check(nonEmpty);
     cmd->add_option("--snapshot", opts->snapshot, "write the last frame to FILE (PNG)");
     cmd->add_option("--save-frames", opts->saveFrames,
                     "write every frame's absolute XYZ to DIR/frame-NNNNNN.pfm (reference frames "

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/spectral/representation_catalogue.h>
@@ -38,6 +39,7 @@ struct RunOptions {
     std::string size = "960x600";
     double rateHz = 60.0;
     std::string record;
+    bool force = false; // --force: overwrite an existing recording
     int recordFlushMs = 500;
     std::string digests;
     std::string snapshot;
@@ -63,7 +65,7 @@ std::optional<std::pair<int, int>> parseSize(const std::string& s)
     char x = 0;
     char extra = 0;
     if (std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
-        w <= 0 || h <= 0 || w > 16384 || h > 16384) {
+        !frameSizeOk(w, h)) {
         return std::nullopt;
     }
     return std::make_pair(w, h);
@@ -259,9 +261,25 @@ int runMain(const RunOptions& given)
                    o.output);
         return kExitUsage;
     }
+    if (!o.record.empty() && !o.force) {
+        // Refused before the run starts (the writer refuses it again, race-free): an existing
+        // recording is evidence, and a link must not redirect the write.
+        struct stat st {
+        };
+        if (::lstat(o.record.c_str(), &st) == 0 &&
+            (S_ISLNK(st.st_mode) || (S_ISREG(st.st_mode) && st.st_size > 0))) {
+            log->error("--record {}: {}", o.record,
+                       S_ISLNK(st.st_mode) ? "is a symbolic link; name the file itself"
+                                           : "already exists; pass --force to overwrite it, or "
+                                             "name a new file");
+            return kExitUsage;
+        }
+    }
     const auto size = parseSize(o.size);
     if (!size) {
-        log->error("--size {}: expected WIDTHxHEIGHT, e.g. 960x600", o.size);
+        log->error("--size {}: expected WIDTHxHEIGHT, e.g. 960x600, each side 1-{} and at most "
+                   "{}:1",
+                   o.size, kMaxFrameSide, kMaxFrameAspect);
         return kExitUsage;
     }
     RunConfig config;
@@ -281,7 +299,7 @@ int runMain(const RunOptions& given)
         const auto data = std::filesystem::weakly_canonical(dataDir(), ec);
         const auto rel = abs.lexically_relative(data);
         config.sceneDir = !rel.empty() && *rel.begin() != ".." ? rel.string() : abs.string();
-        if (!std::filesystem::is_regular_file(abs / "scene.json")) {
+        if (!std::filesystem::is_regular_file(abs / "scene.json", ec)) {
             log->error("--scene {}: no scene.json there; name a scene folder such as {}", o.scene,
                        (dataDir() / "scenes" / "painting").string());
             return kExitUsage;
@@ -298,7 +316,16 @@ int runMain(const RunOptions& given)
                   "characterised panel; colours on screen are not the surface's",
                   config.displayPeakCdM2);
     } else if (!o.displayProfile.empty()) {
-        config.display = std::filesystem::absolute(o.displayProfile).string();
+        // Like the scene: relative to the data folder when inside it, so that replay (which
+        // opens only files inside the data folders) finds it on another installation.
+        std::error_code ec;
+        const auto abs = std::filesystem::weakly_canonical(
+                std::filesystem::absolute(o.displayProfile, ec), ec);
+        const auto data = std::filesystem::weakly_canonical(dataDir(), ec);
+        const auto rel = abs.lexically_relative(data);
+        config.display = !rel.empty() && *rel.begin() != ".."
+                                 ? rel.string()
+                                 : std::filesystem::absolute(o.displayProfile, ec).string();
     }
     config.displayInverse = o.displayInverse;
     config.gamutMapping = o.gamut;
@@ -367,6 +394,7 @@ int runMain(const RunOptions& given)
         }
         recordings::WriterOptions options;
         options.flushInterval = std::chrono::milliseconds(o.recordFlushMs);
+        options.overwrite = o.force;
         // Called once from the writer thread; the loop keeps displaying without the recording.
         options.onError = [log](const Error& e) {
             log->error("{}; recording stopped, display continues", e.message);
@@ -384,15 +412,8 @@ int runMain(const RunOptions& given)
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
     // --frames 0: run until SIGINT/SIGTERM (the kiosk), closing the recording properly.
     installStopSignals();
-    const TickSource ticks =
-            o.frames == 0 ? endlessTicks(config.periodNs())
-                          : TickSource([plan = fixedRatePlan(config.periodNs(), o.frames),
-                                        k = std::size_t{0}]() mutable -> std::optional<TickPlan> {
-                                if (k >= plan.size()) {
-                                    return std::nullopt;
-                                }
-                                return plan[k++];
-                            });
+    const TickSource ticks = o.frames == 0 ? endlessTicks(config.periodNs())
+                                           : fixedRateTicks(config.periodNs(), o.frames);
     // Scan-out needs the display pixels of every frame, digests or not.
     auto readback = outputs.readback();
     if (o.output == "kms" && readback == pipeline::render::Readback::None) {
@@ -521,12 +542,15 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                     "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
     cmd->add_option("--frames", opts->frames,
                     "number of frames to run; 0 = until SIGINT/SIGTERM (the kiosk)")
+            ->check(CLI::Range(std::uint64_t{0}, kMaxFrames))
             ->capture_default_str();
     cmd->add_option("--size", opts->size, "frame size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--rate", opts->rateHz, "frame rate (Hz)")
             ->check(CLI::Range(1.0, 1000.0))
             ->capture_default_str();
     cmd->add_option("--record", opts->record, "write every sensor sample and frame input to FILE");
+    cmd->add_flag("--force", opts->force,
+                  "--record: overwrite FILE if it exists (never through a symbolic link)");
     cmd->add_option("--record-flush-ms", opts->recordFlushMs,
                     "close and sync the recording's open chunk at least this often (ms): a power "
                     "cut loses at most about this much")

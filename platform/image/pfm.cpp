@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/input_file.h>
 #include <platform/image/pfm.h>
 
 namespace replica::platform {
@@ -44,8 +45,15 @@ Expected<void> writePfm(const std::filesystem::path& path, const FloatImage& ima
 
 Expected<FloatImage> readPfm(const std::filesystem::path& path)
 {
+    // A regular file of bounded size; the header's size is checked against it before the raster
+    // is allocated.
+    if (auto ok = checkInputFile(path, kMaxImageBytes, "PFM"); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    std::error_code ec;
+    const std::uintmax_t fileBytes = std::filesystem::file_size(path, ec);
     std::ifstream in(path, std::ios::binary);
-    if (!in) {
+    if (!in || ec) {
         return makeError(ErrorCode::NotFound, fmt::format("{}: cannot open", path.string()));
     }
     std::string magic;
@@ -60,6 +68,11 @@ Expected<FloatImage> readPfm(const std::filesystem::path& path)
     }
     const auto pixels =
             static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+    if (pixels * 3 * sizeof(std::uint32_t) > fileBytes) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: truncated PFM ({}x{} pixels expected)", path.string(),
+                                     image.width, image.height));
+    }
     std::vector<std::uint32_t> raw(pixels * 3);
     in.read(reinterpret_cast<char*>(raw.data()),
             static_cast<std::streamsize>(raw.size() * sizeof(std::uint32_t)));

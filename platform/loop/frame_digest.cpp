@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/base/input_file.h>
 #include <platform/loop/frame_digest.h>
 
 namespace replica::platform {
@@ -45,14 +46,17 @@ Expected<void> writeDigests(const std::filesystem::path& path, const std::vector
 
 Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path)
 {
-    std::ifstream in(path, std::ios::binary);
+    auto in = readInputFile(path, kMaxJsonBytes, "digests");
     if (!in) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open digests", path.string()));
+        if (in.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open digests", path.string()));
+        }
+        return tl::unexpected(in.error());
     }
     std::vector<FrameDigest> out;
     try {
-        const auto j = nlohmann::json::parse(in);
+        const auto j = nlohmann::json::parse(*in);
         if (j.value("format", "") != "replica-digests") {
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: not a replica digest file", path.string()));

@@ -88,6 +88,19 @@ TickSource endlessTicks(std::int64_t periodNs)
     };
 }
 
+TickSource fixedRateTicks(std::int64_t periodNs, std::uint64_t frames)
+{
+    // Made one tick at a time: 'run --frames 10000000' must not hold 10 M plans up front.
+    auto k = std::make_shared<std::uint64_t>(0);
+    return [periodNs, frames, k]() -> std::optional<TickPlan> {
+        if (*k >= frames) {
+            return std::nullopt;
+        }
+        const std::uint64_t i = (*k)++;
+        return TickPlan{i, static_cast<std::int64_t>(i) * periodNs, std::nullopt};
+    };
+}
+
 std::vector<TickPlan> fixedRatePlan(std::int64_t periodNs, std::uint64_t frames)
 {
     std::vector<TickPlan> plan;
@@ -160,11 +173,19 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         }
         const TickPlan& tick = *nextTick;
         if (pacing == Pacing::Realtime) {
-            const auto due = wallStart + std::chrono::nanoseconds(tick.tickNs);
-            if (std::chrono::steady_clock::now() > due + std::chrono::milliseconds(2)) {
+            // A recording's tick is untrusted (a tick_ns of 9e18 is 285 years away): computed
+            // without overflow, and no frame waits more than a second. A live run's ticks are a
+            // period apart, at most a second (--rate >= 1), so this never shortens one.
+            const std::int64_t elapsed = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                                 std::chrono::steady_clock::now() - wallStart)
+                                                 .count();
+            if (tick.tickNs < elapsed - 2'000'000) {
                 ++stats.lateFrames;
             }
-            std::this_thread::sleep_until(due);
+            if (tick.tickNs > elapsed) {
+                std::this_thread::sleep_for(std::chrono::nanoseconds(
+                        std::min<std::int64_t>(tick.tickNs - elapsed, 1'000'000'000)));
+            }
         } else if (stepping) {
             std::string line;
             if (!std::getline(std::cin, line)) {

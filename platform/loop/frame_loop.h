@@ -62,6 +62,11 @@ using TickSource = std::function<std::optional<TickPlan>()>;
 
 // Ticks k * period for k = 0, 1, 2, ... without end (the kiosk).
 TickSource endlessTicks(std::int64_t periodNs);
+// Ticks k * period for k = 0 .. frames-1, made one at a time (no plan held in memory).
+TickSource fixedRateTicks(std::int64_t periodNs, std::uint64_t frames);
+// The most frames 'run --frames' takes: at the slowest rate (1 Hz) their ticks stay far inside
+// int64 nanoseconds, and 0 already means "without end".
+constexpr std::uint64_t kMaxFrames = 1'000'000'000;
 
 // Asks a running loop to stop after the frame in hand (async-signal-safe: SIGINT/SIGTERM handlers
 // call it), so that recordings are closed properly. installStopSignals() routes both signals here.

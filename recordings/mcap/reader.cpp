@@ -12,9 +12,9 @@
 namespace replica::recordings::mcap {
 namespace {
 
-// Refuse chunks claiming more than this uncompressed: no Replica chunk comes near it, and a corrupt
-// size field must not make the reader allocate gigabytes.
-constexpr std::uint64_t kMaxChunkBytes = 256ULL << 20;
+// Refuse chunks claiming more than this uncompressed: Replica's writer closes a chunk at 256 KiB,
+// and a corrupt or hostile size field must not make the reader allocate gigabytes.
+constexpr std::uint64_t kMaxChunkBytes = kMaxChunkUncompressedBytes;
 
 struct ChunkFields {
     std::uint64_t startTime = 0, endTime = 0, uncompressedSize = 0;
@@ -38,12 +38,36 @@ std::optional<ChunkFields> chunkFields(std::string_view content)
     return c;
 }
 
-// Decompresses and checks a chunk; returns the reason it is unusable, or the records.
-std::string unpack(const ChunkFields& c, std::string& out)
+// Decompresses and checks a chunk; returns the reason it is unusable, or the records. Every
+// chunk's uncompressed size is taken from 'budget' before anything is allocated; 'overBudget' is
+// set when it runs out (the scan then stops).
+std::string unpack(const ChunkFields& c, std::string& out, std::uint64_t& budget, bool& overBudget)
 {
     if (c.uncompressedSize > kMaxChunkBytes) {
-        return fmt::format("claims {} uncompressed bytes", c.uncompressedSize);
+        return fmt::format("claims {} uncompressed bytes (at most {} MiB)", c.uncompressedSize,
+                           kMaxChunkBytes >> 20);
     }
+    if (c.compression == "zstd") {
+        // The frame says its own content size: a chunk claiming more than its frame holds is
+        // refused before the claim is allocated.
+        const unsigned long long framed =
+                ZSTD_getFrameContentSize(c.records.data(), c.records.size());
+        if (framed == ZSTD_CONTENTSIZE_ERROR) {
+            return "does not decompress (not a zstd frame)";
+        }
+        if (framed != ZSTD_CONTENTSIZE_UNKNOWN && framed != c.uncompressedSize) {
+            return fmt::format("claims {} uncompressed bytes but its zstd frame holds {}",
+                               c.uncompressedSize, framed);
+        }
+    } else if (!c.compression.empty()) {
+        return fmt::format("uses unsupported compression '{}'", c.compression);
+    }
+    if (c.uncompressedSize > budget) {
+        overBudget = true;
+        return fmt::format("would take the recording past its decompression budget ({})",
+                           "see docs/recordings.md, 'Limits'");
+    }
+    budget -= c.uncompressedSize;
     if (c.compression.empty()) {
         out.assign(c.records);
     } else if (c.compression == "zstd") {
@@ -70,7 +94,10 @@ std::string unpack(const ChunkFields& c, std::string& out)
 class Scanner
 {
 public:
-    Scanner(std::string_view file, const ScanOptions& o) : f_(file), o_(o) {}
+    Scanner(std::string_view file, const ScanOptions& o)
+        : f_(file), o_(o), budget_(o.maxDecompressedBytes != 0 ? o.maxDecompressedBytes
+                                                               : decompressionBudget(file.size()))
+    {}
 
     Scan run()
     {
@@ -153,6 +180,9 @@ public:
             default:
                 break; // indexes, attachments, metadata and private records carry no samples
             }
+            if (overBudget_) {
+                return overBudget();
+            }
             if (!ok) {
                 if (!resyncFrom(at)) {
                     if (!o_.resync) {
@@ -167,6 +197,9 @@ public:
             s_.dataSectionEnd = next;
             at = next;
         }
+        if (overBudget_) {
+            return overBudget();
+        }
         problem(fmt::format("no Data End record: the recording was cut short at byte {} (power "
                             "cut or crash?); 'replica recover' rebuilds its index",
                             f_.size()));
@@ -174,6 +207,21 @@ public:
     }
 
 private:
+    Scan overBudget()
+    {
+        // What is not read is lost: counted, so that recover says so (exit 3).
+        ++s_.chunksDamaged;
+        s_.bytesSkipped += f_.size() - std::min<std::size_t>(s_.dataSectionEnd, f_.size());
+        problem(fmt::format("the recording decompresses to more than {} MiB, the budget for a "
+                            "{}-byte file ({}x its size, at least {} MiB; Replica's own "
+                            "recordings take about 3x): not read further",
+                            (o_.maxDecompressedBytes != 0 ? o_.maxDecompressedBytes
+                                                          : decompressionBudget(f_.size())) >>
+                                    20,
+                            f_.size(), kDecompressionRatio, kMinDecompressionBudget >> 20));
+        return std::move(s_);
+    }
+
     void problem(std::string what)
     {
         ++s_.damageCount;
@@ -202,7 +250,10 @@ private:
                 continue;
             }
             std::string records;
-            if (!unpack(*c, records).empty()) {
+            if (!unpack(*c, records, budget_, overBudget_).empty()) {
+                if (overBudget_) {
+                    break;
+                }
                 continue;
             }
             s_.bytesSkipped += p - at;
@@ -277,7 +328,10 @@ private:
             return false;
         }
         std::string records;
-        if (auto why = unpack(*c, records); !why.empty()) {
+        if (auto why = unpack(*c, records, budget_, overBudget_); !why.empty()) {
+            if (overBudget_) {
+                return false; // reported once, by run()
+            }
             problem(fmt::format("chunk at byte {} {}", at, why));
             ++s_.chunksDamaged;
             return false;
@@ -443,6 +497,8 @@ private:
     ScanOptions o_;
     Scan s_;
     std::size_t resyncAt_ = 0;
+    std::uint64_t budget_ = 0;
+    bool overBudget_ = false;
 };
 
 } // namespace

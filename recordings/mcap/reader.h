@@ -13,7 +13,24 @@
 
 namespace replica::recordings::mcap {
 
+// Limits on what a recording can make Replica hold (docs/recordings.md, 'Limits'). A chunk
+// decompresses to at most kMaxChunkUncompressedBytes (Replica's writer closes one at 256 KiB), and
+// all chunks of a file together to at most decompressionBudget(file size): kDecompressionRatio
+// times the file (Replica's recordings decompress to about 3x), and never less than
+// kMinDecompressionBudget.
+constexpr std::uint64_t kMaxChunkUncompressedBytes = 16ULL << 20;
+constexpr std::uint64_t kDecompressionRatio = 10;
+constexpr std::uint64_t kMinDecompressionBudget = 64ULL << 20;
+constexpr std::uint64_t decompressionBudget(std::uint64_t fileBytes)
+{
+    return fileBytes * kDecompressionRatio > kMinDecompressionBudget
+                   ? fileBytes * kDecompressionRatio
+                   : kMinDecompressionBudget;
+}
+
 struct ScanOptions {
+    // Total uncompressed bytes the scan may decompress; 0: decompressionBudget(file size).
+    std::uint64_t maxDecompressedBytes = 0;
     // After damage, search forward for the next chunk that decompresses and matches its CRC and go
     // on from there (recover); otherwise stop at the first record that cannot be trusted.
     bool resync = false;

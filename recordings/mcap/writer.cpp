@@ -37,16 +37,41 @@ FileWriter::~FileWriter()
     }
 }
 
-Expected<std::unique_ptr<FileWriter>> FileWriter::create(const std::filesystem::path& path,
-                                                         const std::string& library)
+Expected<std::unique_ptr<FileWriter>>
+FileWriter::create(const std::filesystem::path& path, const std::string& library, bool overwrite)
 {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    // Never through a symbolic link (O_NOFOLLOW), and truncated only once it is known to be a
+    // regular file we may overwrite.
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd < 0) {
         const int err = errno;
+        if (err == ELOOP) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: is a symbolic link; a recording is never written "
+                                         "through one: name the file itself",
+                                         path.string()));
+        }
         return makeError(
                 ErrorCode::Io,
                 fmt::format("{}: cannot create recording: {}{}", path.string(), std::strerror(err),
                             err == EACCES || err == EROFS ? " (choose a writable directory)" : ""));
+    }
+    struct stat st {
+    };
+    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+        if (!overwrite) {
+            ::close(fd);
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: already exists; pass --force to overwrite it, or "
+                                         "name a new file",
+                                         path.string()));
+        }
+        if (::ftruncate(fd, 0) != 0) {
+            const int err = errno;
+            ::close(fd);
+            return makeError(ErrorCode::Io, fmt::format("{}: cannot truncate: {}", path.string(),
+                                                        std::strerror(err)));
+        }
     }
     std::unique_ptr<FileWriter> w(new FileWriter(fd, path));
     ByteWriter header;

@@ -23,9 +23,10 @@ namespace replica::recordings::mcap {
 class FileWriter
 {
 public:
-    // Creates (truncates) `path` and writes the magic and the Header record.
-    static Expected<std::unique_ptr<FileWriter>> create(const std::filesystem::path& path,
-                                                        const std::string& library);
+    // Creates `path` and writes the magic and the Header record. Never follows a symbolic link;
+    // a non-empty regular file there is truncated only when 'overwrite'.
+    static Expected<std::unique_ptr<FileWriter>>
+    create(const std::filesystem::path& path, const std::string& library, bool overwrite = true);
     ~FileWriter();
     FileWriter(const FileWriter&) = delete;
     FileWriter& operator=(const FileWriter&) = delete;

@@ -57,7 +57,9 @@ TEST(BoothModel, ReportsMissingFolderAndBadFields)
         "centre":[0,1],"edge_u":[1,0,0],"edge_v":[0,0,1],"spd":[]}]})";
     r = loadBooth(dir);
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().message.find("lights[0]: 'centre' must be an array of 3"),
+    // Held against the written schema first: the message names the JSON path.
+    EXPECT_NE(r.error().message.find("booth.json: /lights/0/centre: expected an array of 3 items, "
+                                     "found 2"),
               std::string::npos)
             << r.error().message;
 

@@ -29,6 +29,25 @@ TEST(CsvCells, SplitsAtEveryCommaAndKeepsEmptyCells)
     EXPECT_EQ(splitCsvRow(" "), (Cells{""}));
 }
 
+// Spreadsheet exports: a byte order mark before the first cell, and cells in double quotes that
+// may hold commas and doubled quotes (RFC 4180).
+TEST(CsvCells, ReadsAByteOrderMarkAndQuotedCells)
+{
+    EXPECT_EQ(splitCsvRow("\xEF\xBB\xBFwavelength_nm,a"), (Cells{"wavelength_nm", "a"}));
+    EXPECT_EQ(trimCell("\xEF\xBB\xBF 380"), "380");
+    EXPECT_EQ(splitCsvRow(R"("380","0.5")"), (Cells{"380", "0.5"}));
+    EXPECT_EQ(splitCsvRow(R"(" a, b ",c)"), (Cells{"a, b", "c"}));
+    EXPECT_EQ(splitCsvRow(R"("say ""hi""",2)"), (Cells{R"(say "hi")", "2"}));
+    EXPECT_EQ(splitCsvRow(R"(1,"",3)"), (Cells{"1", "", "3"}));
+    // Text after the closing quote stays in the cell, so a reader refuses it as a number.
+    EXPECT_EQ(splitCsvRow(R"("1"x,2)"), (Cells{"1x", "2"}));
+    // An unterminated quote takes the rest of the line.
+    EXPECT_EQ(splitCsvRow(R"("1,2)"), (Cells{"1,2"}));
+    double v = 0.0;
+    EXPECT_TRUE(parseFiniteNumber(splitCsvRow(R"("0.25")")[0], v));
+    EXPECT_EQ(v, 0.25);
+}
+
 TEST(CsvCells, ReadsDecimalNumbersWithEitherSign)
 {
     double v = 0.0;

@@ -146,10 +146,15 @@ TEST_F(DisplayCli, ReplayRefusesAChangedProfile)
     const auto made = run("run --fast --frames 3 --size 32x20 --display-profile " + copy.string() +
                           " --record " + rec);
     ASSERT_EQ(made.exitCode, 0) << made.err;
-    const auto same = run("replay " + rec + " --clock fast");
+    // A recording is untrusted: it names files outside the data folder only under --data-root.
+    const auto outside = run("replay " + rec + " --clock fast");
+    EXPECT_EQ(outside.exitCode, 1);
+    EXPECT_NE(outside.err.find("outside the data folders"), std::string::npos) << outside.err;
+    const std::string root = " --data-root " + dir_.string();
+    const auto same = run("replay " + rec + " --clock fast" + root);
     EXPECT_EQ(same.exitCode, 0) << same.err;
     std::ofstream(copy, std::ios::app) << "\n";
-    const auto changed = run("replay " + rec + " --clock fast");
+    const auto changed = run("replay " + rec + " --clock fast" + root);
     EXPECT_EQ(changed.exitCode, 1);
     EXPECT_NE(changed.err.find("has changed since it was recorded"), std::string::npos)
             << changed.err;
@@ -351,7 +356,8 @@ TEST_F(DisplayCli, ApplianceNeedsAProfileAndRecordsWhichOne)
     EXPECT_NE(id.find("wide-ips-synthetic"), std::string::npos) << id;
     EXPECT_NE(id.find("fnv1a64"), std::string::npos) << id;
 
-    const auto unc = run(common + "--uncalibrated --record " + rec);
+    // The same file again: an existing recording is overwritten only when asked.
+    const auto unc = run(common + "--uncalibrated --force --record " + rec);
     ASSERT_EQ(unc.exitCode, 0) << unc.err;
     info = run("inspect " + rec + " --json");
     EXPECT_NE(nlohmann::json::parse(info.out)

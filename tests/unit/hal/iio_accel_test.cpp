@@ -1,9 +1,14 @@
 // The IIO accelerometer against a fake sysfs tree in a temporary directory: attribute layouts
 // (shared and per-axis scale, optional offset), bad values, and removal while running.
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <thread>
+
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <hal/accel/iio_accel.h>
 
@@ -126,6 +131,50 @@ TEST_F(FakeIio, SourceSamplesLosesTheDeviceAndFindsItAgain)
         src->poll(clock.nowNs(), got);
         return !got.empty() && got.back().gravity.z < -9.0;
     }));
+}
+
+// A value file that exists but reads empty, junk or nothing at all (EIO from a glitching I2C
+// sensor) must not spin: the source reports Lost, logs once per new error, retries at the
+// reconnect period, and stops promptly when destroyed even in the middle of a long retry wait.
+TEST_F(FakeIio, FailingValueFileBacksOffLogsOnceAndStops)
+{
+    for (const std::string bad : {"", "junk", "\x01\x02"}) {
+        write("iio:device1/in_accel_y_raw", bad);
+        std::ostringstream captured;
+        auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(captured);
+        auto log = std::make_shared<spdlog::logger>("hal.accel", sink);
+        spdlog::drop("hal.accel");
+        spdlog::register_logger(log);
+        hal::SteadyClock clock;
+        hal::accel::IioAccelSourceOptions opt;
+        opt.root = root_;
+        opt.periodNs = 1'000'000;
+        opt.reconnectNs = 20'000'000; // 20 ms: ~15 retries in the 300 ms below
+        auto src = hal::accel::makeIioAccelSource(clock, opt);
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        EXPECT_EQ(src->state(), hal::LinkState::Lost) << "value '" << bad << "'";
+        std::vector<hal::AccelSample> got;
+        src->poll(clock.nowNs(), got);
+        EXPECT_TRUE(got.empty());
+        src.reset();
+        spdlog::drop("hal.accel");
+        const std::string text = captured.str();
+        const auto lines = std::count(text.begin(), text.end(), '\n');
+        // One line on finding the device, one on the first failed read; a busy loop logged
+        // thousands here.
+        EXPECT_LE(lines, 2) << text;
+        EXPECT_NE(text.find("in_accel_y_raw"), std::string::npos) << text;
+    }
+    // A long retry wait is interrupted by stop: destroying the source does not wait it out.
+    hal::SteadyClock clock;
+    hal::accel::IioAccelSourceOptions opt;
+    opt.root = root_;
+    opt.reconnectNs = 3'600'000'000'000; // an hour
+    auto src = hal::accel::makeIioAccelSource(clock, opt);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto t0 = std::chrono::steady_clock::now();
+    src.reset();
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(60));
 }
 
 TEST(AxisMapping, ParsesSignedPermutationsAndRejectsTheRest)

@@ -1,0 +1,173 @@
+// Reading a file that a person or another file named: regular files only (not a directory, FIFO,
+// device or /proc entry), a size limit checked before reading, and errors that name the file
+// instead of exceptions (a symlink loop, a directory, /dev/zero). Also the check for a name
+// taken from an input file before it becomes part of a path.
+#pragma once
+
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <pipeline/base/expected.h>
+
+namespace replica {
+
+// Limits for the text formats Replica reads (JSON, CSV, profiles). The largest shipped file is
+// well under 1 MiB; these leave room for measured data without letting /dev/zero or a 2 GB
+// mistake near memory.
+constexpr std::uintmax_t kMaxJsonBytes = 64u << 20;
+constexpr std::uintmax_t kMaxCsvBytes = 64u << 20;
+// Images (EXR, PNG): file size, and pixels per side checked from the header before allocating.
+constexpr std::uintmax_t kMaxImageBytes = 1024u << 20;
+constexpr int kMaxImageSide = 16384;
+
+namespace input_file_detail {
+
+inline std::string kindOf(mode_t mode)
+{
+    if (S_ISDIR(mode)) {
+        return "a directory";
+    }
+    if (S_ISFIFO(mode)) {
+        return "a FIFO";
+    }
+    if (S_ISCHR(mode) || S_ISBLK(mode)) {
+        return "a device";
+    }
+    if (S_ISSOCK(mode)) {
+        return "a socket";
+    }
+    return "not a regular file";
+}
+
+inline std::string sizeText(std::uintmax_t bytes)
+{
+    return bytes >= (1u << 20) && bytes % (1u << 20) == 0 ? fmt::format("{} MiB", bytes >> 20)
+                                                          : fmt::format("{} bytes", bytes);
+}
+
+struct Fd {
+    int fd = -1;
+    ~Fd()
+    {
+        if (fd >= 0) {
+            ::close(fd);
+        }
+    }
+};
+
+inline Expected<struct stat> openChecked(Fd& f,
+                                         const std::filesystem::path& path,
+                                         std::uintmax_t maxBytes,
+                                         std::string_view what)
+{
+    // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused just below.
+    f.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (f.fd < 0) {
+        const int err = errno;
+        return makeError(
+                err == ENOENT ? ErrorCode::NotFound : ErrorCode::Io,
+                fmt::format("{}: cannot open {} ({}){}", path.string(), what, std::strerror(err),
+                            err == ELOOP ? "; a symbolic link loop: point it at a file" : ""));
+    }
+    struct stat st {
+    };
+    if (::fstat(f.fd, &st) != 0) {
+        return makeError(ErrorCode::Io, fmt::format("{}: cannot stat {} ({})", path.string(), what,
+                                                    std::strerror(errno)));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: is {}, not a {} file; name a regular file", path.string(),
+                                     kindOf(st.st_mode), what));
+    }
+    if (static_cast<std::uintmax_t>(st.st_size) > maxBytes) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: {} bytes, more than the {} a {} file may hold",
+                                     path.string(), st.st_size, sizeText(maxBytes), what));
+    }
+    return st;
+}
+
+} // namespace input_file_detail
+
+// Checks that 'path' is a regular file of at most maxBytes, for readers that open it themselves
+// (OpenEXR, libpng). 'what' names the kind of file in the message ("scene manifest", "CSV").
+inline Expected<void>
+checkInputFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::string_view what)
+{
+    input_file_detail::Fd f;
+    auto st = input_file_detail::openChecked(f, path, maxBytes, what);
+    if (!st) {
+        return tl::unexpected(st.error());
+    }
+    return {};
+}
+
+// The whole of 'path' as bytes, checked as above. Reads at most maxBytes + 1 whatever the size
+// says (a /proc file claims 0 bytes).
+inline Expected<std::string>
+readInputFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::string_view what)
+{
+    input_file_detail::Fd f;
+    auto st = input_file_detail::openChecked(f, path, maxBytes, what);
+    if (!st) {
+        return tl::unexpected(st.error());
+    }
+    std::string text;
+    text.reserve(static_cast<std::size_t>(st->st_size));
+    char buf[65536];
+    for (;;) {
+        const ssize_t got = ::read(f.fd, buf, sizeof buf);
+        if (got < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            return makeError(ErrorCode::Io, fmt::format("{}: cannot read {} ({})", path.string(),
+                                                        what, std::strerror(errno)));
+        }
+        if (got == 0) {
+            break;
+        }
+        text.append(buf, static_cast<std::size_t>(got));
+        if (text.size() > maxBytes) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: more than the {} a {} file may hold", path.string(),
+                                         input_file_detail::sizeText(maxBytes), what));
+        }
+    }
+    return text;
+}
+
+// A name read from an input file (a booth light's name, a luminance map's file name) that will
+// become part of a path: letters, digits, '.', '_', '-' and ' ', not starting with '.', at most
+// 128 characters; so never a separator, '..', or an absolute path.
+inline Expected<void> checkPlainName(const std::string& name, const std::string& where)
+{
+    bool ok = !name.empty() && name.size() <= 128 && name.front() != '.';
+    for (const char c : name) {
+        ok = ok && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '.' || c == '_' || c == '-' || c == ' ');
+    }
+    if (!ok) {
+        std::string shown;
+        for (const char c : name.substr(0, 64)) {
+            shown += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
+        }
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: '{}' cannot name a file: use letters, digits, '.', '_', "
+                                     "'-' (not starting with '.', at most 128 characters)",
+                                     where, shown));
+    }
+    return {};
+}
+
+} // namespace replica

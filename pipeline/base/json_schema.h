@@ -1,0 +1,291 @@
+// One written schema per JSON format the project reads, and the check that holds a document
+// against it before any field is read: the offending JSON path is named (e.g.
+// "scene.json: /ward/alpha: expected a number in [0, 5], found a string"), non-finite and
+// out-of-range numbers are refused, and unknown keys are reported as warnings. Once a document
+// has passed, nlohmann's accessors on the fields the schema names cannot throw.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <pipeline/base/expected.h>
+
+namespace replica {
+
+struct JsonSchema {
+    enum class Type { Any, Object, Array, String, Number, Integer, Bool };
+    Type type = Type::Any;
+    bool required = true;
+    bool nullable = false;
+    double min = -std::numeric_limits<double>::max(); // numbers: inclusive range
+    double max = std::numeric_limits<double>::max();
+    std::size_t minItems = 0; // arrays (and strings: length)
+    std::size_t maxItems = std::numeric_limits<std::size_t>::max();
+    std::vector<std::pair<std::string, JsonSchema>> fields; // objects: the known keys
+    bool openObject = false; // objects: any key, each checked against 'items' (a map)
+    std::shared_ptr<const JsonSchema> items; // arrays: every element
+
+    JsonSchema optional() const
+    {
+        JsonSchema s = *this;
+        s.required = false;
+        return s;
+    }
+    JsonSchema orNull() const
+    {
+        JsonSchema s = *this;
+        s.nullable = true;
+        return s;
+    }
+};
+
+namespace json_schema {
+
+inline JsonSchema any()
+{
+    return {};
+}
+inline JsonSchema number(double min = -std::numeric_limits<double>::max(),
+                         double max = std::numeric_limits<double>::max())
+{
+    JsonSchema s;
+    s.type = JsonSchema::Type::Number;
+    s.min = min;
+    s.max = max;
+    return s;
+}
+inline JsonSchema integer(double min, double max)
+{
+    JsonSchema s = number(min, max);
+    s.type = JsonSchema::Type::Integer;
+    return s;
+}
+inline JsonSchema string(std::size_t maxLength = 4096)
+{
+    JsonSchema s;
+    s.type = JsonSchema::Type::String;
+    s.maxItems = maxLength;
+    return s;
+}
+inline JsonSchema boolean()
+{
+    JsonSchema s;
+    s.type = JsonSchema::Type::Bool;
+    return s;
+}
+inline JsonSchema array(JsonSchema item, std::size_t minItems, std::size_t maxItems)
+{
+    JsonSchema s;
+    s.type = JsonSchema::Type::Array;
+    s.items = std::make_shared<const JsonSchema>(std::move(item));
+    s.minItems = minItems;
+    s.maxItems = maxItems;
+    return s;
+}
+inline JsonSchema object(std::vector<std::pair<std::string, JsonSchema>> fields)
+{
+    JsonSchema s;
+    s.type = JsonSchema::Type::Object;
+    s.fields = std::move(fields);
+    return s;
+}
+// An object used as a map: any key, each value checked against 'value'.
+inline JsonSchema map(JsonSchema value, std::size_t maxKeys)
+{
+    JsonSchema s;
+    s.type = JsonSchema::Type::Object;
+    s.openObject = true;
+    s.items = std::make_shared<const JsonSchema>(std::move(value));
+    s.maxItems = maxKeys;
+    return s;
+}
+
+inline std::string kindOf(const nlohmann::json& j)
+{
+    switch (j.type()) {
+    case nlohmann::json::value_t::null:
+        return "null";
+    case nlohmann::json::value_t::object:
+        return "an object";
+    case nlohmann::json::value_t::array:
+        return "an array";
+    case nlohmann::json::value_t::string:
+        return "a string";
+    case nlohmann::json::value_t::boolean:
+        return "a boolean";
+    case nlohmann::json::value_t::number_integer:
+    case nlohmann::json::value_t::number_unsigned:
+        return "an integer";
+    case nlohmann::json::value_t::number_float:
+        return std::isfinite(j.get<double>()) ? "a number" : "a non-finite number";
+    default:
+        return "something else";
+    }
+}
+
+inline std::string escapeKey(const std::string& key)
+{
+    std::string out;
+    for (const char c : key) {
+        if (c == '~') {
+            out += "~0";
+        } else if (c == '/') {
+            out += "~1";
+        } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+            out += fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
+        } else {
+            out += c;
+        }
+    }
+    return out;
+}
+
+inline Expected<void> check(const nlohmann::json& j,
+                            const JsonSchema& s,
+                            const std::string& path,
+                            std::vector<std::string>& warnings)
+{
+    using T = JsonSchema::Type;
+    const std::string at = path.empty() ? "/" : path;
+    const auto bad = [&](const std::string& expected) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: expected {}, found {}", at, expected, kindOf(j)));
+    };
+    if (j.is_null() && s.nullable) {
+        return {};
+    }
+    switch (s.type) {
+    case T::Any:
+        return {};
+    case T::Bool:
+        return j.is_boolean() ? Expected<void>{} : bad("true or false");
+    case T::String:
+        if (!j.is_string()) {
+            return bad("a string");
+        }
+        if (j.get_ref<const std::string&>().size() > s.maxItems) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: string longer than {} characters", at, s.maxItems));
+        }
+        return {};
+    case T::Number:
+    case T::Integer: {
+        const bool integral = s.type == T::Integer;
+        const std::string expected =
+                fmt::format("{} in [{}, {}]", integral ? "an integer" : "a number", s.min, s.max);
+        if (!j.is_number() || (integral && !j.is_number_integer())) {
+            return bad(expected);
+        }
+        const double v = j.get<double>();
+        if (!std::isfinite(v) || v < s.min || v > s.max) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: expected {}, found {}", at, expected, j.dump()));
+        }
+        return {};
+    }
+    case T::Array: {
+        const std::string expected =
+                s.minItems == s.maxItems
+                        ? fmt::format("an array of {} items", s.minItems)
+                        : fmt::format("an array of {} to {} items", s.minItems, s.maxItems);
+        if (!j.is_array()) {
+            return bad(expected);
+        }
+        if (j.size() < s.minItems || j.size() > s.maxItems) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: expected {}, found {}", at, expected, j.size()));
+        }
+        for (std::size_t k = 0; k < j.size(); ++k) {
+            if (auto ok = check(j[k], *s.items, fmt::format("{}/{}", path, k), warnings); !ok) {
+                return ok;
+            }
+        }
+        return {};
+    }
+    case T::Object: {
+        if (!j.is_object()) {
+            return bad("an object");
+        }
+        if (s.openObject) {
+            if (j.size() > s.maxItems) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}: more than {} keys", at, s.maxItems));
+            }
+            for (const auto& [key, value] : j.items()) {
+                if (auto ok = check(value, *s.items, path + "/" + escapeKey(key), warnings); !ok) {
+                    return ok;
+                }
+            }
+            return {};
+        }
+        for (const auto& [key, field] : s.fields) {
+            const auto it = j.find(key);
+            if (it == j.end()) {
+                if (field.required) {
+                    return makeError(ErrorCode::Corrupt,
+                                     fmt::format("{}/{}: required but missing", path, key));
+                }
+                continue;
+            }
+            if (auto ok = check(*it, field, path + "/" + escapeKey(key), warnings); !ok) {
+                return ok;
+            }
+        }
+        for (const auto& [key, value] : j.items()) {
+            bool known = false;
+            for (const auto& f : s.fields) {
+                known = known || f.first == key;
+            }
+            if (!known) {
+                warnings.push_back(
+                        fmt::format("{}/{}: unknown key, ignored", path, escapeKey(key)));
+            }
+        }
+        return {};
+    }
+    }
+    return {};
+}
+
+} // namespace json_schema
+
+// Where unknown-key warnings go when the caller collects none: the platform points it at its
+// 'pipeline' logger (the pipeline itself logs nothing); by default they are dropped.
+inline std::function<void(const std::string&)>& jsonWarningSink()
+{
+    static std::function<void(const std::string&)> sink;
+    return sink;
+}
+
+// Holds 'j' against 's'; errors and warnings start with 'file'. Warnings go to 'warnings' when
+// given, else to jsonWarningSink().
+inline Expected<void> validateJson(const nlohmann::json& j,
+                                   const JsonSchema& s,
+                                   const std::string& file,
+                                   std::vector<std::string>* warnings = nullptr)
+{
+    std::vector<std::string> w;
+    auto ok = json_schema::check(j, s, "", w);
+    for (auto& line : w) {
+        if (warnings != nullptr) {
+            warnings->push_back(file + ": " + line);
+        } else if (jsonWarningSink()) {
+            jsonWarningSink()(file + ": " + line);
+        }
+    }
+    if (!ok) {
+        return makeError(ok.error().code, file + ": " + ok.error().message);
+    }
+    return {};
+}
+
+} // namespace replica

@@ -1,0 +1,217 @@
+#!/usr/bin/env bash
+# Hostile and careless input over every command and file the CLI reads (issue 22): wrong JSON
+# types, out-of-range and non-finite numbers, directories, FIFOs, devices and symbolic link loops
+# where a file is expected, names that would leave the output folder, recordings that lie about
+# their sizes or hold decompression bombs, name files outside the data folder, carry impossible
+# frames or terminal escapes. Each case must end with its own exit code and exactly one line that
+# says what is wrong (and names the file or JSON path), never an abort, a hang or memory exhaustion:
+# every command runs under a virtual memory limit (ulimit -v, except under ASan, which reserves
+# terabytes of address space) and a hang guard.
+#   hostile_input.sh REPLICA SOURCE_DIR WORK
+set -uo pipefail
+replica="$1"
+data="$2/data"
+sample="$2/recordings/samples/walk-v3.mcap"
+work="$3"
+here="$(cd "$(dirname "$0")" && pwd)"
+rm -rf "$work" && mkdir -p "$work"
+limit_kb=2000000 # 2 GB of address space: a decompression bomb or a 30 M count spectrum would need more
+if ldd "$replica" 2>/dev/null | grep -q libasan; then
+    limit_kb=unlimited
+fi
+pass=0
+status=0
+fail() {
+    echo "FAIL: $*" >&2
+    status=1
+}
+
+# expect CODE PATTERN [env VAR=...] -- replica ARGS...: exit CODE, one stderr line matching PATTERN.
+expect() {
+    local code="$1" pattern="$2"
+    shift 2
+    local envs=()
+    while [ "$1" != "--" ]; do
+        envs+=("$1")
+        shift
+    done
+    shift
+    local err got lines
+    err=$( (ulimit -v "$limit_kb"; env "${envs[@]}" timeout 60 "$replica" "$@") 2>&1 >/dev/null)
+    got=$?
+    lines=$(printf '%s\n' "$err" | grep -c .)
+    if [ "$got" -eq 124 ]; then
+        fail "replica $* hung (killed after 60 s)"
+    elif [ "$got" -ne "$code" ]; then
+        fail "replica $* exited $got, expected $code: $err"
+    elif [ "$lines" -ne 1 ]; then
+        fail "replica $* printed $lines lines, expected one: $err"
+    elif ! printf '%s' "$err" | grep -qE -- "$pattern"; then
+        fail "replica $* did not say /$pattern/: $err"
+    else
+        pass=$((pass + 1))
+        echo "ok: exit $got: $err"
+    fi
+}
+
+R=("--log-level" "error")
+
+# --- The command line: numbers, levels, paths.
+expect 2 "--frames.*not in range" -- "${R[@]}" run --frames -1
+expect 2 "--frames.*not in range" -- "${R[@]}" run --frames 4294967296
+expect 2 "--rate.*'nan' is not a finite number" -- "${R[@]}" run --rate nan
+expect 2 "--rate.*(not a finite number|not in range)" -- "${R[@]}" run --rate inf
+expect 2 "--size 16384x1" -- "${R[@]}" run --size 16384x1 --frames 1
+expect 2 "--specular-lod-bias.*not a finite number" -- "${R[@]}" render --scene "$data/scenes/metamer" \
+    --light d65 --out "$work/x.exr" --specular-lod-bias nan
+expect 2 "--lux.*not a finite number" -- "${R[@]}" display study --lux nan
+expect 2 "--tracker-wait.*not a finite number" -- "${R[@]}" probe --tracker-wait nan
+expect 2 "unknown log level 'bogus'.*trace, debug, info" -- --log-level bogus inspect "$sample"
+expect 2 "REPLICA_LOG.*unknown log level 'loud'" REPLICA_LOG=loud -- inspect "$sample"
+expect 2 "--check.*empty name" -- "${R[@]}" replay "$sample" --check ""
+expect 2 "must end in .exr" -- "${R[@]}" render --scene "$data/scenes/metamer" --light d65 --out "$work/x.png"
+# --log-level after the subcommand works like before it.
+out=$("$replica" inspect "$sample" --log-level error 2>&1 >/dev/null)
+[ $? -eq 0 ] && [ -z "$out" ] || fail "--log-level after the subcommand: $out"
+# The command line wins over $REPLICA_LOG: error on the line, debug in the environment, no debug.
+out=$(REPLICA_LOG=debug "$replica" --log-level error inspect "$sample" 2>&1 >/dev/null)
+[ -z "$out" ] || fail "REPLICA_LOG beat --log-level: $out"
+
+# --- Recordings are written without following links and never over an existing one.
+printf 'evidence' > "$work/existing.mcap"
+expect 2 "already exists; pass --force" -- "${R[@]}" run --frames 1 --record "$work/existing.mcap"
+[ "$(cat "$work/existing.mcap")" = evidence ] || fail "run --record truncated an existing recording"
+ln -s "$work/target" "$work/link.mcap"
+expect 2 "symbolic link" -- "${R[@]}" run --frames 1 --record "$work/link.mcap"
+[ ! -e "$work/target" ] || fail "run --record wrote through a symbolic link"
+
+# --- Scene JSON: wrong types and out-of-range values name the JSON path.
+scene() { # NAME PYTHON-EXPRESSION-ON-j
+    rm -rf "$work/$1" && cp -r "$data/scenes/metamer" "$work/$1"
+    python3 - "$work/$1/scene.json" "$2" <<'PY'
+import json, sys
+path, change = sys.argv[1], sys.argv[2]
+j = json.load(open(path))
+exec(change)
+json.dump(j, open(path, "w"))
+PY
+}
+scene name5 'j["name"] = 5'
+expect 1 "scene.json: /name: expected a string, found an integer" -- "${R[@]}" render --scene "$work/name5" --light d65 --out "$work/x.exr"
+scene wardx 'j["ward"] = "x"'
+expect 1 "scene.json: /ward: expected an object, found a string" -- "${R[@]}" render --scene "$work/wardx" --light d65 --out "$work/x.exr"
+scene alphanull 'j["ward"]["alpha"] = None'
+expect 1 "scene.json: /ward/alpha: expected a number in \[0, 5\], found null" -- "${R[@]}" render --scene "$work/alphanull" --light d65 --out "$work/x.exr"
+scene huge 'j["size_m"][0] = 1e308'
+expect 1 "scene.json: /size_m/0: expected a number in" -- "${R[@]}" render --scene "$work/huge" --light d65 --out "$work/x.exr"
+scene refl 'j["palette"][0]["reflectance"][3] = "0.5"'
+expect 1 "scene.json: /palette/0/reflectance/3: expected a number" -- "${R[@]}" render --scene "$work/refl" --light d65 --out "$work/x.exr"
+# Directories, FIFOs, devices and link loops where scene.json should be.
+mkdir -p "$work/dir" && cp -r "$data/scenes/metamer/." "$work/dir/" && rm "$work/dir/scene.json" && mkdir "$work/dir/scene.json"
+expect 1 "scene.json: is a directory" -- "${R[@]}" render --scene "$work/dir" --light d65 --out "$work/x.exr"
+mkdir -p "$work/fifo" && cp -r "$data/scenes/metamer/." "$work/fifo/" && rm "$work/fifo/scene.json" && mkfifo "$work/fifo/scene.json"
+expect 1 "scene.json: is a FIFO" -- "${R[@]}" render --scene "$work/fifo" --light d65 --out "$work/x.exr"
+mkdir -p "$work/zero" && ln -s /dev/zero "$work/zero/scene.json"
+expect 1 "scene.json: is a device" -- "${R[@]}" render --scene "$work/zero" --light d65 --out "$work/x.exr"
+mkdir -p "$work/loop" && ln -s "$work/loop/b" "$work/loop/a" && ln -s "$work/loop/a" "$work/loop/b" && ln -s a "$work/loop/scene.json"
+expect 1 "symbolic link loop" -- "${R[@]}" render --scene "$work/loop" --light d65 --out "$work/x.exr"
+ln -s "$work/sceneloop" "$work/sceneloop" 2>/dev/null
+expect 2 "--scene .*no scene.json" -- "${R[@]}" run --frames 1 --scene "$work/sceneloop"
+
+# --- Booth JSON.
+booth() {
+    rm -rf "$work/$1" && cp -r "$data/booth" "$work/$1"
+    python3 - "$work/$1/booth.json" "$2" <<'PY'
+import json, sys
+path, change = sys.argv[1], sys.argv[2]
+j = json.load(open(path))
+exec(change)
+json.dump(j, open(path, "w"))
+PY
+}
+booth escape 'j["lights"][0]["luminance"] = "../../../etc/hostname"'
+expect 1 "lights\[0\].luminance: '../../../etc/hostname' cannot name a file" -- "${R[@]}" render --booth "$work/escape" --scene "$data/scenes/metamer" --light d65 --out "$work/x.exr"
+booth far 'j["lights"][0]["centre"][0] = 1e308'
+expect 1 "booth.json: /lights/0/centre/0: expected a number in \[-100, 100\]" -- "${R[@]}" render --booth "$work/far" --scene "$data/scenes/metamer" --light d65 --out "$work/x.exr"
+booth dark 'j["lights"][0]["spd"] = [-1.0] * 36'
+expect 1 "lights\[0\]: spd has no positive power" -- "${R[@]}" render --booth "$work/dark" --scene "$data/scenes/metamer" --light d65 --out "$work/x.exr"
+
+# --- Capture JSON for 'booth build': names that would leave --out, impossible texel counts.
+capture() { # NAME NAME-OF-LIGHT TEXELS
+    cat > "$work/$1.json" <<JSON
+{"lights": [{"name": "$2", "spd_column": "A", "centre": [0, 1.5, 0], "edge_u": [0.5, 0, 0],
+  "edge_v": [0, 0, 0.5], "texels": $3, "corners": [[0, 0], [10, 0], [10, 10], [0, 10]],
+  "exposures": [{"file": "e.png", "seconds": 0.01}], "calibration": {"cdm2_per_unit": 1}}]}
+JSON
+}
+capture escaped "../../escaped" "[8, 8]"
+expect 1 "lights\[0\].name: '../../escaped' cannot name a file" -- "${R[@]}" booth build --capture "$work/escaped.json" --out "$work/out/booth"
+[ ! -e "$work/escaped.exr" ] && [ ! -e "$work/out/escaped.exr" ] || fail "booth build wrote outside --out"
+capture texels-huge ok "[100000, 100000]"
+expect 1 "/lights/0/texels/0: expected an integer in \[1, 4096\]" -- "${R[@]}" booth build --capture "$work/texels-huge.json" --out "$work/out/booth"
+capture texels-negative ok "[-1, 5]"
+expect 1 "/lights/0/texels/0: expected an integer in \[1, 4096\]" -- "${R[@]}" booth build --capture "$work/texels-negative.json" --out "$work/out/booth"
+expect 1 "/dev/zero: is a device" -- "${R[@]}" booth build --capture /dev/zero --out "$work/out/booth"
+expect 1 "is a directory" -- "${R[@]}" booth build --capture "$work" --out "$work/out/booth"
+
+# --- Display profiles: devices, /proc, wrong types.
+expect 1 "/dev/zero: is a device" -- "${R[@]}" run --frames 1 --display-profile /dev/zero
+expect 1 "/proc/self/mem: cannot read display profile" -- "${R[@]}" run --frames 1 --display-profile /proc/self/mem
+python3 - "$data/displays/wide-ips-synthetic.json" "$work/profile-type.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+j["bit_depth"] = "eight"
+json.dump(j, open(sys.argv[2], "w"))
+PY
+expect 1 "profile-type.json: /bit_depth: expected an integer" -- "${R[@]}" display forward "$work/profile-type.json" --rgb 1,2,3
+
+# --- Recordings from the field.
+python3 "$here/craft_recordings.py" "$work/rec" || fail "craft_recordings.py failed"
+rec="$work/rec"
+for cmd in inspect replay; do
+    expect 1 "claims 268435456 uncompressed bytes \(at most 16 MiB\)" -- "${R[@]}" $cmd "$rec/claims-4x256mib.mcap"
+    expect 1 "claims 268435456 uncompressed bytes" -- "${R[@]}" $cmd "$rec/claims-200x256mib.mcap"
+    expect 1 "its zstd frame holds 16" -- "${R[@]}" $cmd "$rec/claims-more-than-frame.mcap"
+    expect 1 "decompresses to more than 64 MiB" -- "${R[@]}" $cmd "$rec/bomb-40x16mib.mcap"
+    expect 1 "/dev/zero: is a device" -- "${R[@]}" $cmd /dev/zero
+    expect 1 "is a directory" -- "${R[@]}" $cmd "$rec"
+done
+if [ -f "$rec/messages-40x16mib.mcap" ]; then # written where the zstd program exists
+    for cmd in inspect replay; do
+        expect 1 "decompresses to more than 64 MiB" -- "${R[@]}" $cmd "$rec/messages-40x16mib.mcap"
+    done
+fi
+expect 1 "recover" -- "${R[@]}" recover "$rec/bomb-40x16mib.mcap" "$work/recovered.mcap"
+expect 1 "size 16384x1" -- "${R[@]}" replay "$rec/frame-16384x1.mcap"
+expect 1 "rate 0 Hz" -- "${R[@]}" replay "$rec/rate-nan.mcap"
+expect 1 "lights 65536x65536" -- "${R[@]}" replay "$rec/lights-overflow.mcap"
+expect 1 "display is '/etc/shadow', outside the data folders" -- "${R[@]}" replay "$rec/profile-etc-shadow.mcap"
+expect 1 "spectrometer_calibration '../../../../etc/passwd' is not a name inside" -- "${R[@]}" replay "$rec/calibration-dotdot.mcap"
+expect 1 "scene_dir is '/tmp', outside the data folders" -- "${R[@]}" replay "$rec/scene-elsewhere.mcap"
+expect 1 "no digest of its scene.*--allow-undigested" -- "${R[@]}" replay "$rec/scene-undigested.mcap"
+expect 1 "frame 1 has tick_ns 10000000, before 20000000" -- "${R[@]}" replay "$rec/tick-backwards.mcap"
+expect 1 "20000 counts; a spectrometer has at most 16384 pixels" -- "${R[@]}" replay "$rec/spectrum-20000-counts.mcap"
+expect 1 "message \(sequence 0\) of 20971[0-9]+ bytes" -- "${R[@]}" replay "$rec/message-2mib.mcap"
+# A tick 285 years away: --clock recorded waits at most a second for a frame, then ends.
+out=$( (ulimit -v "$limit_kb"; timeout 120 "$replica" "${R[@]}" replay "$rec/tick-285-years.mcap" \
+    --clock recorded) 2>&1 >/dev/null)
+code=$?
+if [ "$code" -ne 0 ]; then
+    fail "replay --clock recorded of a tick 285 years away exited $code (124: hung): $out"
+else
+    pass=$((pass + 1))
+    echo "ok: replay --clock recorded of a tick 285 years away ends"
+fi
+# inspect shows a recording's text with its control characters escaped.
+out=$("$replica" inspect "$rec/escapes.mcap" 2>&1)
+if printf '%s' "$out" | grep -q $'\x1b'; then
+    fail "inspect printed a raw escape sequence from a recording"
+elif ! printf '%s' "$out" | grep -qF 'written by \x1b]0;owned\x07'; then
+    fail "inspect did not show the escaped software string: $out"
+else
+    pass=$((pass + 1))
+    echo "ok: inspect escapes control characters"
+fi
+
+echo "hostile_input: $pass cases passed"
+exit $status
