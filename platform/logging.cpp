@@ -1,8 +1,11 @@
 // Area loggers and level parsing.
+#include <algorithm>
 #include <cstdlib>
 #include <mutex>
 #include <sstream>
+#include <vector>
 
+#include <spdlog/sinks/base_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 
 #include <platform/logging.h>
@@ -39,6 +42,30 @@ void applySpec(const std::string& spec)
     }
 }
 
+class TapSink final : public spdlog::sinks::base_sink<std::mutex>
+{
+public:
+    explicit TapSink(LogTap tap) : tap_(std::move(tap)) {}
+
+protected:
+    void sink_it_(const spdlog::details::log_msg& msg) override
+    {
+        tap_(msg.level, std::string(msg.logger_name.begin(), msg.logger_name.end()),
+             std::string(msg.payload.begin(), msg.payload.end()));
+    }
+    void flush_() override {}
+
+private:
+    LogTap tap_;
+};
+
+// Taps added to every logger, including those created later.
+std::vector<spdlog::sink_ptr>& taps()
+{
+    static std::vector<spdlog::sink_ptr> t;
+    return t;
+}
+
 } // namespace
 
 std::shared_ptr<spdlog::logger> logger(const std::string& area)
@@ -49,7 +76,32 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
     }
     auto created = spdlog::stderr_color_mt(area);
     created->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
+    for (const auto& t : taps()) {
+        created->sinks().push_back(t);
+    }
     return created;
+}
+
+std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap)
+{
+    auto sink = std::make_shared<TapSink>(std::move(tap));
+    sink->set_level(minLevel);
+    {
+        std::lock_guard lock(registryMutex());
+        taps().push_back(sink);
+        spdlog::apply_all(
+                [&](const std::shared_ptr<spdlog::logger>& l) { l->sinks().push_back(sink); });
+    }
+    spdlog::sink_ptr held = sink;
+    return std::shared_ptr<void>(nullptr, [held](void*) {
+        std::lock_guard lock(registryMutex());
+        auto& t = taps();
+        t.erase(std::remove(t.begin(), t.end(), held), t.end());
+        spdlog::apply_all([&](const std::shared_ptr<spdlog::logger>& l) {
+            auto& s = l->sinks();
+            s.erase(std::remove(s.begin(), s.end(), held), s.end());
+        });
+    });
 }
 
 void setupLogging(const std::string& spec)

@@ -147,7 +147,8 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     pipeline::scene::SceneState state;
     pipeline::render::RenderedFrame image;
     bool stepping = pacing == Pacing::Step;
-    const auto wallStart = std::chrono::steady_clock::now();
+    auto wallStart = std::chrono::steady_clock::now();
+    bool afterWarmup = false;
 
     for (;;) {
         if (stopRequested()) {
@@ -159,7 +160,15 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             break;
         }
         const TickPlan& tick = *nextTick;
-        if (pacing == Pacing::Realtime) {
+        if (tick.warmup) {
+            afterWarmup = true;
+        } else if (pacing == Pacing::Realtime) {
+            if (afterWarmup) {
+                // Pace from here as if the session had started tickNs ago.
+                wallStart =
+                        std::chrono::steady_clock::now() - std::chrono::nanoseconds(tick.tickNs);
+                afterWarmup = false;
+            }
             const auto due = wallStart + std::chrono::nanoseconds(tick.tickNs);
             if (std::chrono::steady_clock::now() > due + std::chrono::milliseconds(2)) {
                 ++stats.lateFrames;

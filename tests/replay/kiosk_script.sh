@@ -11,7 +11,7 @@ done
 out=$(REPLICA_SESSIONS="$work" REPLICA_KEEP_SESSIONS=3 REPLICA_BIN=/opt/replica "$script" --dry-run)
 status=0
 case "$out" in
-"/opt/replica run --hal live --output kms --frames 0 --record $work/"*.mcap) ;;
+"/opt/replica run --hal live --output kms --frames 0 --record $work/"*".mcap --record-digests true") ;;
 *) echo "FAIL: unexpected command: $out" >&2; status=1 ;;
 esac
 kept=$(cd "$work" && ls -1 | sort | tr '\n' ' ')
