@@ -371,7 +371,9 @@ int replayMain(const ReplayOptions& o)
             firstDiffXyz = FloatImage{image.width, image.height, image.xyz};
             firstDiffRgba = image.rgba;
         }
-        if (o.tolerance) {
+        // Measure every differing frame that has a reference frame: tolerance mode decides on
+        // them, and a plain --check reports them.
+        {
             if (const auto ref = referenceFrame(refDir, frameNo)) {
                 auto r = readXyzFrame(*ref);
                 if (!r) {
@@ -528,6 +530,19 @@ int replayMain(const ReplayOptions& o)
                     log->error("{}", ok.error().message);
                 }
             }
+            nlohmann::json frames = nlohmann::json::array();
+            for (const auto& m : measured) {
+                frames.push_back({{"frame", m.frame},
+                                  {"mean", m.stats.mean},
+                                  {"p95", m.stats.p95},
+                                  {"max", m.stats.max},
+                                  {"max_at", {m.maxX, m.maxY}}});
+                say(fmt::format("reference frame {}: ΔE00 mean {:.3f}, p95 {:.3f}, max {:.3f} at "
+                                "x {} y {} ({})",
+                                m.frame, m.stats.mean, m.stats.p95, m.stats.max, m.maxX, m.maxY,
+                                m.reference.string()));
+            }
+            check["measured"] = frames;
             code = kExitFailure;
         }
         summary["check"] = check;
