@@ -89,8 +89,17 @@ std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap)
     {
         std::lock_guard lock(registryMutex());
         taps().push_back(sink);
-        spdlog::apply_all(
-                [&](const std::shared_ptr<spdlog::logger>& l) { l->sinks().push_back(sink); });
+        spdlog::apply_all([&](const std::shared_ptr<spdlog::logger>& l) {
+            // A quieter console (--log-level error) must not hide warnings from the tap: the
+            // console sinks take the logger's level, the logger lets the tap's level through.
+            if (l->level() > minLevel) {
+                for (auto& existing : l->sinks()) {
+                    existing->set_level(std::max(existing->level(), l->level()));
+                }
+                l->set_level(minLevel);
+            }
+            l->sinks().push_back(sink);
+        });
     }
     spdlog::sink_ptr held = sink;
     return std::shared_ptr<void>(nullptr, [held](void*) {

@@ -18,7 +18,8 @@ void setupLogging(const std::string& spec);
 std::shared_ptr<spdlog::logger> logger(const std::string& area);
 
 // Calls `tap` with every message of `minLevel` or above from every area logger (and those created
-// later) until the returned handle is destroyed. `tap` may run on any thread that logs.
+// later) until the returned handle is destroyed, whatever level the console shows (a logger set
+// above minLevel keeps that level on its console sink). `tap` may run on any thread that logs.
 using LogTap = std::function<void(
         spdlog::level::level_enum level, const std::string& area, const std::string& message)>;
 std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap);

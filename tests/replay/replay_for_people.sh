@@ -5,7 +5,8 @@
 # - --from/--to replays a slice whose digests are exactly those frames of the whole replay;
 # - --frames-out writes one PNG per frame of the slice; --json summaries of run and replay;
 # - progress lines only with --progress when standard error is not a terminal;
-# - inspect takes several files and shows the wall-clock start and the lamp timeline.
+# - inspect takes several files and shows the wall-clock start and the lamp timeline;
+# - warnings are recorded on /replica/log even when the console shows only errors.
 set -euo pipefail
 replica="$1"
 work="$2"
@@ -47,4 +48,11 @@ grep -q "started 20[0-9-]*T" "$work/inspect.txt" || fail "inspect shows no wall-
 grep -q "shown: tungsten, 2856 K" "$work/inspect.txt" || fail "inspect shows no decided tungsten lamp at 2856 K"
 "$replica" inspect --json "$work/none.mcap" "$work/thumbs.mcap" > "$work/inspect.json"
 head -c 1 "$work/inspect.json" | grep -q '\[' || fail "inspect --json of two files is not an array"
+# The appliance's warnings reach /replica/log (foxglove.Log): a mis-wired selector is overruled
+# after 1.5 s of disagreement, with one warning.
+"$replica" --log-level error run --hal sim --output headless --frames 130 --size 32x20 --fast --rate 30 \
+    --lamp-selector sim-miswired --record "$work/miswired.mcap" >/dev/null
+"$replica" inspect --json "$work/miswired.mcap" > "$work/miswired.json"
+grep -A4 '"/replica/log"' "$work/miswired.json" | grep -q '"count": 1,' \
+    || fail "the overruled-selector warning is not in /replica/log"
 echo "PASS: thumbnails leave frames alone; replay matches 75 display digests; slice 30-45 equals the whole replay's; 16 PNGs; progress; inspect of two files"
