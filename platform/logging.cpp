@@ -1,10 +1,13 @@
 // Area loggers and level parsing.
+#include <algorithm>
 #include <cstdlib>
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
+#include <spdlog/sinks/base_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 
 #include <platform/logging.h>
@@ -53,6 +56,30 @@ void applySpec(const std::string& spec)
     }
 }
 
+class TapSink final : public spdlog::sinks::base_sink<std::mutex>
+{
+public:
+    explicit TapSink(LogTap tap) : tap_(std::move(tap)) {}
+
+protected:
+    void sink_it_(const spdlog::details::log_msg& msg) override
+    {
+        tap_(msg.level, std::string(msg.logger_name.begin(), msg.logger_name.end()),
+             std::string(msg.payload.begin(), msg.payload.end()));
+    }
+    void flush_() override {}
+
+private:
+    LogTap tap_;
+};
+
+// Taps added to every logger, including those created later.
+std::vector<spdlog::sink_ptr>& taps()
+{
+    static std::vector<spdlog::sink_ptr> t;
+    return t;
+}
+
 } // namespace
 
 std::shared_ptr<spdlog::logger> logger(const std::string& area)
@@ -63,6 +90,9 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
     }
     auto created = spdlog::stderr_color_mt(area);
     created->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
+    for (const auto& t : taps()) {
+        created->sinks().push_back(t);
+    }
     return created;
 }
 
@@ -88,6 +118,37 @@ std::string checkLogSpec(const std::string& spec)
         }
     }
     return {};
+}
+
+std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap)
+{
+    auto sink = std::make_shared<TapSink>(std::move(tap));
+    sink->set_level(minLevel);
+    {
+        std::lock_guard lock(registryMutex());
+        taps().push_back(sink);
+        spdlog::apply_all([&](const std::shared_ptr<spdlog::logger>& l) {
+            // A quieter console (--log-level error) must not hide warnings from the tap: the
+            // console sinks take the logger's level, the logger lets the tap's level through.
+            if (l->level() > minLevel) {
+                for (auto& existing : l->sinks()) {
+                    existing->set_level(std::max(existing->level(), l->level()));
+                }
+                l->set_level(minLevel);
+            }
+            l->sinks().push_back(sink);
+        });
+    }
+    spdlog::sink_ptr held = sink;
+    return std::shared_ptr<void>(nullptr, [held](void*) {
+        std::lock_guard lock(registryMutex());
+        auto& t = taps();
+        t.erase(std::remove(t.begin(), t.end(), held), t.end());
+        spdlog::apply_all([&](const std::shared_ptr<spdlog::logger>& l) {
+            auto& s = l->sinks();
+            s.erase(std::remove(s.begin(), s.end(), held), s.end());
+        });
+    });
 }
 
 void setupLogging(const std::string& spec, bool fromCommandLine)

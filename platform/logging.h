@@ -2,6 +2,7 @@
 // output, rec, loop, hal.lamp) and the --log-level / $REPLICA_LOG knob.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -20,5 +21,12 @@ std::string checkLogSpec(const std::string& spec);
 
 // The logger for an area; created on first use if setupLogging has not run.
 std::shared_ptr<spdlog::logger> logger(const std::string& area);
+
+// Calls `tap` with every message of `minLevel` or above from every area logger (and those created
+// later) until the returned handle is destroyed, whatever level the console shows (a logger set
+// above minLevel keeps that level on its console sink). `tap` may run on any thread that logs.
+using LogTap = std::function<void(
+        spdlog::level::level_enum level, const std::string& area, const std::string& message)>;
+std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap);
 
 } // namespace replica::platform

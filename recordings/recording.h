@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include <hal/device.h>
 #include <hal/samples.h>
 #include <pipeline/base/expected.h>
@@ -21,7 +23,11 @@ namespace replica::recordings {
 // 2: zstd chunks with CRCs and message indexes, summary, JSON Schemas, /replica/recorder.
 // 3: the lamp selector: /hal/lamp_selector (id 7), lamp_seq in frames, lamp_selector in the
 // session.
-constexpr int kFormatVersion = 3;
+// 4: what was shown, on standard Foxglove channels (ids 8-13): /replica/display_digest (XXH3-64 of
+// every frame sent to the panel), /replica/thumbnail (foxglove.CompressedImage), /tf
+// (foxglove.FrameTransforms), /replica/eye (foxglove.PoseInFrame), /replica/light (the decided
+// light), /replica/log (foxglove.Log). Replay reads only the digests; the rest is for people.
+constexpr int kFormatVersion = 4;
 
 // Limits on a recording, which is untrusted input (docs/recordings.md, 'Limits'): its file size,
 // one message's size (a 2048-pixel spectrum is about 12 KiB of JSON), and a spectrum's pixels
@@ -39,6 +45,51 @@ struct FrameRecord {
     std::optional<std::uint32_t> poseSequence;
     std::optional<std::uint32_t> accelSequence;
     std::optional<std::uint32_t> lampSequence; // format 3; none in earlier recordings
+};
+
+// Format 4: a digest of the 8-bit frame that went to the panel (XXH3-64, seed 0).
+struct DisplayDigestRecord {
+    std::uint64_t frameIndex = 0;
+    std::int64_t tickNs = 0;
+    std::uint64_t rgba = 0;
+};
+
+// Format 4: a thumbnail of the displayed frame (PNG bytes), at session time tNs.
+struct ThumbnailRecord {
+    std::int64_t tNs = 0;
+    std::uint64_t frameIndex = 0;
+    std::vector<std::uint8_t> png;
+};
+
+// Format 4: where things were for a frame, as the renderer used them: the eye in the booth frame,
+// the panel's tilt (about the booth's x axis; the "panel" frame is the booth frame so rotated) and
+// the tracker's mount in the booth.
+struct PosesRecord {
+    std::int64_t tNs = 0;
+    glm::dvec3 eyeBoothM{0.0};
+    double tiltRad = 0.0;
+    glm::dvec3 trackerBoothM{0.0}; // the tracker's origin (unrotated)
+};
+
+// Format 4: the light the appliance decided to render with, written when it changes.
+struct LightRecord {
+    std::int64_t tNs = 0;
+    std::uint64_t frameIndex = 0;
+    std::string mode;                // "lamp" or "direct-sensor"
+    int lamp = -1;                   // booth lamp index, -1 in direct-sensor mode
+    std::string name;                // the lamp's name, or "unknown"
+    std::optional<double> cctK, duv; // of the light rendered with; none where CCT is undefined
+    double distance = 0.0;           // classifier's shape distance to the nearest stored lamp
+    std::string why;                 // one line: what decided it
+};
+
+// Format 4: one of the appliance's warnings or errors (foxglove.Log levels: 3 warning, 4 error,
+// 5 fatal).
+struct LogRecord {
+    std::int64_t tNs = 0;
+    int level = 3;
+    std::string name; // the logger's area
+    std::string message;
 };
 
 // Describes the session: enough to re-create the renderer's inputs other than the samples.
@@ -61,6 +112,8 @@ struct Recording {
     std::vector<hal::AccelSample> accel;
     std::vector<hal::LampSample> lampSelector;
     std::vector<FrameRecord> frames;
+    std::vector<DisplayDigestRecord> displayDigests; // format 4; empty when none were recorded
+    std::vector<LightRecord> lights;                 // format 4: the decided light, on change
     std::uint64_t droppedMessages = 0;   // what the writer recorded as dropped (queue full)
     std::uint64_t rejectedNonFinite = 0; // samples the writer refused: a value was NaN or infinite
 };
@@ -106,6 +159,13 @@ public:
     virtual void write(const hal::AccelSample& s) = 0;
     virtual void write(const hal::LampSample& s) = 0;
     virtual void write(const FrameRecord& f) = 0;
+    virtual void write(const DisplayDigestRecord& d) = 0;
+    virtual void write(const PosesRecord& p) = 0;
+    virtual void write(const LightRecord& l) = 0;
+    // Thread-safe, from any thread (a thumbnail encoder, a log sink): a second bounded queue,
+    // dropped and counted when full, never blocking for long.
+    virtual void write(const ThumbnailRecord& t) = 0;
+    virtual void write(const LogRecord& l) = 0;
     // Flushes everything and writes the summary and footer. Safe to call once; the destructor calls
     // it.
     virtual Expected<void> close() = 0;

@@ -1,4 +1,5 @@
-// Reading recordings of every known format version (1: unchunked, 2: chunked, 3: lamp selector) and
+// Reading recordings of every known format version (1: unchunked, 2: chunked, 3: lamp selector,
+// 4: what was shown; of its channels replay needs only the display digests) and
 // inspecting files.
 #include <fstream>
 #include <iterator>
@@ -82,6 +83,10 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                 rec.lampSelector.push_back(decodeLamp(j));
             } else if (topic == kFrameTopic) {
                 rec.frames.push_back(decodeFrame(j));
+            } else if (topic == kDisplayDigestTopic) { // format 4
+                rec.displayDigests.push_back(decodeDisplayDigest(j));
+            } else if (topic == kLightTopic) { // format 4
+                rec.lights.push_back(decodeLight(j));
             } else if (topic == kRecorderTopic) {
                 const auto r = decodeRecorderStatus(j);
                 rec.droppedMessages = r.droppedTotal();

@@ -23,7 +23,14 @@ using Item = std::variant<hal::SpectrumSample,
                           hal::PoseSample,
                           hal::AccelSample,
                           FrameRecord,
-                          hal::LampSample>;
+                          hal::LampSample,
+                          DisplayDigestRecord,
+                          PosesRecord,
+                          LightRecord>;
+// Written from any thread (thumbnail encoder, log sink), through a mutex.
+using SharedItem = std::variant<ThumbnailRecord, LogRecord>;
+// What the shared queue holds at most: a minute of 1 Hz thumbnails and a burst of warnings.
+constexpr std::size_t kSharedCapacity = 256;
 using Clock = std::chrono::steady_clock;
 
 // How long the writer thread sleeps when the queue is empty (a write() also wakes it).
@@ -74,6 +81,11 @@ public:
     void write(const hal::AccelSample& s) override { push(s, dropped_[2]); }
     void write(const FrameRecord& f) override { push(f, dropped_[3]); }
     void write(const hal::LampSample& s) override { push(s, dropped_[4]); }
+    void write(const DisplayDigestRecord& d) override { push(d, dropped_[5]); }
+    void write(const PosesRecord& p) override { push(p, dropped_[5]); }
+    void write(const LightRecord& l) override { push(l, dropped_[5]); }
+    void write(const ThumbnailRecord& t) override { pushShared(t); }
+    void write(const LogRecord& l) override { pushShared(l); }
 
     Expected<void> close() override
     {
@@ -115,6 +127,46 @@ private:
         wake_.notify_one();
     }
 
+    template <typename Record>
+    void pushShared(const Record& r)
+    {
+        {
+            std::lock_guard lock(sharedMutex_);
+            if (closed_ || shared_.size() >= kSharedCapacity) {
+                dropped_[5].fetch_add(1, std::memory_order_relaxed);
+                return;
+            }
+            shared_.emplace_back(r);
+        }
+        wake_.notify_one();
+    }
+
+    // Moves what other threads wrote into the open chunk; returns whether there was any.
+    bool drainShared()
+    {
+        std::vector<SharedItem> items;
+        {
+            std::lock_guard lock(sharedMutex_);
+            items.swap(shared_);
+        }
+        for (const auto& item : items) {
+            if (failed_) {
+                break;
+            }
+            std::visit(
+                    [&](const auto& r) {
+                        using R = std::decay_t<decltype(r)>;
+                        if constexpr (std::is_same_v<R, ThumbnailRecord>) {
+                            message(ChannelId::Thumbnail, r.tNs, encodeThumbnail(r, wallStart_));
+                        } else {
+                            message(ChannelId::Log, r.tNs, encodeLog(r, wallStart_));
+                        }
+                    },
+                    item);
+        }
+        return !items.empty();
+    }
+
     void loop()
     {
         std::unique_lock lock(mutex_);
@@ -126,6 +178,14 @@ private:
                     chunkOpened = Clock::now();
                 }
                 add(*item);
+                if (file_->pendingBytes() >= options_.chunkBytes) {
+                    flush(chunkOpened);
+                }
+            }
+            if (drainShared()) {
+                if (!chunkOpened) {
+                    chunkOpened = Clock::now();
+                }
                 if (file_->pendingBytes() >= options_.chunkBytes) {
                     flush(chunkOpened);
                 }
@@ -183,6 +243,22 @@ private:
                         payload = encodeLamp(s);
                         channel = ChannelId::LampSelector;
                         t = s.timestampNs;
+                    } else if constexpr (std::is_same_v<S, DisplayDigestRecord>) {
+                        payload = encodeDisplayDigest(s);
+                        channel = ChannelId::DisplayDigest;
+                        t = s.tickNs;
+                    } else if constexpr (std::is_same_v<S, LightRecord>) {
+                        payload = encodeLight(s);
+                        channel = ChannelId::Light;
+                        t = s.tNs;
+                    } else if constexpr (std::is_same_v<S, PosesRecord>) {
+                        // Two messages: the frames for the 3D panel, the eye for plots.
+                        payload = encodeEye(s, wallStart_);
+                        channel = ChannelId::Eye;
+                        t = s.tNs;
+                        if (auto tf = encodeTransforms(s, wallStart_)) {
+                            message(ChannelId::Transforms, t, std::move(*tf));
+                        }
                     } else {
                         payload = encodeFrame(s);
                         channel = ChannelId::Frame;
@@ -218,6 +294,7 @@ private:
         now.droppedAccel = dropped_[2].load();
         now.droppedFrames = dropped_[3].load();
         now.droppedLamp = dropped_[4].load();
+        now.droppedShown = dropped_[5].load();
         now.rejectedNonFinite = rejected_.load();
         const bool changed = now.droppedTotal() != status_.droppedTotal() ||
                              now.rejectedNonFinite != status_.rejectedNonFinite;
@@ -258,11 +335,14 @@ private:
     std::int64_t lastTime_ = 0;
     std::map<std::uint16_t, std::uint32_t> sequence_;
     RecorderStatus status_;
-    std::array<std::atomic<std::uint64_t>, 5> dropped_{};
+    // Spectra, poses, accel, frames, lamp selector, and the format 4 channels of what was shown.
+    std::array<std::atomic<std::uint64_t>, 6> dropped_{};
+    std::mutex sharedMutex_;
+    std::vector<SharedItem> shared_;
     std::atomic<std::uint64_t> rejected_{0}, messages_{0}, chunks_{0}, bytes_{0};
     std::atomic<bool> failed_{false}, stopping_{false};
     std::optional<Error> result_;
-    bool closed_ = false;
+    std::atomic<bool> closed_{false};
     std::mutex mutex_;
     std::condition_variable wake_;
     std::thread thread_;

@@ -1,6 +1,7 @@
 // JSON encoding of Replica's messages and the JSON Schemas that let MCAP viewers plot them.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -78,8 +79,31 @@ std::string schemaText(const std::string& title,
            properties + R"(}, "required": [)" + required + "]}";
 }
 
+// Foxglove's published JSON Schemas (github.com/foxglove/schemas, schemas/jsonschema/), restated:
+// the field names, types and nesting viewers decode by.
+constexpr const char* kFoxgloveTime =
+        R"({"type": "object", "title": "time", "properties": {"sec": {"type": "integer",
+      "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999}}})";
+constexpr const char* kFoxgloveVector3 =
+        R"({"title": "foxglove.Vector3", "type": "object", "properties": {"x": {"type": "number"},
+      "y": {"type": "number"}, "z": {"type": "number"}}})";
+constexpr const char* kFoxgloveQuaternion =
+        R"({"title": "foxglove.Quaternion", "type": "object", "properties": {"x": {"type":
+      "number"}, "y": {"type": "number"}, "z": {"type": "number"}, "w": {"type": "number"}}})";
+
+std::string foxgloveSchema(const std::string& title,
+                           const std::string& description,
+                           const std::string& properties)
+{
+    return R"({"title": ")" + title + R"(", "description": ")" + description +
+           R"(", "type": "object", "properties": {)" + properties + "}}";
+}
+
 std::vector<ChannelDefinition> makeDefinitions()
 {
+    const std::string time = kFoxgloveTime;
+    const std::string v3 = kFoxgloveVector3;
+    const std::string quat = kFoxgloveQuaternion;
     const std::string timeProps = kTimeProps;
     const std::string vec = kVec3;
     const std::string dev = kDevice;
@@ -140,6 +164,7 @@ std::vector<ChannelDefinition> makeDefinitions()
                         R"("dropped_spectra": {"type": "integer"},
     "dropped_poses": {"type": "integer"}, "dropped_accel": {"type": "integer"},
     "dropped_frames": {"type": "integer"}, "dropped_lamp": {"type": "integer"},
+    "dropped_shown": {"type": "integer"},
     "dropped_total": {"type": "integer"},
     "rejected_nonfinite": {"type": "integer"}, "queue_capacity": {"type": "integer"})",
                         R"("dropped_total")")},
@@ -154,6 +179,56 @@ std::vector<ChannelDefinition> makeDefinitions()
     "levels": {"type": "array", "items": {"type": "integer", "minimum": 0, "maximum": 1},
       "maxItems": 32, "description": "debounced level of each line, 1 = active: the switch closes it"})",
                         R"("t", "seq", "lamp", "levels")")},
+            {ChannelId::DisplayDigest, kDisplayDigestTopic, "replica.DisplayDigest",
+             schemaText("replica.DisplayDigest",
+                        "A digest of the 8-bit frame that went to the panel, every frame: replay "
+                        "recomputes it to check what the visitor saw",
+                        R"("frame": {"type": "integer"}, "tick_ns": {"type": "integer"},
+    "hash": {"type": "string", "enum": ["xxh3_64"]},
+    "rgba": {"type": "string", "description": "XXH3-64 (seed 0) of the RGBA8 frame, rows bottom-up, 16 hex digits"})",
+                        R"("frame", "tick_ns", "hash", "rgba")")},
+            {ChannelId::Thumbnail, kThumbnailTopic, "foxglove.CompressedImage",
+             foxgloveSchema("foxglove.CompressedImage", "A thumbnail of the frame the panel showed",
+                            R"("timestamp": )" + time + R"(,
+    "frame_id": {"type": "string"},
+    "data": {"type": "string", "contentEncoding": "base64"},
+    "format": {"type": "string"})")},
+            {ChannelId::Transforms, kTransformsTopic, "foxglove.FrameTransforms",
+             foxgloveSchema("foxglove.FrameTransforms",
+                            "The booth's frames: panel (tilted), tracker and eye in the booth",
+                            R"("transforms": {"type": "array", "items": {"title":
+      "foxglove.FrameTransform", "type": "object", "properties": {"timestamp": )" +
+                                    time + R"(,
+      "parent_frame_id": {"type": "string"}, "child_frame_id": {"type": "string"},
+      "translation": )" + v3 + R"(, "rotation": )" +
+                                    quat + "}}}")},
+            {ChannelId::Eye, kEyeTopic, "foxglove.PoseInFrame",
+             foxgloveSchema("foxglove.PoseInFrame", "The viewer's eye in the booth frame (m)",
+                            R"("timestamp": )" + time + R"(, "frame_id": {"type": "string"},
+    "pose": {"title": "foxglove.Pose", "type": "object", "properties": {"position": )" +
+                                    v3 + R"(, "orientation": )" + quat + "}}")},
+            {ChannelId::Light, kLightTopic, "replica.Light",
+             schemaText("replica.Light",
+                        "The light the appliance decided to render with, when it changes",
+                        R"json("t": {"type": "integer", "description": "session time (ns)"},
+    "frame": {"type": "integer"},
+    "mode": {"type": "string", "enum": ["lamp", "direct-sensor"]},
+    "lamp": {"type": "integer", "description": "booth lamp index; -1 in direct-sensor mode"},
+    "name": {"type": "string"},
+    "cct_k": {"type": "number", "description": "correlated colour temperature (K); absent where undefined"},
+    "duv": {"type": "number"},
+    "distance": {"type": "number", "description": "spectral shape distance to the nearest stored lamp"},
+    "why": {"type": "string"})json",
+                        R"("t", "frame", "mode", "lamp", "name", "why")")},
+            {ChannelId::Log, kLogTopic, "foxglove.Log",
+             foxgloveSchema("foxglove.Log", "The appliance's warnings and errors",
+                            R"("timestamp": )" + time + R"(,
+    "level": {"title": "foxglove.LogLevel", "oneOf": [{"title": "UNKNOWN", "const": 0},
+      {"title": "DEBUG", "const": 1}, {"title": "INFO", "const": 2},
+      {"title": "WARNING", "const": 3}, {"title": "ERROR", "const": 4},
+      {"title": "FATAL", "const": 5}]},
+    "message": {"type": "string"}, "name": {"type": "string"}, "file": {"type": "string"},
+    "line": {"type": "integer", "minimum": 0})")},
     };
     std::vector<ChannelDefinition> out;
     for (const auto& d : defs) {
@@ -257,15 +332,177 @@ std::string encodeFrame(const FrameRecord& f)
 
 std::string encodeRecorderStatus(const RecorderStatus& r)
 {
-    return json{{"dropped_spectra", r.droppedSpectra},
-                {"dropped_poses", r.droppedPoses},
-                {"dropped_accel", r.droppedAccel},
-                {"dropped_frames", r.droppedFrames},
-                {"dropped_lamp", r.droppedLamp},
-                {"dropped_total", r.droppedTotal()},
-                {"rejected_nonfinite", r.rejectedNonFinite},
+    return json{{"dropped_spectra", r.droppedSpectra}, {"dropped_poses", r.droppedPoses},
+                {"dropped_accel", r.droppedAccel},     {"dropped_frames", r.droppedFrames},
+                {"dropped_lamp", r.droppedLamp},       {"dropped_shown", r.droppedShown},
+                {"dropped_total", r.droppedTotal()},   {"rejected_nonfinite", r.rejectedNonFinite},
                 {"queue_capacity", r.queueCapacity}}
             .dump();
+}
+
+namespace {
+
+json foxgloveTime(std::int64_t unixNs)
+{
+    const std::int64_t v = std::max<std::int64_t>(unixNs, 0);
+    return {{"sec", v / 1'000'000'000}, {"nsec", v % 1'000'000'000}};
+}
+
+json quaternion(double x, double y, double z, double w)
+{
+    return {{"x", x}, {"y", y}, {"z", z}, {"w", w}};
+}
+
+json transform(const json& stamp,
+               std::string_view parent,
+               std::string_view child,
+               const glm::dvec3& t,
+               const json& rotation)
+{
+    return {{"timestamp", stamp},
+            {"parent_frame_id", parent},
+            {"child_frame_id", child},
+            {"translation", vec3(t)},
+            {"rotation", rotation}};
+}
+
+} // namespace
+
+std::string base64Encode(const std::vector<std::uint8_t>& bytes)
+{
+    static constexpr char kAlphabet[] =
+            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((bytes.size() + 2) / 3 * 4);
+    std::size_t i = 0;
+    for (; i + 3 <= bytes.size(); i += 3) {
+        const std::uint32_t v =
+                (std::uint32_t{bytes[i]} << 16) | (std::uint32_t{bytes[i + 1]} << 8) | bytes[i + 2];
+        out += kAlphabet[(v >> 18) & 63];
+        out += kAlphabet[(v >> 12) & 63];
+        out += kAlphabet[(v >> 6) & 63];
+        out += kAlphabet[v & 63];
+    }
+    const std::size_t rest = bytes.size() - i;
+    if (rest > 0) {
+        std::uint32_t v = std::uint32_t{bytes[i]} << 16;
+        if (rest == 2) {
+            v |= std::uint32_t{bytes[i + 1]} << 8;
+        }
+        out += kAlphabet[(v >> 18) & 63];
+        out += kAlphabet[(v >> 12) & 63];
+        out += rest == 2 ? kAlphabet[(v >> 6) & 63] : '=';
+        out += '=';
+    }
+    return out;
+}
+
+std::string encodeDisplayDigest(const DisplayDigestRecord& d)
+{
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(d.rgba));
+    return json{{"frame", d.frameIndex}, {"tick_ns", d.tickNs}, {"hash", "xxh3_64"}, {"rgba", hex}}
+            .dump();
+}
+
+std::string encodeThumbnail(const ThumbnailRecord& t, std::int64_t wallStartNs)
+{
+    return json{{"timestamp", foxgloveTime(wallStartNs + t.tNs)},
+                {"frame_id", kPanelFrame},
+                {"data", base64Encode(t.png)},
+                {"format", "png"}}
+            .dump();
+}
+
+std::optional<std::string> encodeTransforms(const PosesRecord& p, std::int64_t wallStartNs)
+{
+    if (!finite(p.eyeBoothM) || !finite(p.trackerBoothM) || !std::isfinite(p.tiltRad)) {
+        return std::nullopt;
+    }
+    const json stamp = foxgloveTime(wallStartNs + p.tNs);
+    const json identity = quaternion(0.0, 0.0, 0.0, 1.0);
+    // A rotation by the tilt about x: (sin(a/2), 0, 0, cos(a/2)).
+    const json tilt = quaternion(std::sin(p.tiltRad / 2.0), 0.0, 0.0, std::cos(p.tiltRad / 2.0));
+    json list = json::array();
+    list.push_back(transform(stamp, kBoothFrame, kPanelFrame, glm::dvec3(0.0), tilt));
+    list.push_back(transform(stamp, kBoothFrame, kTrackerFrame, p.trackerBoothM, identity));
+    list.push_back(transform(stamp, kBoothFrame, kEyeFrame, p.eyeBoothM, identity));
+    return json{{"transforms", list}}.dump();
+}
+
+std::optional<std::string> encodeEye(const PosesRecord& p, std::int64_t wallStartNs)
+{
+    if (!finite(p.eyeBoothM)) {
+        return std::nullopt;
+    }
+    return json{
+            {"timestamp", foxgloveTime(wallStartNs + p.tNs)},
+            {"frame_id", kBoothFrame},
+            {"pose",
+             {{"position", vec3(p.eyeBoothM)}, {"orientation", quaternion(0.0, 0.0, 0.0, 1.0)}}}}
+            .dump();
+}
+
+std::string encodeLight(const LightRecord& l)
+{
+    json j{{"t", l.tNs},     {"frame", l.frameIndex}, {"mode", l.mode},
+           {"lamp", l.lamp}, {"name", l.name},        {"why", l.why}};
+    if (std::isfinite(l.distance)) {
+        j["distance"] = l.distance;
+    }
+    if (l.cctK && std::isfinite(*l.cctK)) {
+        j["cct_k"] = *l.cctK;
+    }
+    if (l.duv && std::isfinite(*l.duv)) {
+        j["duv"] = *l.duv;
+    }
+    return j.dump();
+}
+
+std::string encodeLog(const LogRecord& l, std::int64_t wallStartNs)
+{
+    return json{{"timestamp", foxgloveTime(wallStartNs + l.tNs)},
+                {"level", l.level},
+                {"message", l.message},
+                {"name", l.name},
+                {"file", ""},
+                {"line", 0}}
+            .dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+DisplayDigestRecord decodeDisplayDigest(const json& j)
+{
+    DisplayDigestRecord d;
+    d.frameIndex = j.at("frame");
+    d.tickNs = j.at("tick_ns");
+    if (j.at("hash").get<std::string>() != "xxh3_64") {
+        throw std::out_of_range("display digest: unknown hash " + j.at("hash").get<std::string>());
+    }
+    const std::string hex = j.at("rgba");
+    if (hex.size() != 16 || hex.find_first_not_of("0123456789abcdef") != std::string::npos) {
+        throw std::out_of_range("display digest: rgba is not 16 hex digits");
+    }
+    d.rgba = std::stoull(hex, nullptr, 16);
+    return d;
+}
+
+LightRecord decodeLight(const json& j)
+{
+    LightRecord l;
+    l.tNs = j.at("t");
+    l.frameIndex = j.at("frame");
+    l.mode = j.at("mode");
+    l.lamp = j.at("lamp");
+    l.name = j.at("name");
+    l.why = j.at("why");
+    l.distance = j.value("distance", 0.0);
+    if (j.contains("cct_k")) {
+        l.cctK = j.at("cct_k").get<double>();
+    }
+    if (j.contains("duv")) {
+        l.duv = j.at("duv").get<double>();
+    }
+    return l;
 }
 
 SessionInfo decodeSession(const json& j, int& formatVersion)
@@ -368,6 +605,7 @@ RecorderStatus decodeRecorderStatus(const json& j)
     r.droppedAccel = j.value("dropped_accel", std::uint64_t{0});
     r.droppedFrames = j.value("dropped_frames", std::uint64_t{0});
     r.droppedLamp = j.value("dropped_lamp", std::uint64_t{0});
+    r.droppedShown = j.value("dropped_shown", std::uint64_t{0});
     r.rejectedNonFinite = j.value("rejected_nonfinite", std::uint64_t{0});
     r.queueCapacity = j.value("queue_capacity", std::uint64_t{0});
     return r;

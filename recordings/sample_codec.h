@@ -24,6 +24,13 @@ enum class ChannelId : std::uint16_t {
     Frame = 5,
     Recorder = 6,
     LampSelector = 7, // format 3
+    // Format 4: what was shown, for people (standard Foxglove schemas where one exists).
+    DisplayDigest = 8,
+    Thumbnail = 9,
+    Transforms = 10,
+    Eye = 11,
+    Light = 12,
+    Log = 13,
 };
 
 inline constexpr std::string_view kSessionTopic = "/replica/session";
@@ -33,6 +40,17 @@ inline constexpr std::string_view kAccelTopic = "/hal/accel";
 inline constexpr std::string_view kFrameTopic = "/replica/frame";
 inline constexpr std::string_view kRecorderTopic = "/replica/recorder";
 inline constexpr std::string_view kLampSelectorTopic = "/hal/lamp_selector";
+inline constexpr std::string_view kDisplayDigestTopic = "/replica/display_digest";
+inline constexpr std::string_view kThumbnailTopic = "/replica/thumbnail";
+inline constexpr std::string_view kTransformsTopic = "/tf";
+inline constexpr std::string_view kEyeTopic = "/replica/eye";
+inline constexpr std::string_view kLightTopic = "/replica/light";
+inline constexpr std::string_view kLogTopic = "/replica/log";
+// Foxglove frame ids of the transforms and poses.
+inline constexpr std::string_view kBoothFrame = "booth";
+inline constexpr std::string_view kPanelFrame = "panel";
+inline constexpr std::string_view kTrackerFrame = "tracker";
+inline constexpr std::string_view kEyeFrame = "eye";
 // A copy of the session message kept in a Metadata record outside every chunk (key "session"), so
 // that recover can restore the session when the first chunk is damaged.
 inline constexpr std::string_view kSessionMetadataName = "replica.session";
@@ -41,11 +59,13 @@ inline constexpr std::string_view kSessionMetadataName = "replica.session";
 struct RecorderStatus {
     std::uint64_t droppedSpectra = 0, droppedPoses = 0, droppedAccel = 0, droppedFrames = 0;
     std::uint64_t droppedLamp = 0;
+    std::uint64_t droppedShown = 0;      // format 4: thumbnails, poses, light, log, display digests
     std::uint64_t rejectedNonFinite = 0; // samples refused because a value was NaN or infinite
     std::uint64_t queueCapacity = 0;
     std::uint64_t droppedTotal() const
     {
-        return droppedSpectra + droppedPoses + droppedAccel + droppedFrames + droppedLamp;
+        return droppedSpectra + droppedPoses + droppedAccel + droppedFrames + droppedLamp +
+               droppedShown;
     }
 };
 
@@ -66,6 +86,14 @@ std::optional<std::string> encodeAccel(const hal::AccelSample& s);
 std::string encodeLamp(const hal::LampSample& s);
 std::string encodeFrame(const FrameRecord& f);
 std::string encodeRecorderStatus(const RecorderStatus& r);
+// Format 4. wallStartNs turns session time into the foxglove timestamps {sec, nsec} (Unix time).
+std::string encodeDisplayDigest(const DisplayDigestRecord& d);
+std::string encodeThumbnail(const ThumbnailRecord& t, std::int64_t wallStartNs);
+std::optional<std::string> encodeTransforms(const PosesRecord& p, std::int64_t wallStartNs);
+std::optional<std::string> encodeEye(const PosesRecord& p, std::int64_t wallStartNs);
+std::string encodeLight(const LightRecord& l);
+std::string encodeLog(const LogRecord& l, std::int64_t wallStartNs);
+std::string base64Encode(const std::vector<std::uint8_t>& bytes);
 
 // Decoders throw nlohmann::json exceptions on missing or mistyped fields.
 SessionInfo decodeSession(const nlohmann::json& j, int& formatVersion);
@@ -75,5 +103,7 @@ hal::AccelSample decodeAccel(const nlohmann::json& j);
 hal::LampSample decodeLamp(const nlohmann::json& j);
 FrameRecord decodeFrame(const nlohmann::json& j);
 RecorderStatus decodeRecorderStatus(const nlohmann::json& j);
+DisplayDigestRecord decodeDisplayDigest(const nlohmann::json& j);
+LightRecord decodeLight(const nlohmann::json& j);
 
 } // namespace replica::recordings

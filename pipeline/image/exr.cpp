@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <exception>
 
+#include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
@@ -116,7 +117,8 @@ Expected<ChannelImage> readExr(const std::filesystem::path& path,
 
 Expected<void> writeExr(const std::filesystem::path& path,
                         const ChannelImage& img,
-                        const std::vector<std::pair<std::string, std::string>>& attributes)
+                        const std::vector<std::pair<std::string, std::string>>& attributes,
+                        bool halfFloat)
 {
     if (img.width <= 0 || img.height <= 0 || img.names.size() != img.planes.size()) {
         return makeError(
@@ -130,8 +132,19 @@ Expected<void> writeExr(const std::filesystem::path& path,
             header.insert(k, Imf::StringAttribute(v));
         }
         Imf::FrameBuffer fb;
+        // Half channels take half slices: OpenEXR does not convert a float buffer on output.
+        std::vector<std::vector<Imath::half>> halves(halfFloat ? img.planes.size() : 0);
         for (std::size_t c = 0; c < img.names.size(); ++c) {
-            header.channels().insert(img.names[c], Imf::Channel(Imf::FLOAT));
+            header.channels().insert(img.names[c],
+                                     Imf::Channel(halfFloat ? Imf::HALF : Imf::FLOAT));
+            if (halfFloat) {
+                halves[c].assign(img.planes[c].begin(), img.planes[c].end());
+                fb.insert(img.names[c],
+                          Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c].data()),
+                                     sizeof(Imath::half),
+                                     sizeof(Imath::half) * static_cast<std::size_t>(img.width)));
+                continue;
+            }
             fb.insert(
                     img.names[c],
                     Imf::Slice(

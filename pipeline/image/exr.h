@@ -29,10 +29,12 @@ Expected<ChannelImage> readExr(const std::filesystem::path& path,
 // Names of every channel in the file, for messages and for reading all of them.
 Expected<std::vector<std::string>> exrChannelNames(const std::filesystem::path& path);
 
-// Writes 32-bit float channels with ZIP compression; string attributes are stored as header
+// Writes 32-bit float channels (or, with halfFloat, 16-bit half channels: OpenEXR rounds each
+// value to the nearest half) with ZIP compression; string attributes are stored as header
 // comments.
 Expected<void> writeExr(const std::filesystem::path& path,
                         const ChannelImage& img,
-                        const std::vector<std::pair<std::string, std::string>>& attributes = {});
+                        const std::vector<std::pair<std::string, std::string>>& attributes = {},
+                        bool halfFloat = false);
 
 } // namespace replica::pipeline::image

@@ -17,8 +17,8 @@ FrameCallback FrameOutputs::callback()
         if (digest_) {
             const auto* xyzBytes = reinterpret_cast<const std::uint8_t*>(image.xyz.data());
             digests_.push_back({f.frameIndex, f.tickNs,
-                                fnv1a64({xyzBytes, image.xyz.size() * sizeof(float)}),
-                                fnv1a64(image.rgba)});
+                                frameHash(hash_, {xyzBytes, image.xyz.size() * sizeof(float)}),
+                                frameHash(hash_, image.rgba)});
         }
         if (keepLast_) {
             lastWidth_ = image.width;
@@ -32,7 +32,7 @@ Expected<void> FrameOutputs::finish(const std::string& digestPath,
                                     const std::string& snapshotPath) const
 {
     if (!digestPath.empty()) {
-        if (auto ok = writeDigests(digestPath, digests_); !ok) {
+        if (auto ok = writeDigests(digestPath, digests_, hash_); !ok) {
             return ok;
         }
     }

@@ -15,7 +15,9 @@ class FrameOutputs
 public:
     // digests: hash every frame; keepLastFrame: keep the last frame's display values for a
     // snapshot.
-    FrameOutputs(bool digests, bool keepLastFrame) : digest_(digests), keepLast_(keepLastFrame) {}
+    FrameOutputs(bool digests, bool keepLastFrame, DigestHash hash = kDigestHash)
+        : digest_(digests), keepLast_(keepLastFrame), hash_(hash)
+    {}
     // What the loop must read back for this.
     pipeline::render::Readback readback() const;
     FrameCallback callback();
@@ -26,6 +28,7 @@ public:
 private:
     bool digest_;
     bool keepLast_;
+    DigestHash hash_;
     std::vector<FrameDigest> digests_;
     int lastWidth_ = 0;
     int lastHeight_ = 0;

@@ -2,6 +2,7 @@
 // damage (then it exits non-zero).
 #include <algorithm>
 #include <cstdint>
+#include <ctime>
 #include <string>
 #include <string_view>
 
@@ -31,6 +32,48 @@ struct InspectOptions {
     std::string file;
     bool json = false;
 };
+
+// Unix time (ns) as ISO 8601 UTC with milliseconds.
+std::string isoUtc(std::int64_t unixNs)
+{
+    const std::time_t secs = static_cast<std::time_t>(unixNs / 1'000'000'000);
+    std::tm tm{};
+    if (unixNs <= 0 || ::gmtime_r(&secs, &tm) == nullptr) {
+        return "unknown";
+    }
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+    return fmt::format("{}.{:03d}Z", buf, static_cast<int>((unixNs / 1'000'000) % 1000));
+}
+
+// The lamp timeline: what the appliance decided (format 4's /replica/light), and the booth's
+// selector switch where there is one.
+nlohmann::json lampTimeline(const recordings::Recording& rec)
+{
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& l : rec.lights) {
+        nlohmann::json e{{"t_s", static_cast<double>(l.tNs) * 1e-9},
+                         {"source", "decided"},
+                         {"mode", l.mode},
+                         {"lamp", l.lamp},
+                         {"name", l.name},
+                         {"why", l.why}};
+        if (l.cctK) {
+            e["cct_k"] = *l.cctK;
+        }
+        out.push_back(e);
+    }
+    for (const auto& s : rec.lampSelector) {
+        out.push_back({{"t_s", static_cast<double>(s.timestampNs) * 1e-9},
+                       {"source", "selector"},
+                       {"lamp", s.lamp},
+                       {"state", hal::lampStateName(s.lamp)}});
+    }
+    std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+        return a.at("t_s").template get<double>() < b.at("t_s").template get<double>();
+    });
+    return out;
+}
 
 template <typename Sample>
 nlohmann::json streamJson(const hal::DeviceInfo& info, const std::vector<Sample>& samples)
@@ -132,6 +175,10 @@ int inspectMain(const InspectOptions& o)
                      {"booth", rec->session.boothModel},
                      {"scene", rec->session.scene},
                      {"display_profile", rec->session.displayProfile},
+                     {"wall_clock_start_ns", rec->session.wallClockStartNs},
+                     {"wall_clock_start", isoUtc(rec->session.wallClockStartNs)},
+                     {"lamp_timeline", lampTimeline(*rec)},
+                     {"display_digests", rec->displayDigests.size()},
                      {"spectrometer", streamJson(rec->session.spectrometer, rec->spectra)},
                      {"tracker", streamJson(rec->session.tracker, rec->poses)},
                      {"accel", streamJson(rec->session.accel, rec->accel)},
@@ -193,8 +240,31 @@ int inspectMain(const InspectOptions& o)
     }
     fmt::print("{}: replica recording, format {}, written by {}\n", o.file, rec->formatVersion,
                shown(rec->session.softwareVersion));
+    fmt::print("  started {} (UTC), {:.3f} s of session time\n",
+               isoUtc(rec->session.wallClockStartNs), static_cast<double>(last - first) * 1e-9);
     fmt::print("  booth {}, scene {}, display profile {}\n", shown(rec->session.boothModel),
                shown(rec->session.scene), shown(rec->session.displayProfile));
+    const auto timeline = lampTimeline(*rec);
+    if (timeline.empty()) {
+        fmt::print("  lamp timeline: none recorded (no selector{})\n",
+                   rec->formatVersion < 4 ? "; format < 4 records no decided light" : "");
+    } else {
+        fmt::print("  lamp timeline:\n");
+        for (const auto& e : timeline) {
+            const double t = e.at("t_s").get<double>();
+            if (e.at("source") == "decided") {
+                fmt::print("    {:9.3f} s  shown: {}{} ({})\n", t,
+                           shown(e.at("name").get<std::string>()),
+                           e.contains("cct_k")
+                                   ? fmt::format(", {:.0f} K", e.at("cct_k").get<double>())
+                                   : std::string(),
+                           shown(e.at("why").get<std::string>()));
+            } else {
+                fmt::print("    {:9.3f} s  selector: {} ({})\n", t, e.at("lamp").get<int>(),
+                           shown(e.at("state").get<std::string>()));
+            }
+        }
+    }
     auto line = [](const char* name, const hal::DeviceInfo& info, std::size_t count) {
         fmt::print("  {:<13} {:>7} samples  {} {} ({})\n", name, count, shown(info.model),
                    shown(info.serial), hal::toString(info.kind));
@@ -227,9 +297,28 @@ void registerInspectCommand(CLI::App& app, int& exitCode)
             "inspect",
             "print what a recording holds: devices, sample counts per channel, time span, and any "
             "damage (exit 1 if damaged)");
-    cmd->add_option("file", opts->file, "recording (.mcap)")->required();
-    cmd->add_flag("--json", opts->json, "print the same as JSON");
-    cmd->callback([opts, &exitCode] { exitCode = inspectMain(*opts); });
+    auto files = std::make_shared<std::vector<std::string>>();
+    cmd->add_option("files", *files, "recordings (.mcap), one or more")->required();
+    cmd->add_flag("--json", opts->json,
+                  "print the same as JSON (one object; an array of them for several files)");
+    cmd->callback([opts, files, &exitCode] {
+        // Several files: each in turn (a JSON array with --json); the exit code is the worst.
+        exitCode = kExitOk;
+        if (opts->json && files->size() > 1) {
+            fmt::print("[\n");
+        }
+        for (std::size_t i = 0; i < files->size(); ++i) {
+            InspectOptions one = *opts;
+            one.file = (*files)[i];
+            if (i > 0) {
+                fmt::print("{}", opts->json ? ",\n" : "\n");
+            }
+            exitCode = std::max(exitCode, inspectMain(one));
+        }
+        if (opts->json && files->size() > 1) {
+            fmt::print("]\n");
+        }
+    });
 }
 
 } // namespace replica::platform

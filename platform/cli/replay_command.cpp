@@ -1,15 +1,24 @@
 // 'replica replay': feeds a recording back through the replay HAL and renders the same frames.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <map>
 #include <optional>
+#include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/frame_compare.h>
 #include <platform/cli/frame_outputs.h>
 #include <platform/image/png_writer.h>
+#include <platform/image/xyz_frame.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 
@@ -27,6 +36,59 @@ struct ReplayOptions {
     std::string mismatchDir; // where --check writes the first differing frame
     std::vector<std::string> dataRoots; // folders besides data/ a recording may name files in
     bool allowUndigested = false;       // replay a recording without scene/display digests
+    std::optional<double> fromS, toS;   // the slice, in seconds of session time
+    std::string framesOut;              // PNG of every displayed frame of the slice
+    bool json = false;
+    bool progress = false; // progress lines even when standard error is not a terminal
+    bool noProgress = false;
+    std::optional<double> tolerance; // --check passes within this ΔE00 on the reference frames
+    std::string saveOnly;            // with --save-frames: only these frame numbers
+    std::string saveFormat = "pfm";  // or "exr" (half float)
+};
+
+// The reference frame of `frame` in dir: .exr (committed goldens) or .pfm (local).
+std::optional<std::filesystem::path> referenceFrame(const std::filesystem::path& dir, long frame)
+{
+    std::error_code ec;
+    for (const char* ext : {".exr", ".pfm"}) {
+        auto p = dir / fmt::format("frame-{:06d}{}", frame, ext);
+        if (std::filesystem::exists(p, ec)) {
+            return p;
+        }
+    }
+    return std::nullopt;
+}
+
+// "0,75,149" -> {0, 75, 149}; nullopt on anything else.
+std::optional<std::vector<std::uint64_t>> parseFrameList(const std::string& s)
+{
+    std::vector<std::uint64_t> out;
+    std::stringstream in(s);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        std::size_t used = 0;
+        try {
+            out.push_back(std::stoull(item, &used));
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
+        if (used != item.size()) {
+            return std::nullopt;
+        }
+    }
+    if (out.empty()) {
+        return std::nullopt;
+    }
+    return out;
+}
+
+// ΔE00 of one frame against its reference, with where the largest difference is (x, y from the
+// top-left of the picture).
+struct FrameDeltaE {
+    long frame = -1;
+    DeltaEStats stats;
+    int maxX = 0, maxY = 0;
+    std::filesystem::path reference;
 };
 
 std::filesystem::path
@@ -66,14 +128,15 @@ Expected<void> reportMismatch(const ReplayOptions& o,
     if (refDir.empty()) {
         refDir = std::filesystem::path(o.check).replace_extension(".frames");
     }
-    const auto refPath = framePath(refDir, frame);
-    if (!std::filesystem::exists(refPath, ec)) {
+    const auto found = referenceFrame(refDir, frame);
+    if (!found) {
         fmt::print("no reference frame {} (write reference frames with 'replica replay FILE "
                    "--save-frames DIR' and pass --reference DIR): no ΔE00 statistics\n",
-                   refPath.string());
+                   framePath(refDir, frame).string());
         return {};
     }
-    auto ref = readPfm(refPath);
+    const auto refPath = *found;
+    auto ref = readXyzFrame(refPath);
     if (!ref) {
         return tl::unexpected(ref.error());
     }
@@ -132,56 +195,232 @@ int replayMain(const ReplayOptions& o)
     const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
                           : o.clock == "step"   ? Pacing::Step
                                                 : Pacing::Fast;
+    // The slice: frames whose tick lies in [from, to]. Frames before it are rendered (the state
+    // carried from frame to frame must be the recording's) but neither paced nor output.
+    const auto toNs = [](double sec) { return static_cast<std::int64_t>(std::llround(sec * 1e9)); };
+    // 1 us of slack: tick k is k * round(period), a few ns off k / rate after many frames.
+    constexpr std::int64_t kSlackNs = 1000;
+    const std::int64_t fromNs = o.fromS ? toNs(*o.fromS) - kSlackNs : INT64_MIN;
+    const std::int64_t untilNs = o.toS ? toNs(*o.toS) + kSlackNs : INT64_MAX;
+    if (fromNs > untilNs) {
+        log->error("--from {} is after --to {}: nothing to replay", *o.fromS, *o.toS);
+        return kExitUsage;
+    }
+    auto inSlice = [&](std::int64_t tickNs) { return tickNs >= fromNs && tickNs <= untilNs; };
+    std::vector<TickPlan> plan;
+    std::size_t sliceFrames = 0;
+    for (const auto& f : recording->frames) {
+        if (f.tickNs > untilNs) {
+            break;
+        }
+        TickPlan t{f.frameIndex, f.tickNs, f};
+        t.warmup = !inSlice(f.tickNs);
+        sliceFrames += t.warmup ? 0 : 1;
+        plan.push_back(t);
+    }
+    if ((o.fromS || o.toS) && sliceFrames == 0) {
+        const double lastS = recording->frames.empty()
+                                     ? 0.0
+                                     : static_cast<double>(recording->frames.back().tickNs) * 1e-9;
+        log->error("{}: no frame between {} s and {} s (the recording's frames span 0 to {:.3f} "
+                   "s of session time)",
+                   o.file, o.fromS.value_or(0.0), o.toS ? fmt::format("{}", *o.toS) : "the end",
+                   lastS);
+        return kExitUsage;
+    }
     log->info("replay {}: {} frames, {} spectra, {} poses, {} accel samples, {} lamp selector "
               "samples (recorded by {}); clock={}; renderer={} on {}; {}x{}",
               o.file, recording->frames.size(), recording->spectra.size(), recording->poses.size(),
               recording->accel.size(), recording->lampSelector.size(),
               recording->session.softwareVersion, o.clock, (*appliance)->renderer->description(),
               (*appliance)->output->glRenderer(), config->width, config->height);
+    if (o.fromS || o.toS) {
+        log->info("slice: {} frames from {} s to {} s ({} frames before it rendered first, not "
+                  "output)",
+                  sliceFrames, o.fromS.value_or(0.0),
+                  o.toS ? fmt::format("{}", *o.toS) : std::string("the end"),
+                  plan.size() - sliceFrames);
+    }
 
-    std::optional<std::vector<FrameDigest>> golden;
+    std::optional<DigestFile> golden;
+    std::map<std::uint64_t, FrameDigest> goldenByFrame; // the golden frames inside the slice
     if (!o.check.empty()) {
-        auto g = readDigests(o.check);
+        auto g = readDigestFile(o.check);
         if (!g) {
             log->error("{}", g.error().message);
             return kExitFailure;
         }
+        for (const auto& d : g->frames) {
+            if (inSlice(d.tickNs) && d.tickNs <= untilNs) {
+                goldenByFrame[d.frameIndex] = d;
+            }
+        }
         golden = std::move(*g);
     }
-    if (!o.saveFrames.empty()) {
+    if (o.tolerance && !golden) {
+        log->error("--tolerance needs --check GOLDEN: it says how far frames may be from the "
+                   "golden's reference frames");
+        return kExitUsage;
+    }
+    std::optional<std::vector<std::uint64_t>> saveOnly;
+    if (!o.saveOnly.empty()) {
+        saveOnly = parseFrameList(o.saveOnly);
+        if (!saveOnly) {
+            log->error("--save-only {}: expected frame numbers separated by commas, e.g. 0,75,149",
+                       o.saveOnly);
+            return kExitUsage;
+        }
+    }
+    for (const auto* dir : {&o.saveFrames, &o.framesOut}) {
+        if (dir->empty()) {
+            continue;
+        }
         std::error_code ec;
-        std::filesystem::create_directories(o.saveFrames, ec);
+        std::filesystem::create_directories(*dir, ec);
         if (ec) {
-            log->error("{}: cannot create directory: {}", o.saveFrames, ec.message());
+            log->error("{}: cannot create directory: {}", *dir, ec.message());
             return kExitFailure;
         }
     }
-    FrameOutputs outputs(!o.digests.empty() || golden || !o.saveFrames.empty(),
-                         !o.snapshot.empty());
+    // Digests with the golden's own hash, so that format 1 goldens still verify.
+    const DigestHash hash = golden ? golden->hash : kDigestHash;
+    FrameOutputs outputs(!o.digests.empty() || golden || !o.saveFrames.empty(), !o.snapshot.empty(),
+                         hash);
+    // The recording's own digests of what the panel showed (format 4), by frame.
+    std::map<std::uint64_t, std::uint64_t> shown;
+    for (const auto& d : recording->displayDigests) {
+        if (inSlice(d.tickNs)) {
+            shown[d.frameIndex] = d.rgba;
+        }
+    }
+    auto readback = outputs.readback();
+    if (!o.framesOut.empty() || !shown.empty()) {
+        readback = std::max(readback, pipeline::render::Readback::Display);
+    }
+    std::filesystem::path refDir = o.reference;
+    if (refDir.empty() && golden) {
+        refDir = std::filesystem::path(o.check).replace_extension(".frames");
+    }
+    const pipeline::colour::Xyz white = (*appliance)->displayWhiteXyz;
+
     // Keep the first frame whose digest differs from the golden one, and save frames on request.
     std::optional<FloatImage> firstDiffXyz;
     std::vector<std::uint8_t> firstDiffRgba;
+    long firstDiff = -1;
+    std::uint64_t differing = 0, compared = 0, goldenSeen = 0;
+    std::vector<FrameDeltaE> measured; // tolerance mode: differing frames with a reference
+    std::uint64_t shownMatched = 0, shownDiffering = 0;
+    long firstShownDiff = -1;
     std::optional<Error> saveError;
+    std::uint64_t framesWritten = 0;
     auto keep = outputs.callback();
+    const bool showProgress = !o.noProgress && (o.progress || ::isatty(STDERR_FILENO) == 1);
+    const auto wallStart = std::chrono::steady_clock::now();
+    auto lastProgress = wallStart;
+    std::uint64_t done = 0;
     auto onFrame = [&](const recordings::FrameRecord& f, const pipeline::scene::SceneState& scene,
                        const pipeline::render::RenderedFrame& image) {
+        ++done;
+        if (showProgress) {
+            const auto now = std::chrono::steady_clock::now();
+            if (now - lastProgress >= std::chrono::seconds(1) || done == plan.size()) {
+                lastProgress = now;
+                const double el = std::chrono::duration<double>(now - wallStart).count();
+                const double rate = el > 0.0 ? static_cast<double>(done) / el : 0.0;
+                const double left =
+                        rate > 0.0 ? static_cast<double>(plan.size() - done) / rate : 0.0;
+                std::fprintf(stderr,
+                             "replay: frame %llu (%llu of %zu, %.0f%%), session time %.1f s, "
+                             "%.1f frames/s, %.0f s left%s\n",
+                             static_cast<unsigned long long>(f.frameIndex),
+                             static_cast<unsigned long long>(done), plan.size(),
+                             100.0 * static_cast<double>(done) /
+                                     static_cast<double>(std::max<std::size_t>(plan.size(), 1)),
+                             static_cast<double>(f.tickNs) * 1e-9, rate, left,
+                             inSlice(f.tickNs) ? "" : " (before the slice)");
+            }
+        }
+        if (!inSlice(f.tickNs)) {
+            return;
+        }
         keep(f, scene, image);
-        const std::size_t i = outputs.digests().size() - 1;
-        if (!o.saveFrames.empty() && !saveError) {
-            if (auto ok = writePfm(framePath(o.saveFrames, static_cast<long>(i)),
-                                   {image.width, image.height, image.xyz});
+        if (auto it = shown.find(f.frameIndex); it != shown.end() && !image.rgba.empty()) {
+            if (xxh3_64(image.rgba) == it->second) {
+                ++shownMatched;
+            } else {
+                ++shownDiffering;
+                if (firstShownDiff < 0) {
+                    firstShownDiff = static_cast<long>(f.frameIndex);
+                }
+            }
+        }
+        const auto frameNo = static_cast<long>(f.frameIndex);
+        if (!o.framesOut.empty() && !saveError) {
+            if (auto ok = writePng(framePath(o.framesOut, frameNo, ".png"), image.width,
+                                   image.height, image.rgba);
+                !ok) {
+                saveError = ok.error();
+            } else {
+                ++framesWritten;
+            }
+        }
+        const bool save =
+                !o.saveFrames.empty() && (!saveOnly || std::find(saveOnly->begin(), saveOnly->end(),
+                                                                 f.frameIndex) != saveOnly->end());
+        if (save && !saveError) {
+            if (auto ok = writeXyzFrame(
+                        framePath(o.saveFrames, frameNo, o.saveFormat == "exr" ? ".exr" : ".pfm"),
+                        {image.width, image.height, image.xyz});
                 !ok) {
                 saveError = ok.error();
             }
         }
-        if (golden && !firstDiffXyz &&
-            (i >= golden->size() || !((*golden)[i] == outputs.digests()[i]))) {
+        if (!golden) {
+            return;
+        }
+        ++compared;
+        const auto g = goldenByFrame.find(f.frameIndex);
+        goldenSeen += g != goldenByFrame.end() ? 1 : 0;
+        if (g != goldenByFrame.end() && g->second == outputs.digests().back()) {
+            return;
+        }
+        ++differing;
+        if (!firstDiffXyz) {
+            firstDiff = frameNo;
             firstDiffXyz = FloatImage{image.width, image.height, image.xyz};
             firstDiffRgba = image.rgba;
         }
+        // Measure every differing frame that has a reference frame: tolerance mode decides on
+        // them, and a plain --check reports them.
+        {
+            if (const auto ref = referenceFrame(refDir, frameNo)) {
+                auto r = readXyzFrame(*ref);
+                if (!r) {
+                    saveError = r.error();
+                    return;
+                }
+                auto de = deltaE00Image({image.width, image.height, image.xyz}, *r, white);
+                if (!de) {
+                    saveError = Error{ErrorCode::InvalidArgument,
+                                      fmt::format("{}: {}", ref->string(), de.error().message)};
+                    return;
+                }
+                FrameDeltaE m;
+                m.frame = frameNo;
+                m.reference = *ref;
+                const auto at = static_cast<std::size_t>(std::max_element(de->begin(), de->end()) -
+                                                         de->begin());
+                m.maxX = static_cast<int>(at % static_cast<std::size_t>(image.width));
+                m.maxY = image.height - 1 -
+                         static_cast<int>(at / static_cast<std::size_t>(image.width));
+                m.stats = summarise(std::move(*de));
+                measured.push_back(m);
+            }
+        }
     };
-    auto stats = runFrames(**appliance, sources, replayPlan(recording->frames), pacing, nullptr,
-                           outputs.readback(), onFrame);
+    auto stats = runFrames(**appliance, sources, plan, pacing, nullptr, readback, onFrame);
+    const double wallS =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
     if (saveError) {
         log->error("{}", saveError->message);
         return kExitFailure;
@@ -194,29 +433,144 @@ int replayMain(const ReplayOptions& o)
         log->error("{}", ok.error().message);
         return kExitFailure;
     }
+    auto say = [&](const std::string& line) {
+        if (!o.json) {
+            fmt::print("{}\n", line);
+        }
+    };
+    nlohmann::json summary{
+            {"command", "replay"},
+            {"file", o.file},
+            {"format_version", recording->formatVersion},
+            {"recorded_by", recording->session.softwareVersion},
+            {"clock", o.clock},
+            {"renderer", (*appliance)->renderer->description()},
+            {"gl_renderer", (*appliance)->output->glRenderer()},
+            {"size", {config->width, config->height}},
+            {"frames_in_recording", recording->frames.size()},
+            {"frames_rendered", stats->frames},
+            {"frames_output", outputs.digests().empty() ? sliceFrames : outputs.digests().size()},
+            {"wall_s", wallS},
+            {"replay_mismatches", stats->replayMismatches}};
+    if (o.fromS || o.toS) {
+        summary["slice"] = {{"from_s", o.fromS.value_or(0.0)}, {"frames", sliceFrames}};
+        if (o.toS) {
+            summary["slice"]["to_s"] = *o.toS;
+        }
+    }
     if (!o.digests.empty()) {
-        fmt::print("digests: {}\n", o.digests);
+        summary["digests"] = {{"file", o.digests}, {"hash", digestHashName(hash)}};
+        say(fmt::format("digests: {}", o.digests));
     }
     if (!o.saveFrames.empty()) {
-        fmt::print("frames: {} XYZ frames in {}\n", outputs.digests().size(), o.saveFrames);
+        summary["saved_frames"] = o.saveFrames;
+        say(fmt::format("frames: XYZ frames ({}) in {}", o.saveFormat, o.saveFrames));
     }
+    if (!o.framesOut.empty()) {
+        summary["frames_out"] = {{"dir", o.framesOut}, {"count", framesWritten}};
+        say(fmt::format("frames out: {} PNG frames in {}", framesWritten, o.framesOut));
+    }
+    if (!shown.empty()) {
+        summary["display_digests"] = {{"recorded", shown.size()},
+                                      {"matched", shownMatched},
+                                      {"differing", shownDiffering}};
+        if (shownDiffering > 0) {
+            summary["display_digests"]["first_differing_frame"] = firstShownDiff;
+            log->warn("{}: {} of {} frames differ from the digests of what the panel showed "
+                      "when recorded (first: frame {}); this machine renders differently (a "
+                      "different Mesa or GPU?)",
+                      o.file, shownDiffering, shownMatched + shownDiffering, firstShownDiff);
+        } else {
+            say(fmt::format("shown: all {} frames match the recorded digests of what the panel "
+                            "showed",
+                            shownMatched));
+        }
+    }
+    int code = stats->replayMismatches > 0 ? kExitLossy : kExitOk;
     if (golden) {
-        const long diff = firstDifference(*golden, outputs.digests());
-        if (diff >= 0) {
+        // Golden frames in the slice that were not replayed make the check fail too.
+        const std::uint64_t missing = goldenByFrame.size() - goldenSeen;
+        const bool lengthDiffers = missing > 0;
+        nlohmann::json check{{"golden", o.check},
+                             {"hash", digestHashName(hash)},
+                             {"frames_compared", compared},
+                             {"golden_frames", goldenByFrame.size()},
+                             {"frames_differing", differing},
+                             {"golden_frames_not_replayed", missing}};
+        if (differing == 0 && !lengthDiffers) {
+            check["result"] = "match";
+            say(fmt::format("check: all {} frames match {}", compared, o.check));
+        } else if (o.tolerance && !lengthDiffers && !measured.empty()) {
+            const auto worst = *std::max_element(
+                    measured.begin(), measured.end(),
+                    [](const auto& a, const auto& b) { return a.stats.max < b.stats.max; });
+            const bool within = worst.stats.max <= *o.tolerance;
+            check["result"] = within ? "within_tolerance" : "beyond_tolerance";
+            check["tolerance_de00"] = *o.tolerance;
+            check["reference_frames_measured"] = measured.size();
+            check["worst"] = {{"frame", worst.frame},     {"reference", worst.reference.string()},
+                              {"mean", worst.stats.mean}, {"p95", worst.stats.p95},
+                              {"max", worst.stats.max},   {"max_at", {worst.maxX, worst.maxY}}};
+            nlohmann::json frames = nlohmann::json::array();
+            for (const auto& m : measured) {
+                frames.push_back({{"frame", m.frame},
+                                  {"mean", m.stats.mean},
+                                  {"p95", m.stats.p95},
+                                  {"max", m.stats.max},
+                                  {"max_at", {m.maxX, m.maxY}}});
+            }
+            check["measured"] = frames;
+            const auto line = fmt::format(
+                    "check: {} of {} frames differ from {} bit for bit; on the {} of them with "
+                    "reference frames ΔE00 is at most {:.3f} (worst frame {}: mean {:.3f}, p95 "
+                    "{:.3f}, max {:.3f} at x {} y {}), {} the tolerance {:.3f} by {:.3f}",
+                    differing, compared, o.check, measured.size(), worst.stats.max, worst.frame,
+                    worst.stats.mean, worst.stats.p95, worst.stats.max, worst.maxX, worst.maxY,
+                    within ? "within" : "BEYOND", *o.tolerance,
+                    std::abs(*o.tolerance - worst.stats.max));
+            if (within) {
+                say(line);
+            } else {
+                log->error("{}", line);
+                code = kExitFailure;
+            }
+        } else {
+            check["result"] = "differ";
+            check["first_differing_frame"] = firstDiff;
             log->error("{}: frame {} differs from the golden digests in {} ({} golden frames, {} "
-                       "replayed)",
-                       o.file, diff, o.check, golden->size(), outputs.digests().size());
-            if (firstDiffXyz) {
-                const pipeline::colour::Xyz white = (*appliance)->displayWhiteXyz;
-                if (auto ok = reportMismatch(o, diff, *firstDiffXyz, firstDiffRgba, white); !ok) {
+                       "replayed{})",
+                       o.file, firstDiff, o.check, goldenByFrame.size(), compared,
+                       o.tolerance ? "; no reference frame among the differing frames, so no "
+                                     "tolerance applies"
+                                   : "");
+            if (firstDiffXyz && !o.json) {
+                if (auto ok = reportMismatch(o, firstDiff, *firstDiffXyz, firstDiffRgba, white);
+                    !ok) {
                     log->error("{}", ok.error().message);
                 }
             }
-            return kExitFailure;
+            nlohmann::json frames = nlohmann::json::array();
+            for (const auto& m : measured) {
+                frames.push_back({{"frame", m.frame},
+                                  {"mean", m.stats.mean},
+                                  {"p95", m.stats.p95},
+                                  {"max", m.stats.max},
+                                  {"max_at", {m.maxX, m.maxY}}});
+                say(fmt::format("reference frame {}: ΔE00 mean {:.3f}, p95 {:.3f}, max {:.3f} at "
+                                "x {} y {} ({})",
+                                m.frame, m.stats.mean, m.stats.p95, m.stats.max, m.maxX, m.maxY,
+                                m.reference.string()));
+            }
+            check["measured"] = frames;
+            code = kExitFailure;
         }
-        fmt::print("check: all {} frames match {}\n", golden->size(), o.check);
+        summary["check"] = check;
     }
-    return stats->replayMismatches > 0 ? kExitLossy : kExitOk;
+    summary["exit_code"] = code;
+    if (o.json) {
+        fmt::print("{}\n", summary.dump(2));
+    }
+    return code;
 }
 
 } // namespace
@@ -249,14 +603,42 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
             ->check(nonEmpty);
     cmd->add_option("--snapshot", opts->snapshot, "write the last frame to FILE (PNG)");
     cmd->add_option("--save-frames", opts->saveFrames,
-                    "write every frame's absolute XYZ to DIR/frame-NNNNNN.pfm (reference frames "
-                    "for a golden)");
+                    "write every frame's absolute XYZ to DIR/frame-NNNNNN.pfm (or .exr with "
+                    "--save-format exr): reference frames for a golden");
     cmd->add_option("--reference", opts->reference,
                     "reference XYZ frames for --check (default: GOLDEN with .frames instead of "
                     ".json, if it exists): on a mismatch, ΔE00 of the first differing frame");
     cmd->add_option("--mismatch-dir", opts->mismatchDir,
                     "where --check writes the first differing frame and the difference image "
                     "(default: OUT.mismatch beside --digests OUT, else ./replay-mismatch)");
+    cmd->add_option("--from", opts->fromS,
+                    "replay only the frames from T seconds of session time on (the frames before "
+                    "are rendered first, fast, since each frame depends on those before it)")
+            ->check(CLI::Range(0.0, 1e9));
+    cmd->add_option("--to", opts->toS, "... up to T seconds of session time (inclusive)")
+            ->check(CLI::Range(0.0, 1e9));
+    cmd->add_option("--frames-out", opts->framesOut,
+                    "write what the panel showed for every replayed frame to "
+                    "DIR/frame-NNNNNN.png");
+    cmd->add_flag("--json", opts->json,
+                  "print a JSON summary (frames, slice, check result with ΔE00, display "
+                  "digests) on standard output instead of the text lines");
+    cmd->add_flag("--progress", opts->progress,
+                  "progress lines on standard error (at most one a second) even when it is not "
+                  "a terminal; on a terminal they are on by default");
+    cmd->add_flag("--no-progress", opts->noProgress, "no progress lines");
+    cmd->add_option("--tolerance", opts->tolerance,
+                    "with --check: pass when frames that differ from the golden bit for bit are "
+                    "within DE00 (largest CIEDE2000 of any pixel) of the golden's reference "
+                    "frames (GOLDEN.frames/ or --reference); say by how much")
+            ->check(CLI::Range(0.0, 100.0));
+    cmd->add_option("--save-only", opts->saveOnly,
+                    "with --save-frames: only these frames, e.g. 0,75,149");
+    cmd->add_option("--save-format", opts->saveFormat,
+                    "with --save-frames: pfm (32-bit float) or exr (half float, ZIP: small "
+                    "enough to commit)")
+            ->check(CLI::IsMember({"pfm", "exr"}))
+            ->capture_default_str();
     cmd->add_option("--clock", opts->clock,
                     "recorded: at the recorded pace; fast: as fast as possible; step: one frame "
                     "per line "

@@ -1,4 +1,5 @@
 // 'replica run': the appliance's main job, the fixed-rate loop on the chosen sensors and output.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -8,6 +9,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <sys/stat.h>
 
 #include <pipeline/base/data_dir.h>
@@ -18,6 +20,7 @@
 #include <platform/live_sources.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
+#include <platform/loop/shown_recorder.h>
 #include <platform/site_file.h>
 #include <recordings/recording.h>
 
@@ -54,6 +57,10 @@ struct RunOptions {
     bool noViewing = false;
     bool noFlare = false;
     bool falseColour = false;
+    bool recordDigests = true; // format 4: XXH3-64 of every displayed frame in the recording
+    double thumbnailHz = 1.0;
+    int thumbnailWidth = 320;
+    bool json = false;
     LiveOptions live;
     OutputChoice outputChoice;
 };
@@ -409,6 +416,15 @@ int runMain(const RunOptions& given)
         }
     }
 
+    // What the panel showed, into the recording (format 4 channels).
+    std::unique_ptr<ShownRecorder> shown;
+    if (recorder) {
+        ShownOptions so;
+        so.displayDigests = o.recordDigests;
+        so.thumbnailHz = o.thumbnailHz;
+        so.thumbnailWidth = o.thumbnailWidth;
+        shown = std::make_unique<ShownRecorder>(*recorder, **appliance, so);
+    }
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
     // --frames 0: run until SIGINT/SIGTERM (the kiosk), closing the recording properly.
     installStopSignals();
@@ -419,32 +435,81 @@ int runMain(const RunOptions& given)
     if (o.output == "kms" && readback == pipeline::render::Readback::None) {
         readback = pipeline::render::Readback::Display;
     }
+    if (shown) {
+        readback = std::max(readback, shown->readback());
+    }
+    auto keep = outputs.callback();
+    const FrameCallback onFrame = [&](const recordings::FrameRecord& f,
+                                      const pipeline::scene::SceneState& state,
+                                      const pipeline::render::RenderedFrame& image) {
+        keep(f, state, image);
+        if (shown) {
+            shown->onFrame(f, state, image);
+        }
+    };
+    const auto wallStart = std::chrono::steady_clock::now();
     auto stats = runFrames(**appliance, *sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
-                           recorder.get(), readback, outputs.callback());
+                           recorder.get(), readback, onFrame);
+    const double wallS =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    if (shown) {
+        shown->finish(); // the last thumbnail and the log tap, before the writer closes
+    }
     if (!stats) {
         log->error("{}", stats.error().message);
         return kExitFailure;
     }
     int code = recordFailed ? kExitFailure : kExitOk;
+    nlohmann::json summary{{"command", "run"}, {"frames", stats->frames}, {"wall_s", wallS}};
     if (recorder) {
         if (auto closed = recorder->close(); !closed) {
             // Already logged by onError when it happened; say where the run stands.
             log->warn("recording {} is incomplete; 'replica recover' rebuilds what was written",
                       o.record);
             code = kExitFailure;
-        } else {
+        } else if (!o.json) {
             fmt::print("recording: {}\n", o.record);
         }
+        const auto ws = recorder->stats();
+        summary["recording"] = {{"file", o.record},      {"complete", code == kExitOk},
+                                {"bytes", ws.bytes},     {"messages", ws.messages},
+                                {"dropped", ws.dropped}, {"rejected_nonfinite", ws.rejected},
+                                {"chunks", ws.chunks}};
+    }
+    if (shown) {
+        const auto ss = shown->stats();
+        const auto n = static_cast<double>(std::max<std::uint64_t>(ss.thumbnails, 1));
+        const auto d = static_cast<double>(std::max<std::uint64_t>(ss.digests, 1));
+        summary["shown"] = {{"display_digests", ss.digests},
+                            {"digest_ms_mean", ss.digestMsTotal / d},
+                            {"thumbnails", ss.thumbnails},
+                            {"thumbnail_bytes", ss.thumbnailBytes},
+                            {"thumbnails_skipped", ss.thumbnailsSkipped},
+                            {"thumbnail_copy_ms_mean", ss.copyMsTotal / n},
+                            {"thumbnail_encode_ms_mean", ss.encodeMsTotal / n},
+                            {"light_changes", ss.lightChanges},
+                            {"poses", ss.poses}};
+        log->info("recorded what was shown: {} display digests ({:.3f} ms each in the frame), {} "
+                  "thumbnails ({} bytes; {:.3f} ms copy in the frame, {:.2f} ms encode off it), {} "
+                  "light decisions, {} poses",
+                  ss.digests, ss.digestMsTotal / d, ss.thumbnails, ss.thumbnailBytes,
+                  ss.copyMsTotal / n, ss.encodeMsTotal / n, ss.lightChanges, ss.poses);
     }
     if (auto ok = outputs.finish(o.digests, o.snapshot); !ok) {
         log->error("{}", ok.error().message);
         return kExitFailure;
     }
     if (!o.digests.empty()) {
-        fmt::print("digests: {}\n", o.digests);
+        summary["digests"] = {{"file", o.digests}, {"hash", digestHashName(kDigestHash)}};
+        if (!o.json) {
+            fmt::print("digests: {}\n", o.digests);
+        }
     }
     if (!o.snapshot.empty()) {
-        fmt::print("snapshot: {}\n", o.snapshot);
+        summary["snapshot"] = o.snapshot;
+        if (!o.json) {
+            fmt::print("snapshot: {}\n", o.snapshot);
+        }
     }
     if (sources->lampSelector) {
         log->info("lamp selector {} [{} {}]: overruled by the spectrometer {} times",
@@ -459,9 +524,10 @@ int runMain(const RunOptions& given)
               stats->maxOutOfGamutFraction);
     const FrameTimes& t = stats->frameTimes;
     const double periodMs = 1000.0 / o.rateHz;
-    // --digests reads every frame back as float XYZ and hashes it byte by byte (FNV-1a, the
-    // format's), inside each frame's time: about 19 ms at 960x600 on a 2-core machine, which the
-    // kiosk never pays. Said so that the figure is not taken for the appliance's.
+    // --digests reads every frame back as float XYZ and hashes it (XXH3-64, digest format 2; about
+    // 1 ms for the 11.5 MB of a 960x600 frame, docs/performance.md) inside each frame's time; the
+    // read-back of the XYZ frame costs more than the hash. Said so that the figure is not taken
+    // for the appliance's.
     log->info("frame time: mean {:.1f} ms ({:.0f} frames/s), 95th percentile {:.1f}, max {:.1f}; "
               "{} of {} frames took the whole {:.1f} ms period or more{}",
               t.meanMs(), t.meanMs() > 0.0 ? 1000.0 / t.meanMs() : 0.0, t.percentileMs(0.95),
@@ -469,6 +535,21 @@ int runMain(const RunOptions& given)
               o.digests.empty() ? ""
                                 : " (including --digests: each frame read back as XYZ and "
                                   "hashed, which a run without it does not do)");
+    summary["exit_code"] = code;
+    summary["late_frames"] = stats->lateFrames;
+    summary["dropped"] = {{"spectrometer", stats->droppedSpectra},
+                          {"tracker", stats->droppedPoses},
+                          {"accel", stats->droppedAccel},
+                          {"lamp_selector", stats->droppedLamp}};
+    summary["frame_time_ms"] = {{"mean", t.meanMs()},
+                                {"p95", t.percentileMs(0.95)},
+                                {"max", t.maxMs()},
+                                {"at_least_period", t.atLeast(periodMs)}};
+    summary["out_of_gamut"] = {{"mean", stats->meanOutOfGamutFraction()},
+                               {"max", stats->maxOutOfGamutFraction}};
+    if (o.json) {
+        fmt::print("{}\n", summary.dump(2));
+    }
     return code;
 }
 
@@ -556,6 +637,21 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                     "cut loses at most about this much")
             ->check(CLI::Range(10, 10000))
             ->capture_default_str();
+    cmd->add_option("--record-digests", opts->recordDigests,
+                    "with --record: an XXH3-64 digest of every frame sent to the panel in the "
+                    "recording (/replica/display_digest; replay checks it)")
+            ->capture_default_str();
+    cmd->add_option("--thumbnail-hz", opts->thumbnailHz,
+                    "with --record: PNG thumbnails of the displayed frame per second of session "
+                    "time (/replica/thumbnail); 0: none")
+            ->check(CLI::Range(0.0, 60.0))
+            ->capture_default_str();
+    cmd->add_option("--thumbnail-width", opts->thumbnailWidth, "thumbnail width (pixels)")
+            ->check(CLI::Range(16, 4096))
+            ->capture_default_str();
+    cmd->add_flag("--json", opts->json,
+                  "print a JSON summary (frames, frame times, drops, recording, outputs) on "
+                  "standard output instead of the text lines");
     cmd->add_option("--digests", opts->digests, "write one digest per frame to FILE (JSON)");
     cmd->add_option("--snapshot", opts->snapshot, "write the last frame to FILE (PNG)");
     cmd->add_option("--scene", opts->scene,

@@ -1,9 +1,10 @@
-// FNV-1a frame digests and their JSON file.
+// Frame digests (FNV-1a for version 1 files, XXH3-64 for version 2) and their JSON file.
 #include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <xxhash.h>
 
 #include <pipeline/base/input_file.h>
 #include <platform/loop/frame_digest.h>
@@ -20,7 +21,23 @@ std::uint64_t fnv1a64(std::span<const std::uint8_t> bytes)
     return h;
 }
 
-Expected<void> writeDigests(const std::filesystem::path& path, const std::vector<FrameDigest>& d)
+std::uint64_t xxh3_64(std::span<const std::uint8_t> bytes)
+{
+    return XXH3_64bits(bytes.data(), bytes.size());
+}
+
+std::uint64_t frameHash(DigestHash hash, std::span<const std::uint8_t> bytes)
+{
+    return hash == DigestHash::Fnv1a64 ? fnv1a64(bytes) : xxh3_64(bytes);
+}
+
+const char* digestHashName(DigestHash hash)
+{
+    return hash == DigestHash::Fnv1a64 ? "fnv1a64" : "xxh3_64";
+}
+
+Expected<void>
+writeDigests(const std::filesystem::path& path, const std::vector<FrameDigest>& d, DigestHash hash)
 {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     if (!out) {
@@ -29,7 +46,14 @@ Expected<void> writeDigests(const std::filesystem::path& path, const std::vector
                                      path.string()));
     }
     // One frame per line so that a diff of two digest files points at the frame.
-    out << "{\"format\": \"replica-digests\", \"version\": 1, \"frames\": [\n";
+    // Version 1 files name no hash (FNV-1a); version 2 says it.
+    if (hash == DigestHash::Fnv1a64) {
+        out << "{\"format\": \"replica-digests\", \"version\": 1, \"frames\": [\n";
+    } else {
+        out << fmt::format("{{\"format\": \"replica-digests\", \"version\": {}, \"hash\": "
+                           "\"{}\", \"frames\": [\n",
+                           static_cast<int>(hash), digestHashName(hash));
+    }
     for (std::size_t i = 0; i < d.size(); ++i) {
         out << fmt::format("  {{\"frame\": {}, \"tick_ns\": {}, \"xyz\": \"{:016x}\", \"rgba\": "
                            "\"{:016x}\"}}{}\n",
@@ -44,7 +68,7 @@ Expected<void> writeDigests(const std::filesystem::path& path, const std::vector
     return {};
 }
 
-Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path)
+Expected<DigestFile> readDigestFile(const std::filesystem::path& path)
 {
     auto in = readInputFile(path, kMaxJsonBytes, "digests");
     if (!in) {
@@ -54,12 +78,24 @@ Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path
         }
         return tl::unexpected(in.error());
     }
-    std::vector<FrameDigest> out;
+    DigestFile file;
+    auto& out = file.frames;
     try {
         const auto j = nlohmann::json::parse(*in);
         if (j.value("format", "") != "replica-digests") {
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: not a replica digest file", path.string()));
+        }
+        const int version = j.value("version", 1);
+        if (version == 1) {
+            file.hash = DigestHash::Fnv1a64;
+        } else if (version == 2 && j.value("hash", "") == "xxh3_64") {
+            file.hash = DigestHash::Xxh3_64;
+        } else {
+            return makeError(ErrorCode::Unsupported,
+                             fmt::format("{}: digest file version {} (hash '{}') is not one this "
+                                         "replica knows (1: fnv1a64, 2: xxh3_64); update replica",
+                                         path.string(), version, j.value("hash", "")));
         }
         for (const auto& f : j.at("frames")) {
             FrameDigest d;
@@ -73,7 +109,16 @@ Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: malformed digest file: {}", path.string(), e.what()));
     }
-    return out;
+    return file;
+}
+
+Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path)
+{
+    auto file = readDigestFile(path);
+    if (!file) {
+        return tl::unexpected(file.error());
+    }
+    return std::move(file->frames);
 }
 
 long firstDifference(const std::vector<FrameDigest>& a, const std::vector<FrameDigest>& b)

@@ -1,4 +1,8 @@
-// Frame digests: a 64-bit FNV-1a hash of each read-back frame, written as JSON for replay checks.
+// Frame digests: a 64-bit hash of each read-back frame, written as JSON for replay checks.
+// Digest files of version 1 hash with FNV-1a (byte at a time, ~19 ms a 960x600 XYZ frame); version
+// 2, what new runs write, with XXH3-64 from libxxhash (the same frame in about 1 ms). A replay
+// checked against a golden hashes with the golden's own algorithm, so version 1 goldens still
+// verify.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +16,14 @@
 namespace replica::platform {
 
 std::uint64_t fnv1a64(std::span<const std::uint8_t> bytes);
+// XXH3-64 with seed 0 (the reference algorithm's default, as `xxhsum -H3` prints it).
+std::uint64_t xxh3_64(std::span<const std::uint8_t> bytes);
+
+// A digest file's version is its hash: 1 = FNV-1a 64, 2 = XXH3-64.
+enum class DigestHash : int { Fnv1a64 = 1, Xxh3_64 = 2 };
+constexpr DigestHash kDigestHash = DigestHash::Xxh3_64; // what new digest files use
+std::uint64_t frameHash(DigestHash hash, std::span<const std::uint8_t> bytes);
+const char* digestHashName(DigestHash hash); // "fnv1a64", "xxh3_64"
 
 struct FrameDigest {
     std::uint64_t frameIndex = 0;
@@ -21,7 +33,16 @@ struct FrameDigest {
     bool operator==(const FrameDigest&) const = default;
 };
 
-Expected<void> writeDigests(const std::filesystem::path& path, const std::vector<FrameDigest>& d);
+struct DigestFile {
+    DigestHash hash = kDigestHash;
+    std::vector<FrameDigest> frames;
+};
+
+Expected<void> writeDigests(const std::filesystem::path& path,
+                            const std::vector<FrameDigest>& d,
+                            DigestHash hash = kDigestHash);
+Expected<DigestFile> readDigestFile(const std::filesystem::path& path);
+// The frames only (either version).
 Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path);
 
 // The first index where the two lists differ (in any field or in length), or -1 if they are equal.

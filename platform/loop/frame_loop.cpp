@@ -160,7 +160,8 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     pipeline::scene::SceneState state;
     pipeline::render::RenderedFrame image;
     bool stepping = pacing == Pacing::Step;
-    const auto wallStart = std::chrono::steady_clock::now();
+    auto wallStart = std::chrono::steady_clock::now();
+    bool afterWarmup = false;
 
     for (;;) {
         if (stopRequested()) {
@@ -172,7 +173,16 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             break;
         }
         const TickPlan& tick = *nextTick;
-        if (pacing == Pacing::Realtime) {
+        if (tick.warmup) {
+            afterWarmup = true;
+        } else if (pacing == Pacing::Realtime) {
+            if (afterWarmup) {
+                // Pace from here as if the session had started tickNs ago (a slice's first frame).
+                wallStart = std::chrono::steady_clock::now() -
+                            std::chrono::nanoseconds(std::min<std::int64_t>(
+                                    tick.tickNs, std::int64_t{1'000'000'000} * 86'400 * 365));
+                afterWarmup = false;
+            }
             // A recording's tick is untrusted (a tick_ns of 9e18 is 285 years away): computed
             // without overflow, and no frame waits more than a second. A live run's ticks are a
             // period apart, at most a second (--rate >= 1), so this never shortens one.

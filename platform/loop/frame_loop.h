@@ -27,6 +27,10 @@ struct TickPlan {
     std::uint64_t frameIndex = 0;
     std::int64_t tickNs = 0;
     std::optional<recordings::FrameRecord> recorded;
+    // Replay of a slice ('replay --from'): a frame before the slice, rendered only so that the
+    // state carried from frame to frame (classifier, held samples, caches) is the recording's. It
+    // never waits for its tick or for a step; the first frame after it anchors the pacing.
+    bool warmup = false;
 };
 
 // Ticks k * period for k = 0 .. frames-1.

@@ -55,6 +55,8 @@ public:
     // The classifier's current answer (name "unknown" in direct-sensor mode).
     pipeline::spectral::Classification classification() const;
     const LampArbiter& lampArbiter() const { return arbiter_; }
+    // Where the tracker is mounted in the booth (its frame is the booth's, translated).
+    glm::dvec3 trackerInBoothM() const { return setup_.trackerInBoothM; }
 
 private:
     SceneUpdater(SceneUpdaterSetup setup,

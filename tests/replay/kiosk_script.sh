@@ -28,7 +28,7 @@ else
     status=1
 fi
 case "$out" in
-"/opt/replica run --hal live --output kms --frames 0 --record $work/"*.mcap) ;;
+"/opt/replica run --hal live --output kms --frames 0 --record $work/"*".mcap --record-digests true") ;;
 *) echo "FAIL: unexpected command: $out" >&2; status=1 ;;
 esac
 kept=$(cd "$work" && ls -1 | sort | tr '\n' ' ')

@@ -3,8 +3,11 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <thread>
 
 #include <recordings/recording.h>
+#include <recordings/sample_codec.h>
 
 #include <gtest/gtest.h>
 
@@ -113,6 +116,75 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
         EXPECT_EQ(r->lampSelector[i].lineLevels, want.lineLevels);
         EXPECT_EQ(r->lampSelector[i].lineCount, want.lineCount);
     }
+    std::filesystem::remove(path);
+}
+
+// Format 4: what was shown. Digests and decided lights read back; thumbnails and log lines written
+// from other threads arrive whole; the pose channels carry the tilt as a quaternion.
+TEST(RecordingRoundTrip, WhatWasShownComesBack)
+{
+    const auto path = tempFile("shown");
+    SessionInfo session;
+    session.wallClockStartNs = 1'700'000'000'000'000'000;
+    {
+        auto w = RecordingWriter::create(path, session);
+        ASSERT_TRUE(w) << w.error().message;
+        (*w)->write(DisplayDigestRecord{0, 0, 0x0123456789abcdefULL});
+        (*w)->write(DisplayDigestRecord{1, 16'666'667, 0xfedcba9876543210ULL});
+        LightRecord l;
+        l.tNs = 16'666'667;
+        l.frameIndex = 1;
+        l.mode = "lamp";
+        l.lamp = 2;
+        l.name = "d65-fluorescent";
+        l.cctK = 6500.25;
+        l.duv = -0.001;
+        l.distance = 0.01;
+        l.why = "the booth's lamp selector is set to d65-fluorescent (lamp 2)";
+        (*w)->write(l);
+        (*w)->write(PosesRecord{16'666'667, {0.0, 0.45, 0.6}, 0.5, {0.0, 0.42, 0.05}});
+        std::thread other([&] {
+            (*w)->write(ThumbnailRecord{0, 0, {0x89, 'P', 'N', 'G'}});
+            (*w)->write(LogRecord{5, 3, "loop", "spectrometer S1: 2 spectra dropped"});
+        });
+        other.join();
+        ASSERT_TRUE((*w)->close());
+        EXPECT_EQ((*w)->stats().dropped, 0u);
+    }
+    auto r = readRecording(path);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->formatVersion, 4);
+    ASSERT_EQ(r->displayDigests.size(), 2u);
+    EXPECT_EQ(r->displayDigests[1].rgba, 0xfedcba9876543210ULL);
+    EXPECT_EQ(r->displayDigests[1].tickNs, 16'666'667);
+    ASSERT_EQ(r->lights.size(), 1u);
+    EXPECT_EQ(r->lights[0].name, "d65-fluorescent");
+    EXPECT_EQ(r->lights[0].cctK, 6500.25);
+    EXPECT_EQ(r->lights[0].why, "the booth's lamp selector is set to d65-fluorescent (lamp 2)");
+    const auto report = inspectRecording(path);
+    ASSERT_TRUE(report);
+    std::map<std::string, std::uint64_t> counts;
+    for (const auto& c : report->channels) {
+        counts[c.topic] = c.messages;
+    }
+    EXPECT_EQ(counts["/replica/thumbnail"], 1u);
+    EXPECT_EQ(counts["/replica/log"], 1u);
+    EXPECT_EQ(counts["/tf"], 1u);
+    EXPECT_EQ(counts["/replica/eye"], 1u);
+    // The transforms: the panel turned by the tilt about x, (sin(a/2), 0, 0, cos(a/2)).
+    const auto tf = encodeTransforms(PosesRecord{0, {0.0, 0.45, 0.6}, 0.5, {0.0, 0.42, 0.05}},
+                                     session.wallClockStartNs);
+    ASSERT_TRUE(tf);
+    const auto j = nlohmann::json::parse(*tf);
+    EXPECT_EQ(j["transforms"][0]["child_frame_id"], "panel");
+    EXPECT_DOUBLE_EQ(j["transforms"][0]["rotation"]["x"].get<double>(), std::sin(0.25));
+    EXPECT_DOUBLE_EQ(j["transforms"][0]["rotation"]["w"].get<double>(), std::cos(0.25));
+    EXPECT_EQ(j["transforms"][0]["timestamp"]["sec"], 1'700'000'000);
+    const auto log = nlohmann::json::parse(
+            encodeLog(LogRecord{1'500'000'000, 4, "rec", "x"}, session.wallClockStartNs));
+    EXPECT_EQ(log["timestamp"]["sec"], 1'700'000'001);
+    EXPECT_EQ(log["timestamp"]["nsec"], 500'000'000);
+    EXPECT_EQ(log["level"], 4);
     std::filesystem::remove(path);
 }
 
