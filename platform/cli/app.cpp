@@ -7,6 +7,7 @@
 #include <platform/cli/app.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
+#include <platform/version.h>
 
 namespace replica::platform {
 
@@ -15,7 +16,7 @@ int runCli(int argc, char** argv)
     CLI::App app{"replica: shows a reflective surface on a self-luminous display as it would look "
                  "in the real light in front of it"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", std::string("replica ") + REPLICA_VERSION);
+    app.set_version_flag("--version", versionString());
     std::string logLevel = "info";
     app.add_option("--log-level", logLevel,
                    "log level for every logger (trace, debug, info, warn, error), or per logger as "
@@ -34,6 +35,7 @@ int runCli(int argc, char** argv)
     registerColorCommand(app, exitCode);
     registerSpectralCommand(app, exitCode);
     registerProbeCommand(app, exitCode);
+    registerConfigCommand(app, exitCode);
 
     app.parse_complete_callback([&] { setupLogging(logLevel); });
     try {

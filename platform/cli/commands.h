@@ -21,5 +21,6 @@ void registerRecoverCommand(CLI::App& app, int& exitCode);
 void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
 void registerProbeCommand(CLI::App& app, int& exitCode);
+void registerConfigCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform

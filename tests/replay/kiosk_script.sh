@@ -1,23 +1,20 @@
 #!/usr/bin/env bash
-# deploy/kiosk/replica-kiosk: runs the live appliance with a fresh session file and keeps only the
-# newest recordings, so a long-running gallery never fills its disk.
+# deploy/kiosk/replica-kiosk: runs 'replica run --kiosk' on the site file (its own or
+# $REPLICA_CONFIG), passing extra options through.
 set -uo pipefail
 script="$1"
 work="$2"
 rm -rf "$work" && mkdir -p "$work"
-for i in 1 2 3 4 5; do
-    touch -d "-$i hour" "$work/old$i.mcap"
-done
-out=$(REPLICA_SESSIONS="$work" REPLICA_KEEP_SESSIONS=3 REPLICA_BIN=/opt/replica "$script" --dry-run)
 status=0
-case "$out" in
-"/opt/replica run --hal live --output kms --frames 0 --record $work/"*.mcap) ;;
-*) echo "FAIL: unexpected command: $out" >&2; status=1 ;;
-esac
-kept=$(cd "$work" && ls -1 | sort | tr '\n' ' ')
-if [ "$kept" != "old1.mcap old2.mcap old3.mcap " ]; then
-    echo "FAIL: kept '$kept', expected the three newest" >&2
+out=$(REPLICA_BIN=/opt/replica "$script" --dry-run)
+if [ "$out" != "/opt/replica run --kiosk --config /etc/replica/replica.toml" ]; then
+    echo "FAIL: unexpected command: $out" >&2
     status=1
 fi
-[ $status -eq 0 ] && echo "ok: $out; kept $kept"
+out2=$(REPLICA_CONFIG="$work/site.toml" REPLICA_BIN=/opt/replica "$script" --dry-run --frames 5)
+if [ "$out2" != "/opt/replica run --kiosk --config $work/site.toml --frames 5" ]; then
+    echo "FAIL: unexpected command: $out2" >&2
+    status=1
+fi
+[ $status -eq 0 ] && echo "ok: $out; $out2"
 exit $status
