@@ -219,7 +219,12 @@ int runMain(const RunOptions& o)
                   "characterised panel; colours on screen are not the surface's",
                   config.displayPeakCdM2);
     } else if (!o.displayProfile.empty()) {
-        config.display = std::filesystem::absolute(o.displayProfile).string();
+        // Like the scene: relative to the data folder when inside it, so that a recording made
+        // on the installed appliance replays on a build tree.
+        std::error_code ec;
+        const auto abs = std::filesystem::weakly_canonical(o.displayProfile, ec);
+        const auto rel = abs.lexically_relative(std::filesystem::weakly_canonical(dataDir(), ec));
+        config.display = !rel.empty() && *rel.begin() != ".." ? rel.string() : abs.string();
     }
     config.displayInverse = o.displayInverse;
     config.gamutMapping = o.gamut;

@@ -175,12 +175,14 @@ Expected<LoopStats> runFrames(Appliance& appliance,
                                                std::chrono::steady_clock::now() - wallStart)
                                                .count();
             const std::uint64_t skip = ticksToSkip(nowNs, nextTick->tickNs, options.periodNs);
-            for (std::uint64_t i = 0; i < skip && nextTick; ++i) {
-                nextTick = ticks();
+            // The plan's last tick is rendered even when late: a fixed run ends on its last frame.
+            for (std::uint64_t i = 0; i < skip; ++i) {
+                std::optional<TickPlan> later = ticks();
+                if (!later) {
+                    break;
+                }
+                nextTick = std::move(later);
                 ++stats.skippedTicks;
-            }
-            if (!nextTick) {
-                break;
             }
             if (skip > 0) {
                 log->debug("late: skipped {} ticks to frame {}", skip, nextTick->frameIndex);

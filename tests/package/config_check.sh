@@ -77,6 +77,7 @@ rate_hz = 30.0
 [display]
 output = "headless"
 size = "64x40"
+profile = "displays/wide-ips-synthetic.json"
 [stand]
 panel_width_m = 0.6
 [defaults]
@@ -104,6 +105,7 @@ assert cfg["width"] == 48 and cfg["height"] == 30, (cfg["width"], cfg["height"])
 assert cfg["rate_hz"] == 30.0, cfg["rate_hz"]                                     # from the file
 assert cfg["panel_width_m"] == 0.6 and cfg["panel_height_m"] == 0.324
 assert cfg["default_lamp"] == "tungsten"
+assert cfg["display"] == "displays/wide-ips-synthetic.json", cfg["display"]  # portable: data-relative
 assert cfg["run_options"]["hal"] == "sim"
 assert cfg["site"]["source"].endswith("good.toml")
 print("recorded:", cfg["width"], cfg["height"], cfg["rate_hz"], cfg["panel_width_m"])
