@@ -71,7 +71,18 @@ std::string RunConfig::toJson() const
                      {"viewing_compensation", viewingCompensation},
                      {"viewing_filtered", viewingFiltered},
                      {"flare_subtraction", flareSubtraction},
-                     {"false_colour", falseColour}};
+                     {"false_colour", falseColour},
+                     {"stand_hinge_m", {stand.hingeM.x, stand.hingeM.y, stand.hingeM.z}},
+                     {"stand_hinge_to_panel_m", stand.hingeToPanelM},
+                     {"panel_width_m", stand.panelWidthM},
+                     {"panel_height_m", stand.panelHeightM},
+                     {"tracker_rotation_deg",
+                      {trackerRotationDeg.x, trackerRotationDeg.y, trackerRotationDeg.z}},
+                     {"tracker_translation_m",
+                      {trackerTranslationM.x, trackerTranslationM.y, trackerTranslationM.z}},
+                     {"default_lamp", defaultLamp},
+                     {"default_eye_m", {defaultEyeM.x, defaultEyeM.y, defaultEyeM.z}},
+                     {"default_tilt_rad", defaultTiltRad}};
     if (trackerInBooth) {
         std::vector<double> rotation;
         for (int i = 0; i < 3; ++i) {
@@ -148,6 +159,25 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
             x.translation = {t[0], t[1], t[2]};
             c.trackerInBooth = x;
         }
+        // Absent before the site file: the constants the code had then (the defaults).
+        const auto vec3 = [&j](const char* key, glm::dvec3& v) {
+            if (j.contains(key)) {
+                const auto a = j.at(key).get<std::vector<double>>();
+                if (a.size() != 3) {
+                    throw std::runtime_error(fmt::format("{}: expected 3 numbers", key));
+                }
+                v = {a[0], a[1], a[2]};
+            }
+        };
+        vec3("stand_hinge_m", c.stand.hingeM);
+        c.stand.hingeToPanelM = j.value("stand_hinge_to_panel_m", c.stand.hingeToPanelM);
+        c.stand.panelWidthM = j.value("panel_width_m", c.stand.panelWidthM);
+        c.stand.panelHeightM = j.value("panel_height_m", c.stand.panelHeightM);
+        vec3("tracker_rotation_deg", c.trackerRotationDeg);
+        vec3("tracker_translation_m", c.trackerTranslationM);
+        c.defaultLamp = j.value("default_lamp", std::string());
+        vec3("default_eye_m", c.defaultEyeM);
+        c.defaultTiltRad = j.value("default_tilt_rad", c.defaultTiltRad);
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
     }
@@ -172,6 +202,18 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
                         "out of range",
                         c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz, c.lightsU,
                         c.lightsV));
+    }
+    const auto finite3 = [](const glm::dvec3& v) {
+        return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+    };
+    if (!finite3(c.stand.hingeM) || !std::isfinite(c.stand.hingeToPanelM) ||
+        !(c.stand.panelWidthM > 0.0 && c.stand.panelWidthM <= 10.0) ||
+        !(c.stand.panelHeightM > 0.0 && c.stand.panelHeightM <= 10.0) ||
+        !finite3(c.trackerRotationDeg) || !finite3(c.trackerTranslationM) ||
+        !finite3(c.defaultEyeM) || !std::isfinite(c.defaultTiltRad)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "run configuration: stand, panel size, tracker transform or default "
+                         "eye/tilt not finite or out of range");
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -400,6 +442,7 @@ makeBoothScene(RunConfig& config,
     setup.basis = basis;
     setup.adaptive = std::move(adaptive);
     setup.observer = observer;
+    setup.stand = config.stand;
     // The counts chosen for the scene, recorded.
     if (config.specularSamples == kAutoSpecularSamples) {
         config.specularSamples = pipeline::shading::defaultSpecularSamples(setup.scene);
@@ -557,6 +600,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     app->output = std::move(*output);
 
     pipeline::render::GlesRendererSetup setup;
+    setup.stand = config.stand;
     setup.width = config.width;
     setup.height = config.height;
     setup.booth = app->booth;
@@ -587,6 +631,25 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     updaterSetup.booth = app->booth;
     updaterSetup.calibration = *calibration;
     updaterSetup.trackerInBooth = config.trackerInBooth;
+    updaterSetup.trackerRotationDeg = config.trackerRotationDeg;
+    updaterSetup.trackerInBoothM = config.trackerTranslationM;
+    updaterSetup.defaultEyeM = config.defaultEyeM;
+    updaterSetup.defaultTiltRad = config.defaultTiltRad;
+    if (!config.defaultLamp.empty()) {
+        const auto& lamps = app->booth.lamps;
+        const auto it = std::find_if(lamps.begin(), lamps.end(),
+                                     [&](const auto& l) { return l.name == config.defaultLamp; });
+        if (it == lamps.end()) {
+            std::string names;
+            for (const auto& l : lamps) {
+                names += (names.empty() ? "" : ", ") + l.name;
+            }
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
+                                         config.defaultLamp, config.booth, names));
+        }
+        updaterSetup.defaultLamp = static_cast<int>(it - lamps.begin());
+    }
     auto updater = SceneUpdater::create(std::move(updaterSetup));
     if (!updater) {
         return tl::unexpected(updater.error());

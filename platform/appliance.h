@@ -15,6 +15,7 @@
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/renderer.h>
 #include <pipeline/scene/calibration.h>
+#include <pipeline/scene/stand.h>
 #include <platform/loop/scene_updater.h>
 #include <platform/output/output.h>
 #include <recordings/recording.h>
@@ -139,6 +140,19 @@ struct RunConfig {
     // file by 'replica run --site'). Absent: the fixed mounting, an unrotated tracker at
     // SceneUpdaterSetup::trackerInBoothM, which recordings made without it replay with.
     std::optional<pipeline::scene::RigidTransform> trackerInBooth;
+    // The site's geometry (the site file's [stand] and [tracker]): the stand's hinge and the
+    // panel's physical size, and T_booth_tracker, eye_booth = R(trackerRotationDeg, applied about
+    // x, then y, then z) * eye_tracker + trackerTranslationM. Recordings made before have none
+    // and replay with these defaults, the constants the code had then.
+    pipeline::scene::StandModel stand;
+    glm::dvec3 trackerRotationDeg{0.0};
+    glm::dvec3 trackerTranslationM{0.0, 0.42, 0.05};
+    // The scene before each sensor's first sample (the site file's [defaults]): the lamp shown
+    // until the first spectrum (a booth lamp's name; empty: no light, black, as recordings made
+    // before have), the eye until the first pose, the tilt until the first gravity sample.
+    std::string defaultLamp;
+    glm::dvec3 defaultEyeM{0.0, 0.45, 0.60};
+    double defaultTiltRad = 0.0;
 
     std::int64_t periodNs() const;
     std::string toJson() const;

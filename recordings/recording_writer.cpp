@@ -35,6 +35,7 @@ using Clock = std::chrono::steady_clock;
 
 // How long the writer thread sleeps when the queue is empty (a write() also wakes it).
 constexpr auto kPoll = std::chrono::milliseconds(10);
+constexpr Clock::time_point kNoChunk = Clock::time_point::min();
 
 std::uint64_t logTime(std::int64_t wallStart, std::int64_t t)
 {
@@ -170,11 +171,14 @@ private:
     void loop()
     {
         std::unique_lock lock(mutex_);
-        std::optional<Clock::time_point> chunkOpened;
+        // When the open chunk got its first item; Clock::time_point::min(): no chunk open. (A
+        // sentinel rather than std::optional: GCC 12 at -O3 reports the optional's value as
+        // maybe-uninitialized behind the has_value() test.)
+        Clock::time_point chunkOpened = kNoChunk;
         for (;;) {
             const bool stopping = stopping_.load(std::memory_order_acquire);
             while (auto item = queue_.tryPop()) {
-                if (!chunkOpened) {
+                if (chunkOpened == kNoChunk) {
                     chunkOpened = Clock::now();
                 }
                 add(*item);
@@ -195,13 +199,14 @@ private:
             }
             // Close a little early so that a sample's queueing delay (at most kPoll) still fits
             // inside the promised interval.
-            if (chunkOpened && Clock::now() - *chunkOpened + kPoll >= options_.flushInterval) {
+            if (chunkOpened != kNoChunk &&
+                Clock::now() - chunkOpened + kPoll >= options_.flushInterval) {
                 flush(chunkOpened);
             }
             auto wait = kPoll;
-            if (chunkOpened) {
+            if (chunkOpened != kNoChunk) {
                 const auto due = std::chrono::duration_cast<std::chrono::milliseconds>(
-                        *chunkOpened + options_.flushInterval - kPoll - Clock::now());
+                        chunkOpened + options_.flushInterval - kPoll - Clock::now());
                 wait = std::clamp(due, std::chrono::milliseconds(1), kPoll);
             }
             wake_.wait_for(lock, wait);
@@ -304,9 +309,9 @@ private:
         }
     }
 
-    void flush(std::optional<Clock::time_point>& chunkOpened)
+    void flush(Clock::time_point& chunkOpened)
     {
-        chunkOpened.reset();
+        chunkOpened = kNoChunk;
         if (failed_) {
             return;
         }

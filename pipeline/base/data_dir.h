@@ -1,18 +1,14 @@
 // Where Replica's shipped data (spectra, booth lights, scenes, display profiles) is found.
 #pragma once
 
-#include <cstdlib>
 #include <filesystem>
 
 namespace replica {
 
-// $REPLICA_DATA_DIR if set, else the data/ folder of the source tree this binary was built from.
-inline std::filesystem::path dataDir()
-{
-    if (const char* env = std::getenv("REPLICA_DATA_DIR"); env != nullptr && *env != '\0') {
-        return env;
-    }
-    return REPLICA_SOURCE_DATA_DIR;
-}
+// In this order: $REPLICA_DATA_DIR if set; ../share/replica next to the running binary when it
+// is there (an installed binary, under any prefix, also one unpacked from the .deb); the data/
+// folder of the source tree this binary was built from (the build tree); the install data
+// folder configured at build time.
+std::filesystem::path dataDir();
 
 } // namespace replica

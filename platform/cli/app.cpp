@@ -14,6 +14,7 @@
 #include <platform/cli/app.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
+#include <platform/version.h>
 
 namespace replica::platform {
 namespace {
@@ -92,7 +93,7 @@ int runCli(int argc, char** argv)
     app.failure_message([](const CLI::App*, const CLI::Error& e) {
         return fmt::format("replica: {}; see 'replica --help'\n", oneLine(e.what()));
     });
-    app.set_version_flag("--version", std::string("replica ") + REPLICA_VERSION);
+    app.set_version_flag("--version", versionString());
     std::string logLevel = "info";
     auto* logOpt = app.add_option("--log-level", logLevel,
                                   "log level for every logger (trace, debug, info, warn, error, "
@@ -115,6 +116,7 @@ int runCli(int argc, char** argv)
     registerSpectralCommand(app, exitCode);
     registerProbeCommand(app, exitCode);
     registerCalibrateCommand(app, exitCode);
+    registerConfigCommand(app, exitCode);
     requireFiniteFloats(app);
 
     app.parse_complete_callback([&] {

@@ -22,5 +22,6 @@ void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
 void registerProbeCommand(CLI::App& app, int& exitCode);
 void registerCalibrateCommand(CLI::App& app, int& exitCode);
+void registerConfigCommand(CLI::App& app, int& exitCode);
 
 } // namespace replica::platform

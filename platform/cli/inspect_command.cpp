@@ -172,6 +172,7 @@ int inspectMain(const InspectOptions& o)
     nlohmann::json j{{"file", o.file},
                      {"format_version", rec->formatVersion},
                      {"software", rec->session.softwareVersion},
+                     {"config", nlohmann::json::parse(rec->session.configJson, nullptr, false)},
                      {"booth", rec->session.boothModel},
                      {"scene", rec->session.scene},
                      {"display_profile", rec->session.displayProfile},

@@ -4,7 +4,10 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
+#include <iterator>
+#include <numbers>
 #include <optional>
 #include <utility>
 
@@ -17,11 +20,16 @@
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/frame_outputs.h>
+#include <platform/fault_injection.h>
 #include <platform/live_sources.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 #include <platform/loop/shown_recorder.h>
+#include <platform/session_files.h>
+#include <platform/site_config.h>
 #include <platform/site_file.h>
+#include <platform/systemd_notify.h>
+#include <platform/version.h>
 #include <recordings/recording.h>
 
 namespace replica::platform {
@@ -36,7 +44,7 @@ struct RunOptions {
     std::string accel;
     std::string lampSelector;
     std::string replayFrom; // the recording that devices set to 'replay' play back
-    std::string site;       // site file: [tracker] T_booth_tracker
+    std::string sitePath;   // --site: [sources] and [tracker] T_booth_tracker (calibrate)
     std::string output = "headless";
     std::uint64_t frames = 180;
     std::string size = "960x600";
@@ -63,7 +71,96 @@ struct RunOptions {
     bool json = false;
     LiveOptions live;
     OutputChoice outputChoice;
+    std::string replayFile; // --hal replay
+    std::string config;     // the site file
+    bool kiosk = false;
+    std::string faults; // --inject-faults
+    // From the site file only (no command-line option).
+    std::optional<SiteConfig> site;
 };
+
+constexpr int kExitConfig = 78; // EX_CONFIG: the unit's RestartPreventExitStatus
+
+std::string dataPath(const std::string& p)
+{
+    const std::filesystem::path path(p);
+    return path.is_relative() ? (dataDir() / path).string() : path.string();
+}
+
+// The site file's values for every option the command line did not give.
+void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd)
+{
+    const auto unset = [&cmd](const char* name) { return cmd.get_option(name)->count() == 0; };
+    if (unset("--hal")) {
+        o.hal = s.hal;
+    }
+    if (unset("--replay-file")) {
+        o.replayFile = s.replayFile;
+    }
+    if (unset("--rate")) {
+        o.rateHz = s.rateHz;
+    }
+    if (unset("--output")) {
+        o.output = s.output;
+    }
+    if (unset("--size")) {
+        o.size = s.size;
+    }
+    if (unset("--kms-device")) {
+        o.outputChoice.kmsDevice = s.kmsDevice;
+    }
+    if (unset("--kms-connector")) {
+        o.outputChoice.kmsConnector = s.kmsConnector;
+    }
+    if (unset("--scene") && !s.sceneDir.empty()) {
+        o.scene = dataPath(s.sceneDir);
+    }
+    if (unset("--renderer")) {
+        o.renderer = s.renderer;
+    }
+    if (unset("--display-profile") && unset("--uncalibrated") && !s.displayProfile.empty()) {
+        o.displayProfile = dataPath(s.displayProfile);
+    }
+    if (unset("--tracker-port")) {
+        o.live.trackerPort = s.trackerPort;
+    }
+    if (unset("--tracker-bind")) {
+        o.live.trackerBind = s.trackerBind;
+    }
+    if (unset("--iio-root")) {
+        o.live.iioRoot = s.iioRoot;
+    }
+    if (unset("--accel-name")) {
+        o.live.accelName = s.accelName;
+    }
+    if (unset("--accel-axes")) {
+        o.live.accelAxes = s.accelAxes;
+    }
+    if (unset("--lamp-gpio")) {
+        o.live.lampGpio = s.lampGpio;
+    }
+    if (unset("--record-flush-ms")) {
+        o.recordFlushMs = s.flushMs;
+    }
+}
+
+// Whether the display profile is not a characterised panel: the nominal model, or a profile fitted
+// from synthetic measurements (its description says so, as 'replica display fit --synthetic'
+// writes it).
+bool syntheticDisplay(const RunConfig& config)
+{
+    if (config.display == kUncalibratedDisplay) {
+        return true;
+    }
+    std::ifstream in(dataPath(config.display));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    try {
+        const auto j = nlohmann::json::parse(text);
+        return j.value("description", std::string()).find("SYNTHETIC") != std::string::npos;
+    } catch (const std::exception&) {
+        return false; // buildAppliance reports an unreadable profile
+    }
+}
 
 std::optional<std::pair<int, int>> parseSize(const std::string& s)
 {
@@ -104,15 +201,16 @@ struct DeviceChoice {
 // override it per device. Usage errors come back as InvalidArgument.
 Expected<DeviceChoice> chooseDevices(const RunOptions& o)
 {
-    if (o.hal != "sim" && o.hal != "live") {
+    if (o.hal != "sim" && o.hal != "live" && o.hal != "replay") {
         return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("--hal {}: expected 'sim' (built-in simulated sensors) or "
-                                     "'live' (USB2000+, opentrack, IIO accelerometer)",
+                         fmt::format("--hal {}: expected 'sim' (built-in simulated sensors), "
+                                     "'live' (USB2000+, opentrack, IIO accelerometer) or 'replay' "
+                                     "(the samples of --replay-file)",
                                      o.hal));
     }
     DeviceChoice c;
     c.spectrometer = o.spectrometer.empty() ? o.hal : o.spectrometer;
-    c.tracker = !o.tracker.empty() ? o.tracker : (o.hal == "live" ? "opentrack" : "sim");
+    c.tracker = !o.tracker.empty() ? o.tracker : o.hal == "live" ? "opentrack" : o.hal;
     c.accel = o.accel.empty() ? o.hal : o.accel;
     c.lampSelector =
             !o.lampSelector.empty() ? o.lampSelector : (o.live.lampGpio.empty() ? "none" : "gpio");
@@ -242,9 +340,9 @@ int runMain(const RunOptions& given)
 {
     auto log = logger("replica");
     RunOptions o = given;
-    if (!o.site.empty()) {
+    if (!o.sitePath.empty()) {
         // The site file's [sources] fill in what the command line leaves open.
-        auto site = readSiteSources(o.site);
+        auto site = readSiteSources(o.sitePath);
         if (!site) {
             log->error("{}", site.error().message);
             return kExitUsage;
@@ -257,6 +355,18 @@ int runMain(const RunOptions& given)
                 *cli = *fromSite;
             }
         }
+    }
+    if (o.hal == "replay" && o.replayFile.empty()) {
+        log->error("--hal replay needs --replay-file RECORDING (or run.replay_file in the site "
+                   "file)");
+        return kExitUsage;
+    }
+    if (o.hal == "replay" && o.replayFrom.empty()) {
+        o.replayFrom = o.replayFile; // every device replays it unless told otherwise
+    }
+    if (o.hal == "live" && o.fast) {
+        log->error("--fast needs the simulated sensors: live sensors run on the wall clock");
+        return kExitUsage;
     }
     if (auto choice = chooseDevices(o); !choice) { // usage errors before anything is built
         log->error("{}", choice.error().message);
@@ -339,17 +449,43 @@ int runMain(const RunOptions& given)
     config.viewingCompensation = !o.noViewing;
     config.flareSubtraction = !o.noFlare;
     config.falseColour = o.falseColour;
-    if (!o.site.empty()) {
-        auto t = readTrackerTransform(o.site);
+    if (!o.sitePath.empty()) {
+        auto t = readTrackerTransform(o.sitePath);
         if (!t && t.error().code != ErrorCode::NotFound) {
             log->error("{}", t.error().message);
             return kExitFailure;
         }
         if (t) {
             config.trackerInBooth = *t;
-            log->info("tracker pose in the booth from {} (T_booth_tracker)", o.site);
+            log->info("tracker pose in the booth from {} (T_booth_tracker)", o.sitePath);
         } else {
             log->warn("{}; using the fixed tracker mounting", t.error().message);
+        }
+    }
+    if (o.site) {
+        const SiteConfig& site = *o.site;
+        config.booth = site.boothId;
+        config.stand = site.stand;
+        config.trackerRotationDeg = site.trackerRotationDeg;
+        config.trackerTranslationM = site.trackerTranslationM;
+        config.defaultLamp = site.defaultLamp;
+        config.defaultEyeM = site.defaultEyeM;
+        config.defaultTiltRad = site.defaultTiltDeg * std::numbers::pi / 180.0;
+    }
+    if (o.hal == "live" && syntheticDisplay(config)) {
+        const bool allowed = o.site && o.site->allowSynthetic;
+        for (int i = 0; i < 3; ++i) {
+            log->warn("!!! LIVE RUN ON A SYNTHETIC DISPLAY PROFILE ({}): the colours on this "
+                      "screen are not the surface's. Characterise the panel ('replica display "
+                      "fit') and set display.profile in the site file. !!!",
+                      config.display);
+        }
+        if (o.kiosk && !allowed) {
+            log->error("{}: the kiosk refuses a live run on a synthetic display profile; set "
+                       "display.profile to the panel's profile, or display.allow_synthetic = "
+                       "true to accept wrong colours",
+                       o.site ? o.site->source.string() : std::string("(no site file)"));
+            return kExitConfig;
         }
     }
 
@@ -368,6 +504,16 @@ int runMain(const RunOptions& given)
         log->error("{}", sources.error().message);
         return kExitFailure; // usage errors were caught before anything was built
     }
+    if (!o.faults.empty()) {
+        auto plan = parseFaultPlan(o.faults);
+        if (!plan) {
+            log->error("{}", plan.error().message);
+            return kExitUsage;
+        }
+        injectFaults(*sources, *plan);
+        log->warn("injecting faults into the sensor samples: {}", o.faults);
+    }
+    log->info("{}; data {}", versionString(), dataDir().string());
     log->info("hal: spectrometer={} [{} {}], tracker={} [{} {}], accel={} [{} {}]; output={}; "
               "renderer={} on {}; {}x{} at {} Hz; display {}",
               hal::toString(sources->spectrometer->info().kind),
@@ -380,13 +526,33 @@ int runMain(const RunOptions& given)
               (*appliance)->displayProfileId);
 
     std::unique_ptr<recordings::RecordingWriter> recorder;
+    std::unique_ptr<SessionRecorder> sessions;
     bool recordFailed = false;
-    if (!o.record.empty()) {
+    const bool kioskRecording = o.kiosk && o.site && o.site->recordingEnabled && o.record.empty();
+    if (!o.record.empty() || kioskRecording) {
         recordings::SessionInfo session;
-        session.softwareVersion = std::string("replica ") + REPLICA_VERSION;
+        session.softwareVersion = versionString();
         // The configuration as built: the scene folder and digest, the display profile's digest.
         const RunConfig& built = (*appliance)->config;
-        session.configJson = built.toJson();
+        // The resolved configuration: the run configuration as built, the options the run
+        // resolved from the command line and the site file, and the site file itself.
+        auto resolved = nlohmann::json::parse(built.toJson());
+        resolved["run_options"] = {{"hal", o.hal},
+                                   {"replay_file", o.replayFile},
+                                   {"output", o.output},
+                                   {"kms_device", outputChoice.kmsDevice},
+                                   {"kms_connector", outputChoice.kmsConnector},
+                                   {"kiosk", o.kiosk},
+                                   {"tracker_port", o.live.trackerPort},
+                                   {"tracker_bind", o.live.trackerBind},
+                                   {"iio_root", o.live.iioRoot.string()},
+                                   {"accel_name", o.live.accelName},
+                                   {"accel_axes", o.live.accelAxes},
+                                   {"lamp_gpio", o.live.lampGpio}};
+        if (o.site) {
+            resolved["site"] = nlohmann::json::parse(o.site->toJson());
+        }
+        session.configJson = resolved.dump();
         session.boothModel = built.booth;
         session.scene = built.scene;
         session.displayProfile = (*appliance)->displayProfileId;
@@ -406,13 +572,33 @@ int runMain(const RunOptions& given)
         options.onError = [log](const Error& e) {
             log->error("{}; recording stopped, display continues", e.message);
         };
-        auto w = recordings::RecordingWriter::create(o.record, session, options);
-        if (!w) {
-            // The appliance still displays; the run reports failure at the end.
-            log->error("{}; running without recording", w.error().message);
-            recordFailed = true;
+        if (kioskRecording) {
+            const SiteConfig& site = *o.site;
+            const std::filesystem::path dir = site.recordingDirectory;
+            std::error_code ec;
+            std::filesystem::create_directories(dir, ec);
+            recoverUnfinished(dir);
+            RotationPolicy policy;
+            policy.rotateBytes = site.rotateBytes;
+            policy.rotateAge = std::chrono::seconds(site.rotateSeconds);
+            policy.keepBytes = site.keepBytes;
+            sessions = std::make_unique<SessionRecorder>(
+                    dir, policy, [session, options](const std::filesystem::path& path) {
+                        return recordings::RecordingWriter::create(path, session, options);
+                    });
+            if (auto ok = sessions->open(); !ok) {
+                log->error("{}; running without recording", ok.error().message);
+                sessions.reset();
+            }
         } else {
-            recorder = std::move(*w);
+            auto w = recordings::RecordingWriter::create(o.record, session, options);
+            if (!w) {
+                // The appliance still displays; the run reports failure at the end.
+                log->error("{}; running without recording", w.error().message);
+                recordFailed = true;
+            } else {
+                recorder = std::move(*w);
+            }
         }
     }
 
@@ -447,11 +633,25 @@ int runMain(const RunOptions& given)
             shown->onFrame(f, state, image);
         }
     };
+    SystemdNotifier notifier;
+    LoopOptions loopOptions;
+    loopOptions.skipLateTicks = true;
+    loopOptions.periodNs = config.periodNs();
+    loopOptions.afterFrame = [&notifier](const LoopStats& s) {
+        notifier.frameShown(s.frames, s.skippedTicks);
+    };
+    if (sessions) {
+        loopOptions.nextRecorder = [&sessions](recordings::RecordingWriter*) {
+            return sessions->afterFrame();
+        };
+    }
     const auto wallStart = std::chrono::steady_clock::now();
     auto stats = runFrames(**appliance, *sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
-                           recorder.get(), readback, onFrame);
+                           sessions ? sessions->current() : recorder.get(), readback, onFrame,
+                           loopOptions);
     const double wallS =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    notifier.stopping();
     if (shown) {
         shown->finish(); // the last thumbnail and the log tap, before the writer closes
     }
@@ -460,6 +660,16 @@ int runMain(const RunOptions& given)
         return kExitFailure;
     }
     int code = recordFailed ? kExitFailure : kExitOk;
+    if (sessions) {
+        if (auto closed = sessions->close(); !closed) {
+            log->warn("session {} is incomplete; the next start recovers it",
+                      sessions->currentPath().string());
+            code = kExitFailure;
+        } else {
+            fmt::print("recording: {} ({} rotations)\n", sessions->currentPath().string(),
+                       sessions->rotations());
+        }
+    }
     nlohmann::json summary{{"command", "run"}, {"frames", stats->frames}, {"wall_s", wallS}};
     if (recorder) {
         if (auto closed = recorder->close(); !closed) {
@@ -517,11 +727,12 @@ int runMain(const RunOptions& given)
                   sources->lampSelector->info().model, sources->lampSelector->info().serial,
                   (*appliance)->updater->lampArbiter().overruled());
     }
-    log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}, lamp selector "
-              "{}; late frames {}; out of gamut: mean {:.4f}, max {:.4f} of pixels",
-              stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
-              stats->droppedLamp, stats->lateFrames, stats->meanOutOfGamutFraction(),
-              stats->maxOutOfGamutFraction);
+    log->info(
+            "{} frames; dropped samples: spectrometer {}, tracker {}, accel {}, lamp selector "
+            "{}; late frames {}, skipped ticks {}; out of gamut: mean {:.4f}, max {:.4f} of pixels",
+            stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
+            stats->droppedLamp, stats->lateFrames, stats->skippedTicks,
+            stats->meanOutOfGamutFraction(), stats->maxOutOfGamutFraction);
     const FrameTimes& t = stats->frameTimes;
     const double periodMs = 1000.0 / o.rateHz;
     // --digests reads every frame back as float XYZ and hashes it (XXH3-64, digest format 2; about
@@ -530,8 +741,9 @@ int runMain(const RunOptions& given)
     // for the appliance's.
     log->info("frame time: mean {:.1f} ms ({:.0f} frames/s), 95th percentile {:.1f}, max {:.1f}; "
               "{} of {} frames took the whole {:.1f} ms period or more{}",
-              t.meanMs(), t.meanMs() > 0.0 ? 1000.0 / t.meanMs() : 0.0, t.percentileMs(0.95),
-              t.maxMs(), t.atLeast(periodMs), t.count(), periodMs,
+              t.meanMs(), t.meanMs() > 0.0 ? 1000.0 / t.meanMs() : 0.0, t.percentileMs(0.50),
+              t.percentileMs(0.95), t.percentileMs(0.99), t.maxMs(), t.atLeast(periodMs), t.count(),
+              periodMs,
               o.digests.empty() ? ""
                                 : " (including --digests: each frame read back as XYZ and "
                                   "hashed, which a run without it does not do)");
@@ -561,10 +773,26 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     auto* cmd =
             app.add_subcommand("run", "run the appliance: sensors -> scene -> render -> output at "
                                       "a fixed rate");
+    cmd->add_option("--config", opts->config,
+                    "site file (TOML, docs/appliance.md); the command line overrides it. "
+                    "--kiosk reads " +
+                            defaultSiteConfigPath().string() + " when none is given");
+    cmd->add_flag("--kiosk", opts->kiosk,
+                  "the gallery appliance: run until stopped, record sessions into the site "
+                  "file's recording.directory (rotated, oldest deleted beyond keep_bytes, a "
+                  "crashed session recovered at start); refuses a live run on a synthetic "
+                  "display profile unless display.allow_synthetic");
     cmd->add_option("--hal", opts->hal,
-                    "sensor sources: sim (built-in simulated sensors) or live (USB2000+ over "
-                    "libusb, opentrack UDP head poses, IIO accelerometer)")
+                    "sensor sources: sim (built-in simulated sensors), live (USB2000+ over "
+                    "libusb, opentrack UDP head poses, IIO accelerometer) or replay (the samples "
+                    "of --replay-file, then the last state held)")
             ->capture_default_str();
+    cmd->add_option("--replay-file", opts->replayFile, "--hal replay: the recording to play");
+    cmd->add_option("--inject-faults", opts->faults,
+                    "soak tests: nan-pose=N (every Nth head pose NaN), saturate=N (every Nth "
+                    "spectrum saturated), unplug=EVERY_S/FOR_S (spectrometer and tracker "
+                    "silent FOR_S of every EVERY_S)")
+            ->group("Testing");
     cmd->add_option("--tracker-port", opts->live.trackerPort,
                     "live: UDP port opentrack sends head poses to")
             ->capture_default_str();
@@ -601,7 +829,7 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--replay-from", opts->replayFrom,
                     "the recording that devices set to 'replay' play back (from its session "
                     "start)");
-    cmd->add_option("--site", opts->site,
+    cmd->add_option("--site", opts->sitePath,
                     "site configuration file (e.g. /etc/replica/replica.toml): [sources] "
                     "spectrometer/tracker/accel/lamp_selector (the command line wins) and the "
                     "calibrated tracker pose [tracker] T_booth_tracker from 'replica calibrate "
@@ -692,7 +920,50 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     cmd->add_flag("--false-colour", opts->falseColour,
                   "field-staff overlay: stripe out-of-gamut pixels (magenta: chroma, cyan: above "
                   "peak, blue: below black)");
-    cmd->callback([opts, &exitCode] { exitCode = runMain(*opts); });
+    cmd->callback([opts, cmd, &exitCode] {
+        RunOptions o = *opts;
+        std::string file = o.config;
+        if (file.empty() && o.kiosk) {
+            file = defaultSiteConfigPath().string();
+            std::error_code ec;
+            if (!std::filesystem::exists(file, ec)) {
+                logger("replica")->error("--kiosk: no site file at {}; install the package (it "
+                                         "ships one) or pass --config FILE",
+                                         file);
+                exitCode = kExitConfig;
+                return;
+            }
+        }
+        if (!file.empty()) {
+            auto site = loadSiteConfig(file);
+            if (!site) {
+                logger("replica")->error("{}", site.error().message);
+                exitCode = kExitConfig;
+                return;
+            }
+            if (!site->problems.empty()) {
+                for (const auto& p : site->problems) {
+                    logger("replica")->error("{}", formatProblem(file, p));
+                }
+                logger("replica")->error("{}: {} problems; 'replica config check {}' lists them",
+                                         file, site->problems.size(), file);
+                exitCode = kExitConfig;
+                return;
+            }
+            o.site = site->config;
+            applySite(*o.site, o, *cmd);
+            // The site's log levels, unless the command line or $REPLICA_LOG set them.
+            const auto* parent = cmd->get_parent();
+            if (parent != nullptr && parent->get_option("--log-level")->count() == 0 &&
+                std::getenv("REPLICA_LOG") == nullptr) {
+                setupLogging(o.site->logLevel);
+            }
+        }
+        if (o.kiosk && cmd->get_option("--frames")->count() == 0) {
+            o.frames = 0;
+        }
+        exitCode = runMain(o);
+    });
 }
 
 } // namespace replica::platform

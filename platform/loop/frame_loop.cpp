@@ -77,6 +77,9 @@ void installStopSignals()
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
+    // A file-size limit (ulimit -f) must fail the recording's write (EFBIG, reported like a full
+    // disk), not kill the display.
+    std::signal(SIGXFSZ, SIG_IGN);
 }
 
 TickSource endlessTicks(std::int64_t periodNs)
@@ -139,13 +142,22 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     return runFrames(appliance, sources, ticks, pacing, recorder, readback, onFrame);
 }
 
+std::uint64_t ticksToSkip(std::int64_t nowNs, std::int64_t tickNs, std::int64_t periodNs)
+{
+    if (periodNs <= 0 || nowNs - tickNs < periodNs) {
+        return 0;
+    }
+    return static_cast<std::uint64_t>((nowNs - tickNs) / periodNs);
+}
+
 Expected<LoopStats> runFrames(Appliance& appliance,
                               Sources& sources,
                               const TickSource& ticks,
                               Pacing pacing,
                               recordings::RecordingWriter* recorder,
                               pipeline::render::Readback readback,
-                              const FrameCallback& onFrame)
+                              const FrameCallback& onFrame,
+                              const LoopOptions& options)
 {
     auto log = logger("loop");
     LoopStats stats;
@@ -168,9 +180,27 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             log->info("stop requested: ending after {} frames", stats.frames);
             break;
         }
-        const std::optional<TickPlan> nextTick = ticks();
+        std::optional<TickPlan> nextTick = ticks();
         if (!nextTick) {
             break;
+        }
+        if (pacing == Pacing::Realtime && options.skipLateTicks) {
+            const std::int64_t nowNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                               std::chrono::steady_clock::now() - wallStart)
+                                               .count();
+            const std::uint64_t skip = ticksToSkip(nowNs, nextTick->tickNs, options.periodNs);
+            // The plan's last tick is rendered even when late: a fixed run ends on its last frame.
+            for (std::uint64_t i = 0; i < skip; ++i) {
+                std::optional<TickPlan> later = ticks();
+                if (!later) {
+                    break;
+                }
+                nextTick = std::move(later);
+                ++stats.skippedTicks;
+            }
+            if (skip > 0) {
+                log->debug("late: skipped {} ticks to frame {}", skip, nextTick->frameIndex);
+            }
         }
         const TickPlan& tick = *nextTick;
         if (tick.warmup) {
@@ -283,6 +313,29 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         stats.frameTimes.add(workMs);
         log->debug("frame {}: {:.1f} ms", tick.frameIndex, workMs);
         ++stats.frames;
+        if (options.afterFrame) {
+            options.afterFrame(stats);
+        }
+        if (options.nextRecorder) {
+            auto* next = options.nextRecorder(recorder);
+            if (next != recorder && next != nullptr) {
+                // The new file starts with what the scene holds now.
+                if (const auto* x = spectra.latest()) {
+                    next->write(*x);
+                }
+                if (const auto* x = poses.latest()) {
+                    next->write(*x);
+                }
+                if (const auto* x = accels.latest()) {
+                    next->write(*x);
+                }
+                if (const auto* x = selector.latest()) {
+                    next->write(*x);
+                }
+                ++stats.recorderRotations;
+            }
+            recorder = next;
+        }
     }
     if (stats.replayMismatches > 0) {
         log->warn("replay: {} recorded samples were missing; the latest sample was used instead",

@@ -45,7 +45,9 @@ struct LoopStats {
     std::uint64_t droppedAccel = 0;
     std::uint64_t droppedLamp = 0;
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
-    std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
+    std::uint64_t replayMismatches = 0;  // replay: a recorded sample was not found (latest used)
+    std::uint64_t skippedTicks = 0;      // LoopOptions::skipLateTicks: ticks never rendered
+    std::uint64_t recorderRotations = 0; // LoopOptions::nextRecorder returned a new recorder
     // Each frame's work on the wall clock, from polling the sources to handing the frame on
     // (not the wait for its tick): what says whether the machine keeps the rate.
     FrameTimes frameTimes;
@@ -78,6 +80,24 @@ void requestStop();
 bool stopRequested();
 void installStopSignals();
 
+// How many ticks to skip so that a frame starting nowNs (since the loop's start) renders a tick
+// less than one period old: floor((now - tick) / period) when the frame is at least one period
+// late, else 0. The ticks must be periodNs apart (fixedRatePlan, endlessTicks).
+std::uint64_t ticksToSkip(std::int64_t nowNs, std::int64_t tickNs, std::int64_t periodNs);
+
+struct LoopOptions {
+    // Realtime pacing only: skip (and count) the ticks a slow frame has already missed, so that
+    // the display lags its tick by less than one period. For 'replica run' (live pacing); a
+    // replay renders every recorded frame and leaves it off.
+    bool skipLateTicks = false;
+    std::int64_t periodNs = 0;
+    // After each frame: the systemd watchdog ping and readiness.
+    std::function<void(const LoopStats&)> afterFrame;
+    // After each frame: the recorder for the next frames, 'current' or a new one (rotation). A
+    // new one first gets the latest sample of each sensor, so that it replays on its own.
+    std::function<recordings::RecordingWriter*(recordings::RecordingWriter* current)> nextRecorder;
+};
+
 // Runs the plan. Every polled sample and every frame record go to 'recorder' when it is non-null;
 // 'readback' says which images onFrame needs.
 Expected<LoopStats> runFrames(Appliance& appliance,
@@ -95,6 +115,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
                               Pacing pacing,
                               recordings::RecordingWriter* recorder,
                               pipeline::render::Readback readback,
-                              const FrameCallback& onFrame);
+                              const FrameCallback& onFrame,
+                              const LoopOptions& options = {});
 
 } // namespace replica::platform

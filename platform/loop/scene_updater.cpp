@@ -1,5 +1,8 @@
 // Sample-to-scene conversion.
 #include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
 
 #include <pipeline/scene/stand.h>
 #include <platform/logging.h>
@@ -56,12 +59,40 @@ void SceneUpdater::showLamp(pipeline::scene::SceneState& state, int lamp) const
     state.emitterLuminanceCdM2 = l.luminanceCdM2;
 }
 
+void SceneUpdater::start(pipeline::scene::SceneState& state)
+{
+    started_ = true;
+    state.eyeBoothM = setup_.defaultEyeM;
+    state.tiltRad = setup_.defaultTiltRad;
+    if (setup_.defaultLamp >= 0 &&
+        setup_.defaultLamp < static_cast<int>(setup_.booth.lamps.size())) {
+        showLamp(state, setup_.defaultLamp);
+    }
+    const glm::dvec3 r = setup_.trackerRotationDeg * (std::numbers::pi / 180.0);
+    if (r != glm::dvec3(0.0)) {
+        const auto rx = glm::dmat3(1, 0, 0, 0, std::cos(r.x), std::sin(r.x), 0, -std::sin(r.x),
+                                   std::cos(r.x));
+        const auto ry = glm::dmat3(std::cos(r.y), 0, -std::sin(r.y), 0, 1, 0, std::sin(r.y), 0,
+                                   std::cos(r.y));
+        const auto rz = glm::dmat3(std::cos(r.z), std::sin(r.z), 0, -std::sin(r.z), std::cos(r.z),
+                                   0, 0, 0, 1);
+        trackerRotation_ = rz * ry * rx;
+    }
+}
+
 void SceneUpdater::update(pipeline::scene::SceneState& state,
                           const hal::SpectrumSample* spectrum,
                           const hal::PoseSample* pose,
                           const hal::AccelSample* accel,
                           const hal::LampSample* selector)
 {
+    const bool first = !started_;
+    if (first) {
+        start(state);
+    }
+    const bool hadSpectrum = haveSpectrum_;
+    const bool hadPose = havePose_;
+    const bool hadTilt = haveTilt_;
     if (selector != nullptr && selector->sequence != lastSelector_) {
         lastSelector_ = selector->sequence;
         if (const auto lamp = arbiter_.onSelector(*selector)) {
@@ -82,6 +113,7 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
             if (auto warning = arbiter_.takeWarning()) {
                 logger("loop")->warn("{}", *warning);
             }
+            haveSpectrum_ = true;
             state.lampIndex = lamp;
             if (lamp >= 0) {
                 showLamp(state, lamp);
@@ -98,8 +130,13 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
         lastPose_ = pose->sequence;
         const glm::dvec3 e = pose->eyeTrackerM;
         if (pose->tracked && std::isfinite(e.x) && std::isfinite(e.y) && std::isfinite(e.z)) {
-            state.eyeBoothM = setup_.trackerInBooth ? setup_.trackerInBooth->apply(e)
-                                                    : e + setup_.trackerInBoothM;
+            // The calibrated T_booth_tracker when the site has one; else the site file's angles
+            // and translation (defaults: the fixed mounting, bit for bit as before).
+            state.eyeBoothM = setup_.trackerInBooth
+                                      ? setup_.trackerInBooth->apply(e)
+                                      : (trackerRotation_ ? *trackerRotation_ * e : e) +
+                                                setup_.trackerInBoothM;
+            havePose_ = true;
         } else {
             ++rejectedPoses_;
         }
@@ -108,8 +145,30 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
         lastAccel_ = accel->sequence;
         if (auto tilt = pipeline::scene::tiltFromGravity(accel->gravity)) {
             state.tiltRad = *tilt;
+            haveTilt_ = true;
         } else {
             ++rejectedTilts_;
+        }
+    }
+    // Says in the log when each sensor first gives the scene a value (before that the defaults
+    // show), so that a sensor missing at boot is visible in the journal.
+    auto log = logger("loop");
+    if (first || (!hadSpectrum && haveSpectrum_) || (!hadPose && havePose_) ||
+        (!hadTilt && haveTilt_)) {
+        if (!haveSpectrum_ || !havePose_ || !haveTilt_) {
+            log->info("frame {}: {}{}{}", state.frameIndex,
+                      haveSpectrum_ ? "light sensed; "
+                      : setup_.defaultLamp >= 0
+                              ? fmt::format(
+                                        "no spectrum yet: showing the default lamp '{}'; ",
+                                        setup_.booth
+                                                .lamps[static_cast<std::size_t>(setup_.defaultLamp)]
+                                                .name)
+                              : std::string("no spectrum yet and no default lamp: no light; "),
+                      havePose_ ? "eye tracked; " : "no head pose yet: default eye; ",
+                      haveTilt_ ? "tilt sensed" : "no tilt yet: default tilt");
+        } else {
+            log->info("frame {}: every sensor now feeds the scene", state.frameIndex);
         }
     }
 }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
 #include <hal/samples.h>
@@ -22,9 +23,18 @@ namespace replica::platform {
 struct SceneUpdaterSetup {
     pipeline::scene::Booth booth;
     pipeline::spectral::SpectrometerCalibration calibration;
-    glm::dvec3 trackerInBoothM{0.0, 0.42, 0.05}; // tracker mounted on the stand's base, unrotated
     // The calibrated T_booth_tracker, which replaces trackerInBoothM when present.
     std::optional<pipeline::scene::RigidTransform> trackerInBooth;
+    // T_booth_tracker: eye_booth = R * eye_tracker + trackerInBoothM, R the rotation about x,
+    // then y, then z by these angles (degrees). Defaults: the tracker on the stand's base,
+    // unrotated (an identity rotation is skipped, so the eye is bit for bit what it was).
+    glm::dvec3 trackerRotationDeg{0.0};
+    glm::dvec3 trackerInBoothM{0.0, 0.42, 0.05};
+    // Shown until each sensor's first usable sample: a booth lamp index (-1: no light), the eye
+    // and the tilt.
+    int defaultLamp = -1;
+    glm::dvec3 defaultEyeM{0.0, 0.45, 0.60};
+    double defaultTiltRad = 0.0;
 };
 
 class SceneUpdater
@@ -65,6 +75,7 @@ private:
           arbiter_(static_cast<int>(setup_.booth.lamps.size()))
     {}
     void showLamp(pipeline::scene::SceneState& state, int lamp) const;
+    void start(pipeline::scene::SceneState& state);
 
     SceneUpdaterSetup setup_;
     std::optional<pipeline::spectral::LightClassifier> classifier_; // none: no lamps
@@ -76,6 +87,11 @@ private:
     std::uint64_t rejectedSpectra_ = 0;
     std::uint64_t rejectedPoses_ = 0;
     std::uint64_t rejectedTilts_ = 0;
+    bool started_ = false;
+    bool haveSpectrum_ = false;
+    bool havePose_ = false;
+    bool haveTilt_ = false;
+    std::optional<glm::dmat3> trackerRotation_; // none: identity
 };
 
 } // namespace replica::platform

@@ -1,0 +1,383 @@
+// Reading and checking the site file with toml++.
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <toml++/toml.h>
+
+#include <platform/site_config.h>
+
+namespace replica::platform {
+namespace {
+
+const char* typeName(toml::node_type t)
+{
+    switch (t) {
+    case toml::node_type::table:
+        return "a table";
+    case toml::node_type::array:
+        return "an array";
+    case toml::node_type::string:
+        return "a string";
+    case toml::node_type::integer:
+        return "an integer";
+    case toml::node_type::floating_point:
+        return "a number";
+    case toml::node_type::boolean:
+        return "a boolean";
+    case toml::node_type::date:
+    case toml::node_type::time:
+    case toml::node_type::date_time:
+        return "a date/time";
+    default:
+        return "nothing";
+    }
+}
+
+long lineOf(const toml::node& n)
+{
+    return static_cast<long>(n.source().begin.line);
+}
+
+// Reads keys from the document, remembering which ones it knows, and collects problems.
+class Reader
+{
+public:
+    Reader(const toml::table& root, std::vector<SiteProblem>& problems)
+        : root_(root), problems_(problems)
+    {}
+
+    void string(const char* section,
+                const char* key,
+                std::string& out,
+                const std::set<std::string>& allowed = {})
+    {
+        const toml::node* n = find(section, key);
+        if (n == nullptr) {
+            return;
+        }
+        const auto* s = n->as_string();
+        if (s == nullptr) {
+            wrongType(section, key, *n, "a string");
+            return;
+        }
+        if (!allowed.empty() && !allowed.contains(s->get())) {
+            std::string list;
+            for (const auto& a : allowed) {
+                list += (list.empty() ? "" : ", ") + a;
+            }
+            problem(section, key, *n, fmt::format("'{}' is not one of: {}", s->get(), list));
+            return;
+        }
+        out = s->get();
+    }
+
+    void boolean(const char* section, const char* key, bool& out)
+    {
+        const toml::node* n = find(section, key);
+        if (n == nullptr) {
+            return;
+        }
+        if (const auto* b = n->as_boolean()) {
+            out = b->get();
+        } else {
+            wrongType(section, key, *n, "true or false");
+        }
+    }
+
+    void number(const char* section, const char* key, double& out, double lo, double hi)
+    {
+        const toml::node* n = find(section, key);
+        if (n == nullptr) {
+            return;
+        }
+        double v = 0.0;
+        if (!toDouble(section, key, *n, v)) {
+            return;
+        }
+        if (v < lo || v > hi) {
+            problem(section, key, *n, fmt::format("{} is out of range [{}, {}]", v, lo, hi));
+            return;
+        }
+        out = v;
+    }
+
+    template <typename Int>
+    void integer(const char* section, const char* key, Int& out, std::int64_t lo, std::int64_t hi)
+    {
+        const toml::node* n = find(section, key);
+        if (n == nullptr) {
+            return;
+        }
+        const auto* i = n->as_integer();
+        if (i == nullptr) {
+            wrongType(section, key, *n, "an integer");
+            return;
+        }
+        if (i->get() < lo || i->get() > hi) {
+            problem(section, key, *n, fmt::format("{} is out of range [{}, {}]", i->get(), lo, hi));
+            return;
+        }
+        out = static_cast<Int>(i->get());
+    }
+
+    void vec3(const char* section, const char* key, glm::dvec3& out, double lo, double hi)
+    {
+        const toml::node* n = find(section, key);
+        if (n == nullptr) {
+            return;
+        }
+        const auto* a = n->as_array();
+        if (a == nullptr || a->size() != 3) {
+            problem(section, key, *n,
+                    fmt::format("expected an array of 3 numbers, got {}",
+                                a == nullptr ? typeName(n->type())
+                                             : fmt::format("{} elements", a->size())));
+            return;
+        }
+        glm::dvec3 v{0.0};
+        for (std::size_t i = 0; i < 3; ++i) {
+            if (!toDouble(section, key, *a->get(i), v[static_cast<glm::length_t>(i)])) {
+                return;
+            }
+            if (v[static_cast<glm::length_t>(i)] < lo || v[static_cast<glm::length_t>(i)] > hi) {
+                problem(section, key, *a->get(i),
+                        fmt::format("element {} = {} is out of range [{}, {}]", i + 1,
+                                    v[static_cast<glm::length_t>(i)], lo, hi));
+                return;
+            }
+        }
+        out = v;
+    }
+
+    // Every key of the document that no reader asked for.
+    void reportUnknown()
+    {
+        for (auto&& [k, v] : root_) {
+            const std::string section(k.str());
+            if (!sections_.contains(section)) {
+                problems_.push_back({section, static_cast<long>(k.source().begin.line),
+                                     fmt::format("unknown section or key (known sections: {})",
+                                                 sectionList())});
+                continue;
+            }
+            const auto* t = v.as_table();
+            if (t == nullptr) {
+                problems_.push_back({section, lineOf(v),
+                                     fmt::format("expected a table [{}], got {}", section,
+                                                 typeName(v.type()))});
+                continue;
+            }
+            for (auto&& [kk, vv] : *t) {
+                const std::string key = section + "." + std::string(kk.str());
+                if (!known_.contains(key)) {
+                    problems_.push_back({key, static_cast<long>(kk.source().begin.line),
+                                         "unknown key (misspelt? 'replica config check' lists "
+                                         "the known ones in the shipped replica.toml)"});
+                }
+            }
+        }
+    }
+
+private:
+    const toml::node* find(const char* section, const char* key)
+    {
+        sections_.insert(section);
+        known_.insert(std::string(section) + "." + key);
+        const auto* t = root_.get_as<toml::table>(section);
+        return t != nullptr ? t->get(key) : nullptr;
+    }
+
+    bool toDouble(const char* section, const char* key, const toml::node& n, double& v)
+    {
+        if (const auto* f = n.as_floating_point()) {
+            v = f->get();
+        } else if (const auto* i = n.as_integer()) {
+            v = static_cast<double>(i->get());
+        } else {
+            wrongType(section, key, n, "a number");
+            return false;
+        }
+        if (!std::isfinite(v)) {
+            problem(section, key, n, "not a finite number");
+            return false;
+        }
+        return true;
+    }
+
+    void wrongType(const char* section, const char* key, const toml::node& n, const char* want)
+    {
+        problem(section, key, n, fmt::format("expected {}, got {}", want, typeName(n.type())));
+    }
+
+    void problem(const char* section, const char* key, const toml::node& n, std::string what)
+    {
+        problems_.push_back({std::string(section) + "." + key, lineOf(n), std::move(what)});
+    }
+
+    std::string sectionList() const
+    {
+        std::string s;
+        for (const auto& name : sections_) {
+            s += (s.empty() ? "" : ", ") + name;
+        }
+        return s;
+    }
+
+    const toml::table& root_;
+    std::vector<SiteProblem>& problems_;
+    std::set<std::string> sections_;
+    std::set<std::string> known_;
+};
+
+bool validSize(const std::string& s)
+{
+    int w = 0;
+    int h = 0;
+    char x = 0;
+    char extra = 0;
+    return std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) == 3 && (x == 'x' || x == 'X') &&
+           w > 0 && h > 0 && w <= 16384 && h <= 16384;
+}
+
+nlohmann::json vec(const glm::dvec3& v)
+{
+    return nlohmann::json::array({v.x, v.y, v.z});
+}
+
+} // namespace
+
+std::filesystem::path defaultSiteConfigPath()
+{
+    return REPLICA_SITE_CONFIG;
+}
+
+Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
+{
+    SiteLoad out;
+    out.config.source = file;
+    toml::table root;
+    try {
+        root = toml::parse_file(file.string());
+    } catch (const toml::parse_error& e) {
+        const auto& where = e.source();
+        if (where.begin.line == 0) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: {}; give a readable site file (a commented example "
+                                         "is installed as /usr/share/replica/replica.toml)",
+                                         file.string(), e.description()));
+        }
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}:{}: not valid TOML: {}", file.string(), where.begin.line,
+                                     e.description()));
+    }
+    SiteConfig& c = out.config;
+    Reader r(root, out.problems);
+    r.string("booth", "id", c.boothId);
+    r.string("scene", "dir", c.sceneDir);
+    r.string("scene", "renderer", c.renderer, {"booth", "flat"});
+    r.string("display", "profile", c.displayProfile);
+    r.boolean("display", "allow_synthetic", c.allowSynthetic);
+    r.string("display", "output", c.output, {"kms", "headless"});
+    std::string size = c.size;
+    r.string("display", "size", size);
+    if (validSize(size)) {
+        c.size = size;
+    } else if (const auto* n = root.at_path("display.size").node()) {
+        out.problems.push_back({"display.size", lineOf(*n),
+                                fmt::format("'{}' is not WIDTHxHEIGHT (1..16384 each), e.g. "
+                                            "\"1920x1200\"",
+                                            size)});
+    }
+    r.string("display", "kms_device", c.kmsDevice);
+    r.string("display", "kms_connector", c.kmsConnector);
+    r.vec3("stand", "hinge_m", c.stand.hingeM, -5.0, 5.0);
+    r.number("stand", "hinge_to_panel_m", c.stand.hingeToPanelM, -1.0, 1.0);
+    r.number("stand", "panel_width_m", c.stand.panelWidthM, 0.01, 10.0);
+    r.number("stand", "panel_height_m", c.stand.panelHeightM, 0.01, 10.0);
+    r.vec3("tracker", "rotation_deg", c.trackerRotationDeg, -360.0, 360.0);
+    r.vec3("tracker", "translation_m", c.trackerTranslationM, -10.0, 10.0);
+    r.integer("tracker", "port", c.trackerPort, 1, 65535);
+    r.string("tracker", "bind", c.trackerBind);
+    r.string("devices", "iio_root", c.iioRoot);
+    r.string("devices", "accel_name", c.accelName);
+    r.string("devices", "accel_axes", c.accelAxes);
+    r.string("devices", "lamp_gpio", c.lampGpio);
+    r.string("run", "hal", c.hal, {"live", "sim", "replay"});
+    r.string("run", "replay_file", c.replayFile);
+    r.number("run", "rate_hz", c.rateHz, 1.0, 240.0);
+    r.boolean("recording", "enabled", c.recordingEnabled);
+    r.string("recording", "directory", c.recordingDirectory);
+    r.integer("recording", "rotate_bytes", c.rotateBytes, 1 << 20, std::int64_t{1} << 50);
+    r.integer("recording", "rotate_seconds", c.rotateSeconds, 10, 7 * 24 * 3600);
+    r.integer("recording", "keep_bytes", c.keepBytes, 1 << 20, std::int64_t{1} << 55);
+    r.integer("recording", "flush_ms", c.flushMs, 10, 60000);
+    r.string("log", "level", c.logLevel);
+    r.string("defaults", "lamp", c.defaultLamp);
+    r.vec3("defaults", "eye_m", c.defaultEyeM, -10.0, 10.0);
+    r.number("defaults", "tilt_deg", c.defaultTiltDeg, -90.0, 90.0);
+    r.reportUnknown();
+    if (c.hal == "replay" && c.replayFile.empty()) {
+        out.problems.push_back(
+                {"run.replay_file", 0, "run.hal = \"replay\" needs the recording to play"});
+    }
+    if (c.rotateBytes > c.keepBytes) {
+        out.problems.push_back({"recording.keep_bytes", 0,
+                                "smaller than recording.rotate_bytes: every session would be "
+                                "deleted as soon as it rotates"});
+    }
+    return out;
+}
+
+std::string formatProblem(const std::filesystem::path& file, const SiteProblem& p)
+{
+    if (p.line > 0) {
+        return fmt::format("{}:{}: {}: {}", file.string(), p.line, p.key, p.what);
+    }
+    return fmt::format("{}: {}: {}", file.string(), p.key, p.what);
+}
+
+std::string SiteConfig::toJson() const
+{
+    nlohmann::json j{
+            {"source", source.string()},
+            {"booth", {{"id", boothId}}},
+            {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
+            {"display",
+             {{"profile", displayProfile},
+              {"allow_synthetic", allowSynthetic},
+              {"output", output},
+              {"size", size},
+              {"kms_device", kmsDevice},
+              {"kms_connector", kmsConnector}}},
+            {"stand",
+             {{"hinge_m", vec(stand.hingeM)},
+              {"hinge_to_panel_m", stand.hingeToPanelM},
+              {"panel_width_m", stand.panelWidthM},
+              {"panel_height_m", stand.panelHeightM}}},
+            {"tracker",
+             {{"rotation_deg", vec(trackerRotationDeg)},
+              {"translation_m", vec(trackerTranslationM)},
+              {"port", trackerPort},
+              {"bind", trackerBind}}},
+            {"devices",
+             {{"iio_root", iioRoot},
+              {"accel_name", accelName},
+              {"accel_axes", accelAxes},
+              {"lamp_gpio", lampGpio}}},
+            {"run", {{"hal", hal}, {"replay_file", replayFile}, {"rate_hz", rateHz}}},
+            {"recording",
+             {{"enabled", recordingEnabled},
+              {"directory", recordingDirectory},
+              {"rotate_bytes", rotateBytes},
+              {"rotate_seconds", rotateSeconds},
+              {"keep_bytes", keepBytes},
+              {"flush_ms", flushMs}}},
+            {"log", {{"level", logLevel}}},
+            {"defaults",
+             {{"lamp", defaultLamp}, {"eye_m", vec(defaultEyeM)}, {"tilt_deg", defaultTiltDeg}}}};
+    return j.dump();
+}
+
+} // namespace replica::platform

@@ -1,0 +1,92 @@
+// The site file (/etc/replica/replica.toml): what one installation is — its booth, scene, display,
+// stand and tracker geometry, devices, rate, recording policy, log levels and the scene shown
+// while a sensor is missing. 'replica run --config FILE' reads it (the command line overrides
+// it); 'replica config check FILE' reports every problem with its key and line.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/scene/stand.h>
+
+namespace replica::platform {
+
+// The compiled-in default of the site file: REPLICA_SITE_CONFIG (/etc/replica/replica.toml).
+std::filesystem::path defaultSiteConfigPath();
+
+// Every value has the default a run without a site file has, so that a file holding only some
+// keys changes only those (and recordings made without one are unchanged).
+struct SiteConfig {
+    std::filesystem::path source; // the file read; empty: built-in defaults
+
+    // [booth]
+    std::string boothId = "replica-booth-1";
+    // [scene]
+    std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
+    std::string renderer = "booth"; // or "flat"
+    // [display]
+    std::string displayProfile;   // empty: the shipped synthetic profile
+    bool allowSynthetic = false;  // the kiosk refuses a live run on the synthetic profile
+    std::string output = "kms";   // "kms" or "headless"
+    std::string size = "960x600"; // the frame size WIDTHxHEIGHT
+    std::string kmsDevice = "/dev/dri/card0";
+    std::string kmsConnector; // empty: the first connected
+    // [stand] (pipeline/scene/stand.h): defaults are the compiled-in model.
+    pipeline::scene::StandModel stand;
+    // [tracker]: T_booth_tracker, eye_booth = R(rotation_deg) * eye_tracker + translation_m.
+    glm::dvec3 trackerRotationDeg{0.0};
+    glm::dvec3 trackerTranslationM{0.0, 0.42, 0.05};
+    std::uint16_t trackerPort = 4242;
+    std::string trackerBind = "127.0.0.1";
+    // [devices]
+    std::string iioRoot = "/sys/bus/iio/devices";
+    std::string accelName;
+    std::string accelAxes = "x,y,z";
+    std::string lampGpio;
+    // [run]
+    std::string hal = "live"; // live, sim or replay
+    std::string replayFile;   // hal = "replay": the recording whose samples feed the display
+    double rateHz = 60.0;
+    // [recording]
+    bool recordingEnabled = true;
+    std::string recordingDirectory = "/var/lib/replica/sessions";
+    std::uint64_t rotateBytes = 1ull << 30; // a new session file after this many bytes
+    std::uint64_t rotateSeconds = 3600;     // or after this long
+    std::uint64_t keepBytes = 20ull << 30;  // the oldest sessions go beyond this total
+    int flushMs = 500;
+    // [log]
+    std::string logLevel = "info";
+    // [defaults]: the scene shown before (or without) each sensor's first sample.
+    std::string defaultLamp; // a booth lamp's name; empty: black until the first spectrum
+    glm::dvec3 defaultEyeM{0.0, 0.45, 0.60};
+    double defaultTiltDeg = 0.0;
+
+    // The resolved configuration as JSON (recorded in each session).
+    std::string toJson() const;
+};
+
+struct SiteProblem {
+    std::string key; // "display.size"
+    long line = 0;   // 0: not tied to a line
+    std::string what;
+};
+
+struct SiteLoad {
+    SiteConfig config;
+    std::vector<SiteProblem> problems; // empty: the file is good
+};
+
+// Reads and checks a site file: every unknown key, wrong type, out-of-range or non-finite value
+// is a problem (the values that are good are kept). Fails only when the file cannot be read or
+// is not TOML at all (the error names the line).
+Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file);
+
+// "FILE:LINE: key: what" (LINE left out when 0).
+std::string formatProblem(const std::filesystem::path& file, const SiteProblem& p);
+
+} // namespace replica::platform

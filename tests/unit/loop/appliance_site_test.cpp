@@ -1,0 +1,351 @@
+// The unattended appliance: late ticks skipped so that the lag stays under one period, the site
+// file read with its line numbers, the geometry it sets (T_booth_tracker against closed-form
+// rotations), the default scene before the first samples, and the session folder's retention and
+// in-place recovery.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/scene/booth.h>
+#include <pipeline/spectral/spectrometer_chain.h>
+#include <platform/appliance.h>
+#include <platform/loop/frame_loop.h>
+#include <platform/loop/scene_updater.h>
+#include <platform/session_files.h>
+#include <platform/site_config.h>
+#include <recordings/recording.h>
+
+#include <gtest/gtest.h>
+
+#include "../support/files.h"
+
+namespace replica::platform {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name)
+{
+    const fs::path d = fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+TEST(SkipLateTicks, AFrameOnTimeSkipsNothing)
+{
+    const std::int64_t p = 16'666'667;
+    EXPECT_EQ(ticksToSkip(0, 0, p), 0u);
+    EXPECT_EQ(ticksToSkip(p - 1, 0, p), 0u);  // late, but less than a period: render it
+    EXPECT_EQ(ticksToSkip(-5 * p, 0, p), 0u); // early: the loop sleeps until the tick
+    EXPECT_EQ(ticksToSkip(10 * p, 10 * p, p), 0u);
+    EXPECT_EQ(ticksToSkip(p, 0, 0), 0u); // no period: never skip
+}
+
+TEST(SkipLateTicks, TheTickRenderedIsLessThanOnePeriodOld)
+{
+    // For any lateness, skipping n ticks of a k * period plan leaves the frame at most one period
+    // behind its tick and never ahead of it: 0 <= now - (tick + n period) < period.
+    const std::int64_t p = 16'666'667;
+    std::mt19937_64 rng(7);
+    std::uniform_int_distribution<std::int64_t> late(0, 40 * p);
+    for (int i = 0; i < 10000; ++i) {
+        const std::int64_t tick = static_cast<std::int64_t>(i % 1000) * p;
+        const std::int64_t now = tick + late(rng);
+        const auto n = static_cast<std::int64_t>(ticksToSkip(now, tick, p));
+        const std::int64_t lag = now - (tick + n * p);
+        ASSERT_GE(lag, 0) << now << " " << tick;
+        ASSERT_LT(lag, p) << now << " " << tick;
+    }
+    // 150 frames of 120 ms each on a 60 Hz plan (the 18 s of wall time for 2.5 s of
+    // ticks): each skips 7 ticks (120 / 16.67 = 7.2), so the display never falls behind.
+    EXPECT_EQ(ticksToSkip(120'000'000, 0, p), 7u);
+}
+
+class SiteFile : public ::testing::Test
+{
+protected:
+    fs::path write(const std::string& text)
+    {
+        const fs::path f = scratch("site") / "replica.toml";
+        std::ofstream(f) << text;
+        return f;
+    }
+};
+
+TEST_F(SiteFile, TheShippedFileIsGoodAndHoldsTheCompiledInDefaults)
+{
+    auto site = loadSiteConfig(fs::path(REPLICA_SOURCE_DIR) / "deploy" / "replica.toml");
+    ASSERT_TRUE(site) << site.error().message;
+    for (const auto& p : site->problems) {
+        ADD_FAILURE() << formatProblem("replica.toml", p);
+    }
+    // Every value the file writes out equals the code's default (so that the installed file and
+    // a run without one agree), apart from the kiosk's choices: a default lamp (never black) and
+    // the explicit scene, profile and hal.
+    SiteConfig defaults;
+    const SiteConfig& c = site->config;
+    EXPECT_EQ(c.stand.hingeM, defaults.stand.hingeM);
+    EXPECT_EQ(c.stand.hingeToPanelM, defaults.stand.hingeToPanelM);
+    EXPECT_EQ(c.stand.panelWidthM, defaults.stand.panelWidthM);
+    EXPECT_EQ(c.stand.panelHeightM, defaults.stand.panelHeightM);
+    EXPECT_EQ(c.trackerRotationDeg, defaults.trackerRotationDeg);
+    EXPECT_EQ(c.trackerTranslationM, defaults.trackerTranslationM);
+    EXPECT_EQ(c.rotateBytes, defaults.rotateBytes);
+    EXPECT_EQ(c.keepBytes, defaults.keepBytes);
+    EXPECT_EQ(c.defaultEyeM, defaults.defaultEyeM);
+    EXPECT_EQ(c.defaultLamp, "d65-fluorescent");
+    EXPECT_FALSE(c.allowSynthetic);
+    // And the site's geometry defaults are the run configuration's, which are the constants
+    // recordings made before the site file replay with.
+    RunConfig run;
+    EXPECT_EQ(run.stand.panelWidthM, 0.518);
+    EXPECT_EQ(run.stand.panelHeightM, 0.324);
+    EXPECT_EQ(run.trackerTranslationM, glm::dvec3(0.0, 0.42, 0.05));
+    EXPECT_EQ(run.stand.hingeM, c.stand.hingeM);
+}
+
+TEST_F(SiteFile, EachMistakeIsNamedWithItsKeyAndLine)
+{
+    const auto f = write("[display]\n"                 // 1
+                         "size = \"1920x1200\"\n"      // 2
+                         "\n"                          // 3
+                         "[stand]\n"                   // 4
+                         "panel_width_m = 0.0\n"       // 5
+                         "panel_height_m = \"tall\"\n" // 6
+                         "hinge_m = [1.0, 2.0]\n"      // 7
+                         "[defaults]\n"                // 8
+                         "tilt_deg = -inf\n"           // 9
+                         "lamp = \"tungsten\"\n"       // 10
+                         "eyes = 2\n");                // 11
+    auto site = loadSiteConfig(f);
+    ASSERT_TRUE(site) << site.error().message;
+    ASSERT_EQ(site->problems.size(), 5u);
+    const auto at = [&](const std::string& key) -> const SiteProblem* {
+        for (const auto& p : site->problems) {
+            if (p.key == key) {
+                return &p;
+            }
+        }
+        return nullptr;
+    };
+    ASSERT_TRUE(at("stand.panel_width_m"));
+    EXPECT_EQ(at("stand.panel_width_m")->line, 5);
+    ASSERT_TRUE(at("stand.panel_height_m"));
+    EXPECT_EQ(at("stand.panel_height_m")->line, 6);
+    EXPECT_EQ(at("stand.panel_height_m")->what, "expected a number, got a string");
+    ASSERT_TRUE(at("stand.hinge_m"));
+    EXPECT_EQ(at("stand.hinge_m")->line, 7);
+    ASSERT_TRUE(at("defaults.tilt_deg"));
+    EXPECT_EQ(at("defaults.tilt_deg")->what, "not a finite number");
+    ASSERT_TRUE(at("defaults.eyes"));
+    EXPECT_EQ(at("defaults.eyes")->line, 11);
+    // The good values are kept, the bad ones leave the defaults.
+    EXPECT_EQ(site->config.size, "1920x1200");
+    EXPECT_EQ(site->config.defaultLamp, "tungsten");
+    EXPECT_EQ(site->config.stand.panelWidthM, SiteConfig{}.stand.panelWidthM);
+}
+
+TEST_F(SiteFile, NotTomlIsOneErrorWithItsLine)
+{
+    const auto f = write("[run]\nrate_hz = 60\n[recording\n");
+    auto site = loadSiteConfig(f);
+    ASSERT_FALSE(site);
+    EXPECT_NE(site.error().message.find(f.string() + ":3: not valid TOML"), std::string::npos)
+            << site.error().message;
+}
+
+TEST(RunConfigSite, GeometryRoundTripsAndOldRecordingsGetTodaysConstants)
+{
+    RunConfig c;
+    c.stand.hingeM = {0.01, 0.2, -0.12};
+    c.stand.panelWidthM = 0.6;
+    c.trackerRotationDeg = {0.0, 10.0, 0.0};
+    c.defaultLamp = "tungsten";
+    c.defaultTiltRad = 0.25;
+    auto back = RunConfig::fromJson(c.toJson());
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->stand.hingeM, c.stand.hingeM);
+    EXPECT_EQ(back->stand.panelWidthM, 0.6);
+    EXPECT_EQ(back->trackerRotationDeg, c.trackerRotationDeg);
+    EXPECT_EQ(back->defaultLamp, "tungsten");
+    EXPECT_EQ(back->defaultTiltRad, 0.25);
+
+    // A configuration written before the site file had none of these keys.
+    auto j = nlohmann::json::parse(RunConfig{}.toJson());
+    for (const char* k : {"stand_hinge_m", "stand_hinge_to_panel_m", "panel_width_m",
+                          "panel_height_m", "tracker_rotation_deg", "tracker_translation_m",
+                          "default_lamp", "default_eye_m", "default_tilt_rad"}) {
+        j.erase(k);
+    }
+    auto old = RunConfig::fromJson(j.dump());
+    ASSERT_TRUE(old) << old.error().message;
+    const pipeline::scene::StandModel today;
+    EXPECT_EQ(old->stand.hingeM, today.hingeM);
+    EXPECT_EQ(old->stand.panelWidthM, today.panelWidthM);
+    EXPECT_EQ(old->trackerTranslationM, SceneUpdaterSetup{}.trackerInBoothM);
+    EXPECT_EQ(old->defaultLamp, "");
+    EXPECT_EQ(old->defaultEyeM, pipeline::scene::SceneState{}.eyeBoothM);
+
+    auto bad = nlohmann::json::parse(c.toJson());
+    bad["panel_width_m"] = -1.0;
+    EXPECT_FALSE(RunConfig::fromJson(bad.dump()));
+}
+
+class SiteUpdater : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        auto booth = pipeline::scene::loadDefaultBooth(dataDir().string());
+        ASSERT_TRUE(booth);
+        auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
+                                                                   "sim_usb2000_responsivity.csv");
+        ASSERT_TRUE(cal);
+        setup_.booth = *booth;
+        setup_.calibration = *cal;
+    }
+    SceneUpdaterSetup setup_;
+};
+
+TEST_F(SiteUpdater, TrackerRotationIsXThenYThenZ)
+{
+    setup_.trackerRotationDeg = {90.0, 0.0, 90.0};
+    setup_.trackerInBoothM = {1.0, 2.0, 3.0};
+    auto u = SceneUpdater::create(setup_);
+    ASSERT_TRUE(u);
+    pipeline::scene::SceneState st;
+    hal::PoseSample p;
+    p.sequence = 1;
+    p.tracked = true;
+    // Rx(90) takes +z to -y; Rz(90) takes -y to +x. (The other order would give -y.)
+    p.eyeTrackerM = {0.0, 0.0, 1.0};
+    u->update(st, nullptr, &p, nullptr);
+    EXPECT_NEAR(st.eyeBoothM.x, 2.0, 1e-12);
+    EXPECT_NEAR(st.eyeBoothM.y, 2.0, 1e-12);
+    EXPECT_NEAR(st.eyeBoothM.z, 3.0, 1e-12);
+    // A rotation keeps lengths: |R e| = |e|.
+    p.sequence = 2;
+    p.eyeTrackerM = {0.3, -0.4, 1.2};
+    u->update(st, nullptr, &p, nullptr);
+    const glm::dvec3 d = st.eyeBoothM - setup_.trackerInBoothM;
+    EXPECT_NEAR(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z), 1.3, 1e-12);
+}
+
+TEST_F(SiteUpdater, MissingSensorsShowTheDefaultLampEyeAndTilt)
+{
+    setup_.defaultLamp = 2;
+    setup_.defaultEyeM = {0.1, 0.5, 0.7};
+    setup_.defaultTiltRad = 0.2;
+    auto u = SceneUpdater::create(setup_);
+    ASSERT_TRUE(u);
+    pipeline::scene::SceneState st;
+    u->update(st, nullptr, nullptr, nullptr);
+    EXPECT_EQ(st.lampIndex, 2);
+    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.booth.lamps[2].luminanceCdM2);
+    EXPECT_GT(st.emitterLuminanceCdM2, 0.0); // a light: not a black screen
+    EXPECT_EQ(st.illuminant.v, setup_.booth.lamps[2].spectrum.v);
+    EXPECT_EQ(st.eyeBoothM, setup_.defaultEyeM);
+    EXPECT_EQ(st.tiltRad, 0.2);
+
+    // Without a default lamp: no light until the first spectrum, as before the site file.
+    setup_.defaultLamp = -1;
+    auto dark = SceneUpdater::create(setup_);
+    ASSERT_TRUE(dark);
+    pipeline::scene::SceneState st2;
+    dark->update(st2, nullptr, nullptr, nullptr);
+    EXPECT_EQ(st2.lampIndex, -1);
+    EXPECT_EQ(st2.emitterLuminanceCdM2, 0.0);
+}
+
+void writeRecording(const fs::path& path, int samples)
+{
+    auto w = recordings::RecordingWriter::create(path, recordings::SessionInfo{});
+    ASSERT_TRUE(w) << w.error().message;
+    for (int i = 0; i < samples; ++i) {
+        hal::PoseSample p;
+        p.timestampNs = i * 1'000'000;
+        p.sequence = static_cast<std::uint32_t>(i);
+        p.eyeTrackerM = {0.001 * i, 0.1, 0.6};
+        (*w)->write(p);
+    }
+    ASSERT_TRUE((*w)->close());
+}
+
+TEST(SessionFolder, RetentionDeletesTheOldestUntilTheTotalFits)
+{
+    const fs::path dir = scratch("retention");
+    // Names a shell loop would trip on; sizes 100..400 bytes, oldest first.
+    const std::vector<std::string> names{"a b.mcap", "-rf.mcap", "new\nline.mcap", "d*.mcap"};
+    const auto now = fs::file_time_type::clock::now();
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        tests::spit(dir / names[i], std::string(100 * (i + 1), 'x'));
+        fs::last_write_time(dir / names[i], now - std::chrono::hours(10 - static_cast<int>(i)));
+    }
+    tests::spit(dir / "notes.txt", std::string(5000, 'x')); // not a recording: never counted
+    // 1000 bytes in all; at most 650: the three oldest go (900, 700, 400 left after each).
+    const auto deleted = enforceRetention(dir, 650);
+    EXPECT_EQ(deleted.size(), 3u);
+    EXPECT_TRUE(fs::exists(dir / "d*.mcap"));
+    EXPECT_FALSE(fs::exists(dir / "a b.mcap"));
+    EXPECT_FALSE(fs::exists(dir / "new\nline.mcap"));
+    EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+    // The file being written is never deleted, even when it alone is over.
+    EXPECT_TRUE(enforceRetention(dir, 1, dir / "d*.mcap").empty());
+    EXPECT_TRUE(fs::exists(dir / "d*.mcap"));
+    fs::remove_all(dir);
+}
+
+TEST(SessionFolder, ACrashedSessionIsRecoveredInPlace)
+{
+    const fs::path dir = scratch("recover");
+    writeRecording(dir / "closed.mcap", 50);
+    writeRecording(dir / "crashed.mcap", 3000);
+    EXPECT_TRUE(recordingFinished(dir / "closed.mcap"));
+    // A power cut: the file ends mid-chunk, without summary and footer.
+    const auto size = fs::file_size(dir / "crashed.mcap");
+    fs::resize_file(dir / "crashed.mcap", size - 200);
+    EXPECT_FALSE(recordingFinished(dir / "crashed.mcap"));
+    EXPECT_FALSE(recordings::readRecording(dir / "crashed.mcap").has_value() &&
+                 recordingFinished(dir / "crashed.mcap"));
+
+    const auto recovered = recoverUnfinished(dir);
+    ASSERT_EQ(recovered.size(), 1u);
+    EXPECT_EQ(recovered[0], dir / "crashed.mcap");
+    EXPECT_TRUE(recordingFinished(dir / "crashed.mcap"));
+    auto rec = recordings::readRecording(dir / "crashed.mcap");
+    ASSERT_TRUE(rec) << rec.error().message;
+    EXPECT_GT(rec->poses.size(), 0u);
+    EXPECT_LE(rec->poses.size(), 3000u);
+    // Each kept pose is the one written with its sequence number.
+    for (const auto& p : rec->poses) {
+        EXPECT_EQ(p.eyeTrackerM.x, 0.001 * p.sequence);
+    }
+    // Nothing left to do at the next start.
+    EXPECT_TRUE(recoverUnfinished(dir).empty());
+
+    // Garbage that nothing can be recovered from is set aside, not retried at every start.
+    tests::spit(dir / "junk.mcap", "not a recording at all");
+    EXPECT_TRUE(recoverUnfinished(dir).empty());
+    EXPECT_TRUE(fs::exists(dir / "junk.mcap.unrecoverable"));
+    fs::remove_all(dir);
+}
+
+TEST(SessionFolder, NewSessionNamesNeverOverwrite)
+{
+    const fs::path dir = scratch("names");
+    const fs::path a = newSessionPath(dir);
+    tests::spit(a, "x");
+    const fs::path b = newSessionPath(dir);
+    EXPECT_NE(a, b);
+    EXPECT_EQ(a.parent_path(), dir);
+    EXPECT_EQ(b.extension(), ".mcap");
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace replica::platform
