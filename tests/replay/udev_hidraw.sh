@@ -6,7 +6,7 @@ set -euo pipefail
 rules="$1"
 work="$2"
 rm -rf "$work" && mkdir -p "$work"
-line=$(grep '^SUBSYSTEM=="hidraw"' "$rules")
+line=$(grep '^SUBSYSTEM=="hidraw".*PROGRAM=' "$rules")
 script=$(printf '%s' "$line" | sed -E "s/.*PROGRAM=\"\/bin\/sh -c '([^']*)'\".*/\1/")
 patterns=$(printf '%s' "$line" | sed -E 's/.*RESULT=="([^"]*)".*/\1/')
 [ -n "$script" ] && [ -n "$patterns" ] || { echo "FAIL: cannot read the hidraw rule" >&2; exit 1; }

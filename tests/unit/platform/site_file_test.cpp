@@ -24,7 +24,7 @@ std::string slurp(const std::filesystem::path& p)
     return s.str();
 }
 
-class SiteFile : public ::testing::Test
+class CalibrationSiteFile : public ::testing::Test
 {
 protected:
     void SetUp() override
@@ -38,7 +38,7 @@ protected:
     std::filesystem::path dir_;
 };
 
-TEST_F(SiteFile, TrackerSectionReplacesOnlyItselfAndReadsBack)
+TEST_F(CalibrationSiteFile, TrackerSectionReplacesOnlyItselfAndReadsBack)
 {
     const auto file = dir_ / "replica.toml";
     std::ofstream(file) << "# site of booth 7\n[display]\nprofile = \"panel.json\" # measured\n\n"
@@ -69,7 +69,7 @@ TEST_F(SiteFile, TrackerSectionReplacesOnlyItselfAndReadsBack)
     EXPECT_EQ(again.find("[tracker]"), again.rfind("[tracker]"));
 }
 
-TEST_F(SiteFile, SourcesAreReadWhenPresent)
+TEST_F(CalibrationSiteFile, SourcesAreReadWhenPresent)
 {
     const auto file = dir_ / "sources.toml";
     std::ofstream(file) << "[sources]\ntracker = \"hid\"\nlamp_selector = \"gpio\"\n";
@@ -84,7 +84,7 @@ TEST_F(SiteFile, SourcesAreReadWhenPresent)
     EXPECT_NE(s.error().message.find("[sources] tracker must be a string"), std::string::npos);
 }
 
-TEST_F(SiteFile, BrokenFilesAreRefusedWithTheirLineAndMissingTablesSaidSo)
+TEST_F(CalibrationSiteFile, BrokenFilesAreRefusedWithTheirLineAndMissingTablesSaidSo)
 {
     const auto file = dir_ / "broken.toml";
     std::ofstream(file) << "[display]\nprofile = \"x\"\n[tracker\n";
