@@ -172,7 +172,7 @@ candidateForward(const Candidate& cand, const glm::dvec3& black, const glm::dvec
 }
 
 // Standard normal from two uniform 64-bit draws (Box-Muller), reproducible across libraries.
-double gaussian(std::mt19937_64& rng)
+double fitGaussian(std::mt19937_64& rng)
 {
     const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53;
     const double u2 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
@@ -634,7 +634,7 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
             for (int k = 0; k < 16; ++k) {
                 glm::dvec3 noisy = xyz;
                 for (int q = 0; q < 3; ++q) {
-                    noisy[q] *= 1.0 + rho * gaussian(rng);
+                    noisy[q] *= 1.0 + rho * fitGaussian(rng);
                 }
                 noiseDe += deltaE2000Xyz(noisy, xyz, refWhite);
                 ++draws;
@@ -660,12 +660,12 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
             for (int k = 0; k < 400; ++k) {
                 glm::dvec3 meas = predicted;
                 for (int q = 0; q < 3; ++q) {
-                    meas[q] *= 1.0 + rho / std::sqrt(nWhite) * gaussian(rng);
+                    meas[q] *= 1.0 + rho / std::sqrt(nWhite) * fitGaussian(rng);
                 }
                 glm::dvec3 pred = predicted;
                 for (int c = 0; c < 3; ++c) {
                     pred += direct.matrix[c] *
-                            (topSpread[static_cast<std::size_t>(c)] * gaussian(rng));
+                            (topSpread[static_cast<std::size_t>(c)] * fitGaussian(rng));
                 }
                 noiseDes.push_back(deltaE2000Xyz(meas, pred, refWhite));
                 const double dy = 100.0 * (meas.y - pred.y) / predicted.y;
