@@ -20,6 +20,7 @@
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <platform/appliance.h>
+#include <platform/logging.h>
 #include <platform/loop/frame_digest.h>
 
 namespace replica::platform {
@@ -33,6 +34,8 @@ std::string RunConfig::toJson() const
 {
     nlohmann::json j{{"width", width},
                      {"height", height},
+                     {"panel_width_m", panelWidthM},
+                     {"panel_height_m", panelHeightM},
                      {"rate_hz", rateHz},
                      {"booth", booth},
                      {"scene", scene},
@@ -80,6 +83,8 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         const auto j = nlohmann::json::parse(json);
         c.width = j.at("width").get<int>();
         c.height = j.at("height").get<int>();
+        c.panelWidthM = j.value("panel_width_m", c.panelWidthM);
+        c.panelHeightM = j.value("panel_height_m", c.panelHeightM);
         c.rateHz = j.at("rate_hz").get<double>();
         c.booth = j.at("booth").get<std::string>();
         c.scene = j.at("scene").get<std::string>();
@@ -136,6 +141,13 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
                          "run configuration: size, rate, light count, specular samples, specular "
                          "or diffuse grid, specular lod bias, horizon directions or cache slices "
                          "out of range");
+    }
+    if (!(c.panelWidthM >= 0.02 && c.panelWidthM <= 10.0) ||
+        !(c.panelHeightM >= 0.02 && c.panelHeightM <= 10.0)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("run configuration: panel size {}x{} m out of range (0.02 "
+                                     "to 10 m each)",
+                                     c.panelWidthM, c.panelHeightM));
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -216,6 +228,50 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
 namespace {
 
 // The booth renderer's pass 1: the booth model, the scene folder, the settings.
+// The stand with the configured panel.
+pipeline::scene::StandModel standModel(const RunConfig& config)
+{
+    pipeline::scene::StandModel stand;
+    stand.panelWidthM = config.panelWidthM;
+    stand.panelHeightM = config.panelHeightM;
+    return stand;
+}
+
+// The geometry rules (docs/architecture.md, Outputs): on a display, a run's frame is the mode's
+// size and, with no configured panel size, the panel is the size the display's EDID gives; the
+// renderer maps the frame onto the panel, so a surface shows at its physical size where the
+// pixels are square.
+void applyDisplayGeometry(RunConfig& config, const Output& output, const OutputChoice& choice)
+{
+    auto log = logger("output");
+    const auto display = output.display();
+    if (display && choice.frameFromMode) {
+        config.width = display->width;
+        config.height = display->height;
+    }
+    if (display && choice.panelFromDisplay) {
+        const PanelSize panel = resolvePanelSize(std::nullopt, display->edidSize,
+                                                 config.panelWidthM, config.panelHeightM);
+        config.panelWidthM = panel.widthM;
+        config.panelHeightM = panel.heightM;
+        if (panel.source == "edid") {
+            log->info("panel {:.0f}x{:.0f} mm from the EDID of {}", panel.widthM * 1000.0,
+                      panel.heightM * 1000.0, display->connector);
+        } else {
+            log->warn("{} gives no physical size: the panel is taken as {:.0f}x{:.0f} mm; set "
+                      "its active area with --panel-size-mm",
+                      display->connector, panel.widthM * 1000.0, panel.heightM * 1000.0);
+        }
+    }
+    const PanelSize panel{config.panelWidthM, config.panelHeightM, ""};
+    if (const double e = pixelAspectError(panel, config.width, config.height); e > 0.02) {
+        log->warn("a {}x{} frame on a {:.0f}x{:.0f} mm panel has pixels {:.1f}% off square: "
+                  "surfaces show stretched; check the panel size and the mode",
+                  config.width, config.height, config.panelWidthM * 1000.0,
+                  config.panelHeightM * 1000.0, 100.0 * e);
+    }
+}
+
 Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
 makeBoothScene(RunConfig& config,
                const pipeline::scene::Booth& lamps,
@@ -245,6 +301,7 @@ makeBoothScene(RunConfig& config,
         return tl::unexpected(booth.error());
     }
     pipeline::render::BoothSceneSetup setup;
+    setup.stand = standModel(config);
     setup.booth = std::move(*booth);
     for (const auto& lamp : lamps.lamps) {
         setup.lamps.push_back(lamp.name);
@@ -396,17 +453,19 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
         return tl::unexpected(surface.error());
     }
 
-    auto output = outputChoice.kind == "kms"
-                          ? createKmsOutput(outputChoice.kmsDevice, outputChoice.kmsConnector)
-                          : createHeadlessOutput();
+    auto output =
+            outputChoice.kind == "kms" ? createKmsOutput(outputChoice.kms) : createHeadlessOutput();
     if (!output) {
         return tl::unexpected(output.error());
     }
     app->output = std::move(*output);
+    applyDisplayGeometry(config, *app->output, outputChoice);
+    app->config = config;
 
     pipeline::render::GlesRendererSetup setup;
     setup.width = config.width;
     setup.height = config.height;
+    setup.stand = standModel(config);
     setup.booth = app->booth;
     setup.surface = std::move(*surface);
     setup.basis = basis;

@@ -12,6 +12,7 @@
 #include <pipeline/base/expected.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/renderer.h>
+#include <pipeline/scene/stand.h>
 #include <platform/loop/scene_updater.h>
 #include <platform/output/output.h>
 #include <recordings/recording.h>
@@ -33,6 +34,11 @@ constexpr int kMaxCacheSlices = 16;
 struct RunConfig {
     int width = 960;
     int height = 600;
+    // The panel's active area the frame covers (metres): the site's configured size, the
+    // display's EDID on KMS, else the stand model's 24-inch panel. Recordings made before it have
+    // none and replay on that default, which is what they were rendered on.
+    double panelWidthM = pipeline::scene::StandModel{}.panelWidthM;
+    double panelHeightM = pipeline::scene::StandModel{}.panelHeightM;
     double rateHz = 60.0;
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
@@ -169,11 +175,15 @@ Expected<std::string> sceneDigest(const std::filesystem::path& dir);
 // records them); a replay gets the settings its recording ran with.
 pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config);
 
-// Where frames go; not part of RunConfig because it never changes what a frame looks like.
+// Where frames go; not part of RunConfig because it never changes what a frame looks like (what
+// it decides of the frame, its size and panel, goes into the RunConfig as built).
 struct OutputChoice {
     std::string kind = "headless"; // or "kms"
-    std::string kmsDevice = "/dev/dri/card0";
-    std::string kmsConnector; // empty: the first connected one
+    KmsOptions kms;
+    // KMS: the frame takes the mode's size (a run; a replay keeps its recording's size).
+    bool frameFromMode = false;
+    // KMS: the panel's size comes from the display's EDID (a run with no configured size).
+    bool panelFromDisplay = false;
 };
 
 // Creates the output and everything that renders. Fails with a one-line reason. With the booth

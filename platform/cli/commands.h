@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <platform/output/output.h>
+
 namespace replica::platform {
 
 constexpr int kExitOk = 0;
@@ -21,5 +23,8 @@ void registerRecoverCommand(CLI::App& app, int& exitCode);
 void registerColorCommand(CLI::App& app, int& exitCode);
 void registerSpectralCommand(CLI::App& app, int& exitCode);
 void registerProbeCommand(CLI::App& app, int& exitCode);
+
+// --kms-device, --kms-connector, --kms-mode, --kms-modeset, --kms-path (run and replay).
+void addKmsOptions(CLI::App& cmd, KmsOptions& kms);
 
 } // namespace replica::platform

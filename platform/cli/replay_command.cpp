@@ -24,6 +24,9 @@ struct ReplayOptions {
     std::string saveFrames;  // write every frame's XYZ here (reference frames for a golden)
     std::string reference;   // reference XYZ frames for --check (default: GOLDEN.frames/)
     std::string mismatchDir; // where --check writes the first differing frame
+    std::string savePng;     // write every frame's display counts here (PNG)
+    std::string output = "headless";
+    KmsOptions kms;
 };
 
 std::filesystem::path
@@ -104,7 +107,20 @@ int replayMain(const ReplayOptions& o)
         log->error("{}: {}", o.file, config.error().message);
         return kExitFailure;
     }
-    auto appliance = buildAppliance(*config);
+    if (o.output != "headless" && o.output != "kms") {
+        log->error("--output {}: expected 'headless' or 'kms'", o.output);
+        return kExitUsage;
+    }
+    OutputChoice outputChoice;
+    outputChoice.kind = o.output;
+    outputChoice.kms = o.kms;
+    if (o.output == "kms" && o.kms.mode.empty()) {
+        // The recording's frame size is the mode to ask for; the preferred one if there is none
+        // of that size (the frame is then centred or cropped).
+        outputChoice.kms.mode = fmt::format("{}x{}", config->width, config->height);
+        outputChoice.kms.modeOrPreferred = true;
+    }
+    auto appliance = buildAppliance(*config, outputChoice);
     if (!appliance) {
         log->error("{}", appliance.error().message);
         return kExitFailure;
@@ -129,11 +145,14 @@ int replayMain(const ReplayOptions& o)
         }
         golden = std::move(*g);
     }
-    if (!o.saveFrames.empty()) {
+    for (const std::string& dir : {o.saveFrames, o.savePng}) {
+        if (dir.empty()) {
+            continue;
+        }
         std::error_code ec;
-        std::filesystem::create_directories(o.saveFrames, ec);
+        std::filesystem::create_directories(dir, ec);
         if (ec) {
-            log->error("{}: cannot create directory: {}", o.saveFrames, ec.message());
+            log->error("{}: cannot create directory: {}", dir, ec.message());
             return kExitFailure;
         }
     }
@@ -143,6 +162,7 @@ int replayMain(const ReplayOptions& o)
     std::optional<FloatImage> firstDiffXyz;
     std::vector<std::uint8_t> firstDiffRgba;
     std::optional<Error> saveError;
+    std::size_t pngCount = 0;
     auto keep = outputs.callback();
     auto onFrame = [&](const recordings::FrameRecord& f, const pipeline::scene::SceneState& scene,
                        const pipeline::render::RenderedFrame& image) {
@@ -155,14 +175,26 @@ int replayMain(const ReplayOptions& o)
                 saveError = ok.error();
             }
         }
+        if (!o.savePng.empty() && !saveError) {
+            if (auto ok = writePng(framePath(o.savePng, static_cast<long>(pngCount++), ".png"),
+                                   image.width, image.height, image.rgba);
+                !ok) {
+                saveError = ok.error();
+            }
+        }
         if (golden && !firstDiffXyz &&
             (i >= golden->size() || !((*golden)[i] == outputs.digests()[i]))) {
             firstDiffXyz = FloatImage{image.width, image.height, image.xyz};
             firstDiffRgba = image.rgba;
         }
     };
+    auto readback = outputs.readback();
+    if ((!o.savePng.empty() || (*appliance)->output->needsPixels()) &&
+        readback == pipeline::render::Readback::None) {
+        readback = pipeline::render::Readback::Display;
+    }
     auto stats = runFrames(**appliance, sources, replayPlan(recording->frames), pacing, nullptr,
-                           outputs.readback(), onFrame);
+                           readback, onFrame);
     if (saveError) {
         log->error("{}", saveError->message);
         return kExitFailure;
@@ -220,6 +252,15 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--save-frames", opts->saveFrames,
                     "write every frame's absolute XYZ to DIR/frame-NNNNNN.pfm (reference frames "
                     "for a golden)");
+    cmd->add_option("--save-png", opts->savePng,
+                    "write every frame's display counts to DIR/frame-NNNNNN.png (as the panel "
+                    "shows them)");
+    cmd->add_option("--output", opts->output,
+                    "headless (no display) or kms (fullscreen: the recording's frame size as the "
+                    "mode, or the preferred mode with the frame centred)")
+            ->check(CLI::IsMember({"headless", "kms"}))
+            ->capture_default_str();
+    addKmsOptions(*cmd, opts->kms);
     cmd->add_option("--reference", opts->reference,
                     "reference XYZ frames for --check (default: GOLDEN with .frames instead of "
                     ".json, if it exists): on a mismatch, ΔE00 of the first differing frame");

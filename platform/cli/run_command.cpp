@@ -24,7 +24,8 @@ struct RunOptions {
     std::string lampSelector = "none"; // sim only: none, sim, sim-miswired
     std::string output = "headless";
     std::uint64_t frames = 180;
-    std::string size = "960x600";
+    std::string size; // headless: 960x600 when not given; kms: the mode's size
+    std::string panelSizeMm;
     double rateHz = 60.0;
     std::string record;
     int recordFlushMs = 500;
@@ -77,7 +78,13 @@ int runMain(const RunOptions& o)
                    o.output);
         return kExitUsage;
     }
-    const auto size = parseSize(o.size);
+    if (o.output == "kms" && !o.size.empty()) {
+        log->error("--size {}: on KMS the frame is the display mode's size; choose the mode with "
+                   "--kms-mode WIDTHxHEIGHT",
+                   o.size);
+        return kExitUsage;
+    }
+    const auto size = parseSize(o.size.empty() ? std::string("960x600") : o.size);
     if (!size) {
         log->error("--size {}: expected WIDTHxHEIGHT, e.g. 960x600", o.size);
         return kExitUsage;
@@ -85,6 +92,15 @@ int runMain(const RunOptions& o)
     RunConfig config;
     config.width = size->first;
     config.height = size->second;
+    if (!o.panelSizeMm.empty()) {
+        auto panel = parseSizeMm(o.panelSizeMm);
+        if (!panel) {
+            log->error("--panel-size-mm: {}", panel.error().message);
+            return kExitUsage;
+        }
+        config.panelWidthM = panel->width / 1000.0;
+        config.panelHeightM = panel->height / 1000.0;
+    }
     config.rateHz = o.rateHz;
     config.renderer = o.renderer;
     // The flat renderer has no 36-band scene to re-encode: it keeps the best fixed basis.
@@ -126,6 +142,8 @@ int runMain(const RunOptions& o)
 
     OutputChoice outputChoice = o.outputChoice;
     outputChoice.kind = o.output;
+    outputChoice.frameFromMode = true;
+    outputChoice.panelFromDisplay = o.panelSizeMm.empty();
     auto appliance = buildAppliance(config, outputChoice);
     if (!appliance) {
         log->error("{}", appliance.error().message);
@@ -160,8 +178,8 @@ int runMain(const RunOptions& o)
               sources->tracker->info().serial, hal::toString(sources->accel->info().kind),
               sources->accel->info().model, sources->accel->info().serial,
               (*appliance)->output->name(), (*appliance)->renderer->description(),
-              (*appliance)->output->glRenderer(), config.width, config.height, config.rateHz,
-              (*appliance)->displayProfileId);
+              (*appliance)->output->glRenderer(), (*appliance)->config.width,
+              (*appliance)->config.height, config.rateHz, (*appliance)->displayProfileId);
 
     std::unique_ptr<recordings::RecordingWriter> recorder;
     bool recordFailed = false;
@@ -213,7 +231,7 @@ int runMain(const RunOptions& o)
                             });
     // Scan-out needs the display pixels of every frame, digests or not.
     auto readback = outputs.readback();
-    if (o.output == "kms" && readback == pipeline::render::Readback::None) {
+    if ((*appliance)->output->needsPixels() && readback == pipeline::render::Readback::None) {
         readback = pipeline::render::Readback::Display;
     }
     auto stats = runFrames(**appliance, *sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
@@ -271,6 +289,25 @@ int runMain(const RunOptions& o)
 
 } // namespace
 
+void addKmsOptions(CLI::App& cmd, KmsOptions& kms)
+{
+    cmd.add_option("--kms-device", kms.device, "kms: the DRM card to drive")->capture_default_str();
+    cmd.add_option("--kms-connector", kms.connector,
+                   "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
+    cmd.add_option("--kms-mode", kms.mode,
+                   "kms: the mode, WIDTHxHEIGHT or WIDTHxHEIGHT@HZ (default: the display's "
+                   "preferred mode)");
+    cmd.add_option("--kms-modeset", kms.modeset,
+                   "kms: auto (atomic where the driver has it, else legacy), atomic or legacy")
+            ->check(CLI::IsMember({"auto", "atomic", "legacy"}))
+            ->capture_default_str();
+    cmd.add_option("--kms-path", kms.path,
+                   "kms: auto (EGL on a GBM surface, else CPU copies into dumb buffers), gbm or "
+                   "dumb")
+            ->check(CLI::IsMember({"auto", "gbm", "dumb"}))
+            ->capture_default_str();
+}
+
 void registerRunCommand(CLI::App& app, int& exitCode)
 {
     auto opts = std::make_shared<RunOptions>();
@@ -306,14 +343,16 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--output", opts->output,
                     "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")
             ->capture_default_str();
-    cmd->add_option("--kms-device", opts->outputChoice.kmsDevice, "kms: the DRM card to drive")
-            ->capture_default_str();
-    cmd->add_option("--kms-connector", opts->outputChoice.kmsConnector,
-                    "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
+    addKmsOptions(*cmd, opts->outputChoice.kms);
     cmd->add_option("--frames", opts->frames,
                     "number of frames to run; 0 = until SIGINT/SIGTERM (the kiosk)")
             ->capture_default_str();
-    cmd->add_option("--size", opts->size, "frame size WIDTHxHEIGHT")->capture_default_str();
+    cmd->add_option("--size", opts->size,
+                    "headless: frame size WIDTHxHEIGHT (default 960x600); on kms the frame is the "
+                    "mode's size");
+    cmd->add_option("--panel-size-mm", opts->panelSizeMm,
+                    "the panel's active area WIDTHxHEIGHT in millimetres, which the frame covers "
+                    "(default: the display's EDID on kms, else 518x324, a 24-inch 16:10 panel)");
     cmd->add_option("--rate", opts->rateHz, "frame rate (Hz)")
             ->check(CLI::Range(1.0, 1000.0))
             ->capture_default_str();
