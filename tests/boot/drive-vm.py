@@ -4,8 +4,8 @@
 drive-vm.py WORKDIR TIMEOUT_S -- QEMU_ARGS...
 Starts qemu with the given arguments plus a serial log (WORKDIR/serial.log), a second serial port
 the guest agent reads the host's word from, and a QMP socket. Prints each "BOOTTEST" line of the
-guest as it comes; on "ready for screendump" takes WORKDIR/screen.png with QMP screendump and tells
-the guest to go on; on "done" (or at the timeout) ends qemu with QMP quit. Writes
+guest as it comes; on "ready for screendump NAME" takes WORKDIR/screen-NAME.png with QMP
+screendump and tells the guest to go on; on "done" (or at the timeout) ends qemu with QMP quit. Writes
 WORKDIR/timings.json (host seconds from qemu's start to the first frame and to the end).
 Exit status: 0 when the guest said done and no "FAIL" line, 1 otherwise.
 """
@@ -102,7 +102,8 @@ def main():
             if "ready for screendump" in line:
                 # The recording's first frames come before its first light sample and are
                 # black: take the screen again until it shows something (at most 5 minutes).
-                screen = os.path.join(work, "screen.png")
+                name = line.split()[-1]
+                screen = os.path.join(work, "screen-%s.png" % name)
                 for attempt in range(150):
                     reply = qmp(f, "screendump", filename=screen, format="png")
                     if "error" in reply:
@@ -112,9 +113,10 @@ def main():
                     if Image.open(screen).convert("RGB").getbbox() is not None:
                         break
                     time.sleep(2)
-                timings["host_s_to_screendump"] = round(time.monotonic() - start, 1)
-                print("[%7.1f s] screendump taken (%d black before it)"
-                      % (timings["host_s_to_screendump"], attempt), flush=True)
+                taken = round(time.monotonic() - start, 1)
+                timings.setdefault("host_s_to_screendump", taken)
+                print("[%7.1f s] screendump %s taken (%d black before it)"
+                      % (taken, os.path.basename(screen), attempt), flush=True)
                 ctl.sendall(b"screendump-taken\n")
             if line.endswith("done"):
                 done = True
