@@ -34,8 +34,8 @@ std::string RunConfig::toJson() const
 {
     nlohmann::json j{{"width", width},
                      {"height", height},
-                     {"panel_width_m", panelWidthM},
-                     {"panel_height_m", panelHeightM},
+                     {"panel_width_m", stand.panelWidthM},
+                     {"panel_height_m", stand.panelHeightM},
                      {"rate_hz", rateHz},
                      {"booth", booth},
                      {"scene", scene},
@@ -83,8 +83,8 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         const auto j = nlohmann::json::parse(json);
         c.width = j.at("width").get<int>();
         c.height = j.at("height").get<int>();
-        c.panelWidthM = j.value("panel_width_m", c.panelWidthM);
-        c.panelHeightM = j.value("panel_height_m", c.panelHeightM);
+        c.stand.panelWidthM = j.value("panel_width_m", c.stand.panelWidthM);
+        c.stand.panelHeightM = j.value("panel_height_m", c.stand.panelHeightM);
         c.rateHz = j.at("rate_hz").get<double>();
         c.booth = j.at("booth").get<std::string>();
         c.scene = j.at("scene").get<std::string>();
@@ -142,12 +142,12 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
                          "or diffuse grid, specular lod bias, horizon directions or cache slices "
                          "out of range");
     }
-    if (!(c.panelWidthM >= 0.02 && c.panelWidthM <= 10.0) ||
-        !(c.panelHeightM >= 0.02 && c.panelHeightM <= 10.0)) {
+    if (!(c.stand.panelWidthM >= 0.02 && c.stand.panelWidthM <= 10.0) ||
+        !(c.stand.panelHeightM >= 0.02 && c.stand.panelHeightM <= 10.0)) {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("run configuration: panel size {}x{} m out of range (0.02 "
                                      "to 10 m each)",
-                                     c.panelWidthM, c.panelHeightM));
+                                     c.stand.panelWidthM, c.stand.panelHeightM));
     }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
@@ -228,15 +228,6 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
 namespace {
 
 // The booth renderer's pass 1: the booth model, the scene folder, the settings.
-// The stand with the configured panel.
-pipeline::scene::StandModel standModel(const RunConfig& config)
-{
-    pipeline::scene::StandModel stand;
-    stand.panelWidthM = config.panelWidthM;
-    stand.panelHeightM = config.panelHeightM;
-    return stand;
-}
-
 // The geometry rules (docs/architecture.md, Outputs): on a display, a run's frame is the mode's
 // size and, with no configured panel size, the panel is the size the display's EDID gives; the
 // renderer maps the frame onto the panel, so a surface shows at its physical size where the
@@ -250,10 +241,11 @@ void applyDisplayGeometry(RunConfig& config, const Output& output, const OutputC
         config.height = display->height;
     }
     if (display && choice.panelFromDisplay) {
-        const PanelSize panel = resolvePanelSize(std::nullopt, display->edidSize,
-                                                 config.panelWidthM, config.panelHeightM);
-        config.panelWidthM = panel.widthM;
-        config.panelHeightM = panel.heightM;
+        const PanelSize panel =
+                resolvePanelSize(std::nullopt, display->edidSize, config.stand.panelWidthM,
+                                 config.stand.panelHeightM);
+        config.stand.panelWidthM = panel.widthM;
+        config.stand.panelHeightM = panel.heightM;
         if (panel.source == "edid") {
             log->info("panel {:.0f}x{:.0f} mm from the EDID of {}", panel.widthM * 1000.0,
                       panel.heightM * 1000.0, display->connector);
@@ -263,12 +255,12 @@ void applyDisplayGeometry(RunConfig& config, const Output& output, const OutputC
                       display->connector, panel.widthM * 1000.0, panel.heightM * 1000.0);
         }
     }
-    const PanelSize panel{config.panelWidthM, config.panelHeightM, ""};
+    const PanelSize panel{config.stand.panelWidthM, config.stand.panelHeightM, ""};
     if (const double e = pixelAspectError(panel, config.width, config.height); e > 0.02) {
         log->warn("a {}x{} frame on a {:.0f}x{:.0f} mm panel has pixels {:.1f}% off square: "
                   "surfaces show stretched; check the panel size and the mode",
-                  config.width, config.height, config.panelWidthM * 1000.0,
-                  config.panelHeightM * 1000.0, 100.0 * e);
+                  config.width, config.height, config.stand.panelWidthM * 1000.0,
+                  config.stand.panelHeightM * 1000.0, 100.0 * e);
     }
 }
 
@@ -301,7 +293,7 @@ makeBoothScene(RunConfig& config,
         return tl::unexpected(booth.error());
     }
     pipeline::render::BoothSceneSetup setup;
-    setup.stand = standModel(config);
+    setup.stand = config.stand;
     setup.booth = std::move(*booth);
     for (const auto& lamp : lamps.lamps) {
         setup.lamps.push_back(lamp.name);
@@ -465,7 +457,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     pipeline::render::GlesRendererSetup setup;
     setup.width = config.width;
     setup.height = config.height;
-    setup.stand = standModel(config);
+    setup.stand = config.stand;
     setup.booth = app->booth;
     setup.surface = std::move(*surface);
     setup.basis = basis;

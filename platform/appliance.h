@@ -34,11 +34,6 @@ constexpr int kMaxCacheSlices = 16;
 struct RunConfig {
     int width = 960;
     int height = 600;
-    // The panel's active area the frame covers (metres): the site's configured size, the
-    // display's EDID on KMS, else the stand model's 24-inch panel. Recordings made before it have
-    // none and replay on that default, which is what they were rendered on.
-    double panelWidthM = pipeline::scene::StandModel{}.panelWidthM;
-    double panelHeightM = pipeline::scene::StandModel{}.panelHeightM;
     double rateHz = 60.0;
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
@@ -123,6 +118,11 @@ struct RunConfig {
     bool viewingFiltered = true;
     bool flareSubtraction = true;
     bool falseColour = false;
+    // The stand, with the panel's active area the frame covers (stand.panelWidthM, panelHeightM):
+    // the configured size, else the display's EDID on KMS, else the 24-inch panel of the defaults.
+    // Recordings made before the panel size was recorded replay on that default, which is what
+    // they were rendered on.
+    pipeline::scene::StandModel stand;
 
     std::int64_t periodNs() const;
     std::string toJson() const;

@@ -98,8 +98,8 @@ int runMain(const RunOptions& o)
             log->error("--panel-size-mm: {}", panel.error().message);
             return kExitUsage;
         }
-        config.panelWidthM = panel->width / 1000.0;
-        config.panelHeightM = panel->height / 1000.0;
+        config.stand.panelWidthM = panel->width / 1000.0;
+        config.stand.panelHeightM = panel->height / 1000.0;
     }
     config.rateHz = o.rateHz;
     config.renderer = o.renderer;

@@ -179,24 +179,21 @@ TEST(PanelSize, TheSurfaceShowsAtItsPhysicalSizeOnAnyPanel)
          {std::tuple{0.518, 0.324, 1920, 1200}, std::tuple{0.325, 0.203, 1280, 800},
           std::tuple{1.429, 0.804, 3840, 2160}}) {
         platform::RunConfig config;
-        config.panelWidthM = wM;
-        config.panelHeightM = hM;
-        pipeline::scene::StandModel stand;
-        stand.panelWidthM = config.panelWidthM;
-        stand.panelHeightM = config.panelHeightM;
-        const auto layout = pipeline::render::layoutOnPanel(scene, stand);
+        config.stand.panelWidthM = wM;
+        config.stand.panelHeightM = hM;
+        const auto layout = pipeline::render::layoutOnPanel(scene, config.stand);
         // Surface u spans 1 / scale.x of the frame's width.
         EXPECT_NEAR(px / layout.scale.x, 0.2 / (wM / px), 1e-9) << wM;
         EXPECT_NEAR(py / layout.scale.y, 0.15 / (hM / py), 1e-9) << hM;
     }
     // The panel size is recorded; recordings without it replay on the 24-inch stand.
     platform::RunConfig c;
-    c.panelWidthM = 0.325;
-    c.panelHeightM = 0.203;
+    c.stand.panelWidthM = 0.325;
+    c.stand.panelHeightM = 0.203;
     auto back = platform::RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(back);
-    EXPECT_DOUBLE_EQ(back->panelWidthM, 0.325);
-    EXPECT_DOUBLE_EQ(back->panelHeightM, 0.203);
+    EXPECT_DOUBLE_EQ(back->stand.panelWidthM, 0.325);
+    EXPECT_DOUBLE_EQ(back->stand.panelHeightM, 0.203);
     std::string old = c.toJson();
     for (const char* key : {"\"panel_width_m\":0.325,", "\"panel_height_m\":0.203,"}) {
         const auto at = old.find(key);
@@ -205,9 +202,9 @@ TEST(PanelSize, TheSurfaceShowsAtItsPhysicalSizeOnAnyPanel)
     }
     auto legacy = platform::RunConfig::fromJson(old);
     ASSERT_TRUE(legacy) << legacy.error().message;
-    EXPECT_DOUBLE_EQ(legacy->panelWidthM, 0.518);
-    EXPECT_DOUBLE_EQ(legacy->panelHeightM, 0.324);
-    c.panelWidthM = 0.001;
+    EXPECT_DOUBLE_EQ(legacy->stand.panelWidthM, 0.518);
+    EXPECT_DOUBLE_EQ(legacy->stand.panelHeightM, 0.324);
+    c.stand.panelWidthM = 0.001;
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
 }
 
