@@ -204,7 +204,7 @@ TEST(PanelSize, TheSurfaceShowsAtItsPhysicalSizeOnAnyPanel)
     ASSERT_TRUE(legacy) << legacy.error().message;
     EXPECT_DOUBLE_EQ(legacy->stand.panelWidthM, 0.518);
     EXPECT_DOUBLE_EQ(legacy->stand.panelHeightM, 0.324);
-    c.stand.panelWidthM = 0.001;
+    c.stand.panelWidthM = -0.5;
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
 }
 
