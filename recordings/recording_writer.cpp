@@ -187,7 +187,7 @@ private:
                 }
             }
             if (drainShared()) {
-                if (!chunkOpened) {
+                if (chunkOpened == kNoChunk) {
                     chunkOpened = Clock::now();
                 }
                 if (file_->pendingBytes() >= options_.chunkBytes) {

@@ -763,8 +763,8 @@ int runMain(const RunOptions& given)
     // 1 ms for the 11.5 MB of a 960x600 frame, docs/performance.md) inside each frame's time; the
     // read-back of the XYZ frame costs more than the hash. Said so that the figure is not taken
     // for the appliance's.
-    log->info("frame time: mean {:.1f} ms ({:.0f} frames/s), 95th percentile {:.1f}, max {:.1f}; "
-              "{} of {} frames took the whole {:.1f} ms period or more{}",
+    log->info("frame time: mean {:.1f} ms ({:.0f} frames/s), 50th percentile {:.1f}, 95th {:.1f}, "
+              "99th {:.1f}, max {:.1f}; {} of {} frames took the whole {:.1f} ms period or more{}",
               t.meanMs(), t.meanMs() > 0.0 ? 1000.0 / t.meanMs() : 0.0, t.percentileMs(0.50),
               t.percentileMs(0.95), t.percentileMs(0.99), t.maxMs(), t.atLeast(periodMs), t.count(),
               periodMs,
@@ -778,7 +778,9 @@ int runMain(const RunOptions& given)
                           {"accel", stats->droppedAccel},
                           {"lamp_selector", stats->droppedLamp}};
     summary["frame_time_ms"] = {{"mean", t.meanMs()},
+                                {"p50", t.percentileMs(0.50)},
                                 {"p95", t.percentileMs(0.95)},
+                                {"p99", t.percentileMs(0.99)},
                                 {"max", t.maxMs()},
                                 {"at_least_period", t.atLeast(periodMs)}};
     summary["out_of_gamut"] = {{"mean", stats->meanOutOfGamutFraction()},
@@ -1001,7 +1003,7 @@ void registerRunCommand(CLI::App& app, int& exitCode)
             const auto* parent = cmd->get_parent();
             if (parent != nullptr && parent->get_option("--log-level")->count() == 0 &&
                 std::getenv("REPLICA_LOG") == nullptr) {
-                setupLogging(o.site->logLevel);
+                setupLogging(o.site->logLevel, true);
             }
         }
         if (o.kiosk && cmd->get_option("--frames")->count() == 0) {
