@@ -21,6 +21,7 @@
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <platform/appliance.h>
+#include <platform/logging.h>
 #include <platform/loop/frame_digest.h>
 
 namespace replica::platform {
@@ -215,6 +216,13 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
                          "run configuration: stand, panel size, tracker transform or default "
                          "eye/tilt not finite or out of range");
     }
+    if (!(c.stand.panelWidthM >= 0.02 && c.stand.panelWidthM <= 10.0) ||
+        !(c.stand.panelHeightM >= 0.02 && c.stand.panelHeightM <= 10.0)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("run configuration: panel size {}x{} m out of range (0.02 "
+                                     "to 10 m each)",
+                                     c.stand.panelWidthM, c.stand.panelHeightM));
+    }
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("run configuration: renderer '{}' is not 'booth' or 'flat'",
@@ -405,6 +413,42 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
 namespace {
 
 // The booth renderer's pass 1: the booth model, the scene folder, the settings.
+// The geometry rules (docs/architecture.md, Outputs): on a display, a run's frame is the mode's
+// size and, with no configured panel size, the panel is the size the display's EDID gives; the
+// renderer maps the frame onto the panel, so a surface shows at its physical size where the
+// pixels are square.
+void applyDisplayGeometry(RunConfig& config, const Output& output, const OutputChoice& choice)
+{
+    auto log = logger("output");
+    const auto display = output.display();
+    if (display && choice.frameFromMode) {
+        config.width = display->width;
+        config.height = display->height;
+    }
+    if (display && choice.panelFromDisplay) {
+        const PanelSize panel =
+                resolvePanelSize(std::nullopt, display->edidSize, config.stand.panelWidthM,
+                                 config.stand.panelHeightM);
+        config.stand.panelWidthM = panel.widthM;
+        config.stand.panelHeightM = panel.heightM;
+        if (panel.source == "edid") {
+            log->info("panel {:.0f}x{:.0f} mm from the EDID of {}", panel.widthM * 1000.0,
+                      panel.heightM * 1000.0, display->connector);
+        } else {
+            log->warn("{} gives no physical size: the panel is taken as {:.0f}x{:.0f} mm; set "
+                      "its active area with --panel-size-mm",
+                      display->connector, panel.widthM * 1000.0, panel.heightM * 1000.0);
+        }
+    }
+    const PanelSize panel{config.stand.panelWidthM, config.stand.panelHeightM, ""};
+    if (const double e = pixelAspectError(panel, config.width, config.height); e > 0.02) {
+        log->warn("a {}x{} frame on a {:.0f}x{:.0f} mm panel has pixels {:.1f}% off square: "
+                  "surfaces show stretched; check the panel size and the mode",
+                  config.width, config.height, config.stand.panelWidthM * 1000.0,
+                  config.stand.panelHeightM * 1000.0, 100.0 * e);
+    }
+}
+
 Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
 makeBoothScene(RunConfig& config,
                const pipeline::scene::Booth& lamps,
@@ -434,6 +478,7 @@ makeBoothScene(RunConfig& config,
         return tl::unexpected(booth.error());
     }
     pipeline::render::BoothSceneSetup setup;
+    setup.stand = config.stand;
     setup.booth = std::move(*booth);
     for (const auto& lamp : lamps.lamps) {
         setup.lamps.push_back(lamp.name);
@@ -591,18 +636,20 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
         return tl::unexpected(surface.error());
     }
 
-    auto output = outputChoice.kind == "kms"
-                          ? createKmsOutput(outputChoice.kmsDevice, outputChoice.kmsConnector)
-                          : createHeadlessOutput();
+    auto output =
+            outputChoice.kind == "kms" ? createKmsOutput(outputChoice.kms) : createHeadlessOutput();
     if (!output) {
         return tl::unexpected(output.error());
     }
     app->output = std::move(*output);
+    applyDisplayGeometry(config, *app->output, outputChoice);
+    app->config = config;
 
     pipeline::render::GlesRendererSetup setup;
     setup.stand = config.stand;
     setup.width = config.width;
     setup.height = config.height;
+    setup.stand = config.stand;
     setup.booth = app->booth;
     setup.surface = std::move(*surface);
     setup.basis = basis;

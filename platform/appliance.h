@@ -214,11 +214,15 @@ Expected<void> checkRecordedReferences(const RunConfig& config,
 // records them); a replay gets the settings its recording ran with.
 pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config);
 
-// Where frames go; not part of RunConfig because it never changes what a frame looks like.
+// Where frames go; not part of RunConfig because it never changes what a frame looks like (what
+// it decides of the frame, its size and panel, goes into the RunConfig as built).
 struct OutputChoice {
     std::string kind = "headless"; // or "kms"
-    std::string kmsDevice = "/dev/dri/card0";
-    std::string kmsConnector; // empty: the first connected one
+    KmsOptions kms;
+    // KMS: the frame takes the mode's size (a run; a replay keeps its recording's size).
+    bool frameFromMode = false;
+    // KMS: the panel's size comes from the display's EDID (a run with no configured size).
+    bool panelFromDisplay = false;
 };
 
 // Creates the output and everything that renders. Fails with a one-line reason. With the booth

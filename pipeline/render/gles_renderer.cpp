@@ -213,6 +213,7 @@ public:
         // Read back what the caller uses.
         out.width = w;
         out.height = h;
+        out.displayFramebuffer = displayPass_.framebuffer();
         const auto pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
         if (readback == Readback::DisplayAndXyz) {

@@ -19,6 +19,9 @@ struct RenderedFrame {
                             // the illuminance on the panel in lux (booth renderer: the flare)
     std::vector<std::uint8_t> rgba; // 8-bit display counts, 4 per pixel
     display::GamutCounters gamut;   // pixels out of the display's gamut, by class (every frame)
+    // The GL framebuffer that holds the display counts (RGBA8, bottom-up) in the renderer's
+    // context, until the next render(): what an output on the GPU copies instead of rgba.
+    std::uint32_t displayFramebuffer = 0;
 };
 
 // What render() copies back from the GPU: reading back costs time, so the loop asks only for what

@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <platform/output/output.h>
+
 namespace replica::platform {
 
 constexpr int kExitOk = 0;
@@ -23,5 +25,8 @@ void registerSpectralCommand(CLI::App& app, int& exitCode);
 void registerProbeCommand(CLI::App& app, int& exitCode);
 void registerCalibrateCommand(CLI::App& app, int& exitCode);
 void registerConfigCommand(CLI::App& app, int& exitCode);
+
+// --kms-device, --kms-connector, --kms-mode, --kms-modeset, --kms-path (run and replay).
+void addKmsOptions(CLI::App& cmd, KmsOptions& kms);
 
 } // namespace replica::platform

@@ -44,6 +44,9 @@ struct ReplayOptions {
     std::optional<double> tolerance; // --check passes within this ΔE00 on the reference frames
     std::string saveOnly;            // with --save-frames: only these frame numbers
     std::string saveFormat = "pfm";  // or "exr" (half float)
+    std::string savePng;             // write every frame's display counts here (PNG)
+    std::string output = "headless";
+    KmsOptions kms;
 };
 
 // The reference frame of `frame` in dir: .exr (committed goldens) or .pfm (local).
@@ -186,7 +189,20 @@ int replayMain(const ReplayOptions& o)
             return kExitFailure;
         }
     }
-    auto appliance = buildAppliance(*config);
+    if (o.output != "headless" && o.output != "kms") {
+        log->error("--output {}: expected 'headless' or 'kms'", o.output);
+        return kExitUsage;
+    }
+    OutputChoice outputChoice;
+    outputChoice.kind = o.output;
+    outputChoice.kms = o.kms;
+    if (o.output == "kms" && o.kms.mode.empty()) {
+        // The recording's frame size is the mode to ask for; the preferred one if there is none
+        // of that size (the frame is then centred or cropped).
+        outputChoice.kms.mode = fmt::format("{}x{}", config->width, config->height);
+        outputChoice.kms.modeOrPreferred = true;
+    }
+    auto appliance = buildAppliance(*config, outputChoice);
     if (!appliance) {
         log->error("{}", appliance.error().message);
         return kExitFailure;
@@ -271,7 +287,7 @@ int replayMain(const ReplayOptions& o)
             return kExitUsage;
         }
     }
-    for (const auto* dir : {&o.saveFrames, &o.framesOut}) {
+    for (const auto* dir : {&o.saveFrames, &o.framesOut, &o.savePng}) {
         if (dir->empty()) {
             continue;
         }
@@ -313,6 +329,7 @@ int replayMain(const ReplayOptions& o)
     long firstShownDiff = -1;
     std::optional<Error> saveError;
     std::uint64_t framesWritten = 0;
+    std::size_t pngCount = 0;
     auto keep = outputs.callback();
     const bool showProgress = !o.noProgress && (o.progress || ::isatty(STDERR_FILENO) == 1);
     const auto wallStart = std::chrono::steady_clock::now();
@@ -375,6 +392,13 @@ int replayMain(const ReplayOptions& o)
                 saveError = ok.error();
             }
         }
+        if (!o.savePng.empty() && !saveError) {
+            if (auto ok = writePng(framePath(o.savePng, static_cast<long>(pngCount++), ".png"),
+                                   image.width, image.height, image.rgba);
+                !ok) {
+                saveError = ok.error();
+            }
+        }
         if (!golden) {
             return;
         }
@@ -418,6 +442,10 @@ int replayMain(const ReplayOptions& o)
             }
         }
     };
+    if ((!o.savePng.empty() || (*appliance)->output->needsPixels()) &&
+        readback == pipeline::render::Readback::None) {
+        readback = pipeline::render::Readback::Display;
+    }
     auto stats = runFrames(**appliance, sources, plan, pacing, nullptr, readback, onFrame);
     const double wallS =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
@@ -605,6 +633,15 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--save-frames", opts->saveFrames,
                     "write every frame's absolute XYZ to DIR/frame-NNNNNN.pfm (or .exr with "
                     "--save-format exr): reference frames for a golden");
+    cmd->add_option("--save-png", opts->savePng,
+                    "write every frame's display counts to DIR/frame-NNNNNN.png (as the panel "
+                    "shows them)");
+    cmd->add_option("--output", opts->output,
+                    "headless (no display) or kms (fullscreen: the recording's frame size as the "
+                    "mode, or the preferred mode with the frame centred)")
+            ->check(CLI::IsMember({"headless", "kms"}))
+            ->capture_default_str();
+    addKmsOptions(*cmd, opts->kms);
     cmd->add_option("--reference", opts->reference,
                     "reference XYZ frames for --check (default: GOLDEN with .frames instead of "
                     ".json, if it exists): on a mismatch, ΔE00 of the first differing frame");

@@ -47,7 +47,8 @@ struct RunOptions {
     std::string sitePath;   // --site: [sources] and [tracker] T_booth_tracker (calibrate)
     std::string output = "headless";
     std::uint64_t frames = 180;
-    std::string size = "960x600";
+    std::string size; // headless: 960x600 when not given; kms: the mode's size
+    std::string panelSizeMm;
     double rateHz = 60.0;
     std::string record;
     bool force = false; // --force: overwrite an existing recording
@@ -103,14 +104,14 @@ void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd)
     if (unset("--output")) {
         o.output = s.output;
     }
-    if (unset("--size")) {
+    if (unset("--size") && o.output != "kms") { // on KMS the frame is the mode's size
         o.size = s.size;
     }
     if (unset("--kms-device")) {
-        o.outputChoice.kmsDevice = s.kmsDevice;
+        o.outputChoice.kms.device = s.kmsDevice;
     }
     if (unset("--kms-connector")) {
-        o.outputChoice.kmsConnector = s.kmsConnector;
+        o.outputChoice.kms.connector = s.kmsConnector;
     }
     if (unset("--scene") && !s.sceneDir.empty()) {
         o.scene = dataPath(s.sceneDir);
@@ -392,7 +393,13 @@ int runMain(const RunOptions& given)
             return kExitUsage;
         }
     }
-    const auto size = parseSize(o.size);
+    if (o.output == "kms" && !o.size.empty()) {
+        log->error("--size {}: on KMS the frame is the display mode's size; choose the mode with "
+                   "--kms-mode WIDTHxHEIGHT",
+                   o.size);
+        return kExitUsage;
+    }
+    const auto size = parseSize(o.size.empty() ? std::string("960x600") : o.size);
     if (!size) {
         log->error("--size {}: expected WIDTHxHEIGHT, e.g. 960x600, each side 1-{} and at most "
                    "{}:1",
@@ -402,6 +409,15 @@ int runMain(const RunOptions& given)
     RunConfig config;
     config.width = size->first;
     config.height = size->second;
+    if (!o.panelSizeMm.empty()) {
+        auto panel = parseSizeMm(o.panelSizeMm);
+        if (!panel) {
+            log->error("--panel-size-mm: {}", panel.error().message);
+            return kExitUsage;
+        }
+        config.stand.panelWidthM = panel->width / 1000.0;
+        config.stand.panelHeightM = panel->height / 1000.0;
+    }
     config.rateHz = o.rateHz;
     config.renderer = o.renderer;
     // The flat renderer has no 36-band scene to re-encode: it keeps the best fixed basis.
@@ -465,7 +481,12 @@ int runMain(const RunOptions& given)
     if (o.site) {
         const SiteConfig& site = *o.site;
         config.booth = site.boothId;
+        const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
         config.stand = site.stand;
+        if (!o.panelSizeMm.empty()) { // the command line wins over the site file
+            config.stand.panelWidthM = panelW;
+            config.stand.panelHeightM = panelH;
+        }
         config.trackerRotationDeg = site.trackerRotationDeg;
         config.trackerTranslationM = site.trackerTranslationM;
         config.defaultLamp = site.defaultLamp;
@@ -491,6 +512,9 @@ int runMain(const RunOptions& given)
 
     OutputChoice outputChoice = o.outputChoice;
     outputChoice.kind = o.output;
+    outputChoice.frameFromMode = true;
+    // The EDID's physical size only when neither the command line nor a site file gives one.
+    outputChoice.panelFromDisplay = o.panelSizeMm.empty() && !o.site;
     auto appliance = buildAppliance(config, outputChoice);
     if (!appliance) {
         log->error("{}", appliance.error().message);
@@ -522,8 +546,8 @@ int runMain(const RunOptions& given)
               sources->tracker->info().serial, hal::toString(sources->accel->info().kind),
               sources->accel->info().model, sources->accel->info().serial,
               (*appliance)->output->name(), (*appliance)->renderer->description(),
-              (*appliance)->output->glRenderer(), config.width, config.height, config.rateHz,
-              (*appliance)->displayProfileId);
+              (*appliance)->output->glRenderer(), (*appliance)->config.width,
+              (*appliance)->config.height, config.rateHz, (*appliance)->displayProfileId);
 
     std::unique_ptr<recordings::RecordingWriter> recorder;
     std::unique_ptr<SessionRecorder> sessions;
@@ -540,8 +564,8 @@ int runMain(const RunOptions& given)
         resolved["run_options"] = {{"hal", o.hal},
                                    {"replay_file", o.replayFile},
                                    {"output", o.output},
-                                   {"kms_device", outputChoice.kmsDevice},
-                                   {"kms_connector", outputChoice.kmsConnector},
+                                   {"kms_device", outputChoice.kms.device},
+                                   {"kms_connector", outputChoice.kms.connector},
                                    {"kiosk", o.kiosk},
                                    {"tracker_port", o.live.trackerPort},
                                    {"tracker_bind", o.live.trackerBind},
@@ -618,7 +642,7 @@ int runMain(const RunOptions& given)
                                            : fixedRateTicks(config.periodNs(), o.frames);
     // Scan-out needs the display pixels of every frame, digests or not.
     auto readback = outputs.readback();
-    if (o.output == "kms" && readback == pipeline::render::Readback::None) {
+    if ((*appliance)->output->needsPixels() && readback == pipeline::render::Readback::None) {
         readback = pipeline::render::Readback::Display;
     }
     if (shown) {
@@ -769,6 +793,25 @@ int runMain(const RunOptions& given)
 
 } // namespace
 
+void addKmsOptions(CLI::App& cmd, KmsOptions& kms)
+{
+    cmd.add_option("--kms-device", kms.device, "kms: the DRM card to drive")->capture_default_str();
+    cmd.add_option("--kms-connector", kms.connector,
+                   "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
+    cmd.add_option("--kms-mode", kms.mode,
+                   "kms: the mode, WIDTHxHEIGHT or WIDTHxHEIGHT@HZ (default: the display's "
+                   "preferred mode)");
+    cmd.add_option("--kms-modeset", kms.modeset,
+                   "kms: auto (atomic where the driver has it, else legacy), atomic or legacy")
+            ->check(CLI::IsMember({"auto", "atomic", "legacy"}))
+            ->capture_default_str();
+    cmd.add_option("--kms-path", kms.path,
+                   "kms: auto (EGL on a GBM surface, else CPU copies into dumb buffers), gbm or "
+                   "dumb")
+            ->check(CLI::IsMember({"auto", "gbm", "dumb"}))
+            ->capture_default_str();
+}
+
 void registerRunCommand(CLI::App& app, int& exitCode)
 {
     auto opts = std::make_shared<RunOptions>();
@@ -847,15 +890,17 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--output", opts->output,
                     "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")
             ->capture_default_str();
-    cmd->add_option("--kms-device", opts->outputChoice.kmsDevice, "kms: the DRM card to drive")
-            ->capture_default_str();
-    cmd->add_option("--kms-connector", opts->outputChoice.kmsConnector,
-                    "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
+    addKmsOptions(*cmd, opts->outputChoice.kms);
     cmd->add_option("--frames", opts->frames,
                     "number of frames to run; 0 = until SIGINT/SIGTERM (the kiosk)")
             ->check(CLI::Range(std::uint64_t{0}, kMaxFrames))
             ->capture_default_str();
-    cmd->add_option("--size", opts->size, "frame size WIDTHxHEIGHT")->capture_default_str();
+    cmd->add_option("--size", opts->size,
+                    "headless: frame size WIDTHxHEIGHT (default 960x600); on kms the frame is the "
+                    "mode's size");
+    cmd->add_option("--panel-size-mm", opts->panelSizeMm,
+                    "the panel's active area WIDTHxHEIGHT in millimetres, which the frame covers "
+                    "(default: the display's EDID on kms, else 518x324, a 24-inch 16:10 panel)");
     cmd->add_option("--rate", opts->rateHz, "frame rate (Hz)")
             ->check(CLI::Range(1.0, 1000.0))
             ->capture_default_str();

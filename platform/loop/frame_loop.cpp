@@ -294,7 +294,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
                    image.gamut.belowBlack);
         stats.sumOutOfGamutFraction += oog;
         stats.maxOutOfGamutFraction = std::max(stats.maxOutOfGamutFraction, oog);
-        DisplayFrame frame{image.width, image.height, image.rgba};
+        DisplayFrame frame{image.width, image.height, image.rgba, image.displayFramebuffer};
         if (auto ok = appliance.output->present(frame); !ok) {
             log->warn("output {}: {}", appliance.output->name(), ok.error().message);
         }

@@ -88,7 +88,9 @@ TEST(ScanoutCopy, NoPixelsMeansBlackNotGarbage)
 
 TEST(KmsOutput, AMissingCardIsAClearError)
 {
-    auto out = platform::createKmsOutput("/dev/dri/no-such-card");
+    platform::KmsOptions options;
+    options.device = "/dev/dri/no-such-card";
+    auto out = platform::createKmsOutput(options);
     ASSERT_FALSE(out);
     EXPECT_EQ(out.error().code, ErrorCode::NotFound);
     EXPECT_NE(out.error().message.find("/dev/dri/no-such-card"), std::string::npos);
