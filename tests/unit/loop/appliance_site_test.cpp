@@ -268,7 +268,7 @@ void writeRecording(const fs::path& path, int samples)
     ASSERT_TRUE(w) << w.error().message;
     for (int i = 0; i < samples; ++i) {
         hal::PoseSample p;
-        p.timestampNs = i * 1'000'000;
+        p.timestampNs = std::int64_t{i} * 1'000'000;
         p.sequence = static_cast<std::uint32_t>(i);
         p.eyeTrackerM = {0.001 * i, 0.1, 0.6};
         (*w)->write(p);
