@@ -13,6 +13,7 @@
 #include <glm/matrix.hpp>
 
 #include <pipeline/display/display_fit.h>
+#include <pipeline/display/synthetic_display.h>
 #include <pipeline/display/tone_fit.h>
 #include <pipeline/display/xyz_difference.h>
 
@@ -169,14 +170,6 @@ candidateForward(const Candidate& cand, const glm::dvec3& black, const glm::dvec
 {
     return black + cand.matrix * glm::dvec3(cand.value(0, counts.x), cand.value(1, counts.y),
                                             cand.value(2, counts.z));
-}
-
-// Standard normal from two uniform 64-bit draws (Box-Muller), reproducible across libraries.
-double fitGaussian(std::mt19937_64& rng)
-{
-    const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53;
-    const double u2 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
 }
 
 // Nelder-Mead on f over n parameters from x0 with initial step 'step'; returns the best point.
@@ -634,7 +627,7 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
             for (int k = 0; k < 16; ++k) {
                 glm::dvec3 noisy = xyz;
                 for (int q = 0; q < 3; ++q) {
-                    noisy[q] *= 1.0 + rho * fitGaussian(rng);
+                    noisy[q] *= 1.0 + rho * standardNormal(rng);
                 }
                 noiseDe += deltaE2000Xyz(noisy, xyz, refWhite);
                 ++draws;
@@ -660,12 +653,12 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
             for (int k = 0; k < 400; ++k) {
                 glm::dvec3 meas = predicted;
                 for (int q = 0; q < 3; ++q) {
-                    meas[q] *= 1.0 + rho / std::sqrt(nWhite) * fitGaussian(rng);
+                    meas[q] *= 1.0 + rho / std::sqrt(nWhite) * standardNormal(rng);
                 }
                 glm::dvec3 pred = predicted;
                 for (int c = 0; c < 3; ++c) {
                     pred += direct.matrix[c] *
-                            (topSpread[static_cast<std::size_t>(c)] * fitGaussian(rng));
+                            (topSpread[static_cast<std::size_t>(c)] * standardNormal(rng));
                 }
                 noiseDes.push_back(deltaE2000Xyz(meas, pred, refWhite));
                 const double dy = 100.0 * (meas.y - pred.y) / predicted.y;

@@ -16,16 +16,14 @@ glm::dvec3 xyFull(const glm::dvec2& xy)
     return {xy.x / xy.y, 1.0, (1.0 - xy.x - xy.y) / xy.y};
 }
 
-// Standard normal from two uniform 64-bit draws (Box-Muller): mt19937_64's output is fixed by the
-// standard, std::normal_distribution's is not, and the shipped data must regenerate identically.
-double gaussian(std::mt19937_64& rng)
+} // namespace
+
+double standardNormal(std::mt19937_64& rng)
 {
     const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53;
     const double u2 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
 }
-
-} // namespace
 
 glm::dmat3 SyntheticDisplay::matrix() const
 {
@@ -147,7 +145,7 @@ syntheticMeasurements(const SyntheticDisplay& display, const MeterNoise& noise, 
         const glm::dvec3 truth = display.forward(p);
         for (int c = 0; c < 3; ++c) {
             const double sigma = noise.relative * std::abs(truth[c]) + noise.absoluteCdM2;
-            m.xyz[c] = truth[c] + sigma * gaussian(rng);
+            m.xyz[c] = truth[c] + sigma * standardNormal(rng);
         }
         out.push_back(m);
     }
@@ -199,7 +197,7 @@ std::vector<Measurement> syntheticSession(const SyntheticDisplay& display,
         const glm::dvec3 truth = display.forward(p);
         for (int c = 0; c < 3; ++c) {
             const double sigma = noise.relative * std::abs(truth[c]) + noise.absoluteCdM2;
-            m.xyz[c] = truth[c] + sigma * gaussian(rng);
+            m.xyz[c] = truth[c] + sigma * standardNormal(rng);
         }
         out.push_back(m);
     }

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -72,5 +73,10 @@ std::vector<Measurement> syntheticSession(const SyntheticDisplay& display,
                                           const MeterNoise& noise,
                                           const SessionPlan& plan,
                                           std::uint64_t seed);
+
+// Standard normal from two uniform 64-bit draws (Box-Muller): mt19937_64's output is fixed by the
+// standard, std::normal_distribution's is not, so simulated meter noise (the shipped data, the
+// fit's bootstrap) regenerates identically everywhere.
+double standardNormal(std::mt19937_64& rng);
 
 } // namespace replica::pipeline::display
