@@ -37,14 +37,13 @@ struct ReplayOptions {
     std::vector<std::string> dataRoots; // folders besides data/ a recording may name files in
     bool allowUndigested = false;       // replay a recording without scene/display digests
     std::optional<double> fromS, toS;   // the slice, in seconds of session time
-    std::string framesOut;              // PNG of every displayed frame of the slice
+    std::string framesOut; // PNG of every displayed frame of the slice (--frames-out, --save-png)
     bool json = false;
     bool progress = false; // progress lines even when standard error is not a terminal
     bool noProgress = false;
     std::optional<double> tolerance; // --check passes within this ΔE00 on the reference frames
     std::string saveOnly;            // with --save-frames: only these frame numbers
     std::string saveFormat = "pfm";  // or "exr" (half float)
-    std::string savePng;             // write every frame's display counts here (PNG)
     std::string output = "headless";
     KmsOptions kms;
 };
@@ -287,7 +286,7 @@ int replayMain(const ReplayOptions& o)
             return kExitUsage;
         }
     }
-    for (const auto* dir : {&o.saveFrames, &o.framesOut, &o.savePng}) {
+    for (const auto* dir : {&o.saveFrames, &o.framesOut}) {
         if (dir->empty()) {
             continue;
         }
@@ -329,7 +328,6 @@ int replayMain(const ReplayOptions& o)
     long firstShownDiff = -1;
     std::optional<Error> saveError;
     std::uint64_t framesWritten = 0;
-    std::size_t pngCount = 0;
     auto keep = outputs.callback();
     const bool showProgress = !o.noProgress && (o.progress || ::isatty(STDERR_FILENO) == 1);
     const auto wallStart = std::chrono::steady_clock::now();
@@ -392,13 +390,6 @@ int replayMain(const ReplayOptions& o)
                 saveError = ok.error();
             }
         }
-        if (!o.savePng.empty() && !saveError) {
-            if (auto ok = writePng(framePath(o.savePng, static_cast<long>(pngCount++), ".png"),
-                                   image.width, image.height, image.rgba);
-                !ok) {
-                saveError = ok.error();
-            }
-        }
         if (!golden) {
             return;
         }
@@ -442,8 +433,7 @@ int replayMain(const ReplayOptions& o)
             }
         }
     };
-    if ((!o.savePng.empty() || (*appliance)->output->needsPixels()) &&
-        readback == pipeline::render::Readback::None) {
+    if ((*appliance)->output->needsPixels() && readback == pipeline::render::Readback::None) {
         readback = pipeline::render::Readback::Display;
     }
     auto stats = runFrames(**appliance, sources, plan, pacing, nullptr, readback, onFrame);
@@ -633,9 +623,6 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--save-frames", opts->saveFrames,
                     "write every frame's absolute XYZ to DIR/frame-NNNNNN.pfm (or .exr with "
                     "--save-format exr): reference frames for a golden");
-    cmd->add_option("--save-png", opts->savePng,
-                    "write every frame's display counts to DIR/frame-NNNNNN.png (as the panel "
-                    "shows them)");
     cmd->add_option("--output", opts->output,
                     "headless (no display) or kms (fullscreen: the recording's frame size as the "
                     "mode, or the preferred mode with the frame centred)")
@@ -654,9 +641,12 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
             ->check(CLI::Range(0.0, 1e9));
     cmd->add_option("--to", opts->toS, "... up to T seconds of session time (inclusive)")
             ->check(CLI::Range(0.0, 1e9));
-    cmd->add_option("--frames-out", opts->framesOut,
-                    "write what the panel showed for every replayed frame to "
-                    "DIR/frame-NNNNNN.png");
+    // One option under two names: --save-png is its older name, kept so that scripts using it
+    // (deploy/boot-test once did) go on working.
+    cmd->add_option("--frames-out,--save-png", opts->framesOut,
+                    "write what the panel showed (its display counts) for every replayed frame "
+                    "to DIR/frame-NNNNNN.png, NNNNNN the recording's frame number; --save-png "
+                    "is the same option");
     cmd->add_flag("--json", opts->json,
                   "print a JSON summary (frames, slice, check result with ΔE00, display "
                   "digests) on standard output instead of the text lines");

@@ -3,7 +3,8 @@
 # - thumbnails never change frames: the same run with none and with 10 Hz thumbnails gives the
 #   same digests, and replay reproduces the recorded per-frame display digests;
 # - --from/--to replays a slice whose digests are exactly those frames of the whole replay;
-# - --frames-out writes one PNG per frame of the slice; --json summaries of run and replay;
+# - --frames-out writes one PNG per frame of the slice, and --save-png (its other name) the same;
+#   --json summaries of run and replay;
 # - progress lines only with --progress when standard error is not a terminal;
 # - inspect takes several files and shows the wall-clock start and the lamp timeline;
 # - warnings are recorded on /replica/log even when the console shows only errors.
@@ -35,6 +36,10 @@ got=$(grep '"frame"' "$work/slice.json" | sed 's/,$//')
 [ "$want" = "$got" ] || fail "slice digests are not frames 30-45 of the whole replay"
 [ "$(ls "$work/png" | wc -l)" -eq 16 ] || fail "--frames-out wrote $(ls "$work/png" | wc -l) PNGs, want 16"
 [ -s "$work/png/frame-000030.png" ] && [ -s "$work/png/frame-000045.png" ] || fail "wrong frame names"
+# --save-png is the same option under its older name: the same files, byte for byte.
+"$replica" --log-level warn replay "$work/thumbs.mcap" --from 1 --to 1.5 --save-png "$work/png-alias" \
+    > /dev/null
+diff -r "$work/png" "$work/png-alias" > /dev/null || fail "--save-png wrote other files than --frames-out"
 grep -q "^replay: frame 45 (46 of 46, 100%)" "$work/slice.err" || fail "--progress printed no final line: $(cat "$work/slice.err")"
 # A slice after the end is refused with the recording's span.
 if "$replica" --log-level warn replay "$work/thumbs.mcap" --from 100 2> "$work/after.err"; then
@@ -55,4 +60,4 @@ head -c 1 "$work/inspect.json" | grep -q '\[' || fail "inspect --json of two fil
 "$replica" inspect --json "$work/miswired.mcap" > "$work/miswired.json"
 grep -A4 '"/replica/log"' "$work/miswired.json" | grep '"count": 1,' >/dev/null \
     || fail "the overruled-selector warning is not in /replica/log"
-echo "PASS: thumbnails leave frames alone; replay matches 75 display digests; slice 30-45 equals the whole replay's; 16 PNGs; progress; inspect of two files"
+echo "PASS: thumbnails leave frames alone; replay matches 75 display digests; slice 30-45 equals the whole replay's; 16 PNGs, the same under --save-png; progress; inspect of two files"
