@@ -288,4 +288,23 @@ inline Expected<void> validateJson(const nlohmann::json& j,
     return {};
 }
 
+// Parses 'text' (the contents of 'file') and holds it against 's': the parsed document, or one
+// error naming the file (and the JSON path, for a schema violation). Warnings as validateJson.
+inline Expected<nlohmann::json> parseJsonChecked(const std::string& text,
+                                                 const JsonSchema& s,
+                                                 const std::string& file,
+                                                 std::vector<std::string>* warnings = nullptr)
+{
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+        return makeError(ErrorCode::Corrupt, file + ": not valid JSON (" + e.what() + ")");
+    }
+    if (auto ok = validateJson(j, s, file, warnings); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return j;
+}
+
 } // namespace replica

@@ -99,16 +99,11 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
         }
         return tl::unexpected(text.error());
     }
-    nlohmann::json j;
-    try {
-        j = nlohmann::json::parse(*text);
-    } catch (const nlohmann::json::exception& e) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
+    auto parsed = parseJsonChecked(*text, boothSchema(), file.string());
+    if (!parsed) {
+        return tl::unexpected(parsed.error());
     }
-    if (auto ok = validateJson(j, boothSchema(), file.string()); !ok) {
-        return tl::unexpected(ok.error());
-    }
+    nlohmann::json& j = *parsed;
     if (!j.contains("format") || j["format"] != kFormat) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: 'format' must be \"{}\"", file.string(), kFormat));

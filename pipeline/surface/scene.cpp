@@ -96,16 +96,11 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
         }
         return tl::unexpected(text.error());
     }
-    nlohmann::json j;
-    try {
-        j = nlohmann::json::parse(*text);
-    } catch (const nlohmann::json::exception& e) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: not valid JSON ({})", file.string(), e.what()));
+    auto parsed = parseJsonChecked(*text, sceneSchema(), file.string());
+    if (!parsed) {
+        return tl::unexpected(parsed.error());
     }
-    if (auto ok = validateJson(j, sceneSchema(), file.string()); !ok) {
-        return tl::unexpected(ok.error());
-    }
+    nlohmann::json& j = *parsed;
     const std::string f = file.string();
     if (!j.contains("format") || j["format"] != kFormat) {
         return makeError(ErrorCode::Corrupt,

@@ -121,16 +121,12 @@ int runBuild(const std::string& input, const std::string& out)
     if (!text) {
         return fail(cmd, kExitFailure, text.error().message);
     }
-    nlohmann::json j;
-    try {
-        j = nlohmann::json::parse(*text);
-    } catch (const nlohmann::json::exception& e) {
-        return fail(cmd, kExitFailure, fmt::format("{}: not valid JSON ({})", input, e.what()));
-    }
     std::vector<std::string> warnings;
-    if (auto ok = validateJson(j, captureSchema(), input, &warnings); !ok) {
-        return fail(cmd, kExitFailure, ok.error().message);
+    auto parsed = parseJsonChecked(*text, captureSchema(), input, &warnings);
+    if (!parsed) {
+        return fail(cmd, kExitFailure, parsed.error().message);
     }
+    const nlohmann::json& j = *parsed;
     for (const auto& w : warnings) {
         std::fprintf(stderr, "replica %s: warning: %s\n", cmd, w.c_str());
     }
