@@ -14,6 +14,7 @@
 #include <pipeline/colour/xyz.h>
 #include <pipeline/display/colorchecker_study.h>
 #include <pipeline/display/dither.h>
+#include <pipeline/spectral/light_classifier.h>
 
 namespace replica::pipeline::display {
 namespace {
@@ -204,6 +205,210 @@ colorCheckerStudy(const DisplayInverse& inverse,
         lr.mappedAbsolute = errorStats(dmAbs);
         lr.clippedAbsolute = errorStats(dcAbs);
         results.push_back(std::move(lr));
+    }
+    return results;
+}
+
+Expected<SensedSamples> colorCheckerSamples(const std::filesystem::path& dataDir)
+{
+    auto chart = colour::loadSpectralCsv(dataDir / "spectra" / kColorChecker);
+    if (!chart) {
+        return tl::unexpected(chart.error());
+    }
+    auto patches = chart->allSpectra();
+    if (!patches) {
+        return tl::unexpected(patches.error());
+    }
+    return SensedSamples{chart->columns, std::move(*patches)};
+}
+
+Expected<std::vector<spectral::FineLight>> fineBoothLights(const std::filesystem::path& dataDir)
+{
+    std::vector<spectral::FineLight> out;
+    for (const auto& light : boothLights()) {
+        auto table = colour::loadSpectralCsv(dataDir / "spectra" / light.file);
+        if (!table) {
+            return tl::unexpected(table.error());
+        }
+        auto fine = spectral::restoreLines(*table, light.column);
+        if (!fine) {
+            return tl::unexpected(fine.error());
+        }
+        fine->name = light.name;
+        out.push_back(std::move(*fine));
+    }
+    return out;
+}
+
+Expected<std::vector<SensedLightStats>>
+sensedStudy(const DisplayInverse& inverse,
+            const std::function<glm::dvec3(const glm::dvec3&)>& panel,
+            const colour::Observer& observer,
+            const std::vector<spectral::FineLight>& lights,
+            const SensedSamples& samples,
+            const spectral::AdaptiveEncoder* encoder,
+            const colour::ChannelBasis& basis,
+            const SensedStudyOptions& options)
+{
+    if (options.draws < 1 || lights.empty() || samples.reflectances.empty()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "sensed study: needs at least one draw, one light and one sample");
+    }
+    const DisplayModel& model = inverse.model();
+    const double maxCount = model.maxCount();
+    const double e = options.illuminanceLux;
+    const glm::dvec3 d65{0.95047, 1.0, 1.08883};
+
+    std::vector<colour::Spectrum> real;
+    for (const auto& l : lights) {
+        auto spd = spectral::fineLightToWorkingGrid(l);
+        if (!spd) {
+            return tl::unexpected(spd.error());
+        }
+        if (!(colour::spectrumToXyz(observer, *spd).y > 0.0)) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: the light has no luminance", l.name));
+        }
+        real.push_back(*spd);
+    }
+    // XYZ (cd/m^2) of every sample rendered under 'spd' (scaled to the real light's Y).
+    auto render = [&](const colour::Spectrum& spd) -> Expected<std::vector<glm::dvec3>> {
+        colour::ChannelBasis b = basis;
+        if (encoder != nullptr) {
+            auto adapted = encoder->basisFor(spd);
+            if (!adapted) {
+                return tl::unexpected(adapted.error());
+            }
+            b = std::move(*adapted);
+        }
+        const colour::ChannelToXyz toXyz = colour::channelToXyz(b, observer, spd);
+        std::vector<glm::dvec3> out;
+        for (const auto& refl : samples.reflectances) {
+            const colour::ChannelCoeffs c = colour::projectReflectance(b, refl);
+            glm::dvec3 xyz(0.0);
+            for (std::size_t k = 0; k < colour::kChannels; ++k) {
+                xyz += c[k] * toXyz[k];
+            }
+            out.push_back(xyz * (e / std::numbers::pi));
+        }
+        return out;
+    };
+
+    std::vector<SensedLightStats> results;
+    for (std::size_t li = 0; li < lights.size(); ++li) {
+        const colour::Xyz lightXyz = colour::spectrumToXyz(observer, real[li]);
+        const glm::dvec3 lightUnitY = lightXyz / lightXyz.y;
+        const double scale = e / std::numbers::pi / lightXyz.y;
+        auto lab = [&](const glm::dvec3& xyz) {
+            return colour::xyzToLab(
+                    colour::cat02Adapt(xyz / (e / std::numbers::pi), lightUnitY, d65), d65);
+        };
+        std::vector<colour::Lab> truth;
+        for (const auto& refl : samples.reflectances) {
+            truth.push_back(lab(colour::spectrumToXyz(observer, refl * real[li]) * scale));
+        }
+        const glm::dvec3 flare = options.flare == FlareHandling::Dark
+                                         ? glm::dvec3(0.0)
+                                         : frontSurfaceFlareXyz(model, e, lightUnitY);
+        const glm::dvec3 realFlare =
+                options.flare == FlareHandling::Dark
+                        ? glm::dvec3(0.0)
+                        : model.frontSurfaceReflectance * e / std::numbers::pi * lightUnitY;
+        SensedLightStats st;
+        st.light = lights[li].name;
+        std::vector<double> dRender;
+        std::vector<double> dIn;
+        std::vector<double> dOut;
+        double shape = 0.0;
+        for (int d = 0; d < options.draws; ++d) {
+            const std::uint64_t drawSeed =
+                    options.seed * 1'000'003ULL + static_cast<std::uint64_t>(d);
+            spectral::InstrumentImpairments imp = options.impairments;
+            imp.wavelengthErrorNm =
+                    spectral::drawWavelengthError(options.wavelengthErrorMaxNm, drawSeed);
+            spectral::SensingCorrections corr = options.corrections;
+            if (corr.wavelengthLines) {
+                // The shift found once against the lines of whichever lamps have them (the
+                // booth's fluorescent lamps, measured beforehand averaging 50 spectra).
+                double sum = 0.0;
+                int found = 0;
+                spectral::SensingCorrections pre = corr;
+                pre.scansAveraged = 50;
+                for (std::size_t k = 0; k < lights.size(); ++k) {
+                    if (lights[k].lines.empty()) {
+                        continue;
+                    }
+                    auto m = spectral::senseLight(lights[k], observer, imp, pre,
+                                                  drawSeed * 31 + 101 + k);
+                    if (!m) {
+                        return tl::unexpected(m.error());
+                    }
+                    if (m->linesFound) {
+                        sum += m->wavelengthFoundNm;
+                        ++found;
+                    }
+                }
+                if (found > 0) {
+                    corr.rememberedOffsetNm = sum / found;
+                }
+            }
+            auto sensed = spectral::senseLight(lights[li], observer, imp, corr, drawSeed * 31 + li);
+            if (!sensed) {
+                return tl::unexpected(sensed.error());
+            }
+            shape += spectral::spectralShapeDistance(sensed->spd, real[li]);
+            colour::Spectrum used = sensed->spd;
+            if (options.mode == SensingMode::Classifier) {
+                // The same instrument measured each lamp beforehand, averaging 50 spectra.
+                std::vector<spectral::StoredLight> stored;
+                spectral::SensingCorrections pre = corr;
+                pre.scansAveraged = 50;
+                for (std::size_t k = 0; k < lights.size(); ++k) {
+                    auto m = spectral::senseLight(lights[k], observer, imp, pre,
+                                                  drawSeed * 31 + 17 + k);
+                    if (!m) {
+                        return tl::unexpected(m.error());
+                    }
+                    stored.push_back({lights[k].name, m->spd});
+                }
+                auto classifier = spectral::LightClassifier::create(stored);
+                if (!classifier) {
+                    return tl::unexpected(classifier.error());
+                }
+                const spectral::Classification c = classifier->nearest(sensed->spd);
+                if (c.index >= 0) {
+                    used = stored[static_cast<std::size_t>(c.index)].spd *
+                           (lightXyz.y /
+                            std::max(
+                                    colour::spectrumToXyz(
+                                            observer, stored[static_cast<std::size_t>(c.index)].spd)
+                                            .y,
+                                    1e-300));
+                }
+                if (c.index != static_cast<int>(li)) {
+                    ++st.misclassified;
+                }
+            }
+            auto xyz = render(used);
+            if (!xyz) {
+                return tl::unexpected(xyz.error());
+            }
+            for (std::size_t p = 0; p < xyz->size(); ++p) {
+                dRender.push_back(colour::ciede2000(truth[p], lab((*xyz)[p])));
+                const glm::dvec3 target = options.flare == FlareHandling::InBoothSubtract
+                                                  ? (*xyz)[p] - flare
+                                                  : (*xyz)[p];
+                const InverseResult mapped = inverse.invert(target, GamutMode::HueKeeping);
+                const glm::dvec3 shown = tileReading(mapped.counts, maxCount, panel) + realFlare;
+                const double de = colour::ciede2000(truth[p], lab(shown));
+                (mapped.gamutClass == GamutClass::InGamut ? dIn : dOut).push_back(de);
+            }
+        }
+        st.render = errorStats(dRender);
+        st.panelInGamut = errorStats(dIn);
+        st.panelOutOfGamut = errorStats(dOut);
+        st.lightShapeError = shape / options.draws;
+        results.push_back(std::move(st));
     }
     return results;
 }

@@ -10,6 +10,8 @@
 
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/display/display_inverse.h>
+#include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/spectral/sensed_light.h>
 
 namespace replica::pipeline::display {
 
@@ -80,5 +82,63 @@ colorCheckerStudy(const DisplayInverse& inverse,
                   const std::function<glm::dvec3(const glm::dvec3&)>& panel,
                   const std::filesystem::path& dataDir,
                   const StudyOptions& options);
+
+// ---- End to end from the sensed light ---------------------------------------------------------
+//
+// The light goes through the simulated spectrometer (spectral/sensed_light.h), then the renderer's
+// mode, the render and the display (inverse, dithered counts, the panel); what the panel emits is
+// compared with the real surface under the real light. Comparison: absolute (every XYZ relative
+// to the perfect diffuser under the real light at the known illuminance, CAT02 from the real
+// light's white to D65, CIELAB, CIEDE2000), as the paper's normalisation would hide a sensed
+// light's error in the white patch.
+
+enum class SensingMode {
+    Direct,     // render under the sensed spectrum itself
+    Classifier, // the nearest pre-measured lamp (the study's lights, each measured by the same
+                // instrument averaging 50 spectra); an unknown answer falls back to direct
+};
+
+struct SensedStudyOptions {
+    spectral::InstrumentImpairments impairments;
+    double wavelengthErrorMaxNm = 0.5; // each draw is a new instrument: error uniform in +-this
+    spectral::SensingCorrections corrections;
+    SensingMode mode = SensingMode::Direct;
+    int draws = 20; // instruments x noise realisations
+    std::uint64_t seed = 1;
+    double illuminanceLux = 2000.0;
+    FlareHandling flare = FlareHandling::InBoothSubtract;
+};
+
+struct SensedLightStats {
+    std::string light;
+    ErrorStats render;       // rendered XYZ vs the real surface, all samples and draws
+    ErrorStats panelInGamut; // what the panel emits vs the real surface, in-gamut samples
+    ErrorStats panelOutOfGamut;
+    int misclassified = 0;        // draws the classifier named another lamp (classifier mode)
+    double lightShapeError = 0.0; // mean spectral shape distance, sensed vs real light
+};
+
+struct SensedSamples {
+    std::vector<std::string> names;
+    std::vector<colour::Spectrum> reflectances;
+};
+
+// The ColorChecker (24 patches) as SensedSamples.
+Expected<SensedSamples> colorCheckerSamples(const std::filesystem::path& dataDir);
+
+// The booth lights as fine lights (spectral/sensed_light.h restoreLines).
+Expected<std::vector<spectral::FineLight>> fineBoothLights(const std::filesystem::path& dataDir);
+
+// 'encoder' renders as the appliance does (adaptive_k6, encoded for the light it renders under);
+// null renders with 'basis' (a fixed representation).
+Expected<std::vector<SensedLightStats>>
+sensedStudy(const DisplayInverse& inverse,
+            const std::function<glm::dvec3(const glm::dvec3&)>& panel,
+            const colour::Observer& observer,
+            const std::vector<spectral::FineLight>& lights,
+            const SensedSamples& samples,
+            const spectral::AdaptiveEncoder* encoder,
+            const colour::ChannelBasis& basis,
+            const SensedStudyOptions& options);
 
 } // namespace replica::pipeline::display

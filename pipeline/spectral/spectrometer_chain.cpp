@@ -83,7 +83,7 @@ Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
     const auto& c = raw.wavelengthCoeffs;
     for (int p = cal.darkPixelLast + 1; p < n; ++p) {
         const double x = p;
-        const double wl = c[0] + x * (c[1] + x * (c[2] + x * c[3]));
+        const double wl = c[0] + options.wavelengthOffsetNm + x * (c[1] + x * (c[2] + x * c[3]));
         if (!s.wavelengthNm.empty() && !(wl > s.wavelengthNm.back())) {
             return makeError(
                     ErrorCode::InvalidArgument,
@@ -99,6 +99,20 @@ Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
         const double corrected = poly > 1e-6 ? signal / poly : signal;
         s.wavelengthNm.push_back(wl);
         s.value.push_back(corrected);
+    }
+    if (!(options.strayLightFraction >= 0.0) || !(options.strayLightFraction < 1.0)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("stray-light fraction {} is outside [0, 1)",
+                                     options.strayLightFraction));
+    }
+    if (options.strayLightFraction > 0.0 && !s.value.empty()) {
+        // measured = true + f * peak(true) on every pixel, so peak(measured) = (1 + f) peak(true).
+        const double peak = *std::max_element(s.value.begin(), s.value.end());
+        const double stray = std::max(peak, 0.0) * options.strayLightFraction /
+                             (1.0 + options.strayLightFraction);
+        for (double& v : s.value) {
+            v -= stray;
+        }
     }
     if (options.boxcarHalfWidth < 0) {
         return makeError(ErrorCode::InvalidArgument,
@@ -125,6 +139,70 @@ Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
         s.value[i] = r > 1e-9 ? s.value[i] / (seconds * r) : 0.0;
     }
     return colour::resampleToWorkingGrid(s, "spectrometer");
+}
+
+std::optional<double> estimateWavelengthOffset(const RawSpectrum& raw,
+                                               const SpectrometerCalibration& cal,
+                                               std::span<const double> linesNm,
+                                               const LineSearchOptions& options)
+{
+    const auto n = static_cast<int>(raw.counts.size());
+    if (n <= cal.darkPixelLast + 8 || cal.darkPixelFirst < 0 ||
+        cal.darkPixelLast < cal.darkPixelFirst) {
+        return std::nullopt;
+    }
+    double dark = 0.0;
+    for (int p = cal.darkPixelFirst; p <= cal.darkPixelLast; ++p) {
+        dark += raw.counts[static_cast<std::size_t>(p)];
+    }
+    dark /= static_cast<double>(cal.darkPixelLast - cal.darkPixelFirst + 1);
+    const auto& c = raw.wavelengthCoeffs;
+    auto wavelength = [&](double x) { return c[0] + x * (c[1] + x * (c[2] + x * c[3])); };
+    auto signal = [&](int p) { return raw.counts[static_cast<std::size_t>(p)] - dark; };
+    double sum = 0.0;
+    int found = 0;
+    for (double line : linesNm) {
+        // The brightest pixel within the search window.
+        int best = -1;
+        for (int p = cal.darkPixelLast + 2; p < n - 1; ++p) {
+            const double wl = wavelength(p);
+            if (std::abs(wl - line) <= options.searchNm && (best < 0 || signal(p) > signal(best))) {
+                best = p;
+            }
+        }
+        if (best < 0) {
+            continue;
+        }
+        // The local baseline: the lowest signal within 4 nm either side.
+        double baseline = signal(best);
+        for (int p = cal.darkPixelLast + 1; p < n; ++p) {
+            if (std::abs(wavelength(p) - wavelength(best)) <= 4.0) {
+                baseline = std::min(baseline, signal(p));
+            }
+        }
+        const double a = signal(best - 1) - baseline;
+        const double b = signal(best) - baseline;
+        const double d = signal(best + 1) - baseline;
+        if (!(b > options.contrast * std::max(baseline, 1.0)) || !(a > 0.0) || !(d > 0.0) ||
+            b < a || b < d) {
+            continue; // no clear peak here
+        }
+        // Three-point Gaussian (parabola through the logarithms) for the sub-pixel centre.
+        const double la = std::log(a);
+        const double lb = std::log(b);
+        const double ld = std::log(d);
+        const double curvature = la - 2.0 * lb + ld;
+        if (!(curvature < -1e-12)) {
+            continue;
+        }
+        const double delta = std::clamp(0.5 * (la - ld) / curvature, -1.0, 1.0);
+        sum += line - wavelength(best + delta);
+        ++found;
+    }
+    if (found < std::max(options.minLines, 1)) {
+        return std::nullopt;
+    }
+    return sum / found;
 }
 
 AutoIntegrationDecision nextIntegrationTime(std::span<const std::uint16_t> counts,

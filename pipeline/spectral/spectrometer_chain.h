@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -45,7 +46,33 @@ struct ChainOptions {
     // the dark-subtracted, linearised counts before the responsivity; 0 = none. It trades noise for
     // resolution: w = 5 averages about 4 nm, well inside one 10 nm band.
     int boxcarHalfWidth = 0;
+    // Stray-light correction: the fraction of the peak signal that the instrument scatters evenly
+    // onto every pixel (characterised once, e.g. with a long-pass filter: USB2000+ data sheet
+    // 0.05 %). Subtracted from the linearised counts as f / (1 + f) of their peak. 0 = none.
+    double strayLightFraction = 0.0;
+    // Added to every pixel's wavelength from the EEPROM polynomial (the shift found against known
+    // lamp lines by estimateWavelengthOffset). 0 = the polynomial as it is.
+    double wavelengthOffsetNm = 0.0;
 };
+
+// Mercury lines every fluorescent lamp carries (NIST, air wavelengths), for the wavelength check.
+inline constexpr std::array<double, 3> kMercuryLinesNm{404.656, 435.833, 546.074};
+
+// How far the EEPROM wavelength polynomial is off, from known emission lines in the spectrum
+// itself: for each line within +-searchNm of its place, the centre of the peak (three-point
+// Gaussian fit on the dark-subtracted counts) is compared with the line's wavelength. Returns the
+// mean of (true - found) over the lines found, to be added to every pixel's wavelength; nullopt
+// when fewer than minLines clear lines (peak at least 'contrast' times the local baseline above it)
+// are present, as under an incandescent lamp.
+struct LineSearchOptions {
+    double searchNm = 1.5;
+    double contrast = 1.0;
+    int minLines = 2;
+};
+std::optional<double> estimateWavelengthOffset(const RawSpectrum& raw,
+                                               const SpectrometerCalibration& cal,
+                                               std::span<const double> linesNm,
+                                               const LineSearchOptions& options = {});
 
 // The same with options.
 Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,

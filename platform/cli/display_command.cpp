@@ -23,6 +23,7 @@
 #include <pipeline/display/viewing_angle_csv.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/display_patches.h>
+#include <platform/cli/sensed_report.h>
 #include <platform/logging.h>
 
 namespace replica::platform {
@@ -49,6 +50,7 @@ struct DisplayOptions {
     std::string basis = "replica_k6";
     std::string tone = "robust";
     std::string icc;
+    SensedReportOptions sensed;
 };
 
 // The shipped profile, where a command takes the profile as an option.
@@ -349,6 +351,19 @@ int studyMain(const DisplayOptions& o)
     if (!setup) {
         return kExitFailure;
     }
+    if (o.sensed.sensed) {
+        auto lights = pd::fineBoothLights(dataDir());
+        auto samples = pd::colorCheckerSamples(dataDir());
+        if (!lights || !samples) {
+            logger("replica")->error("{}",
+                                     !lights ? lights.error().message : samples.error().message);
+            return kExitFailure;
+        }
+        SensedReportOptions so = o.sensed;
+        so.json = o.json;
+        return sensedReport(*setup->inverse, setup->panel, *lights, *samples, o.lux,
+                            setup->options.flare, so);
+    }
     auto results = pd::colorCheckerStudy(*setup->inverse, setup->panel, dataDir(), setup->options);
     if (!results) {
         logger("replica")->error("{}", results.error().message);
@@ -603,6 +618,7 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
             ->check(CLI::IsMember({"subtract", "ignore", "dark"}))
             ->capture_default_str();
     studyCmd->add_flag("--json", study->json, "print the table and every patch as JSON");
+    addSensedOptions(studyCmd, study->sensed);
     studyCmd->callback([study, &exitCode] { exitCode = studyMain(*study); });
 
     auto flare = std::make_shared<DisplayOptions>();

@@ -17,12 +17,15 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/display/display_inverse.h>
+#include <pipeline/display/display_profile.h>
 #include <pipeline/spectral/accuracy.h>
 #include <pipeline/spectral/basis_fit.h>
 #include <pipeline/spectral/metamers.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/spectral/six_channel_model.h>
 #include <platform/cli/commands.h>
+#include <platform/cli/sensed_report.h>
 
 namespace replica::platform {
 namespace {
@@ -36,6 +39,8 @@ struct EvalOptions {
     std::string representation = spectral::kApplianceRepresentation;
     std::string encodedFor; // adaptive representations: the light the surfaces were encoded for
     bool json = false;
+    SensedReportOptions sensed;
+    std::string profile; // --sensed: the display profile (default: the shipped synthetic one)
 };
 
 nlohmann::json labJson(const colour::Lab& lab)
@@ -73,6 +78,32 @@ int runEval(const EvalOptions& o)
     auto set = spectral::loadNamedSpectra(o.reflectances);
     if (!set) {
         return fail(set.error().message);
+    }
+    if (o.sensed.sensed) {
+        // The light through the simulated spectrometer, adaptive_k6 (the appliance's), the display.
+        auto fine = spectral::restoreLines(*lightTable, "value");
+        if (!fine) {
+            return fail(fine.error().message);
+        }
+        fine->name = std::filesystem::path(o.illuminant).stem().string();
+        const std::string profile =
+                o.profile.empty() ? (data / "displays" / "wide-ips-synthetic.json").string()
+                                  : o.profile;
+        auto model = pipeline::display::loadProfile(profile);
+        if (!model) {
+            return fail(model.error().message);
+        }
+        auto inverse = pipeline::display::DisplayInverse::build(*model);
+        if (!inverse) {
+            return fail(fmt::format("{}: {}", profile, inverse.error().message));
+        }
+        const pipeline::display::DisplayModel panelModel = *model;
+        SensedReportOptions so = o.sensed;
+        so.json = o.json;
+        return sensedReport(
+                *inverse, [panelModel](const glm::dvec3& c) { return panelModel.forward(c); },
+                {*fine}, pipeline::display::SensedSamples{set->names, set->spectra}, 2000.0,
+                pipeline::display::FlareHandling::InBoothSubtract, so);
     }
     auto rep = spectral::makeRepresentation(data, *obs, *d65, o.representation);
     if (!rep) {
@@ -419,6 +450,10 @@ void registerSpectralCommand(CLI::App& app, int& exitCode)
                   "adaptive_k6 only: evaluate surfaces encoded for this light (CSV as "
                   "--illuminant) while rendering under --illuminant");
     e->add_flag("--json", eval->json, "print JSON with 'samples' and 'stats'");
+    addSensedOptions(e, eval->sensed);
+    e->add_option(
+            "--profile", eval->profile,
+            "with --sensed: display profile (default: data/displays/wide-ips-synthetic.json)");
     e->callback([eval, &exitCode] { exitCode = runEval(*eval); });
 
     auto fit = std::make_shared<FitOptions>();
