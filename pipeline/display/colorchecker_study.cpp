@@ -137,6 +137,12 @@ colorCheckerStudy(const DisplayInverse& inverse,
         std::vector<glm::dvec3> channel;
         std::vector<glm::dvec3> shownMapped;
         std::vector<glm::dvec3> shownClipped;
+        std::vector<glm::dvec3> paper;
+        std::vector<glm::dvec3> shownPaper;
+        std::vector<spectral::Xyz> paperVectors;
+        if (options.paperSix != nullptr) {
+            paperVectors = options.paperSix->lightVectors(*spd);
+        }
         for (std::size_t p = 0; p < patches->size(); ++p) {
             const colour::Spectrum& refl = (*patches)[p];
             spectral.push_back(colour::spectrumToXyz(*observer, refl * *spd) * scale);
@@ -157,6 +163,17 @@ colorCheckerStudy(const DisplayInverse& inverse,
             pr.name = chart->columns[p];
             pr.gamutClass = mapped.gamutClass;
             pr.targetXyz = target;
+            if (options.paperSix != nullptr) {
+                const glm::dvec3 px =
+                        spectral::shade(options.paperSix->encode(refl), paperVectors) * e /
+                        std::numbers::pi;
+                paper.push_back(px);
+                const InverseResult pm = inverse.invert(
+                        options.flare == FlareHandling::InBoothSubtract ? px - flare : px,
+                        GamutMode::HueKeeping);
+                shownPaper.push_back(tileReading(pm.counts, maxCount, panel) + realFlare);
+                pr.paperSixGamutClass = pm.gamutClass;
+            }
             lr.patches.push_back(pr);
         }
         // The paper's comparison: each workflow relative to its own white patch, put on the
@@ -178,9 +195,21 @@ colorCheckerStudy(const DisplayInverse& inverse,
         std::vector<double> dm;
         std::vector<double> dc;
         std::vector<double> dmIn;
+        std::vector<double> ps;
+        std::vector<double> psm;
+        std::vector<double> psmIn;
         for (std::size_t i = 0; i < lr.patches.size(); ++i) {
             auto& pr = lr.patches[i];
             const colour::Lab base = relative(spectral, i);
+            if (options.paperSix != nullptr) {
+                pr.paperSixDe00 = colour::ciede2000(base, relative(paper, i));
+                pr.paperSixMappedDe00 = colour::ciede2000(base, relative(shownPaper, i));
+                ps.push_back(pr.paperSixDe00);
+                psm.push_back(pr.paperSixMappedDe00);
+                if (pr.paperSixGamutClass == GamutClass::InGamut) {
+                    psmIn.push_back(pr.paperSixMappedDe00);
+                }
+            }
             pr.sixChannelDe00 = colour::ciede2000(base, relative(channel, i));
             pr.mappedDe00 = colour::ciede2000(base, relative(shownMapped, i));
             pr.clippedDe00 = colour::ciede2000(base, relative(shownClipped, i));
@@ -204,6 +233,9 @@ colorCheckerStudy(const DisplayInverse& inverse,
         lr.mappedInGamut = errorStats(dmIn);
         lr.mappedAbsolute = errorStats(dmAbs);
         lr.clippedAbsolute = errorStats(dcAbs);
+        lr.paperSix = errorStats(ps);
+        lr.paperSixMapped = errorStats(psm);
+        lr.paperSixMappedInGamut = errorStats(psmIn);
         results.push_back(std::move(lr));
     }
     return results;

@@ -11,6 +11,7 @@
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/spectral/representation.h>
 #include <pipeline/spectral/sensed_light.h>
 
 namespace replica::pipeline::display {
@@ -37,6 +38,10 @@ struct StudyOptions {
     colour::ChannelBasis basis = colour::boxBasis();
     double illuminanceLux = 2000.0; // on the screen plane
     FlareHandling flare = FlareHandling::InBoothSubtract;
+    // The paper's own construction beside the renderer's (spectral/six_channel_model.h 'paper6':
+    // light and reflectance each projected onto six channels, multiplied, a fixed [6 x 3] to XYZ),
+    // through the same display. Null: not computed.
+    const spectral::Representation* paperSix = nullptr;
 };
 
 struct ErrorStats {
@@ -59,7 +64,10 @@ struct PatchResult {
     // instead of brightening every other patch.
     double mappedAbsoluteDe00 = 0.0;
     double clippedAbsoluteDe00 = 0.0;
-    glm::dvec3 targetXyz{0.0}; // absolute, cd/m^2
+    glm::dvec3 targetXyz{0.0};       // absolute, cd/m^2
+    double paperSixDe00 = 0.0;       // paper6 channels vs full spectral (options.paperSix)
+    double paperSixMappedDe00 = 0.0; // screen output through paper6, hue-keeping mapping
+    GamutClass paperSixGamutClass = GamutClass::InGamut;
 };
 
 struct LightResult {
@@ -72,6 +80,9 @@ struct LightResult {
     ErrorStats mappedAbsolute;
     ErrorStats clippedAbsolute;
     std::vector<std::string> outOfGamut;
+    ErrorStats paperSix; // options.paperSix only
+    ErrorStats paperSixMapped;
+    ErrorStats paperSixMappedInGamut;
 };
 
 // 'panel' is what a meter reads for integer counts (the ground truth of a synthetic panel, or the

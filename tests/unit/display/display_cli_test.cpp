@@ -13,7 +13,11 @@
 #include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/colour/xyz.h>
 #include <pipeline/display/cgats.h>
+#include <pipeline/spectral/accuracy.h>
+#include <pipeline/spectral/reference_sets.h>
+#include <pipeline/spectral/representation_catalogue.h>
 
 #include <gtest/gtest.h>
 
@@ -335,6 +339,36 @@ TEST_F(DisplayCli, StudyNamesThePapersOutOfGamutPatchesUnderTungsten)
         // Hue-keeping mapping beats per-channel clipping on the worst patch.
         EXPECT_LT(l.at("screen_mapped_absolute").at("max").get<double>(),
                   l.at("screen_clipped_absolute").at("max").get<double>());
+    }
+}
+
+TEST_F(DisplayCli, StudyShowsThePapersSixChannelConstructionBesideReplicas)
+{
+    const auto r = run("display study --json --panel truth");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    // The paper6 column against spectral eval's library path on the same light (CIE F7 for the
+    // D65 booth): both relative to the white patch, CAT02 to D65; the study's white sits at the
+    // spectral white's Y rather than 1/1.13, so they agree to a few hundredths, not exactly.
+    auto obs = pipeline::colour::loadCie1931(dataDir());
+    auto d65 = pipeline::spectral::loadCieIlluminant(dataDir(), "D65");
+    auto f7 = pipeline::spectral::loadCieIlluminant(dataDir(), "F7");
+    auto cc = pipeline::spectral::loadReflectanceSet(dataDir(), "colorchecker");
+    ASSERT_TRUE(obs && d65 && f7 && cc);
+    auto rep = pipeline::spectral::makeRepresentation(dataDir(), *obs, *d65, "paper6");
+    ASSERT_TRUE(rep);
+    auto lib = pipeline::spectral::evaluateRepresentation(*obs, *d65, **rep, *f7, *cc);
+    ASSERT_TRUE(lib);
+    const auto& f7Row = j.at("lights").at(0);
+    EXPECT_NE(f7Row.at("light").get<std::string>().find("F7"), std::string::npos);
+    EXPECT_NEAR(f7Row.at("paper6").at("mean").get<double>(), lib->stats.mean, 0.03);
+    EXPECT_NEAR(f7Row.at("paper6").at("max").get<double>(), lib->stats.max, 0.1);
+    for (const auto& l : j.at("lights")) {
+        // Replica's basis is several times closer than the paper's construction...
+        EXPECT_LT(3.0 * l.at("six_channel").at("mean").get<double>(),
+                  l.at("paper6").at("mean").get<double>());
+        // The screen column through paper6 is filled in.
+        EXPECT_GT(l.at("screen_paper6_mapped").at("n").get<int>(), 0);
     }
 }
 
