@@ -36,7 +36,7 @@ std::vector<SensedConfig> sensedConfigs()
         change(s.impairments);
         c.push_back(s);
     };
-    off("resolution (1.3 nm)", [](auto& i) { i.fwhmNm = 0.0; });
+    off("1.3 nm blur (a line in 1 pixel)", [](auto& i) { i.fwhmNm = 0.0; });
     off(
             "wavelength error (+-0.5 nm)", [](auto&) {}, 0.0);
     off("stray light (0.05 %)", [](auto& i) { i.strayFraction = 0.0; });
