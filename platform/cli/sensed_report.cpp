@@ -53,7 +53,7 @@ std::vector<SensedConfig> sensedConfigs()
     return c;
 }
 
-nlohmann::json statsJson(const pd::ErrorStats& s)
+nlohmann::json sensedStatsJson(const pd::ErrorStats& s)
 {
     return {{"n", s.count}, {"mean", s.mean}, {"std", s.std}, {"p90", s.p90}, {"max", s.max}};
 }
@@ -129,11 +129,11 @@ int sensedReport(const pd::DisplayInverse& inverse,
         }
         for (const auto& r : *res) {
             if (o.json) {
-                rows.push_back({{"instrument", cfg.name},
+                rows.push_back({{"instrument", cfg.name.substr(cfg.name.find_first_not_of(' '))},
                                 {"light", r.light},
-                                {"render", statsJson(r.render)},
-                                {"panel_in_gamut", statsJson(r.panelInGamut)},
-                                {"panel_out_of_gamut", statsJson(r.panelOutOfGamut)},
+                                {"render", sensedStatsJson(r.render)},
+                                {"panel_in_gamut", sensedStatsJson(r.panelInGamut)},
+                                {"panel_out_of_gamut", sensedStatsJson(r.panelOutOfGamut)},
                                 {"misclassified_draws", r.misclassified},
                                 {"light_shape_distance", r.lightShapeError}});
                 continue;
