@@ -81,6 +81,11 @@ int runEval(const EvalOptions& o)
     }
     if (o.sensed.sensed) {
         // The light through the simulated spectrometer, adaptive_k6 (the appliance's), the display.
+        if (o.representation != spectral::kApplianceRepresentation || !o.encodedFor.empty()) {
+            return fail(fmt::format("--sensed renders as the appliance does ({}, encoded for the "
+                                    "sensed light); drop --representation and --encoded-for",
+                                    spectral::kApplianceRepresentation));
+        }
         auto fine = spectral::restoreLines(*lightTable, "value");
         if (!fine) {
             return fail(fine.error().message);

@@ -177,6 +177,10 @@ TEST_F(CliFiles, EvalSensedAblatesEachImpairmentAndIsReproducible)
     const auto again = runReplica(cmd, dir_);
     ASSERT_EQ(again.exitCode, 0) << again.err;
     EXPECT_EQ(again.out, r.out);
+    const auto wrong = runReplica(cmd + " --representation paper6", dir_);
+    EXPECT_EQ(wrong.exitCode, 1);
+    EXPECT_NE(wrong.err.find("--sensed renders as the appliance does"), std::string::npos)
+            << wrong.err;
 }
 
 TEST_F(CliFiles, EvalAdaptiveIsExactForItsLightAndEncodedForAnotherMatchesTheLibrary)
