@@ -62,6 +62,51 @@ double horizonVisibility(const surface::HorizonMap* horizon,
     return elevationVisibility(sinB, l.z, softness);
 }
 
+// The relief's visibility of one light, the per-light set-up both eq. (1) sums share: the
+// light's direction in the macro tangent frame (right, up, nGeo), its horizon softness
+// (lightSoftness) and the horizon test at the texel or, with 'at', bilinear at that fractional
+// texel position. 1 without a horizon map (what horizonVisibility returns there).
+struct ReliefLightVisibility {
+    const surface::HorizonMap* horizon;
+    int tx;
+    int ty;
+    const std::optional<glm::dvec2>& at;
+    const Vec3& right;
+    const Vec3& up;
+    const Vec3& nGeo;
+    double texelAreaM2;
+    double softness;
+
+    bool active() const { return horizon != nullptr && horizon->directions > 0; }
+
+    // Along the unit direction d to the light, d2 the squared distance, cosG = nGeo . d.
+    double along(const booth::PointLight& l, const Vec3& d, double d2, double cosG) const
+    {
+        if (!active()) {
+            return 1.0;
+        }
+        const Vec3 lt(glm::dot(d, right), glm::dot(d, up), cosG);
+        return horizonVisibility(horizon, tx, ty, at, lt,
+                                 lightSoftness(l, d, nGeo, cosG, d2, texelAreaM2, softness));
+    }
+
+    // Along the direction from p to the light's position (a region's centroid): one test for the
+    // whole region. 1 when p is at the centroid.
+    double towards(const booth::PointLight& l, const Vec3& p) const
+    {
+        if (!active()) {
+            return 1.0;
+        }
+        Vec3 d = l.position - p;
+        const double d2 = glm::dot(d, d);
+        if (!(d2 > 0.0)) {
+            return 1.0;
+        }
+        d /= std::sqrt(d2);
+        return along(l, d, d2, glm::dot(nGeo, d));
+    }
+};
+
 } // namespace
 
 double radicalInverse2(unsigned k)
@@ -123,6 +168,8 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             double softness,
                             const std::optional<glm::dvec2>& bilinearAt)
 {
+    const ReliefLightVisibility vis{horizon, tx,   ty,          bilinearAt, right,
+                                    up,      nGeo, texelAreaM2, softness};
     double e = 0.0;
     for (const booth::PointLight& l : lights) {
         Vec3 d = l.position - p;
@@ -137,11 +184,7 @@ double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
         if (!(cosL > 0.0) || !(cosG > 0.0) || !(cosS > 0.0)) {
             continue;
         }
-        const Vec3 lt(glm::dot(d, right), glm::dot(d, up), cosG);
-        const double v =
-                horizonVisibility(horizon, tx, ty, bilinearAt, lt,
-                                  lightSoftness(l, d, nGeo, cosG, d2, texelAreaM2, softness));
-        e += l.sumCdM2 * cosS * cosL / std::max(d2, texelAreaM2) * v;
+        e += l.sumCdM2 * cosS * cosL / std::max(d2, texelAreaM2) * vis.along(l, d, d2, cosG);
     }
     return e * texelAreaM2;
 }
@@ -226,26 +269,15 @@ double areaLightIrradiance(const std::vector<booth::PointLight>& lights,
                            double softness,
                            const std::optional<glm::dvec2>& bilinearAt)
 {
+    const ReliefLightVisibility vis{horizon, tx,   ty,          bilinearAt, right,
+                                    up,      nGeo, texelAreaM2, softness};
     double e = 0.0;
     for (const booth::PointLight& l : lights) {
         const double er = regionIrradiance(l, lightNormal, p, nGeo, nShade);
         if (!(er > 0.0)) {
             continue;
         }
-        double v = 1.0;
-        if (horizon != nullptr && horizon->directions > 0) {
-            // One horizon test for the region, along its centroid's direction.
-            Vec3 d = l.position - p;
-            const double d2 = glm::dot(d, d);
-            if (d2 > 0.0) {
-                d /= std::sqrt(d2);
-                const double cosG = glm::dot(nGeo, d);
-                const Vec3 lt(glm::dot(d, right), glm::dot(d, up), cosG);
-                v = horizonVisibility(horizon, tx, ty, bilinearAt, lt,
-                                      lightSoftness(l, d, nGeo, cosG, d2, texelAreaM2, softness));
-            }
-        }
-        e += er * v;
+        e += er * vis.towards(l, p);
     }
     return e;
 }
