@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <numbers>
 #include <span>
 
 #include <fmt/format.h>
@@ -15,12 +16,15 @@
 #include <pipeline/base/input_file.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
+#include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <platform/appliance.h>
+#include <platform/booth_dimmer.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_digest.h>
 
@@ -63,6 +67,8 @@ std::string RunConfig::toJson() const
                      {"texel_exact_ties", texelExactTies},
                      {"horizon_pick", horizonPick},
                      {"area_lights", areaLights},
+                     {"booth_dimmer", boothDimmer},
+                     {"booth_dimmer_auto", boothDimmerAuto || boothDimmerChosenAuto},
                      {"cache_slices", cacheSlices},
                      {"surround_illuminance", surroundIlluminance},
                      {"horizon_directions", horizonDirections},
@@ -133,6 +139,10 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.texelExactTies = j.value("texel_exact_ties", false);
         c.horizonPick = j.value("horizon_pick", false);
         c.areaLights = j.value("area_lights", 0);
+        // Absent before the booth dimmer: those recordings replay undimmed. A recorded "auto"
+        // is the number it chose; a replay never chooses again.
+        c.boothDimmer = j.value("booth_dimmer", 1.0);
+        c.boothDimmerChosenAuto = j.value("booth_dimmer_auto", false);
         c.cacheSlices = j.value("cache_slices", 1);
         c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
         c.surroundIlluminance = j.value("surround_illuminance", true);
@@ -192,15 +202,15 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 ||
         !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias) ||
         c.cacheSlices < 1 || c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights ||
-        c.areaLights > 1) {
+        c.areaLights > 1 || !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0) {
         return makeError(
                 ErrorCode::InvalidArgument,
                 fmt::format(
                         "run configuration: size {}x{} (each side 1-{}, at most "
                         "{}:1), rate {} Hz (1-1000), lights {}x{} (at most 256), "
                         "display peak/black, specular samples, specular or diffuse "
-                        "grid, specular lod bias, horizon directions, cache slices or area lights "
-                        "out of range",
+                        "grid, specular lod bias, horizon directions, cache slices, area lights "
+                        "or booth dimmer (0 to 1) out of range",
                         c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz, c.lightsU,
                         c.lightsV));
     }
@@ -449,12 +459,84 @@ void applyDisplayGeometry(RunConfig& config, const Output& output, const OutputC
     }
 }
 
+// The site's [booth] dimmer = "auto": the scale that brings the surface's 99th percentile of Y,
+// under the brightest of the booth's lamps at the stand's brightest tilt of 0, 15, 30, 45 and 60
+// degrees (the CPU model on a 32 x 20 probe frame from the default eye, each lamp's own adaptive
+// basis), to the panel's peak. Logs the scale and what it does to the display's error on the
+// probe (over-peak share, dE00 against the dimmed scene), per lamp at its brightest tilt.
+void chooseBoothDimmer(RunConfig& config,
+                       const pipeline::render::BoothSceneSetup& setup,
+                       const pipeline::display::DisplayModel& displayModel)
+{
+    namespace sh = pipeline::shading;
+    auto log = logger("booth");
+    std::vector<sh::XyzFrame> frames; // per lamp, the frame of its brightest tilt
+    std::vector<std::string> names;
+    for (const auto& name : setup.lamps) {
+        const pipeline::booth::BoothLight* light = setup.booth.find(name);
+        if (light == nullptr) {
+            continue;
+        }
+        pipeline::colour::ChannelBasis basis = setup.basis;
+        if (setup.adaptive) {
+            if (auto b = setup.adaptive->basisFor(light->spd)) {
+                basis = std::move(*b);
+            }
+        }
+        const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
+                                         0.01, basis);
+        const auto pl = sh::prepareLight(*light, setup.observer, setup.settings.lights, basis);
+        double brightest = -1.0;
+        sh::XyzFrame keep;
+        for (const double tiltDeg : {0.0, 15.0, 30.0, 45.0, 60.0}) {
+            sh::View view;
+            view.panel = sh::panelPoseFromTilt(config.stand, tiltDeg);
+            view.eye = config.defaultEyeM;
+            view.pixelsX = 32;
+            view.pixelsY = 20;
+            sh::XyzFrame f = sh::renderRealtime(ps, pl, view, setup.observer, setup.settings);
+            const double q = quantileY({f}, 0.99);
+            if (q > brightest) {
+                brightest = q;
+                keep = std::move(f);
+            }
+        }
+        frames.push_back(std::move(keep));
+        names.push_back(name);
+    }
+    const double peakY = displayModel.whiteXyz().y;
+    double scale = 1.0;
+    for (const auto& f : frames) {
+        scale = std::min(scale, autoBoothDimmer({f}, peakY));
+    }
+    config.boothDimmer = scale;
+    config.boothDimmerAuto = false;
+    config.boothDimmerChosenAuto = true;
+    auto inverse = pipeline::display::DisplayInverse::build(displayModel);
+    if (!inverse) {
+        log->info("booth dimmer (auto): {:.4f} for the panel's peak {:.0f} cd/m^2",
+                  config.boothDimmer, peakY);
+        return;
+    }
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        const DimmerEffect before = boothDimmerEffect(frames[i], 1.0, *inverse);
+        const DimmerEffect after = boothDimmerEffect(frames[i], config.boothDimmer, *inverse);
+        log->info("booth dimmer (auto) {:.4f} for the panel's peak {:.0f} cd/m^2; lamp {} at its "
+                  "brightest tilt: surface above the peak {:.1f}% -> {:.1f}%, display dE00 mean "
+                  "/ p95 / max {:.2f} / {:.2f} / {:.2f} -> {:.2f} / {:.2f} / {:.2f}",
+                  config.boothDimmer, peakY, names[i], 100.0 * before.overPeakFraction,
+                  100.0 * after.overPeakFraction, before.de00Mean, before.de00P95, before.de00Max,
+                  after.de00Mean, after.de00P95, after.de00Max);
+    }
+}
+
 Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
 makeBoothScene(RunConfig& config,
                const pipeline::scene::Booth& lamps,
                const pipeline::colour::ChannelBasis& basis,
                const pipeline::colour::Observer& observer,
-               std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive)
+               std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
+               const pipeline::display::DisplayModel& displayModel)
 {
     const auto dir = resolveSceneDir(config.sceneDir);
     auto digest = sceneDigest(dir);
@@ -502,6 +584,17 @@ makeBoothScene(RunConfig& config,
         config.areaLights = pipeline::shading::defaultAreaLights(setup.scene) ? 1 : 0;
     }
     setup.settings = boothRenderSettings(config);
+    if (config.boothDimmerAuto) {
+        chooseBoothDimmer(config, setup, displayModel);
+    }
+    setup.luminanceScale = config.boothDimmer;
+    if (config.boothDimmer != 1.0) {
+        for (auto& light : setup.booth.lights) {
+            for (double& t : light.luminance.cdM2) {
+                t *= config.boothDimmer;
+            }
+        }
+    }
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
     if (!pass) {
         return tl::unexpected(pass.error());
@@ -660,7 +753,8 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     setup.lightsV = config.lightsV;
     setup.surroundIlluminance = config.surroundIlluminance;
     if (config.renderer == "booth") {
-        auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer, encoder);
+        auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer, encoder,
+                                         setup.display.model);
         if (!boothScene) {
             return tl::unexpected(boothScene.error());
         }

@@ -107,6 +107,14 @@ struct RunConfig {
     // surface, points on relief), chosen when the appliance is built and recorded as chosen.
     // Recordings made before it have none and replay with point lights, bit for bit.
     int areaLights = kAutoAreaLights;
+    // The booth dimmer (platform/booth_dimmer.h): every booth light's luminance times this, in
+    // (0, 1]. boothDimmerAuto asks buildAppliance to choose it for the scene and the display
+    // (the site's [booth] dimmer = "auto"); the number chosen is recorded with
+    // boothDimmerChosenAuto set. Recordings made before it have none and replay at 1, bit for
+    // bit.
+    double boothDimmer = 1.0;
+    bool boothDimmerAuto = false;
+    bool boothDimmerChosenAuto = false;
     // shading::RenderSettings::cacheSlices: a tilt recomputes the cached diffuse term in this many
     // bands over as many frames. Recordings made before it have none and replay with 1 (whole at
     // once), frame for frame.

@@ -103,6 +103,40 @@ public:
         out = v;
     }
 
+    // A number in [lo, hi] (not 0 when lo is 0: a dimmer that turns the booth off is refused) or
+    // the string "auto".
+    void numberOrAuto(const char* section,
+                      const char* key,
+                      double& out,
+                      bool& autoOut,
+                      double lo,
+                      double hi)
+    {
+        const toml::node* n = find(section, key);
+        if (n == nullptr) {
+            return;
+        }
+        if (const auto* s = n->as_string()) {
+            if (s->get() == "auto") {
+                autoOut = true;
+            } else {
+                problem(section, key, *n,
+                        fmt::format("'{}' is neither a number nor \"auto\"", s->get()));
+            }
+            return;
+        }
+        double v = 0.0;
+        if (!toDouble(section, key, *n, v)) {
+            return;
+        }
+        if (!(v > lo) || v > hi) {
+            problem(section, key, *n, fmt::format("{} is out of range ({}, {}]", v, lo, hi));
+            return;
+        }
+        out = v;
+        autoOut = false;
+    }
+
     template <typename Int>
     void integer(const char* section, const char* key, Int& out, std::int64_t lo, std::int64_t hi)
     {
@@ -275,6 +309,7 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     SiteConfig& c = out.config;
     Reader r(root, out.problems);
     r.string("booth", "id", c.boothId);
+    r.numberOrAuto("booth", "dimmer", c.boothDimmer, c.boothDimmerAuto, 0.0, 1.0);
     r.string("scene", "dir", c.sceneDir);
     r.string("scene", "renderer", c.renderer, {"booth", "flat"});
     r.string("display", "profile", c.displayProfile);
@@ -342,7 +377,9 @@ std::string SiteConfig::toJson() const
 {
     nlohmann::json j{
             {"source", source.string()},
-            {"booth", {{"id", boothId}}},
+            {"booth",
+             {{"id", boothId},
+              {"dimmer", boothDimmerAuto ? nlohmann::json("auto") : nlohmann::json(boothDimmer)}}},
             {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
             {"display",
              {{"profile", displayProfile},

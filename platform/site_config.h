@@ -26,6 +26,9 @@ struct SiteConfig {
 
     // [booth]
     std::string boothId = "replica-booth-1";
+    // dimmer = <number in (0, 1]> | "auto" (platform/booth_dimmer.h); absent: 1, undimmed.
+    double boothDimmer = 1.0;
+    bool boothDimmerAuto = false;
     // [scene]
     std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
     std::string renderer = "booth"; // or "flat"

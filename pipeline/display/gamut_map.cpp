@@ -29,6 +29,23 @@ double GamutCounters::outOfGamutFraction() const
     return pixels == 0 ? 0.0 : static_cast<double>(outOfGamut()) / static_cast<double>(pixels);
 }
 
+double GamutCounters::surfaceOutOfGamutFraction() const
+{
+    if (surfacePixels == 0) {
+        return outOfGamutFraction();
+    }
+    return static_cast<double>(surfaceChroma + surfaceOverPeak + surfaceBelowBlack) /
+           static_cast<double>(surfacePixels);
+}
+
+double GamutCounters::surfaceOverPeakFraction() const
+{
+    if (surfacePixels == 0) {
+        return pixels == 0 ? 0.0 : static_cast<double>(overPeak) / static_cast<double>(pixels);
+    }
+    return static_cast<double>(surfaceOverPeak) / static_cast<double>(surfacePixels);
+}
+
 MappedLinear
 mapToGamut(const GamutGeometry& g, const glm::dvec3& xyzIn, GamutMode mode, double tolerance)
 {

@@ -32,9 +32,22 @@ struct GamutCounters {
     std::uint64_t overPeak = 0;
     std::uint64_t belowBlack = 0;
 
+    // The same classes counted over the surface's pixels only (the rectangle a booth surface
+    // covers; the black panel around it is below black by construction and says nothing about the
+    // booth and the display). surfacePixels 0: no surface rectangle (the flat renderer, a bare
+    // display pass): the whole frame is the surface.
+    std::uint64_t surfacePixels = 0;
+    std::uint64_t surfaceChroma = 0;
+    std::uint64_t surfaceOverPeak = 0;
+    std::uint64_t surfaceBelowBlack = 0;
+
     void add(GamutClass c);
     std::uint64_t outOfGamut() const { return chroma + overPeak + belowBlack; }
     double outOfGamutFraction() const;
+    // Out of gamut over the surface's pixels (the whole frame's fraction without a surface).
+    double surfaceOutOfGamutFraction() const;
+    // Above the panel's peak over the surface's pixels (likewise).
+    double surfaceOverPeakFraction() const;
 };
 
 struct MappedLinear {

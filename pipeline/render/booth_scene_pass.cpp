@@ -95,7 +95,8 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state, bool&
         if (auto ok = encodeFor(state.illuminant, false); !ok) {
             return ok;
         }
-        direct_ = uniformEmitter(setup_.booth.lights.front(), state.emitterLuminanceCdM2,
+        direct_ = uniformEmitter(setup_.booth.lights.front(),
+                                 state.emitterLuminanceCdM2 * setup_.luminanceScale,
                                  state.illuminant);
         light_ = shading::prepareLight(direct_, setup_.observer, setup_.settings.lights,
                                        setup_.basis);

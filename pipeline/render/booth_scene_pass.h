@@ -33,6 +33,9 @@ struct BoothSceneSetup {
     // gets a basis of its own and a re-encoded surface (pipeline/spectral/adaptive_encoding.h).
     std::shared_ptr<const spectral::AdaptiveEncoder> adaptive;
     double reencodeDistance = spectral::kAdaptiveReencodeDistance;
+    // The booth dimmer (platform/booth_dimmer.h) for the direct-sensor mode's uniform emitter:
+    // the sensed luminance times this. The booth's own lamps come already scaled in 'booth'.
+    double luminanceScale = 1.0;
 };
 
 // The cached diffuse term's tilt is the mean of the last kTiltWindow sensed tilts (the

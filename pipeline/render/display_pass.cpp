@@ -331,6 +331,37 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     return {};
 }
 
+Expected<std::array<GLuint, 4>> DisplayPass::countClasses(const PixelRect& rect) const
+{
+    // Count the classes on the GPU: 16 bytes come back instead of the class image.
+    const std::array<GLuint, 4> zero{};
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), zero.data());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, counts_);
+    glUseProgram(countProgram_);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, classTarget_);
+    glUniform2i(glGetUniformLocation(countProgram_, "uOrigin"), rect.x, rect.y);
+    glUniform2i(glGetUniformLocation(countProgram_, "uEnd"), rect.x + rect.width,
+                rect.y + rect.height);
+    if (rect.width > 0 && rect.height > 0) {
+        const int runs = (rect.width + kCountRun - 1) / kCountRun;
+        const int rowPairs = (rect.height + 1) / 2;
+        glDispatchCompute(static_cast<GLuint>((runs + 7) / 8),
+                          static_cast<GLuint>((rowPairs + 7) / 8), 1);
+    }
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    const void* mapped =
+            glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), GL_MAP_READ_BIT);
+    if (mapped == nullptr) {
+        return makeError(ErrorCode::DeviceFailure, "display pass: cannot read the gamut counts");
+    }
+    std::array<GLuint, 4> c{};
+    std::memcpy(c.data(), mapped, sizeof(c));
+    glUnmapBuffer(GL_SHADER_STORAGE_BUFFER);
+    return c;
+}
+
 Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const DisplayPassFrame& frame)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
@@ -376,39 +407,34 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     }
     glDisable(GL_SCISSOR_TEST);
 
-    // Count the classes on the GPU: 16 bytes come back instead of the class image.
-    const std::array<GLuint, 4> zero{};
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), zero.data());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, counts_);
-    glUseProgram(countProgram_);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, classTarget_);
-    glUniform2i(glGetUniformLocation(countProgram_, "uOrigin"), shade.x, shade.y);
-    glUniform2i(glGetUniformLocation(countProgram_, "uEnd"), shade.x + shade.width,
-                shade.y + shade.height);
-    if (shade.width > 0 && shade.height > 0) {
-        const int runs = (shade.width + kCountRun - 1) / kCountRun;
-        const int rowPairs = (shade.height + 1) / 2;
-        glDispatchCompute(static_cast<GLuint>((runs + 7) / 8),
-                          static_cast<GLuint>((rowPairs + 7) / 8), 1);
+    auto c = countClasses(shade);
+    if (!c) {
+        return tl::unexpected(c.error());
     }
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     display::GamutCounters counters;
-    const void* mapped =
-            glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), GL_MAP_READ_BIT);
-    if (mapped == nullptr) {
-        return makeError(ErrorCode::DeviceFailure, "display pass: cannot read the gamut counts");
+    if (frame.blackOutside) {
+        // The surface's own counts: the rectangle shaded above when the surround was cleared,
+        // else counted again over the rectangle alone.
+        const PixelRect& inside = *frame.blackOutside;
+        PixelRect surface{std::clamp(inside.x, 0, width_), std::clamp(inside.y, 0, height_), 0, 0};
+        surface.width = std::clamp(inside.width, 0, width_ - surface.x);
+        surface.height = std::clamp(inside.height, 0, height_ - surface.y);
+        auto s = surroundConstant_ ? c : countClasses(surface);
+        if (!s) {
+            return tl::unexpected(s.error());
+        }
+        counters.surfacePixels = static_cast<std::uint64_t>(surface.width) *
+                                 static_cast<std::uint64_t>(surface.height);
+        counters.surfaceChroma = (*s)[1];
+        counters.surfaceOverPeak = (*s)[2];
+        counters.surfaceBelowBlack = (*s)[3];
     }
-    std::array<GLuint, 4> c{};
-    std::memcpy(c.data(), mapped, sizeof(c));
-    glUnmapBuffer(GL_SHADER_STORAGE_BUFFER);
     counters.pixels = static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
-    counters.chroma = c[1];
-    counters.overPeak = c[2];
+    counters.chroma = (*c)[1];
+    counters.overPeak = (*c)[2];
     // The cleared surround is below black, pixel for pixel.
-    counters.belowBlack = c[3] + (static_cast<std::uint64_t>(width_) * height_ -
-                                  static_cast<std::uint64_t>(shade.width) * shade.height);
+    counters.belowBlack = (*c)[3] + (static_cast<std::uint64_t>(width_) * height_ -
+                                     static_cast<std::uint64_t>(shade.width) * shade.height);
     glUseProgram(0);
     return counters;
 }

@@ -88,6 +88,9 @@ public:
     bool surroundConstant() const { return surroundConstant_; }
 
 private:
+    // The class image's counts (in gamut, chroma, over peak, below black) over 'rect', on the GPU.
+    Expected<std::array<GLuint, 4>> countClasses(const PixelRect& rect) const;
+
     DisplayPassSetup setup_;
     int width_ = 0;
     int height_ = 0;

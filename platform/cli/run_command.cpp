@@ -481,6 +481,8 @@ int runMain(const RunOptions& given)
     if (o.site) {
         const SiteConfig& site = *o.site;
         config.booth = site.boothId;
+        config.boothDimmer = site.boothDimmer;
+        config.boothDimmerAuto = site.boothDimmerAuto;
         const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
         config.stand = site.stand;
         if (!o.panelSizeMm.empty()) { // the command line wins over the site file
@@ -751,12 +753,13 @@ int runMain(const RunOptions& given)
                   sources->lampSelector->info().model, sources->lampSelector->info().serial,
                   (*appliance)->updater->lampArbiter().overruled());
     }
-    log->info(
-            "{} frames; dropped samples: spectrometer {}, tracker {}, accel {}, lamp selector "
-            "{}; late frames {}, skipped ticks {}; out of gamut: mean {:.4f}, max {:.4f} of pixels",
-            stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
-            stats->droppedLamp, stats->lateFrames, stats->skippedTicks,
-            stats->meanOutOfGamutFraction(), stats->maxOutOfGamutFraction);
+    log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}, lamp selector "
+              "{}; late frames {}, skipped ticks {}; out of gamut: mean {:.4f}, max {:.4f} of the "
+              "surface's pixels (above the panel's peak: mean {:.4f}, max {:.4f})",
+              stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
+              stats->droppedLamp, stats->lateFrames, stats->skippedTicks,
+              stats->meanOutOfGamutFraction(), stats->maxOutOfGamutFraction,
+              stats->meanOverPeakFraction(), stats->maxOverPeakFraction);
     const FrameTimes& t = stats->frameTimes;
     const double periodMs = 1000.0 / o.rateHz;
     // --digests reads every frame back as float XYZ and hashes it (XXH3-64, digest format 2; about
@@ -783,8 +786,12 @@ int runMain(const RunOptions& given)
                                 {"p99", t.percentileMs(0.99)},
                                 {"max", t.maxMs()},
                                 {"at_least_period", t.atLeast(periodMs)}};
+    // Fractions of the surface's pixels (the black surround is below black by construction).
     summary["out_of_gamut"] = {{"mean", stats->meanOutOfGamutFraction()},
-                               {"max", stats->maxOutOfGamutFraction}};
+                               {"max", stats->maxOutOfGamutFraction},
+                               {"over_peak_mean", stats->meanOverPeakFraction()},
+                               {"over_peak_max", stats->maxOverPeakFraction},
+                               {"of", "surface pixels"}};
     if (o.json) {
         fmt::print("{}\n", summary.dump(2));
     }

@@ -287,13 +287,21 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         if (auto ok = appliance.renderer->render(state, image, readback); !ok) {
             return tl::unexpected(ok.error());
         }
-        const double oog = image.gamut.outOfGamutFraction();
-        log->debug("frame {}: {:.4f} of pixels out of gamut (chroma {}, above peak {}, below "
-                   "black {})",
-                   tick.frameIndex, oog, image.gamut.chroma, image.gamut.overPeak,
-                   image.gamut.belowBlack);
+        // Over the surface's pixels: the black panel around a booth surface is below black by
+        // construction and would count whatever the booth and the display do.
+        const double oog = image.gamut.surfaceOutOfGamutFraction();
+        const auto& g = image.gamut;
+        const bool surface = g.surfacePixels > 0;
+        log->debug("frame {}: {:.4f} of the {} pixels out of gamut (chroma {}, above peak {}, "
+                   "below black {})",
+                   tick.frameIndex, oog, surface ? "surface's" : "frame's",
+                   surface ? g.surfaceChroma : g.chroma, surface ? g.surfaceOverPeak : g.overPeak,
+                   surface ? g.surfaceBelowBlack : g.belowBlack);
         stats.sumOutOfGamutFraction += oog;
         stats.maxOutOfGamutFraction = std::max(stats.maxOutOfGamutFraction, oog);
+        stats.sumOverPeakFraction += g.surfaceOverPeakFraction();
+        stats.maxOverPeakFraction =
+                std::max(stats.maxOverPeakFraction, g.surfaceOverPeakFraction());
         DisplayFrame frame{image.width, image.height, image.rgba, image.displayFramebuffer};
         if (auto ok = appliance.output->present(frame); !ok) {
             log->warn("output {}: {}", appliance.output->name(), ok.error().message);

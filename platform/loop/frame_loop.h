@@ -51,8 +51,17 @@ struct LoopStats {
     // Each frame's work on the wall clock, from polling the sources to handing the frame on
     // (not the wait for its tick): what says whether the machine keeps the rate.
     FrameTimes frameTimes;
-    double sumOutOfGamutFraction = 0.0; // over frames: the display pass's per-frame count
+    // Over frames: the display pass's per-frame count over the surface's pixels (the whole
+    // frame without a surface rectangle; display::GamutCounters::surfaceOutOfGamutFraction), and
+    // the share of them above the panel's peak.
+    double sumOutOfGamutFraction = 0.0;
     double maxOutOfGamutFraction = 0.0;
+    double sumOverPeakFraction = 0.0;
+    double maxOverPeakFraction = 0.0;
+    double meanOverPeakFraction() const
+    {
+        return frames > 0 ? sumOverPeakFraction / static_cast<double>(frames) : 0.0;
+    }
     double meanOutOfGamutFraction() const
     {
         return frames > 0 ? sumOutOfGamutFraction / static_cast<double>(frames) : 0.0;

@@ -99,6 +99,11 @@ TEST_F(SiteFile, TheShippedFileIsGoodAndHoldsTheCompiledInDefaults)
     EXPECT_EQ(c.keepBytes, defaults.keepBytes);
     EXPECT_EQ(c.defaultEyeM, defaults.defaultEyeM);
     EXPECT_EQ(c.defaultLamp, "d65-fluorescent");
+    // The shipped booth is brighter than the shipped profile's peak: the kiosk dims it to fit
+    // (platform/booth_dimmer.h); a run without a site file is undimmed.
+    EXPECT_TRUE(c.boothDimmerAuto);
+    EXPECT_FALSE(defaults.boothDimmerAuto);
+    EXPECT_EQ(defaults.boothDimmer, 1.0);
     EXPECT_FALSE(c.allowSynthetic);
     // And the site's geometry defaults are the run configuration's, which are the constants
     // recordings made before the site file replay with.
