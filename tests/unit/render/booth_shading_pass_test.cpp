@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <map>
+#include <numbers>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -13,6 +17,7 @@
 #include <pipeline/reference/frame_error.h>
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/render/booth_shading_pass.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 #include <platform/output/output.h>
 
 #include <gtest/gtest.h>
@@ -693,6 +698,136 @@ void BoothPassTest::expectHardCasesFinite(surface::SurfaceScene scene,
             }
         }
     }
+}
+
+TEST_F(BoothPassTest, HardCasesOnShippedScenesMatchTheCpuModelAndTheReference)
+{
+    // The hard cases on every shipped scene, checked for accuracy rather than finiteness:
+    // the booth's d65-fluorescent scaled to a 1 cd/m^2 and a 1e5 cd/m^2 peak, the panel tilted 80
+    // to 89 degrees, eyes grazing the panel (2 degrees above its plane, from above and from the
+    // side), and a lamp one texel wide. The appliance's setting for each scene (its specular
+    // sample count, areas on flat scenes and points on relief), per pixel.
+    // Stated tolerances, each against an independent value:
+    //  - against the CPU model (double): expectMatchesTheCpuModel's, 1e-4 relative in Y on all but
+    //    0.2 % of the pixels, dE00 <= 0.01 max and 0.001 mean;
+    //  - linearity: the 1 cd/m^2 booth's frame times 1e5 is the 1e5 booth's to 1e-4 relative in Y
+    //    (pixels over 1 % of the white): nothing in the pass has an absolute threshold;
+    //  - against the exact reference (36 bands, every texel), half the budget or less:
+    //    the booth light at every tilt and eye dE00 p95 <= 0.5 and max <= 2 (measured at most
+    //    0.35 / 1.21, the painting seen grazing from the side; the flat scenes at 80-89 degrees
+    //    0.012 / 0.013); the one-texel lamp on the matte metamer p95 <= 0.05 (measured 0.001); on
+    //    glossy scenes the one-texel lamp's highlight is a stated limit (below).
+    const booth::BoothLight& d65 = booth_->lights[2];
+    // The appliance's basis, built for the light (every case has d65-fluorescent's spectrum): what
+    // is left is the geometry's error, not the fixed basis's (the metamer's p95 1.5 under
+    // replica_k6, docs/accuracy.md).
+    auto encoder = spectral::AdaptiveEncoder::createDefault(dataDir());
+    ASSERT_TRUE(encoder) << encoder.error().message;
+    auto adaptive = encoder->basisFor(d65.spd);
+    ASSERT_TRUE(adaptive) << adaptive.error().message;
+    const colour::ChannelBasis& basis = *adaptive;
+    const auto scaledTo = [&](double peak) {
+        booth::BoothLight l = d65;
+        const double m = l.luminance.max();
+        for (double& t : l.luminance.cdM2) {
+            t *= peak / m;
+        }
+        return l;
+    };
+    const booth::BoothLight dim = scaledTo(1.0);
+    const booth::BoothLight bright = scaledTo(1e5);
+    booth::BoothLight strip = d65; // one lit column in the middle of the lamp
+    for (int y = 0; y < strip.luminance.height; ++y) {
+        for (int x = 0; x < strip.luminance.width; ++x) {
+            if (x != strip.luminance.width / 2) {
+                strip.luminance.at(x, y) = 0.0;
+            }
+        }
+    }
+    struct Case {
+        std::string what;
+        shading::View view;
+    };
+    std::vector<Case> cases;
+    for (const double tilt : {80.0, 85.0, 89.0}) {
+        cases.push_back({fmt::format("tilt {}", tilt), view(24, 16, tilt)});
+    }
+    for (const bool side : {false, true}) {
+        shading::View v = view(24, 16, 30.0);
+        const double g = 2.0 * std::numbers::pi / 180.0;
+        const shading::Vec3 along = side ? v.panel.right : v.panel.up;
+        v.eye = v.panel.centre + 0.6 * (std::cos(g) * along + std::sin(g) * v.panel.normal);
+        cases.push_back({side ? "grazing eye from the side" : "grazing eye from above", v});
+    }
+    double worstP95 = 0.0, worstMax = 0.0, worstStrip = 0.0, worstStripMatte = 0.0;
+    for (const auto& [name, scene] : scenes_) {
+        shading::RenderSettings settings;
+        settings.specularSamples = shading::defaultSpecularSamples(scene);
+        settings.areaLights = shading::defaultAreaLights(scene);
+        const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, basis);
+        auto pass = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_TRUE(pass) << pass.error().message;
+        const auto render = [&](const booth::BoothLight& light, const shading::View& v,
+                                const std::string& label) {
+            const auto pl = shading::prepareLight(light, *obs_, settings.lights, basis);
+            EXPECT_TRUE((*pass)->setLight(pl));
+            auto gl = renderBoothFrame(**pass, pl, v);
+            EXPECT_TRUE(gl) << label;
+            if (!gl) {
+                return shading::XyzFrame{};
+            }
+            EXPECT_EQ(gl->nonFinite, 0) << label;
+            const auto cpu = shading::renderRealtime(ps, pl, v, *obs_, settings);
+            const Agreement a = agree(cpu, *gl);
+            EXPECT_LE(a.fracOverTol, 0.002) << label << " max rel " << a.maxRelY;
+            EXPECT_LE(a.de.max, 0.01) << label;
+            EXPECT_LE(a.de.mean, 0.001) << label;
+            return std::move(*gl);
+        };
+        for (const Case& c : cases) {
+            const std::string label = name + ", " + c.what;
+            const auto lo = render(dim, c.view, label + ", 1 cd/m^2");
+            const auto hi = render(bright, c.view, label + ", 1e5 cd/m^2");
+            ASSERT_EQ(lo.xyz.size(), hi.xyz.size());
+            for (std::size_t i = 0; i < hi.xyz.size(); ++i) {
+                if (hi.xyz[i].y > 0.01 * hi.whiteY) {
+                    ASSERT_NEAR(lo.xyz[i].y * 1e5, hi.xyz[i].y, 1e-4 * hi.xyz[i].y)
+                            << label << ", pixel " << i;
+                }
+            }
+            const auto e = reference::compareFrames(
+                    reference::renderReference(scene, bright, c.view, *obs_), hi);
+            EXPECT_LE(e.p95, 0.5) << label;
+            EXPECT_LE(e.max, 2.0) << label;
+            worstP95 = std::max(worstP95, e.p95);
+            worstMax = std::max(worstMax, e.max);
+            std::printf("[ hard case ] %s: dE00 against the reference mean %.3f p95 %.3f max "
+                        "%.3f\n",
+                        label.c_str(), e.mean, e.p95, e.max);
+        }
+        for (const double tilt : {30.0, 85.0}) {
+            const shading::View v = view(24, 16, tilt);
+            const std::string label = fmt::format("{}, one-texel lamp, tilt {}", name, tilt);
+            const auto gl = render(strip, v, label);
+            const auto e = reference::compareFrames(
+                    reference::renderReference(scene, strip, v, *obs_), gl);
+            // Matte: the budget. Glossy: the specular samples find the strip's mirror image in the
+            // mip chain, blurred over the level's texels, so the highlight is spread wrong
+            // (measured p95 4.6 on the ColorChecker, 8.1 on the painting at 30 degrees, where
+            // the strip's reflection is in view): a stated limit, held to 1.25 times that.
+            const double limit = scene.glossy() ? (name == "painting" ? 10.2 : 5.8) : 0.05;
+            EXPECT_LE(e.p95, limit) << label;
+            (scene.glossy() ? worstStrip : worstStripMatte) =
+                    std::max(scene.glossy() ? worstStrip : worstStripMatte, e.p95);
+            std::printf("[ hard case ] %s: dE00 against the reference mean %.3f p95 %.3f max "
+                        "%.3f\n",
+                        label.c_str(), e.mean, e.p95, e.max);
+        }
+    }
+    RecordProperty("worst_p95", std::to_string(worstP95));
+    RecordProperty("worst_max", std::to_string(worstMax));
+    RecordProperty("worst_strip_p95_glossy", std::to_string(worstStrip));
+    RecordProperty("worst_strip_p95_matte", std::to_string(worstStripMatte));
 }
 
 TEST_F(BoothPassTest, PanelLayoutShowsTheSurfaceAtPhysicalSizeAndBlackAround)
