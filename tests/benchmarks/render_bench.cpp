@@ -2,7 +2,9 @@
 // the CI machine): every shipped scene and light, the knobs of the issue (lights 8-256, specular
 // samples 1-64, horizon directions, channel representation), ms per 1920x1200 frame measured on
 // the GPU path and CIEDE2000 mean / 95th / max against the exact reference on an error frame;
-// the planner's choice and its saving; a Pareto-front PNG.
+// the planner's choice and its saving; the painting's Pareto front as a table. The plotted
+// speed-against-error figures (the whole appliance frame, every scene and light) come from
+// replica_bench_pareto through tools/render_plots.sh.
 // Usage: replica_bench_render [OUT_DIR] [WIDTHxHEIGHT of the error frame, default 64x40]
 //        [--defaults-only [SPECULAR_SAMPLES]: the default setting (or it with that many specular
 //        samples) under every scene and light; no sweep, no planner, no plot]
@@ -29,7 +31,6 @@
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/tuning/planner.h>
-#include <platform/image/png_writer.h>
 #include <platform/output/output.h>
 
 using namespace replica;
@@ -101,62 +102,6 @@ std::string describe(const shading::RenderSettings& s, const surface::SurfaceSce
            ((scene.flat() || !s.reliefPass) && s.diffuseGrid > 0
                     ? ", diffuse grid " + std::to_string(s.diffuseGrid)
                     : std::string());
-}
-
-void writePareto(const std::filesystem::path& file, const std::vector<Point>& pts)
-{
-    const int w = 720, h = 480, m = 50;
-    std::vector<std::uint8_t> img(static_cast<std::size_t>(w * h * 4), 255);
-    const auto put = [&](int x, int y, int r, int g, int b) {
-        if (x < 0 || y < 0 || x >= w || y >= h) {
-            return;
-        }
-        const std::size_t k = static_cast<std::size_t>(((h - 1 - y) * w + x) * 4); // rows up
-        img[k] = static_cast<std::uint8_t>(r);
-        img[k + 1] = static_cast<std::uint8_t>(g);
-        img[k + 2] = static_cast<std::uint8_t>(b);
-    };
-    double x0 = 1e30, x1 = 0, y1 = 0;
-    for (const auto& p : pts) {
-        x0 = std::min(x0, p.msFullHd);
-        x1 = std::max(x1, p.msFullHd);
-        y1 = std::max(y1, p.p95);
-    }
-    const double lx0 = std::log10(x0) - 0.05, lx1 = std::log10(x1) + 0.05;
-    y1 = std::max(y1 * 1.05, 1.0);
-    const auto sx = [&](double ms) {
-        return m + static_cast<int>((std::log10(ms) - lx0) / (lx1 - lx0) * (w - 2 * m));
-    };
-    const auto sy = [&](double de) { return h - m - static_cast<int>(de / y1 * (h - 2 * m)); };
-    for (int x = m; x < w - m; ++x) {
-        put(x, h - m, 0, 0, 0);
-        put(x, sy(1.0), 180, 180, 180); // the dE00 p95 = 1 budget line
-    }
-    for (int y = m; y < h - m; ++y) {
-        put(m, y, 0, 0, 0);
-    }
-    for (double dec = std::ceil(lx0); dec <= lx1; dec += 1.0) { // decade ticks
-        for (int y = h - m; y < h - m + 8; ++y) {
-            put(sx(std::pow(10.0, dec)), y, 0, 0, 0);
-        }
-    }
-    std::vector<Point> sorted = pts;
-    std::sort(sorted.begin(), sorted.end(),
-              [](const Point& a, const Point& b) { return a.msFullHd < b.msFullHd; });
-    double best = 1e30;
-    for (const auto& p : sorted) {
-        const bool front = p.p95 < best;
-        best = std::min(best, p.p95);
-        for (int dy = -3; dy <= 3; ++dy) {
-            for (int dx = -3; dx <= 3; ++dx) {
-                put(sx(p.msFullHd) + dx, sy(p.p95) + dy, front ? 220 : 60, front ? 30 : 90,
-                    front ? 30 : 200);
-            }
-        }
-    }
-    if (auto ok = platform::writePng(file, w, h, img); !ok) {
-        std::fprintf(stderr, "%s\n", ok.error().message.c_str());
-    }
 }
 
 // What --views renders: the appliance's default setting with any of these changed, and which of
@@ -273,8 +218,10 @@ int main(int argc, char** argv)
                     "Sweeps the booth renderer's knobs on every shipped scene and light: ms per "
                     "1920x1200 frame of the GL pass and dE00 mean / p95 / max on a WxH frame "
                     "(default 64x40) against the exact reference, then the planner's choices and "
-                    "the painting's Pareto front. Markdown on stdout; the Pareto plot goes to "
-                    "OUT_DIR/render_pareto.png (default OUT_DIR: render_sweep). A whole sweep "
+                    "the painting's Pareto front. Markdown on stdout (OUT_DIR, default "
+                    "render_sweep, "
+                    "is created for compatibility; tools/render_plots.sh draws the plots). A "
+                    "whole sweep "
                     "takes about 4 minutes on a 2-core machine.\n"
                     "  --defaults-only [SAMPLES]  the default setting only (SAMPLES specular "
                     "samples instead of the scene's default)\n"
@@ -573,9 +520,5 @@ int main(int argc, char** argv)
                         p.mean, p.max);
         }
     }
-    writePareto(outDir / "render_pareto.png", pareto);
-    std::printf("\nPareto plot: %s (x: log ms per 1920x1200 frame, decade ticks; y: dE00 p95; "
-                "grey line: p95 = 1; red: front, blue: dominated)\n",
-                (outDir / "render_pareto.png").string().c_str());
     return 0;
 }
