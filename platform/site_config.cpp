@@ -105,12 +105,8 @@ public:
 
     // A number in [lo, hi] (not 0 when lo is 0: a dimmer that turns the booth off is refused) or
     // the string "auto".
-    void numberOrAuto(const char* section,
-                      const char* key,
-                      double& out,
-                      bool& autoOut,
-                      double lo,
-                      double hi)
+    void numberOrAuto(
+            const char* section, const char* key, double& out, bool& autoOut, double lo, double hi)
     {
         const toml::node* n = find(section, key);
         if (n == nullptr) {
