@@ -120,6 +120,7 @@ set key top right font ",8" box opaque
 set xlabel "$3"
 set ylabel "CIEDE2000 p95 (worst of tilts 10, 30, 50 deg)"
 set yrange [0:*]
+set offsets graph 0, graph 0, graph 0.6, graph 0
 set mxtics 10
 set arrow 1 from graph 0, first 1 to graph 1, first 1 nohead dt 2 lc rgb 'grey40'
 GP
