@@ -180,6 +180,7 @@ set style fill solid 0.8 border -1
 set boxwidth 0.9
 set xtics rotate by -60 font ",8" nomirror
 set ylabel "CIEDE2000"
+set xlabel "scene / light / setting (CC ColorChecker, met metamer, paint painting; A tungsten, D50fl and D65fl the fluorescents; default: 32 areas on flat scenes, 32 points on relief)"
 set grid ytics
 set key top left
 set yrange [0:*]
