@@ -67,8 +67,10 @@ MeasurementSet measure(const SyntheticDisplay& d, double noise, std::uint64_t se
 struct Figures {
     double truthMean = 0.0; // model vs panel, dE00, 400 unmeasured colours
     double truthMax = 0.0;
-    double rampInverseMax = 0.0;   // counts, R, G, B and grey ramps at every count
-    double colourInverseP95 = 0.0; // counts, the 400 colours (in gamut), per-channel
+    double rampInverseMax = 0.0;        // counts, R, G, B and grey ramps at every count
+    double rampInverseMaxClip = 0.0;    // the same through per-channel clipping, not hue-keeping
+    double rampInverseMaxInGamut = 0.0; // hue-keeping, over the counts the model finds in gamut
+    double colourInverseP95 = 0.0;      // counts, the 400 colours (in gamut), per-channel
     double colourInverseMax = 0.0;
     int rampWorstChannel = 0;
     int rampWorstCount = 0;
@@ -113,6 +115,7 @@ Figures evaluate(const DisplayModel& model, const SyntheticDisplay& truth)
                 c[ch] = v;
             }
             const auto r = inv->invert(truth.forward(c), GamutMode::HueKeeping, ToneInverse::Exact);
+            const auto rc = inv->invert(truth.forward(c), GamutMode::Clip, ToneInverse::Exact);
             for (int k = 0; k < 3; ++k) {
                 if ((ch == 3 || k == ch) && truth.toneResponse(k, v) >= 1e-3) {
                     const double e = std::abs(r.counts[k] - c[k]);
@@ -121,6 +124,11 @@ Figures evaluate(const DisplayModel& model, const SyntheticDisplay& truth)
                         f.rampWorstChannel = ch;
                         f.rampWorstCount = v;
                     }
+                    if (r.inGamut()) {
+                        f.rampInverseMaxInGamut = std::max(f.rampInverseMaxInGamut, e);
+                    }
+                    f.rampInverseMaxClip =
+                            std::max(f.rampInverseMaxClip, std::abs(rc.counts[k] - c[k]));
                 }
             }
         }
@@ -147,27 +155,47 @@ TEST(RobustFit, DISABLED_Table)
                 auto m = fitDisplay(measure(panel, noise, 17), o);
                 ASSERT_TRUE(m.has_value()) << m.error().message;
                 const Figures f = evaluate(*m, panel);
-                std::printf(
-                        "%-10s %5.1f%% %-5s truth dE mean %.3f max %.3f | inverse ramps max "
-                        "%.2f (%d@%d) colours p95 %.2f max %.2f | heldout %.3f/%.3f noiseDe %.3f "
-                        "noise %.3f%% shapes %s %s %s expInv %.2f %.2f %.2f add %.3f (p99 "
-                        "%.3f) %+.3f%% +- %.3f %s\n",
-                        name, 100 * noise,
-                        method == 0   ? "rob"
-                        : method == 1 ? "old"
-                                      : "noNM",
-                        f.truthMean, f.truthMax, f.rampInverseMax, f.rampWorstChannel,
-                        f.rampWorstCount, f.colourInverseP95, f.colourInverseMax,
-                        m->fit.heldOutMeanDe00, m->fit.heldOutMaxDe00, m->fit.heldOutNoiseMeanDe00,
-                        m->fit.noisePercent, m->fit.toneShape[0].c_str(),
-                        m->fit.toneShape[1].c_str(), m->fit.toneShape[2].c_str(),
-                        m->fit.inverseCountsMax[0], m->fit.inverseCountsMax[1],
-                        m->fit.inverseCountsMax[2], m->fit.additivityDe00,
-                        m->fit.additivityNoiseDe00, m->fit.additivityLuminancePercent,
-                        m->fit.additivityLuminanceSigmaPercent,
-                        m->fit.additiveWithinNoise ? "additive" : "NOT");
+                std::printf("%-10s %5.1f%% %-5s truth dE mean %.3f max %.3f | inverse ramps max "
+                            "%.2f (%d@%d) clip %.2f in-gamut %.2f colours p95 %.2f max %.2f | "
+                            "heldout %.3f/%.3f noiseDe %.3f "
+                            "noise %.3f%% shapes %s %s %s expInv %.2f %.2f %.2f add %.3f (p99 "
+                            "%.3f) %+.3f%% +- %.3f %s\n",
+                            name, 100 * noise,
+                            method == 0   ? "rob"
+                            : method == 1 ? "old"
+                                          : "noNM",
+                            f.truthMean, f.truthMax, f.rampInverseMax, f.rampWorstChannel,
+                            f.rampWorstCount, f.rampInverseMaxClip, f.rampInverseMaxInGamut,
+                            f.colourInverseP95, f.colourInverseMax, m->fit.heldOutMeanDe00,
+                            m->fit.heldOutMaxDe00, m->fit.heldOutNoiseMeanDe00, m->fit.noisePercent,
+                            m->fit.toneShape[0].c_str(), m->fit.toneShape[1].c_str(),
+                            m->fit.toneShape[2].c_str(), m->fit.inverseCountsMax[0],
+                            m->fit.inverseCountsMax[1], m->fit.inverseCountsMax[2],
+                            m->fit.additivityDe00, m->fit.additivityNoiseDe00,
+                            m->fit.additivityLuminancePercent,
+                            m->fit.additivityLuminanceSigmaPercent,
+                            m->fit.additiveWithinNoise ? "additive" : "NOT");
             }
         }
+    }
+}
+
+// The S-shaped panel at 0.2 % over several seeds (the table's is 17): the ramps' inverse through
+// the hue-keeping mapping, through per-channel clipping, and over the counts the model finds in
+// gamut, with the worst channel (3: grey) and count. About 10 s; run with
+// --gtest_also_run_disabled_tests --gtest_filter=RobustFit.DISABLED_SShapedSeeds.
+TEST(RobustFit, DISABLED_SShapedSeeds)
+{
+    for (std::uint64_t seed : {11u, 17u, 23u, 31u, 47u, 59u}) {
+        FitOptions o;
+        auto m = fitDisplay(measure(sShapedPanel(), 0.002, seed), o);
+        ASSERT_TRUE(m.has_value()) << m.error().message;
+        const Figures f = evaluate(*m, sShapedPanel());
+        std::printf("seed %2llu: inverse ramps max %.2f (%d@%d), clipped %.2f, in gamut %.2f; "
+                    "colours p95 %.2f; truth dE00 max %.3f\n",
+                    static_cast<unsigned long long>(seed), f.rampInverseMax, f.rampWorstChannel,
+                    f.rampWorstCount, f.rampInverseMaxClip, f.rampInverseMaxInGamut,
+                    f.colourInverseP95, f.truthMax);
     }
 }
 
@@ -206,7 +234,8 @@ TEST(RobustFit, AveragesAColorimetersNoise)
     // count of the R, G, B and grey ramps where the light is at least 0.1 % of full drive.
     for (const auto& [panel, inverseLimit] :
          {std::pair{gogPanel(), 0.5}, std::pair{srgbPanel(), 0.5},
-          std::pair{sShapedPanel(), 0.75}}) { // the S-shape's top end: 0.60 (docs/display.md)
+          std::pair{sShapedPanel(), 0.75}}) { // seed 17: 0.60 at full blue; 0.6-1.5 over six seeds
+                                              // (DISABLED_SShapedSeeds, docs/display.md)
         const Figures robust = evaluate(fit(panel, 0.002, 17), panel);
         const Figures old = evaluate(fit(panel, 0.002, 17, ToneMethod::Interpolate), panel);
         EXPECT_LE(robust.truthMax, 0.5);
