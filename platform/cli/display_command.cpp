@@ -678,6 +678,14 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
     patCmd->add_option("--out", pat->out, "readings to write, .ti3 (rewritten after each)");
     patCmd->add_option("--show-dir", pat->showDir,
                        "headless display: the patch on show as DIR/patch.png and DIR/patch.txt");
+    patCmd->add_option("--output", pat->output,
+                       "where the patch is shown: headless (--show-dir) or kms (fullscreen on "
+                       "the panel, no display server)")
+            ->capture_default_str();
+    patCmd->add_option("--kms-device", pat->kmsDevice, "DRM device for --output kms")
+            ->capture_default_str();
+    patCmd->add_option("--kms-connector", pat->kmsConnector,
+                       "connector for --output kms, e.g. HDMI-A-1 (default: the first connected)");
     patCmd->add_option("--spotread", pat->spotread,
                        "meter command, e.g. 'spotread -e -x' (one key press per reading, parsed "
                        "from its 'Result is XYZ:' line); without it X Y Z are read from stdin");

@@ -1,4 +1,6 @@
 // Measuring a panel patch by patch.
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +21,7 @@
 #include <platform/cli/display_patches.h>
 #include <platform/image/png_writer.h>
 #include <platform/logging.h>
+#include <platform/output/output.h>
 
 namespace replica::platform {
 namespace {
@@ -162,9 +165,21 @@ int patchesMain(const PatchesOptions& o)
         fmt::print("patch set: {} ({} patches)\n", o.makeSet, set.size());
         return kExitOk;
     }
-    if (o.set.empty() || o.out.empty() || o.showDir.empty()) {
-        log->error("display patches: give SET.ti1, --out READINGS.ti3 and --show-dir DIR (or "
-                   "--make-set SET.ti1)");
+    const bool kms = o.output == "kms";
+    if (o.output != "headless" && !kms) {
+        log->error("display patches: --output is 'headless' (with --show-dir DIR) or 'kms', not "
+                   "'{}'",
+                   o.output);
+        return kExitUsage;
+    }
+    if (kms && !o.showDir.empty()) {
+        log->error("display patches: --show-dir is the headless display's; with --output kms the "
+                   "patch is shown on the panel");
+        return kExitUsage;
+    }
+    if (o.set.empty() || o.out.empty() || (!kms && o.showDir.empty())) {
+        log->error("display patches: give SET.ti1, --out READINGS.ti3 and --show-dir DIR or "
+                   "--output kms (or --make-set SET.ti1)");
         return kExitUsage;
     }
     std::ifstream sf(o.set, std::ios::binary);
@@ -199,7 +214,32 @@ int patchesMain(const PatchesOptions& o)
         fmt::print("resuming at patch {} of {} ({} readings in {})\n", readings.size() + 1,
                    set->size(), readings.size(), o.out);
     }
-    std::filesystem::create_directories(o.showDir);
+    // The panel, through the appliance's KMS output (CPU copies into dumb buffers: a patch is
+    // one flat colour, drawn here, with no renderer behind it).
+    std::unique_ptr<Output> panel;
+    DisplayInfo mode;
+    if (kms) {
+        KmsOptions ko;
+        ko.device = o.kmsDevice;
+        ko.connector = o.kmsConnector;
+        ko.path = "dumb";
+        auto out = createKmsOutput(ko);
+        if (!out) {
+            log->error("{}: cannot show patches on the panel: {}; without the panel: --output "
+                       "headless --show-dir DIR",
+                       o.kmsDevice, out.error().message);
+            return kExitFailure;
+        }
+        panel = std::move(*out);
+        mode = panel->display().value_or(DisplayInfo{});
+        if (mode.width <= 0 || mode.height <= 0) {
+            log->error("{}: the KMS output reports no mode", o.kmsDevice);
+            return kExitFailure;
+        }
+        fmt::print("showing patches on {} {}x{}\n", mode.connector, mode.width, mode.height);
+    } else {
+        std::filesystem::create_directories(o.showDir);
+    }
     std::optional<Meter> meter;
     if (!o.spotread.empty()) {
         meter = Meter::start(o.spotread);
@@ -211,20 +251,35 @@ int patchesMain(const PatchesOptions& o)
     const double maxCount = std::ldexp(1.0, o.bits) - 1.0;
     for (std::size_t i = readings.size(); i < set->size(); ++i) {
         const glm::dvec3 c = (*set)[i];
-        // Show: a full-frame PNG of the patch (8-bit) and its counts, for the headless display.
-        std::vector<std::uint8_t> rgba;
-        constexpr int kSide = 64;
-        for (int p = 0; p < kSide * kSide; ++p) {
-            for (int k = 0; k < 3; ++k) {
-                rgba.push_back(static_cast<std::uint8_t>(std::lround(c[k] / maxCount * 255.0)));
-            }
-            rgba.push_back(255);
+        // Show: fullscreen on the panel, or a full-frame PNG of the patch (8-bit) and its counts
+        // for the headless display.
+        const int width = kms ? mode.width : 64;
+        const int height = kms ? mode.height : 64;
+        std::array<std::uint8_t, 4> px{0, 0, 0, 255};
+        for (int k = 0; k < 3; ++k) {
+            px[static_cast<std::size_t>(k)] =
+                    static_cast<std::uint8_t>(std::lround(c[k] / maxCount * 255.0));
         }
-        const auto dir = std::filesystem::path(o.showDir);
-        if (auto ok = writePng(dir / "patch.png", kSide, kSide, rgba);
-            !ok || !writeAtomically(dir / "patch.txt", fmt::format("{} {} {}\n", c.x, c.y, c.z))) {
-            log->error("{}: cannot show the patch", o.showDir);
-            return kExitFailure;
+        std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) *
+                                       static_cast<std::size_t>(height) * 4);
+        for (std::size_t p = 0; p < rgba.size(); p += 4) {
+            std::copy(px.begin(), px.end(), rgba.begin() + static_cast<std::ptrdiff_t>(p));
+        }
+        if (kms) {
+            if (auto ok = panel->present(DisplayFrame{width, height, rgba, 0}); !ok) {
+                log->error("{}: cannot show patch {} of {}: {}; {} readings kept in {}",
+                           o.kmsDevice, i + 1, set->size(), ok.error().message, readings.size(),
+                           o.out);
+                return kExitFailure;
+            }
+        } else {
+            const auto dir = std::filesystem::path(o.showDir);
+            if (auto ok = writePng(dir / "patch.png", width, height, rgba);
+                !ok ||
+                !writeAtomically(dir / "patch.txt", fmt::format("{} {} {}\n", c.x, c.y, c.z))) {
+                log->error("{}: cannot show the patch", o.showDir);
+                return kExitFailure;
+            }
         }
         if (o.settleMs > 0) {
             std::this_thread::sleep_for(std::chrono::milliseconds(o.settleMs));

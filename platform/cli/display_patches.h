@@ -9,11 +9,14 @@
 namespace replica::platform {
 
 struct PatchesOptions {
-    std::string set;      // .ti1 to show
-    std::string out;      // .ti3 readings (resumed when it exists)
-    std::string showDir;  // headless display: patch.png and patch.txt of the patch on show
-    std::string spotread; // command line of the meter; empty: readings on stdin
-    std::string makeSet;  // write the default patch set here and stop
+    std::string set;     // .ti1 to show
+    std::string out;     // .ti3 readings (resumed when it exists)
+    std::string showDir; // headless display: patch.png and patch.txt of the patch on show
+    std::string output = "headless"; // "headless" (--show-dir) or "kms": fullscreen on the panel
+    std::string kmsDevice = "/dev/dri/card0";
+    std::string kmsConnector; // empty: the first connected one
+    std::string spotread;     // command line of the meter; empty: readings on stdin
+    std::string makeSet;      // write the default patch set here and stop
     int bits = 8;
     int settleMs = 0;
     int step = 5;

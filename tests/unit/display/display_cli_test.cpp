@@ -318,6 +318,37 @@ TEST_F(DisplayCli, PatchesDriveSpotreadAndResumeAfterAnInterruption)
             << bad.err;
 }
 
+TEST_F(DisplayCli, PatchesOnThePanelThroughKms)
+{
+    const std::string set = (dir_ / "set.ti1").string();
+    const std::string out = (dir_ / "r.ti3").string();
+    ASSERT_EQ(run("display patches --make-set " + set + " --step 32 --colours 6").exitCode, 0);
+    // Argument handling: an unknown output, and the headless display's folder with kms.
+    const auto unknown = run("display patches " + set + " --out " + out + " --output x11");
+    EXPECT_EQ(unknown.exitCode, 2);
+    EXPECT_NE(unknown.err.find("--output is 'headless' (with --show-dir DIR) or 'kms', not 'x11'"),
+              std::string::npos)
+            << unknown.err;
+    const auto both = run("display patches " + set + " --out " + out + " --output kms --show-dir " +
+                          (dir_ / "show").string());
+    EXPECT_EQ(both.exitCode, 2);
+    EXPECT_NE(both.err.find("--show-dir is the headless display's"), std::string::npos) << both.err;
+    const auto neither = run("display patches " + set + " --out " + out);
+    EXPECT_EQ(neither.exitCode, 2);
+    EXPECT_NE(neither.err.find("--show-dir DIR or --output kms"), std::string::npos) << neither.err;
+    // No DRM device: one line naming it and what to do instead, nothing read, no readings file.
+    const std::string card = (dir_ / "no-such-card").string();
+    const auto none = run("display patches " + set + " --out " + out +
+                          " --output kms --kms-device " + card + " < /dev/null");
+    EXPECT_EQ(none.exitCode, 1);
+    EXPECT_NE(none.err.find(card + ": cannot show patches on the panel: "), std::string::npos)
+            << none.err;
+    EXPECT_NE(none.err.find("without the panel: --output headless --show-dir DIR"),
+              std::string::npos)
+            << none.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST_F(DisplayCli, StudyNamesThePapersOutOfGamutPatchesUnderTungsten)
 {
     const auto r = run("display study --json");
