@@ -1,0 +1,203 @@
+// The four modes of the pass (booth_shading_pass.cpp says when each runs), as the pixel loop of
+// shading/realtime_model.cpp renderRealtime: eq. (1)'s cache, eq. (2)'s channel sum
+// (colour::ChannelCoeffs times the light's per-channel XYZ), the specular grid, and the compose
+// minus the screen's front-surface flare.
+
+void main() {
+    float u;
+    float v;
+    if (uMode == 2 || uMode == 3) {
+        // A node of the specular or the diffuse grid (row j = v, down the surface, like the
+        // textures' rows).
+        vec2 node = floor(gl_FragCoord.xy);
+        ivec2 nodes = uMode == 2 ? uGridNodes : uDiffNodes;
+        u = node.x / float(nodes.x - 1);
+        v = node.y / float(nodes.y - 1);
+    } else {
+        vec2 frag = gl_FragCoord.xy / uViewport;
+        u = uSurfOffset.x + uSurfScale.x * frag.x;
+        v = uSurfOffset.y + uSurfScale.y * (1.0 - frag.y);
+    }
+    bool inside = u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0;
+    // On the panel plane also around the surface: the flare term needs E_geo on every pixel.
+    vec3 p = uCentre + uRight * ((u - 0.5) * uSizeM.x) + uUp * ((0.5 - v) * uSizeM.y);
+    float texX = u * float(uTexels.x);
+    float texY = v * float(uTexels.y);
+#if BOOTH_EXACT_TIES
+    // RenderSettings::texelExactTies (view.cpp shadingPoint's rule): the pixel's texel position
+    // from its offset into the surface's pixels times the texels, divided last. For the
+    // whole-pixel rectangles the CPU model renders the product is exact, and a correctly rounded
+    // division (llvmpipe's) of it lands exactly on a texel edge where the pixel centre does, so
+    // float takes the texel after the edge as double does. u * texels rounded such a centre
+    // either way: at 48x30 a pixel row in thirty read the texel row before the CPU model's.
+    if (uMode == 0 || uMode == 1) {
+        vec2 along = vec2(gl_FragCoord.x - uSurfPixels.x, uSurfPixels.y - gl_FragCoord.y) *
+                     vec2(uTexels);
+        texX = along.x / uSurfPixels.z;
+        texY = along.y / uSurfPixels.w;
+    }
+    ivec2 tc = clamp(ivec2(floor(vec2(texX, texY))), ivec2(0), uTexels - 1);
+#else
+    ivec2 tc = clamp(ivec2(int(texX), int(texY)), ivec2(0), uTexels - 1);
+#endif
+    vec3 nShade = uNormal;
+    // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
+    bool facets = uMode == 0 || (uSpecSamples > 0 && (uMode == 2 || !kGrid));
+    if (inside && uRelief && facets) {
+#if BOOTH_FACET_CACHE && BOOTH_MODE == 1
+        vec3 nl = texelFetch(uFacetCache, ivec2(gl_FragCoord.xy), 0).xyz;
+#else
+        vec3 nl = bilinearNormal(texX, texY);
+#endif
+#if BOOTH_FACET_CACHE && BOOTH_MODE == 0
+        outFacet = vec4(nl, 0.0);
+#endif
+        nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
+#if BOOTH_HORIZON_BILINEAR && BOOTH_MODE == 0
+        // Eq. (1)'s horizons at this point (RenderSettings::horizonBilinear); the compose's lobe
+        // reads the texel's below.
+        bilinearHorizons(texX, texY);
+#elif BOOTH_HORIZON_HALF
+        for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {
+            uvec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
+            for (int w = 0; w < 4; ++w) {
+                vec2 pair = unpackHalf2x16(b[w]);
+                hz[8 * j + 2 * w] = pair.x;
+                hz[8 * j + 2 * w + 1] = pair.y;
+            }
+        }
+#else
+        for (int j = 0; j < (uHorizonDirs + 3) / 4; ++j) {
+            vec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
+            hz[4 * j] = b.x;
+            hz[4 * j + 1] = b.y;
+            hz[4 * j + 2] = b.z;
+            hz[4 * j + 3] = b.w;
+        }
+#endif
+    }
+
+    if (uMode == 2) {
+        float spec = 0.0;
+        vec3 toEye = uEye - p;
+        float eyeDist = length(toEye);
+        toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;
+        if (dot(toEye, uNormal) > 0.0) {
+            spec = filteredSpecular(p, uNormal, nShade, toEye);
+        }
+        outXyz = vec4((isnan(spec) || isinf(spec)) ? 0.0 : spec, 0.0, 0.0, 0.0);
+        return;
+    }
+    if (uMode == 3) {
+        // realtime_model.cpp's diffuse grid: eq. (1) with the macro normal at this node.
+        float eg = 0.0;
+        float unused = 0.0;
+#define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, uNormal, false, eg, unused); }
+        BOOTH_LIGHT_CALLS
+#undef LIGHT_AT
+        for (int i = BOOTH_UNROLLED_LIGHTS; i < uLightCount; ++i) {
+            diffuseLight(i, p, uNormal, false, eg, unused);
+        }
+        outXyz = vec4((isnan(eg) || isinf(eg)) ? 0.0 : eg, 0.0, 0.0, 0.0);
+        return;
+    }
+    if (uMode == 0 && !inside) {
+        // Around the surface only E_geo (pass 2's flare): eq. (1) with the macro normal, the
+        // cosines clamped instead of tested: the same sum, and on llvmpipe about half the cost of
+        // the full loop below, which ran here on every pixel of the panel (measured: a metamer
+        // frame that recomputes the cache, 393 -> 217 ms on the loaded 2-core machine).
+        float eg = 0.0;
+#if BOOTH_AREA_LIGHTS
+        float unused = 0.0;
+        for (int i = 0; i < uLightCount; ++i) {
+            diffuseLight(i, p, uNormal, false, eg, unused);
+        }
+#else
+        for (int i = 0; i < uLightCount; ++i) {
+            vec4 l = uLight[i];
+            vec3 d = l.xyz - p;
+            float d2 = max(dot(d, d), 1e-30);
+            d *= inversesqrt(d2);
+            eg += l.w * max(-dot(uLightNormal, d), 0.0) * max(dot(uNormal, d), 0.0)
+                  / max(d2, uTexelArea);
+        }
+#endif
+        outXyz = vec4(0.0, 0.0, 0.0, (isnan(eg) || isinf(eg)) ? 0.0 : eg);
+        return;
+    }
+    if (uMode == 0) {
+        // Eq. (1): eGeo with the macro normal (flare, flat scenes), e with facets and horizons.
+        bool relief = inside && uRelief;
+        float eGeo = 0.0;
+        float e = 0.0;
+        // The first BOOTH_UNROLLED_LIGHTS lights one after another at constant indices
+        // (BOOTH_LIGHT_CALLS, written out by the pass: LIGHT_AT(0) LIGHT_AT(1) ...; llvmpipe
+        // reads a uniform array at a loop counter as a gather per pixel, at a constant index as
+        // one load), then any beyond them in a loop. Same lights in the same order.
+#if BOOTH_DIFFUSE_GRID
+        // Flat, and inside the surface here: E_geo between the diffuse grid's nodes.
+        eGeo = gridValue(uDiffGrid, uDiffNodes, u, v);
+#else
+#define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, nShade, relief, eGeo, e); }
+        BOOTH_LIGHT_CALLS
+#undef LIGHT_AT
+        for (int i = BOOTH_UNROLLED_LIGHTS; i < uLightCount; ++i) {
+            diffuseLight(i, p, nShade, relief, eGeo, e);
+        }
+#endif
+        if (!relief) {
+            e = eGeo;
+        }
+        if (!uDiffuse) {
+            e = 0.0;
+        }
+        vec3 xyz = vec3(0.0); // the panel around the surface stays black
+        if (inside) {
+            // Eq. (2): channel coefficients times the light's per-channel XYZ.
+            vec3 a = texelFetch(uCoeffA, tc, 0).rgb;
+            vec3 b = texelFetch(uCoeffB, tc, 0).rgb;
+            xyz = a.r * uChannelXyz[0] + a.g * uChannelXyz[1] + a.b * uChannelXyz[2]
+                + b.r * uChannelXyz[3] + b.g * uChannelXyz[4] + b.b * uChannelXyz[5];
+            xyz *= e / kPi;
+        }
+        if (isnan(eGeo) || isinf(eGeo)) {
+            eGeo = 0.0;
+        }
+        if (uSpecSamples == 0 && uFlareRho == 0.0) {
+            // Nothing left for the compose: the cache is the frame (clamped as mode 1 would).
+            xyz = max(xyz, vec3(0.0));
+            if (any(isnan(xyz)) || any(isinf(xyz))) {
+                xyz = vec3(0.0);
+            }
+        }
+        outXyz = vec4(xyz, eGeo);
+        return;
+    }
+
+    // Compose (drawn over the surface's rectangle only; around it the frame is the cache): the
+    // cached diffuse term and E_geo, plus this eye's specular, minus the flare.
+    vec4 cached = texelFetch(uCache, ivec2(gl_FragCoord.xy), 0);
+    vec3 xyz = cached.rgb;
+    float eGeo = cached.a;
+    if (kGrid) {
+        if (inside) {
+            xyz += uSpecXyz * gridValue(uSpecGrid, uGridNodes, u, v);
+        }
+    } else if (inside && uSpecSamples > 0) {
+        vec3 toEye = uEye - p;
+        float eyeDist = length(toEye);
+        toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;
+        bool behind = !(dot(toEye, uNormal) > 0.0);
+        if (!behind) {
+            xyz += uSpecXyz * filteredSpecular(p, uNormal, nShade, toEye);
+        }
+    }
+    vec3 outv = max(xyz - uWhite * (uFlareRho * eGeo / kPi), vec3(0.0));
+    if (any(isnan(outv)) || any(isinf(outv))) {
+        outv = vec3(0.0); // never reaches a pixel; the read-back check counts none
+    }
+    if (isnan(eGeo) || isinf(eGeo)) {
+        eGeo = 0.0;
+    }
+    outXyz = vec4(outv, eGeo);
+}
