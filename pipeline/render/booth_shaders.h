@@ -1,4 +1,5 @@
-// GLSL ES 3.10 sources of the booth shading pass (surface radiance in absolute XYZ).
+// GLSL ES 3.10 sources of the booth shading pass (surface radiance in absolute XYZ): the files
+// under glsl/, joined at build time (pipeline/CMakeLists.txt, glsl/embed_glsl.cmake).
 #pragma once
 
 namespace replica::pipeline::render {

@@ -42,32 +42,21 @@ void nearest(GLenum target)
     glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
-GLuint texture2d(GLenum internalFormat, GLenum format, int w, int h, const float* data)
-{
-    GLuint tex = 0;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D, tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, w, h);
-    if (data != nullptr) {
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, GL_FLOAT, data);
-    }
-    nearest(GL_TEXTURE_2D);
-    return tex;
-}
-
 // A grid's target: one R32F texel per node (made on 'unit', so that creating it binds over no
 // other input) and a framebuffer that draws into it.
-Expected<void>
-nodeTarget(shading::GridNodes nodes, GLint unit, const char* grid, GLuint& texture, GLuint& fbo)
+Expected<void> nodeTarget(shading::GridNodes nodes,
+                          GLint unit,
+                          const char* grid,
+                          GlTexture& texture,
+                          GlFramebuffer& fbo)
 {
     glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
-    texture = texture2d(GL_R32F, GL_RED, nodes.x, nodes.y, nullptr);
+    texture = texture2d(GL_R32F, GL_RED, GL_FLOAT, nodes.x, nodes.y, nullptr);
     glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE0);
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+    fbo = GlFramebuffer::make();
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo.get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.get(), 0);
     const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (!complete) {
@@ -82,7 +71,7 @@ nodeTarget(shading::GridNodes nodes, GLint unit, const char* grid, GLuint& textu
 // The horizon map as a 2-D array texture: directions [4j, 4j + 4) in layer j of an RGBA32F array,
 // or with 'half' [8j, 8j + 8) as half floats in layer j of an RGBA32UI array (packHalf2x16's
 // layout: direction 2i in the low 16 bits of word i). 'dirs' 0: one empty texel.
-GLuint horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
+GlTexture horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
 {
     const int perLayer = half ? 8 : 4;
     const int layers = std::max((dirs + perLayer - 1) / perLayer, 1);
@@ -105,9 +94,8 @@ GLuint horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
             }
         }
     }
-    GLuint tex = 0;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
+    GlTexture tex = GlTexture::make();
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tex.get());
     glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, half ? GL_RGBA32UI : GL_RGBA32F, w, h, layers);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     if (half) {
@@ -262,7 +250,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     // Horizon sines a layer of the horizon texture (horizonTexture) and layers.
     const int perLayer = settings_.horizonHalf ? 8 : 4;
     const int layers = std::max((horizonDirs_ + perLayer - 1) / perLayer, 1);
-    // booth_shaders.cpp eq. (1) on a flat surface: one LIGHT_AT per light up to
+    // glsl/booth_main.glsl eq. (1) on a flat surface: one LIGHT_AT per light up to
     // kBoothUnrolledLights, a loop for any beyond. Not on relief: there each light's horizon test
     // is large, and 32 copies of it took LLVM seconds to compile (a test's pass 2 -> 16 s) for no
     // measurable gain in the frame.
@@ -310,15 +298,15 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
         if (!program) {
             return tl::unexpected(program.error());
         }
-        programs_[static_cast<std::size_t>(mode)] = *program;
+        programs_[static_cast<std::size_t>(mode)] = std::move(*program);
     }
-    glGenVertexArrays(1, &vao_);
+    vao_ = GlVertexArray::make();
 
     const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
     std::vector<float> a, b;
     channelPlanes(ps, a, b);
-    coeffA_ = texture2d(GL_RGB32F, GL_RGB, s.width, s.height, a.data());
-    coeffB_ = texture2d(GL_RGB32F, GL_RGB, s.width, s.height, b.data());
+    coeffA_ = texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, a.data());
+    coeffB_ = texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, b.data());
 
     std::vector<float> n(relief_ ? texels * 3 : 3, 0.0f);
     if (relief_) {
@@ -330,19 +318,21 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     } else {
         n[2] = 1.0f;
     }
-    normals_ = relief_ ? texture2d(GL_RGB32F, GL_RGB, s.width, s.height, n.data())
-                       : texture2d(GL_RGB32F, GL_RGB, 1, 1, n.data());
+    normals_ = relief_ ? texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, n.data())
+                       : texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, 1, 1, n.data());
 
     horizon_ = horizonTexture(ps.horizon, horizonDirs_, settings_.horizonHalf);
 
-    glGenBuffers(1, &lightsUbo_);
-    glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
+    lightsUbo_ = GlBuffer::make();
+    glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_.get());
     // Per light: position and intensity, the two spread vectors, the region's rectangle
-    // (booth_shaders.cpp): 16 KiB for 256 lights, the least GL_MAX_UNIFORM_BLOCK_SIZE of GLES 3.1.
+    // (glsl/booth_interface.glsl): 16 KiB for 256 lights, the least GL_MAX_UNIFORM_BLOCK_SIZE of
+    // GLES 3.1.
     glBufferData(GL_UNIFORM_BUFFER, kBoothMaxLights * 4 * 4 * sizeof(float), nullptr,
                  GL_DYNAMIC_DRAW);
     // Blocks a mode does not use are gone from its program: bound where present.
-    for (const GLuint p : programs_) {
+    for (const GlProgram& program : programs_) {
+        const GLuint p = program.get();
         if (const GLuint block =
                     p != 0 ? glGetUniformBlockIndex(p, "BoothLights") : GL_INVALID_INDEX;
             block != GL_INVALID_INDEX) {
@@ -362,11 +352,12 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
         table[i + 2] = static_cast<float>(hl.z);
         table[i + 3] = static_cast<float>(w);
     }
-    glGenBuffers(1, &samplesUbo_);
-    glBindBuffer(GL_UNIFORM_BUFFER, samplesUbo_);
+    samplesUbo_ = GlBuffer::make();
+    glBindBuffer(GL_UNIFORM_BUFFER, samplesUbo_.get());
     glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(table.size() * sizeof(float)),
                  table.data(), GL_STATIC_DRAW);
-    for (const GLuint p : programs_) {
+    for (const GlProgram& program : programs_) {
+        const GLuint p = program.get();
         if (const GLuint block =
                     p != 0 ? glGetUniformBlockIndex(p, "BoothSpecSamples") : GL_INVALID_INDEX;
             block != GL_INVALID_INDEX) {
@@ -414,31 +405,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     return glCheck("uploading the scene");
 }
 
-BoothShadingPass::~BoothShadingPass()
-{
-    const std::array<GLuint, 10> textures{coeffA_,
-                                          coeffB_,
-                                          normals_,
-                                          horizon_,
-                                          lum_,
-                                          caches_[0].texture,
-                                          caches_[1].texture,
-                                          facetTexture_,
-                                          gridTexture_,
-                                          diffuseTexture_};
-    glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
-    for (const CacheBuffer& c : caches_) {
-        glDeleteFramebuffers(1, &c.fbo);
-    }
-    glDeleteFramebuffers(1, &gridFbo_);
-    glDeleteFramebuffers(1, &diffuseFbo_);
-    glDeleteBuffers(1, &lightsUbo_);
-    glDeleteBuffers(1, &samplesUbo_);
-    glDeleteVertexArrays(1, &vao_);
-    for (const GLuint p : programs_) {
-        glDeleteProgram(p); // 0 is ignored
-    }
-}
+BoothShadingPass::~BoothShadingPass() = default;
 
 Expected<void> BoothShadingPass::setChannels(const shading::PreparedScene& ps)
 {
@@ -454,9 +421,9 @@ Expected<void> BoothShadingPass::setChannels(const shading::PreparedScene& ps)
     channelPlanes(ps, a, b);
     const surface::SurfaceScene& s = *ps.scene;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glBindTexture(GL_TEXTURE_2D, coeffA_);
+    glBindTexture(GL_TEXTURE_2D, coeffA_.get());
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_FLOAT, a.data());
-    glBindTexture(GL_TEXTURE_2D, coeffB_);
+    glBindTexture(GL_TEXTURE_2D, coeffB_.get());
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_FLOAT, b.data());
     cacheValid_ = false; // the cached diffuse term was shaded from the old coefficients
     return glCheck("replacing the channel coefficients");
@@ -512,14 +479,14 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
             packed[3 * block + k + c] = static_cast<float>(rect[c]);
         }
     }
-    glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_);
+    glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_.get());
     glBufferSubData(GL_UNIFORM_BUFFER, 0, static_cast<GLsizeiptr>(packed.size() * sizeof(float)),
                     packed.data());
 
     // Mip chain exactly as booth::buildMipChain made it (each level uploaded, not regenerated).
-    glDeleteTextures(1, &lum_);
-    glGenTextures(1, &lum_);
-    glBindTexture(GL_TEXTURE_2D, lum_);
+    lum_.reset();
+    lum_ = GlTexture::make();
+    glBindTexture(GL_TEXTURE_2D, lum_.get());
     const auto& levels = pl.mips.levels;
     lumMaxLevel_ = static_cast<int>(levels.size()) - 1;
     glTexStorage2D(GL_TEXTURE_2D, static_cast<GLsizei>(levels.size()), GL_R32F, levels[0].width,
@@ -535,7 +502,7 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     nearest(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
     if (hwFilter_) {
-        // booth::MipChain::sample's rule (booth_shaders.cpp lumSample); border colour 0.
+        // booth::MipChain::sample's rule (glsl/mip_chain.glsl lumSample); border colour 0.
         constexpr GLenum kClampToBorder = 0x812D; // GL_CLAMP_TO_BORDER_EXT / _OES
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
                         settings_.specularNearestLevel ? GL_LINEAR_MIPMAP_NEAREST
@@ -588,7 +555,7 @@ void BoothShadingPass::set3All(const char* name, const glm::dvec3& v) const
 
 void BoothShadingPass::usePose(int mode, const shading::PanelPose& panel) const
 {
-    const GLuint p = programs_[static_cast<std::size_t>(mode)];
+    const GLuint p = programs_[static_cast<std::size_t>(mode)].get();
     const auto set = [p](const char* name, const shading::Vec3& v) {
         const glm::vec3 f = f3(v);
         glProgramUniform3f(p, glGetUniformLocation(p, name), f.x, f.y, f.z);
@@ -602,36 +569,34 @@ void BoothShadingPass::usePose(int mode, const shading::PanelPose& panel) const
 
 Expected<void> BoothShadingPass::ensureCacheTarget(int width, int height) const
 {
-    if (caches_[0].texture != 0 && cacheWidth_ == width && cacheHeight_ == height) {
+    if (caches_[0].texture && cacheWidth_ == width && cacheHeight_ == height) {
         return {};
     }
     for (CacheBuffer& c : caches_) {
-        glDeleteFramebuffers(1, &c.fbo);
-        glDeleteTextures(1, &c.texture);
         c = CacheBuffer{}; // a new texture holds nothing yet
     }
-    glDeleteTextures(1, &facetTexture_);
-    facetTexture_ = 0;
+    facetTexture_.reset();
     front_ = 0;
     pending_.reset();
     glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
     if (facetCache_) {
-        facetTexture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
+        facetTexture_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
     }
     // The back cache only where refreshes are sliced: 9 MB at 960x600 that nothing else reads.
     const int buffers = settings_.cacheSlices > 1 ? 2 : 1;
     bool complete = true;
     for (int b = 0; b < buffers; ++b) {
         CacheBuffer& c = caches_[static_cast<std::size_t>(b)];
-        c.texture = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
+        c.texture = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
         glBindTexture(GL_TEXTURE_2D, 0);
-        glGenFramebuffers(1, &c.fbo);
-        glBindFramebuffer(GL_FRAMEBUFFER, c.fbo);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, c.texture, 0);
+        c.fbo = GlFramebuffer::make();
+        glBindFramebuffer(GL_FRAMEBUFFER, c.fbo.get());
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, c.texture.get(),
+                               0);
         if (facetCache_) {
             // Mode 0 writes the facet normal beside the cached terms; the blit reads attachment 0.
             glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D,
-                                   facetTexture_, 0);
+                                   facetTexture_.get(), 0);
             const std::array<GLenum, 2> attachments{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
             glDrawBuffers(2, attachments.data());
             glReadBuffer(GL_COLOR_ATTACHMENT0);
@@ -660,7 +625,7 @@ void BoothShadingPass::drawCacheSlice(int buffer,
     if (slice == 0 && diffuseNodes_.x > 0) {
         // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface (it stays
         // for the refresh's later bands: nothing else draws into it).
-        glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_);
+        glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_.get());
         glViewport(0, 0, diffuseNodes_.x, diffuseNodes_.y);
         usePose(3, pose);
         glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -668,12 +633,12 @@ void BoothShadingPass::drawCacheSlice(int buffer,
     }
     if (diffuseNodes_.x > 0) {
         glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
-        glBindTexture(GL_TEXTURE_2D, diffuseTexture_);
+        glBindTexture(GL_TEXTURE_2D, diffuseTexture_.get());
         glActiveTexture(GL_TEXTURE0);
     }
     // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare); or,
     // without the surround's illuminance, the surface's rectangle and zero around it.
-    glBindFramebuffer(GL_FRAMEBUFFER, c.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, c.fbo.get());
     PixelRect region{0, 0, width, height};
     if (!surroundIlluminance_) {
         // Mode 0 writes only the rectangle, so zero around it stays zero from one refresh to
@@ -733,7 +698,7 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         return ok;
     }
     glViewport(0, 0, width, height);
-    glBindVertexArray(vao_);
+    glBindVertexArray(vao_.get());
     uniformAll(glProgramUniform2f, "uViewport", static_cast<float>(width),
                static_cast<float>(height));
     uniformAll(glProgramUniform2f, "uSurfOffset", static_cast<float>(layout.offset.x),
@@ -748,18 +713,18 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                static_cast<float>(height * (1.0 + layout.offset.y / sx.y)),
                static_cast<float>(width / sx.x), static_cast<float>(height / sx.y));
     set3All("uEye", view.eye);
-    glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightsUbo_);
-    glBindBufferBase(GL_UNIFORM_BUFFER, 1, samplesUbo_);
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightsUbo_.get());
+    glBindBufferBase(GL_UNIFORM_BUFFER, 1, samplesUbo_.get());
     glActiveTexture(GL_TEXTURE0 + kUnitCoeffA);
-    glBindTexture(GL_TEXTURE_2D, coeffA_);
+    glBindTexture(GL_TEXTURE_2D, coeffA_.get());
     glActiveTexture(GL_TEXTURE0 + kUnitCoeffB);
-    glBindTexture(GL_TEXTURE_2D, coeffB_);
+    glBindTexture(GL_TEXTURE_2D, coeffB_.get());
     glActiveTexture(GL_TEXTURE0 + kUnitNormals);
-    glBindTexture(GL_TEXTURE_2D, normals_);
+    glBindTexture(GL_TEXTURE_2D, normals_.get());
     glActiveTexture(GL_TEXTURE0 + kUnitHorizon);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, horizon_);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, horizon_.get());
     glActiveTexture(GL_TEXTURE0 + kUnitLum);
-    glBindTexture(GL_TEXTURE_2D, lum_);
+    glBindTexture(GL_TEXTURE_2D, lum_.get());
     glActiveTexture(GL_TEXTURE0 + kUnitCache);
     glBindTexture(GL_TEXTURE_2D, 0); // not sampled while it is the render target
 
@@ -807,7 +772,7 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     }
     if (gridNodes_.x > 0) {
         // This eye's specular term at the grid's nodes, for the compose to interpolate.
-        glBindFramebuffer(GL_FRAMEBUFFER, gridFbo_);
+        glBindFramebuffer(GL_FRAMEBUFFER, gridFbo_.get());
         glViewport(0, 0, gridNodes_.x, gridNodes_.y);
         usePose(2, view.panel);
         glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -818,7 +783,7 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     // pixel so that the shader's own bounds test decides every edge pixel): the cached part, the
     // specular term for this frame's pose and eye, minus the flare.
     const CacheBuffer& front = caches_[static_cast<std::size_t>(front_)];
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, front.fbo);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, front.fbo.get());
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     restore();
@@ -827,11 +792,11 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
         glScissor(rect.x, rect.y, rect.width, rect.height);
         usePose(1, view.panel);
         glActiveTexture(GL_TEXTURE0 + kUnitCache);
-        glBindTexture(GL_TEXTURE_2D, front.texture);
+        glBindTexture(GL_TEXTURE_2D, front.texture.get());
         glActiveTexture(GL_TEXTURE0 + kUnitFacet);
-        glBindTexture(GL_TEXTURE_2D, facetTexture_);
+        glBindTexture(GL_TEXTURE_2D, facetTexture_.get());
         glActiveTexture(GL_TEXTURE0 + kUnitSpecGrid);
-        glBindTexture(GL_TEXTURE_2D, gridTexture_);
+        glBindTexture(GL_TEXTURE_2D, gridTexture_.get());
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glBindTexture(GL_TEXTURE_2D, 0);
         glActiveTexture(GL_TEXTURE0 + kUnitFacet);
@@ -852,10 +817,11 @@ Expected<std::unique_ptr<XyzTarget>> XyzTarget::create(int width, int height)
     std::unique_ptr<XyzTarget> t(new XyzTarget());
     t->width_ = width;
     t->height_ = height;
-    t->texture_ = texture2d(GL_RGBA32F, GL_RGBA, width, height, nullptr);
-    glGenFramebuffers(1, &t->fbo_);
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->texture_, 0);
+    t->texture_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
+    t->fbo_ = GlFramebuffer::make();
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_.get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->texture_.get(),
+                           0);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         return makeError(ErrorCode::Unsupported,
                          "render: an RGBA32F target is not renderable on this GL (float colour "
@@ -867,15 +833,11 @@ Expected<std::unique_ptr<XyzTarget>> XyzTarget::create(int width, int height)
     return t;
 }
 
-XyzTarget::~XyzTarget()
-{
-    glDeleteFramebuffers(1, &fbo_);
-    glDeleteTextures(1, &texture_);
-}
+XyzTarget::~XyzTarget() = default;
 
 void XyzTarget::bind() const
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
 }
 
 shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
@@ -886,7 +848,7 @@ shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
     f.width = width_;
     f.height = height_;
     std::vector<float> px(static_cast<std::size_t>(width_) * height_ * 4);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, px.data());
     f.xyz.resize(static_cast<std::size_t>(width_) * height_);

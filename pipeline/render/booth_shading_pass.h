@@ -12,6 +12,7 @@
 
 #include <pipeline/base/expected.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/render/gl_handles.h>
 #include <pipeline/render/pixel_rect.h>
 #include <pipeline/scene/stand.h>
 #include <pipeline/shading/frame.h>
@@ -135,22 +136,22 @@ private:
     colour::Xyz specXyz_{0.0};
     // One program per shader mode (booth_shaders.h): 0 cache, 1 compose, 2 specular grid,
     // 3 diffuse grid (0 where the pass has no diffuse grid).
-    std::array<GLuint, 4> programs_{};
+    std::array<GlProgram, 4> programs_{};
     // Sets a uniform in every mode's program (where that mode still has it).
     template <typename Fn, typename... Args>
     void uniformAll(Fn fn, const char* name, Args... args) const
     {
-        for (const GLuint p : programs_) {
-            if (p != 0) {
+        for (const GlProgram& program : programs_) {
+            if (const GLuint p = program.get(); p != 0) {
                 fn(p, glGetUniformLocation(p, name), args...);
             }
         }
     }
     void set3All(const char* name, const glm::dvec3& v) const;
-    GLuint vao_ = 0;
-    GLuint lightsUbo_ = 0;
-    GLuint samplesUbo_ = 0;
-    GLuint coeffA_ = 0, coeffB_ = 0, normals_ = 0, horizon_ = 0, lum_ = 0;
+    GlVertexArray vao_;
+    GlBuffer lightsUbo_;
+    GlBuffer samplesUbo_;
+    GlTexture coeffA_, coeffB_, normals_, horizon_, lum_;
 
     // The cache of the eye-independent part and what it was drawn for.
     struct CacheKey {
@@ -165,8 +166,8 @@ private:
     mutable bool surroundIlluminance_ = true;
     mutable long cacheRefreshes_ = 0;
     struct CacheBuffer {
-        GLuint texture = 0; // RGBA32F: diffuse XYZ, E_geo in alpha
-        GLuint fbo = 0;
+        GlTexture texture; // RGBA32F: diffuse XYZ, E_geo in alpha
+        GlFramebuffer fbo;
         // The rectangle outside which this buffer is known to hold zero (cleared for it, and mode
         // 0 writes only inside it); none after a new texture or a draw with the surround's
         // illuminance.
@@ -189,17 +190,17 @@ private:
     // facet normal depends on the layout and size alone, and a change of either redraws the
     // cache whole, so a band drawn into the back cache writes there what it already holds.
     bool facetCache_ = false;
-    mutable GLuint facetTexture_ = 0;
+    mutable GlTexture facetTexture_;
     mutable int cacheWidth_ = 0, cacheHeight_ = 0;
 
     // The specular grid (settings.specularGrid > 0 on a glossy scene): its nodes and target.
     shading::GridNodes gridNodes_;
-    GLuint gridTexture_ = 0;
-    GLuint gridFbo_ = 0;
+    GlTexture gridTexture_;
+    GlFramebuffer gridFbo_;
     // The diffuse grid (settings.diffuseGrid > 0 on a flat surface): drawn with the cache.
     shading::GridNodes diffuseNodes_;
-    GLuint diffuseTexture_ = 0;
-    GLuint diffuseFbo_ = 0;
+    GlTexture diffuseTexture_;
+    GlFramebuffer diffuseFbo_;
 };
 
 // An RGBA32F render target with read-back into an XyzFrame (rows top-down, like the CPU model):
@@ -229,8 +230,8 @@ private:
     XyzTarget() = default;
     int width_ = 0;
     int height_ = 0;
-    GLuint texture_ = 0;
-    GLuint fbo_ = 0;
+    GlTexture texture_;
+    GlFramebuffer fbo_;
 };
 
 // One frame of the GPU path into a fresh target: for tests, the benchmark and 'replica render'.

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <numbers>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -139,23 +140,6 @@ void main() {
 }
 )";
 
-GLuint texture2d(GLenum internalFormat, GLenum format, GLenum type, int w, int h, const void* data)
-{
-    GLuint tex = 0;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D, tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, w, h);
-    if (data != nullptr) {
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, type, data);
-    }
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return tex;
-}
-
 void setVec3(GLuint program, const char* name, const glm::dvec3& v)
 {
     glUniform3f(glGetUniformLocation(program, name), static_cast<float>(v.x),
@@ -169,15 +153,7 @@ void setInt(GLuint program, const char* name, int v)
 
 } // namespace
 
-DisplayPass::~DisplayPass()
-{
-    const std::array<GLuint, 5> textures{rgbaTarget_, classTarget_, toneLut_, lut3d_, viewingGrid_};
-    glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
-    glDeleteBuffers(1, &counts_);
-    glDeleteFramebuffers(1, &fbo_);
-    glDeleteProgram(program_);
-    glDeleteProgram(countProgram_);
-}
+DisplayPass::~DisplayPass() = default;
 
 Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int height)
 {
@@ -217,18 +193,18 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     if (!program) {
         return tl::unexpected(program.error());
     }
-    program_ = *program;
+    program_ = std::move(*program);
     const std::string countSource =
             fmt::format("#version 310 es\n#define COUNT_RUN {}\n", kCountRun) + kCountShader;
     auto cs = compileShader(GL_COMPUTE_SHADER, countSource.c_str(), "gamut count");
     if (!cs) {
         return tl::unexpected(cs.error());
     }
-    auto count = linkShaders({*cs}, "gamut count");
+    auto count = linkShaders({&*cs}, "gamut count");
     if (!count) {
         return tl::unexpected(count.error());
     }
-    countProgram_ = *count;
+    countProgram_ = std::move(*count);
 
     rgbaTarget_ = texture2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height, nullptr);
     classTarget_ = texture2d(GL_R8, GL_RED, GL_UNSIGNED_BYTE, width, height, nullptr);
@@ -253,8 +229,8 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
         }
         latticeScale = lut.scale();
     }
-    glGenTextures(1, &lut3d_);
-    glBindTexture(GL_TEXTURE_3D, lut3d_);
+    lut3d_ = GlTexture::make();
+    glBindTexture(GL_TEXTURE_3D, lut3d_.get());
     glTexStorage3D(GL_TEXTURE_3D, 1, GL_RGBA32F, n, n, n);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, n, n, n, GL_RGBA, GL_FLOAT, lattice.data());
@@ -285,14 +261,16 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     }
     surroundRgba_[3] = 1.0f;
 
-    glGenBuffers(1, &counts_);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
+    counts_ = GlBuffer::make();
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_.get());
     glBufferData(GL_SHADER_STORAGE_BUFFER, 4 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
 
-    glGenFramebuffers(1, &fbo_);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, rgbaTarget_, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, classTarget_, 0);
+    fbo_ = GlFramebuffer::make();
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, rgbaTarget_.get(),
+                           0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, classTarget_.get(),
+                           0);
     const std::array<GLenum, 2> buffers{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glDrawBuffers(2, buffers.data());
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
@@ -303,26 +281,26 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     glReadBuffer(GL_COLOR_ATTACHMENT0);
 
     // Uniforms that never change.
-    glUseProgram(program_);
-    glUniformMatrix3fv(glGetUniformLocation(program_, "uDispXyzToLinear"), 1, GL_FALSE,
+    glUseProgram(program_.get());
+    glUniformMatrix3fv(glGetUniformLocation(program_.get(), "uDispXyzToLinear"), 1, GL_FALSE,
                        params.xyzToLinear.data());
-    glUniform3fv(glGetUniformLocation(program_, "uDispBlackXyz"), 1, params.blackXyz.data());
-    glUniform1f(glGetUniformLocation(program_, "uDispBlackY"), params.blackY);
-    glUniform1f(glGetUniformLocation(program_, "uDispWhiteY"), params.whiteY);
-    glUniform1f(glGetUniformLocation(program_, "uDispMaxCount"), params.maxCount);
-    setInt(program_, "uDispLutSize", params.lutSize);
+    glUniform3fv(glGetUniformLocation(program_.get(), "uDispBlackXyz"), 1, params.blackXyz.data());
+    glUniform1f(glGetUniformLocation(program_.get(), "uDispBlackY"), params.blackY);
+    glUniform1f(glGetUniformLocation(program_.get(), "uDispWhiteY"), params.whiteY);
+    glUniform1f(glGetUniformLocation(program_.get(), "uDispMaxCount"), params.maxCount);
+    setInt(program_.get(), "uDispLutSize", params.lutSize);
     if (params.viewingRows > 0) {
-        glUniform4fv(glGetUniformLocation(program_, "uDispViewing"), params.viewingRows,
+        glUniform4fv(glGetUniformLocation(program_.get(), "uDispViewing"), params.viewingRows,
                      params.viewing.data());
     }
-    setInt(program_, "uDispLut3dSize", n);
-    setVec3(program_, "uDispLut3dScale", latticeScale);
-    setInt(program_, "uXyz", 0);
-    setInt(program_, "uDispToneLut", 1);
-    setInt(program_, "uDispLut3d", 2);
-    setInt(program_, "uDispViewingGrid", 3);
-    glUseProgram(countProgram_);
-    setInt(countProgram_, "uClass", 0);
+    setInt(program_.get(), "uDispLut3dSize", n);
+    setVec3(program_.get(), "uDispLut3dScale", latticeScale);
+    setInt(program_.get(), "uXyz", 0);
+    setInt(program_.get(), "uDispToneLut", 1);
+    setInt(program_.get(), "uDispLut3d", 2);
+    setInt(program_.get(), "uDispViewingGrid", 3);
+    glUseProgram(countProgram_.get());
+    setInt(countProgram_.get(), "uClass", 0);
     glUseProgram(0);
     if (GLenum err = glGetError(); err != GL_NO_ERROR) {
         return makeError(ErrorCode::Unsupported,
@@ -335,14 +313,14 @@ Expected<std::array<GLuint, 4>> DisplayPass::countClasses(const PixelRect& rect)
 {
     // Count the classes on the GPU: 16 bytes come back instead of the class image.
     const std::array<GLuint, 4> zero{};
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_.get());
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), zero.data());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, counts_);
-    glUseProgram(countProgram_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, counts_.get());
+    glUseProgram(countProgram_.get());
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, classTarget_);
-    glUniform2i(glGetUniformLocation(countProgram_, "uOrigin"), rect.x, rect.y);
-    glUniform2i(glGetUniformLocation(countProgram_, "uEnd"), rect.x + rect.width,
+    glBindTexture(GL_TEXTURE_2D, classTarget_.get());
+    glUniform2i(glGetUniformLocation(countProgram_.get(), "uOrigin"), rect.x, rect.y);
+    glUniform2i(glGetUniformLocation(countProgram_.get(), "uEnd"), rect.x + rect.width,
                 rect.y + rect.height);
     if (rect.width > 0 && rect.height > 0) {
         const int runs = (rect.width + kCountRun - 1) / kCountRun;
@@ -364,30 +342,32 @@ Expected<std::array<GLuint, 4>> DisplayPass::countClasses(const PixelRect& rect)
 
 Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const DisplayPassFrame& frame)
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
     glViewport(0, 0, width_, height_);
-    glUseProgram(program_);
-    setVec3(program_, "uDispEye", frame.eyeM);
-    setVec3(program_, "uDispPanelOrigin", frame.pose.originM);
-    setVec3(program_, "uDispPanelRight", frame.pose.rightM);
-    setVec3(program_, "uDispPanelUp", frame.pose.upM);
-    setVec3(program_, "uDispPanelNormal", frame.pose.normal);
-    setVec3(program_, "uDispLightNormal", frame.lightNormal);
-    setInt(program_, "uDispIlluminanceInAlpha", frame.illuminanceInAlpha ? 1 : 0);
+    glUseProgram(program_.get());
+    setVec3(program_.get(), "uDispEye", frame.eyeM);
+    setVec3(program_.get(), "uDispPanelOrigin", frame.pose.originM);
+    setVec3(program_.get(), "uDispPanelRight", frame.pose.rightM);
+    setVec3(program_.get(), "uDispPanelUp", frame.pose.upM);
+    setVec3(program_.get(), "uDispPanelNormal", frame.pose.normal);
+    setVec3(program_.get(), "uDispLightNormal", frame.lightNormal);
+    setInt(program_.get(), "uDispIlluminanceInAlpha", frame.illuminanceInAlpha ? 1 : 0);
     const int lights = frame.lights != nullptr && !frame.illuminanceInAlpha ? frame.lightCount : 0;
-    setInt(program_, "uDispLightCount", lights);
+    setInt(program_.get(), "uDispLightCount", lights);
     if (lights > 0) {
-        glUniform4fv(glGetUniformLocation(program_, "uDispLights"), lights, frame.lights->data());
+        glUniform4fv(glGetUniformLocation(program_.get(), "uDispLights"), lights,
+                     frame.lights->data());
     }
-    setVec3(program_, "uDispFlarePerLux", static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
+    setVec3(program_.get(), "uDispFlarePerLux",
+            static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, xyzTexture);
     glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, toneLut_);
+    glBindTexture(GL_TEXTURE_2D, toneLut_.get());
     glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_3D, lut3d_);
+    glBindTexture(GL_TEXTURE_3D, lut3d_.get());
     glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D, viewingGrid_);
+    glBindTexture(GL_TEXTURE_2D, viewingGrid_.get());
     PixelRect shade{0, 0, width_, height_};
     if (frame.blackOutside && surroundConstant_) {
         const PixelRect& inside = *frame.blackOutside;

@@ -17,6 +17,7 @@
 #include <pipeline/base/expected.h>
 #include <pipeline/display/display_model.h>
 #include <pipeline/display/gamut_map.h>
+#include <pipeline/render/gl_handles.h>
 #include <pipeline/render/pixel_rect.h>
 #include <pipeline/scene/stand.h>
 
@@ -76,11 +77,11 @@ public:
     Expected<void> init(const DisplayPassSetup& setup, int width, int height);
     // Whether init found the viewing gain filtered (DisplayPassSetup::viewingFiltered and the
     // extension it needs).
-    bool viewingFiltered() const { return viewingGrid_ != 0; }
+    bool viewingFiltered() const { return static_cast<bool>(viewingGrid_); }
     // Reads xyzTexture (RGBA32F, texelFetch), draws into framebuffer(), counts the gamut classes.
     Expected<display::GamutCounters> draw(GLuint xyzTexture, const DisplayPassFrame& frame);
     // The RGBA8 display target (counts / 255; alpha 1).
-    GLuint framebuffer() const { return fbo_; }
+    GLuint framebuffer() const { return fbo_.get(); }
     // Whether a frame's black surround can be cleared instead of shaded (see blackOutside): the
     // profile has a black above 0 (so XYZ 0 minus any flare is below it), the gamut mapping keeps
     // hue (clipping would map each pixel's flare-lowered XYZ differently), no false colour, and
@@ -94,15 +95,15 @@ private:
     DisplayPassSetup setup_;
     int width_ = 0;
     int height_ = 0;
-    GLuint program_ = 0;
-    GLuint countProgram_ = 0;
-    GLuint fbo_ = 0;
-    GLuint rgbaTarget_ = 0;
-    GLuint classTarget_ = 0;
-    GLuint toneLut_ = 0;
-    GLuint viewingGrid_ = 0; // 0 unless the gain is filtered (DisplayPassSetup::viewingFiltered)
-    GLuint lut3d_ = 0;
-    GLuint counts_ = 0; // SSBO of 4 uints, one per gamut class
+    GlProgram program_;
+    GlProgram countProgram_;
+    GlFramebuffer fbo_;
+    GlTexture rgbaTarget_;
+    GlTexture classTarget_;
+    GlTexture toneLut_;
+    GlTexture viewingGrid_; // none unless the gain is filtered (DisplayPassSetup::viewingFiltered)
+    GlTexture lut3d_;
+    GlBuffer counts_; // SSBO of 4 uints, one per gamut class
     float flarePerLux_ = 0.0f;
     bool surroundConstant_ = false;
     std::array<float, 4> surroundRgba_{}; // the surround's output, as the shader writes it

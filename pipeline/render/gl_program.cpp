@@ -34,17 +34,17 @@ void main() {
 }
 )";
 
-Expected<GLuint> compileShader(GLenum type, const char* source, const char* what)
+Expected<GlShader> compileShader(GLenum type, const char* source, const char* what)
 {
-    GLuint shader = glCreateShader(type);
-    glShaderSource(shader, 1, &source, nullptr);
-    glCompileShader(shader);
+    GlShader shader(glCreateShader(type));
+    const char* const sources[] = {source};
+    glShaderSource(shader.get(), 1, sources, nullptr);
+    glCompileShader(shader.get());
     GLint ok = GL_FALSE;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    glGetShaderiv(shader.get(), GL_COMPILE_STATUS, &ok);
     if (ok != GL_TRUE) {
         std::array<char, 4096> log{};
-        glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
-        glDeleteShader(shader);
+        glGetShaderInfoLog(shader.get(), static_cast<GLsizei>(log.size()), nullptr, log.data());
         return makeError(ErrorCode::Unsupported,
                          fmt::format("render: {} {} shader does not compile: {}", what,
                                      stageName(type), log.data()));
@@ -52,22 +52,18 @@ Expected<GLuint> compileShader(GLenum type, const char* source, const char* what
     return shader;
 }
 
-Expected<GLuint> linkShaders(std::initializer_list<GLuint> shaders, const char* what)
+Expected<GlProgram> linkShaders(std::initializer_list<const GlShader*> shaders, const char* what)
 {
-    GLuint program = glCreateProgram();
-    for (const GLuint s : shaders) {
-        glAttachShader(program, s);
+    GlProgram program = GlProgram::make();
+    for (const GlShader* s : shaders) {
+        glAttachShader(program.get(), s->get());
     }
-    glLinkProgram(program);
-    for (const GLuint s : shaders) {
-        glDeleteShader(s);
-    }
+    glLinkProgram(program.get());
     GLint ok = GL_FALSE;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    glGetProgramiv(program.get(), GL_LINK_STATUS, &ok);
     if (ok != GL_TRUE) {
         std::array<char, 4096> log{};
-        glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
-        glDeleteProgram(program);
+        glGetProgramInfoLog(program.get(), static_cast<GLsizei>(log.size()), nullptr, log.data());
         return makeError(ErrorCode::Unsupported,
                          fmt::format("render: {} program does not link: {}", what, log.data()));
     }
@@ -88,7 +84,8 @@ bool hasExtension(const char* name)
     return false;
 }
 
-Expected<GLuint> linkProgram(const char* vertexSource, const char* fragmentSource, const char* what)
+Expected<GlProgram>
+linkProgram(const char* vertexSource, const char* fragmentSource, const char* what)
 {
     auto vs = compileShader(GL_VERTEX_SHADER, vertexSource, what);
     if (!vs) {
@@ -96,10 +93,9 @@ Expected<GLuint> linkProgram(const char* vertexSource, const char* fragmentSourc
     }
     auto fs = compileShader(GL_FRAGMENT_SHADER, fragmentSource, what);
     if (!fs) {
-        glDeleteShader(*vs);
         return tl::unexpected(fs.error());
     }
-    return linkShaders({*vs, *fs}, what);
+    return linkShaders({&*vs, &*fs}, what);
 }
 
 } // namespace replica::pipeline::render

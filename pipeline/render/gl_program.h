@@ -7,6 +7,7 @@
 #include <GLES3/gl31.h>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/render/gl_handles.h>
 
 namespace replica::pipeline::render {
 
@@ -14,13 +15,14 @@ namespace replica::pipeline::render {
 extern const char* const kFullscreenVertexShader;
 
 // Needs a current GLES 3.1 context. 'what' names the program in error messages.
-Expected<GLuint> compileShader(GLenum type, const char* source, const char* what);
+Expected<GlShader> compileShader(GLenum type, const char* source, const char* what);
 
-// Links the compiled shaders into a program and deletes them, whether or not it links.
-Expected<GLuint> linkShaders(std::initializer_list<GLuint> shaders, const char* what);
+// Links the compiled shaders into a program (the shaders stay their owners' to delete; a linked
+// program keeps what it needs of them).
+Expected<GlProgram> linkShaders(std::initializer_list<const GlShader*> shaders, const char* what);
 
 // Vertex + fragment from source.
-Expected<GLuint>
+Expected<GlProgram>
 linkProgram(const char* vertexSource, const char* fragmentSource, const char* what);
 
 // Whether the current context lists the extension (e.g. "GL_OES_texture_float_linear").

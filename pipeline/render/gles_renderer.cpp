@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <glm/matrix.hpp>
 
+#include <pipeline/render/gl_handles.h>
 #include <pipeline/render/gl_program.h>
 #include <pipeline/render/gles_renderer.h>
 
@@ -53,25 +54,6 @@ void main() {
 }
 )";
 
-GLuint
-makeTexture(GLenum internalFormat, GLenum format, GLenum type, int w, int h, const void* data)
-{
-    GLuint tex = 0;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D, tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, internalFormat, w, h);
-    if (data != nullptr) {
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, type, data);
-    }
-    // Nearest sampling: exact texel values, no dependence on float-filtering extensions.
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return tex;
-}
-
 glm::vec3 toFloat(const glm::dvec3& v)
 {
     return glm::vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
@@ -81,13 +63,7 @@ class GlesRenderer final : public Renderer
 {
 public:
     explicit GlesRenderer(GlesRendererSetup setup) : setup_(std::move(setup)) {}
-    ~GlesRenderer() override
-    {
-        glDeleteFramebuffers(static_cast<GLsizei>(fbos_.size()), fbos_.data());
-        glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
-        glDeleteVertexArrays(1, &vao_);
-        glDeleteProgram(xyzProgram_);
-    }
+    ~GlesRenderer() override = default;
     GlesRenderer(const GlesRenderer&) = delete;
     GlesRenderer& operator=(const GlesRenderer&) = delete;
 
@@ -97,12 +73,12 @@ public:
         if (!xyz) {
             return tl::unexpected(xyz.error());
         }
-        xyzProgram_ = *xyz;
+        xyzProgram_ = std::move(*xyz);
         if (auto display = displayPass_.init(setup_.display, setup_.width, setup_.height);
             !display) {
             return tl::unexpected(display.error());
         }
-        glGenVertexArrays(1, &vao_);
+        vao_ = GlVertexArray::make();
         if (setup_.boothScene) {
             setup_.boothScene->setSurroundIlluminance(setup_.surroundIlluminance ||
                                                       !displayPass_.surroundConstant());
@@ -122,15 +98,14 @@ public:
                 b[i * 3 + c] = s.coeffs[i * colour::kChannels + 3 + c];
             }
         }
-        coeffA_ = makeTexture(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, a.data());
-        coeffB_ = makeTexture(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, b.data());
-        xyzTarget_ =
-                makeTexture(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
-        textures_ = {coeffA_, coeffB_, xyzTarget_};
+        coeffA_ = texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, a.data());
+        coeffB_ = texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, b.data());
+        xyzTarget_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
 
-        glGenFramebuffers(1, fbos_.data());
-        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, xyzTarget_, 0);
+        fbo_ = GlFramebuffer::make();
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
+                               xyzTarget_.get(), 0);
         if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
             return makeError(ErrorCode::Unsupported,
                              "render: the RGBA32F XYZ target is not renderable on this GL (float "
@@ -180,7 +155,7 @@ public:
         glViewport(0, 0, w, h);
 
         // Pass 1: absolute XYZ.
-        glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
         if (setup_.boothScene) {
             if (auto ok = setup_.boothScene->draw(state, w, h); !ok) {
                 return ok;
@@ -189,7 +164,7 @@ public:
             drawFlatXyz(state, pose, packed, count);
         }
         glViewport(0, 0, w, h);
-        glBindVertexArray(vao_);
+        glBindVertexArray(vao_.get());
 
         // Pass 2: panel counts (display_pass.cpp).
         DisplayPassFrame df;
@@ -204,7 +179,7 @@ public:
         }
         const colour::Xyz lightXyz = colour::spectrumToXyz(setup_.observer, state.illuminant);
         df.lightXyzUnitY = lightXyz.y > 0.0 ? lightXyz / lightXyz.y : glm::dvec3(0.0);
-        auto gamut = displayPass_.draw(xyzTarget_, df);
+        auto gamut = displayPass_.draw(xyzTarget_.get(), df);
         if (!gamut) {
             return tl::unexpected(gamut.error());
         }
@@ -218,7 +193,7 @@ public:
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
         if (readback == Readback::DisplayAndXyz) {
             out.xyz.resize(pixels * 4);
-            glBindFramebuffer(GL_FRAMEBUFFER, fbos_[0]);
+            glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
             glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, out.xyz.data());
         } else {
             out.xyz.clear();
@@ -249,17 +224,17 @@ private:
         const colour::ChannelToXyz m =
                 colour::channelToXyz(setup_.basis, setup_.observer, state.illuminant);
 
-        glBindVertexArray(vao_);
+        glBindVertexArray(vao_.get());
 
-        glUseProgram(xyzProgram_);
-        setVec3(xyzProgram_, "uPanelOrigin", pose.originM);
-        setVec3(xyzProgram_, "uPanelRight", pose.rightM);
-        setVec3(xyzProgram_, "uPanelUp", pose.upM);
-        setVec3(xyzProgram_, "uPanelNormal", pose.normal);
-        setVec3(xyzProgram_, "uLightNormal", setup_.booth.emitter.normal);
-        glUniform1i(glGetUniformLocation(xyzProgram_, "uLightCount"), count);
+        glUseProgram(xyzProgram_.get());
+        setVec3(xyzProgram_.get(), "uPanelOrigin", pose.originM);
+        setVec3(xyzProgram_.get(), "uPanelRight", pose.rightM);
+        setVec3(xyzProgram_.get(), "uPanelUp", pose.upM);
+        setVec3(xyzProgram_.get(), "uPanelNormal", pose.normal);
+        setVec3(xyzProgram_.get(), "uLightNormal", setup_.booth.emitter.normal);
+        glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uLightCount"), count);
         if (count > 0) {
-            glUniform4fv(glGetUniformLocation(xyzProgram_, "uLights"), count, packed.data());
+            glUniform4fv(glGetUniformLocation(xyzProgram_.get(), "uLights"), count, packed.data());
         }
         std::array<float, colour::kChannels * 3> mf{};
         for (std::size_t k = 0; k < colour::kChannels; ++k) {
@@ -267,14 +242,14 @@ private:
                 mf[k * 3 + static_cast<std::size_t>(c)] = static_cast<float>(m[k][c]);
             }
         }
-        glUniform3fv(glGetUniformLocation(xyzProgram_, "uChannelXyz"),
+        glUniform3fv(glGetUniformLocation(xyzProgram_.get(), "uChannelXyz"),
                      static_cast<GLsizei>(colour::kChannels), mf.data());
         glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, coeffA_);
-        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffA"), 0);
+        glBindTexture(GL_TEXTURE_2D, coeffA_.get());
+        glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uCoeffA"), 0);
         glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, coeffB_);
-        glUniform1i(glGetUniformLocation(xyzProgram_, "uCoeffB"), 1);
+        glBindTexture(GL_TEXTURE_2D, coeffB_.get());
+        glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uCoeffB"), 1);
         glDrawArrays(GL_TRIANGLES, 0, 3);
     }
 
@@ -285,13 +260,12 @@ private:
     }
 
     GlesRendererSetup setup_;
-    GLuint xyzProgram_ = 0;
-    GLuint vao_ = 0;
-    GLuint coeffA_ = 0;
-    GLuint coeffB_ = 0;
-    GLuint xyzTarget_ = 0;
-    std::vector<GLuint> textures_;
-    std::array<GLuint, 1> fbos_{};
+    GlProgram xyzProgram_;
+    GlVertexArray vao_;
+    GlTexture coeffA_;
+    GlTexture coeffB_;
+    GlTexture xyzTarget_;
+    GlFramebuffer fbo_;
     DisplayPass displayPass_;
 };
 

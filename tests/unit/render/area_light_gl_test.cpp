@@ -1,4 +1,4 @@
-// The GL pass's area-light diffuse term (booth_shaders.cpp, BOOTH_AREA_LIGHTS) against a fine
+// The GL pass's area-light diffuse term (glsl/diffuse_area_lights.glsl) against a fine
 // quadrature of Lambert's integral over a uniform lamp (not the CPU model it follows), at every
 // tilt from -30 to 85 degrees and on to 89; and what the GL pass reports against what the CPU
 // model reports (eye behind the surface, flare clamped) and its light limit.
