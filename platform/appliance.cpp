@@ -56,27 +56,16 @@ std::string RunConfig::toJson() const
                      {"specular_samples", specularSamples},
                      {"specular_grid", specularGrid},
                      {"diffuse_grid", diffuseGrid},
-                     {"hardware_filter", hardwareFilter},
-                     {"specular_lod_bias", specularLodBias},
-                     {"specular_nearest_level", specularNearestLevel},
-                     {"horizon_spread", horizonSpread},
-                     {"horizon_half", horizonHalf},
-                     {"horizon_bilinear", horizonBilinear},
-                     {"specular_branch_free", specularBranchFree},
-                     {"specular_exact_level", specularExactLevel},
-                     {"texel_exact_ties", texelExactTies},
-                     {"horizon_pick", horizonPick},
                      {"area_lights", areaLights},
                      {"booth_dimmer", boothDimmer},
                      {"booth_dimmer_auto", boothDimmerAuto || boothDimmerChosenAuto},
                      {"cache_slices", cacheSlices},
-                     {"surround_illuminance", surroundIlluminance},
+                     {"render_profile", renderProfile()},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
                      {"display_inverse", displayInverse},
                      {"gamut_mapping", gamutMapping},
                      {"viewing_compensation", viewingCompensation},
-                     {"viewing_filtered", viewingFiltered},
                      {"flare_subtraction", flareSubtraction},
                      {"false_colour", falseColour},
                      {"stand_hinge_m", {stand.hingeM.x, stand.hingeM.y, stand.hingeM.z}},
@@ -90,6 +79,21 @@ std::string RunConfig::toJson() const
                      {"default_lamp", defaultLamp},
                      {"default_eye_m", {defaultEyeM.x, defaultEyeM.y, defaultEyeM.z}},
                      {"default_tilt_rad", defaultTiltRad}};
+    if (renderProfile() == pipeline::render::kExplicitRenderProfile) {
+        // Switches no profile names: one key each, as recordings made before profiles hold them.
+        j["hardware_filter"] = switches.hardwareFilter;
+        j["specular_lod_bias"] = switches.specularLodBias;
+        j["specular_nearest_level"] = switches.specularNearestLevel;
+        j["horizon_spread"] = switches.horizonSpread;
+        j["horizon_half"] = switches.horizonHalf;
+        j["horizon_bilinear"] = switches.horizonBilinear;
+        j["specular_branch_free"] = switches.specularBranchFree;
+        j["specular_exact_level"] = switches.specularExactLevel;
+        j["texel_exact_ties"] = switches.texelExactTies;
+        j["horizon_pick"] = switches.horizonPick;
+        j["surround_illuminance"] = switches.surroundIlluminance;
+        j["viewing_filtered"] = switches.viewingFiltered;
+    }
     if (trackerInBooth) {
         std::vector<double> rotation;
         for (int i = 0; i < 3; ++i) {
@@ -102,6 +106,57 @@ std::string RunConfig::toJson() const
     }
     return j.dump();
 }
+
+namespace {
+
+// The render switches a run configuration records: "render_profile" N >= 1 names them; without
+// it (recordings made before profiles) or with 0, one key each, an absent key being the switch
+// as it was before it existed (render profile 1's).
+Expected<pipeline::render::RenderSwitches> readSwitches(const nlohmann::json& j)
+{
+    using pipeline::render::kExplicitRenderProfile;
+    const int profile = j.value("render_profile", kExplicitRenderProfile);
+    static constexpr const char* kKeys[] = {
+            "hardware_filter",      "specular_lod_bias",    "specular_nearest_level",
+            "horizon_spread",       "horizon_half",         "horizon_bilinear",
+            "specular_branch_free", "specular_exact_level", "texel_exact_ties",
+            "horizon_pick",         "surround_illuminance", "viewing_filtered"};
+    if (profile != kExplicitRenderProfile) {
+        for (const char* key : kKeys) {
+            if (j.contains(key)) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("run configuration: render_profile {} and the "
+                                             "explicit switch '{}' both given; a profile fixes "
+                                             "every switch",
+                                             profile, key));
+            }
+        }
+        auto p = pipeline::render::findRenderProfile(profile);
+        if (!p) {
+            return makeError(ErrorCode::Unsupported,
+                             fmt::format("run configuration: {}", p.error().message));
+        }
+        return (*p)->switches;
+    }
+    // Profile 1 is every switch as it was before it existed: what an absent key means. (A switch
+    // added after profiles has no key: recordings that name no profile replay it as then.)
+    pipeline::render::RenderSwitches s = (*pipeline::render::findRenderProfile(1))->switches;
+    s.hardwareFilter = j.value("hardware_filter", s.hardwareFilter);
+    s.specularNearestLevel = j.value("specular_nearest_level", s.specularNearestLevel);
+    s.horizonSpread = j.value("horizon_spread", s.horizonSpread);
+    s.horizonHalf = j.value("horizon_half", s.horizonHalf);
+    s.horizonBilinear = j.value("horizon_bilinear", s.horizonBilinear);
+    s.specularBranchFree = j.value("specular_branch_free", s.specularBranchFree);
+    s.specularExactLevel = j.value("specular_exact_level", s.specularExactLevel);
+    s.texelExactTies = j.value("texel_exact_ties", s.texelExactTies);
+    s.horizonPick = j.value("horizon_pick", s.horizonPick);
+    s.specularLodBias = j.value("specular_lod_bias", s.specularLodBias);
+    s.surroundIlluminance = j.value("surround_illuminance", s.surroundIlluminance);
+    s.viewingFiltered = j.value("viewing_filtered", s.viewingFiltered);
+    return s;
+}
+
+} // namespace
 
 Expected<RunConfig> RunConfig::fromJson(const std::string& json)
 {
@@ -129,23 +184,17 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         // Absent before the specular grid: those recordings were shaded per pixel.
         c.specularGrid = j.value("specular_grid", 0);
         c.diffuseGrid = j.value("diffuse_grid", 0);
-        c.hardwareFilter = j.value("hardware_filter", false);
-        c.specularNearestLevel = j.value("specular_nearest_level", false);
-        c.horizonSpread = j.value("horizon_spread", false);
-        c.horizonHalf = j.value("horizon_half", false);
-        c.horizonBilinear = j.value("horizon_bilinear", false);
-        c.specularBranchFree = j.value("specular_branch_free", false);
-        c.specularExactLevel = j.value("specular_exact_level", false);
-        c.texelExactTies = j.value("texel_exact_ties", false);
-        c.horizonPick = j.value("horizon_pick", false);
         c.areaLights = j.value("area_lights", 0);
         // Absent before the booth dimmer: those recordings replay undimmed. A recorded "auto"
         // is the number it chose; a replay never chooses again.
         c.boothDimmer = j.value("booth_dimmer", 1.0);
         c.boothDimmerChosenAuto = j.value("booth_dimmer_auto", false);
         c.cacheSlices = j.value("cache_slices", 1);
-        c.specularLodBias = j.value("specular_lod_bias", pipeline::shading::kLegacySpecularLodBias);
-        c.surroundIlluminance = j.value("surround_illuminance", true);
+        if (auto switches = readSwitches(j); switches) {
+            c.switches = *switches;
+        } else {
+            return tl::unexpected(switches.error());
+        }
         c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
         // Recordings made before display profiles had none of these: the plain pass 2 they had
         // was on-axis, without flare subtraction.
@@ -153,7 +202,6 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.displayInverse = j.value("display_inverse", std::string("analytic"));
         c.gamutMapping = j.value("gamut_mapping", std::string("hue"));
         c.viewingCompensation = j.value("viewing_compensation", false);
-        c.viewingFiltered = j.value("viewing_filtered", false);
         c.flareSubtraction = j.value("flare_subtraction", false);
         c.falseColour = j.value("false_colour", false);
         if (j.contains("t_booth_tracker")) {
@@ -200,7 +248,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json)
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
         c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 ||
-        !(std::abs(c.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias) ||
+        !(std::abs(c.switches.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias) ||
         c.cacheSlices < 1 || c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights ||
         c.areaLights > 1 || !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0) {
         return makeError(
@@ -402,17 +450,8 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.specularSamples = config.specularSamples;
     s.specularGrid = config.specularGrid;
     s.diffuseGrid = config.diffuseGrid;
-    s.hardwareFilter = config.hardwareFilter;
-    s.specularLodBias = config.specularLodBias;
-    s.specularNearestLevel = config.specularNearestLevel;
     s.horizonDirections = config.horizonDirections;
-    s.horizonSpread = config.horizonSpread;
-    s.horizonHalf = config.horizonHalf;
-    s.horizonBilinear = config.horizonBilinear;
-    s.specularBranchFree = config.specularBranchFree;
-    s.specularExactLevel = config.specularExactLevel;
-    s.texelExactTies = config.texelExactTies;
-    s.horizonPick = config.horizonPick;
+    pipeline::render::applyRenderSwitches(config.switches, s);
     s.areaLights = config.areaLights != 0;
     s.cacheSlices = config.cacheSlices;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
@@ -649,7 +688,7 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
                                                 : pipeline::render::InverseMethod::Analytic;
     d.gamut = config.gamutMapping == "clip" ? pd::GamutMode::Clip : pd::GamutMode::HueKeeping;
     d.viewingCompensation = config.viewingCompensation;
-    d.viewingFiltered = config.viewingFiltered;
+    d.viewingFiltered = config.switches.viewingFiltered;
     d.flareSubtraction = config.flareSubtraction;
     d.falseColour = config.falseColour;
     id = displayProfileId(config, d.model.name);
@@ -751,7 +790,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     setup.display = std::move(*display);
     setup.lightsU = config.lightsU;
     setup.lightsV = config.lightsV;
-    setup.surroundIlluminance = config.surroundIlluminance;
+    setup.surroundIlluminance = config.switches.surroundIlluminance;
     if (config.renderer == "booth") {
         auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer, encoder,
                                          setup.display.model);

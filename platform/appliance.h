@@ -13,6 +13,7 @@
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
 #include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/render/render_profile.h>
 #include <pipeline/render/renderer.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/scene/stand.h>
@@ -72,36 +73,13 @@ struct RunConfig {
     // have none: they replay per pixel.
     int diffuseGrid = kAutoDiffuseGrid;
     int horizonDirections = 8;
-    // shading::RenderSettings::hardwareFilter: the sampler filters the luminance mip chain (same
-    // rule, other float rounding). Recordings made before it have none and replay with the
-    // shader's own filter, bit for bit.
-    bool hardwareFilter = true;
-    // shading::RenderSettings::specularLodBias. Recordings made before it have none and replay
-    // with the level bias the renderer had then (kLegacySpecularLodBias), bit for bit.
-    double specularLodBias = pipeline::shading::kDefaultSpecularLodBias;
-    // shading::RenderSettings::specularNearestLevel; recordings made before it replay trilinear.
-    bool specularNearestLevel = true;
-    // shading::RenderSettings::horizonSpread; recordings made before it have none and replay
-    // with one fixed horizon softness, bit for bit.
-    bool horizonSpread = true;
-    // shading::RenderSettings::horizonHalf; recordings made before it have none and replay with
-    // float horizon sines, bit for bit.
-    bool horizonHalf = true;
-    // shading::RenderSettings::horizonBilinear; recordings made before it have none and replay
-    // with each texel's own horizon, bit for bit.
-    bool horizonBilinear = true;
-    // shading::RenderSettings::specularBranchFree; recordings made before it have none and replay
-    // with the early returns, bit for bit.
-    bool specularBranchFree = true;
-    // shading::RenderSettings::specularExactLevel; recordings made before it have none and
-    // replay with log2, bit for bit.
-    bool specularExactLevel = true;
-    // shading::RenderSettings::texelExactTies; recordings made before it have none and replay
-    // with u * texels, bit for bit.
-    bool texelExactTies = true;
-    // shading::RenderSettings::horizonPick; recordings made before it have none and replay with
-    // the tent weights (the same frames where measured, but not by construction).
-    bool horizonPick = true;
+    // How the renderer evaluates the equations (pipeline/render/render_profile.h): a new run
+    // the current profile's switches. Recorded as the profile's number ("render_profile"), or,
+    // where the switches match no profile, one key each; recordings made before profiles hold the
+    // keys, absent keys replaying as before each switch existed (profile 1 when all are absent).
+    pipeline::render::RenderSwitches switches = pipeline::render::currentRenderSwitches();
+    // The profile these switches are (kExplicitRenderProfile: none).
+    int renderProfile() const { return pipeline::render::matchRenderProfile(switches); }
     // shading::RenderSettings::areaLights: 1 eq. (1) from the median-cut regions' areas, 0 from
     // point lights; kAutoAreaLights: shading::defaultAreaLights for the scene (areas on a flat
     // surface, points on relief), chosen when the appliance is built and recorded as chosen.
@@ -119,10 +97,6 @@ struct RunConfig {
     // bands over as many frames. Recordings made before it have none and replay with 1 (whole at
     // once), frame for frame.
     int cacheSlices = kDefaultCacheSlices;
-    // Whether pass 1 also shades the illuminance around the surface when the display pass clears
-    // that surround and never reads it (GlesRendererSetup::surroundIlluminance). New runs: no.
-    // Recordings made before have none and replay with it, so their XYZ digests stand.
-    bool surroundIlluminance = false;
     // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
     // light; recordings made with replica_k6 or box6 replay as such.
     std::string basis = "adaptive_k6";
@@ -139,9 +113,6 @@ struct RunConfig {
     std::string displayInverse = "analytic"; // or "lut3d" (docs/display.md compares them)
     std::string gamutMapping = "hue";        // or "clip" (per channel, for comparison only)
     bool viewingCompensation = true;
-    // render::DisplayPassSetup::viewingFiltered; recordings made before it have none and replay
-    // with the table's rows, bit for bit.
-    bool viewingFiltered = true;
     bool flareSubtraction = true;
     bool falseColour = false;
     // The tracker's calibrated pose in the booth ('replica calibrate tracker', read from the site

@@ -144,10 +144,10 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // Made before the specular grid and the sampler's filter: per pixel, the shader's filter.
     EXPECT_EQ(o->specularGrid, 0);
     EXPECT_EQ(o->diffuseGrid, 0); // and before the diffuse grid: eq. (1) per pixel
-    EXPECT_FALSE(o->hardwareFilter);
-    EXPECT_TRUE(o->surroundIlluminance);
+    EXPECT_FALSE(o->switches.hardwareFilter);
+    EXPECT_TRUE(o->switches.surroundIlluminance);
     // And before the specular mip level bias was a setting: the renderer's bias of then.
-    EXPECT_EQ(o->specularLodBias, shading::kLegacySpecularLodBias);
+    EXPECT_EQ(o->switches.specularLodBias, shading::kLegacySpecularLodBias);
     // And before area lights: point lights; a new run chooses for its scene, recorded as chosen.
     EXPECT_EQ(o->areaLights, 0);
     EXPECT_EQ(c.areaLights, platform::kAutoAreaLights);
@@ -163,35 +163,38 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     EXPECT_FALSE(platform::RunConfig::fromJson(badArea.toJson()));
     // And before each of these was a recorded setting: off (the rule of then), and on for a new
     // run; each is recorded both ways.
-    const std::pair<const char*, bool platform::RunConfig::*> recordedSwitches[] = {
-            {"the nearest mip level (else trilinear)", &platform::RunConfig::specularNearestLevel},
+    const std::pair<const char*, bool pipeline::render::RenderSwitches::*> recordedSwitches[] = {
+            {"the nearest mip level (else trilinear)",
+             &pipeline::render::RenderSwitches::specularNearestLevel},
             {"each light's horizon spread over its region (else one fixed softness)",
-             &platform::RunConfig::horizonSpread},
-            {"horizon sines as half floats (else floats)", &platform::RunConfig::horizonHalf},
+             &pipeline::render::RenderSwitches::horizonSpread},
+            {"horizon sines as half floats (else floats)",
+             &pipeline::render::RenderSwitches::horizonHalf},
             {"eq. (1)'s horizon read bilinearly (else each texel's own)",
-             &platform::RunConfig::horizonBilinear},
+             &pipeline::render::RenderSwitches::horizonBilinear},
             {"branch-free specular samples (else the early returns)",
-             &platform::RunConfig::specularBranchFree},
+             &pipeline::render::RenderSwitches::specularBranchFree},
             {"the nearest mip level from the ratio's exponent (else log2)",
-             &platform::RunConfig::specularExactLevel},
-            {"the exact texel tie rule (else u * texels)", &platform::RunConfig::texelExactTies},
+             &pipeline::render::RenderSwitches::specularExactLevel},
+            {"the exact texel tie rule (else u * texels)",
+             &pipeline::render::RenderSwitches::texelExactTies},
             {"the horizon directions picked (else tent-weighted)",
-             &platform::RunConfig::horizonPick},
+             &pipeline::render::RenderSwitches::horizonPick},
             {"the viewing gain filtered from a half-degree grid (else the table's rows)",
-             &platform::RunConfig::viewingFiltered},
+             &pipeline::render::RenderSwitches::viewingFiltered},
     };
     for (const auto& [what, key] : recordedSwitches) {
-        EXPECT_FALSE((*o).*key) << what;
-        EXPECT_TRUE(c.*key) << what;
+        EXPECT_FALSE((*o).switches.*key) << what;
+        EXPECT_TRUE(c.switches.*key) << what;
         platform::RunConfig flipped = c;
-        flipped.*key = false;
+        flipped.switches.*key = false;
         const auto off = platform::RunConfig::fromJson(flipped.toJson());
         const auto on = platform::RunConfig::fromJson(c.toJson());
         ASSERT_TRUE(off && on) << what;
-        EXPECT_FALSE((*off).*key) << what;
-        EXPECT_TRUE((*on).*key) << what;
+        EXPECT_FALSE((*off).switches.*key) << what;
+        EXPECT_TRUE((*on).switches.*key) << what;
     }
-    EXPECT_NE(c.specularLodBias, shading::kLegacySpecularLodBias);
+    EXPECT_NE(c.switches.specularLodBias, shading::kLegacySpecularLodBias);
     // Made before sliced cache refreshes: recomputed whole at once, as then; a new run slices.
     EXPECT_EQ(o->cacheSlices, 1);
     EXPECT_EQ(c.cacheSlices, platform::kDefaultCacheSlices);
@@ -213,22 +216,22 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
     EXPECT_EQ(c.diffuseGrid, platform::kAutoDiffuseGrid);
-    EXPECT_TRUE(c.hardwareFilter);
+    EXPECT_TRUE(c.switches.hardwareFilter);
     c.specularGrid = 8;
     c.diffuseGrid = 5;
-    c.specularLodBias = 0.25;
+    c.switches.specularLodBias = 0.25;
     auto round = platform::RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(round);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
-    EXPECT_TRUE(round->hardwareFilter);
-    EXPECT_EQ(round->specularLodBias, 0.25);
-    c.specularLodBias = 1e9; // a corrupt value is refused, not rendered
+    EXPECT_TRUE(round->switches.hardwareFilter);
+    EXPECT_EQ(round->switches.specularLodBias, 0.25);
+    c.switches.specularLodBias = 1e9; // a corrupt value is refused, not rendered
     const auto corrupt = platform::RunConfig::fromJson(c.toJson());
     ASSERT_FALSE(corrupt);
     EXPECT_NE(corrupt.error().message.find("specular lod bias"), std::string::npos)
             << corrupt.error().message;
-    c.specularLodBias = 0.0;
+    c.switches.specularLodBias = 0.0;
     c.specularGrid = -2;
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
     c.specularGrid = 8;
@@ -290,12 +293,12 @@ TEST(ApplianceBoothScene, TheClearedSurroundIsNotShadedAndNoPixelChanges)
     RunConfig c;
     c.width = 96;
     c.height = 60;
-    ASSERT_FALSE(c.surroundIlluminance); // new runs leave it out
+    ASSERT_FALSE(c.switches.surroundIlluminance); // new runs leave it out
     const auto without = surroundFrame(c);
     if (!without) {
         GTEST_SKIP() << "no EGL/GLES context";
     }
-    c.surroundIlluminance = true; // as recordings made before it replay
+    c.switches.surroundIlluminance = true; // as recordings made before it replay
     const auto with = surroundFrame(c);
     ASSERT_TRUE(with);
     EXPECT_FALSE(without->surround);
@@ -329,7 +332,7 @@ TEST(ApplianceBoothScene, TheClearedSurroundIsNotShadedAndNoPixelChanges)
 
     // A display pass that shades the surround (per-channel clipping) gets its illuminance
     // whatever the configuration says.
-    c.surroundIlluminance = false;
+    c.switches.surroundIlluminance = false;
     c.gamutMapping = "clip";
     const auto clip = surroundFrame(c);
     ASSERT_TRUE(clip);
@@ -347,17 +350,17 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
     c.specularGrid = 3;
     c.diffuseGrid = 2;
     c.horizonDirections = 12;
-    c.specularLodBias = 0.75;
+    c.switches.specularLodBias = 0.75;
     for (const bool on : {false, true}) {
-        c.hardwareFilter = on;
-        c.specularNearestLevel = !on;
-        c.horizonSpread = on;
-        c.horizonHalf = !on;
-        c.horizonBilinear = on;
-        c.specularBranchFree = !on;
-        c.specularExactLevel = on;
-        c.texelExactTies = !on;
-        c.horizonPick = on;
+        c.switches.hardwareFilter = on;
+        c.switches.specularNearestLevel = !on;
+        c.switches.horizonSpread = on;
+        c.switches.horizonHalf = !on;
+        c.switches.horizonBilinear = on;
+        c.switches.specularBranchFree = !on;
+        c.switches.specularExactLevel = on;
+        c.switches.texelExactTies = !on;
+        c.switches.horizonPick = on;
         c.areaLights = on ? 0 : 1;
         c.cacheSlices = on ? 3 : 1;
         c.flareSubtraction = !on;
