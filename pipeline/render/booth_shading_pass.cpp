@@ -1,4 +1,6 @@
-// Host side of the booth shading pass: texture and uniform upload, draw, read-back.
+// Host side of the booth shading pass: the programs, the scene and light uploaded, the cache of
+// the eye-independent part, the draw. The upload helpers are booth_upload.cpp's, the target
+// read back by tests and tools xyz_target.cpp's.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,9 +17,11 @@
 #include <pipeline/brdf/ward.h>
 #include <pipeline/render/booth_shaders.h>
 #include <pipeline/render/booth_shading_pass.h>
+#include <pipeline/render/booth_upload.h>
 #include <pipeline/render/gl_program.h>
 
 namespace replica::pipeline::render {
+using namespace booth_upload;
 namespace {
 
 enum TextureUnit : GLint {
@@ -31,145 +35,6 @@ enum TextureUnit : GLint {
     kUnitFacet,
     kUnitDiffGrid
 };
-
-// Float textures are read with texelFetch only: nearest sampling keeps them complete without the
-// float-filtering extension, and the shader does its own (border-0) bilinear where the model does.
-void nearest(GLenum target)
-{
-    glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-}
-
-// A grid's target: one R32F texel per node (made on 'unit', so that creating it binds over no
-// other input) and a framebuffer that draws into it.
-Expected<void> nodeTarget(shading::GridNodes nodes,
-                          GLint unit,
-                          const char* grid,
-                          GlTexture& texture,
-                          GlFramebuffer& fbo)
-{
-    glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
-    texture = texture2d(GL_R32F, GL_RED, GL_FLOAT, nodes.x, nodes.y, nullptr);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glActiveTexture(GL_TEXTURE0);
-    fbo = GlFramebuffer::make();
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo.get());
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.get(), 0);
-    const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (!complete) {
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("render: the booth pass's R32F {0} grid is not renderable on "
-                                     "this GL; run with a {0} grid of 0 (per pixel)",
-                                     grid));
-    }
-    return {};
-}
-
-// The horizon map as a 2-D array texture: directions [4j, 4j + 4) in layer j of an RGBA32F array,
-// or with 'half' [8j, 8j + 8) as half floats in layer j of an RGBA32UI array (packHalf2x16's
-// layout: direction 2i in the low 16 bits of word i). 'dirs' 0: one empty texel.
-GlTexture horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
-{
-    const int perLayer = half ? 8 : 4;
-    const int layers = std::max((dirs + perLayer - 1) / perLayer, 1);
-    const int w = dirs > 0 ? map.width : 1;
-    const int h = dirs > 0 ? map.height : 1;
-    const auto texels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-    const auto k = static_cast<std::size_t>(dirs);
-    const std::size_t components = texels * 4 * static_cast<std::size_t>(layers);
-    std::vector<float> sines(half ? 0 : components, 0.0f);
-    std::vector<std::uint32_t> words(half ? components : 0, 0u);
-    for (std::size_t i = 0; i < texels && k > 0; ++i) {
-        for (std::size_t d = 0; d < k; ++d) {
-            const float sinB = map.sinBeta[i * k + d];
-            if (half) {
-                const std::size_t word = ((d / 8) * texels + i) * 4 + (d % 8) / 2;
-                words[word] |= static_cast<std::uint32_t>(glm::packHalf1x16(sinB))
-                               << (d % 2 == 0 ? 0 : 16);
-            } else {
-                sines[((d / 4) * texels + i) * 4 + d % 4] = sinB;
-            }
-        }
-    }
-    GlTexture tex = GlTexture::make();
-    glBindTexture(GL_TEXTURE_2D_ARRAY, tex.get());
-    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, half ? GL_RGBA32UI : GL_RGBA32F, w, h, layers);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    if (half) {
-        glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, layers, GL_RGBA_INTEGER,
-                        GL_UNSIGNED_INT, words.data());
-    } else {
-        glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, layers, GL_RGBA, GL_FLOAT,
-                        sines.data());
-    }
-    nearest(GL_TEXTURE_2D_ARRAY);
-    return tex;
-}
-
-glm::vec3 f3(const glm::dvec3& v)
-{
-    return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
-}
-
-// 2 x the specular mip level bias when RenderSettings::specularExactLevel applies (the nearest
-// level and a bias of whole half levels; within kMaxSpecularLodBias, 4^bias keeps the shader's
-// clamped ratio, 1e-20 to 1e30, a normal float), else nothing: the shader then takes log2.
-std::optional<int> exactLevelTwiceBias(const shading::RenderSettings& s)
-{
-    const double twice = 2.0 * s.specularLodBias;
-    if (!s.specularExactLevel || !s.specularNearestLevel ||
-        !(std::abs(twice) <= 2.0 * shading::kMaxSpecularLodBias) || twice != std::round(twice)) {
-        return std::nullopt;
-    }
-    return static_cast<int>(twice);
-}
-
-int wardModelIndex(brdf::WardModel m)
-{
-    switch (m) {
-    case brdf::WardModel::Ward1992:
-        return 0;
-    case brdf::WardModel::WardDur:
-        return 1;
-    case brdf::WardModel::WardDurGuarded:
-        return 2;
-    case brdf::WardModel::Gmd:
-        return 3;
-    }
-    return 2;
-}
-
-Expected<void> glCheck(const char* what)
-{
-    if (GLenum err = glGetError(); err != GL_NO_ERROR) {
-        return makeError(ErrorCode::DeviceFailure,
-                         fmt::format("render: GL error 0x{:04x} while {}", err, what));
-    }
-    return {};
-}
-
-// Channel coefficients per texel, exactly as the CPU model forms them (then rounded to float):
-// channels 0-2 in 'a', 3-5 in 'b' (the paper's two RGB float images).
-void channelPlanes(const shading::PreparedScene& ps, std::vector<float>& a, std::vector<float>& b)
-{
-    const surface::SurfaceScene& s = *ps.scene;
-    const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
-    a.assign(texels * 3, 0.0f);
-    b.assign(texels * 3, 0.0f);
-    for (int y = 0; y < s.height; ++y) {
-        for (int x = 0; x < s.width; ++x) {
-            const colour::ChannelCoeffs c = s.channels(ps.paletteCoeffs, x, y);
-            const std::size_t i = static_cast<std::size_t>(y) * s.width + x;
-            for (std::size_t k = 0; k < 3; ++k) {
-                a[i * 3 + k] = static_cast<float>(c[k]);
-                b[i * 3 + k] = static_cast<float>(c[3 + k]);
-            }
-        }
-    }
-}
 
 } // namespace
 
@@ -255,44 +120,26 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     // is large, and 32 copies of it took LLVM seconds to compile (a test's pass 2 -> 16 s) for no
     // measurable gain in the frame.
     const int unrolledLights = relief_ ? 0 : std::clamp(settings_.lights, 0, kBoothUnrolledLights);
-    std::string lightCalls;
-    for (int i = 0; i < unrolledLights; ++i) {
-        lightCalls += fmt::format(" LIGHT_AT({})", i);
-    }
     // The specular samples likewise, SPEC_AT(k) up to kBoothUnrolledSpecSamples: llvmpipe kept
     // the loop and read each sample's half vector as a gather per pixel. Written out, the
     // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md).
     const int unrolledSpec = std::clamp(samples, 0, kBoothUnrolledSpecSamples);
-    std::string specCalls;
-    for (int k = 0; k < unrolledSpec; ++k) {
-        specCalls += fmt::format(" SPEC_AT({})", k);
-    }
     const int modes = diffuseNodes_.x > 0 ? 4 : 3;
     for (int mode = 0; mode < modes; ++mode) {
-        const std::string source =
-                fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
-                            "#define BOOTH_GRID {}\n#define BOOTH_DIFFUSE_GRID {}\n"
-                            "#define BOOTH_HW_FILTER {}\n"
-                            "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
-                            "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n"
-                            "#define BOOTH_NEAREST_LEVEL {}\n#define BOOTH_FACET_CACHE {}\n"
-                            "#define BOOTH_LIGHT_CALLS{}\n"
-                            "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_HORIZON_HALF {}\n"
-                            "#define BOOTH_HORIZON_BILINEAR {}\n#define BOOTH_SPEC_CALLS{}\n"
-                            "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n"
-                            "#define BOOTH_EXACT_LEVEL {}\n#define BOOTH_EXACT_TIES {}\n"
-                            "#define BOOTH_HORIZON_PICK {}\n#define BOOTH_AREA_LIGHTS {}\n",
-                            mode, relief_ ? 1 : 0, gridNodes_.x > 0 ? 1 : 0,
-                            diffuseNodes_.x > 0 ? 1 : 0, hwFilter_ ? 1 : 0, horizonDirs_,
-                            perLayer * layers, samples, wardModelIndex(s.model),
-                            settings_.specularNearestLevel ? 1 : 0, facetCache_ ? 1 : 0, lightCalls,
-                            unrolledLights, settings_.horizonHalf ? 1 : 0,
-                            settings_.horizonBilinear ? 1 : 0, specCalls, unrolledSpec,
-                            settings_.specularBranchFree ? 1 : 0,
-                            exactLevelTwiceBias(settings_) ? 1 : 0,
-                            settings_.texelExactTies ? 1 : 0, settings_.horizonPick ? 1 : 0,
-                            settings_.areaLights ? 1 : 0) +
-                kBoothXyzShader;
+        BoothShaderConfig config;
+        config.mode = mode;
+        config.relief = relief_;
+        config.specularGrid = gridNodes_.x > 0;
+        config.diffuseGrid = diffuseNodes_.x > 0;
+        config.hardwareFilter = hwFilter_;
+        config.horizonDirections = horizonDirs_;
+        config.horizonSlots = perLayer * layers;
+        config.specularSamples = samples;
+        config.wardModel = s.model;
+        config.facetCache = facetCache_;
+        config.unrolledLights = unrolledLights;
+        config.unrolledSpecularSamples = unrolledSpec;
+        const std::string source = boothShaderSource(config, settings_);
         auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
                                    fmt::format("booth XYZ mode {}", mode).c_str());
         if (!program) {
@@ -807,110 +654,6 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     }
     glActiveTexture(GL_TEXTURE0);
     return glCheck("drawing the booth pass");
-}
-
-Expected<std::unique_ptr<XyzTarget>> XyzTarget::create(int width, int height)
-{
-    if (width <= 0 || height <= 0) {
-        return makeError(ErrorCode::InvalidArgument, "render: empty XYZ target");
-    }
-    std::unique_ptr<XyzTarget> t(new XyzTarget());
-    t->width_ = width;
-    t->height_ = height;
-    t->texture_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
-    t->fbo_ = GlFramebuffer::make();
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_.get());
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->texture_.get(),
-                           0);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-        return makeError(ErrorCode::Unsupported,
-                         "render: an RGBA32F target is not renderable on this GL (float colour "
-                         "buffers need GLES 3.2 or EXT_color_buffer_float)");
-    }
-    if (auto ok = glCheck("creating the XYZ target"); !ok) {
-        return tl::unexpected(ok.error());
-    }
-    return t;
-}
-
-XyzTarget::~XyzTarget() = default;
-
-void XyzTarget::bind() const
-{
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
-}
-
-shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
-                                  const shading::View& view,
-                                  double flareRho) const
-{
-    shading::XyzFrame f;
-    f.width = width_;
-    f.height = height_;
-    std::vector<float> px(static_cast<std::size_t>(width_) * height_ * 4);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, px.data());
-    f.xyz.resize(static_cast<std::size_t>(width_) * height_);
-    for (int y = 0; y < height_; ++y) {
-        const std::size_t src = static_cast<std::size_t>(height_ - 1 - y) * width_; // GL rows up
-        for (int x = 0; x < width_; ++x) {
-            const float* p = &px[(src + x) * 4];
-            colour::Xyz v(p[0], p[1], p[2]);
-            const double flare = flareRho * static_cast<double>(p[3]) / std::numbers::pi;
-            for (int c = 0; c < 3; ++c) {
-                if (!std::isfinite(v[c])) {
-                    ++f.nonFinite;
-                    v[c] = 0.0;
-                }
-                if (flareRho > 0.0 && v[c] == 0.0 && light.white[c] * flare > 0.0) {
-                    ++f.flareClamped;
-                }
-            }
-            f.xyz[static_cast<std::size_t>(y) * width_ + x] = v;
-        }
-    }
-    if (light.light != nullptr) {
-        const booth::BoothLight& bl = *light.light;
-        const shading::Vec3 n = view.panel.normal;
-        f.whiteY = shading::pointLightIrradiance(light.points, bl.normal(), bl.texelAreaM2(),
-                                                 view.panel.centre, n, n, nullptr, 0, 0,
-                                                 view.panel.right, view.panel.up, 0.0) /
-                   std::numbers::pi;
-        f.whiteXyz = light.white * f.whiteY;
-    }
-    return f;
-}
-
-Expected<shading::XyzFrame> renderBoothFrame(const BoothShadingPass& pass,
-                                             const shading::PreparedLight& light,
-                                             const shading::View& view)
-{
-    auto target = XyzTarget::create(view.pixelsX, view.pixelsY);
-    if (!target) {
-        return tl::unexpected(target.error());
-    }
-    (*target)->bind();
-    if (auto ok = pass.draw(view, view.pixelsX, view.pixelsY); !ok) {
-        return tl::unexpected(ok.error());
-    }
-    const shading::RenderSettings& s = pass.settings();
-    shading::XyzFrame f =
-            (*target)->read(light, view, s.subtractFlare ? shading::kScreenFlareRho : 0.0);
-    if (light.light != nullptr) {
-        f.whiteY = shading::panelWhiteY(light, view.panel, s.areaLights);
-        f.whiteXyz = light.white * f.whiteY;
-    }
-    // The eye's side of the surface, pixel by pixel as the CPU model tests it.
-    const std::vector<shading::Vec3> flat;
-    for (int py = 0; py < view.pixelsY; ++py) {
-        for (int px = 0; px < view.pixelsX; ++px) {
-            const shading::ShadingPoint sp =
-                    shading::shadingPoint(view, *pass.scene().scene, flat, px, py);
-            f.eyeBehindPixels += shading::eyeBehind(view, sp) ? 1 : 0;
-        }
-    }
-    return f;
 }
 
 } // namespace replica::pipeline::render
