@@ -6,29 +6,11 @@
 #include <GLES3/gl3.h>
 #include <fmt/format.h>
 
+#include <platform/output/egl_util.h>
 #include <platform/output/output.h>
 
 namespace replica::platform {
 namespace {
-
-bool hasExtension(const char* list, const char* name)
-{
-    if (list == nullptr) {
-        return false;
-    }
-    const std::size_t n = std::strlen(name);
-    for (const char* p = list; (p = std::strstr(p, name)) != nullptr; p += n) {
-        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) {
-            return true;
-        }
-    }
-    return false;
-}
-
-std::string eglErrorString()
-{
-    return fmt::format("EGL error 0x{:04x}", eglGetError());
-}
 
 class HeadlessOutput final : public Output
 {

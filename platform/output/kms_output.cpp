@@ -29,6 +29,7 @@
 #include <xf86drmMode.h>
 
 #include <platform/logging.h>
+#include <platform/output/egl_util.h>
 #include <platform/output/output.h>
 #include <platform/output/scanout_copy.h>
 
@@ -414,25 +415,6 @@ private:
     bool modeSet_ = false;
     bool flipped_ = false;
 };
-
-std::string eglErrorString()
-{
-    return fmt::format("EGL error 0x{:04x}", eglGetError());
-}
-
-bool hasExtension(const char* list, const char* name)
-{
-    if (list == nullptr) {
-        return false;
-    }
-    const std::size_t n = std::strlen(name);
-    for (const char* p = list; (p = std::strstr(p, name)) != nullptr; p += n) {
-        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) {
-            return true;
-        }
-    }
-    return false;
-}
 
 // A KMS framebuffer for a GBM buffer, made once and removed when GBM destroys the buffer.
 struct BoFramebuffer {
