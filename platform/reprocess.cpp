@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <hal/accel/iio_accel.h>
+#include <hal/lamp/lamp_debouncer.h>
 #include <hal/tracker/hid_tracker_source.h>
 #include <hal/tracker/opentrack_udp.h>
 #include <platform/reprocess.h>
@@ -123,6 +124,16 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         ++report.accelReprocessed;
         report.accelChanged += sameBits(g, s.gravity) ? 0 : 1;
         s.gravity = g;
+    }
+    for (auto& s : rec.lampSelector) {
+        ++report.lamp;
+        if (s.lamp == hal::kLampLost || s.lineCount == 0) {
+            continue;
+        }
+        const int lamp = hal::lamp::decodeOneHot(s.lineLevels & hal::lamp::lineMask(s.lineCount));
+        ++report.lampReprocessed;
+        report.lampChanged += lamp != s.lamp ? 1 : 0;
+        s.lamp = lamp;
     }
     return report;
 }

@@ -23,6 +23,9 @@ struct ReprocessOptions {
 struct ReprocessReport {
     std::size_t poses = 0, posesReprocessed = 0, posesChanged = 0;
     std::size_t accel = 0, accelReprocessed = 0, accelChanged = 0;
+    // The lamp selector's recorded line levels (debounced; the raw edges are not recorded)
+    // decoded again into a lamp; samples of lines lost have none.
+    std::size_t lamp = 0, lampReprocessed = 0, lampChanged = 0;
     // HID reports whose device-clock time now maps to another session time than recorded. The
     // sample keeps its recorded time (when the loop received it, so the frames that used it
     // still find it); only its values are re-derived.

@@ -198,9 +198,10 @@ int replayMain(const ReplayOptions& o)
         }
         reprocessed = *r;
         if (r->posesReprocessed + r->accelReprocessed == 0) {
-            log->warn("{}: --reprocess: the recording holds no raw inputs (format {}; raw "
-                      "inputs are recorded from format 5 on, from live devices and the "
-                      "simulated accelerometer): replaying the recorded samples",
+            log->warn("{}: --reprocess: the recording holds no raw inputs of the tracker or "
+                      "accelerometer (format {}; they are recorded from format 5 on, from live "
+                      "devices and the simulated accelerometer): replaying their recorded "
+                      "samples",
                       o.file, recording->formatVersion);
         }
     }
@@ -510,11 +511,19 @@ int replayMain(const ReplayOptions& o)
                                 {"pose_times_differ", r.poseTimesDiffer},
                                 {"accel", r.accel},
                                 {"accel_reprocessed", r.accelReprocessed},
-                                {"accel_changed", r.accelChanged}};
+                                {"accel_changed", r.accelChanged},
+                                {"lamp", r.lamp},
+                                {"lamp_reprocessed", r.lampReprocessed},
+                                {"lamp_changed", r.lampChanged}};
         say(fmt::format("reprocessed: {} of {} poses ({} changed) and {} of {} accelerometer "
                         "samples ({} changed) from their raw inputs; the rest as recorded",
                         r.posesReprocessed, r.poses, r.posesChanged, r.accelReprocessed, r.accel,
                         r.accelChanged));
+        if (r.lamp > 0) {
+            say(fmt::format("reprocessed: {} of {} lamp selector positions decoded again from "
+                            "their line levels ({} changed)",
+                            r.lampReprocessed, r.lamp, r.lampChanged));
+        }
         if (r.poseTimesDiffer > 0) {
             say(fmt::format("reprocessed: {} HID reports' device times map to other session "
                             "times than recorded; the samples keep their recorded times",
@@ -540,7 +549,9 @@ int replayMain(const ReplayOptions& o)
         if (shownDiffering > 0) {
             summary["display_digests"]["first_differing_frame"] = firstShownDiff;
             const bool reprocessedChanges =
-                    reprocessed && reprocessed->posesChanged + reprocessed->accelChanged > 0;
+                    reprocessed && reprocessed->posesChanged + reprocessed->accelChanged +
+                                                   reprocessed->lampChanged >
+                                           0;
             log->warn("{}: {} of {} frames differ from the digests of what the panel showed "
                       "when recorded (first: frame {}); {}",
                       o.file, shownDiffering, shownMatched + shownDiffering, firstShownDiff,

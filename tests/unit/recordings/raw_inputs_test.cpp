@@ -195,6 +195,41 @@ TEST(RawInputs, DatagramsAndSysfsReadingsComeBackAndReprocessBitExactly)
     EXPECT_FALSE(platform::reprocess(badAxes, o));
 }
 
+TEST(RawInputs, LampSelectorPositionsAreDecodedAgainFromTheirLineLevels)
+{
+    // Line levels as recorded (one-hot, line i = lamp i); the lamp fields as a buggy decoder
+    // might have written them.
+    Recording rec;
+    const struct {
+        std::uint32_t levels, lines;
+        int recorded, want;
+    } cases[] = {
+            {0b010, 3, 1, 1},                         // lamp 1, decoded right
+            {0b100, 3, 0, 2},                         // lamp 2, recorded wrong
+            {0b000, 3, hal::kLampOff, hal::kLampOff}, // off
+            {0b011, 3, 0, hal::kLampInvalid},         // two lines: a wiring fault, not lamp 0
+            {0b1000, 3, 3, hal::kLampOff},            // a level beyond the switch's lines: ignored
+            {0, 3, hal::kLampLost, hal::kLampLost},   // lines lost: nothing to decode
+    };
+    std::uint32_t seq = 0;
+    for (const auto& c : cases) {
+        hal::LampSample l;
+        l.sequence = seq++;
+        l.lineLevels = c.levels;
+        l.lineCount = c.lines;
+        l.lamp = c.recorded;
+        rec.lampSelector.push_back(l);
+    }
+    auto r = platform::reprocess(rec, {});
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->lamp, 6u);
+    EXPECT_EQ(r->lampReprocessed, 5u);
+    EXPECT_EQ(r->lampChanged, 3u);
+    for (std::size_t i = 0; i < std::size(cases); ++i) {
+        EXPECT_EQ(rec.lampSelector[i].lamp, cases[i].want) << i;
+    }
+}
+
 // Writes a recording whose one raw message is 'payload' on 'channel' and reads it back.
 Expected<Recording> readWithRawMessage(ChannelId channel, const std::string& payload)
 {
