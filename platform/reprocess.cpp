@@ -21,10 +21,10 @@ bool sameBits(const glm::dvec3& a, const glm::dvec3& b)
            std::bit_cast<std::uint64_t>(a.z) == std::bit_cast<std::uint64_t>(b.z);
 }
 
-Expected<hal::accel::AxisMapping> axes(const std::optional<std::string>& chosen,
-                                       const std::string& recorded,
-                                       const char* what,
-                                       std::uint32_t sequence)
+Expected<hal::accel::AxisMapping> reprocessAxes(const std::optional<std::string>& chosen,
+                                                const std::string& recorded,
+                                                const char* what,
+                                                std::uint32_t sequence)
 {
     auto m = hal::accel::parseAxisMapping(chosen ? *chosen : recorded);
     if (!m) {
@@ -82,7 +82,7 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
                                                  "descriptor: {}",
                                                  s.sequence, layout.error().message));
                 }
-                auto m = axes(options.trackerAxes, raw.axes, "pose", s.sequence);
+                auto m = reprocessAxes(options.trackerAxes, raw.axes, "pose", s.sequence);
                 if (!m) {
                     return tl::unexpected(m.error());
                 }
@@ -116,7 +116,7 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         if (!s.raw) {
             continue;
         }
-        auto m = axes(options.accelAxes, s.raw->axes, "accelerometer sample", s.sequence);
+        auto m = reprocessAxes(options.accelAxes, s.raw->axes, "accelerometer sample", s.sequence);
         if (!m) {
             return tl::unexpected(m.error());
         }

@@ -148,9 +148,9 @@ Expected<std::array<double, 3>> IioAccelDevice::readRaw() const
 
 namespace {
 
-std::array<double, 3> scaled(const std::array<double, 3>& raw,
-                             const std::array<double, 3>& offset,
-                             const std::array<double, 3>& scale)
+std::array<double, 3> scaledReading(const std::array<double, 3>& raw,
+                                    const std::array<double, 3>& offset,
+                                    const std::array<double, 3>& scale)
 {
     std::array<double, 3> a{};
     for (std::size_t k = 0; k < 3; ++k) {
@@ -167,12 +167,12 @@ Expected<std::array<double, 3>> IioAccelDevice::read() const
     if (!raw) {
         return tl::unexpected(raw.error());
     }
-    return scaled(*raw, offset_, scale_);
+    return scaledReading(*raw, offset_, scale_);
 }
 
 glm::dvec3 gravityFromRaw(const RawAccelInput& raw, const AxisMapping& mapping)
 {
-    return gravityInPanel(scaled(raw.raw, raw.offset, raw.scale), mapping);
+    return gravityInPanel(scaledReading(raw.raw, raw.offset, raw.scale), mapping);
 }
 
 std::string toString(const AxisMapping& m)
