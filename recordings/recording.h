@@ -117,7 +117,8 @@ struct Recording {
     std::vector<FrameRecord> frames;
     std::vector<DisplayDigestRecord> displayDigests; // format 4; empty when none were recorded
     std::vector<LightRecord> lights;                 // format 4: the decided light, on change
-    // Format 5: raw messages whose sample is not in the recording (dropped by the recorder).
+    // Format 5: raw messages that found no use: their sample is not in the recording (dropped by
+    // the recorder), or a HID report's descriptor is not (lost with a damaged chunk).
     std::uint64_t unmatchedRaw = 0;
     std::uint64_t droppedMessages = 0;   // what the writer recorded as dropped (queue full)
     std::uint64_t rejectedNonFinite = 0; // samples the writer refused: a value was NaN or infinite

@@ -79,6 +79,7 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
     std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>> descriptors;
     std::map<std::uint32_t, std::shared_ptr<const hal::RawTrackerInput>> rawTracker;
     std::map<std::uint32_t, std::shared_ptr<const hal::RawAccelInput>> rawAccel;
+    std::uint64_t unusableRaw = 0;
     for (const auto& m : s.messages) {
         const std::string& topic = s.channels.at(m.channelId).topic;
         if (m.data.size() > kMaxMessageBytes) {
@@ -111,6 +112,8 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                 auto r = decodeRawTracker(j, descriptors);
                 if (r.descriptorId) {
                     descriptors[*r.descriptorId] = r.descriptor;
+                } else if (r.descriptorMissing) {
+                    ++unusableRaw;
                 } else {
                     rawTracker[r.sequence] = std::move(r.raw);
                 }
@@ -140,7 +143,8 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                                      "(up to {}); update replica",
                                      name, rec.formatVersion, kFormatVersion));
     }
-    rec.unmatchedRaw = attachRaw(rec.poses, rawTracker) + attachRaw(rec.accel, rawAccel);
+    rec.unmatchedRaw =
+            unusableRaw + attachRaw(rec.poses, rawTracker) + attachRaw(rec.accel, rawAccel);
     return rec;
 }
 

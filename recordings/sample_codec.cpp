@@ -561,11 +561,11 @@ decodeRawTracker(const json& j,
         r->kind = hal::RawTrackerInput::Kind::HidReport;
         const auto id = j.at("descriptor").get<std::uint32_t>();
         const auto it = descriptors.find(id);
+        // A descriptor the file does not hold before the report (e.g. its chunk was lost and
+        // 'replica recover' dropped it) leaves the report unusable: no raw input, not an error.
         if (it == descriptors.end()) {
-            throw std::out_of_range(
-                    fmt::format("HID report of pose {} names descriptor {}, which the recording "
-                                "does not hold before it",
-                                m.sequence, id));
+            m.descriptorMissing = true;
+            return m;
         }
         r->hidDescriptor = it->second;
         r->axes = j.at("axes");

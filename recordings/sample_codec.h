@@ -132,6 +132,7 @@ struct RawTrackerMessage {
     std::shared_ptr<hal::RawTrackerInput> raw; // null for a descriptor message
     std::optional<std::uint32_t> descriptorId;
     std::shared_ptr<const std::vector<std::uint8_t>> descriptor;
+    bool descriptorMissing = false; // a HID report naming a descriptor not read before it
 };
 RawTrackerMessage
 decodeRawTracker(const nlohmann::json& j,
