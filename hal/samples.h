@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -24,12 +26,43 @@ struct SpectrumSample {
     bool saturated = false; // any pixel at the detector's full scale
 };
 
+// Raw in, processed out: what a device gave before any processing, with the parameters the
+// processing used. A driver attaches it to the sample it made from it; the recorder keeps it on
+// /replica/raw/<device>, and 'replica replay --reprocess' re-derives the sample from it with
+// today's code (platform/reprocess.*), so a processing fix applies to old field recordings.
+// (A spectrum is raw already: SpectrumSample holds the counts and the EEPROM coefficients.)
+struct RawTrackerInput {
+    enum class Kind : std::uint8_t { OpentrackDatagram, HidReport };
+    Kind kind = Kind::OpentrackDatagram;
+    std::int64_t arrivalNs = 0;      // session time the bytes arrived
+    std::vector<std::uint8_t> bytes; // the datagram, or the input report (report ID first when
+                                     // the device numbers its reports) as hidapi gave it
+    // HID: the report descriptor of this opening of the device (one object per opening).
+    std::shared_ptr<const std::vector<std::uint8_t>> hidDescriptor;
+    // Processing parameters. Opentrack: the mounting (hal/tracker/opentrack_udp.h); HID: device
+    // axes to the tracker frame ("x,-y,z") and the timestamp re-anchoring threshold.
+    double zSign = -1.0;
+    glm::dvec3 eyeOffsetHeadM{0.0};
+    std::string axes = "x,y,z";
+    std::int64_t reanchorNs = 50'000'000;
+};
+
+// An IIO accelerometer's reading as sysfs gave it: in_accel_{x,y,z}_raw with the scale and
+// offset read at open, and the mounting ("-y,x,z") that turns it into the panel frame.
+struct RawAccelInput {
+    std::array<double, 3> raw{};
+    std::array<double, 3> scale{};
+    std::array<double, 3> offset{};
+    std::string axes = "x,y,z";
+};
+
 // The viewer's eye position as the head tracker reports it, in the tracker's own frame (metres).
 struct PoseSample {
     std::int64_t timestampNs = 0;
     std::uint32_t sequence = 0;
     glm::dvec3 eyeTrackerM{0.0}; // tracker frame: x right, y up, z towards the viewer
     bool tracked = false;        // false while the markers are out of view
+    std::shared_ptr<const RawTrackerInput> raw; // what the device sent; none for sim, staleness
 };
 
 // Gravity as the accelerometer on the display measures it (device frame, m/s^2).
@@ -37,6 +70,7 @@ struct AccelSample {
     std::int64_t timestampNs = 0;
     std::uint32_t sequence = 0;
     glm::dvec3 gravity{0.0};
+    std::shared_ptr<const RawAccelInput> raw; // what sysfs gave; none when not recorded
 };
 
 // What the booth's lamp selector switch says, once its GPIO lines have settled (debounced).

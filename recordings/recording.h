@@ -27,7 +27,10 @@ namespace replica::recordings {
 // every frame sent to the panel), /replica/thumbnail (foxglove.CompressedImage), /tf
 // (foxglove.FrameTransforms), /replica/eye (foxglove.PoseInFrame), /replica/light (the decided
 // light), /replica/log (foxglove.Log). Replay reads only the digests; the rest is for people.
-constexpr int kFormatVersion = 4;
+// 5: raw in, processed out: /replica/raw/tracker (id 14: opentrack datagrams, HID input reports
+// and descriptors) and /replica/raw/accel (id 15: IIO raw values, scale, offset, mounting) beside
+// the processed samples; the reader attaches them to their samples by sequence number.
+constexpr int kFormatVersion = 5;
 
 // Limits on a recording, which is untrusted input (docs/recordings.md, 'Limits'): its file size,
 // one message's size (a 2048-pixel spectrum is about 12 KiB of JSON), and a spectrum's pixels
@@ -114,6 +117,9 @@ struct Recording {
     std::vector<FrameRecord> frames;
     std::vector<DisplayDigestRecord> displayDigests; // format 4; empty when none were recorded
     std::vector<LightRecord> lights;                 // format 4: the decided light, on change
+    // Format 5: raw messages that found no use: their sample is not in the recording (dropped by
+    // the recorder), or a HID report's descriptor is not (lost with a damaged chunk).
+    std::uint64_t unmatchedRaw = 0;
     std::uint64_t droppedMessages = 0;   // what the writer recorded as dropped (queue full)
     std::uint64_t rejectedNonFinite = 0; // samples the writer refused: a value was NaN or infinite
 };

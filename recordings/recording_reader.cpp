@@ -3,6 +3,7 @@
 // inspecting files.
 #include <fstream>
 #include <iterator>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -33,6 +34,21 @@ Expected<std::string> slurp(const std::filesystem::path& path)
     return bytes;
 }
 
+// Gives each sample its raw input; returns how many raw inputs found no sample.
+template <typename Sample, typename Raw>
+std::uint64_t attachRaw(std::vector<Sample>& samples,
+                        std::map<std::uint32_t, std::shared_ptr<const Raw>>& raw)
+{
+    std::uint64_t matched = 0;
+    for (auto& s : samples) {
+        if (auto it = raw.find(s.sequence); it != raw.end()) {
+            s.raw = it->second;
+            ++matched;
+        }
+    }
+    return matched >= raw.size() ? 0 : raw.size() - matched;
+}
+
 } // namespace
 
 Expected<Recording> readRecording(const std::filesystem::path& path)
@@ -59,6 +75,11 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
     }
     Recording rec;
     bool haveSession = false;
+    // Format 5: raw inputs, attached to their samples by sequence number once all are read.
+    std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>> descriptors;
+    std::map<std::uint32_t, std::shared_ptr<const hal::RawTrackerInput>> rawTracker;
+    std::map<std::uint32_t, std::shared_ptr<const hal::RawAccelInput>> rawAccel;
+    std::uint64_t unusableRaw = 0;
     for (const auto& m : s.messages) {
         const std::string& topic = s.channels.at(m.channelId).topic;
         if (m.data.size() > kMaxMessageBytes) {
@@ -87,6 +108,18 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                 rec.displayDigests.push_back(decodeDisplayDigest(j));
             } else if (topic == kLightTopic) { // format 4
                 rec.lights.push_back(decodeLight(j));
+            } else if (topic == kRawTrackerTopic) { // format 5
+                auto r = decodeRawTracker(j, descriptors);
+                if (r.descriptorId) {
+                    descriptors[*r.descriptorId] = r.descriptor;
+                } else if (r.descriptorMissing) {
+                    ++unusableRaw;
+                } else {
+                    rawTracker[r.sequence] = std::move(r.raw);
+                }
+            } else if (topic == kRawAccelTopic) { // format 5
+                auto [seq, raw] = decodeRawAccel(j);
+                rawAccel[seq] = std::move(raw);
             } else if (topic == kRecorderTopic) {
                 const auto r = decodeRecorderStatus(j);
                 rec.droppedMessages = r.droppedTotal();
@@ -110,6 +143,8 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                                      "(up to {}); update replica",
                                      name, rec.formatVersion, kFormatVersion));
     }
+    rec.unmatchedRaw =
+            unusableRaw + attachRaw(rec.poses, rawTracker) + attachRaw(rec.accel, rawAccel);
     return rec;
 }
 

@@ -277,6 +277,34 @@ private:
         }
         message(channel, t, std::move(*payload));
         lastTime_ = std::max(lastTime_, t);
+        addRaw(item);
+    }
+
+    // Format 5: the raw input a sample was made from, on its own channel after the sample.
+    void addRaw(const Item& item)
+    {
+        if (const auto* p = std::get_if<hal::PoseSample>(&item); p && p->raw) {
+            const auto& d = p->raw->hidDescriptor;
+            if (p->raw->kind == hal::RawTrackerInput::Kind::HidReport && d &&
+                d.get() != lastDescriptor_.get()) {
+                // A new opening of the device: its descriptor once, before its first report.
+                lastDescriptor_ = d;
+                ++descriptorId_;
+                message(ChannelId::RawTracker, p->raw->arrivalNs,
+                        encodeRawTrackerDescriptor(p->raw->arrivalNs, descriptorId_, *d));
+            }
+            if (auto raw = encodeRawTracker(*p, descriptorId_)) {
+                message(ChannelId::RawTracker, p->raw->arrivalNs, std::move(*raw));
+            } else {
+                rejected_.fetch_add(1, std::memory_order_relaxed);
+            }
+        } else if (const auto* a = std::get_if<hal::AccelSample>(&item); a && a->raw) {
+            if (auto raw = encodeRawAccel(*a)) {
+                message(ChannelId::RawAccel, a->timestampNs, std::move(*raw));
+            } else {
+                rejected_.fetch_add(1, std::memory_order_relaxed);
+            }
+        }
     }
 
     void message(ChannelId channel, std::int64_t t, std::string payload)
@@ -339,6 +367,8 @@ private:
     std::int64_t wallStart_ = 0;
     std::int64_t lastTime_ = 0;
     std::map<std::uint16_t, std::uint32_t> sequence_;
+    std::shared_ptr<const std::vector<std::uint8_t>> lastDescriptor_; // HID, writer thread only
+    std::uint32_t descriptorId_ = 0;
     RecorderStatus status_;
     // Spectra, poses, accel, frames, lamp selector, and the format 4 channels of what was shown.
     std::array<std::atomic<std::uint64_t>, 6> dropped_{};

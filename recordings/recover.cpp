@@ -40,10 +40,14 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
     options.chunkedOnly = true; // the writer chunks every record that carries samples
     // Replica's channel ids are fixed per format version: a file whose first chunk (the channel
     // definitions) was lost can still have its samples recovered.
-    // Format 3 only added channel 7, so its definitions serve format 2 files as well.
+    // Each format only added channels (3: id 7, 4: ids 8-13, 5: ids 14-15), so today's
+    // definitions serve every chunked format (2 and later) as well.
     const auto probe = bytes.substr(0, 256);
-    if (probe.find(fmt::format("(format {})", kFormatVersion)) != std::string::npos ||
-        probe.find("(format 2)") != std::string::npos) {
+    bool knownFormat = false;
+    for (int v = 2; v <= kFormatVersion; ++v) {
+        knownFormat = knownFormat || probe.find(fmt::format("(format {})", v)) != std::string::npos;
+    }
+    if (knownFormat) {
         for (const auto& d : channelDefinitions()) {
             options.fallbackChannels[d.channel.id] = d.channel;
             options.fallbackSchemas[d.schema.id] = d.schema;

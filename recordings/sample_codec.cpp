@@ -229,6 +229,35 @@ std::vector<ChannelDefinition> makeDefinitions()
       {"title": "FATAL", "const": 5}]},
     "message": {"type": "string"}, "name": {"type": "string"}, "file": {"type": "string"},
     "line": {"type": "integer", "minimum": 0})")},
+            {ChannelId::RawTracker, kRawTrackerTopic, "replica.RawTracker",
+             schemaText(
+                     "replica.RawTracker",
+                     "Raw in, processed out: what the head tracker sent for pose seq, before "
+                     "processing, with the processing's parameters; or (kind hid-descriptor) "
+                     "the report descriptor of one opening of a HID tracker",
+                     R"json("t": {"type": "integer", "description": "session time (ns) the bytes arrived"},
+    "seq": {"type": "integer", "description": "the pose on /hal/tracker made from them"},
+    "kind": {"type": "string", "enum": ["opentrack", "hid", "hid-descriptor"]},
+    "bytes": {"type": "string", "contentEncoding": "base64", "description":
+      "opentrack: the 48-byte datagram; hid: the input report, report ID first when numbered; hid-descriptor: the report descriptor"},
+    "descriptor": {"type": "integer", "description": "hid, hid-descriptor: which descriptor"},
+    "z_sign": {"type": "number", "description": "opentrack: sign of z in the tracker frame"},
+    "eye_offset_head_m": )json" +
+                             vec +
+                             R"json(, "axes": {"type": "string", "description": "hid: device axes to the tracker frame, e.g. x,-y,z"},
+    "reanchor_ns": {"type": "integer", "description": "hid: device clock re-anchoring threshold"})json",
+                     R"("t", "kind", "bytes")")},
+            {ChannelId::RawAccel, kRawAccelTopic, "replica.RawAccel",
+             schemaText("replica.RawAccel",
+                        "Raw in, processed out: the accelerometer's sysfs reading for accel "
+                        "sample seq; gravity = -mounting((raw + offset) * scale)",
+                        timeProps + R"(,
+    "raw": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3,
+      "description": "in_accel_{x,y,z}_raw"},
+    "scale": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
+    "offset": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
+    "axes": {"type": "string", "description": "mounting: sensor axis for the panel's x, y, z"})",
+                        R"("t", "seq", "raw", "scale", "offset", "axes")")},
     };
     std::vector<ChannelDefinition> out;
     for (const auto& d : defs) {
@@ -395,6 +424,169 @@ std::string base64Encode(const std::vector<std::uint8_t>& bytes)
         out += '=';
     }
     return out;
+}
+
+std::vector<std::uint8_t> base64Decode(const std::string& text)
+{
+    const auto value = [](char c) -> int {
+        if (c >= 'A' && c <= 'Z') {
+            return c - 'A';
+        }
+        if (c >= 'a' && c <= 'z') {
+            return c - 'a' + 26;
+        }
+        if (c >= '0' && c <= '9') {
+            return c - '0' + 52;
+        }
+        return c == '+' ? 62 : c == '/' ? 63 : -1;
+    };
+    if (text.size() % 4 != 0) {
+        throw std::out_of_range("bytes: base64 text whose length is not a multiple of 4");
+    }
+    std::vector<std::uint8_t> out;
+    out.reserve(text.size() / 4 * 3);
+    for (std::size_t i = 0; i < text.size(); i += 4) {
+        const bool last = i + 4 == text.size();
+        int v[4];
+        int pad = 0;
+        for (std::size_t k = 0; k < 4; ++k) {
+            const char c = text[i + k];
+            if (c == '=' && last && k >= 2 && (k == 3 || text[i + 3] == '=')) {
+                v[k] = 0;
+                ++pad;
+                continue;
+            }
+            v[k] = value(c);
+            if (v[k] < 0 || pad > 0) {
+                throw std::out_of_range("bytes: not base64");
+            }
+        }
+        const std::uint32_t w = (static_cast<std::uint32_t>(v[0]) << 18) |
+                                (static_cast<std::uint32_t>(v[1]) << 12) |
+                                (static_cast<std::uint32_t>(v[2]) << 6) |
+                                static_cast<std::uint32_t>(v[3]);
+        out.push_back(static_cast<std::uint8_t>(w >> 16));
+        if (pad < 2) {
+            out.push_back(static_cast<std::uint8_t>((w >> 8) & 0xff));
+        }
+        if (pad < 1) {
+            out.push_back(static_cast<std::uint8_t>(w & 0xff));
+        }
+    }
+    return out;
+}
+
+std::string encodeRawTrackerDescriptor(std::int64_t tNs,
+                                       std::uint32_t id,
+                                       const std::vector<std::uint8_t>& descriptor)
+{
+    return json{{"t", tNs},
+                {"kind", "hid-descriptor"},
+                {"descriptor", id},
+                {"bytes", base64Encode(descriptor)}}
+            .dump();
+}
+
+std::optional<std::string> encodeRawTracker(const hal::PoseSample& s, std::uint32_t descriptorId)
+{
+    if (!s.raw) {
+        return std::nullopt;
+    }
+    const hal::RawTrackerInput& r = *s.raw;
+    json j{{"t", r.arrivalNs}, {"seq", s.sequence}, {"bytes", base64Encode(r.bytes)}};
+    if (r.kind == hal::RawTrackerInput::Kind::OpentrackDatagram) {
+        if (!std::isfinite(r.zSign) || !finite(r.eyeOffsetHeadM)) {
+            return std::nullopt;
+        }
+        j["kind"] = "opentrack";
+        j["z_sign"] = r.zSign;
+        j["eye_offset_head_m"] = vec3(r.eyeOffsetHeadM);
+    } else {
+        j["kind"] = "hid";
+        j["descriptor"] = descriptorId;
+        j["axes"] = r.axes;
+        j["reanchor_ns"] = r.reanchorNs;
+    }
+    return j.dump();
+}
+
+std::optional<std::string> encodeRawAccel(const hal::AccelSample& s)
+{
+    if (!s.raw || !finite(s.raw->raw) || !finite(s.raw->scale) || !finite(s.raw->offset)) {
+        return std::nullopt;
+    }
+    return json{{"t", s.timestampNs},    {"seq", s.sequence},       {"raw", s.raw->raw},
+                {"scale", s.raw->scale}, {"offset", s.raw->offset}, {"axes", s.raw->axes}}
+            .dump();
+}
+
+namespace {
+
+// A report or descriptor larger than any HID device's (4096 bytes, the kernel's limit).
+constexpr std::size_t kMaxRawBytes = 4096;
+
+std::vector<std::uint8_t> rawBytes(const json& j)
+{
+    auto bytes = base64Decode(j.at("bytes").get<std::string>());
+    if (bytes.size() > kMaxRawBytes) {
+        throw std::out_of_range(fmt::format("{} raw bytes; a device report is at most {}",
+                                            bytes.size(), kMaxRawBytes));
+    }
+    return bytes;
+}
+
+} // namespace
+
+RawTrackerMessage
+decodeRawTracker(const json& j,
+                 const std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>>&
+                         descriptors)
+{
+    RawTrackerMessage m;
+    const std::string kind = j.at("kind");
+    if (kind == "hid-descriptor") {
+        m.descriptorId = j.at("descriptor").get<std::uint32_t>();
+        m.descriptor = std::make_shared<const std::vector<std::uint8_t>>(rawBytes(j));
+        return m;
+    }
+    auto r = std::make_shared<hal::RawTrackerInput>();
+    m.sequence = j.at("seq");
+    r->arrivalNs = j.at("t");
+    r->bytes = rawBytes(j);
+    if (kind == "opentrack") {
+        r->kind = hal::RawTrackerInput::Kind::OpentrackDatagram;
+        r->zSign = j.at("z_sign");
+        r->eyeOffsetHeadM = vec3From(j.at("eye_offset_head_m"));
+    } else if (kind == "hid") {
+        r->kind = hal::RawTrackerInput::Kind::HidReport;
+        const auto id = j.at("descriptor").get<std::uint32_t>();
+        const auto it = descriptors.find(id);
+        // A descriptor the file does not hold before the report (e.g. its chunk was lost and
+        // 'replica recover' dropped it) leaves the report unusable: no raw input, not an error.
+        if (it == descriptors.end()) {
+            m.descriptorMissing = true;
+            return m;
+        }
+        r->hidDescriptor = it->second;
+        r->axes = j.at("axes");
+        r->reanchorNs = j.at("reanchor_ns");
+    } else {
+        throw std::out_of_range("unknown raw tracker kind '" + kind + "'");
+    }
+    m.raw = std::move(r);
+    return m;
+}
+
+std::pair<std::uint32_t, std::shared_ptr<hal::RawAccelInput>> decodeRawAccel(const json& j)
+{
+    auto r = std::make_shared<hal::RawAccelInput>();
+    const std::uint32_t seq = j.at("seq");
+    (void)j.at("t").get<std::int64_t>();
+    r->raw = j.at("raw");
+    r->scale = j.at("scale");
+    r->offset = j.at("offset");
+    r->axes = j.at("axes");
+    return {seq, std::move(r)};
 }
 
 std::string encodeDisplayDigest(const DisplayDigestRecord& d)

@@ -2,9 +2,12 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -31,6 +34,10 @@ enum class ChannelId : std::uint16_t {
     Eye = 11,
     Light = 12,
     Log = 13,
+    // Format 5: raw in, processed out. What the devices gave before processing, beside the
+    // processed samples on 3 and 4, so that 'replay --reprocess' can re-derive them.
+    RawTracker = 14,
+    RawAccel = 15,
 };
 
 inline constexpr std::string_view kSessionTopic = "/replica/session";
@@ -46,6 +53,8 @@ inline constexpr std::string_view kTransformsTopic = "/tf";
 inline constexpr std::string_view kEyeTopic = "/replica/eye";
 inline constexpr std::string_view kLightTopic = "/replica/light";
 inline constexpr std::string_view kLogTopic = "/replica/log";
+inline constexpr std::string_view kRawTrackerTopic = "/replica/raw/tracker";
+inline constexpr std::string_view kRawAccelTopic = "/replica/raw/accel";
 // Foxglove frame ids of the transforms and poses.
 inline constexpr std::string_view kBoothFrame = "booth";
 inline constexpr std::string_view kPanelFrame = "panel";
@@ -94,6 +103,17 @@ std::optional<std::string> encodeEye(const PosesRecord& p, std::int64_t wallStar
 std::string encodeLight(const LightRecord& l);
 std::string encodeLog(const LogRecord& l, std::int64_t wallStartNs);
 std::string base64Encode(const std::vector<std::uint8_t>& bytes);
+// Strict (padding required, no whitespace); throws std::out_of_range on anything else.
+std::vector<std::uint8_t> base64Decode(const std::string& text);
+
+// Format 5, /replica/raw/tracker: a HID report descriptor (once per opening of the device, before
+// the first report read with it; 'id' numbers them within the recording) and each datagram or
+// report that made a pose (seq: the pose's). Raw accel: the sysfs reading of each sample.
+std::string encodeRawTrackerDescriptor(std::int64_t tNs,
+                                       std::uint32_t id,
+                                       const std::vector<std::uint8_t>& descriptor);
+std::optional<std::string> encodeRawTracker(const hal::PoseSample& s, std::uint32_t descriptorId);
+std::optional<std::string> encodeRawAccel(const hal::AccelSample& s);
 
 // Decoders throw nlohmann::json exceptions on missing or mistyped fields.
 SessionInfo decodeSession(const nlohmann::json& j, int& formatVersion);
@@ -105,5 +125,21 @@ FrameRecord decodeFrame(const nlohmann::json& j);
 RecorderStatus decodeRecorderStatus(const nlohmann::json& j);
 DisplayDigestRecord decodeDisplayDigest(const nlohmann::json& j);
 LightRecord decodeLight(const nlohmann::json& j);
+// A raw tracker message: either a descriptor (returned in 'descriptor' with its id) or the raw
+// input of pose 'sequence' (its HID descriptor looked up in 'descriptors' by id).
+struct RawTrackerMessage {
+    std::uint32_t sequence = 0;
+    std::shared_ptr<hal::RawTrackerInput> raw; // null for a descriptor message
+    std::optional<std::uint32_t> descriptorId;
+    std::shared_ptr<const std::vector<std::uint8_t>> descriptor;
+    bool descriptorMissing = false; // a HID report naming a descriptor not read before it
+};
+RawTrackerMessage
+decodeRawTracker(const nlohmann::json& j,
+                 const std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>>&
+                         descriptors);
+// The raw input of accel sample 'sequence'.
+std::pair<std::uint32_t, std::shared_ptr<hal::RawAccelInput>>
+decodeRawAccel(const nlohmann::json& j);
 
 } // namespace replica::recordings

@@ -133,7 +133,7 @@ Expected<IioAccelDevice> IioAccelDevice::find(const fs::path& root, const std::s
                                                 root.string()));
 }
 
-Expected<std::array<double, 3>> IioAccelDevice::read() const
+Expected<std::array<double, 3>> IioAccelDevice::readRaw() const
 {
     std::array<double, 3> a{};
     for (int i = 0; i < 3; ++i) {
@@ -141,10 +141,53 @@ Expected<std::array<double, 3>> IioAccelDevice::read() const
         if (!raw) {
             return tl::unexpected(raw.error());
         }
-        const auto k = static_cast<std::size_t>(i);
-        a[k] = (*raw + offset_[k]) * scale_[k];
+        a[static_cast<std::size_t>(i)] = *raw;
     }
     return a;
+}
+
+namespace {
+
+std::array<double, 3> scaledReading(const std::array<double, 3>& raw,
+                                    const std::array<double, 3>& offset,
+                                    const std::array<double, 3>& scale)
+{
+    std::array<double, 3> a{};
+    for (std::size_t k = 0; k < 3; ++k) {
+        a[k] = (raw[k] + offset[k]) * scale[k];
+    }
+    return a;
+}
+
+} // namespace
+
+Expected<std::array<double, 3>> IioAccelDevice::read() const
+{
+    auto raw = readRaw();
+    if (!raw) {
+        return tl::unexpected(raw.error());
+    }
+    return scaledReading(*raw, offset_, scale_);
+}
+
+glm::dvec3 gravityFromRaw(const RawAccelInput& raw, const AxisMapping& mapping)
+{
+    return gravityInPanel(scaledReading(raw.raw, raw.offset, raw.scale), mapping);
+}
+
+std::string toString(const AxisMapping& m)
+{
+    std::string out;
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (k > 0) {
+            out += ',';
+        }
+        if (m.sign[k] < 0.0) {
+            out += '-';
+        }
+        out += static_cast<char>('x' + m.axis[k]);
+    }
+    return out;
 }
 
 Expected<AxisMapping> parseAxisMapping(const std::string& text)
@@ -206,6 +249,7 @@ public:
         info_.model = "iio-accel";
         info_.serial = options_.name.empty() ? "first" : options_.name;
         info_.kind = SourceKind::Live;
+        axesText_ = toString(options_.mounting);
         thread_ = std::thread([this] { run(); });
     }
     ~IioAccelSource() override
@@ -255,7 +299,7 @@ private:
                 dev = std::move(*d);
             }
             const std::int64_t started = clock_.nowNs();
-            auto a = dev->read();
+            auto a = dev->readRaw();
             if (!a) {
                 // A value file that exists but reads empty, junk or EIO (a glitching I2C sensor)
                 // is handled like an unplugged device: Lost, one line per new error, and a retry
@@ -279,10 +323,16 @@ private:
                 lastError.clear();
             }
             state_ = LinkState::Connected;
+            auto raw = std::make_shared<RawAccelInput>();
+            raw->raw = *a;
+            raw->scale = dev->scale();
+            raw->offset = dev->offset();
+            raw->axes = axesText_;
             AccelSample s;
             s.timestampNs = clock_.nowNs();
             s.sequence = sequence++;
-            s.gravity = gravityInPanel(*a, options_.mounting);
+            s.gravity = gravityFromRaw(*raw, options_.mounting);
+            s.raw = std::move(raw);
             queue_.push(s);
             if (!waitFor(options_.periodNs - (clock_.nowNs() - started))) {
                 return;
@@ -292,6 +342,7 @@ private:
 
     const Clock& clock_;
     IioAccelSourceOptions options_;
+    std::string axesText_;
     DeviceInfo info_;
     std::atomic<LinkState> state_{LinkState::Lost};
     LiveQueue<AccelSample> queue_{1024};

@@ -33,6 +33,8 @@ public:
     // a = (raw + offset) * scale per axis, m/s^2. Fails naming the attribute file if a read fails
     // (the device was removed, or the driver returned garbage).
     Expected<std::array<double, 3>> read() const;
+    // The in_accel_{x,y,z}_raw values as sysfs gave them (before scale and offset).
+    Expected<std::array<double, 3>> readRaw() const;
 
     const std::string& name() const { return name_; }
     const std::filesystem::path& dir() const { return dir_; }
@@ -57,10 +59,16 @@ struct AxisMapping {
 };
 
 Expected<AxisMapping> parseAxisMapping(const std::string& text);
+// The text parseAxisMapping reads back: "x,y,z", "-y,x,z".
+std::string toString(const AxisMapping& mapping);
 
 // An accelerometer at rest reads the reaction to gravity (+1 g pointing up); the HAL's
 // AccelSample carries gravity itself (pointing down) in the panel frame: -(mapped reading).
 glm::dvec3 gravityInPanel(const std::array<double, 3>& reading, const AxisMapping& mapping);
+
+// The whole processing of a raw reading: (raw + offset) * scale per axis, then the mounting.
+// What the live source reports, and what 'replay --reprocess' recomputes from a recording.
+glm::dvec3 gravityFromRaw(const RawAccelInput& raw, const AxisMapping& mapping);
 
 struct IioAccelSourceOptions {
     AxisMapping mounting;

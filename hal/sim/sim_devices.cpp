@@ -177,6 +177,15 @@ public:
                                    -kStandardGravity * std::sin(tilt)};
             s.gravity += glm::dvec3{noise_.gaussian(), noise_.gaussian(), noise_.gaussian()} *
                          params_.noiseMs2;
+            // Raw in, processed out, as an IIO device in m/s^2 would give it: the reading (the
+            // reaction to gravity) with scale 1 and offset -0.0, mounted as is. Adding -0.0 and
+            // multiplying by 1 change no double (not even +0.0), so the live processing gives
+            // back exactly this sample.
+            auto raw = std::make_shared<RawAccelInput>();
+            raw->raw = {-s.gravity.x, -s.gravity.y, -s.gravity.z};
+            raw->scale = {1.0, 1.0, 1.0};
+            raw->offset = {-0.0, -0.0, -0.0};
+            s.raw = std::move(raw);
             out.push_back(s);
             ++next_;
         }

@@ -76,6 +76,10 @@ Expected<void> HidTrackerReader::configure()
     description_ = {};
     description_.layout = *layout;
     description_.where = where;
+    processor_.emplace(*layout, options_.axes, options_.reanchorNs);
+    descriptorBytes_ =
+            std::make_shared<const std::vector<std::uint8_t>>(bytes->begin(), bytes->end());
+    axesText_ = accel::toString(options_.axes);
     buffer_.assign(std::max<std::size_t>(layout->inputReportBytes, 1) + 64, 0);
 
     // Read one feature value; a device that refuses a feature request is still usable.
@@ -146,13 +150,36 @@ Expected<void> HidTrackerReader::configure()
         }
         description_.modeSent = mode;
     }
-    offsetNs_.reset();
-    lastNs_ = 0;
     return {};
 }
 
-std::int64_t HidTrackerReader::sessionTime(std::optional<std::int64_t> deviceNs,
-                                           std::int64_t hostNs)
+Expected<eht::Layout> trackerLayout(std::span<const std::uint8_t> bytes)
+{
+    auto descriptor = hid::parseReportDescriptor(bytes);
+    if (!descriptor) {
+        return tl::unexpected(descriptor.error());
+    }
+    return eht::findLayout(*descriptor);
+}
+
+eht::DecodeResult HidReportProcessor::process(std::span<const std::uint8_t> report,
+                                              std::int64_t arrivalNs,
+                                              PoseSample& out)
+{
+    eht::TrackingReport r;
+    const auto result = eht::decodeTracking(layout_, report, r);
+    if (result != eht::DecodeResult::Ok) {
+        return result;
+    }
+    out.timestampNs = sessionTime(r.deviceTimeNs, arrivalNs);
+    const auto eye = eyePoint(r, axes_);
+    out.tracked = eye.has_value();
+    out.eyeTrackerM = eye ? *eye : glm::dvec3(0.0);
+    return result;
+}
+
+std::int64_t HidReportProcessor::sessionTime(std::optional<std::int64_t> deviceNs,
+                                             std::int64_t hostNs)
 {
     if (!deviceNs) {
         lastNs_ = std::max(lastNs_, hostNs);
@@ -163,7 +190,7 @@ std::int64_t HidTrackerReader::sessionTime(std::optional<std::int64_t> deviceNs,
     // that stepped back (reset) or fell far behind (drift, a pause) is re-anchored.
     const std::int64_t lag = hostNs - *deviceNs;
     if (!offsetNs_ || *deviceNs < lastDeviceNs_ || lag < *offsetNs_ ||
-        lag - *offsetNs_ > options_.reanchorNs) {
+        lag - *offsetNs_ > reanchorNs_) {
         offsetNs_ = lag;
     }
     lastDeviceNs_ = *deviceNs;
@@ -181,8 +208,9 @@ Expected<std::optional<PoseSample>> HidTrackerReader::next()
         return tl::unexpected(deviceError(got.status, description_.where, "reading a report"));
     }
     const std::int64_t host = clock_->nowNs();
-    eht::TrackingReport r;
-    switch (eht::decodeTracking(description_.layout, {buffer_.data(), got.bytes}, r)) {
+    const std::span<const std::uint8_t> report{buffer_.data(), got.bytes};
+    PoseSample s;
+    switch (processor_->process(report, host, s)) {
     case eht::DecodeResult::OtherReport:
         return std::optional<PoseSample>();
     case eht::DecodeResult::Short:
@@ -196,14 +224,16 @@ Expected<std::optional<PoseSample>> HidTrackerReader::next()
     case eht::DecodeResult::Ok:
         break;
     }
-    PoseSample s;
-    s.timestampNs = sessionTime(r.deviceTimeNs, host);
-    const auto eye = eyePoint(r, options_.axes);
-    s.tracked = eye.has_value();
-    if (eye) {
-        s.eyeTrackerM = *eye;
-    }
-    return std::optional<PoseSample>(s);
+    // Raw in, processed out: the report as received, the descriptor of this opening, the axes.
+    auto raw = std::make_shared<RawTrackerInput>();
+    raw->kind = RawTrackerInput::Kind::HidReport;
+    raw->arrivalNs = host;
+    raw->bytes.assign(report.begin(), report.end());
+    raw->hidDescriptor = descriptorBytes_;
+    raw->axes = axesText_;
+    raw->reanchorNs = options_.reanchorNs;
+    s.raw = std::move(raw);
+    return std::optional<PoseSample>(std::move(s));
 }
 
 namespace {

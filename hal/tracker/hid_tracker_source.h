@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,36 @@ struct HidTrackerOptions {
     std::int64_t reanchorNs = 50'000'000;
 };
 
+// The report descriptor parsed and the tracker found in it; fails naming the byte offset or what
+// is missing.
+Expected<hid::eht::Layout> trackerLayout(std::span<const std::uint8_t> descriptor);
+
+// The processing of tracking reports into poses, without the device: decoding, the eye point,
+// and the device clock anchored into session time through the least-delayed arrival. The live
+// reader runs it on each report as it arrives; 'replay --reprocess' runs it on the recorded
+// reports with their arrival times, and so gets the same poses bit for bit.
+class HidReportProcessor
+{
+public:
+    HidReportProcessor(hid::eht::Layout layout, accel::AxisMapping axes, std::int64_t reanchorNs)
+        : layout_(std::move(layout)), axes_(axes), reanchorNs_(reanchorNs)
+    {}
+    // Ok: 'out' holds the pose (time, tracked, eye; sequence untouched).
+    hid::eht::DecodeResult
+    process(std::span<const std::uint8_t> report, std::int64_t arrivalNs, PoseSample& out);
+    const hid::eht::Layout& layout() const { return layout_; }
+
+private:
+    std::int64_t sessionTime(std::optional<std::int64_t> deviceNs, std::int64_t hostNs);
+
+    hid::eht::Layout layout_;
+    accel::AxisMapping axes_;
+    std::int64_t reanchorNs_;
+    std::optional<std::int64_t> offsetNs_; // session time - device time, smallest seen
+    std::int64_t lastDeviceNs_ = 0;
+    std::int64_t lastNs_ = 0;
+};
+
 // The deterministic part: one opened device, read report by report (tests drive it directly).
 class HidTrackerReader
 {
@@ -68,17 +99,16 @@ private:
         : device_(std::move(device)), clock_(&clock), options_(std::move(options))
     {}
     Expected<void> configure();
-    std::int64_t sessionTime(std::optional<std::int64_t> deviceNs, std::int64_t hostNs);
 
     std::unique_ptr<hid::HidDevice> device_;
     const Clock* clock_;
     HidTrackerOptions options_;
     HidTrackerDescription description_;
+    std::optional<HidReportProcessor> processor_;
+    std::shared_ptr<const std::vector<std::uint8_t>> descriptorBytes_; // handed up as raw
+    std::string axesText_;
     std::vector<std::uint8_t> buffer_;
     long rejected_ = 0;
-    std::optional<std::int64_t> offsetNs_; // session time - device time, smallest seen
-    std::int64_t lastDeviceNs_ = 0;
-    std::int64_t lastNs_ = 0;
 };
 
 // The eye point a tracking report gives: the midpoint of the eyes when both are tracked, else

@@ -121,6 +121,14 @@ private:
             s.timestampNs = clock_.nowNs();
             s.eyeTrackerM = eyeFromHeadPose(*pose, options_.mounting);
             s.tracked = true;
+            // Raw in, processed out: the datagram as received, with the mounting it was read with.
+            auto raw = std::make_shared<RawTrackerInput>();
+            raw->kind = RawTrackerInput::Kind::OpentrackDatagram;
+            raw->arrivalNs = s.timestampNs;
+            raw->bytes.assign(buf.begin(), buf.begin() + got);
+            raw->zSign = options_.mounting.zSign;
+            raw->eyeOffsetHeadM = options_.mounting.eyeOffsetHeadM;
+            s.raw = std::move(raw);
             std::lock_guard lock(mutex_);
             s.sequence = sequence_++;
             queue_.push_back(s);

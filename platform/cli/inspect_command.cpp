@@ -90,6 +90,18 @@ nlohmann::json streamJson(const hal::DeviceInfo& info, const std::vector<Sample>
     return j;
 }
 
+// Format 5: how many samples carry the device's raw input (/replica/raw/*).
+nlohmann::json rawInputsJson(const recordings::Recording& rec)
+{
+    const auto withRaw = [](const auto& samples) {
+        return static_cast<std::size_t>(std::count_if(
+                samples.begin(), samples.end(), [](const auto& s) { return s.raw != nullptr; }));
+    };
+    return {{"poses", withRaw(rec.poses)},
+            {"accel", withRaw(rec.accel)},
+            {"unmatched", rec.unmatchedRaw}};
+}
+
 nlohmann::json channelsJson(const recordings::FileReport& report)
 {
     nlohmann::json channels = nlohmann::json::object();
@@ -184,6 +196,7 @@ int inspectMain(const InspectOptions& o)
                      {"tracker", streamJson(rec->session.tracker, rec->poses)},
                      {"accel", streamJson(rec->session.accel, rec->accel)},
                      {"lamp_selector", streamJson(rec->session.lampSelector, rec->lampSelector)},
+                     {"raw_inputs", rawInputsJson(*rec)},
                      {"frames", rec->frames.size()},
                      {"dropped_messages", rec->droppedMessages},
                      {"rejected_nonfinite", rec->rejectedNonFinite},
@@ -276,6 +289,14 @@ int inspectMain(const InspectOptions& o)
     if (!rec->session.lampSelector.model.empty() || !rec->lampSelector.empty()) {
         line("lamp selector", rec->session.lampSelector, rec->lampSelector.size());
     }
+    const auto raw = rawInputsJson(*rec);
+    fmt::print("  raw inputs    {} of {} poses, {} of {} accelerometer samples{} ('replay "
+               "--reprocess' re-derives them)\n",
+               raw.at("poses").get<std::size_t>(), rec->poses.size(),
+               raw.at("accel").get<std::size_t>(), rec->accel.size(),
+               rec->unmatchedRaw > 0
+                       ? fmt::format("; {} without their sample (dropped)", rec->unmatchedRaw)
+                       : std::string());
     fmt::print("  {:<13} {:>7} frames\n", "frames", rec->frames.size());
     fmt::print("  time span {:.3f} s ({} .. {} ns); dropped messages {}, rejected (NaN/inf) {}\n",
                static_cast<double>(last - first) * 1e-9, first, last, rec->droppedMessages,

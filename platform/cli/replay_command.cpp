@@ -21,6 +21,7 @@
 #include <platform/image/xyz_frame.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
+#include <platform/reprocess.h>
 
 namespace replica::platform {
 namespace {
@@ -45,6 +46,8 @@ struct ReplayOptions {
     std::string saveOnly;            // with --save-frames: only these frame numbers
     std::string saveFormat = "pfm";  // or "exr" (half float)
     std::string output = "headless";
+    bool reprocess = false; // re-derive samples from their recorded raw inputs
+    std::optional<std::string> trackerAxes, accelAxes; // with --reprocess: instead of recorded
     KmsOptions kms;
 };
 
@@ -177,6 +180,30 @@ int replayMain(const ReplayOptions& o)
     if (auto ok = checkRecordedReferences(*config, roots, o.allowUndigested); !ok) {
         log->error("{}: {}", o.file, ok.error().message);
         return kExitFailure;
+    }
+    std::optional<ReprocessReport> reprocessed;
+    if ((o.trackerAxes || o.accelAxes) && !o.reprocess) {
+        log->error("--tracker-axes and --accel-axes change how raw inputs are processed: they "
+                   "need --reprocess");
+        return kExitUsage;
+    }
+    if (o.reprocess) {
+        ReprocessOptions ro;
+        ro.trackerAxes = o.trackerAxes;
+        ro.accelAxes = o.accelAxes;
+        auto r = reprocess(*recording, ro);
+        if (!r) {
+            log->error("{}: --reprocess: {}", o.file, r.error().message);
+            return kExitFailure;
+        }
+        reprocessed = *r;
+        if (r->posesReprocessed + r->accelReprocessed == 0) {
+            log->warn("{}: --reprocess: the recording holds no raw inputs of the tracker or "
+                      "accelerometer (format {}; they are recorded from format 5 on, from live "
+                      "devices and the simulated accelerometer): replaying their recorded "
+                      "samples",
+                      o.file, recording->formatVersion);
+        }
     }
     for (std::size_t i = 0; i < recording->frames.size(); ++i) {
         const std::int64_t before = i > 0 ? recording->frames[i - 1].tickNs : 0;
@@ -476,6 +503,33 @@ int replayMain(const ReplayOptions& o)
             summary["slice"]["to_s"] = *o.toS;
         }
     }
+    if (reprocessed) {
+        const ReprocessReport& r = *reprocessed;
+        summary["reprocess"] = {{"poses", r.poses},
+                                {"poses_reprocessed", r.posesReprocessed},
+                                {"poses_changed", r.posesChanged},
+                                {"pose_times_differ", r.poseTimesDiffer},
+                                {"accel", r.accel},
+                                {"accel_reprocessed", r.accelReprocessed},
+                                {"accel_changed", r.accelChanged},
+                                {"lamp", r.lamp},
+                                {"lamp_reprocessed", r.lampReprocessed},
+                                {"lamp_changed", r.lampChanged}};
+        say(fmt::format("reprocessed: {} of {} poses ({} changed) and {} of {} accelerometer "
+                        "samples ({} changed) from their raw inputs; the rest as recorded",
+                        r.posesReprocessed, r.poses, r.posesChanged, r.accelReprocessed, r.accel,
+                        r.accelChanged));
+        if (r.lamp > 0) {
+            say(fmt::format("reprocessed: {} of {} lamp selector positions decoded again from "
+                            "their line levels ({} changed)",
+                            r.lampReprocessed, r.lamp, r.lampChanged));
+        }
+        if (r.poseTimesDiffer > 0) {
+            say(fmt::format("reprocessed: {} HID reports' device times map to other session "
+                            "times than recorded; the samples keep their recorded times",
+                            r.poseTimesDiffer));
+        }
+    }
     if (!o.digests.empty()) {
         summary["digests"] = {{"file", o.digests}, {"hash", digestHashName(hash)}};
         say(fmt::format("digests: {}", o.digests));
@@ -494,10 +548,16 @@ int replayMain(const ReplayOptions& o)
                                       {"differing", shownDiffering}};
         if (shownDiffering > 0) {
             summary["display_digests"]["first_differing_frame"] = firstShownDiff;
+            const bool reprocessedChanges =
+                    reprocessed && reprocessed->posesChanged + reprocessed->accelChanged +
+                                                   reprocessed->lampChanged >
+                                           0;
             log->warn("{}: {} of {} frames differ from the digests of what the panel showed "
-                      "when recorded (first: frame {}); this machine renders differently (a "
-                      "different Mesa or GPU?)",
-                      o.file, shownDiffering, shownMatched + shownDiffering, firstShownDiff);
+                      "when recorded (first: frame {}); {}",
+                      o.file, shownDiffering, shownMatched + shownDiffering, firstShownDiff,
+                      reprocessedChanges
+                              ? "--reprocess changed samples, as expected"
+                              : "this machine renders differently (a different Mesa or GPU?)");
         } else {
             say(fmt::format("shown: all {} frames match the recorded digests of what the panel "
                             "showed",
@@ -672,6 +732,17 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
                     "on standard input")
             ->check(CLI::IsMember({"recorded", "fast", "step"}))
             ->capture_default_str();
+    cmd->add_flag("--reprocess", opts->reprocess,
+                  "raw in, processed out: re-derive the tracker's and accelerometer's samples "
+                  "from the raw inputs recorded beside them (format 5) with today's processing "
+                  "code, so a processing fix applies to old field recordings; samples without "
+                  "raw inputs stay as recorded");
+    cmd->add_option("--tracker-axes", opts->trackerAxes,
+                    "with --reprocess: HID tracker axes to use instead of the recorded ones "
+                    "(as 'run --tracker-axes', e.g. x,-y,z)");
+    cmd->add_option("--accel-axes", opts->accelAxes,
+                    "with --reprocess: accelerometer mounting to use instead of the recorded one "
+                    "(as 'run --accel-axes', e.g. -y,x,z)");
     cmd->callback([opts, &exitCode] { exitCode = replayMain(*opts); });
 }
 

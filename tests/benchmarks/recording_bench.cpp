@@ -60,11 +60,18 @@ struct SampleMaker {
     hal::PoseSample pose(std::uint32_t seq, std::int64_t t)
     {
         const double s = 1e-9 * static_cast<double>(t);
-        return {t, seq, {0.3 * std::sin(s) + 1e-4 * noise(rng), 0.05 * std::cos(2 * s), 0.6}, true};
+        return {t,
+                seq,
+                {0.3 * std::sin(s) + 1e-4 * noise(rng), 0.05 * std::cos(2 * s), 0.6},
+                true,
+                nullptr};
     }
     hal::AccelSample accel(std::uint32_t seq, std::int64_t t)
     {
-        return {t, seq, {0.01 * noise(rng), -8.14 + 0.01 * noise(rng), -5.43 + 0.01 * noise(rng)}};
+        return {t,
+                seq,
+                {0.01 * noise(rng), -8.14 + 0.01 * noise(rng), -5.43 + 0.01 * noise(rng)},
+                nullptr};
     }
 };
 

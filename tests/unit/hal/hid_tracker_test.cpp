@@ -5,6 +5,7 @@
 // padding, a 32-bit millisecond timestamp, int16 positions in 0.1 cm listed Z, X, Y, and its
 // calibrated screen in 0.01 inch). Expected values come from the byte layouts as written here,
 // not from the parser.
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -20,6 +21,8 @@
 #include <hal/tracker/hid_eye_head.h>
 #include <hal/tracker/hid_tracker_source.h>
 #include <hal/tracker/hidapi_device.h>
+#include <platform/reprocess.h>
+#include <recordings/recording.h>
 
 #include <gtest/gtest.h>
 
@@ -447,6 +450,138 @@ TEST(HidTracker, DeviceTimestampsAreAnchoredToTheLeastDelayedArrival)
     auto p = r->next();
     ASSERT_TRUE(p && *p);
     EXPECT_EQ((*p)->timestampNs, base + 50'000'000);
+}
+
+bool sameEyeBits(const glm::dvec3& a, const glm::dvec3& b)
+{
+    for (int i = 0; i < 3; ++i) {
+        if (std::bit_cast<std::uint64_t>(a[i]) != std::bit_cast<std::uint64_t>(b[i])) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// Raw in, processed out: each pose carries its report as received and the descriptor of its
+// opening; recorded and read back, reprocessing the reports gives the same poses bit for bit
+// (device-clock anchoring included), and another axis mapping changes them.
+TEST(HidTracker, RawReportsAreRecordedAndReprocessToTheSamePoses)
+{
+    hal::VirtualClock clock;
+    std::vector<hal::PoseSample> live;
+    std::uint32_t seq = 0;
+    for (int opening = 0; opening < 2; ++opening) { // a replug: a second opening
+        auto s = deviceA();
+        auto r = HidTrackerReader::open(std::make_unique<FakeHidTracker>(s), clock, {});
+        ASSERT_TRUE(r) << r.error().message;
+        // The 90 ms delay re-anchors the device clock (more than 50 ms behind).
+        const std::int64_t delays[] = {4'000'000, 1'000'000, 6'000'000, 90'000'000, 2'000'000};
+        for (int i = 0; i < 5; ++i) {
+            const auto sent = reportA(static_cast<std::uint64_t>(1'000'000 + 8'333 * i),
+                                      {-32'000 + 1'000 * (i + 1), 10'000, 600'000},
+                                      {32'000, 12'000, 610'000}, {0, 60'000, 650'000});
+            s->inputs.push_back(sent);
+            clock.set(opening * 5'000'000'000LL + 1'000'000'000 + 8'333'000 * i + delays[i]);
+            auto p = r->next();
+            ASSERT_TRUE(p && *p);
+            hal::PoseSample sample = **p;
+            sample.sequence = seq++;
+            ASSERT_TRUE(sample.raw);
+            EXPECT_EQ(sample.raw->kind, hal::RawTrackerInput::Kind::HidReport);
+            EXPECT_EQ(sample.raw->arrivalNs, clock.nowNs());
+            EXPECT_EQ(sample.raw->bytes, sent);
+            live.push_back(sample);
+        }
+    }
+    ASSERT_EQ(*live[0].raw->hidDescriptor, kDescriptorA);
+    EXPECT_EQ(live[0].raw->hidDescriptor, live[4].raw->hidDescriptor);
+    EXPECT_NE(live[4].raw->hidDescriptor, live[5].raw->hidDescriptor);
+
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("replica-hid-raw-" + std::to_string(::getpid()) + ".mcap");
+    {
+        recordings::SessionInfo session;
+        session.softwareVersion = "test";
+        auto w = recordings::RecordingWriter::create(path, session);
+        ASSERT_TRUE(w) << w.error().message;
+        for (const auto& p : live) {
+            (*w)->write(p);
+        }
+        ASSERT_TRUE((*w)->close());
+    }
+    auto rec = recordings::readRecording(path);
+    std::filesystem::remove(path);
+    ASSERT_TRUE(rec) << rec.error().message;
+    ASSERT_EQ(rec->poses.size(), live.size());
+    EXPECT_EQ(rec->unmatchedRaw, 0u);
+    for (std::size_t i = 0; i < live.size(); ++i) {
+        ASSERT_TRUE(rec->poses[i].raw) << i;
+        EXPECT_EQ(rec->poses[i].raw->bytes, live[i].raw->bytes) << i;
+        EXPECT_EQ(rec->poses[i].raw->arrivalNs, live[i].raw->arrivalNs) << i;
+    }
+    EXPECT_EQ(*rec->poses[0].raw->hidDescriptor, kDescriptorA);
+    EXPECT_EQ(rec->poses[0].raw->hidDescriptor, rec->poses[4].raw->hidDescriptor);
+    EXPECT_NE(rec->poses[4].raw->hidDescriptor, rec->poses[5].raw->hidDescriptor);
+
+    // The processed values wiped: reprocessing must compute them again, bit for bit.
+    auto wiped = *rec;
+    for (auto& p : wiped.poses) {
+        p.eyeTrackerM = glm::dvec3(9.0);
+        p.tracked = false;
+    }
+    auto rep = platform::reprocess(wiped, {});
+    ASSERT_TRUE(rep) << rep.error().message;
+    EXPECT_EQ(rep->posesReprocessed, live.size());
+    EXPECT_EQ(rep->posesChanged, live.size());
+    EXPECT_EQ(rep->poseTimesDiffer, 0u); // the anchoring re-ran as live, reanchor included
+    for (std::size_t i = 0; i < live.size(); ++i) {
+        EXPECT_TRUE(sameEyeBits(wiped.poses[i].eyeTrackerM, live[i].eyeTrackerM)) << i;
+        EXPECT_TRUE(wiped.poses[i].tracked);
+    }
+    auto same = *rec;
+    rep = platform::reprocess(same, {});
+    ASSERT_TRUE(rep);
+    EXPECT_EQ(rep->posesChanged, 0u);
+
+    // A changed processing parameter: the device's x mirrored. The eye midpoint's x is
+    // (left + right) / 2 = 500 (i + 1) um as the reports were written.
+    auto mirrored = *rec;
+    platform::ReprocessOptions o;
+    o.trackerAxes = "-x,y,z";
+    rep = platform::reprocess(mirrored, o);
+    ASSERT_TRUE(rep);
+    EXPECT_EQ(rep->posesChanged, live.size());
+    for (std::size_t i = 0; i < live.size(); ++i) {
+        EXPECT_NEAR(live[i].eyeTrackerM.x, 0.0005 * static_cast<double>(i % 5 + 1), 1e-12);
+        EXPECT_NEAR(mirrored.poses[i].eyeTrackerM.x, -0.0005 * static_cast<double>(i % 5 + 1),
+                    1e-12);
+        EXPECT_EQ(mirrored.poses[i].eyeTrackerM.z, live[i].eyeTrackerM.z);
+    }
+
+    // Raw inputs that today's code cannot process: one line naming the pose, no crash.
+    auto cut = *rec;
+    auto shortRaw = std::make_shared<hal::RawTrackerInput>(*cut.poses[2].raw);
+    shortRaw->bytes.resize(20);
+    cut.poses[2].raw = shortRaw;
+    rep = platform::reprocess(cut, {});
+    ASSERT_FALSE(rep);
+    EXPECT_NE(rep.error().message.find("pose 2: a 20-byte HID report that is too short"),
+              std::string::npos)
+            << rep.error().message;
+    auto broken = *rec;
+    auto badDescriptor = std::make_shared<hal::RawTrackerInput>(*broken.poses[0].raw);
+    badDescriptor->hidDescriptor =
+            std::make_shared<const std::vector<std::uint8_t>>(std::vector<std::uint8_t>{0xC0});
+    broken.poses[0].raw = badDescriptor;
+    rep = platform::reprocess(broken, {});
+    ASSERT_FALSE(rep);
+    EXPECT_NE(rep.error().message.find("pose 0: the recorded HID report descriptor"),
+              std::string::npos)
+            << rep.error().message;
+    o.trackerAxes = "x,x,z";
+    auto badAxes = *rec;
+    rep = platform::reprocess(badAxes, o);
+    ASSERT_FALSE(rep);
 }
 
 TEST(HidTracker, BrokenDevicesAreRefusedWithAReason)

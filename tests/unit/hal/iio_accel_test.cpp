@@ -117,6 +117,14 @@ TEST_F(FakeIio, SourceSamplesLosesTheDeviceAndFindsItAgain)
     // The reading is the reaction to gravity; the sample carries gravity itself.
     EXPECT_DOUBLE_EQ(got[0].gravity.y, -1000 * 0.00980665);
     EXPECT_EQ(got[1].sequence, got[0].sequence + 1);
+    // Raw in, processed out: the sysfs values as read, with the scale, offset and mounting.
+    ASSERT_TRUE(got[0].raw);
+    EXPECT_EQ(got[0].raw->raw, (std::array<double, 3>{-12.0, 1000.0, 40.0}));
+    EXPECT_EQ(got[0].raw->scale, (std::array<double, 3>{0.00980665, 0.00980665, 0.00980665}));
+    EXPECT_EQ(got[0].raw->offset, (std::array<double, 3>{0.0, 0.0, 0.0}));
+    EXPECT_EQ(got[0].raw->axes, "x,y,z");
+    const glm::dvec3 again = hal::accel::gravityFromRaw(*got[0].raw, {});
+    EXPECT_EQ(again, got[0].gravity);
     fs::remove_all(dev_);
     ASSERT_TRUE(eventually([&] { return src->state() == hal::LinkState::Lost; }));
     fs::create_directories(dev_);

@@ -114,6 +114,12 @@ TEST(OpentrackSource, ReceivesPosesDropsBadOnesAndGoesStale)
     EXPECT_DOUBLE_EQ(got[1].eyeTrackerM.z, -0.70);
     EXPECT_EQ(got[1].sequence, got[0].sequence + 1);
     EXPECT_EQ((*src)->state(), hal::LinkState::Connected);
+    // Raw in, processed out: each pose carries the datagram as it arrived and the mounting.
+    ASSERT_TRUE(got[1].raw);
+    EXPECT_EQ(got[1].raw->kind, hal::RawTrackerInput::Kind::OpentrackDatagram);
+    EXPECT_EQ(got[1].raw->bytes, datagram({3.0, 4.0, 70.0, 0, 0, 0}));
+    EXPECT_EQ(got[1].raw->arrivalNs, got[1].timestampNs);
+    EXPECT_EQ(got[1].raw->zSign, -1.0);
 
     // Silence: the source turns Stalled and reports one untracked sample.
     ASSERT_TRUE(eventually([&] { return (*src)->state() == hal::LinkState::Stalled; }));
@@ -121,6 +127,7 @@ TEST(OpentrackSource, ReceivesPosesDropsBadOnesAndGoesStale)
     (*src)->poll(clock.nowNs(), got);
     ASSERT_EQ(got.size(), 1u);
     EXPECT_FALSE(got[0].tracked);
+    EXPECT_FALSE(got[0].raw); // made by the source, not by the device
     got.clear();
     (*src)->poll(clock.nowNs(), got);
     EXPECT_TRUE(got.empty());

@@ -153,7 +153,7 @@ TEST(RecordingRoundTrip, WhatWasShownComesBack)
     }
     auto r = readRecording(path);
     ASSERT_TRUE(r) << r.error().message;
-    EXPECT_EQ(r->formatVersion, 4);
+    EXPECT_EQ(r->formatVersion, kFormatVersion);
     ASSERT_EQ(r->displayDigests.size(), 2u);
     EXPECT_EQ(r->displayDigests[1].rgba, 0xfedcba9876543210ULL);
     EXPECT_EQ(r->displayDigests[1].tickNs, 16'666'667);
