@@ -50,6 +50,9 @@ const JsonSchema& runConfigSchema()
                 {"horizon_pick", flag},
                 {"area_lights", integer(kAutoAreaLights, 1).optional()},
                 {"cache_slices", integer(1, kMaxCacheSlices).optional()},
+                // A luminance scale on the booth's lights (0 excluded by fromJson).
+                {"booth_dimmer", number(0.0, 1.0).optional()},
+                {"booth_dimmer_auto", flag},
                 {"surround_illuminance", flag},
                 {"horizon_directions", integer(0, 32).optional()},
                 {"display_digest", string(64).optional()},
