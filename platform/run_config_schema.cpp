@@ -53,6 +53,8 @@ const JsonSchema& runConfigSchema()
                 // A luminance scale on the booth's lights (0 excluded by fromJson).
                 {"booth_dimmer", number(0.0, 1.0).optional()},
                 {"booth_dimmer_auto", flag},
+                // The render profile that fixes the render switches (0: each switch's own key).
+                {"render_profile", integer(0, 65535).optional()},
                 {"surround_illuminance", flag},
                 {"horizon_directions", integer(0, 32).optional()},
                 {"display_digest", string(64).optional()},
