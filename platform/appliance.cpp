@@ -27,6 +27,7 @@
 #include <platform/booth_dimmer.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_digest.h>
+#include <platform/run_config_schema.h>
 
 namespace replica::platform {
 
@@ -158,11 +159,14 @@ Expected<pipeline::render::RenderSwitches> readSwitches(const nlohmann::json& j)
 
 } // namespace
 
-Expected<RunConfig> RunConfig::fromJson(const std::string& json)
+Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std::string>* warnings)
 {
     RunConfig c;
     try {
         const auto j = nlohmann::json::parse(json);
+        if (auto ok = validateJson(j, runConfigSchema(), "run configuration", warnings); !ok) {
+            return tl::unexpected(ok.error());
+        }
         c.width = j.at("width").get<int>();
         c.height = j.at("height").get<int>();
         c.rateHz = j.at("rate_hz").get<double>();

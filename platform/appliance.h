@@ -135,7 +135,11 @@ struct RunConfig {
 
     std::int64_t periodNs() const;
     std::string toJson() const;
-    static Expected<RunConfig> fromJson(const std::string& json);
+    // A recording's configuration is untrusted: it is held against runConfigSchema() first
+    // (run_config_schema.h), naming the JSON path of a refused value; unknown keys go to
+    // 'warnings' when given, else to jsonWarningSink().
+    static Expected<RunConfig> fromJson(const std::string& json,
+                                        std::vector<std::string>* warnings = nullptr);
 };
 
 // The light-adaptive basis (pipeline/spectral/adaptive_encoding.h): the default for new runs.

@@ -56,7 +56,7 @@ std::vector<fs::path> recoverUnfinished(const fs::path& dir)
         }
         fs::path tmp = f;
         tmp += ".recovering";
-        auto r = recordings::recoverRecording(f, tmp);
+        auto r = recordings::recoverRecording(f, tmp, recordings::ExistingOutput::Replace);
         std::error_code ec;
         if (!r) {
             fs::remove(tmp, ec);

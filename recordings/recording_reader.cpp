@@ -11,6 +11,7 @@
 #include <recordings/mcap/reader.h>
 #include <recordings/recording.h>
 #include <recordings/sample_codec.h>
+#include <recordings/session_schema.h>
 
 namespace replica::recordings {
 namespace {
@@ -92,6 +93,11 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
         try {
             const auto j = nlohmann::json::parse(m.data);
             if (topic == kSessionTopic) {
+                if (auto ok = validateJson(j, sessionSchema(),
+                                           fmt::format("{}: {} message", name, topic));
+                    !ok) {
+                    return tl::unexpected(ok.error());
+                }
                 rec.session = decodeSession(j, rec.formatVersion);
                 haveSession = true;
             } else if (topic == kSpectrometerTopic) {

@@ -1,11 +1,17 @@
 // Recovery: a resynchronising linear scan, then a fresh writer for everything that survived.
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
+#include <random>
 #include <set>
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <pipeline/base/input_file.h>
 #include <recordings/mcap/reader.h>
@@ -14,20 +20,173 @@
 #include <recordings/sample_codec.h>
 
 namespace replica::recordings {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Everything about OUT that can be refused before the input is read.
+Expected<void> checkOutput(const fs::path& in, const fs::path& out, ExistingOutput existing)
+{
+    const std::string name = out.string();
+    std::error_code ec;
+    const auto st = fs::symlink_status(out, ec);
+    if (ec && ec != std::errc::no_such_file_or_directory) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: cannot check the output: {}", name, ec.message()));
+    }
+    if (fs::exists(st)) {
+        if (fs::is_symlink(st)) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: is a symbolic link; recover never writes through "
+                                         "or replaces one: name the file itself",
+                                         name));
+        }
+        std::error_code same;
+        if (fs::equivalent(in, out, same)) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: is the input itself; recover writes a new file: "
+                                         "give a different OUT",
+                                         name));
+        }
+        if (!fs::is_regular_file(st)) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: exists and is not a regular file (a directory or "
+                                         "device); name a new file",
+                                         name));
+        }
+        if (existing == ExistingOutput::Refuse) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: already exists; pass --force to replace it, or "
+                                         "name a new file",
+                                         name));
+        }
+    }
+    const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+    if (!fs::is_directory(dir, ec)) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: the folder {} does not exist; create it or name another "
+                                     "OUT",
+                                     name, dir.string()));
+    }
+    return {};
+}
+
+// A new, empty file beside `out` (same folder, so the rename cannot cross file systems), created
+// exclusively and never through a link.
+Expected<fs::path> createTemporaryBeside(const fs::path& out)
+{
+    std::random_device entropy;
+    for (int attempt = 0; attempt < 16; ++attempt) {
+        fs::path tmp = out;
+        tmp.replace_filename(fmt::format(".{}.recover-{}-{:08x}", out.filename().string(),
+                                         ::getpid(), entropy()));
+        const int fd =
+                ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+        if (fd >= 0) {
+            ::close(fd);
+            return tmp;
+        }
+        if (errno != EEXIST) {
+            const int err = errno;
+            return makeError(ErrorCode::Io,
+                             fmt::format("{}: cannot create a file in its folder: {}{}",
+                                         out.string(), std::strerror(err),
+                                         err == EACCES || err == EROFS
+                                                 ? " (choose a writable folder)"
+                                                 : ""));
+        }
+    }
+    return makeError(ErrorCode::Io,
+                     fmt::format("{}: no free temporary name beside it", out.string()));
+}
+
+// Puts the finished temporary file at `out`: over an existing regular file only when asked,
+// never over anything that appeared there since the check (link fails if `out` exists).
+Expected<void> moveIntoPlace(const fs::path& tmp, const fs::path& out, ExistingOutput existing)
+{
+    if (existing == ExistingOutput::Replace) {
+        if (::rename(tmp.c_str(), out.c_str()) != 0) {
+            const int err = errno;
+            return makeError(ErrorCode::Io, fmt::format("{}: cannot rename the recovered file "
+                                                        "onto it: {}",
+                                                        out.string(), std::strerror(err)));
+        }
+    } else {
+        if (::link(tmp.c_str(), out.c_str()) != 0) {
+            const int err = errno;
+            return makeError(err == EEXIST ? ErrorCode::InvalidArgument : ErrorCode::Io,
+                             err == EEXIST ? fmt::format("{}: appeared while recovering; pass "
+                                                         "--force to replace it, or name a new "
+                                                         "file",
+                                                         out.string())
+                                           : fmt::format("{}: cannot create it: {}", out.string(),
+                                                         std::strerror(err)));
+        }
+        ::unlink(tmp.c_str());
+    }
+    // The rename itself survives a power cut once the folder is synced.
+    const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+    const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd >= 0) {
+        (void)::fsync(dfd);
+        ::close(dfd);
+    }
+    return {};
+}
+
+// Every kept message into a fresh, complete recording at `path` (finish() syncs it).
+Expected<void> writeRecovered(const mcap::Scan& s, const fs::path& path)
+{
+    auto w = mcap::FileWriter::create(path, s.library.empty() ? "replica recover" : s.library,
+                                      false);
+    if (!w) {
+        return tl::unexpected(w.error());
+    }
+    for (const auto& md : s.metadata) {
+        if (auto ok = (*w)->addMetadata(md); !ok) {
+            return tl::unexpected(ok.error());
+        }
+    }
+    std::set<std::uint16_t> schemasUsed;
+    for (const auto& [id, c] : s.channels) {
+        schemasUsed.insert(c.schemaId);
+    }
+    for (const auto& [id, schema] : s.schemas) {
+        if (schemasUsed.contains(id)) {
+            (*w)->addSchema(schema);
+        }
+    }
+    for (const auto& [id, c] : s.channels) {
+        (*w)->addChannel(c);
+    }
+    constexpr std::size_t kChunkBytes = 256 * 1024;
+    for (const auto& m : s.messages) {
+        (*w)->addMessage(m);
+        if ((*w)->pendingBytes() >= kChunkBytes) {
+            if (auto ok = (*w)->closeChunk(false); !ok) {
+                return tl::unexpected(ok.error());
+            }
+        }
+    }
+    if (auto ok = (*w)->finish(); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return {};
+}
+
+} // namespace
 
 Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
-                                         const std::filesystem::path& out)
+                                         const std::filesystem::path& out,
+                                         ExistingOutput existing)
 {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(in, ec)) {
         return makeError(ErrorCode::NotFound,
                          fmt::format("{}: no such recording (or not a regular file)", in.string()));
     }
-    std::error_code ec2;
-    if (std::filesystem::equivalent(in, out, ec2)) {
-        return makeError(
-                ErrorCode::InvalidArgument,
-                fmt::format("{}: recover writes a new file; give a different OUT", out.string()));
+    if (auto ok = checkOutput(in, out, existing); !ok) {
+        return tl::unexpected(ok.error());
     }
     auto read = readInputFile(in, kMaxRecordingBytes, "recording");
     if (!read) {
@@ -108,38 +267,22 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
     r.channelsAssumed = s.channelsAssumed;
     r.sessionRestored = sessionRestored;
 
-    auto w = mcap::FileWriter::create(out, s.library.empty() ? "replica recover" : s.library);
-    if (!w) {
-        return tl::unexpected(w.error());
+    auto tmp = createTemporaryBeside(out);
+    if (!tmp) {
+        return tl::unexpected(tmp.error());
     }
-    for (const auto& md : s.metadata) {
-        if (auto ok = (*w)->addMetadata(md); !ok) {
-            return tl::unexpected(ok.error());
-        }
+    // Whatever goes wrong from here, the temporary file goes and `out` stays as it was.
+    auto written = writeRecovered(s, *tmp);
+    if (!written) {
+        written =
+                makeError(written.error().code, fmt::format("{}: not written (left as it was): {}",
+                                                            out.string(), written.error().message));
+    } else {
+        written = moveIntoPlace(*tmp, out, existing);
     }
-    std::set<std::uint16_t> schemasUsed;
-    for (const auto& [id, c] : s.channels) {
-        schemasUsed.insert(c.schemaId);
-    }
-    for (const auto& [id, schema] : s.schemas) {
-        if (schemasUsed.contains(id)) {
-            (*w)->addSchema(schema);
-        }
-    }
-    for (const auto& [id, c] : s.channels) {
-        (*w)->addChannel(c);
-    }
-    constexpr std::size_t kChunkBytes = 256 * 1024;
-    for (const auto& m : s.messages) {
-        (*w)->addMessage(m);
-        if ((*w)->pendingBytes() >= kChunkBytes) {
-            if (auto ok = (*w)->closeChunk(false); !ok) {
-                return tl::unexpected(ok.error());
-            }
-        }
-    }
-    if (auto ok = (*w)->finish(); !ok) {
-        return tl::unexpected(ok.error());
+    if (!written) {
+        std::filesystem::remove(*tmp, ec);
+        return tl::unexpected(written.error());
     }
     return r;
 }

@@ -22,10 +22,18 @@ struct RecoverReport {
     bool lossy() const { return bytesDropped > 0 || messagesDropped > 0 || chunksDamaged > 0; }
 };
 
+// What recover does when its output already exists ('replica recover --force': Replace).
+enum class ExistingOutput { Refuse, Replace };
+
 // Reads `in` linearly (no footer needed), resynchronising on the next intact chunk after damage,
 // and writes every message it could keep to `out` as a complete, indexed recording. Fails when
 // `in` cannot be read, nothing is recoverable, or `out` cannot be written.
+// The output is written to a new file beside `out` and renamed onto it only once complete and
+// synced, so an interrupted or failed recover leaves `out` as it was (and `in` is only read).
+// `out` must not be `in`, a symbolic link (never followed nor replaced), a directory or any other
+// non-regular file; an existing regular file is refused unless `existing` is Replace.
 Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
-                                         const std::filesystem::path& out);
+                                         const std::filesystem::path& out,
+                                         ExistingOutput existing);
 
 } // namespace replica::recordings

@@ -370,7 +370,9 @@ Expected<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> b
             auto& bits = d.reportBits[{rt, g.reportId}];
             const bool constant = (v.raw & 0x01) != 0;
             const bool variable = (v.raw & 0x02) != 0;
-            const auto [lo, hi] = logicalRange(g);
+            // Not a structured binding: clang before 16 cannot capture one in the lambda below
+            // (the libFuzzer build, tests/fuzz/run_fuzz.sh).
+            const auto logical = logicalRange(g);
             std::vector<std::uint32_t> path;
             for (const auto& c : open) {
                 path.push_back(c.usage);
@@ -385,8 +387,8 @@ Expected<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> b
                 f.constant = constant || !variable || u == 0;
                 f.relative = (v.raw & 0x04) != 0;
                 f.nullState = (v.raw & 0x40) != 0;
-                f.logicalMin = lo;
-                f.logicalMax = hi;
+                f.logicalMin = logical.first;
+                f.logicalMax = logical.second;
                 f.unit = g.unit;
                 f.collections = path;
                 return f;

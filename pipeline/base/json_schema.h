@@ -21,6 +21,8 @@
 
 namespace replica {
 
+struct JsonSchemaField;
+
 struct JsonSchema {
     enum class Type { Any, Object, Array, String, Number, Integer, Bool };
     Type type = Type::Any;
@@ -30,23 +32,34 @@ struct JsonSchema {
     double max = std::numeric_limits<double>::max();
     std::size_t minItems = 0; // arrays (and strings: length)
     std::size_t maxItems = std::numeric_limits<std::size_t>::max();
-    std::vector<std::pair<std::string, JsonSchema>> fields; // objects: the known keys
+    // Objects: the known keys. A plain struct, not std::pair: clang with libstdc++ refuses a
+    // pair of a type still incomplete here (the libFuzzer build, tests/fuzz/run_fuzz.sh).
+    std::vector<JsonSchemaField> fields;
     bool openObject = false; // objects: any key, each checked against 'items' (a map)
     std::shared_ptr<const JsonSchema> items; // arrays: every element
 
-    JsonSchema optional() const
-    {
-        JsonSchema s = *this;
-        s.required = false;
-        return s;
-    }
-    JsonSchema orNull() const
-    {
-        JsonSchema s = *this;
-        s.nullable = true;
-        return s;
-    }
+    JsonSchema optional() const;
+    JsonSchema orNull() const;
 };
+
+struct JsonSchemaField {
+    std::string first; // the key
+    JsonSchema second; // its schema
+};
+
+inline JsonSchema JsonSchema::optional() const
+{
+    JsonSchema s = *this;
+    s.required = false;
+    return s;
+}
+
+inline JsonSchema JsonSchema::orNull() const
+{
+    JsonSchema s = *this;
+    s.nullable = true;
+    return s;
+}
 
 namespace json_schema {
 
@@ -91,7 +104,7 @@ inline JsonSchema array(JsonSchema item, std::size_t minItems, std::size_t maxIt
     s.maxItems = maxItems;
     return s;
 }
-inline JsonSchema object(std::vector<std::pair<std::string, JsonSchema>> fields)
+inline JsonSchema object(std::vector<JsonSchemaField> fields)
 {
     JsonSchema s;
     s.type = JsonSchema::Type::Object;

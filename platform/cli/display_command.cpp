@@ -510,9 +510,13 @@ int flareMain(const DisplayOptions& o)
     ignore.flare = "ignore";
     DisplayOptions subtract = o;
     subtract.flare = "subtract";
+    // One setup's error is the other's too: say it once.
     auto a = studySetup(ignore);
+    if (!a) {
+        return kExitFailure;
+    }
     auto b = studySetup(subtract);
-    if (!a || !b) {
+    if (!b) {
         return kExitFailure;
     }
     auto left = pd::colorCheckerStudy(*a->inverse, a->panel, dataDir(), a->options);

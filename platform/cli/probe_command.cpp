@@ -3,11 +3,14 @@
 // 'replica run --hal live' would, takes one reading, and says what to do about anything missing.
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include <hal/accel/iio_accel.h>
@@ -21,6 +24,7 @@
 #include <hal/tracker/opentrack_source.h>
 #include <pipeline/scene/stand.h>
 #include <platform/cli/commands.h>
+#include <platform/logging.h>
 
 namespace replica::platform {
 namespace {
@@ -264,17 +268,32 @@ int runProbe(const ProbeOptions& o)
                           {"hid_trackers", probeHidTrackers(o)},
                           {"lamp_selector", probeLampSelector(o)}};
     bool all = true;
+    std::vector<std::string> missing;
     for (const char* k : {"spectrometer", "accelerometer", "tracker"}) {
         const auto& d = report[k];
-        all = all && d.value("found", false) && d.value("ok", true);
+        if (!(d.value("found", false) && d.value("ok", true))) {
+            all = false;
+            missing.emplace_back(k);
+        }
     }
     const auto& lamp = report["lamp_selector"];
-    if (lamp["configured"].get<bool>()) {
-        all = all && lamp.value("found", false) && lamp.value("ok", true);
+    if (lamp["configured"].get<bool>() && !(lamp.value("found", false) && lamp.value("ok", true))) {
+        all = false;
+        missing.emplace_back("lamp selector");
     }
     report["all_found"] = all;
+    // The report goes to standard output; a failing probe also says so in one line on standard
+    // error, as every other failing command does.
+    const auto summary = [&missing] {
+        logger("replica")->error("probe: {} missing or not working (the report says why); "
+                                 "connect it and probe again, or run with --hal sim",
+                                 fmt::join(missing, ", "));
+    };
     if (o.json) {
         std::cout << report.dump(2) << "\n";
+        if (!all) {
+            summary();
+        }
         return all ? kExitOk : kExitFailure;
     }
     const auto& s = report["spectrometer"];
@@ -342,6 +361,10 @@ int runProbe(const ProbeOptions& o)
     } else {
         fmt::print("lamp selector  MISSING: {}; GPIO chips: {}\n", lamp["error"].get<std::string>(),
                    chipList);
+    }
+    if (!all) {
+        std::fflush(stdout);
+        summary();
     }
     return all ? kExitOk : kExitFailure;
 }

@@ -12,11 +12,14 @@ namespace {
 struct RecoverOptions {
     std::string in, out;
     bool json = false;
+    bool force = false;
 };
 
 int recoverMain(const RecoverOptions& o)
 {
-    auto r = recordings::recoverRecording(o.in, o.out);
+    auto r = recordings::recoverRecording(o.in, o.out,
+                                          o.force ? recordings::ExistingOutput::Replace
+                                                  : recordings::ExistingOutput::Refuse);
     if (!r) {
         if (o.json) {
             fmt::print("{}\n", nlohmann::json{{"error", r.error().message}}.dump(2));
@@ -62,6 +65,9 @@ void registerRecoverCommand(CLI::App& app, int& exitCode)
     cmd->add_option("in", opts->in, "damaged recording (.mcap)")->required();
     cmd->add_option("out", opts->out, "where to write the rebuilt recording")->required();
     cmd->add_flag("--json", opts->json, "print the report as JSON");
+    cmd->add_flag("--force", opts->force,
+                  "replace OUT if it is an existing regular file (written beside it, then "
+                  "renamed onto it; a symbolic link is never followed or replaced)");
     cmd->callback([opts, &exitCode] { exitCode = recoverMain(*opts); });
 }
 

@@ -170,7 +170,11 @@ int replayMain(const ReplayOptions& o)
         log->error("{}", recording.error().message);
         return kExitFailure;
     }
-    auto config = RunConfig::fromJson(recording->session.configJson);
+    std::vector<std::string> configWarnings;
+    auto config = RunConfig::fromJson(recording->session.configJson, &configWarnings);
+    for (const auto& w : configWarnings) {
+        log->warn("{}: {}", o.file, w);
+    }
     if (!config) {
         log->error("{}: {}", o.file, config.error().message);
         return kExitFailure;

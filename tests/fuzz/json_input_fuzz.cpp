@@ -1,11 +1,13 @@
 // Fuzz target for the text formats a person hands Replica: scene.json, booth.json, display
 // profiles (JSON) and the CSV tables (spectral, display measurements, viewing angles). The first
 // byte picks the format, the rest is the file. Every input must come back as a value or an Error,
-// never an exception, abort or hang. With REPLICA_FUZZ_STANDALONE it is a plain program that runs
-// the corpus under json_corpus/ plus seeded random mutations (every CI build, any compiler); the
-// same entry point builds under libFuzzer with clang.
+// never an exception, abort or hang. With REPLICA_FUZZ_STANDALONE it links the plain driver
+// standalone_driver.cpp: the corpus under json_corpus/ plus seeded random mutations with the
+// tokens of json_input.dict (every CI build, any compiler); under clang the same entry point
+// links libFuzzer (tests/fuzz/run_fuzz.sh, with the same dictionary).
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -21,16 +23,21 @@
 
 namespace {
 
-// scene.json and booth.json are read from a folder: one scratch folder per process.
+// scene.json and booth.json are read from a folder: one scratch folder per process, removed at
+// exit (the path is never destroyed, so the exit handler can still read it).
 const std::filesystem::path& scratch()
 {
-    static const std::filesystem::path dir = [] {
-        auto d = std::filesystem::temp_directory_path() /
-                 ("replica-json-fuzz-" + std::to_string(::getpid()));
-        std::filesystem::create_directories(d);
+    static const std::filesystem::path* const dir = [] {
+        auto* d = new std::filesystem::path(std::filesystem::temp_directory_path() /
+                                            ("replica-json-fuzz-" + std::to_string(::getpid())));
+        std::filesystem::create_directories(*d);
+        std::atexit([] {
+            std::error_code ec;
+            std::filesystem::remove_all(scratch(), ec);
+        });
         return d;
     }();
-    return dir;
+    return *dir;
 }
 
 } // namespace
@@ -68,67 +75,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 }
 
 #ifdef REPLICA_FUZZ_STANDALONE
-#include <cstdio>
-#include <cstdlib>
-#include <iterator>
-#include <random>
-#include <vector>
+#include "standalone_driver.h"
 
-// Usage: json_input_fuzz CORPUS_DIR [MUTATIONS_PER_FILE [SEED]]
-int main(int argc, char** argv)
-{
-    if (argc < 2) {
-        std::fprintf(stderr, "usage: %s CORPUS_DIR [MUTATIONS_PER_FILE [SEED]]\n", argv[0]);
-        return 2;
-    }
-    const long mutations = argc > 2 ? std::strtol(argv[2], nullptr, 10) : 200;
-    std::mt19937_64 rng(argc > 3 ? std::strtoull(argv[3], nullptr, 10) : 1);
-    std::vector<std::string> corpus;
-    for (const auto& e : std::filesystem::directory_iterator(argv[1])) {
-        std::ifstream in(e.path(), std::ios::binary);
-        corpus.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    }
-    if (corpus.empty()) {
-        std::fprintf(stderr, "%s: empty corpus\n", argv[1]);
-        return 1;
-    }
-    // Text-shaped edits: wrong types, non-finite and huge numbers, BOMs, quotes, truncation.
-    const std::vector<std::string> tokens = {
-            "null", "\"x\"", "5",     "-1",         "1e308", "-1e308", "NaN",  "[]",
-            "{}",   "true",  "\"\"",  ",",          "\"",    "\n",     "\r\n", "\xEF\xBB\xBF",
-            "[[[[", "0",     "65536", "4294967296", "..",    "/"};
-    long runs = 0;
-    auto run = [&](const std::string& s) {
-        LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(s.data()), s.size());
-        ++runs;
-    };
-    for (const auto& seed : corpus) {
-        run(seed);
-        for (long k = 0; k < mutations; ++k) {
-            std::string m = seed;
-            const int edits = 1 + static_cast<int>(rng() % 4);
-            for (int e = 0; e < edits && m.size() > 1; ++e) {
-                const std::size_t at = 1 + rng() % (m.size() - 1); // byte 0 picks the format
-                switch (rng() % 4) {
-                case 0:
-                    m[at] = static_cast<char>(m[at] ^ (1 << (rng() % 8)));
-                    break;
-                case 1:
-                    m.resize(at);
-                    break;
-                case 2:
-                    m.erase(at, rng() % 16);
-                    break;
-                default:
-                    m.insert(at, tokens[rng() % tokens.size()]);
-                }
-            }
-            run(m);
-        }
-    }
-    std::filesystem::remove_all(scratch());
-    std::printf("ok: %ld inputs (%zu corpus files, %ld mutations each), no crash\n", runs,
-                corpus.size(), mutations);
-    return 0;
-}
+// The standalone driver's mutations leave byte 0, which picks the format, alone.
+const std::size_t replica::fuzz::kKeepPrefix = 1;
 #endif

@@ -1,30 +1,55 @@
 #!/usr/bin/env bash
-# Builds the reader's libFuzzer target with clang (ASan + UBSan) and fuzzes for a bounded time,
-# starting from the committed corpus (new finds go to a scratch corpus, not the repository).
-# Without clang and its fuzzer runtime it says so and exits 77 (ctest: skipped); the standalone
-# corpus-and-mutations run (fuzz.mcap_reader_corpus) covers every compiler.
+# Builds one fuzz target with clang and libFuzzer (ASan + UBSan) and fuzzes it for a bounded time,
+# starting from its committed corpus (new finds go to a scratch corpus, not the repository).
+#   run_fuzz.sh SOURCE_DIR WORK_DIR TARGET [SECONDS]      TARGET: mcap_reader or json_input
+# The clang build is a CMake build tree under WORK_DIR/build (REPLICA_LIBFUZZER=ON), built once
+# and then only where sources changed. Without clang and its fuzzer runtime (Debian's clang,
+# libclang-rt-14-dev) it says so and exits 77 (ctest: skipped); the standalone corpus-and-mutations
+# tests (fuzz.*_corpus) cover every compiler. Extra libFuzzer flags: FUZZ_FLAGS (e.g. -jobs=2).
 set -euo pipefail
 src="$1"
 work="$2"
-seconds="${3:-45}"
-rm -rf "$work/scratch" && mkdir -p "$work/scratch" "$work/crashes"
+target="$3"
+seconds="${4:-40}"
+case "$target" in
+mcap_reader) corpus="$src/tests/fuzz/corpus" dict="" max_len=32768 ;;
+json_input) corpus="$src/tests/fuzz/json_corpus" dict="$src/tests/fuzz/json_input.dict" max_len=16384 ;;
+*) echo "run_fuzz.sh: unknown target '$target' (mcap_reader, json_input)" >&2; exit 2 ;;
+esac
+mkdir -p "$work/crashes/$target"
+rm -rf "$work/scratch/$target" && mkdir -p "$work/scratch/$target"
 cxx="${CLANGXX:-clang++}"
+cc="${CLANGCC:-clang}"
 probe="$work/probe.cpp"
 echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned long) { return 0; }' > "$probe"
 if ! command -v "$cxx" >/dev/null 2>&1 || ! "$cxx" -fsanitize=fuzzer "$probe" -o "$work/probe" 2>/dev/null; then
     echo "SKIP: $cxx with -fsanitize=fuzzer is not available (apt-get install clang)"
     exit 77
 fi
-bin="$work/mcap_reader_fuzz"
-# Rebuild only when a source changed.
-sources=("$src/tests/fuzz/mcap_reader_fuzz.cpp" "$src"/recordings/mcap/*.cpp "$src/recordings/sample_codec.cpp")
-if [ ! -x "$bin" ] || [ -n "$(find "${sources[@]}" "$src"/recordings/*.h "$src"/recordings/mcap/*.h -newer "$bin" 2>/dev/null)" ]; then
-    "$cxx" -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-        -I"$src" "$(pkg-config --cflags-only-I glm 2>/dev/null || true)" "${sources[@]}" \
-        -o "$bin" -lfmt -lzstd -lz
+build="$work/build"
+if [ ! -f "$build/build.ninja" ]; then
+    # -O1 with line tables: fast enough to fuzz, readable stacks. Warnings are clang's, not
+    # the project's compiler's: not errors here.
+    cmake -S "$src" -B "$build" -G Ninja -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
+        -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+        -DCMAKE_UNITY_BUILD=OFF -DREPLICA_WERROR=OFF -DREPLICA_SANITIZE=ON -DREPLICA_LIBFUZZER=ON \
+        -DREPLICA_BUILD_BENCHMARKS=OFF >"$work/configure.log" 2>&1 ||
+        { tail -20 "$work/configure.log"; exit 1; }
 fi
+cmake --build "$build" --target "replica_fuzz_$target" -j "${FUZZ_BUILD_JOBS:-2}" >"$work/build-$target.log" 2>&1 ||
+    { tail -30 "$work/build-$target.log"; exit 1; }
 # -max_len: a little above the largest seed, so mutations can grow files.
-"$bin" -max_total_time="$seconds" -max_len=32768 -timeout=10 -rss_limit_mb=2048 \
-    -artifact_prefix="$work/crashes/" -print_final_stats=1 \
-    "$work/scratch" "$src/tests/fuzz/corpus" 2>&1 | tail -15
-echo "PASS: fuzzed the recording reader for ${seconds} s without a crash"
+set +e
+# shellcheck disable=SC2086
+"$build/tests/fuzz/replica_fuzz_$target" -max_total_time="$seconds" -max_len="$max_len" \
+    -timeout=10 -rss_limit_mb=2048 -artifact_prefix="$work/crashes/$target/" \
+    -print_final_stats=1 ${dict:+-dict="$dict"} ${FUZZ_FLAGS:-} \
+    "$work/scratch/$target" "$corpus" >"$work/fuzz-$target.log" 2>&1
+rc=$?
+set -e
+tail -25 "$work/fuzz-$target.log"
+if [ "$rc" -ne 0 ]; then
+    echo "FAIL: libFuzzer found a problem in $target (exit $rc); the input is in $work/crashes/$target/"
+    exit 1
+fi
+echo "PASS: fuzzed $target for ${seconds} s without a crash"

@@ -83,6 +83,9 @@ CONFIG = {"basis": "replica_k6", "booth": "replica-booth-1", "booth_lights": 32,
           "specular_samples": 16, "viewing_compensation": True, "width": 32}
 
 
+DELETE = object()  # a config_changes value: remove the key
+
+
 def device(model):
     return {"firmware": "sim", "model": model, "serial": "SIM-1", "source": "sim"}
 
@@ -96,12 +99,19 @@ def session(config, software="replica 0.1.0"):
 
 
 def recording(config_changes=None, frames=((0, 0), (1, 16666667)), software="replica 0.1.0",
-              extra=()):
+              extra=(), session_changes=None, config_text=None):
     config = dict(CONFIG)
     config.update(config_changes or {})
+    for key, value in (config_changes or {}).items():
+        if value is DELETE:
+            del config[key]
+    sess = session(config, software)
+    if config_text is not None:  # the configuration string exactly as given
+        sess["config"] = config_text
+    sess.update(session_changes or {})
     records = b"".join(schema(i, n) for i, n, _ in TOPICS)
     records += b"".join(channel(i, i, t) for i, _, t in TOPICS)
-    records += message(1, 0, 0, json.dumps(session(config, software)).encode())
+    records += message(1, 0, 0, json.dumps(sess).encode())
     for k, (index, tick) in enumerate(frames):
         records += message(5, k, tick, json.dumps({"frame": index, "tick_ns": tick}).encode())
     for cid, data in extra:
@@ -126,6 +136,25 @@ def main():
     write("scene-undigested.mcap", recording({"scene_digest": ""}))
     write("rate-nan.mcap", recording({"rate_hz": 0.0}))
     write("lights-overflow.mcap", recording({"lights_u": 65536, "lights_v": 65536}))
+    # The session message and the run configuration against their written schemas.
+    write("session-format-string.mcap", recording(session_changes={"format_version": "3"}))
+    write("session-config-object.mcap", recording(session_changes={"config": {"width": 32}}))
+    write("session-clock-negative.mcap", recording(session_changes={"wall_clock_start_ns": -5}))
+    write("session-device-number.mcap",
+          recording(session_changes={"tracker": {"model": 7, "serial": "", "firmware": "",
+                                                 "source": "sim"}}))
+    write("session-unknown-key.mcap", recording(session_changes={"owner": "someone"}))
+    write("config-rate-1e308.mcap", recording({"rate_hz": 1e308}))
+    write("config-rate-inf.mcap", recording(config_text=json.dumps(CONFIG).replace(
+        '"rate_hz": 60.0', '"rate_hz": 1e999')))
+    write("config-width-string.mcap", recording({"width": "32"}))
+    write("config-width-missing.mcap", recording({"width": DELETE}))
+    write("config-rotation-8.mcap",
+          recording({"t_booth_tracker": {"rotation": [1, 0, 0, 0, 1, 0, 0, 0],
+                                         "translation": [0, 0.42, 0.05]}}))
+    write("config-lod-bias-null.mcap", recording({"specular_lod_bias": None}))
+    write("config-not-json.mcap", recording(config_text='{"width": 32,'))
+    write("config-unknown-key.mcap", recording({"exposure_hack": 3}))
     write("tick-backwards.mcap", recording(frames=((0, 20000000), (1, 10000000))))
     write("tick-285-years.mcap", recording(frames=((0, 0), (1, 9000000000000000000))))
     write("escapes.mcap", recording(software="\x1b]0;owned\x07\x1b[2J\x1b[31mreplica"))

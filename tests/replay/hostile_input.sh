@@ -168,6 +168,15 @@ json.dump(j, open(sys.argv[2], "w"))
 PY
 expect 1 "profile-type.json: /bit_depth: expected an integer" -- "${R[@]}" display forward "$work/profile-type.json" --rgb 1,2,3
 
+# --- Errors that printed nothing on standard error, or one error several times (found by
+# running every command with bad inputs; the count is in docs/recordings.md).
+# probe's report goes to standard output; a failing probe also says so in one line.
+expect 1 "probe: .*missing or not working" -- "${R[@]}" probe --iio-root "$work/no-iio" --tracker-wait 0.2
+expect 1 "probe: .*missing or not working" -- "${R[@]}" probe --json --iio-root "$work/no-iio" --tracker-wait 0.2
+# display flare sets up the study twice; a bad profile or basis is said once.
+expect 1 "is a directory, not a display profile" -- "${R[@]}" display flare "$work"
+expect 1 "nope.csv: cannot open spectral table" -- "${R[@]}" display flare --basis nope
+
 # --- Recordings from the field.
 python3 "$here/craft_recordings.py" "$work/rec" || fail "craft_recordings.py failed"
 rec="$work/rec"
@@ -185,9 +194,54 @@ if [ -f "$rec/messages-40x16mib.mcap" ]; then # written where the zstd program e
     done
 fi
 expect 1 "recover" -- "${R[@]}" recover "$rec/bomb-40x16mib.mcap" "$work/recovered.mcap"
-expect 1 "size 16384x1" -- "${R[@]}" replay "$rec/frame-16384x1.mcap"
-expect 1 "rate 0 Hz" -- "${R[@]}" replay "$rec/rate-nan.mcap"
-expect 1 "lights 65536x65536" -- "${R[@]}" replay "$rec/lights-overflow.mcap"
+# recover writes a new file beside OUT and renames it into place: an existing OUT is replaced only
+# with --force, a symbolic link is never followed or replaced, the input is never written.
+cp "$sample" "$work/rec-in.mcap"
+sum_in=$(sha256sum < "$work/rec-in.mcap")
+printf 'keep me' > "$work/rec-out.mcap"
+expect 1 "rec-out.mcap: already exists; pass --force" -- "${R[@]}" recover "$work/rec-in.mcap" "$work/rec-out.mcap"
+[ "$(cat "$work/rec-out.mcap")" = "keep me" ] || fail "recover without --force changed an existing OUT"
+out=$("$replica" "${R[@]}" recover --force "$work/rec-in.mcap" "$work/rec-out.mcap" 2>&1 >/dev/null)
+code=$?
+if [ "$code" -ne 0 ] || [ -n "$out" ] || ! "$replica" "${R[@]}" inspect "$work/rec-out.mcap" >/dev/null; then
+    fail "recover --force over an existing file: exit $code: $out"
+else
+    pass=$((pass + 1))
+    echo "ok: recover --force replaces an existing OUT with a sound recording"
+fi
+ln -s "$work/rec-target.mcap" "$work/rec-link.mcap"
+expect 1 "rec-link.mcap: is a symbolic link" -- "${R[@]}" recover --force "$work/rec-in.mcap" "$work/rec-link.mcap"
+[ ! -e "$work/rec-target.mcap" ] || fail "recover wrote through a symbolic link"
+expect 1 "rec-in.mcap: is the input itself" -- "${R[@]}" recover --force "$work/rec-in.mcap" "$work/rec-in.mcap"
+ln "$work/rec-in.mcap" "$work/rec-hardlink.mcap"
+expect 1 "rec-hardlink.mcap: is the input itself" -- "${R[@]}" recover --force "$work/rec-in.mcap" "$work/rec-hardlink.mcap"
+mkdir -p "$work/rec-dir.mcap"
+expect 1 "rec-dir.mcap: exists and is not a regular file" -- "${R[@]}" recover --force "$work/rec-in.mcap" "$work/rec-dir.mcap"
+mkfifo "$work/rec-fifo.mcap"
+expect 1 "rec-fifo.mcap: exists and is not a regular file" -- "${R[@]}" recover --force "$work/rec-in.mcap" "$work/rec-fifo.mcap"
+expect 1 "the folder .*/nowhere does not exist" -- "${R[@]}" recover "$work/rec-in.mcap" "$work/nowhere/out.mcap"
+[ "$(sha256sum < "$work/rec-in.mcap")" = "$sum_in" ] || fail "recover changed its input"
+leftover=$(find "$work" -maxdepth 1 -name '.*.recover-*')
+[ -z "$leftover" ] || fail "recover left temporary files: $leftover"
+# The session message and the run configuration are held against their written schemas
+# (recordings/session_schema.cpp, platform/run_config_schema.cpp): the JSON path is named.
+expect 1 "run configuration: /width: expected an integer in \[1, 8192\], found 16384" -- "${R[@]}" replay "$rec/frame-16384x1.mcap"
+expect 1 "run configuration: /rate_hz: expected a number in \[1, 1000\], found 0.0" -- "${R[@]}" replay "$rec/rate-nan.mcap"
+expect 1 "run configuration: /lights_u: expected an integer in \[1, 256\], found 65536" -- "${R[@]}" replay "$rec/lights-overflow.mcap"
+expect 1 "/replica/session message: /format_version: expected an integer in \[0, 65535\], found a string" -- "${R[@]}" replay "$rec/session-format-string.mcap"
+expect 1 "/replica/session message: /config: expected a string, found an object" -- "${R[@]}" replay "$rec/session-config-object.mcap"
+expect 1 "/replica/session message: /wall_clock_start_ns: expected an integer in \[0, .*\], found -5" -- "${R[@]}" replay "$rec/session-clock-negative.mcap"
+expect 1 "/replica/session message: /tracker/model: expected a string, found an integer" -- "${R[@]}" replay "$rec/session-device-number.mcap"
+expect 1 "run configuration: /rate_hz: expected a number in \[1, 1000\], found 1e\+308" -- "${R[@]}" replay "$rec/config-rate-1e308.mcap"
+expect 1 "run configuration: .*number overflow parsing '1e999'" -- "${R[@]}" replay "$rec/config-rate-inf.mcap"
+expect 1 "run configuration: /width: expected an integer in \[1, 8192\], found a string" -- "${R[@]}" replay "$rec/config-width-string.mcap"
+expect 1 "run configuration: /width: required but missing" -- "${R[@]}" replay "$rec/config-width-missing.mcap"
+expect 1 "run configuration: /t_booth_tracker/rotation: expected an array of 9 items, found 8" -- "${R[@]}" replay "$rec/config-rotation-8.mcap"
+expect 1 "run configuration: /specular_lod_bias: expected a number in \[-8, 8\], found null" -- "${R[@]}" replay "$rec/config-lod-bias-null.mcap"
+expect 1 "run configuration: .*parse error" -- "${R[@]}" replay "$rec/config-not-json.mcap"
+# Unknown keys are warned (one line naming the recording and the key) and the replay goes on.
+expect 0 "session-unknown-key.mcap: /replica/session message: /owner: unknown key, ignored" -- --log-level warn replay "$rec/session-unknown-key.mcap"
+expect 0 "config-unknown-key.mcap: run configuration: /exposure_hack: unknown key, ignored" -- --log-level warn replay "$rec/config-unknown-key.mcap"
 expect 1 "display is '/etc/shadow', outside the data folders" -- "${R[@]}" replay "$rec/profile-etc-shadow.mcap"
 expect 1 "spectrometer_calibration '../../../../etc/passwd' is not a name inside" -- "${R[@]}" replay "$rec/calibration-dotdot.mcap"
 expect 1 "scene_dir is '/tmp', outside the data folders" -- "${R[@]}" replay "$rec/scene-elsewhere.mcap"

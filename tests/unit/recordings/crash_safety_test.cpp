@@ -119,7 +119,7 @@ TEST(CrashSafety, SigkillAtRandomMomentsLosesAtMostTheFlushInterval)
     for (const auto& c : children) {
         SCOPED_TRACE(c.path.string());
         const auto out = tempRecordingPath("sigkill-recovered");
-        auto report = recoverRecording(c.path, out);
+        auto report = recoverRecording(c.path, out, ExistingOutput::Replace);
         ASSERT_TRUE(report) << report.error().message;
         auto rec = readRecording(out);
         ASSERT_TRUE(rec) << rec.error().message;
@@ -187,7 +187,7 @@ TEST(CrashSafety, DiskFullGivesOneErrorKeepsRunningAndKeepsWhatWasWritten)
     ASSERT_FALSE(damaged);
     EXPECT_NE(damaged.error().message.find("replica recover"), std::string::npos);
     const auto out = tempRecordingPath("fsize-recovered");
-    auto report = recoverRecording(path, out);
+    auto report = recoverRecording(path, out, ExistingOutput::Replace);
     ASSERT_TRUE(report) << report.error().message;
     auto rec = readRecording(out);
     ASSERT_TRUE(rec) << rec.error().message;

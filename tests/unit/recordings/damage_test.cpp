@@ -113,7 +113,7 @@ std::size_t recoverAndCheck(std::string_view bytes, const std::string& label, bo
     const auto in = tempPath("in");
     const auto out = tempPath("out");
     spit(in, bytes);
-    auto report = recoverRecording(in, out);
+    auto report = recoverRecording(in, out, ExistingOutput::Replace);
     std::size_t kept = 0;
     if (report) {
         auto rec = readRecording(out);

@@ -211,7 +211,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
         k.cacheSlices = slices;
         const auto bad = platform::RunConfig::fromJson(k.toJson());
         ASSERT_FALSE(bad) << slices;
-        EXPECT_NE(bad.error().message.find("cache slices"), std::string::npos);
+        EXPECT_NE(bad.error().message.find("/cache_slices: expected an integer in [1, 16]"),
+                  std::string::npos)
+                << bad.error().message;
     }
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
@@ -229,7 +231,8 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     c.switches.specularLodBias = 1e9; // a corrupt value is refused, not rendered
     const auto corrupt = platform::RunConfig::fromJson(c.toJson());
     ASSERT_FALSE(corrupt);
-    EXPECT_NE(corrupt.error().message.find("specular lod bias"), std::string::npos)
+    EXPECT_NE(corrupt.error().message.find("/specular_lod_bias: expected a number in [-8, 8]"),
+              std::string::npos)
             << corrupt.error().message;
     c.switches.specularLodBias = 0.0;
     c.specularGrid = -2;
@@ -238,7 +241,9 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     c.diffuseGrid = 257;
     const auto badGrid = platform::RunConfig::fromJson(c.toJson());
     ASSERT_FALSE(badGrid);
-    EXPECT_NE(badGrid.error().message.find("diffuse grid"), std::string::npos);
+    EXPECT_NE(badGrid.error().message.find("/diffuse_grid: expected an integer in [-1, 256]"),
+              std::string::npos)
+            << badGrid.error().message;
 
     const auto shipped = platform::resolveSceneDir("scenes/metamer");
     auto d1 = platform::sceneDigest(shipped);

@@ -1,0 +1,89 @@
+// See run_config_schema.h. Ranges are the physical and format limits the appliance itself keeps
+// (frame size, rate, light counts, the site file's geometry ranges widened a little); the checks
+// across fields (aspect ratio, lights_u * lights_v, names of renderers and inverses) stay in
+// RunConfig::fromJson. A key added to RunConfig::toJson must be added here too
+// (RunConfigSchema.EveryKeyTheRunWritesIsKnown fails otherwise).
+#include <platform/appliance.h>
+#include <platform/run_config_schema.h>
+
+namespace replica::platform {
+
+const JsonSchema& runConfigSchema()
+{
+    using namespace json_schema;
+    static const JsonSchema s = [] {
+        const auto metres3 = array(number(-100.0, 100.0), 3, 3);
+        const auto flag = boolean().optional();
+        const auto name = string(4096);
+        const double lodBias = pipeline::shading::kMaxSpecularLodBias;
+        return object({
+                // Read by every version (required).
+                {"width", integer(1, kMaxFrameSide)},
+                {"height", integer(1, kMaxFrameSide)},
+                {"rate_hz", number(1.0, 1000.0)},
+                {"booth", name},
+                {"scene", name},
+                {"basis", name},
+                {"lights_u", integer(1, 256)},
+                {"lights_v", integer(1, 256)},
+                {"spectrometer_calibration", name},
+                {"display", name},
+                {"display_peak_cd_m2", number(0.0, 1e5)},
+                {"display_black_cd_m2", number(0.0, 1e5)},
+                // Added later: absent in older recordings, which replay with the old behaviour.
+                {"renderer", name.optional()},
+                {"scene_dir", name.optional()},
+                {"scene_digest", string(64).optional()},
+                {"booth_lights", integer(1, 256).optional()},
+                {"specular_samples", integer(kAutoSpecularSamples, 256).optional()},
+                {"specular_grid", integer(kAutoSpecularGrid, 256).optional()},
+                {"diffuse_grid", integer(kAutoDiffuseGrid, 256).optional()},
+                {"hardware_filter", flag},
+                {"specular_lod_bias", number(-lodBias, lodBias).optional()},
+                {"specular_nearest_level", flag},
+                {"horizon_spread", flag},
+                {"horizon_half", flag},
+                {"horizon_bilinear", flag},
+                {"specular_branch_free", flag},
+                {"specular_exact_level", flag},
+                {"texel_exact_ties", flag},
+                {"horizon_pick", flag},
+                {"area_lights", integer(kAutoAreaLights, 1).optional()},
+                {"cache_slices", integer(1, kMaxCacheSlices).optional()},
+                // A luminance scale on the booth's lights (0 excluded by fromJson).
+                {"booth_dimmer", number(0.0, 1.0).optional()},
+                {"booth_dimmer_auto", flag},
+                // The render profile that fixes the render switches (0: each switch's own key).
+                {"render_profile", integer(0, 65535).optional()},
+                {"surround_illuminance", flag},
+                {"horizon_directions", integer(0, 32).optional()},
+                {"display_digest", string(64).optional()},
+                {"display_inverse", string(64).optional()},
+                {"gamut_mapping", string(64).optional()},
+                {"viewing_compensation", flag},
+                {"viewing_filtered", flag},
+                {"flare_subtraction", flag},
+                {"false_colour", flag},
+                {"stand_hinge_m", metres3.optional()},
+                {"stand_hinge_to_panel_m", number(-10.0, 10.0).optional()},
+                {"panel_width_m", number(0.01, 10.0).optional()},
+                {"panel_height_m", number(0.01, 10.0).optional()},
+                {"tracker_rotation_deg", array(number(-360.0, 360.0), 3, 3).optional()},
+                {"tracker_translation_m", metres3.optional()},
+                {"default_lamp", string(256).optional()},
+                {"default_eye_m", metres3.optional()},
+                {"default_tilt_rad", number(-3.2, 3.2).optional()},
+                // A rotation matrix (row-major; entries within [-1, 1] up to rounding) and a
+                // translation in metres.
+                {"t_booth_tracker", object({{"rotation", array(number(-1.000001, 1.000001), 9, 9)},
+                                            {"translation", metres3}})
+                                            .optional()},
+                // What 'replica run' adds for people (never read back): any values.
+                {"run_options", map(any(), 64).optional()},
+                {"site", map(any(), 64).optional()},
+        });
+    }();
+    return s;
+}
+
+} // namespace replica::platform

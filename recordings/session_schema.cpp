@@ -1,0 +1,35 @@
+// See session_schema.h.
+#include <recordings/recording.h>
+#include <recordings/session_schema.h>
+
+namespace replica::recordings {
+
+const JsonSchema& sessionSchema()
+{
+    using namespace json_schema;
+    static const JsonSchema s = [] {
+        const auto device = object({{"model", string(4096)},
+                                    {"serial", string(4096)},
+                                    {"firmware", string(4096)},
+                                    {"source", string(16)}});
+        return object({
+                // Any integer: a version this reader does not know is refused after decoding,
+                // with its own message (update replica).
+                {"format_version", integer(0, 65535)},
+                {"software", string(4096)},
+                {"config", string(kMaxMessageBytes)},
+                {"booth", string(4096)},
+                {"scene", string(4096)},
+                {"display_profile", string(4096)},
+                // Unix time in ns: from 1970 to the end of int64 (2262).
+                {"wall_clock_start_ns", integer(0, 9.2e18)},
+                {"spectrometer", device},
+                {"tracker", device},
+                {"accel", device},
+                {"lamp_selector", device.optional()}, // format 3 and later
+        });
+    }();
+    return s;
+}
+
+} // namespace replica::recordings
