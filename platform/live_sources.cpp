@@ -92,7 +92,8 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
         hal::spectrometer::Usb2000SourceOptions specOptions;
         specOptions.nextIntegrationUs = autoIntegration;
         s.spectrometer = hal::spectrometer::makeUsb2000Source(
-                hal::spectrometer::libusbUsb2000Opener(), clock, std::move(specOptions));
+                hal::spectrometer::libusbUsb2000Opener(options.spectrometerSerial), clock,
+                std::move(specOptions));
     }
     if (options.accel) {
         hal::accel::IioAccelSourceOptions accelOptions;

@@ -18,6 +18,7 @@ struct LiveOptions {
     // --lamp-selector'): a site with a missing device runs that one on simulation (or on a
     // recording) and the rest live. makeLiveSources opens only the devices marked live here.
     bool spectrometer = true;
+    std::string spectrometerSerial;    // the USB2000+ with this USB serial; empty = the first found
     std::string tracker = "opentrack"; // "opentrack", "hid" or "" (not live)
     bool accel = true;
     std::string hidTracker;            // --tracker hid: /dev/hidrawN; empty = the first found

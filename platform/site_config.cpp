@@ -335,6 +335,7 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     r.string("devices", "accel_name", c.accelName);
     r.string("devices", "accel_axes", c.accelAxes);
     r.string("devices", "lamp_gpio", c.lampGpio);
+    r.string("devices", "spectrometer_serial", c.spectrometerSerial);
     r.string("run", "hal", c.hal, {"live", "sim", "replay"});
     r.string("run", "replay_file", c.replayFile);
     r.number("run", "rate_hz", c.rateHz, 1.0, 240.0);
@@ -398,7 +399,8 @@ std::string SiteConfig::toJson() const
              {{"iio_root", iioRoot},
               {"accel_name", accelName},
               {"accel_axes", accelAxes},
-              {"lamp_gpio", lampGpio}}},
+              {"lamp_gpio", lampGpio},
+              {"spectrometer_serial", spectrometerSerial}}},
             {"run", {{"hal", hal}, {"replay_file", replayFile}, {"rate_hz", rateHz}}},
             {"recording",
              {{"enabled", recordingEnabled},

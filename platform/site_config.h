@@ -51,6 +51,7 @@ struct SiteConfig {
     std::string accelName;
     std::string accelAxes = "x,y,z";
     std::string lampGpio;
+    std::string spectrometerSerial; // the USB2000+'s USB serial number; empty: the first found
     // [run]
     std::string hal = "live"; // live, sim or replay
     std::string replayFile;   // hal = "replay": the recording whose samples feed the display

@@ -1,5 +1,9 @@
 // libusb-1.0 implementation of UsbTransport.
+#include <array>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <vector>
 
 #include <fmt/format.h>
 #include <libusb.h>
@@ -96,7 +100,73 @@ private:
     UsbDeviceId id_;
 };
 
+// The first line of a sysfs attribute, without trailing white space ("" if unreadable).
+std::string sysfsLine(const std::filesystem::path& file)
+{
+    std::ifstream in(file);
+    std::string line;
+    std::getline(in, line);
+    while (!line.empty() && (line.back() == '\n' || line.back() == ' ' || line.back() == '\r')) {
+        line.pop_back();
+    }
+    return line;
+}
+
+int sysfsInt(const std::filesystem::path& file)
+{
+    const std::string text = sysfsLine(file);
+    int v = 0;
+    for (const char c : text) {
+        if (c < '0' || c > '9' || v > 100000) {
+            break;
+        }
+        v = v * 10 + (c - '0');
+    }
+    return text.empty() ? -1 : v;
+}
+
+// The serial number string read from the device itself (its string descriptor iSerialNumber);
+// "" when it has none or cannot be opened.
+std::string usbSerialFromDevice(libusb_device* dev)
+{
+    libusb_device_descriptor d{};
+    if (libusb_get_device_descriptor(dev, &d) != LIBUSB_SUCCESS || d.iSerialNumber == 0) {
+        return {};
+    }
+    libusb_device_handle* h = nullptr;
+    if (libusb_open(dev, &h) != LIBUSB_SUCCESS) {
+        return {};
+    }
+    std::array<unsigned char, 128> text{};
+    const int n = libusb_get_string_descriptor_ascii(h, d.iSerialNumber, text.data(),
+                                                     static_cast<int>(text.size()));
+    libusb_close(h);
+    return n > 0 ? std::string(reinterpret_cast<const char*>(text.data()),
+                               static_cast<std::size_t>(n))
+                 : std::string();
+}
+
+std::string serialOf(libusb_device* dev, int bus, int address)
+{
+    std::string s = usbSerialFromSysfs(bus, address);
+    return s.empty() ? usbSerialFromDevice(dev) : s;
+}
+
 } // namespace
+
+std::string usbSerialFromSysfs(int bus, int address)
+{
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    for (fs::directory_iterator it("/sys/bus/usb/devices", ec), end; !ec && it != end;
+         it.increment(ec)) {
+        const fs::path dir = it->path();
+        if (sysfsInt(dir / "busnum") == bus && sysfsInt(dir / "devnum") == address) {
+            return sysfsLine(dir / "serial");
+        }
+    }
+    return {};
+}
 
 Expected<std::vector<UsbDeviceId>> listUsbDevices(std::uint16_t vendor, std::uint16_t product)
 {
@@ -115,16 +185,20 @@ Expected<std::vector<UsbDeviceId>> listUsbDevices(std::uint16_t vendor, std::uin
         libusb_device_descriptor d{};
         if (libusb_get_device_descriptor(list[i], &d) == LIBUSB_SUCCESS && d.idVendor == vendor &&
             d.idProduct == product) {
-            found.push_back({vendor, product, libusb_get_bus_number(list[i]),
-                             libusb_get_device_address(list[i])});
+            const int b = libusb_get_bus_number(list[i]);
+            const int a = libusb_get_device_address(list[i]);
+            found.push_back({vendor, product, b, a, serialOf(list[i], b, a)});
         }
     }
     libusb_free_device_list(list, 1);
     return found;
 }
 
-Expected<std::unique_ptr<UsbTransport>>
-openLibusbTransport(std::uint16_t vendor, std::uint16_t product, int bus, int address)
+Expected<std::unique_ptr<UsbTransport>> openLibusbTransport(std::uint16_t vendor,
+                                                            std::uint16_t product,
+                                                            int bus,
+                                                            int address,
+                                                            const std::string& serial)
 {
     auto ctx = makeContext();
     if (!ctx) {
@@ -137,7 +211,8 @@ openLibusbTransport(std::uint16_t vendor, std::uint16_t product, int bus, int ad
                                                     libusb_strerror(static_cast<int>(n))));
     }
     libusb_device* chosen = nullptr;
-    UsbDeviceId id{vendor, product, 0, 0};
+    UsbDeviceId id{vendor, product, 0, 0, {}};
+    std::vector<std::string> others; // with a serial: the devices that have another one
     for (ssize_t i = 0; i < n && chosen == nullptr; ++i) {
         libusb_device_descriptor d{};
         if (libusb_get_device_descriptor(list[i], &d) != LIBUSB_SUCCESS || d.idVendor != vendor ||
@@ -146,15 +221,39 @@ openLibusbTransport(std::uint16_t vendor, std::uint16_t product, int bus, int ad
         }
         const int b = libusb_get_bus_number(list[i]);
         const int a = libusb_get_device_address(list[i]);
-        if ((bus == 0 || bus == b) && (address == 0 || address == a)) {
-            chosen = list[i];
-            id.bus = b;
-            id.address = a;
+        if ((bus != 0 && bus != b) || (address != 0 && address != a)) {
+            continue;
         }
+        if (!serial.empty()) {
+            const std::string found = serialOf(list[i], b, a);
+            if (found != serial) {
+                others.push_back(fmt::format("'{}' at bus {} address {}", found, b, a));
+                continue;
+            }
+        }
+        chosen = list[i];
+        id.bus = b;
+        id.address = a;
+        id.serial = serial;
     }
     libusb_device_handle* handle = nullptr;
     int rc = chosen != nullptr ? libusb_open(chosen, &handle) : LIBUSB_ERROR_NOT_FOUND;
     libusb_free_device_list(list, 1);
+    if (rc == LIBUSB_ERROR_NOT_FOUND && !serial.empty()) {
+        std::string seen;
+        for (const auto& o : others) {
+            seen += (seen.empty() ? "" : ", ") + o;
+        }
+        return makeError(
+                ErrorCode::NotFound,
+                fmt::format("no USB device {:04x}:{:04x} with serial '{}' "
+                            "(devices.spectrometer_serial): {}",
+                            vendor, product, serial,
+                            others.empty()
+                                    ? "none of that kind is attached; check the "
+                                      "cable and `lsusb`"
+                                    : "attached: " + seen + "; set the serial of the one to use"));
+    }
     if (rc == LIBUSB_ERROR_NOT_FOUND) {
         return makeError(ErrorCode::NotFound,
                          fmt::format("no USB device {:04x}:{:04x} found: check the cable and "

@@ -165,9 +165,11 @@ private:
 
 } // namespace
 
-TransportOpener libusbUsb2000Opener()
+TransportOpener libusbUsb2000Opener(std::string serial)
 {
-    return [] { return openLibusbTransport(usb2000::kVendorId, usb2000::kProductId); };
+    return [serial = std::move(serial)] {
+        return openLibusbTransport(usb2000::kVendorId, usb2000::kProductId, 0, 0, serial);
+    };
 }
 
 std::unique_ptr<SpectrometerSource>

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include <hal/clock.h>
 #include <hal/sources.h>
@@ -26,8 +27,9 @@ struct Usb2000SourceOptions {
 // Opens a transport to the device, or says why not (NotFound while unplugged).
 using TransportOpener = std::function<Expected<std::unique_ptr<UsbTransport>>()>;
 
-// The opener for real hardware: the first USB2000+ on the bus.
-TransportOpener libusbUsb2000Opener();
+// The opener for real hardware: the first USB2000+ on the bus, or with a serial the one whose USB
+// serial number string is that (NotFound, naming the serials attached, while none is).
+TransportOpener libusbUsb2000Opener(std::string serial = {});
 
 // Starts the reader thread at once; the first open attempt happens on it, so construction never
 // blocks on USB. state() is Lost until a device has been opened.

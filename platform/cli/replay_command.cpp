@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -11,6 +12,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <pthread.h>
 #include <unistd.h>
 
 #include <platform/appliance.h>
@@ -49,6 +51,7 @@ struct ReplayOptions {
     bool reprocess = false; // re-derive samples from their recorded raw inputs
     std::optional<std::string> trackerAxes, accelAxes; // with --reprocess: instead of recorded
     KmsOptions kms;
+    bool hold = false; // keep the last frame on the display until SIGTERM/SIGINT
 };
 
 // The reference frame of `frame` in dir: .exr (committed goldens) or .pfm (local).
@@ -652,6 +655,20 @@ int replayMain(const ReplayOptions& o)
     if (o.json) {
         fmt::print("{}\n", summary.dump(2));
     }
+    if (o.hold && code == kExitOk) {
+        // The output stays open (appliance is alive until we return): the display keeps the
+        // last frame until systemd (or the user) stops us.
+        sigset_t stop;
+        sigemptyset(&stop);
+        sigaddset(&stop, SIGTERM);
+        sigaddset(&stop, SIGINT);
+        pthread_sigmask(SIG_BLOCK, &stop, nullptr);
+        log->info("replay: holding frame {} on the display until SIGTERM or SIGINT",
+                  plan.empty() ? 0 : plan.back().frameIndex);
+        int sig = 0;
+        sigwait(&stop, &sig);
+        log->info("replay: signal {}: released the display", sig);
+    }
     return code;
 }
 
@@ -693,6 +710,10 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
             ->check(CLI::IsMember({"headless", "kms"}))
             ->capture_default_str();
     addKmsOptions(*cmd, opts->kms);
+    cmd->add_flag("--hold", opts->hold,
+                  "after the last frame, keep it on the display until SIGTERM or SIGINT (a still "
+                  "for a demo, or for a screen check: with --from T --to T the display shows "
+                  "exactly the frame at T)");
     cmd->add_option("--reference", opts->reference,
                     "reference XYZ frames for --check (default: GOLDEN with .frames instead of "
                     ".json, if it exists): on a mismatch, ΔE00 of the first differing frame");

@@ -140,6 +140,9 @@ void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd)
     if (unset("--lamp-gpio")) {
         o.live.lampGpio = s.lampGpio;
     }
+    if (unset("--spectrometer-serial")) {
+        o.live.spectrometerSerial = s.spectrometerSerial;
+    }
     if (unset("--record-flush-ms")) {
         o.recordFlushMs = s.flushMs;
     }
@@ -574,7 +577,8 @@ int runMain(const RunOptions& given)
                                    {"iio_root", o.live.iioRoot.string()},
                                    {"accel_name", o.live.accelName},
                                    {"accel_axes", o.live.accelAxes},
-                                   {"lamp_gpio", o.live.lampGpio}};
+                                   {"lamp_gpio", o.live.lampGpio},
+                                   {"spectrometer_serial", o.live.spectrometerSerial}};
         if (o.site) {
             resolved["site"] = nlohmann::json::parse(o.site->toJson());
         }
@@ -862,6 +866,9 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                     "live: the booth's lamp selector switch, CHIP:OFFSET,OFFSET,... with one GPIO "
                     "line per lamp in the booth's lamp order (active low, pull-up), e.g. "
                     "gpiochip0:17,27,22; without it the spectrometer alone decides the light");
+    cmd->add_option("--spectrometer-serial", opts->live.spectrometerSerial,
+                    "live: open the USB2000+ whose USB serial number is this (as `lsusb -v` "
+                    "shows it); default: the first one found");
     cmd->add_option("--lamp-selector", opts->lampSelector,
                     "the booth's lamp switch: none, gpio (the live switch on --lamp-gpio; the "
                     "default when that is given), sim (follows the simulated lamps, with contact "

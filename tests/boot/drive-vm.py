@@ -6,7 +6,8 @@ Starts qemu with the given arguments plus a serial log (WORKDIR/serial.log), a s
 the guest agent reads the host's word from, and a QMP socket. Prints each "BOOTTEST" line of the
 guest as it comes; on "ready for screendump NAME" takes WORKDIR/screen-NAME.png with QMP
 screendump and tells the guest to go on; on "done" (or at the timeout) ends qemu with QMP quit. Writes
-WORKDIR/timings.json (host seconds from qemu's start to the first frame and to the end).
+WORKDIR/timings.json (host seconds from qemu's start to the first frame and to the end) and the
+BOOTTEST lines to WORKDIR/report.txt.
 Exit status: 0 when the guest said done and no "FAIL" line, 1 otherwise.
 """
 import json
@@ -72,6 +73,7 @@ def main():
     ctl = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     ctl.connect(ctl_sock)
     timings = {}
+    report = open(os.path.join(work, "report.txt"), "w")
     failed = False
     done = False
     seen = 0
@@ -95,7 +97,9 @@ def main():
             line = line[line.index("BOOTTEST"):]
             now = time.monotonic() - start
             print("[%7.1f s] %s" % (now, line), flush=True)
-            if "FAIL" in line:
+            report.write("[%7.1f s] %s\n" % (now, line))
+            report.flush()
+            if line.startswith("BOOTTEST FAIL"):
                 failed = True
             if "first-frame at" in line:
                 timings["host_s_to_first_frame"] = round(now, 1)

@@ -1,7 +1,8 @@
 // The USB2000+ driver on the real libusb path, against an emulated device: run under umockdev-run
 // with usb2000.umockdev (the device's sysfs and USB descriptors) and the ioctl record that
 // make_usb2000_ioctl.py writes. Unmodified libusb enumerates 2457:101e, claims it and does real
-// bulk transfers that umockdev answers from the record. Exit 0 on success, 1 with a reason.
+// bulk transfers that umockdev answers from the record; a device is chosen by its USB serial
+// (devices.spectrometer_serial). Exit 0 on success, 1 with a reason.
 #include <cstdio>
 #include <string>
 
@@ -28,7 +29,25 @@ int main()
                                       std::to_string(devices->size())
                             : devices.error().message);
     }
-    auto transport = spec::openLibusbTransport(spec::usb2000::kVendorId, spec::usb2000::kProductId);
+    // The serial number string comes from the device record's sysfs 'serial' (the kernel's copy
+    // of the string descriptor), not from the EEPROM record the driver reads later.
+    if ((*devices)[0].serial != "USB2+F00001") {
+        return fail("USB serial read back as '" + (*devices)[0].serial + "'");
+    }
+    // devices.spectrometer_serial naming another instrument: NotFound (the source stays Lost and
+    // retries), and the message names the serial asked for and the one attached.
+    auto other = spec::openLibusbTransport(spec::usb2000::kVendorId, spec::usb2000::kProductId, 0,
+                                           0, "USB2+F09999");
+    if (other || other.error().code != replica::ErrorCode::NotFound ||
+        other.error().message.find("'USB2+F09999'") == std::string::npos ||
+        other.error().message.find("'USB2+F00001' at bus 1 address 2") == std::string::npos) {
+        return fail("a serial no device has must be NotFound naming both serials, got " +
+                    (other ? std::string("an open device") : other.error().message));
+    }
+    const std::string noMatch = other.error().message;
+    // The device whose serial it is: the rest of the session on it.
+    auto transport = spec::openLibusbTransport(spec::usb2000::kVendorId, spec::usb2000::kProductId,
+                                               0, 0, "USB2+F00001");
     if (!transport) {
         return fail("open: " + transport.error().message);
     }
@@ -58,6 +77,7 @@ int main()
         return fail("an unplugged device must read as NotFound (reopen later), got " +
                     (gone ? std::string("a spectrum") : gone.error().message));
     }
+    std::printf("ok: another serial -> '%s'\n", noMatch.c_str());
     std::printf("ok: %s: EEPROM serial %s, c0 %.1f nm, saturation %u; spectrum peak %u at pixel "
                 "1010; unplug -> '%s'\n",
                 where.c_str(), cal.serial.c_str(), cal.wavelengthCoeffs[0],

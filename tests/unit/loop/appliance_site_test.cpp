@@ -155,6 +155,21 @@ TEST_F(SiteFile, EachMistakeIsNamedWithItsKeyAndLine)
     EXPECT_EQ(site->config.stand.panelWidthM, SiteConfig{}.stand.panelWidthM);
 }
 
+TEST_F(SiteFile, TheSpectrometerSerialChoosesTheInstrument)
+{
+    // The USB serial number string of the USB2000+ to open (tests/umockdev opens by it).
+    auto site = loadSiteConfig(write("[devices]\nspectrometer_serial = \"USB2+F00001\"\n"));
+    ASSERT_TRUE(site) << site.error().message;
+    EXPECT_TRUE(site->problems.empty());
+    EXPECT_EQ(site->config.spectrometerSerial, "USB2+F00001");
+    EXPECT_EQ(SiteConfig{}.spectrometerSerial, ""); // default: the first one found
+    auto bad = loadSiteConfig(write("[devices]\nspectrometer_serial = 1234\n"));
+    ASSERT_TRUE(bad) << bad.error().message;
+    ASSERT_EQ(bad->problems.size(), 1u);
+    EXPECT_EQ(bad->problems[0].key, "devices.spectrometer_serial");
+    EXPECT_EQ(bad->problems[0].line, 2);
+}
+
 TEST_F(SiteFile, NotTomlIsOneErrorWithItsLine)
 {
     const auto f = write("[run]\nrate_hz = 60\n[recording\n");
