@@ -105,6 +105,15 @@ std::string RunConfig::toJson() const
         const glm::dvec3& t = trackerInBooth->translation;
         j["t_booth_tracker"] = {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}};
     }
+    if (!plannedLamps.empty()) {
+        nlohmann::json lamps = nlohmann::json::object();
+        for (const auto& [name, p] : plannedLamps) {
+            lamps[name] = {{"lights", p.lights},
+                           {"specular_samples", p.specularSamples},
+                           {"horizon_directions", p.horizonDirections}};
+        }
+        j["planned_lamps"] = lamps;
+    }
     return j.dump();
 }
 
@@ -241,6 +250,22 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
         c.defaultLamp = j.value("default_lamp", std::string());
         vec3("default_eye_m", c.defaultEyeM);
         c.defaultTiltRad = j.value("default_tilt_rad", c.defaultTiltRad);
+        // Absent before the planner in the loop: the fixed rules.
+        if (j.contains("planned_lamps")) {
+            for (const auto& [name, l] : j.at("planned_lamps").items()) {
+                LampPlan p;
+                p.lights = l.at("lights").get<int>();
+                p.specularSamples = l.at("specular_samples").get<int>();
+                p.horizonDirections = l.at("horizon_directions").get<int>();
+                if (p.lights < 1 || p.lights > 256 || p.specularSamples < 0 ||
+                    p.specularSamples > 256 || p.horizonDirections < 0 ||
+                    p.horizonDirections > 32) {
+                    throw std::runtime_error(
+                            fmt::format("planned_lamps.{}: a count out of range", name));
+                }
+                c.plannedLamps[name] = p;
+            }
+        }
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
     }
@@ -627,6 +652,31 @@ makeBoothScene(RunConfig& config,
         config.areaLights = pipeline::shading::defaultAreaLights(setup.scene) ? 1 : 0;
     }
     setup.settings = boothRenderSettings(config);
+    // The planner in the loop: the scene's cached plan (computed once when missing), recorded.
+    if (config.planner && config.plannedLamps.empty()) {
+        auto plan = loadOrComputeRenderPlan(dir, dataDir() / "booth", config.basis,
+                                            config.plannerCache.empty()
+                                                    ? defaultPlanCacheDir()
+                                                    : std::filesystem::path(config.plannerCache));
+        if (!plan) {
+            return tl::unexpected(plan.error());
+        }
+        for (const auto& lamp : setup.lamps) {
+            const auto it = plan->lamps.find(lamp);
+            if (it != plan->lamps.end()) {
+                config.plannedLamps[lamp] = it->second;
+            }
+        }
+    }
+    for (const auto& [name, p] : config.plannedLamps) {
+        pipeline::render::LampSettings ls;
+        ls.lights = p.lights;
+        ls.specularSamples = p.specularSamples;
+        ls.horizonDirections = p.horizonDirections;
+        setup.perLamp[name] = ls;
+        logger("planner")->info("lamp {}: {} lights, {} specular samples, {} horizon directions",
+                                name, p.lights, p.specularSamples, p.horizonDirections);
+    }
     if (config.boothDimmerAuto) {
         chooseBoothDimmer(config, setup, displayModel);
     }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -19,6 +20,7 @@
 #include <pipeline/scene/stand.h>
 #include <platform/loop/scene_updater.h>
 #include <platform/output/output.h>
+#include <platform/render_plan.h>
 #include <recordings/recording.h>
 
 namespace replica::platform {
@@ -97,6 +99,15 @@ struct RunConfig {
     // bands over as many frames. Recordings made before it have none and replay with 1 (whole at
     // once), frame for frame.
     int cacheSlices = kDefaultCacheSlices;
+    // The planner in the loop (platform/render_plan.h). planner asks buildAppliance for the
+    // cached plan of the scene (computed once when missing; plannerCache empty: the default cache
+    // folder); the per-lamp choice it takes is recorded as plannedLamps ("planned_lamps"), and a
+    // lamp there draws with its own lights, specular samples and horizon directions. Recordings
+    // made before have none and replay with the fixed rules above, bit for bit; a replay never
+    // plans again.
+    bool planner = false;
+    std::string plannerCache;
+    std::map<std::string, LampPlan> plannedLamps;
     // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
     // light; recordings made with replica_k6 or box6 replay as such.
     std::string basis = "adaptive_k6";

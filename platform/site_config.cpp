@@ -308,6 +308,7 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     r.numberOrAuto("booth", "dimmer", c.boothDimmer, c.boothDimmerAuto, 0.0, 1.0);
     r.string("scene", "dir", c.sceneDir);
     r.string("scene", "renderer", c.renderer, {"booth", "flat"});
+    r.boolean("render", "planner", c.renderPlanner);
     r.string("display", "profile", c.displayProfile);
     r.boolean("display", "allow_synthetic", c.allowSynthetic);
     r.string("display", "output", c.output, {"kms", "headless"});
@@ -378,6 +379,7 @@ std::string SiteConfig::toJson() const
              {{"id", boothId},
               {"dimmer", boothDimmerAuto ? nlohmann::json("auto") : nlohmann::json(boothDimmer)}}},
             {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
+            {"render", {{"planner", renderPlanner}}},
             {"display",
              {{"profile", displayProfile},
               {"allow_synthetic", allowSynthetic},

@@ -32,6 +32,8 @@ struct SiteConfig {
     // [scene]
     std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
     std::string renderer = "booth"; // or "flat"
+    // [render] planner = true: the planner in the loop (RunConfig::planner); absent: false.
+    bool renderPlanner = false;
     // [display]
     std::string displayProfile;   // empty: the shipped synthetic profile
     bool allowSynthetic = false;  // the kiosk refuses a live run on the synthetic profile

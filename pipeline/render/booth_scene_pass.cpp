@@ -40,19 +40,103 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
     std::unique_ptr<BoothScenePass> p(new BoothScenePass());
     p->setup_ = std::move(setup);
     const auto& s = p->setup_;
-    p->prepared_ = shading::prepareScene(s.scene, std::max(s.settings.horizonDirections, 1), 0.01,
-                                         s.basis);
-    auto pass = BoothShadingPass::create(p->prepared_, s.settings, p->setup_.observer);
-    if (!pass) {
-        return tl::unexpected(pass.error());
+    const auto makeVariant = [&](const shading::RenderSettings& settings) -> Expected<void> {
+        Variant v;
+        v.settings = settings;
+        v.prepared = std::make_unique<shading::PreparedScene>(shading::prepareScene(
+                s.scene, std::max(settings.horizonDirections, 1), 0.01, s.basis));
+        auto pass = BoothShadingPass::create(*v.prepared, settings, p->setup_.observer);
+        if (!pass) {
+            return tl::unexpected(pass.error());
+        }
+        v.pass = std::move(*pass);
+        p->variants_.push_back(std::move(v));
+        return {};
+    };
+    if (auto ok = makeVariant(s.settings); !ok) {
+        return tl::unexpected(ok.error());
     }
-    p->pass_ = std::move(*pass);
+    for (const auto& lamp : s.lamps) {
+        std::size_t index = 0;
+        const auto it = s.perLamp.find(lamp);
+        if (it != s.perLamp.end()) {
+            shading::RenderSettings settings = s.settings;
+            settings.lights = it->second.lights;
+            if (s.scene.glossy()) {
+                settings.specularSamples = it->second.specularSamples;
+            }
+            if (!s.scene.flat() && it->second.horizonDirections > 0) {
+                settings.horizonDirections = it->second.horizonDirections;
+            }
+            const auto same = [&](const Variant& v) {
+                return v.settings.lights == settings.lights &&
+                       v.settings.specularSamples == settings.specularSamples &&
+                       v.settings.horizonDirections == settings.horizonDirections;
+            };
+            const auto found = std::find_if(p->variants_.begin(), p->variants_.end(), same);
+            if (found == p->variants_.end()) {
+                if (auto ok = makeVariant(settings); !ok) {
+                    return tl::unexpected(ok.error());
+                }
+                index = p->variants_.size() - 1;
+            } else {
+                index = static_cast<std::size_t>(found - p->variants_.begin());
+            }
+        }
+        p->lampVariant_.push_back(index);
+    }
+    p->active_ = 0;
+    p->prepared_ = p->variants_[0].prepared.get();
+    p->pass_ = p->variants_[0].pass.get();
     return p;
+}
+
+Expected<void> BoothScenePass::useVariant(std::size_t v)
+{
+    Variant& var = variants_[v];
+    if (var.encodings != encodings_) {
+        var.prepared->paletteCoeffs = prepared_->paletteCoeffs;
+        if (auto ok = var.pass->setChannels(*var.prepared); !ok) {
+            return ok;
+        }
+        var.encodings = encodings_;
+    }
+    if (v != active_) {
+        // Each pass holds its own light and cache: they must follow the variant drawn.
+        var.pass->setSurroundIlluminance(pass_->surroundIlluminance());
+        active_ = v;
+        prepared_ = var.prepared.get();
+        pass_ = var.pass.get();
+    }
+    return {};
+}
+
+long BoothScenePass::cacheRefreshes() const
+{
+    long n = 0;
+    for (const auto& v : variants_) {
+        n += v.pass->cacheRefreshes();
+    }
+    return n;
+}
+
+void BoothScenePass::invalidateCache()
+{
+    for (auto& v : variants_) {
+        v.pass->invalidateCache();
+    }
+}
+
+void BoothScenePass::setSurroundIlluminance(bool on)
+{
+    for (auto& v : variants_) {
+        v.pass->setSurroundIlluminance(on);
+    }
 }
 
 std::string BoothScenePass::description() const
 {
-    const auto& s = setup_.settings;
+    const auto& s = variants_[active_].settings;
     const bool glossy = setup_.scene.glossy();
     const bool flat = setup_.scene.flat();
     const std::string grids =
@@ -83,7 +167,10 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state, bool&
         if (auto ok = encodeFor(l->spd, true); !ok) {
             return ok;
         }
-        light_ = shading::prepareLight(*l, setup_.observer, setup_.settings.lights, setup_.basis);
+        if (auto ok = useVariant(lampVariant_[static_cast<std::size_t>(lamp)]); !ok) {
+            return ok;
+        }
+        light_ = shading::prepareLight(*l, setup_.observer, pass_->settings().lights, setup_.basis);
         lightIndex_ = index;
         changed = true;
     } else {
@@ -95,10 +182,13 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state, bool&
         if (auto ok = encodeFor(state.illuminant, false); !ok) {
             return ok;
         }
+        if (auto ok = useVariant(0); !ok) {
+            return ok;
+        }
         direct_ = uniformEmitter(setup_.booth.lights.front(),
                                  state.emitterLuminanceCdM2 * setup_.luminanceScale,
                                  state.illuminant);
-        light_ = shading::prepareLight(direct_, setup_.observer, setup_.settings.lights,
+        light_ = shading::prepareLight(direct_, setup_.observer, pass_->settings().lights,
                                        setup_.basis);
         directSpd_ = state.illuminant;
         directLuminance_ = state.emitterLuminanceCdM2;
@@ -126,13 +216,14 @@ Expected<void> BoothScenePass::encodeFor(const colour::Spectrum& spd, bool lampC
     // By linearity a texel's coefficients follow from its palette entries'
     // (SurfaceScene::channels).
     for (std::size_t i = 0; i < setup_.scene.palette.size(); ++i) {
-        prepared_.paletteCoeffs[i] =
+        prepared_->paletteCoeffs[i] =
                 colour::projectReflectance(setup_.basis, setup_.scene.palette[i]);
     }
     encodedFor_ = spd;
     encoded_ = true;
     ++encodings_;
-    return pass_->setChannels(prepared_);
+    variants_[active_].encodings = encodings_;
+    return pass_->setChannels(*prepared_);
 }
 
 Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, int height)

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,14 @@
 #include <pipeline/spectral/adaptive_encoding.h>
 
 namespace replica::pipeline::render {
+
+// One lamp's own counts (the planner in the loop, platform/render_plan.h); the rest of the
+// settings stay BoothSceneSetup::settings.
+struct LampSettings {
+    int lights = 32;
+    int specularSamples = 24;  // glossy scenes only
+    int horizonDirections = 8; // scenes with relief only; 0 keeps the setup's
+};
 
 struct BoothSceneSetup {
     booth::BoothModel booth;        // lights with luminance images (data/booth)
@@ -36,6 +45,10 @@ struct BoothSceneSetup {
     // The booth dimmer (platform/booth_dimmer.h) for the direct-sensor mode's uniform emitter:
     // the sensed luminance times this. The booth's own lamps come already scaled in 'booth'.
     double luminanceScale = 1.0;
+    // Per lamp name: its own lights, specular samples and horizon directions. A lamp not named
+    // here, and the direct-sensor mode, draw with 'settings'. Each distinct setting gets a shading
+    // pass of its own, built by create(); a lamp change switches to its pass.
+    std::map<std::string, LampSettings> perLamp;
 };
 
 // The cached diffuse term's tilt is the mean of the last kTiltWindow sensed tilts (the
@@ -72,10 +85,10 @@ public:
     double heldTiltRad() const { return heldTiltRad_; }
     // The pass's cache of the eye-independent part (booth_shading_pass.h): how often it was
     // recomputed, and a way to force it (e.g. after the channel encoding changed).
-    long cacheRefreshes() const { return pass_->cacheRefreshes(); }
-    void invalidateCache() { pass_->invalidateCache(); }
+    long cacheRefreshes() const;
+    void invalidateCache();
     // BoothShadingPass::setSurroundIlluminance.
-    void setSurroundIlluminance(bool on) { pass_->setSurroundIlluminance(on); }
+    void setSurroundIlluminance(bool on);
     bool surroundIlluminance() const { return pass_->surroundIlluminance(); }
 
     std::string description() const;
@@ -95,9 +108,23 @@ private:
     // refuses (no luminance, a non-finite band) keeps the encoding it has.
     Expected<void> encodeFor(const colour::Spectrum& spd, bool lampChange);
 
+    // One shading pass per distinct setting (variants_[0]: setup_.settings), each with the scene
+    // prepared for its horizon directions; 'encodings' is the encodings_ its channels hold.
+    struct Variant {
+        shading::RenderSettings settings;
+        std::unique_ptr<shading::PreparedScene> prepared;
+        std::unique_ptr<BoothShadingPass> pass;
+        int encodings = 0;
+    };
+    // Makes variant v the one drawn, its channels brought up to date.
+    Expected<void> useVariant(std::size_t v);
+
     BoothSceneSetup setup_;
-    shading::PreparedScene prepared_;
-    std::unique_ptr<BoothShadingPass> pass_;
+    std::vector<Variant> variants_;
+    std::vector<std::size_t> lampVariant_; // by lamp index
+    std::size_t active_ = 0;
+    shading::PreparedScene* prepared_ = nullptr; // variants_[active_]'s
+    BoothShadingPass* pass_ = nullptr;
     // The light on the GPU now: a booth light (by index) or the direct-mode emitter.
     int lightIndex_ = -2;
     colour::Spectrum directSpd_{};

@@ -16,9 +16,15 @@ struct ErrorBudget {
     double max = 3.0;
 };
 
+// The probe's views: the panel at tilts 10, 30 and 50 degrees seen from two eyes (the centre and
+// off to the left, render_bench's --views eyes), so a setting must meet the budget at the
+// grazing tilt where the horizons matter and at the steep one where the highlights move, not on
+// one view. The worst p95 and the worst max over them decide.
+std::vector<View> probeViews(const scene::StandModel& stand, int probeX = 32, int probeY = 20);
+
 struct Plan {
     RenderSettings settings;
-    reference::FrameError probeError; // of the chosen setting on the probe frame
+    reference::FrameError probeError; // of the chosen setting: worst p95 and max over the views
     double relativeCost = 0.0;        // cost model units per pixel (see planner.cpp)
     bool met = false;                 // false: nothing met the budget; settings = the most accurate
     std::vector<std::string> skipped; // passes not needed, with the reason
@@ -28,6 +34,18 @@ struct Plan {
 // Cost model per pixel, in units of one point-light evaluation (calibrated on the CPU model).
 double settingCost(const RenderSettings& s, bool glossy, bool relief);
 
+// The cheapest setting (by settingCost) whose worst p95 and max over 'views' meet the budget.
+// 'base' gives everything but lights, specular samples and horizon directions (grids, area
+// lights, mip rules: the appliance's own), so the probe measures what the appliance will draw.
+Plan planRenderViews(const surface::SurfaceScene& scene,
+                     const booth::BoothLight& light,
+                     const std::vector<View>& views,
+                     const colour::Observer& obs,
+                     const ErrorBudget& budget,
+                     const RenderSettings& base,
+                     const colour::ChannelBasis& basis);
+
+// One view (the old probe; 'replica render --plan'): planRenderViews on 'view' at probeX x probeY.
 Plan planRender(const surface::SurfaceScene& scene,
                 const booth::BoothLight& light,
                 const View& view,

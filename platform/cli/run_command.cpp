@@ -66,6 +66,8 @@ struct RunOptions {
     bool noViewing = false;
     bool noFlare = false;
     bool falseColour = false;
+    bool planner = false;
+    std::string planCache;
     bool recordDigests = true; // format 4: XXH3-64 of every displayed frame in the recording
     double thumbnailHz = 1.0;
     int thumbnailWidth = 320;
@@ -468,6 +470,8 @@ int runMain(const RunOptions& given)
     config.viewingCompensation = !o.noViewing;
     config.flareSubtraction = !o.noFlare;
     config.falseColour = o.falseColour;
+    config.planner = o.planner;
+    config.plannerCache = o.planCache;
     if (!o.sitePath.empty()) {
         auto t = readTrackerTransform(o.sitePath);
         if (!t && t.error().code != ErrorCode::NotFound) {
@@ -486,6 +490,7 @@ int runMain(const RunOptions& given)
         config.booth = site.boothId;
         config.boothDimmer = site.boothDimmer;
         config.boothDimmerAuto = site.boothDimmerAuto;
+        config.planner = config.planner || site.renderPlanner;
         const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
         config.stand = site.stand;
         if (!o.panelSizeMm.empty()) { // the command line wins over the site file
@@ -978,6 +983,13 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                   "drive every pixel as if seen on the panel normal");
     cmd->add_flag("--no-flare-subtraction", opts->noFlare,
                   "do not subtract the screen's own reflection of the booth light");
+    cmd->add_flag("--planner", opts->planner,
+                  "draw each lamp with the planner's lights, specular samples and horizon "
+                  "directions (cached per scene, computed once when missing; recorded); the site "
+                  "file's [render] planner = true asks the same");
+    cmd->add_option("--plan-cache", opts->planCache,
+                    "folder of the planner's cached plans (default $REPLICA_PLAN_CACHE, else "
+                    "$XDG_CACHE_HOME/replica/plans, else ~/.cache/replica/plans)");
     cmd->add_flag("--false-colour", opts->falseColour,
                   "field-staff overlay: stripe out-of-gamut pixels (magenta: chroma, cyan: above "
                   "peak, blue: below black)");

@@ -1,0 +1,310 @@
+// The planner's per-lamp choice: computed, cached in a file, read back with every field checked.
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/base/input_file.h>
+#include <pipeline/booth/booth_model.h>
+#include <pipeline/colour/spectral_table.h>
+#include <pipeline/scene/stand.h>
+#include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/tuning/planner.h>
+#include <platform/appliance.h>
+#include <platform/logging.h>
+#include <platform/loop/frame_digest.h>
+#include <platform/render_plan.h>
+
+namespace replica::platform {
+
+namespace {
+
+constexpr const char* kPlanFormat = "replica-plan/1";
+
+} // namespace
+
+std::string renderPlanJson(const RenderPlan& plan)
+{
+    nlohmann::json lamps = nlohmann::json::object();
+    for (const auto& [name, p] : plan.lamps) {
+        lamps[name] = {{"lights", p.lights},
+                       {"specular_samples", p.specularSamples},
+                       {"horizon_directions", p.horizonDirections},
+                       {"probe_de00_p95", p.probeP95},
+                       {"probe_de00_max", p.probeMax},
+                       {"met_budget", p.met}};
+    }
+    const nlohmann::json j{{"format", kPlanFormat},
+                           {"scene_digest", plan.sceneDigest},
+                           {"booth_digest", plan.boothDigest},
+                           {"basis", plan.basis},
+                           {"lamps", lamps}};
+    return j.dump(2) + "\n";
+}
+
+Expected<RenderPlan> parseRenderPlan(const std::string& text, const std::string& source)
+{
+    const auto bad = [&](const std::string& what) {
+        return makeError(
+                ErrorCode::Corrupt,
+                fmt::format("{}: {}; delete the file and run with --planner again to plan anew",
+                            source, what));
+    };
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(text);
+    } catch (const std::exception& e) {
+        return bad(fmt::format("not JSON ({})", e.what()));
+    }
+    if (!j.is_object() || !j.contains("format") || !j["format"].is_string() ||
+        j["format"].get<std::string>() != kPlanFormat) {
+        return bad(fmt::format("not a plan (\"format\" must be \"{}\")", kPlanFormat));
+    }
+    RenderPlan plan;
+    for (const char* key : {"scene_digest", "booth_digest", "basis"}) {
+        if (!j.contains(key) || !j[key].is_string()) {
+            return bad(fmt::format("\"{}\" must be a string", key));
+        }
+    }
+    plan.sceneDigest = j["scene_digest"].get<std::string>();
+    plan.boothDigest = j["booth_digest"].get<std::string>();
+    plan.basis = j["basis"].get<std::string>();
+    if (!j.contains("lamps") || !j["lamps"].is_object() || j["lamps"].empty()) {
+        return bad("\"lamps\" must be an object with one entry per lamp");
+    }
+    for (const auto& [name, l] : j["lamps"].items()) {
+        const auto count = [&](const char* key, int lo, int hi, int& out) -> bool {
+            if (!l.is_object() || !l.contains(key) || !l[key].is_number_integer()) {
+                return false;
+            }
+            const auto v = l[key].get<long long>();
+            if (v < lo || v > hi) {
+                return false;
+            }
+            out = static_cast<int>(v);
+            return true;
+        };
+        LampPlan p;
+        if (!count("lights", 1, 256, p.lights)) {
+            return bad(fmt::format("lamp '{}': \"lights\" must be an integer in 1..256", name));
+        }
+        if (!count("specular_samples", 0, 256, p.specularSamples)) {
+            return bad(fmt::format("lamp '{}': \"specular_samples\" must be an integer in 0..256",
+                                   name));
+        }
+        if (!count("horizon_directions", 0, 32, p.horizonDirections)) {
+            return bad(fmt::format("lamp '{}': \"horizon_directions\" must be an integer in 0..32",
+                                   name));
+        }
+        p.probeP95 = l.value("probe_de00_p95", 0.0);
+        p.probeMax = l.value("probe_de00_max", 0.0);
+        p.met = l.value("met_budget", false);
+        plan.lamps[name] = p;
+    }
+    return plan;
+}
+
+Expected<RenderPlan> readRenderPlan(const std::filesystem::path& path)
+{
+    auto text = readInputFile(path, kMaxJsonBytes, "render plan");
+    if (!text) {
+        return tl::unexpected(text.error());
+    }
+    return parseRenderPlan(*text, path.string());
+}
+
+Expected<void> writeRenderPlan(const std::filesystem::path& path, const RenderPlan& plan)
+{
+    std::error_code ec;
+    std::filesystem::create_directories(path.parent_path(), ec);
+    const auto tmp = path.string() + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out << renderPlanJson(plan);
+        if (!out) {
+            return makeError(ErrorCode::Io, fmt::format("{}: cannot write the render plan", tmp));
+        }
+    }
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        return makeError(ErrorCode::Io, fmt::format("{}: cannot write the render plan ({})",
+                                                    path.string(), ec.message()));
+    }
+    return {};
+}
+
+Expected<std::string> boothDigest(const std::filesystem::path& boothDir)
+{
+    std::vector<std::filesystem::path> files;
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(boothDir, ec)) {
+        const auto ext = e.path().extension().string();
+        if (e.is_regular_file() && (ext == ".json" || ext == ".exr")) {
+            files.push_back(e.path());
+        }
+    }
+    if (ec || files.empty()) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: no booth model to plan for", boothDir.string()));
+    }
+    std::sort(files.begin(), files.end());
+    std::string all;
+    for (const auto& f : files) {
+        auto bytes = readInputFile(f, kMaxImageBytes, "booth model");
+        if (!bytes) {
+            return tl::unexpected(bytes.error());
+        }
+        all += f.filename().string();
+        all += *bytes;
+    }
+    return fmt::format(
+            "{:016x}",
+            fnv1a64(std::span(reinterpret_cast<const std::uint8_t*>(all.data()), all.size())));
+}
+
+std::filesystem::path renderPlanPath(const std::filesystem::path& cacheDir,
+                                     const std::string& sceneName,
+                                     const std::string& sceneDigest,
+                                     const std::string& boothDigest,
+                                     const std::string& basis)
+{
+    return cacheDir /
+           fmt::format("plan-{}-{}-{}-{}.json", sceneName, sceneDigest, boothDigest, basis);
+}
+
+std::filesystem::path defaultPlanCacheDir()
+{
+    if (const char* d = std::getenv("REPLICA_PLAN_CACHE"); d != nullptr && *d != '\0') {
+        return d;
+    }
+    if (const char* d = std::getenv("XDG_CACHE_HOME"); d != nullptr && *d != '\0') {
+        return std::filesystem::path(d) / "replica" / "plans";
+    }
+    if (const char* d = std::getenv("HOME"); d != nullptr && *d != '\0') {
+        return std::filesystem::path(d) / ".cache" / "replica" / "plans";
+    }
+    return "/var/tmp/replica-plans";
+}
+
+Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
+                                       const std::filesystem::path& boothDir,
+                                       const std::string& basisName)
+{
+    namespace sh = pipeline::shading;
+    auto scene = pipeline::surface::loadScene(sceneDir);
+    if (!scene) {
+        return tl::unexpected(scene.error());
+    }
+    auto booth = pipeline::booth::loadBooth(boothDir);
+    if (!booth) {
+        return tl::unexpected(booth.error());
+    }
+    auto obs = pipeline::colour::loadCie1931(dataDir());
+    if (!obs) {
+        return tl::unexpected(obs.error());
+    }
+    auto sd = sceneDigest(sceneDir);
+    if (!sd) {
+        return tl::unexpected(sd.error());
+    }
+    auto bd = boothDigest(boothDir);
+    if (!bd) {
+        return tl::unexpected(bd.error());
+    }
+    std::shared_ptr<pipeline::spectral::AdaptiveEncoder> encoder;
+    pipeline::colour::ChannelBasis fixed = pipeline::colour::boxBasis();
+    if (basisName == "adaptive_k6") {
+        auto made = pipeline::spectral::AdaptiveEncoder::createDefault(dataDir());
+        if (!made) {
+            return tl::unexpected(made.error());
+        }
+        encoder = std::make_shared<pipeline::spectral::AdaptiveEncoder>(std::move(*made));
+    } else if (basisName != "box6") {
+        auto fitted =
+                pipeline::colour::loadChannelBasis(dataDir() / "channels" / (basisName + ".csv"));
+        if (!fitted) {
+            return tl::unexpected(fitted.error());
+        }
+        fixed = std::move(*fitted);
+    }
+    // The appliance's settings for everything the planner does not choose.
+    sh::RenderSettings base;
+    base.specularGrid = sh::defaultSpecularGrid(*scene);
+    base.diffuseGrid = sh::defaultDiffuseGrid(*scene);
+    base.areaLights = sh::defaultAreaLights(*scene);
+    const auto views = sh::probeViews(pipeline::scene::StandModel{});
+    RenderPlan plan;
+    plan.sceneDigest = *sd;
+    plan.boothDigest = *bd;
+    plan.basis = basisName;
+    for (const auto& light : booth->lights) {
+        pipeline::colour::ChannelBasis basis = fixed;
+        if (encoder) {
+            auto b = encoder->basisFor(light.spd);
+            if (!b) {
+                return tl::unexpected(b.error());
+            }
+            basis = std::move(*b);
+        }
+        const sh::Plan p = sh::planRenderViews(*scene, light, views, *obs, {}, base, basis);
+        LampPlan lp;
+        lp.lights = p.settings.lights;
+        lp.specularSamples = scene->glossy() ? p.settings.specularSamples : 0;
+        lp.horizonDirections = scene->flat() ? 0 : p.settings.horizonDirections;
+        lp.probeP95 = p.probeError.p95;
+        lp.probeMax = p.probeError.max;
+        lp.met = p.met;
+        plan.lamps[light.name] = lp;
+    }
+    return plan;
+}
+
+Expected<RenderPlan> loadOrComputeRenderPlan(const std::filesystem::path& sceneDir,
+                                             const std::filesystem::path& boothDir,
+                                             const std::string& basis,
+                                             const std::filesystem::path& cacheDir)
+{
+    auto log = logger("planner");
+    auto sd = sceneDigest(sceneDir);
+    if (!sd) {
+        return tl::unexpected(sd.error());
+    }
+    auto bd = boothDigest(boothDir);
+    if (!bd) {
+        return tl::unexpected(bd.error());
+    }
+    const auto path = renderPlanPath(cacheDir, sceneDir.filename().string(), *sd, *bd, basis);
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec)) {
+        auto plan = readRenderPlan(path);
+        if (!plan) {
+            return plan;
+        }
+        if (plan->sceneDigest != *sd || plan->boothDigest != *bd || plan->basis != basis) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: the plan is for another scene, booth or basis than "
+                                         "its name says; delete it and the appliance plans again",
+                                         path.string()));
+        }
+        log->info("render plan: {}", path.string());
+        return plan;
+    }
+    log->info("no render plan for {} at {}: planning every lamp now (minutes, once)",
+              sceneDir.string(), path.string());
+    auto plan = computeRenderPlan(sceneDir, boothDir, basis);
+    if (!plan) {
+        return plan;
+    }
+    if (auto ok = writeRenderPlan(path, *plan); !ok) {
+        log->warn("{} (the plan is used for this run only)", ok.error().message);
+    } else {
+        log->info("render plan written: {}", path.string());
+    }
+    return plan;
+}
+
+} // namespace replica::platform

@@ -1,0 +1,71 @@
+// The planner in the loop: for a scene and every booth lamp, the cheapest lights / specular samples
+// / horizon directions that meet the ΔE00 budget from the planner's probe views
+// (shading::planRenderViews), computed once and cached in a file keyed by the scene, booth and
+// basis, and recorded in a run's configuration (RunConfig::plannedLamps) so replay draws the same.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include <pipeline/base/expected.h>
+
+namespace replica::platform {
+
+// One lamp's choice. Everything else in the renderer's settings stays as the run configures it.
+struct LampPlan {
+    int lights = 32;
+    int specularSamples = 0;
+    int horizonDirections = 8;
+    double probeP95 = 0.0; // worst over the probe views, against the exact reference
+    double probeMax = 0.0;
+    bool met = false; // false: nothing met the budget; the most accurate setting tried
+    bool operator==(const LampPlan& o) const
+    {
+        return lights == o.lights && specularSamples == o.specularSamples &&
+               horizonDirections == o.horizonDirections;
+    }
+};
+
+struct RenderPlan {
+    std::string sceneDigest;
+    std::string boothDigest;
+    std::string basis;
+    std::map<std::string, LampPlan> lamps;
+};
+
+// The plan file's text ("replica-plan/1") and its reader. The reader refuses anything malformed
+// with one line naming the file and what is wrong (counts out of the renderer's range included).
+std::string renderPlanJson(const RenderPlan& plan);
+Expected<RenderPlan> parseRenderPlan(const std::string& text, const std::string& source);
+Expected<RenderPlan> readRenderPlan(const std::filesystem::path& path);
+Expected<void> writeRenderPlan(const std::filesystem::path& path, const RenderPlan& plan);
+
+// FNV-1a 64 (hex) of booth.json and the images it names in 'boothDir'.
+Expected<std::string> boothDigest(const std::filesystem::path& boothDir);
+
+// Where the plan for these digests lives under 'cacheDir'.
+std::filesystem::path renderPlanPath(const std::filesystem::path& cacheDir,
+                                     const std::string& sceneName,
+                                     const std::string& sceneDigest,
+                                     const std::string& boothDigest,
+                                     const std::string& basis);
+
+// The default cache folder: $REPLICA_PLAN_CACHE, else $XDG_CACHE_HOME/replica/plans, else
+// $HOME/.cache/replica/plans, else /var/tmp/replica-plans.
+std::filesystem::path defaultPlanCacheDir();
+
+// Computes the plan for the scene folder and every light of the booth folder, with the
+// appliance's settings for the rest ('areaLights' as the appliance will draw). Minutes on a slow
+// CPU.
+Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
+                                       const std::filesystem::path& boothDir,
+                                       const std::string& basis);
+
+// The cached plan for the scene, or computed once and written to the cache (a log line says so).
+Expected<RenderPlan> loadOrComputeRenderPlan(const std::filesystem::path& sceneDir,
+                                             const std::filesystem::path& boothDir,
+                                             const std::string& basis,
+                                             const std::filesystem::path& cacheDir);
+
+} // namespace replica::platform
