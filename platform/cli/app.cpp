@@ -108,6 +108,7 @@ int runCli(int argc, char** argv)
     registerReplayCommand(app, exitCode);
     registerInspectCommand(app, exitCode);
     registerRenderCommand(app, exitCode);
+    registerPlanCommand(app, exitCode);
     registerBoothCommand(app, exitCode);
     registerSceneCommand(app, exitCode);
     registerDisplayCommand(app, exitCode);

@@ -16,6 +16,7 @@ void registerRunCommand(CLI::App& app, int& exitCode);
 void registerReplayCommand(CLI::App& app, int& exitCode);
 void registerInspectCommand(CLI::App& app, int& exitCode);
 void registerRenderCommand(CLI::App& app, int& exitCode);
+void registerPlanCommand(CLI::App& app, int& exitCode);
 void registerBoothCommand(CLI::App& app, int& exitCode);
 void registerSceneCommand(CLI::App& app, int& exitCode);
 void registerDisplayCommand(CLI::App& app, int& exitCode);

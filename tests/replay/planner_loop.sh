@@ -19,6 +19,12 @@ if ! grep 'planning every lamp now' "$work/first.log" > /dev/null; then
     exit 1
 fi
 plan=$(ls "$work"/plans/plan-metamer-*.json)
+# 'replica plan' finds the same cached file (and does not plan again).
+said=$("$replica" --log-level warn plan --scene "$scenes/metamer" --plan-cache "$work/plans")
+if [ "$(echo "$said" | head -1)" != "$plan" ]; then
+    echo "FAIL: 'replica plan' names another file than the run cached: $said" >&2
+    exit 1
+fi
 # The metamer is matte: no lamp may pay for a specular sample.
 samples=$(grep -o '"specular_samples": [0-9]*' "$plan" | sort -u)
 if [ "$samples" != '"specular_samples": 0' ]; then

@@ -1,0 +1,79 @@
+// replica plan: the planner's per-lamp choice for a scene, computed (or read from the cache) and
+// written where 'replica run --planner' looks for it.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include <pipeline/base/data_dir.h>
+#include <platform/appliance.h>
+#include <platform/cli/commands.h>
+#include <platform/render_plan.h>
+
+namespace replica::platform {
+
+namespace {
+
+struct PlanArgs {
+    std::string scene;
+    std::string basis = "adaptive_k6";
+    std::string cache;
+    bool force = false;
+};
+
+int runPlan(const PlanArgs& a)
+{
+    // As 'replica run --scene': a folder that exists from here, else one under the data folder.
+    std::error_code ec;
+    const std::filesystem::path scene = std::filesystem::is_directory(a.scene, ec)
+                                                ? std::filesystem::absolute(a.scene, ec)
+                                                : resolveSceneDir(a.scene);
+    const std::filesystem::path booth = dataDir() / "booth";
+    const std::filesystem::path cache =
+            a.cache.empty() ? defaultPlanCacheDir() : std::filesystem::path(a.cache);
+    auto sd = sceneDigest(scene);
+    auto bd = boothDigest(booth);
+    if (!sd || !bd) {
+        std::fprintf(stderr, "replica plan: %s\n", (!sd ? sd.error() : bd.error()).message.c_str());
+        return kExitFailure;
+    }
+    const auto path = renderPlanPath(cache, scene.filename().string(), *sd, *bd, a.basis);
+    if (a.force) {
+        std::filesystem::remove(path, ec);
+    }
+    auto plan = loadOrComputeRenderPlan(scene, booth, a.basis, cache);
+    if (!plan) {
+        std::fprintf(stderr, "replica plan: %s\n", plan.error().message.c_str());
+        return kExitFailure;
+    }
+    std::printf("%s\n", path.string().c_str());
+    for (const auto& [name, p] : plan->lamps) {
+        std::printf("%s: %d lights, %d specular samples, %d horizon directions; worst dE00 p95 "
+                    "%.3f, max %.3f over the probe views%s\n",
+                    name.c_str(), p.lights, p.specularSamples, p.horizonDirections, p.probeP95,
+                    p.probeMax, p.met ? "" : " (the budget is not met)");
+    }
+    return kExitOk;
+}
+
+} // namespace
+
+void registerPlanCommand(CLI::App& app, int& exitCode)
+{
+    auto args = std::make_shared<PlanArgs>();
+    CLI::App* cmd = app.add_subcommand(
+            "plan", "the planner's lights, specular samples and horizon directions for each lamp "
+                    "of the booth on a scene, written to the cache 'replica run --planner' reads");
+    cmd->add_option("--scene", args->scene,
+                    "scene folder (one that does not exist from here: under the data folder)")
+            ->required();
+    cmd->add_option("--basis", args->basis, "channel basis the appliance will run with")
+            ->capture_default_str();
+    cmd->add_option("--plan-cache", args->cache,
+                    "folder of the cached plans (default as 'replica run --plan-cache')");
+    cmd->add_flag("--force", args->force, "plan again even when a cached plan exists");
+    cmd->callback([args, &exitCode] { exitCode = runPlan(*args); });
+}
+
+} // namespace replica::platform
