@@ -99,6 +99,16 @@ struct FrameDeltaE {
     std::filesystem::path reference;
 };
 
+// One measured frame as --json reports it (the worst adds its reference file).
+nlohmann::json frameDeltaEJson(const FrameDeltaE& m)
+{
+    return {{"frame", m.frame},
+            {"mean", m.stats.mean},
+            {"p95", m.stats.p95},
+            {"max", m.stats.max},
+            {"max_at", {m.maxX, m.maxY}}};
+}
+
 std::filesystem::path
 framePath(const std::filesystem::path& dir, long frame, const char* suffix = ".pfm")
 {
@@ -593,16 +603,11 @@ int replayMain(const ReplayOptions& o)
             check["result"] = within ? "within_tolerance" : "beyond_tolerance";
             check["tolerance_de00"] = *o.tolerance;
             check["reference_frames_measured"] = measured.size();
-            check["worst"] = {{"frame", worst.frame},     {"reference", worst.reference.string()},
-                              {"mean", worst.stats.mean}, {"p95", worst.stats.p95},
-                              {"max", worst.stats.max},   {"max_at", {worst.maxX, worst.maxY}}};
+            check["worst"] = frameDeltaEJson(worst);
+            check["worst"]["reference"] = worst.reference.string();
             nlohmann::json frames = nlohmann::json::array();
             for (const auto& m : measured) {
-                frames.push_back({{"frame", m.frame},
-                                  {"mean", m.stats.mean},
-                                  {"p95", m.stats.p95},
-                                  {"max", m.stats.max},
-                                  {"max_at", {m.maxX, m.maxY}}});
+                frames.push_back(frameDeltaEJson(m));
             }
             check["measured"] = frames;
             const auto line = fmt::format(
@@ -636,11 +641,7 @@ int replayMain(const ReplayOptions& o)
             }
             nlohmann::json frames = nlohmann::json::array();
             for (const auto& m : measured) {
-                frames.push_back({{"frame", m.frame},
-                                  {"mean", m.stats.mean},
-                                  {"p95", m.stats.p95},
-                                  {"max", m.stats.max},
-                                  {"max_at", {m.maxX, m.maxY}}});
+                frames.push_back(frameDeltaEJson(m));
                 say(fmt::format("reference frame {}: ΔE00 mean {:.3f}, p95 {:.3f}, max {:.3f} at "
                                 "x {} y {} ({})",
                                 m.frame, m.stats.mean, m.stats.p95, m.stats.max, m.maxX, m.maxY,
