@@ -130,26 +130,18 @@ GP
                 echo "set title \"$s under $l\""
                 cmd="plot"
                 sep=""
-                [ -s "${p}_front.dat" ] && {
-                    cmd+="$sep \"${p}_front.dat\" using 1:2 with steps lw 2 lc rgb '#d62728' title 'Pareto front'"
+                # One series per row: file suffix, gnuplot style, legend title.
+                while IFS='|' read -r suffix style title; do
+                    [ -s "${p}_${suffix}.dat" ] || continue
+                    cmd+="$sep \"${p}_${suffix}.dat\" using 1:2 with $style title $title"
                     sep=","
-                }
-                [ -s "${p}_area_lights.dat" ] && {
-                    cmd+="$sep \"${p}_area_lights.dat\" using 1:2 with points pt 7 ps 1.1 lc rgb '#1f77b4' title 'area lights (8, 32, 128)'"
-                    sep=","
-                }
-                [ -s "${p}_point_lights.dat" ] && {
-                    cmd+="$sep \"${p}_point_lights.dat\" using 1:2 with points pt 5 ps 1.0 lc rgb '#ff7f0e' title 'point lights (8, 32, 128)'"
-                    sep=","
-                }
-                [ -s "${p}_specular_samples.dat" ] && {
-                    cmd+="$sep \"${p}_specular_samples.dat\" using 1:2 with points pt 9 ps 1.2 lc rgb '#2ca02c' title 'specular samples (2, 8, 32; 32 lights)'"
-                    sep=","
-                }
-                [ -s "${p}_default.dat" ] && {
-                    cmd+="$sep \"${p}_default.dat\" using 1:2 with points pt 3 ps 2.5 lw 2 lc rgb 'black' title \"appliance's default\""
-                    sep=","
-                }
+                done <<'SERIES'
+front|steps lw 2 lc rgb '#d62728'|'Pareto front'
+area_lights|points pt 7 ps 1.1 lc rgb '#1f77b4'|'area lights (8, 32, 128)'
+point_lights|points pt 5 ps 1.0 lc rgb '#ff7f0e'|'point lights (8, 32, 128)'
+specular_samples|points pt 9 ps 1.2 lc rgb '#2ca02c'|'specular samples (2, 8, 32; 32 lights)'
+default|points pt 3 ps 2.5 lw 2 lc rgb 'black'|"appliance's default"
+SERIES
                 if [ -z "$sep" ]; then # no rows for this scene and light (a partial run)
                     cmd="plot [1:10] [0:1] -1 notitle"
                 else
