@@ -47,7 +47,7 @@ double maxDiff(const glm::dmat3& a, const glm::dmat3& b)
 struct Synthetic {
     std::vector<glm::dvec3> tracker;
     std::vector<glm::dvec3> booth;
-    RigidTransform truth;
+    pipeline::RigidTransform truth;
 };
 
 // Booth points in a 0.6 m box in front of the stand; the tracker sees them through the inverse
