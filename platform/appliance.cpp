@@ -567,7 +567,8 @@ void chooseBoothDimmer(RunConfig& config,
         sh::XyzFrame keep;
         for (const double tiltDeg : {0.0, 15.0, 30.0, 45.0, 60.0}) {
             sh::View view;
-            view.panel = sh::panelPoseFromTilt(config.stand, tiltDeg);
+            view.panel = pipeline::scene::panelPose(config.stand,
+                                                    pipeline::scene::degreesToRadians(tiltDeg));
             view.eye = config.defaultEyeM;
             view.pixelsX = 32;
             view.pixelsY = 20;

@@ -171,7 +171,7 @@ TEST(StandFit, RecoversHingeAndPanelOffsetFromTwoOrThreeTilts)
         for (const double deg : tiltsDeg) {
             const double t = deg * 3.14159265358979323846 / 180.0;
             const PanelPose pose = panelPose(truth, t);
-            const glm::dvec3 top = pose.originM + 0.5 * pose.rightM + pose.upM;
+            const glm::dvec3 top = pose.cornerM() + 0.5 * pose.rightEdgeM() + pose.upEdgeM();
             // Gravity in panel axes for tilt t (tiltFromGravity's inverse), the sensor 2 degrees
             // rotated about the panel normal.
             const glm::dvec3 gPanel{0.0, -g * std::cos(t), -g * std::sin(t)};
