@@ -73,10 +73,6 @@ std::string RunConfig::toJson() const
                      {"stand_hinge_to_panel_m", stand.hingeToPanelM},
                      {"panel_width_m", stand.panelWidthM},
                      {"panel_height_m", stand.panelHeightM},
-                     {"tracker_rotation_deg",
-                      {trackerRotationDeg.x, trackerRotationDeg.y, trackerRotationDeg.z}},
-                     {"tracker_translation_m",
-                      {trackerTranslationM.x, trackerTranslationM.y, trackerTranslationM.z}},
                      {"default_lamp", defaultLamp},
                      {"default_eye_m", {defaultEyeM.x, defaultEyeM.y, defaultEyeM.z}},
                      {"default_tilt_rad", defaultTiltRad}};
@@ -95,14 +91,14 @@ std::string RunConfig::toJson() const
         j["surround_illuminance"] = switches.surroundIlluminance;
         j["viewing_filtered"] = switches.viewingFiltered;
     }
-    if (trackerInBooth) {
+    {
         std::vector<double> rotation;
         for (int i = 0; i < 3; ++i) {
             for (int k = 0; k < 3; ++k) {
-                rotation.push_back(trackerInBooth->rotation[k][i]); // row-major
+                rotation.push_back(trackerInBooth.rotation[k][i]); // row-major
             }
         }
-        const glm::dvec3& t = trackerInBooth->translation;
+        const glm::dvec3& t = trackerInBooth.translation;
         j["t_booth_tracker"] = {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}};
     }
     if (!plannedLamps.empty()) {
@@ -224,11 +220,16 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
                 return makeError(ErrorCode::Corrupt,
                                  "run configuration: t_booth_tracker needs 9 + 3 numbers");
             }
-            pipeline::scene::RigidTransform x;
+            pipeline::RigidTransform x;
             for (std::size_t k = 0; k < 9; ++k) {
                 x.rotation[static_cast<int>(k % 3)][static_cast<int>(k / 3)] = r[k];
             }
             x.translation = {t[0], t[1], t[2]};
+            if (!pipeline::isRotation(x.rotation)) {
+                return makeError(ErrorCode::Corrupt,
+                                 "run configuration: t_booth_tracker/rotation is not a rotation "
+                                 "(orthonormal, determinant +1)");
+            }
             c.trackerInBooth = x;
         }
         // Absent before the site file: the constants the code had then (the defaults).
@@ -245,8 +246,15 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
         c.stand.hingeToPanelM = j.value("stand_hinge_to_panel_m", c.stand.hingeToPanelM);
         c.stand.panelWidthM = j.value("panel_width_m", c.stand.panelWidthM);
         c.stand.panelHeightM = j.value("panel_height_m", c.stand.panelHeightM);
-        vec3("tracker_rotation_deg", c.trackerRotationDeg);
-        vec3("tracker_translation_m", c.trackerTranslationM);
+        // Recordings made before t_booth_tracker was recorded whole: the angles (degrees) and
+        // translation of the site file, absent = the fixed mounting.
+        if (!j.contains("t_booth_tracker")) {
+            glm::dvec3 rotationDeg{0.0};
+            glm::dvec3 translationM = pipeline::kDefaultTrackerInBoothM;
+            vec3("tracker_rotation_deg", rotationDeg);
+            vec3("tracker_translation_m", translationM);
+            c.trackerInBooth = pipeline::rigidFromDegrees(rotationDeg, translationM);
+        }
         c.defaultLamp = j.value("default_lamp", std::string());
         vec3("default_eye_m", c.defaultEyeM);
         c.defaultTiltRad = j.value("default_tilt_rad", c.defaultTiltRad);
@@ -297,8 +305,9 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
     if (!finite3(c.stand.hingeM) || !std::isfinite(c.stand.hingeToPanelM) ||
         !(c.stand.panelWidthM > 0.0 && c.stand.panelWidthM <= 10.0) ||
         !(c.stand.panelHeightM > 0.0 && c.stand.panelHeightM <= 10.0) ||
-        !finite3(c.trackerRotationDeg) || !finite3(c.trackerTranslationM) ||
-        !finite3(c.defaultEyeM) || !std::isfinite(c.defaultTiltRad)) {
+        !finite3(c.trackerInBooth.translation) ||
+        !pipeline::isRotation(c.trackerInBooth.rotation) || !finite3(c.defaultEyeM) ||
+        !std::isfinite(c.defaultTiltRad)) {
         return makeError(ErrorCode::InvalidArgument,
                          "run configuration: stand, panel size, tracker transform or default "
                          "eye/tilt not finite or out of range");
@@ -558,7 +567,8 @@ void chooseBoothDimmer(RunConfig& config,
         sh::XyzFrame keep;
         for (const double tiltDeg : {0.0, 15.0, 30.0, 45.0, 60.0}) {
             sh::View view;
-            view.panel = sh::panelPoseFromTilt(config.stand, tiltDeg);
+            view.panel = pipeline::scene::panelPose(config.stand,
+                                                    pipeline::scene::degreesToRadians(tiltDeg));
             view.eye = config.defaultEyeM;
             view.pixelsX = 32;
             view.pixelsY = 20;
@@ -865,8 +875,6 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     updaterSetup.booth = app->booth;
     updaterSetup.calibration = *calibration;
     updaterSetup.trackerInBooth = config.trackerInBooth;
-    updaterSetup.trackerRotationDeg = config.trackerRotationDeg;
-    updaterSetup.trackerInBoothM = config.trackerTranslationM;
     updaterSetup.defaultEyeM = config.defaultEyeM;
     updaterSetup.defaultTiltRad = config.defaultTiltRad;
     if (!config.defaultLamp.empty()) {

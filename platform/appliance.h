@@ -13,6 +13,7 @@
 
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
+#include <pipeline/base/rigid_transform.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/render_profile.h>
 #include <pipeline/render/renderer.h>
@@ -126,17 +127,14 @@ struct RunConfig {
     bool viewingCompensation = true;
     bool flareSubtraction = true;
     bool falseColour = false;
-    // The tracker's calibrated pose in the booth ('replica calibrate tracker', read from the site
-    // file by 'replica run --site'). Absent: the fixed mounting, an unrotated tracker at
-    // SceneUpdaterSetup::trackerInBoothM, which recordings made without it replay with.
-    std::optional<pipeline::scene::RigidTransform> trackerInBooth;
     // The site's geometry (the site file's [stand] and [tracker]): the stand's hinge and the
-    // panel's physical size, and T_booth_tracker, eye_booth = R(trackerRotationDeg, applied about
-    // x, then y, then z) * eye_tracker + trackerTranslationM. Recordings made before have none
-    // and replay with these defaults, the constants the code had then.
+    // panel's physical size, and T_booth_tracker (eye_booth = trackerInBooth.apply(eye_tracker)):
+    // 'replica run --site' takes it from the site file, calibrated ('replica calibrate tracker')
+    // or as angles and a translation. Recorded as t_booth_tracker (a rotation matrix and a
+    // translation); recordings made before hold the angles in degrees or nothing, and replay with
+    // what those give (nothing: the fixed mounting, pipeline::defaultTrackerInBooth()).
     pipeline::scene::StandModel stand;
-    glm::dvec3 trackerRotationDeg{0.0};
-    glm::dvec3 trackerTranslationM{0.0, 0.42, 0.05};
+    pipeline::RigidTransform trackerInBooth = pipeline::defaultTrackerInBooth();
     // The scene before each sensor's first sample (the site file's [defaults]): the lamp shown
     // until the first spectrum (a booth lamp's name; empty: no light, black, as recordings made
     // before have), the eye until the first pose, the tilt until the first gravity sample.

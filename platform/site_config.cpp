@@ -181,6 +181,55 @@ public:
         out = v;
     }
 
+    // An inline table { rotation = [9 numbers, row-major], translation = [3 numbers] }: a rigid
+    // transform, the rotation orthonormal with determinant +1 (to 1e-6, as printed with 9
+    // decimals), the translation within +-10 m.
+    void rigid(const char* section, const char* key, std::optional<pipeline::RigidTransform>& out)
+    {
+        const toml::node* n = find(section, key);
+        if (n == nullptr) {
+            return;
+        }
+        const auto* t = n->as_table();
+        const auto* rot = t != nullptr ? (*t)["rotation"].as_array() : nullptr;
+        const auto* tr = t != nullptr ? (*t)["translation"].as_array() : nullptr;
+        if (rot == nullptr || tr == nullptr || rot->size() != 9 || tr->size() != 3 ||
+            t->size() != 2) {
+            problem(section, key, *n,
+                    "expected { rotation = [9 numbers, row-major], translation = [3 numbers] } "
+                    "(as 'replica calibrate tracker' writes it)");
+            return;
+        }
+        pipeline::RigidTransform x;
+        for (std::size_t k = 0; k < 9; ++k) {
+            double v = 0.0;
+            if (!toDouble(section, key, *rot->get(k), v)) {
+                return;
+            }
+            x.rotation[static_cast<int>(k % 3)][static_cast<int>(k / 3)] = v;
+        }
+        for (std::size_t k = 0; k < 3; ++k) {
+            double v = 0.0;
+            if (!toDouble(section, key, *tr->get(k), v)) {
+                return;
+            }
+            if (std::abs(v) > 10.0) {
+                problem(section, key, *tr->get(k),
+                        fmt::format("translation element {} = {} is out of range [-10, 10] m",
+                                    k + 1, v));
+                return;
+            }
+            x.translation[static_cast<int>(k)] = v;
+        }
+        if (!pipeline::isRotation(x.rotation)) {
+            problem(section, key, *n,
+                    "rotation is not a rotation matrix (orthonormal, determinant +1); run "
+                    "'replica calibrate tracker' again");
+            return;
+        }
+        out = x;
+    }
+
     // Every key of the document that no reader asked for.
     void reportUnknown()
     {
@@ -330,6 +379,12 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     r.number("stand", "panel_height_m", c.stand.panelHeightM, 0.01, 10.0);
     r.vec3("tracker", "rotation_deg", c.trackerRotationDeg, -360.0, 360.0);
     r.vec3("tracker", "translation_m", c.trackerTranslationM, -10.0, 10.0);
+    r.rigid("tracker", "T_booth_tracker", c.trackerCalibrated);
+    {
+        double unused = 0.0; // the calibration's figures, for people
+        r.number("tracker", "calibration_rms_m", unused, 0.0, 1.0);
+        r.number("tracker", "calibration_points", unused, 0.0, 1e6);
+    }
     r.integer("tracker", "port", c.trackerPort, 1, 65535);
     r.string("tracker", "bind", c.trackerBind);
     r.string("devices", "iio_root", c.iioRoot);
@@ -414,6 +469,16 @@ std::string SiteConfig::toJson() const
             {"log", {{"level", logLevel}}},
             {"defaults",
              {{"lamp", defaultLamp}, {"eye_m", vec(defaultEyeM)}, {"tilt_deg", defaultTiltDeg}}}};
+    if (trackerCalibrated) {
+        std::vector<double> rotation;
+        for (int i = 0; i < 3; ++i) {
+            for (int k = 0; k < 3; ++k) {
+                rotation.push_back(trackerCalibrated->rotation[k][i]); // row-major
+            }
+        }
+        j["tracker"]["T_booth_tracker"] = {{"rotation", rotation},
+                                           {"translation", vec(trackerCalibrated->translation)}};
+    }
     return j.dump();
 }
 

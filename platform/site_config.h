@@ -6,12 +6,14 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/base/rigid_transform.h>
 #include <pipeline/scene/stand.h>
 
 namespace replica::platform {
@@ -43,9 +45,19 @@ struct SiteConfig {
     std::string kmsConnector; // empty: the first connected
     // [stand] (pipeline/scene/stand.h): defaults are the compiled-in model.
     pipeline::scene::StandModel stand;
-    // [tracker]: T_booth_tracker, eye_booth = R(rotation_deg) * eye_tracker + translation_m.
+    // [tracker]: T_booth_tracker, the tracker's pose in the booth, as the file spells it: angles
+    // about x, then y, then z (degrees) and a translation, or the calibrated T_booth_tracker
+    // matrix ('replica calibrate tracker'), which wins when present. trackerInBooth() is the
+    // one transform the run uses.
     glm::dvec3 trackerRotationDeg{0.0};
-    glm::dvec3 trackerTranslationM{0.0, 0.42, 0.05};
+    glm::dvec3 trackerTranslationM = pipeline::kDefaultTrackerInBoothM;
+    std::optional<pipeline::RigidTransform> trackerCalibrated;
+    pipeline::RigidTransform trackerInBooth() const
+    {
+        return trackerCalibrated
+                       ? *trackerCalibrated
+                       : pipeline::rigidFromDegrees(trackerRotationDeg, trackerTranslationM);
+    }
     std::uint16_t trackerPort = 4242;
     std::string trackerBind = "127.0.0.1";
     // [devices]

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <platform/site_config.h>
 #include <platform/site_file.h>
 
 namespace replica::platform {
@@ -197,49 +198,26 @@ Expected<SiteSources> readSiteSources(const std::filesystem::path& file)
     return s;
 }
 
-Expected<pipeline::scene::RigidTransform> readTrackerTransform(const std::filesystem::path& file)
+Expected<pipeline::RigidTransform> readTrackerTransform(const std::filesystem::path& file)
 {
-    auto text = readText(file);
-    if (!text) {
-        return tl::unexpected(text.error());
+    // The one reader of [tracker] (platform/site_config.cpp); problems elsewhere in the file are
+    // not this reader's business (e.g. [sources], which 'run --site' reads on its own).
+    auto site = loadSiteConfig(file);
+    if (!site) {
+        return tl::unexpected(site.error());
     }
-    auto t = parse(*text, file);
-    if (!t) {
-        return tl::unexpected(t.error());
+    for (const auto& p : site->problems) {
+        if (p.key.starts_with("tracker.T_booth_tracker")) {
+            return makeError(ErrorCode::Corrupt, formatProblem(file, p));
+        }
     }
-    const auto* table = (*t)["tracker"]["T_booth_tracker"].as_table();
-    if (table == nullptr) {
+    if (!site->config.trackerCalibrated) {
         return makeError(ErrorCode::NotFound,
                          fmt::format("{}: no [tracker] T_booth_tracker; run 'replica calibrate "
                                      "tracker'",
                                      file.string()));
     }
-    const auto* rot = (*table)["rotation"].as_array();
-    const auto* tr = (*table)["translation"].as_array();
-    if (rot == nullptr || tr == nullptr || rot->size() != 9 || tr->size() != 3) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: [tracker] T_booth_tracker needs rotation = [9 numbers] "
-                                     "and translation = [3 numbers]",
-                                     file.string()));
-    }
-    pipeline::scene::RigidTransform x;
-    for (std::size_t k = 0; k < 9; ++k) {
-        const auto v = (*rot)[k].value<double>();
-        if (!v) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: rotation[{}] is not a number", file.string(), k));
-        }
-        x.rotation[static_cast<int>(k % 3)][static_cast<int>(k / 3)] = *v;
-    }
-    for (std::size_t k = 0; k < 3; ++k) {
-        const auto v = (*tr)[k].value<double>();
-        if (!v) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: translation[{}] is not a number", file.string(), k));
-        }
-        x.translation[static_cast<int>(k)] = *v;
-    }
-    return x;
+    return *site->config.trackerCalibrated;
 }
 
 } // namespace replica::platform

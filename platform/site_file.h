@@ -38,6 +38,6 @@ struct SiteSources {
 Expected<SiteSources> readSiteSources(const std::filesystem::path& file);
 
 // Reads T_booth_tracker back from a site file (nullopt-like NotFound when it has none).
-Expected<pipeline::scene::RigidTransform> readTrackerTransform(const std::filesystem::path& file);
+Expected<pipeline::RigidTransform> readTrackerTransform(const std::filesystem::path& file);
 
 } // namespace replica::platform

@@ -137,7 +137,8 @@ public:
             s.tracked = st.tracked;
             if (st.tracked) {
                 const glm::dvec3 jitter{noise_.gaussian(), noise_.gaussian(), noise_.gaussian()};
-                s.eyeTrackerM = st.eyeBoothM - params_.trackerInBoothM + jitter * params_.jitterM;
+                s.eyeTrackerM = params_.trackerInBooth.applyInverse(st.eyeBoothM) +
+                                jitter * params_.jitterM;
             }
             out.push_back(s);
             ++next_;

@@ -9,6 +9,7 @@
 
 #include <hal/sim/scenario.h>
 #include <hal/sources.h>
+#include <pipeline/base/rigid_transform.h>
 
 namespace replica::hal::sim {
 
@@ -43,8 +44,9 @@ std::unique_ptr<SpectrometerSource> makeSimSpectrometer(ScenarioParams scenario,
                                                         SimSpectrometerParams params);
 
 struct SimTrackerParams {
-    std::int64_t periodNs = 8'333'333;           // 120 Hz
-    glm::dvec3 trackerInBoothM{0.0, 0.42, 0.05}; // tracker origin in the booth frame (no rotation)
+    std::int64_t periodNs = 8'333'333; // 120 Hz
+    // T_booth_tracker the readings are simulated for: eye_tracker = its inverse of eye_booth.
+    pipeline::RigidTransform trackerInBooth = pipeline::defaultTrackerInBooth();
     double jitterM = 0.0002;
     std::uint64_t seed = 2;
 };

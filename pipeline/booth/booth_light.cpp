@@ -68,7 +68,10 @@ std::vector<PointLight> pointLights(const BoothLight& light,
                 syy += l * (dy * dy + 1.0 / 12.0);
             }
         }
-        PointLight p{light.pointAtTexel(r.centroidX, r.centroidY), r.sumCdM2};
+        PointLight p;
+        p.position = light.pointAtTexel(r.centroidX, r.centroidY);
+        p.intensityCd = r.sumCdM2 * light.texelAreaM2();
+        p.sumCdM2 = r.sumCdM2;
         if (sum > 0.0) {
             p.spreadU = uHat * (std::sqrt(sxx / sum) * light.texelWidthM());
             p.spreadV = vHat * (std::sqrt(syy / sum) * light.texelHeightM());

@@ -39,10 +39,15 @@ struct BoothLight {
 // spectral radiance whose CIE Y is L. Zero spectrum if the light has no luminous power.
 colour::Spectrum unitLuminanceSpd(const colour::Observer& obs, const colour::Spectrum& spd);
 
-// A point light from a median-cut region: eq. (1) uses sumCdM2 * texelArea as the intensity (cd)
-// normal to the plane, with the two cosines and 1/d^2.
+// A point light standing for part of an emitter (paper eq. 1): its intensity (cd) normal to the
+// emitter's plane, used with the two cosines and 1/d^2. The one point light: median-cut regions of
+// a booth light's luminance image (pointLights) and the uniform grid of the flat renderer
+// (scene::uniformGridLights) both give these.
 struct PointLight {
     Vec3 position{0.0};
+    double intensityCd = 0.0; // L * a: the summed luminance of the region times one texel's area
+    // Median-cut regions only (0 for a uniform grid): the summed luminance of the region's
+    // texels, eq. (1)'s L_n, whose intensity is sumCdM2 * texel area.
     double sumCdM2 = 0.0;
     // The region's luminance-weighted standard deviation about 'position' along edgeU and edgeV,
     // as vectors in metres: how far the light the point stands for spreads over the ceiling.

@@ -251,9 +251,7 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
             heldValid_ = true;
         }
     }
-    const auto pose = [&](double tiltRad) {
-        return shading::panelPoseFromTilt(setup_.stand, tiltRad * 180.0 / std::numbers::pi);
-    };
+    const auto pose = [&](double tiltRad) { return scene::panelPose(setup_.stand, tiltRad); };
     const shading::PanelPose held = pose(heldTiltRad_);
     shading::View view;
     // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel);

@@ -346,9 +346,9 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glViewport(0, 0, width_, height_);
     glUseProgram(program_.get());
     setVec3(program_.get(), "uDispEye", frame.eyeM);
-    setVec3(program_.get(), "uDispPanelOrigin", frame.pose.originM);
-    setVec3(program_.get(), "uDispPanelRight", frame.pose.rightM);
-    setVec3(program_.get(), "uDispPanelUp", frame.pose.upM);
+    setVec3(program_.get(), "uDispPanelOrigin", frame.pose.cornerM());
+    setVec3(program_.get(), "uDispPanelRight", frame.pose.rightEdgeM());
+    setVec3(program_.get(), "uDispPanelUp", frame.pose.upEdgeM());
     setVec3(program_.get(), "uDispPanelNormal", frame.pose.normal);
     setVec3(program_.get(), "uDispLightNormal", frame.lightNormal);
     setInt(program_.get(), "uDispIlluminanceInAlpha", frame.illuminanceInAlpha ? 1 : 0);

@@ -147,8 +147,8 @@ public:
             for (int i = 0; i < count; ++i) {
                 const auto& l = lights[static_cast<std::size_t>(i)];
                 packed.insert(packed.end(),
-                              {static_cast<float>(l.positionM.x), static_cast<float>(l.positionM.y),
-                               static_cast<float>(l.positionM.z),
+                              {static_cast<float>(l.position.x), static_cast<float>(l.position.y),
+                               static_cast<float>(l.position.z),
                                static_cast<float>(l.intensityCd)});
             }
         }
@@ -227,9 +227,9 @@ private:
         glBindVertexArray(vao_.get());
 
         glUseProgram(xyzProgram_.get());
-        setVec3(xyzProgram_.get(), "uPanelOrigin", pose.originM);
-        setVec3(xyzProgram_.get(), "uPanelRight", pose.rightM);
-        setVec3(xyzProgram_.get(), "uPanelUp", pose.upM);
+        setVec3(xyzProgram_.get(), "uPanelOrigin", pose.cornerM());
+        setVec3(xyzProgram_.get(), "uPanelRight", pose.rightEdgeM());
+        setVec3(xyzProgram_.get(), "uPanelUp", pose.upEdgeM());
         setVec3(xyzProgram_.get(), "uPanelNormal", pose.normal);
         setVec3(xyzProgram_.get(), "uLightNormal", setup_.booth.emitter.normal);
         glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uLightCount"), count);

@@ -58,9 +58,10 @@ Expected<Booth> loadDefaultBooth(const std::string& dataDir)
     return booth;
 }
 
-std::vector<PointLight> uniformGridLights(const Emitter& e, double luminanceCdM2, int nu, int nv)
+std::vector<booth::PointLight>
+uniformGridLights(const Emitter& e, double luminanceCdM2, int nu, int nv)
 {
-    std::vector<PointLight> lights;
+    std::vector<booth::PointLight> lights;
     if (nu <= 0 || nv <= 0) {
         return lights;
     }
@@ -69,7 +70,14 @@ std::vector<PointLight> uniformGridLights(const Emitter& e, double luminanceCdM2
         for (int i = 0; i < nu; ++i) {
             const double u = (i + 0.5) / nu - 0.5;
             const double v = (j + 0.5) / nv - 0.5;
-            lights.push_back({e.centreM + u * e.edgeUM + v * e.edgeVM, luminanceCdM2 * cellArea});
+            booth::PointLight l;
+            l.position = e.centreM + u * e.edgeUM + v * e.edgeVM;
+            l.intensityCd = luminanceCdM2 * cellArea;
+            l.regionU = e.edgeUM / static_cast<double>(nu);
+            l.regionV = e.edgeVM / static_cast<double>(nv);
+            l.regionOrigin = l.position - 0.5 * l.regionU - 0.5 * l.regionV;
+            l.meanCdM2 = luminanceCdM2;
+            lights.push_back(l);
         }
     }
     return lights;

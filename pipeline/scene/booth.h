@@ -7,6 +7,7 @@
 #include <glm/vec3.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/booth/booth_light.h>
 #include <pipeline/colour/spectrum.h>
 
 namespace replica::pipeline::scene {
@@ -42,14 +43,9 @@ struct Booth {
 // share one ceiling.
 Expected<Booth> loadDefaultBooth(const std::string& dataDir);
 
-// A point light standing for part of the emitter (paper eq. 1): its position, and L * a (cd), the
-// summed luminance of its region times the area of one texel.
-struct PointLight {
-    glm::dvec3 positionM{0.0};
-    double intensityCd = 0.0;
-};
-
-// Splits a uniform emitter into nu x nv equal cells, one point light at each cell centre.
-std::vector<PointLight> uniformGridLights(const Emitter& e, double luminanceCdM2, int nu, int nv);
+// Splits a uniform emitter into nu x nv equal cells, one point light at each cell centre (its
+// intensity L times the cell's area; the cell is its region rectangle, of luminance L).
+std::vector<booth::PointLight>
+uniformGridLights(const Emitter& e, double luminanceCdM2, int nu, int nv);
 
 } // namespace replica::pipeline::scene

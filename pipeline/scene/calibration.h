@@ -12,16 +12,10 @@
 #include <glm/vec3.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/base/rigid_transform.h>
 #include <pipeline/scene/stand.h>
 
 namespace replica::pipeline::scene {
-
-// p_booth = rotation * p_tracker + translation.
-struct RigidTransform {
-    glm::dmat3 rotation{1.0};
-    glm::dvec3 translation{0.0};
-    glm::dvec3 apply(const glm::dvec3& p) const { return rotation * p + translation; }
-};
 
 struct RigidFitOptions {
     double maxRmsM = 0.010;   // refuse a fit whose RMS residual is larger (points were wrong)
@@ -29,7 +23,7 @@ struct RigidFitOptions {
 };
 
 struct RigidFit {
-    RigidTransform T_booth_tracker;
+    RigidTransform T_booth_tracker; // p_booth = rotation * p_tracker + translation
     std::vector<double> residualsM; // |T p_tracker - p_booth| per point
     double rmsM = 0.0;
     std::size_t worst = 0; // index of the largest residual

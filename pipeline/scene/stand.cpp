@@ -11,13 +11,23 @@ PanelPose panelPose(const StandModel& stand, double tiltRad)
 {
     const double c = std::cos(tiltRad);
     const double s = std::sin(tiltRad);
-    PanelPose p;
     const glm::dvec3 up{0.0, c, -s};
-    p.normal = glm::dvec3{0.0, s, c};
-    p.rightM = glm::dvec3{stand.panelWidthM, 0.0, 0.0};
-    p.upM = up * stand.panelHeightM;
-    p.originM = stand.hingeM + up * stand.hingeToPanelM - 0.5 * p.rightM;
+    const glm::dvec3 rightM{stand.panelWidthM, 0.0, 0.0};
+    const glm::dvec3 upM = up * stand.panelHeightM;
+    const glm::dvec3 originM = stand.hingeM + up * stand.hingeToPanelM - 0.5 * rightM;
+    PanelPose p;
+    p.right = glm::normalize(rightM);
+    p.up = glm::normalize(upM);
+    p.normal = glm::cross(p.right, p.up);
+    p.centre = originM + 0.5 * rightM + 0.5 * upM;
+    p.widthM = stand.panelWidthM;
+    p.heightM = stand.panelHeightM;
     return p;
+}
+
+PanelPose panelPose(double tiltRad)
+{
+    return panelPose(StandModel{}, tiltRad);
 }
 
 std::optional<double> tiltFromGravity(const glm::dvec3& g)

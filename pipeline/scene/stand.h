@@ -1,6 +1,7 @@
 // The display's stand: the screen turns about a horizontal hinge; the tilt angle gives its pose.
 #pragma once
 
+#include <numbers>
 #include <optional>
 
 #include <glm/vec3.hpp>
@@ -14,16 +15,31 @@ struct StandModel {
     double panelHeightM = 0.324;
 };
 
-// The panel in the booth frame: its bottom-left corner of the active area and full edge vectors.
+// The panel's active area in the booth frame (the one panel pose: the CPU model's View, the booth
+// pass, pass 2 and the flat renderer all take it): its centre, unit axes and size.
 struct PanelPose {
-    glm::dvec3 originM{0.0}; // bottom-left corner of the active area
-    glm::dvec3 rightM{0.0};  // full width along the panel's x
-    glm::dvec3 upM{0.0};     // full height along the panel's y
-    glm::dvec3 normal{0.0};  // out of the screen, towards the viewer
+    glm::dvec3 centre{0.0};           // centre of the active area
+    glm::dvec3 right{1.0, 0.0, 0.0};  // unit, along the panel's x
+    glm::dvec3 up{0.0, 1.0, 0.0};     // unit, up the panel's y
+    glm::dvec3 normal{0.0, 0.0, 1.0}; // cross(right, up): out of the screen, towards the viewer
+    double widthM = StandModel{}.panelWidthM;
+    double heightM = StandModel{}.panelHeightM;
+
+    glm::dvec3 rightEdgeM() const { return right * widthM; } // the full width along right
+    glm::dvec3 upEdgeM() const { return up * heightM; }      // the full height along up
+    glm::dvec3 cornerM() const { return centre - 0.5 * rightEdgeM() - 0.5 * upEdgeM(); }
 };
 
 // tiltRad = 0 is vertical; positive leans the top back so the screen faces up towards the ceiling.
+// Radians, as everywhere inside; degrees only at the edges (the CLI, the site file), converted
+// there with degreesToRadians.
 PanelPose panelPose(const StandModel& stand, double tiltRad);
+PanelPose panelPose(double tiltRad); // the default stand
+
+constexpr double degreesToRadians(double deg)
+{
+    return deg * std::numbers::pi / 180.0;
+}
 
 // The tilt from gravity measured in the panel frame (x right, y up the panel, z out of the screen),
 // or nullopt when it is undefined: gravity (nearly) along the hinge axis, implausible magnitude, or

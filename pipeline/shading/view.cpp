@@ -10,22 +10,6 @@
 
 namespace replica::pipeline::shading {
 
-PanelPose panelPoseFromTilt(const scene::StandModel& stand, double tiltDeg)
-{
-    const scene::PanelPose pose = scene::panelPose(stand, tiltDeg * std::numbers::pi / 180.0);
-    PanelPose p;
-    p.right = glm::normalize(pose.rightM);
-    p.up = glm::normalize(pose.upM);
-    p.normal = glm::cross(p.right, p.up);
-    p.centre = pose.originM + 0.5 * pose.rightM + 0.5 * pose.upM;
-    return p;
-}
-
-PanelPose panelPoseFromTilt(double tiltDeg)
-{
-    return panelPoseFromTilt(scene::StandModel{}, tiltDeg);
-}
-
 Vec3 sampleNormal(const std::vector<Vec3>& normals, int w, int h, double x, double y)
 {
     const Vec3 n = bilinearAtTexel(x, y, [&](int ix, int iy) {

@@ -15,18 +15,9 @@ namespace replica::pipeline::shading {
 
 using Vec3 = glm::dvec3;
 
-// A rectangle in the booth frame with unit axes; normal = cross(right, up) faces the viewer.
-struct PanelPose {
-    Vec3 centre{0.0};
-    Vec3 right{1.0, 0.0, 0.0};
-    Vec3 up{0.0, 1.0, 0.0};
-    Vec3 normal{0.0, 0.0, 1.0};
-};
-
-// The panel's pose from the stand's hinge model (scene::panelPose): the surface is shown at its
-// physical size, centred on the panel's active area.
-PanelPose panelPoseFromTilt(const scene::StandModel& stand, double tiltDeg);
-PanelPose panelPoseFromTilt(double tiltDeg); // the default stand
+// The panel's pose (scene::PanelPose, from the stand's hinge model by scene::panelPose): the
+// surface is shown at its physical size, centred on the panel's active area.
+using scene::PanelPose;
 
 struct View {
     PanelPose panel;

@@ -29,7 +29,7 @@ std::vector<View> probeViews(const scene::StandModel& stand, int probeX, int pro
     for (double tilt : {10.0, 30.0, 50.0}) {
         for (const Vec3& eye : {Vec3{0.0, 0.45, 0.60}, Vec3{-0.30, 0.40, 0.55}}) {
             View v;
-            v.panel = panelPoseFromTilt(stand, tilt);
+            v.panel = scene::panelPose(stand, scene::degreesToRadians(tilt));
             v.eye = eye;
             v.pixelsX = probeX;
             v.pixelsY = probeY;

@@ -190,10 +190,10 @@ int calibrateStand(const CalibrateOptions& o)
     constexpr double kDeg = 180.0 / 3.14159265358979323846;
     for (std::size_t i = 0; i < fit->tiltsRad.size(); ++i) {
         const auto pose = pipeline::scene::panelPose(fit->stand, fit->tiltsRad[i]);
-        const glm::dvec3 c0 = pose.originM;
-        const glm::dvec3 c1 = pose.originM + pose.rightM;
-        const glm::dvec3 c2 = c1 + pose.upM;
-        const glm::dvec3 c3 = c0 + pose.upM;
+        const glm::dvec3 c0 = pose.cornerM();
+        const glm::dvec3 c1 = pose.cornerM() + pose.rightEdgeM();
+        const glm::dvec3 c2 = c1 + pose.upEdgeM();
+        const glm::dvec3 c3 = c0 + pose.upEdgeM();
         fmt::print(
                 "tilt {:5.1f} deg: corners (m) ({:.3f}, {:.3f}, {:.3f}) ({:.3f}, {:.3f}, {:.3f}) "
                 "({:.3f}, {:.3f}, {:.3f}) ({:.3f}, {:.3f}, {:.3f})\n",

@@ -121,7 +121,7 @@ int runRender(const RenderArgs& a)
     if (!obs) {
         return fail(kExitFailure, obs.error().message);
     }
-    view.panel = shading::panelPoseFromTilt(a.tilt);
+    view.panel = scene::panelPose(scene::degreesToRadians(a.tilt));
     // The channel basis (docs/accuracy.md), for the CPU model and the GL pass alike.
     auto basis = namedBasis(a.basis, light->spd);
     if (!basis) {

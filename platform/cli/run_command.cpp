@@ -472,19 +472,6 @@ int runMain(const RunOptions& given)
     config.falseColour = o.falseColour;
     config.planner = o.planner;
     config.plannerCache = o.planCache;
-    if (!o.sitePath.empty()) {
-        auto t = readTrackerTransform(o.sitePath);
-        if (!t && t.error().code != ErrorCode::NotFound) {
-            log->error("{}", t.error().message);
-            return kExitFailure;
-        }
-        if (t) {
-            config.trackerInBooth = *t;
-            log->info("tracker pose in the booth from {} (T_booth_tracker)", o.sitePath);
-        } else {
-            log->warn("{}; using the fixed tracker mounting", t.error().message);
-        }
-    }
     if (o.site) {
         const SiteConfig& site = *o.site;
         config.booth = site.boothId;
@@ -497,11 +484,25 @@ int runMain(const RunOptions& given)
             config.stand.panelWidthM = panelW;
             config.stand.panelHeightM = panelH;
         }
-        config.trackerRotationDeg = site.trackerRotationDeg;
-        config.trackerTranslationM = site.trackerTranslationM;
+        config.trackerInBooth = site.trackerInBooth();
         config.defaultLamp = site.defaultLamp;
         config.defaultEyeM = site.defaultEyeM;
         config.defaultTiltRad = site.defaultTiltDeg * std::numbers::pi / 180.0;
+    }
+    if (!o.sitePath.empty()) {
+        auto t = readTrackerTransform(o.sitePath);
+        if (!t && t.error().code != ErrorCode::NotFound) {
+            log->error("{}", t.error().message);
+            return kExitFailure;
+        }
+        if (t) {
+            config.trackerInBooth = *t; // the calibration wins over the site's angles
+            log->info("tracker pose in the booth from {} (T_booth_tracker)", o.sitePath);
+        } else {
+            log->warn("{}; using [tracker] rotation_deg and translation_m (absent: the fixed "
+                      "mounting)",
+                      t.error().message);
+        }
     }
     if (o.hal == "live" && syntheticDisplay(config)) {
         const bool allowed = o.site && o.site->allowSynthetic;

@@ -1,6 +1,5 @@
 // Sample-to-scene conversion.
 #include <cmath>
-#include <numbers>
 
 #include <fmt/format.h>
 
@@ -68,16 +67,6 @@ void SceneUpdater::start(pipeline::scene::SceneState& state)
         setup_.defaultLamp < static_cast<int>(setup_.booth.lamps.size())) {
         showLamp(state, setup_.defaultLamp);
     }
-    const glm::dvec3 r = setup_.trackerRotationDeg * (std::numbers::pi / 180.0);
-    if (r != glm::dvec3(0.0)) {
-        const auto rx = glm::dmat3(1, 0, 0, 0, std::cos(r.x), std::sin(r.x), 0, -std::sin(r.x),
-                                   std::cos(r.x));
-        const auto ry = glm::dmat3(std::cos(r.y), 0, -std::sin(r.y), 0, 1, 0, std::sin(r.y), 0,
-                                   std::cos(r.y));
-        const auto rz = glm::dmat3(std::cos(r.z), std::sin(r.z), 0, -std::sin(r.z), std::cos(r.z),
-                                   0, 0, 0, 1);
-        trackerRotation_ = rz * ry * rx;
-    }
 }
 
 void SceneUpdater::update(pipeline::scene::SceneState& state,
@@ -130,12 +119,7 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
         lastPose_ = pose->sequence;
         const glm::dvec3 e = pose->eyeTrackerM;
         if (pose->tracked && std::isfinite(e.x) && std::isfinite(e.y) && std::isfinite(e.z)) {
-            // The calibrated T_booth_tracker when the site has one; else the site file's angles
-            // and translation (defaults: the fixed mounting, bit for bit as before).
-            state.eyeBoothM = setup_.trackerInBooth
-                                      ? setup_.trackerInBooth->apply(e)
-                                      : (trackerRotation_ ? *trackerRotation_ * e : e) +
-                                                setup_.trackerInBoothM;
+            state.eyeBoothM = setup_.trackerInBooth.apply(e);
             havePose_ = true;
         } else {
             ++rejectedPoses_;

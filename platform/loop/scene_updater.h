@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <optional>
 
-#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
 #include <hal/samples.h>
 #include <pipeline/base/expected.h>
+#include <pipeline/base/rigid_transform.h>
 #include <pipeline/scene/booth.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/scene/scene_state.h>
@@ -23,13 +23,9 @@ namespace replica::platform {
 struct SceneUpdaterSetup {
     pipeline::scene::Booth booth;
     pipeline::spectral::SpectrometerCalibration calibration;
-    // The calibrated T_booth_tracker, which replaces trackerInBoothM when present.
-    std::optional<pipeline::scene::RigidTransform> trackerInBooth;
-    // T_booth_tracker: eye_booth = R * eye_tracker + trackerInBoothM, R the rotation about x,
-    // then y, then z by these angles (degrees). Defaults: the tracker on the stand's base,
-    // unrotated (an identity rotation is skipped, so the eye is bit for bit what it was).
-    glm::dvec3 trackerRotationDeg{0.0};
-    glm::dvec3 trackerInBoothM{0.0, 0.42, 0.05};
+    // T_booth_tracker: eye_booth = trackerInBooth.apply(eye_tracker). Default: the fixed
+    // mounting (pipeline/base/rigid_transform.h).
+    pipeline::RigidTransform trackerInBooth = pipeline::defaultTrackerInBooth();
     // Shown until each sensor's first usable sample: a booth lamp index (-1: no light), the eye
     // and the tilt.
     int defaultLamp = -1;
@@ -65,8 +61,8 @@ public:
     // The classifier's current answer (name "unknown" in direct-sensor mode).
     pipeline::spectral::Classification classification() const;
     const LampArbiter& lampArbiter() const { return arbiter_; }
-    // Where the tracker is mounted in the booth (its frame is the booth's, translated).
-    glm::dvec3 trackerInBoothM() const { return setup_.trackerInBoothM; }
+    // The tracker's pose in the booth (T_booth_tracker).
+    const pipeline::RigidTransform& trackerInBooth() const { return setup_.trackerInBooth; }
 
 private:
     SceneUpdater(SceneUpdaterSetup setup,
@@ -91,7 +87,6 @@ private:
     bool haveSpectrum_ = false;
     bool havePose_ = false;
     bool haveTilt_ = false;
-    std::optional<glm::dmat3> trackerRotation_; // none: identity
 };
 
 } // namespace replica::platform

@@ -116,7 +116,7 @@ void ShownRecorder::onFrame(const recordings::FrameRecord& frame,
                        lastPose_->tiltRad != state.tiltRad;
     if (moved && (!lastPose_ || state.tickNs - lastPoseNs_ >= options_.posePeriodNs)) {
         writer_.write(recordings::PosesRecord{frame.tickNs, state.eyeBoothM, state.tiltRad,
-                                              appliance_.updater->trackerInBoothM()});
+                                              appliance_.updater->trackerInBooth().translation});
         lastPose_ = state;
         lastPoseNs_ = state.tickNs;
         std::lock_guard lock(mutex_);

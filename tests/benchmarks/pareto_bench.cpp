@@ -261,7 +261,7 @@ int main(int argc, char** argv)
             std::vector<shading::XyzFrame> refs;
             for (const double tiltDeg : tilts) {
                 shading::View v;
-                v.panel = shading::panelPoseFromTilt(tiltDeg);
+                v.panel = scene::panelPose(scene::degreesToRadians(tiltDeg));
                 v.pixelsX = o.errorWidth;
                 v.pixelsY = o.errorHeight;
                 views.push_back(v);

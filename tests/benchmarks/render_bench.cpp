@@ -182,7 +182,7 @@ int runViews(const ViewsOptions& o,
                     }
                     const auto& [label, eye] = eyes[e];
                     shading::View view;
-                    view.panel = shading::panelPoseFromTilt(tilt);
+                    view.panel = scene::panelPose(scene::degreesToRadians(tilt));
                     view.eye = eye;
                     view.pixelsX = fw;
                     view.pixelsY = fh;
@@ -333,7 +333,7 @@ int main(int argc, char** argv)
         }
         for (const auto& light : booth->lights) {
             shading::View view;
-            view.panel = shading::panelPoseFromTilt(tilt);
+            view.panel = scene::panelPose(scene::degreesToRadians(tilt));
             view.pixelsX = fw;
             view.pixelsY = fh;
             const auto ref = reference::renderReference(*scene, light, view, *obs);

@@ -18,6 +18,7 @@
 #include <platform/loop/scene_updater.h>
 #include <platform/session_files.h>
 #include <platform/site_config.h>
+#include <platform/site_file.h>
 #include <recordings/recording.h>
 
 #include <gtest/gtest.h>
@@ -95,6 +96,8 @@ TEST_F(SiteFile, TheShippedFileIsGoodAndHoldsTheCompiledInDefaults)
     EXPECT_EQ(c.stand.panelHeightM, defaults.stand.panelHeightM);
     EXPECT_EQ(c.trackerRotationDeg, defaults.trackerRotationDeg);
     EXPECT_EQ(c.trackerTranslationM, defaults.trackerTranslationM);
+    EXPECT_FALSE(c.trackerCalibrated);
+    EXPECT_EQ(c.trackerInBooth(), pipeline::defaultTrackerInBooth());
     EXPECT_EQ(c.rotateBytes, defaults.rotateBytes);
     EXPECT_EQ(c.keepBytes, defaults.keepBytes);
     EXPECT_EQ(c.defaultEyeM, defaults.defaultEyeM);
@@ -110,7 +113,8 @@ TEST_F(SiteFile, TheShippedFileIsGoodAndHoldsTheCompiledInDefaults)
     RunConfig run;
     EXPECT_EQ(run.stand.panelWidthM, 0.518);
     EXPECT_EQ(run.stand.panelHeightM, 0.324);
-    EXPECT_EQ(run.trackerTranslationM, glm::dvec3(0.0, 0.42, 0.05));
+    EXPECT_EQ(run.trackerInBooth.translation, glm::dvec3(0.0, 0.42, 0.05));
+    EXPECT_EQ(run.trackerInBooth.rotation, glm::dmat3(1.0));
     EXPECT_EQ(run.stand.hingeM, c.stand.hingeM);
 }
 
@@ -170,6 +174,56 @@ TEST_F(SiteFile, TheSpectrometerSerialChoosesTheInstrument)
     EXPECT_EQ(bad->problems[0].line, 2);
 }
 
+TEST_F(SiteFile, TheCalibratedTrackerTransformWinsAndAMalformedOneIsNamed)
+{
+    // [tracker] T_booth_tracker as 'replica calibrate tracker' writes it: a quarter turn about
+    // y (tracker +x -> booth -z) and a translation; it wins over the angles beside it.
+    auto site = loadSiteConfig(write(
+            "[tracker]\nrotation_deg = [0.0, 0.0, 45.0]\ntranslation_m = [0.0, 0.5, 0.0]\n"
+            "T_booth_tracker = { rotation = [0, 0, 1, 0, 1, 0, -1, 0, 0], translation = [0.1, "
+            "0.42, -0.05] }\ncalibration_rms_m = 0.0012\ncalibration_points = 12\n"));
+    ASSERT_TRUE(site) << site.error().message;
+    for (const auto& p : site->problems) {
+        ADD_FAILURE() << formatProblem("site.toml", p);
+    }
+    const glm::dvec3 e = site->config.trackerInBooth().apply({1.0, 0.0, 0.0});
+    EXPECT_NEAR(e.x, 0.1, 1e-15);
+    EXPECT_NEAR(e.y, 0.42, 1e-15);
+    EXPECT_NEAR(e.z, -1.05, 1e-15);
+    // Without it, the angles (degrees at the file's edge, radians inside).
+    auto angles = loadSiteConfig(write("[tracker]\nrotation_deg = [0.0, 0.0, 90.0]\n"));
+    ASSERT_TRUE(angles) << angles.error().message;
+    const glm::dvec3 a = angles->config.trackerInBooth().apply({1.0, 0.0, 0.0});
+    EXPECT_NEAR(a.x, 0.0, 1e-15);
+    EXPECT_NEAR(a.y, 1.0 + 0.42, 1e-15);
+    EXPECT_NEAR(a.z, 0.05, 1e-15);
+    // Malformed: each a one-line problem naming file, line and key.
+    for (const char* bad :
+         {"T_booth_tracker = { rotation = [1, 0, 0, 0, 1, 0, 0, 0], translation = [0, 0, 0] }",
+          "T_booth_tracker = { rotation = [-1, 0, 0, 0, 1, 0, 0, 0, 1], translation = [0, 0, 0] }",
+          "T_booth_tracker = { rotation = [1, 0, 0, 0, 1, 0, 0, 0, 1], translation = [0, \"x\", 0] "
+          "}",
+          "T_booth_tracker = { rotation = [1, 0, 0, 0, 1, 0, 0, 0, 1], translation = [0, 99, 0] }",
+          "T_booth_tracker = [1, 2, 3]"}) {
+        const auto f = write(std::string("[tracker]\nport = 4242\n") + bad + "\n");
+        auto s = loadSiteConfig(f);
+        ASSERT_TRUE(s) << s.error().message;
+        ASSERT_EQ(s->problems.size(), 1u) << bad;
+        EXPECT_EQ(s->problems[0].key, "tracker.T_booth_tracker") << bad;
+        EXPECT_EQ(s->problems[0].line, 3) << bad;
+        EXPECT_FALSE(s->config.trackerCalibrated);
+        const std::string line = formatProblem(f, s->problems[0]);
+        EXPECT_EQ(line.find('\n'), std::string::npos);
+        EXPECT_NE(line.find(f.string() + ":3: tracker.T_booth_tracker: "), std::string::npos)
+                << line;
+        // 'run --site' reads the same key through the same reader and refuses it.
+        auto t = readTrackerTransform(f);
+        ASSERT_FALSE(t);
+        EXPECT_EQ(t.error().code, ErrorCode::Corrupt);
+        EXPECT_EQ(t.error().message, line);
+    }
+}
+
 TEST_F(SiteFile, NotTomlIsOneErrorWithItsLine)
 {
     const auto f = write("[run]\nrate_hz = 60\n[recording\n");
@@ -184,22 +238,22 @@ TEST(RunConfigSite, GeometryRoundTripsAndOldRecordingsGetTodaysConstants)
     RunConfig c;
     c.stand.hingeM = {0.01, 0.2, -0.12};
     c.stand.panelWidthM = 0.6;
-    c.trackerRotationDeg = {0.0, 10.0, 0.0};
+    c.trackerInBooth = pipeline::rigidFromDegrees({0.0, 10.0, 0.0}, {0.01, 0.4, 0.06});
     c.defaultLamp = "tungsten";
     c.defaultTiltRad = 0.25;
     auto back = RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(back) << back.error().message;
     EXPECT_EQ(back->stand.hingeM, c.stand.hingeM);
     EXPECT_EQ(back->stand.panelWidthM, 0.6);
-    EXPECT_EQ(back->trackerRotationDeg, c.trackerRotationDeg);
+    EXPECT_EQ(back->trackerInBooth, c.trackerInBooth); // bit for bit through the JSON
     EXPECT_EQ(back->defaultLamp, "tungsten");
     EXPECT_EQ(back->defaultTiltRad, 0.25);
 
     // A configuration written before the site file had none of these keys.
     auto j = nlohmann::json::parse(RunConfig{}.toJson());
-    for (const char* k : {"stand_hinge_m", "stand_hinge_to_panel_m", "panel_width_m",
-                          "panel_height_m", "tracker_rotation_deg", "tracker_translation_m",
-                          "default_lamp", "default_eye_m", "default_tilt_rad"}) {
+    for (const char* k :
+         {"stand_hinge_m", "stand_hinge_to_panel_m", "panel_width_m", "panel_height_m",
+          "t_booth_tracker", "default_lamp", "default_eye_m", "default_tilt_rad"}) {
         j.erase(k);
     }
     auto old = RunConfig::fromJson(j.dump());
@@ -207,13 +261,43 @@ TEST(RunConfigSite, GeometryRoundTripsAndOldRecordingsGetTodaysConstants)
     const pipeline::scene::StandModel today;
     EXPECT_EQ(old->stand.hingeM, today.hingeM);
     EXPECT_EQ(old->stand.panelWidthM, today.panelWidthM);
-    EXPECT_EQ(old->trackerTranslationM, SceneUpdaterSetup{}.trackerInBoothM);
+    EXPECT_EQ(old->trackerInBooth, pipeline::defaultTrackerInBooth());
+    EXPECT_EQ(old->trackerInBooth, SceneUpdaterSetup{}.trackerInBooth);
     EXPECT_EQ(old->defaultLamp, "");
     EXPECT_EQ(old->defaultEyeM, pipeline::scene::SceneState{}.eyeBoothM);
 
     auto bad = nlohmann::json::parse(c.toJson());
     bad["panel_width_m"] = -1.0;
     EXPECT_FALSE(RunConfig::fromJson(bad.dump()));
+}
+
+TEST(RunConfigSite, RecordingsWithTheTrackerAnglesInDegreesReplayWithTheSameTransform)
+{
+    // Recordings made before t_booth_tracker was written whole hold the site's angles (degrees)
+    // and translation: a quarter turn about y takes tracker +x to booth -z.
+    auto j = nlohmann::json::parse(RunConfig{}.toJson());
+    j.erase("t_booth_tracker");
+    j["tracker_rotation_deg"] = {0.0, 90.0, 0.0};
+    j["tracker_translation_m"] = {0.1, 0.2, 0.3};
+    auto old = RunConfig::fromJson(j.dump());
+    ASSERT_TRUE(old) << old.error().message;
+    const glm::dvec3 e = old->trackerInBooth.apply({1.0, 0.0, 0.0});
+    EXPECT_NEAR(e.x, 0.1, 1e-15);
+    EXPECT_NEAR(e.y, 0.2, 1e-15);
+    EXPECT_NEAR(e.z, 0.3 - 1.0, 1e-15);
+    // Both present (a calibrated run): the matrix wins, as it did.
+    j["t_booth_tracker"] = {{"rotation", {1, 0, 0, 0, 1, 0, 0, 0, 1}},
+                            {"translation", {0.0, 0.5, 0.0}}};
+    auto both = RunConfig::fromJson(j.dump());
+    ASSERT_TRUE(both) << both.error().message;
+    EXPECT_EQ(both->trackerInBooth.translation, glm::dvec3(0.0, 0.5, 0.0));
+    EXPECT_EQ(both->trackerInBooth.rotation, glm::dmat3(1.0));
+    // A matrix that is not a rotation (a mirror) is refused, naming the key.
+    j["t_booth_tracker"]["rotation"] = {-1, 0, 0, 0, 1, 0, 0, 0, 1};
+    auto mirror = RunConfig::fromJson(j.dump());
+    ASSERT_FALSE(mirror);
+    EXPECT_NE(mirror.error().message.find("t_booth_tracker"), std::string::npos)
+            << mirror.error().message;
 }
 
 class SiteUpdater : public ::testing::Test
@@ -234,8 +318,7 @@ protected:
 
 TEST_F(SiteUpdater, TrackerRotationIsXThenYThenZ)
 {
-    setup_.trackerRotationDeg = {90.0, 0.0, 90.0};
-    setup_.trackerInBoothM = {1.0, 2.0, 3.0};
+    setup_.trackerInBooth = pipeline::rigidFromDegrees({90.0, 0.0, 90.0}, {1.0, 2.0, 3.0});
     auto u = SceneUpdater::create(setup_);
     ASSERT_TRUE(u);
     pipeline::scene::SceneState st;
@@ -252,7 +335,7 @@ TEST_F(SiteUpdater, TrackerRotationIsXThenYThenZ)
     p.sequence = 2;
     p.eyeTrackerM = {0.3, -0.4, 1.2};
     u->update(st, nullptr, &p, nullptr);
-    const glm::dvec3 d = st.eyeBoothM - setup_.trackerInBoothM;
+    const glm::dvec3 d = st.eyeBoothM - setup_.trackerInBooth.translation;
     EXPECT_NEAR(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z), 1.3, 1e-12);
 }
 

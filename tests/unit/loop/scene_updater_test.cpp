@@ -182,7 +182,8 @@ TEST_F(SceneUpdaterTest, EyeMovesIntoTheBoothFrameAndHoldsThroughNaNAndLostTrack
     p.tracked = true;
     p.eyeTrackerM = {0.1, 0.05, 0.5};
     u.update(st, nullptr, &p, nullptr);
-    const glm::dvec3 expected = p.eyeTrackerM + setup_.trackerInBoothM;
+    // The fixed mounting: a translation by (0, 0.42, 0.05) m, exactly.
+    const glm::dvec3 expected = p.eyeTrackerM + glm::dvec3(0.0, 0.42, 0.05);
     EXPECT_EQ(st.eyeBoothM, expected);
 
     hal::PoseSample nan = p;

@@ -131,7 +131,7 @@ TEST_F(AdaptiveBooth, SpikyLightsMatchTheFullSpectralModelFarBetterThanReplicaK6
     ASSERT_TRUE(replica);
     shading::RenderSettings settings = setup_.settings;
     shading::View view;
-    view.panel = shading::panelPoseFromTilt(20.0);
+    view.panel = scene::panelPose(scene::degreesToRadians(20.0));
     view.pixelsX = 64;
     view.pixelsY = 40;
     for (const char* name : {"F11", "LED-B4"}) {

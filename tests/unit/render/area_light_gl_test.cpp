@@ -86,7 +86,7 @@ TEST_F(AreaLightGl, MatteFramesMatchTheQuadratureAtEveryTilt)
         for (const double tilt : {-30.0, -20.0, -10.0, 0.0, 8.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0,
                                   80.0, 85.0, 89.0}) {
             shading::View v;
-            v.panel = shading::panelPoseFromTilt(tilt);
+            v.panel = scene::panelPose(scene::degreesToRadians(tilt));
             v.pixelsX = 10;
             v.pixelsY = 6;
             auto gl = renderBoothFrame(**pass, pl, v);
@@ -132,7 +132,7 @@ TEST_F(AreaLightGl, ReportsWhatTheCpuModelReports)
         ASSERT_TRUE((*pass)->setLight(pl));
         for (const Vec3& eye : {Vec3(0.0, 0.45, 0.60), Vec3(0.0, 0.45, -0.60)}) {
             shading::View v;
-            v.panel = shading::panelPoseFromTilt(20.0);
+            v.panel = scene::panelPose(scene::degreesToRadians(20.0));
             v.eye = eye;
             v.pixelsX = 12;
             v.pixelsY = 8;

@@ -231,7 +231,7 @@ double worstFrameError(const MatteCase& c,
     s.channels = ChannelRep::Spectral36;
     s.diffuseGrid = 0;
     View view;
-    view.panel = panelPoseFromTilt(tiltDeg);
+    view.panel = scene::panelPose(scene::degreesToRadians(tiltDeg));
     view.eye = eye;
     view.pixelsX = 10;
     view.pixelsY = 6;
@@ -326,7 +326,7 @@ TEST(AreaLight, OneTexelWideLampIsTheStripItIs)
     const Vec3 stripOrigin = c.light.pointAtTexel(40, 0);
     const Vec3 eu = c.light.pointAtTexel(41, 0) - stripOrigin;
     for (const double tilt : {-20.0, 10.0, 45.0, 85.0}) {
-        view.panel = panelPoseFromTilt(tilt);
+        view.panel = scene::panelPose(scene::degreesToRadians(tilt));
         const XyzFrame f = renderRealtime(ps, pl, view, test::observer(), s);
         for (int py = 0; py < view.pixelsY; ++py) {
             for (int px = 0; px < view.pixelsX; ++px) {
@@ -352,7 +352,7 @@ TEST(AreaLight, TheExactReferenceAgreesWithTheQuadrature)
     view.pixelsY = 4;
     const Vec3 origin = c.light.centre - 0.5 * (c.light.edgeU + c.light.edgeV);
     for (const double tilt : {-20.0, 10.0, 60.0}) {
-        view.panel = panelPoseFromTilt(tilt);
+        view.panel = scene::panelPose(scene::degreesToRadians(tilt));
         const XyzFrame ref = reference::renderReference(c.scene, c.light, view, test::observer());
         double worst = 0.0;
         for (int py = 0; py < view.pixelsY; ++py) {

@@ -190,7 +190,7 @@ TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
     // double, at the pixel centre on the panel plane (around the surface too).
     const auto light = shading::prepareLight(*setup_.booth.find("d65-fluorescent"), setup_.observer,
                                              setup_.settings.lights, setup_.basis);
-    const auto panel = shading::panelPoseFromTilt(setup_.stand, 0.35 * 180.0 / std::numbers::pi);
+    const auto panel = scene::panelPose(setup_.stand, 0.35);
     const SurfaceLayout layout = layoutOnPanel(setup_.scene, setup_.stand);
     const booth::BoothLight& bl = *light.light;
     double worst = 0.0;
@@ -240,9 +240,9 @@ TiltOffsetCost diffuseCostOfTiltOffset(double offsetDeg)
                 shading::View truth;
                 truth.pixelsX = 32;
                 truth.pixelsY = 20;
-                truth.panel = shading::panelPoseFromTilt(tiltDeg);
+                truth.panel = scene::panelPose(scene::degreesToRadians(tiltDeg));
                 shading::View held = truth;
-                held.panel = shading::panelPoseFromTilt(tiltDeg + offsetDeg);
+                held.panel = scene::panelPose(scene::degreesToRadians(tiltDeg + offsetDeg));
                 const auto a = shading::renderRealtime(ps, pl, truth, obs, settings);
                 const auto b = shading::renderRealtime(ps, pl, held, obs, settings);
                 const auto e = reference::compareFrames(a, b);
@@ -318,13 +318,13 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         }
         SurfaceLayout layout = layoutOnPanel(scene, setup_.stand);
         shading::View view; // the specular term's pose and eye stay put: only the cache moves
-        view.panel = shading::panelPoseFromTilt(setup_.stand, 20.0);
+        view.panel = scene::panelPose(setup_.stand, scene::degreesToRadians(20.0));
         view.eye = {0.05, 0.45, 0.6};
         view.pixelsX = kCacheW;
         view.pixelsY = kCacheH;
         const auto frame = [&](const BoothShadingPass& pass, double cacheTiltDeg) {
             const shading::PanelPose cachePose =
-                    shading::panelPoseFromTilt(setup_.stand, cacheTiltDeg);
+                    scene::panelPose(setup_.stand, scene::degreesToRadians(cacheTiltDeg));
             target_->bind();
             auto ok = pass.draw(view, kCacheW, kCacheH, layout, &cachePose);
             EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);

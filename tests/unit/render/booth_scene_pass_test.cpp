@@ -68,7 +68,7 @@ TEST_F(BoothScenePassTest, ClassifiedLampUsesItsBoothLight)
     ASSERT_TRUE(target);
     (*target)->bind();
     shading::View v;
-    v.panel = shading::panelPoseFromTilt(setup_.stand, 0.5 * 180.0 / std::numbers::pi);
+    v.panel = scene::panelPose(setup_.stand, 0.5);
     v.eye = st.eyeBoothM;
     ASSERT_TRUE((*direct)->draw(v, kW, kH, layoutOnPanel(setup_.scene, setup_.stand)));
     const auto want = (*target)->read({}, {}).xyz;

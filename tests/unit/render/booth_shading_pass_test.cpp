@@ -97,7 +97,7 @@ protected:
     static shading::View view(int w, int h, double tiltDeg = 30.0)
     {
         shading::View v;
-        v.panel = shading::panelPoseFromTilt(tiltDeg);
+        v.panel = scene::panelPose(scene::degreesToRadians(tiltDeg));
         v.pixelsX = w;
         v.pixelsY = h;
         return v;

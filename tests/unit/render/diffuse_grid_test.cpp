@@ -35,7 +35,7 @@ TEST(DiffuseGrid, CostsTheFlatScenesAHundredthOfADeltaE00UnderEveryLight)
             // angles: where the illuminance bends most over the surface.
             for (const double tilt : {5.0, 30.0, 60.0}) {
                 View view;
-                view.panel = panelPoseFromTilt(tilt);
+                view.panel = scene::panelPose(scene::degreesToRadians(tilt));
                 view.pixelsX = 96;
                 view.pixelsY = 64;
                 const XyzFrame a = renderRealtime(ps, pl, view, *obs, perPixel);

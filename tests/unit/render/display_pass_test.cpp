@@ -83,12 +83,12 @@ protected:
     {
         const auto st = state();
         const auto pose = scene::panelPose(setup_.stand, st.tiltRad);
-        const glm::dvec3 p =
-                pose.originM + (x + 0.5) / f.width * pose.rightM + (y + 0.5) / f.height * pose.upM;
+        const glm::dvec3 p = pose.cornerM() + (x + 0.5) / f.width * pose.rightEdgeM() +
+                             (y + 0.5) / f.height * pose.upEdgeM();
         double e = 0.0;
         for (const auto& l : scene::uniformGridLights(setup_.booth.emitter, st.emitterLuminanceCdM2,
                                                       setup_.lightsU, setup_.lightsV)) {
-            const glm::dvec3 d = l.positionM - p;
+            const glm::dvec3 d = l.position - p;
             const double d2 = glm::dot(d, d);
             const glm::dvec3 dir = d / std::sqrt(d2);
             e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *
@@ -181,7 +181,8 @@ TEST_F(DisplayPassTest, FilteredViewingGainDrivesWhatTheTableRowsDo)
     const scene::PanelPose pose = scene::panelPose(scene::StandModel{}, 0.3);
     DisplayPassFrame frame;
     frame.pose = pose;
-    frame.eyeM = pose.originM + 0.1 * pose.rightM + 0.1 * pose.upM + 0.03 * pose.normal;
+    frame.eyeM =
+            pose.cornerM() + 0.1 * pose.rightEdgeM() + 0.1 * pose.upEdgeM() + 0.03 * pose.normal;
     const glm::dvec3 grey = 0.1 * profile_.whiteXyz(); // in gamut at every angle
     std::vector<float> xyz;
     for (int i = 0; i < w * h; ++i) {

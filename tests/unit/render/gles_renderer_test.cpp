@@ -59,11 +59,11 @@ protected:
         const auto pose = scene::panelPose(setup_.stand, st.tiltRad);
         const double u = (x + 0.5) / setup_.width;
         const double v = (y + 0.5) / setup_.height;
-        const glm::dvec3 p = pose.originM + u * pose.rightM + v * pose.upM;
+        const glm::dvec3 p = pose.cornerM() + u * pose.rightEdgeM() + v * pose.upEdgeM();
         double e = 0.0;
         for (const auto& l : scene::uniformGridLights(setup_.booth.emitter, st.emitterLuminanceCdM2,
                                                       setup_.lightsU, setup_.lightsV)) {
-            const glm::dvec3 d = l.positionM - p;
+            const glm::dvec3 d = l.position - p;
             const double d2 = glm::dot(d, d);
             const glm::dvec3 dir = d / std::sqrt(d2);
             e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *

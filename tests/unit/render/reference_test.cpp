@@ -1,5 +1,6 @@
 // The exact reference against closed forms (Lambert's polygon formula, a point source), and the
 // real-time model against the reference, including the hard cases that must never produce NaN/Inf.
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -47,7 +48,7 @@ const GrazingPainting& grazingPainting()
         auto booth = booth::loadBooth(dataDir() / "booth");
         EXPECT_TRUE(scene && booth);
         GrazingPainting out{*scene, *booth, {}};
-        out.view.panel = shading::panelPoseFromTilt(10.0);
+        out.view.panel = scene::panelPose(scene::degreesToRadians(10.0));
         out.view.pixelsX = 32;
         out.view.pixelsY = 20;
         return out;
@@ -114,6 +115,14 @@ TEST(PointLights, HotTexelEqualsThePointSourceFormula)
             shading::pointLightIrradiance(prepared.points, light.normal(), light.texelAreaM2(), p,
                                           n, n, nullptr, 0, 0, Vec3(1, 0, 0), Vec3(0, 0, -1), 0.0);
     EXPECT_NEAR(e, expected, 1e-9 * expected);
+    // The point light's intensity is L * a of the texel (the flat renderer's uniform grid gives
+    // the same field): the one whose region holds the hot texel carries at least it.
+    double hottest = 0.0;
+    for (const auto& l : prepared.points) {
+        EXPECT_NEAR(l.intensityCd, l.sumCdM2 * light.texelAreaM2(), 1e-12 * l.intensityCd);
+        hottest = std::max(hottest, l.intensityCd);
+    }
+    EXPECT_GE(hottest, 2.0e6 * light.texelAreaM2());
     const auto ref = reference::integrateTexels(reference::texelCloud(light), p, n, n, n,
                                                 brdf::WardModel::WardDur, 0.1, false, nullptr,
                                                 Vec3(1, 0, 0), Vec3(0, 0, -1));
@@ -183,7 +192,7 @@ struct Case {
 Case setup(bool bumpy, bool glossy, double tiltDeg, int px = 24, int py = 16)
 {
     Case s{test::testScene(48, 32, bumpy, glossy), test::stripedLight(64, 32, 0.6), {}};
-    s.view.panel = shading::panelPoseFromTilt(tiltDeg);
+    s.view.panel = scene::panelPose(scene::degreesToRadians(tiltDeg));
     s.view.pixelsX = px;
     s.view.pixelsY = py;
     return s;

@@ -63,7 +63,7 @@ TEST(SpecularGrid, CostsTheFlatColorCheckerLittleAgainstPerPixelShading)
     auto scene = surface::loadScene(dataDir() / "scenes" / "colorchecker");
     ASSERT_TRUE(obs && booth && scene);
     View view;
-    view.panel = panelPoseFromTilt(30.0);
+    view.panel = scene::panelPose(scene::degreesToRadians(30.0));
     view.pixelsX = 96;
     view.pixelsY = 64;
     RenderSettings perPixel;

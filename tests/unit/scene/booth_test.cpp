@@ -44,6 +44,29 @@ TEST(DefaultBooth, HasTheBoothModelsCeiling)
     EXPECT_DOUBLE_EQ(b->emitter.normal.y, -1.0);
 }
 
+TEST(DefaultBooth, TheUniformGridTilesTheCeilingWithItsPower)
+{
+    // 4 x 2 cells of a 1 x 0.5 m emitter at 2000 cd/m^2: each light L * a = 2000 * 0.0625 cd at
+    // its cell's centre; the cells' rectangles tile the emitter.
+    Emitter e;
+    const auto lights = uniformGridLights(e, 2000.0, 4, 2);
+    ASSERT_EQ(lights.size(), 8u);
+    double power = 0.0;
+    for (const auto& l : lights) {
+        EXPECT_NEAR(l.intensityCd, 2000.0 * 1.0 * 0.5 / 8.0, 1e-12);
+        EXPECT_EQ(l.meanCdM2, 2000.0);
+        EXPECT_NEAR(glm::length(l.regionU), 0.25, 1e-15);
+        EXPECT_NEAR(glm::length(l.regionV), 0.25, 1e-15);
+        EXPECT_NEAR(glm::length(l.regionOrigin + 0.5 * (l.regionU + l.regionV) - l.position), 0.0,
+                    1e-15);
+        power += l.intensityCd;
+    }
+    EXPECT_NEAR(power, 2000.0 * 0.5, 1e-9);
+    // The first cell's centre: the emitter's corner plus half a cell along each edge.
+    EXPECT_NEAR(glm::length(lights[0].position - (e.centreM + glm::dvec3(-0.375, 0.0, -0.125))),
+                0.0, 1e-15);
+}
+
 TEST(DefaultBooth, RefusesAModelWhoseLightsHaveTwoCeilings)
 {
     const auto dir = std::filesystem::temp_directory_path() / "replica_two_ceilings";

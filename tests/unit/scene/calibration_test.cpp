@@ -47,7 +47,7 @@ double maxDiff(const glm::dmat3& a, const glm::dmat3& b)
 struct Synthetic {
     std::vector<glm::dvec3> tracker;
     std::vector<glm::dvec3> booth;
-    RigidTransform truth;
+    pipeline::RigidTransform truth;
 };
 
 // Booth points in a 0.6 m box in front of the stand; the tracker sees them through the inverse
@@ -171,7 +171,7 @@ TEST(StandFit, RecoversHingeAndPanelOffsetFromTwoOrThreeTilts)
         for (const double deg : tiltsDeg) {
             const double t = deg * 3.14159265358979323846 / 180.0;
             const PanelPose pose = panelPose(truth, t);
-            const glm::dvec3 top = pose.originM + 0.5 * pose.rightM + pose.upM;
+            const glm::dvec3 top = pose.cornerM() + 0.5 * pose.rightEdgeM() + pose.upEdgeM();
             // Gravity in panel axes for tilt t (tiltFromGravity's inverse), the sensor 2 degrees
             // rotated about the panel normal.
             const glm::dvec3 gPanel{0.0, -g * std::cos(t), -g * std::sin(t)};
