@@ -57,7 +57,7 @@ Expected<Vec3> vec3Field(const nlohmann::json& j, const char* key, const std::st
 
 } // namespace
 
-const BoothLight* BoothModel::find(const std::string& name) const
+const BoothLight* Booth::find(const std::string& name) const
 {
     for (const auto& l : lights) {
         if (l.name == name) {
@@ -77,7 +77,7 @@ const BoothLight* BoothModel::find(const std::string& name) const
     return match;
 }
 
-std::string BoothModel::names() const
+std::string Booth::names() const
 {
     std::string s;
     for (const auto& l : lights) {
@@ -86,7 +86,7 @@ std::string BoothModel::names() const
     return s;
 }
 
-Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
+Expected<Booth> loadBooth(const std::filesystem::path& dir)
 {
     const auto file = dir / "booth.json";
     auto text = readInputFile(file, kMaxJsonBytes, "booth model");
@@ -112,7 +112,7 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: 'lights' must be a non-empty array", file.string()));
     }
-    BoothModel booth;
+    Booth booth;
     for (std::size_t k = 0; k < j["lights"].size(); ++k) {
         const auto& lj = j["lights"][k];
         const std::string where = fmt::format("{}: lights[{}]", file.string(), k);
@@ -174,7 +174,7 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
     return booth;
 }
 
-Expected<void> saveBooth(const std::filesystem::path& dir, const BoothModel& booth)
+Expected<void> saveBooth(const std::filesystem::path& dir, const Booth& booth)
 {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
