@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_file.h>
 #include <pipeline/base/json_schema.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
@@ -89,25 +90,14 @@ std::string Booth::names() const
 Expected<Booth> loadBooth(const std::filesystem::path& dir)
 {
     const auto file = dir / "booth.json";
-    auto text = readInputFile(file, kMaxJsonBytes, "booth model");
-    if (!text) {
-        if (text.error().code == ErrorCode::NotFound) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("{}: cannot open booth model; run 'replica booth build' "
-                                         "or point --booth at a folder with booth.json",
-                                         file.string()));
-        }
-        return tl::unexpected(text.error());
-    }
-    auto parsed = parseJsonChecked(*text, boothSchema(), file.string());
+    auto parsed = readJsonManifest(file, boothSchema(), "booth model",
+                                   "run 'replica booth build' or point --booth at a folder with "
+                                   "booth.json",
+                                   kFormat);
     if (!parsed) {
         return tl::unexpected(parsed.error());
     }
     nlohmann::json& j = *parsed;
-    if (!j.contains("format") || j["format"] != kFormat) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: 'format' must be \"{}\"", file.string(), kFormat));
-    }
     if (!j.contains("lights") || !j["lights"].is_array() || j["lights"].empty()) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: 'lights' must be a non-empty array", file.string()));
