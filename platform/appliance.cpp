@@ -610,7 +610,7 @@ void chooseBoothDimmer(RunConfig& config,
 
 Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
 makeBoothScene(RunConfig& config,
-               const pipeline::scene::Booth& lamps,
+               const pipeline::booth::Booth& booth,
                const pipeline::colour::ChannelBasis& basis,
                const pipeline::colour::Observer& observer,
                std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
@@ -633,15 +633,11 @@ makeBoothScene(RunConfig& config,
         return tl::unexpected(scene.error());
     }
     config.scene = scene->name;
-    auto booth = pipeline::booth::loadBooth(dataDir() / "booth");
-    if (!booth) {
-        return tl::unexpected(booth.error());
-    }
     pipeline::render::BoothSceneSetup setup;
     setup.stand = config.stand;
-    setup.booth = std::move(*booth);
-    for (const auto& lamp : lamps.lamps) {
-        setup.lamps.push_back(lamp.name);
+    setup.booth = booth;
+    for (const auto& light : booth.lights) {
+        setup.lamps.push_back(light.name);
     }
     setup.scene = std::move(*scene);
     setup.basis = basis;
@@ -878,17 +874,13 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     updaterSetup.defaultEyeM = config.defaultEyeM;
     updaterSetup.defaultTiltRad = config.defaultTiltRad;
     if (!config.defaultLamp.empty()) {
-        const auto& lamps = app->booth.lamps;
+        const auto& lamps = app->booth.lights;
         const auto it = std::find_if(lamps.begin(), lamps.end(),
                                      [&](const auto& l) { return l.name == config.defaultLamp; });
         if (it == lamps.end()) {
-            std::string names;
-            for (const auto& l : lamps) {
-                names += (names.empty() ? "" : ", ") + l.name;
-            }
             return makeError(ErrorCode::InvalidArgument,
                              fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
-                                         config.defaultLamp, config.booth, names));
+                                         config.defaultLamp, config.booth, app->booth.names()));
         }
         updaterSetup.defaultLamp = static_cast<int>(it - lamps.begin());
     }
@@ -909,25 +901,25 @@ Expected<Sources> makeSimSources(const Appliance& appliance, const std::string& 
     }
     const std::filesystem::path dir = dataDir();
     hal::sim::ScenarioParams scenario;
-    scenario.lampCount = static_cast<int>(appliance.booth.lamps.size());
+    scenario.lampCount = static_cast<int>(appliance.booth.lights.size());
 
     hal::sim::SimSpectrometerParams spec;
-    for (const auto& lamp : appliance.booth.lamps) {
+    for (const auto& lamp : appliance.booth.lights) {
         // The simulator sees each lamp at its table's own resolution, not the working grid.
-        auto table = pipeline::colour::loadSpectralCsv(dir / "spectra" / lamp.spectrumFile);
+        auto table = pipeline::colour::loadSpectralCsv(dir / "spectra" / lamp.referenceFile);
         if (!table) {
             return tl::unexpected(table.error());
         }
         hal::sim::SimLamp sim{lamp.name, table->wavelengthNm, {}};
         std::size_t column = table->columns.size();
         for (std::size_t c = 0; c < table->columns.size(); ++c) {
-            if (table->columns[c] == lamp.spectrumColumn) {
+            if (table->columns[c] == lamp.referenceColumn) {
                 column = c;
             }
         }
         if (column == table->columns.size()) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("{}: no column '{}'", table->source, lamp.spectrumColumn));
+            return makeError(ErrorCode::NotFound, fmt::format("{}: no column '{}'", table->source,
+                                                              lamp.referenceColumn));
         }
         for (const auto& row : table->rows) {
             sim.power.push_back(row[column]);

@@ -169,7 +169,7 @@ struct Sources {
 
 struct Appliance {
     RunConfig config;
-    pipeline::scene::Booth booth;
+    pipeline::booth::Booth booth; // scene::loadDefaultBooth: its lights are the lamps
     std::unique_ptr<Output>
             output; // owns the GL context: created before, destroyed after the renderer
     std::unique_ptr<pipeline::render::Renderer> renderer;

@@ -70,15 +70,14 @@ LuminanceImage tubeImage(const CeilingGeometry& g,
 
 } // namespace
 
-Expected<BoothModel> generateShippedBooth(const std::filesystem::path& dataDir,
-                                          const CeilingGeometry& g)
+Expected<Booth> generateShippedBooth(const std::filesystem::path& dataDir, const CeilingGeometry& g)
 {
     auto table = colour::loadSpectralCsv(dataDir / "spectra" /
                                          "cie_illuminants_10nm_380_730_triangular.csv");
     if (!table) {
         return tl::unexpected(table.error());
     }
-    BoothModel booth;
+    Booth booth;
     // Names and mean luminances as in scene::loadDefaultBooth, so the loop and the booth model
     // agree.
     struct Spec {

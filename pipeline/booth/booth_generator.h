@@ -19,7 +19,7 @@ struct CeilingGeometry {
 };
 
 // Deterministic: same output on every machine (no library random distributions).
-Expected<BoothModel> generateShippedBooth(const std::filesystem::path& dataDir,
-                                          const CeilingGeometry& g = {});
+Expected<Booth> generateShippedBooth(const std::filesystem::path& dataDir,
+                                     const CeilingGeometry& g = {});
 
 } // namespace replica::pipeline::booth

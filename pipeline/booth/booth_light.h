@@ -25,6 +25,21 @@ struct BoothLight {
     Vec3 edgeV{0.0, 0.0, 1.0};
     LuminanceImage luminance;
     colour::Spectrum spd; // relative spectral power; the luminance image carries the absolute scale
+    // The lamp as the appliance knows it (filled by scene::loadDefaultBooth from its table of
+    // lamps, by name; empty and zero in a booth read by loadBooth alone, as booth.json does not
+    // hold them):
+    // - referenceSpectrum: the lamp kind's CIE reference SPD (A, F8, F7) on the working grid,
+    //   relative: what the light classifier matches a sensed spectrum against and the illuminant
+    //   a frame is shaded under once the lamp is known. It differs in value from 'spd' (the
+    //   booth model's own SPD, which the booth renderer's lights carry), so both stay.
+    // - referenceFile / referenceColumn: where it comes from (data/spectra/<file>, column), at the
+    //   table's own resolution for the simulated spectrometer.
+    // - nominalLuminanceCdM2: the emitter's mean luminance with this lamp on, as the state's
+    //   emitter luminance (the flat renderer's uniform grid, the booth renderer's unknown light).
+    colour::Spectrum referenceSpectrum{};
+    std::string referenceFile;
+    std::string referenceColumn;
+    double nominalLuminanceCdM2 = 0.0;
 
     Vec3 normal() const;
     double areaM2() const;

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_file.h>
 #include <pipeline/base/json_schema.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
@@ -57,7 +58,7 @@ Expected<Vec3> vec3Field(const nlohmann::json& j, const char* key, const std::st
 
 } // namespace
 
-const BoothLight* BoothModel::find(const std::string& name) const
+const BoothLight* Booth::find(const std::string& name) const
 {
     for (const auto& l : lights) {
         if (l.name == name) {
@@ -77,7 +78,7 @@ const BoothLight* BoothModel::find(const std::string& name) const
     return match;
 }
 
-std::string BoothModel::names() const
+std::string Booth::names() const
 {
     std::string s;
     for (const auto& l : lights) {
@@ -86,33 +87,22 @@ std::string BoothModel::names() const
     return s;
 }
 
-Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
+Expected<Booth> loadBooth(const std::filesystem::path& dir)
 {
     const auto file = dir / "booth.json";
-    auto text = readInputFile(file, kMaxJsonBytes, "booth model");
-    if (!text) {
-        if (text.error().code == ErrorCode::NotFound) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("{}: cannot open booth model; run 'replica booth build' "
-                                         "or point --booth at a folder with booth.json",
-                                         file.string()));
-        }
-        return tl::unexpected(text.error());
-    }
-    auto parsed = parseJsonChecked(*text, boothSchema(), file.string());
+    auto parsed = readJsonManifest(file, boothSchema(), "booth model",
+                                   "run 'replica booth build' or point --booth at a folder with "
+                                   "booth.json",
+                                   kFormat);
     if (!parsed) {
         return tl::unexpected(parsed.error());
     }
     nlohmann::json& j = *parsed;
-    if (!j.contains("format") || j["format"] != kFormat) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: 'format' must be \"{}\"", file.string(), kFormat));
-    }
     if (!j.contains("lights") || !j["lights"].is_array() || j["lights"].empty()) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: 'lights' must be a non-empty array", file.string()));
     }
-    BoothModel booth;
+    Booth booth;
     for (std::size_t k = 0; k < j["lights"].size(); ++k) {
         const auto& lj = j["lights"][k];
         const std::string where = fmt::format("{}: lights[{}]", file.string(), k);
@@ -174,7 +164,7 @@ Expected<BoothModel> loadBooth(const std::filesystem::path& dir)
     return booth;
 }
 
-Expected<void> saveBooth(const std::filesystem::path& dir, const BoothModel& booth)
+Expected<void> saveBooth(const std::filesystem::path& dir, const Booth& booth)
 {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);

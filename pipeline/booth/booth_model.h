@@ -10,8 +10,17 @@
 
 namespace replica::pipeline::booth {
 
-struct BoothModel {
+// The one booth type: its lights (booth.json order; the appliance's lamp index is the index
+// into 'lights') with their luminance images, SPDs and, from scene::loadDefaultBooth, the lamp
+// fields the state stage uses.
+struct Booth {
+    std::string id; // "replica-booth-1" from scene::loadDefaultBooth; empty from loadBooth
     std::vector<BoothLight> lights;
+
+    // The ceiling the flat renderer's uniform grid and pass 2's flare estimate light the surface
+    // from: the first light's rectangle (loadDefaultBooth checks that all lights share it).
+    // Precondition: !lights.empty() (loadBooth refuses a booth without lights).
+    const BoothLight& ceiling() const { return lights.front(); }
 
     // Exact name, or the one light whose name is 'name-...' ("d65" for "d65-fluorescent").
     const BoothLight* find(const std::string& name) const;
@@ -20,9 +29,9 @@ struct BoothModel {
 
 // Reads <dir>/booth.json and the EXRs it names (channel "Y", cd/m^2). Errors name the file and
 // field.
-Expected<BoothModel> loadBooth(const std::filesystem::path& dir);
+Expected<Booth> loadBooth(const std::filesystem::path& dir);
 
 // Writes booth.json and <name>.exr per light into dir (created if needed).
-Expected<void> saveBooth(const std::filesystem::path& dir, const BoothModel& booth);
+Expected<void> saveBooth(const std::filesystem::path& dir, const Booth& booth);
 
 } // namespace replica::pipeline::booth

@@ -30,7 +30,7 @@ struct LampSettings {
 };
 
 struct BoothSceneSetup {
-    booth::BoothModel booth;        // lights with luminance images (data/booth)
+    booth::Booth booth;             // lights with luminance images (data/booth)
     std::vector<std::string> lamps; // the scene state's lamp names, by lampIndex
     surface::SurfaceScene scene;
     colour::ChannelBasis basis;

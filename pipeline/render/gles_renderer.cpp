@@ -140,7 +140,7 @@ public:
         int count = 0;
         if (!setup_.boothScene) {
             const auto lights =
-                    scene::uniformGridLights(setup_.booth.emitter, state.emitterLuminanceCdM2,
+                    scene::uniformGridLights(setup_.booth.ceiling(), state.emitterLuminanceCdM2,
                                              setup_.lightsU, setup_.lightsV);
             count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
             packed.reserve(static_cast<std::size_t>(count) * 4);
@@ -172,7 +172,7 @@ public:
         df.eyeM = state.eyeBoothM;
         df.lights = &packed;
         df.lightCount = count;
-        df.lightNormal = setup_.booth.emitter.normal;
+        df.lightNormal = setup_.booth.ceiling().normal();
         df.illuminanceInAlpha = setup_.boothScene != nullptr;
         if (setup_.boothScene) {
             df.blackOutside = setup_.boothScene->surfaceRect(w, h);
@@ -231,7 +231,7 @@ private:
         setVec3(xyzProgram_.get(), "uPanelRight", pose.rightEdgeM());
         setVec3(xyzProgram_.get(), "uPanelUp", pose.upEdgeM());
         setVec3(xyzProgram_.get(), "uPanelNormal", pose.normal);
-        setVec3(xyzProgram_.get(), "uLightNormal", setup_.booth.emitter.normal);
+        setVec3(xyzProgram_.get(), "uLightNormal", setup_.booth.ceiling().normal());
         glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uLightCount"), count);
         if (count > 0) {
             glUniform4fv(glGetUniformLocation(xyzProgram_.get(), "uLights"), count, packed.data());
@@ -273,6 +273,10 @@ private:
 
 Expected<std::unique_ptr<Renderer>> createGlesRenderer(GlesRendererSetup setup)
 {
+    if (setup.booth.lights.empty()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "the renderer needs a booth with at least one light (its ceiling)");
+    }
     auto r = std::make_unique<GlesRenderer>(std::move(setup));
     if (auto ok = r->init(); !ok) {
         return tl::unexpected(ok.error());

@@ -19,7 +19,7 @@ namespace replica::pipeline::render {
 struct GlesRendererSetup {
     int width = 960;
     int height = 600;
-    scene::Booth booth;
+    booth::Booth booth; // scene::loadDefaultBooth; the flat image is lit from its ceiling()
     scene::StandModel stand;
     SurfaceImage surface;
     colour::ChannelBasis basis;

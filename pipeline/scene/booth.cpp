@@ -1,4 +1,6 @@
 // The shipped booth and its simplest point-light decomposition.
+#include <algorithm>
+#include <array>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -9,31 +11,28 @@
 #include <pipeline/scene/booth.h>
 
 namespace replica::pipeline::scene {
+namespace {
 
-Expected<Booth> loadDefaultBooth(const std::string& dataDir)
+// The lamps this build knows, by the booth model's light names.
+struct LampKind {
+    const char* name;
+    const char* file; // under data/spectra/
+    const char* column;
+    double nominalLuminanceCdM2;
+};
+
+constexpr std::array<LampKind, 3> kLampKinds = {{
+        {"tungsten", "cie_illuminants_A_D50_D65_5nm_300_780.csv", "A", 2200.0},
+        {"d50-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F8", 2600.0},
+        {"d65-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F7", 2600.0},
+}};
+
+} // namespace
+
+Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir)
 {
-    Booth booth;
-    booth.id = "replica-booth-1";
-    booth.lamps = {
-            {"tungsten", "cie_illuminants_A_D50_D65_5nm_300_780.csv", "A", 2200.0, {}},
-            {"d50-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F8", 2600.0, {}},
-            {"d65-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F7", 2600.0, {}},
-    };
-    for (auto& lamp : booth.lamps) {
-        auto table = colour::loadSpectralCsv(std::filesystem::path(dataDir) / "spectra" /
-                                             lamp.spectrumFile);
-        if (!table) {
-            return tl::unexpected(table.error());
-        }
-        auto s = table->spectrum(lamp.spectrumColumn);
-        if (!s) {
-            return tl::unexpected(s.error());
-        }
-        lamp.spectrum = *s;
-    }
-    // One geometry for the whole appliance: the ceiling of the booth model (data/booth), which
-    // the booth renderer lights the surface with.
     const auto boothDir = std::filesystem::path(dataDir) / "booth";
+    const auto boothFile = (boothDir / "booth.json").string();
     auto model = booth::loadBooth(boothDir);
     if (!model) {
         return tl::unexpected(model.error());
@@ -42,39 +41,66 @@ Expected<Booth> loadDefaultBooth(const std::string& dataDir)
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: the booth model has no lights", boothDir.string()));
     }
-    const booth::BoothLight& first = model->lights.front();
-    for (const auto& l : model->lights) {
+    booth::Booth b = std::move(*model);
+    b.id = "replica-booth-1";
+    // One geometry for the whole appliance: the flat renderer and pass 2 light the surface from
+    // the first light's ceiling, the booth renderer from every light's own.
+    const booth::BoothLight& first = b.ceiling();
+    for (const auto& l : b.lights) {
         if (l.centre != first.centre || l.edgeU != first.edgeU || l.edgeV != first.edgeV) {
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: light '{}' has another ceiling than '{}'; the "
                                          "appliance's booth has one emitter for all its lamps",
-                                         (boothDir / "booth.json").string(), l.name, first.name));
+                                         boothFile, l.name, first.name));
         }
     }
-    booth.emitter.centreM = first.centre;
-    booth.emitter.edgeUM = first.edgeU;
-    booth.emitter.edgeVM = first.edgeV;
-    booth.emitter.normal = first.normal();
-    return booth;
+    for (auto& light : b.lights) {
+        const auto kind = std::find_if(kLampKinds.begin(), kLampKinds.end(),
+                                       [&](const LampKind& k) { return light.name == k.name; });
+        if (kind == kLampKinds.end()) {
+            std::string known;
+            for (const auto& k : kLampKinds) {
+                known += (known.empty() ? "" : ", ") + std::string(k.name);
+            }
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: light '{}' is not a lamp this build knows ({}); "
+                                         "name each light after one of them",
+                                         boothFile, light.name, known));
+        }
+        light.referenceFile = kind->file;
+        light.referenceColumn = kind->column;
+        light.nominalLuminanceCdM2 = kind->nominalLuminanceCdM2;
+        auto table = colour::loadSpectralCsv(std::filesystem::path(dataDir) / "spectra" /
+                                             light.referenceFile);
+        if (!table) {
+            return tl::unexpected(table.error());
+        }
+        auto s = table->spectrum(light.referenceColumn);
+        if (!s) {
+            return tl::unexpected(s.error());
+        }
+        light.referenceSpectrum = *s;
+    }
+    return b;
 }
 
 std::vector<booth::PointLight>
-uniformGridLights(const Emitter& e, double luminanceCdM2, int nu, int nv)
+uniformGridLights(const booth::BoothLight& ceiling, double luminanceCdM2, int nu, int nv)
 {
     std::vector<booth::PointLight> lights;
     if (nu <= 0 || nv <= 0) {
         return lights;
     }
-    const double cellArea = glm::length(e.edgeUM) * glm::length(e.edgeVM) / (nu * nv);
+    const double cellArea = glm::length(ceiling.edgeU) * glm::length(ceiling.edgeV) / (nu * nv);
     for (int j = 0; j < nv; ++j) {
         for (int i = 0; i < nu; ++i) {
             const double u = (i + 0.5) / nu - 0.5;
             const double v = (j + 0.5) / nv - 0.5;
             booth::PointLight l;
-            l.position = e.centreM + u * e.edgeUM + v * e.edgeVM;
+            l.position = ceiling.centre + u * ceiling.edgeU + v * ceiling.edgeV;
             l.intensityCd = luminanceCdM2 * cellArea;
-            l.regionU = e.edgeUM / static_cast<double>(nu);
-            l.regionV = e.edgeVM / static_cast<double>(nv);
+            l.regionU = ceiling.edgeU / static_cast<double>(nu);
+            l.regionV = ceiling.edgeV / static_cast<double>(nv);
             l.regionOrigin = l.position - 0.5 * l.regionU - 0.5 * l.regionV;
             l.meanCdM2 = luminanceCdM2;
             lights.push_back(l);

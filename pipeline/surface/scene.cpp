@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include <pipeline/base/input_file.h>
+#include <pipeline/base/json_file.h>
 #include <pipeline/base/json_schema.h>
 #include <pipeline/image/exr.h>
 #include <pipeline/surface/scene.h>
@@ -86,26 +86,13 @@ SurfaceScene::channels(const std::vector<colour::ChannelCoeffs>& pc, int x, int 
 Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
 {
     const auto file = dir / "scene.json";
-    auto text = readInputFile(file, kMaxJsonBytes, "scene manifest");
-    if (!text) {
-        if (text.error().code == ErrorCode::NotFound) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("{}: cannot open scene manifest; --scene must name a "
-                                         "folder with scene.json",
-                                         file.string()));
-        }
-        return tl::unexpected(text.error());
-    }
-    auto parsed = parseJsonChecked(*text, sceneSchema(), file.string());
+    auto parsed = readJsonManifest(file, sceneSchema(), "scene manifest",
+                                   "--scene must name a folder with scene.json", kFormat);
     if (!parsed) {
         return tl::unexpected(parsed.error());
     }
     nlohmann::json& j = *parsed;
     const std::string f = file.string();
-    if (!j.contains("format") || j["format"] != kFormat) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: 'format' must be \"{}\"", f, kFormat));
-    }
     SurfaceScene s;
     s.name = j.value("name", dir.filename().string());
     if (!j.contains("size_m") || !j["size_m"].is_array() || j["size_m"].size() != 2 ||

@@ -136,7 +136,7 @@ int runBuild(const std::string& input, const std::string& out)
     if (!table) {
         return fail(cmd, kExitFailure, table.error().message);
     }
-    booth::BoothModel model;
+    booth::Booth model;
     try {
         for (std::size_t li = 0; li < j.at("lights").size(); ++li) {
             const auto& lj = j["lights"][li];

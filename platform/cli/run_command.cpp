@@ -307,7 +307,7 @@ makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock
         if (c.lampSelector != "gpio") {
             lo.lampGpio.clear();
         }
-        auto made = makeLiveSources(liveClock, lo, appliance.booth.lamps.size());
+        auto made = makeLiveSources(liveClock, lo, appliance.booth.lights.size());
         if (!made) {
             return tl::unexpected(made.error());
         }

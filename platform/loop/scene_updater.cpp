@@ -10,22 +10,22 @@
 namespace replica::platform {
 namespace {
 
-std::vector<pipeline::spectral::StoredLight> lampLights(const pipeline::scene::Booth& booth)
+std::vector<pipeline::spectral::StoredLight> lampLights(const pipeline::booth::Booth& booth)
 {
     std::vector<pipeline::spectral::StoredLight> out;
-    for (const auto& lamp : booth.lamps) {
-        out.push_back({lamp.name, lamp.spectrum});
+    for (const auto& lamp : booth.lights) {
+        out.push_back({lamp.name, lamp.referenceSpectrum});
     }
     return out;
 }
 
-double meanLuminance(const pipeline::scene::Booth& booth)
+double meanLuminance(const pipeline::booth::Booth& booth)
 {
     double sum = 0.0;
-    for (const auto& lamp : booth.lamps) {
-        sum += lamp.luminanceCdM2;
+    for (const auto& lamp : booth.lights) {
+        sum += lamp.nominalLuminanceCdM2;
     }
-    return booth.lamps.empty() ? 0.0 : sum / static_cast<double>(booth.lamps.size());
+    return booth.lights.empty() ? 0.0 : sum / static_cast<double>(booth.lights.size());
 }
 
 } // namespace
@@ -33,7 +33,7 @@ double meanLuminance(const pipeline::scene::Booth& booth)
 Expected<SceneUpdater> SceneUpdater::create(SceneUpdaterSetup setup,
                                             const pipeline::spectral::LightClassifierParams& params)
 {
-    if (setup.booth.lamps.empty()) {
+    if (setup.booth.lights.empty()) {
         return SceneUpdater(std::move(setup), std::nullopt);
     }
     auto classifier = pipeline::spectral::LightClassifier::create(lampLights(setup.booth), params);
@@ -52,10 +52,10 @@ pipeline::spectral::Classification SceneUpdater::classification() const
 
 void SceneUpdater::showLamp(pipeline::scene::SceneState& state, int lamp) const
 {
-    const auto& l = setup_.booth.lamps[static_cast<std::size_t>(lamp)];
+    const auto& l = setup_.booth.lights[static_cast<std::size_t>(lamp)];
     state.lampIndex = lamp;
-    state.illuminant = l.spectrum;
-    state.emitterLuminanceCdM2 = l.luminanceCdM2;
+    state.illuminant = l.referenceSpectrum;
+    state.emitterLuminanceCdM2 = l.nominalLuminanceCdM2;
 }
 
 void SceneUpdater::start(pipeline::scene::SceneState& state)
@@ -64,7 +64,7 @@ void SceneUpdater::start(pipeline::scene::SceneState& state)
     state.eyeBoothM = setup_.defaultEyeM;
     state.tiltRad = setup_.defaultTiltRad;
     if (setup_.defaultLamp >= 0 &&
-        setup_.defaultLamp < static_cast<int>(setup_.booth.lamps.size())) {
+        setup_.defaultLamp < static_cast<int>(setup_.booth.lights.size())) {
         showLamp(state, setup_.defaultLamp);
     }
 }
@@ -140,17 +140,18 @@ void SceneUpdater::update(pipeline::scene::SceneState& state,
     if (first || (!hadSpectrum && haveSpectrum_) || (!hadPose && havePose_) ||
         (!hadTilt && haveTilt_)) {
         if (!haveSpectrum_ || !havePose_ || !haveTilt_) {
-            log->info("frame {}: {}{}{}", state.frameIndex,
-                      haveSpectrum_ ? "light sensed; "
-                      : setup_.defaultLamp >= 0
-                              ? fmt::format(
-                                        "no spectrum yet: showing the default lamp '{}'; ",
-                                        setup_.booth
-                                                .lamps[static_cast<std::size_t>(setup_.defaultLamp)]
-                                                .name)
-                              : std::string("no spectrum yet and no default lamp: no light; "),
-                      havePose_ ? "eye tracked; " : "no head pose yet: default eye; ",
-                      haveTilt_ ? "tilt sensed" : "no tilt yet: default tilt");
+            log->info(
+                    "frame {}: {}{}{}", state.frameIndex,
+                    haveSpectrum_ ? "light sensed; "
+                    : setup_.defaultLamp >= 0
+                            ? fmt::format(
+                                      "no spectrum yet: showing the default lamp '{}'; ",
+                                      setup_.booth
+                                              .lights[static_cast<std::size_t>(setup_.defaultLamp)]
+                                              .name)
+                            : std::string("no spectrum yet and no default lamp: no light; "),
+                    havePose_ ? "eye tracked; " : "no head pose yet: default eye; ",
+                    haveTilt_ ? "tilt sensed" : "no tilt yet: default tilt");
         } else {
             log->info("frame {}: every sensor now feeds the scene", state.frameIndex);
         }

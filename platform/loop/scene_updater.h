@@ -21,7 +21,7 @@
 namespace replica::platform {
 
 struct SceneUpdaterSetup {
-    pipeline::scene::Booth booth;
+    pipeline::booth::Booth booth;
     pipeline::spectral::SpectrometerCalibration calibration;
     // T_booth_tracker: eye_booth = trackerInBooth.apply(eye_tracker). Default: the fixed
     // mounting (pipeline/base/rigid_transform.h).
@@ -68,7 +68,7 @@ private:
     SceneUpdater(SceneUpdaterSetup setup,
                  std::optional<pipeline::spectral::LightClassifier> classifier)
         : setup_(std::move(setup)), classifier_(std::move(classifier)),
-          arbiter_(static_cast<int>(setup_.booth.lamps.size()))
+          arbiter_(static_cast<int>(setup_.booth.lights.size()))
     {}
     void showLamp(pipeline::scene::SceneState& state, int lamp) const;
     void start(pipeline::scene::SceneState& state);

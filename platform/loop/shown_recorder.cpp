@@ -141,7 +141,7 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
     l.frameIndex = frame.frameIndex;
     const auto c = appliance_.updater->classification();
     l.distance = c.distance;
-    const auto& lamps = appliance_.booth.lamps;
+    const auto& lamps = appliance_.booth.lights;
     if (s.lampIndex >= 0 && static_cast<std::size_t>(s.lampIndex) < lamps.size()) {
         l.mode = "lamp";
         l.lamp = s.lampIndex;

@@ -135,7 +135,7 @@ Gpu* gpu()
                                       : pipeline::render::InverseMethod::Analytic;
             s.display.flareSubtraction = v != 2;
             s.display.viewingCompensation = v != 2;
-            fx->state.illuminant = s.booth.lamps[0].spectrum;
+            fx->state.illuminant = s.booth.lights[0].referenceSpectrum;
             auto r = pipeline::render::createGlesRenderer(std::move(s));
             if (!r) {
                 std::fprintf(stderr, "renderer: %s\n", r.error().message.c_str());

@@ -85,8 +85,8 @@ void BM_ApplianceFrame(benchmark::State& st)
                          : std::string()));
     pipeline::scene::SceneState state;
     state.lampIndex = 2; // d65-fluorescent
-    state.illuminant = app->booth.lamps[2].spectrum;
-    state.emitterLuminanceCdM2 = app->booth.lamps[2].luminanceCdM2;
+    state.illuminant = app->booth.lights[2].referenceSpectrum;
+    state.emitterLuminanceCdM2 = app->booth.lights[2].nominalLuminanceCdM2;
     state.tiltRad = 0.35;
     pipeline::render::RenderedFrame frame;
     if (!app->renderer->render(state, frame, pipeline::render::Readback::Display)) {
@@ -150,8 +150,9 @@ void BM_ApplianceLampChange(benchmark::State& st)
     for (auto _ : st) {
         lamp = lamp == 0 ? 2 : 0;
         state.lampIndex = lamp;
-        state.illuminant = app->booth.lamps[static_cast<std::size_t>(lamp)].spectrum;
-        state.emitterLuminanceCdM2 = app->booth.lamps[static_cast<std::size_t>(lamp)].luminanceCdM2;
+        state.illuminant = app->booth.lights[static_cast<std::size_t>(lamp)].referenceSpectrum;
+        state.emitterLuminanceCdM2 =
+                app->booth.lights[static_cast<std::size_t>(lamp)].nominalLuminanceCdM2;
         auto ok = app->renderer->render(state, frame, pipeline::render::Readback::Display);
         benchmark::DoNotOptimize(ok);
     }
@@ -182,7 +183,7 @@ FlatFixture* flatFixture()
         s.surface =
                 *pipeline::render::makeColorCheckerSurface(dataDir().string(), s.basis, 600, 400);
         s.display.model = pipeline::display::nominalDisplayModel("srgb-like-800", 800.0, 0.4);
-        fx->state.illuminant = s.booth.lamps[0].spectrum;
+        fx->state.illuminant = s.booth.lights[0].referenceSpectrum;
         fx->state.emitterLuminanceCdM2 = 2200.0;
         fx->state.tiltRad = 0.35;
         auto r = pipeline::render::createGlesRenderer(std::move(s));

@@ -107,11 +107,11 @@ bool timeAppliance(const platform::RunConfig& c,
         return false;
     }
     resolved = (*app)->config;
-    const auto& lamp = (*app)->booth.lamps[static_cast<std::size_t>(lampIndex)];
+    const auto& lamp = (*app)->booth.lights[static_cast<std::size_t>(lampIndex)];
     scene::SceneState state;
     state.lampIndex = lampIndex;
-    state.illuminant = lamp.spectrum;
-    state.emitterLuminanceCdM2 = lamp.luminanceCdM2;
+    state.illuminant = lamp.referenceSpectrum;
+    state.emitterLuminanceCdM2 = lamp.nominalLuminanceCdM2;
     state.tiltRad = 30.0 * kPi / 180.0;
     render::RenderedFrame frame;
     for (int i = 0; i < 3; ++i) {

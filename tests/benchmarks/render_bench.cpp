@@ -128,7 +128,7 @@ int runViews(const ViewsOptions& o,
              int fw,
              int fh,
              const colour::Observer& obs,
-             const booth::BoothModel& booth,
+             const booth::Booth& booth,
              const spectral::AdaptiveEncoder& encoder)
 {
     const std::vector<std::pair<const char*, shading::Vec3>> eyes{

@@ -21,7 +21,7 @@ std::filesystem::path freshDir(const std::string& name)
 
 TEST(BoothModel, RoundTripsThroughJsonAndExr)
 {
-    BoothModel b;
+    Booth b;
     b.lights.push_back(test::stripedLight(40, 20));
     b.lights[0].name = "d50";
     b.lights[0].spd[5] = 7.0;
@@ -71,7 +71,7 @@ TEST(BoothModel, ReportsMissingFolderAndBadFields)
 
 TEST(BoothModel, RejectsNanInTheLuminanceExrNamingThePixel)
 {
-    BoothModel b;
+    Booth b;
     b.lights.push_back(test::ceilingLight(8, 4, 100.0));
     const auto dir = freshDir("nan");
     ASSERT_TRUE(saveBooth(dir, b));

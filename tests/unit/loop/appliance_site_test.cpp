@@ -349,9 +349,9 @@ TEST_F(SiteUpdater, MissingSensorsShowTheDefaultLampEyeAndTilt)
     pipeline::scene::SceneState st;
     u->update(st, nullptr, nullptr, nullptr);
     EXPECT_EQ(st.lampIndex, 2);
-    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.booth.lamps[2].luminanceCdM2);
+    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.booth.lights[2].nominalLuminanceCdM2);
     EXPECT_GT(st.emitterLuminanceCdM2, 0.0); // a light: not a black screen
-    EXPECT_EQ(st.illuminant.v, setup_.booth.lamps[2].spectrum.v);
+    EXPECT_EQ(st.illuminant.v, setup_.booth.lights[2].referenceSpectrum.v);
     EXPECT_EQ(st.eyeBoothM, setup_.defaultEyeM);
     EXPECT_EQ(st.tiltRad, 0.2);
 

@@ -135,8 +135,8 @@ TEST(BoothDimmer, ScalesTheRenderedFrameAndAutoFitsThePanel)
             return f;
         }
         state.lampIndex = 2;
-        state.illuminant = (*app)->booth.lamps[2].spectrum;
-        state.emitterLuminanceCdM2 = (*app)->booth.lamps[2].luminanceCdM2;
+        state.illuminant = (*app)->booth.lights[2].referenceSpectrum;
+        state.emitterLuminanceCdM2 = (*app)->booth.lights[2].nominalLuminanceCdM2;
         EXPECT_TRUE((*app)->renderer->render(state, f, pipeline::render::Readback::DisplayAndXyz));
         if (resolved != nullptr) {
             *resolved = (*app)->config;

@@ -96,11 +96,11 @@ protected:
         setup_.booth = *booth;
         setup_.calibration = *cal;
         hal::sim::SimSpectrometerParams p;
-        for (const auto& lamp : booth->lamps) {
-            auto t = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" / lamp.spectrumFile);
+        for (const auto& lamp : booth->lights) {
+            auto t = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" / lamp.referenceFile);
             ASSERT_TRUE(t);
             const auto c = static_cast<std::size_t>(
-                    std::find(t->columns.begin(), t->columns.end(), lamp.spectrumColumn) -
+                    std::find(t->columns.begin(), t->columns.end(), lamp.referenceColumn) -
                     t->columns.begin());
             hal::sim::SimLamp sim{lamp.name, t->wavelengthNm, {}};
             for (const auto& row : t->rows) {

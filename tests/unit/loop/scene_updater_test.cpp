@@ -88,15 +88,15 @@ TEST_F(SceneUpdaterTest, ClassifiesTheLampAndUsesItsStoredSpectrumAndLuminance)
         u.update(st, &f7_[static_cast<std::size_t>(i)], nullptr, nullptr);
         EXPECT_EQ(st.lampIndex, -1);
         EXPECT_EQ(u.classification().name, "unknown");
-        EXPECT_NE(st.illuminant.v, setup_.booth.lamps[2].spectrum.v);
+        EXPECT_NE(st.illuminant.v, setup_.booth.lights[2].referenceSpectrum.v);
         EXPECT_GT(st.illuminant[20], 0.0);
         EXPECT_DOUBLE_EQ(st.emitterLuminanceCdM2, (2200.0 + 2600.0 + 2600.0) / 3.0);
     }
     u.update(st, &f7_[static_cast<std::size_t>(confirm - 1)], nullptr, nullptr);
     EXPECT_EQ(st.lampIndex, 2);
     EXPECT_EQ(u.classification().name, "d65-fluorescent");
-    EXPECT_EQ(st.illuminant.v, setup_.booth.lamps[2].spectrum.v);
-    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.booth.lamps[2].luminanceCdM2);
+    EXPECT_EQ(st.illuminant.v, setup_.booth.lights[2].referenceSpectrum.v);
+    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.booth.lights[2].nominalLuminanceCdM2);
     // The same sample again changes nothing (sequence numbers).
     u.update(st, &f7_[static_cast<std::size_t>(confirm - 1)], nullptr, nullptr);
     EXPECT_EQ(st.lampIndex, 2);
@@ -128,14 +128,14 @@ TEST_F(SceneUpdaterTest, HysteresisIgnoresOneStraySpectrumAndSwitchesOnConfirmat
     }
     feed(tungsten_[static_cast<std::size_t>(confirm)]);
     EXPECT_EQ(st.lampIndex, 0);
-    EXPECT_EQ(st.illuminant.v, setup_.booth.lamps[0].spectrum.v);
+    EXPECT_EQ(st.illuminant.v, setup_.booth.lights[0].referenceSpectrum.v);
     EXPECT_EQ(st.emitterLuminanceCdM2, 2200.0);
 }
 
 TEST_F(SceneUpdaterTest, BadBoothsAreRefusedAndAnEmptyOneIsDirectSensorMode)
 {
     SceneUpdaterSetup dark = setup_;
-    dark.booth.lamps[1].spectrum = pipeline::colour::Spectrum::constant(0.0);
+    dark.booth.lights[1].referenceSpectrum = pipeline::colour::Spectrum::constant(0.0);
     auto bad = SceneUpdater::create(dark);
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error().message,
@@ -146,7 +146,7 @@ TEST_F(SceneUpdaterTest, BadBoothsAreRefusedAndAnEmptyOneIsDirectSensorMode)
     EXPECT_FALSE(SceneUpdater::create(setup_, params));
 
     SceneUpdaterSetup empty = setup_;
-    empty.booth.lamps.clear();
+    empty.booth.lights.clear();
     auto u = SceneUpdater::create(empty);
     ASSERT_TRUE(u);
     pipeline::scene::SceneState st;

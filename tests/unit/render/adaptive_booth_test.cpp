@@ -285,7 +285,7 @@ TEST(AdaptiveAppliance, SimRunReencodesAtEachConfirmedLampChange)
                 const int encodings = booth.encodings();
                 if (st.lampIndex >= 0) {
                     const auto& lamp =
-                            (*app)->booth.lamps[static_cast<std::size_t>(st.lampIndex)].name;
+                            (*app)->booth.lights[static_cast<std::size_t>(st.lampIndex)].name;
                     const auto m = colour::channelToXyz(booth.basis(), observer,
                                                         boothModel.find(lamp)->spd);
                     // Encoded for the lamp shown: its XYZ vectors are [I3 | 0].

@@ -282,8 +282,8 @@ std::optional<SurroundFrame> surroundFrame(RunConfig c)
     }
     pipeline::scene::SceneState st;
     st.lampIndex = 0;
-    st.illuminant = (*app)->booth.lamps[0].spectrum;
-    st.emitterLuminanceCdM2 = (*app)->booth.lamps[0].luminanceCdM2;
+    st.illuminant = (*app)->booth.lights[0].referenceSpectrum;
+    st.emitterLuminanceCdM2 = (*app)->booth.lights[0].nominalLuminanceCdM2;
     st.tiltRad = 0.3;
     st.eyeBoothM = {0.1, 0.5, 0.45};
     SurroundFrame f;

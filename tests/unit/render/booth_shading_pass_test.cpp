@@ -61,7 +61,7 @@ protected:
     static void SetUpTestSuite()
     {
         obs_ = new colour::Observer(*colour::loadCie1931(dataDir()));
-        booth_ = new booth::BoothModel(*booth::loadBooth(dataDir() / "booth"));
+        booth_ = new booth::Booth(*booth::loadBooth(dataDir() / "booth"));
         basis_ = new colour::ChannelBasis(*colour::loadDefaultChannelBasis(dataDir()));
         for (const char* name : {"colorchecker", "metamer", "painting"}) {
             auto s = surface::loadScene(dataDir() / "scenes" / name);
@@ -196,14 +196,14 @@ protected:
                                       const shading::RenderSettings& settings);
 
     static colour::Observer* obs_;
-    static booth::BoothModel* booth_;
+    static booth::Booth* booth_;
     static colour::ChannelBasis* basis_;
     static std::map<std::string, surface::SurfaceScene> scenes_;
     std::unique_ptr<platform::Output> output_;
 };
 
 colour::Observer* BoothPassTest::obs_ = nullptr;
-booth::BoothModel* BoothPassTest::booth_ = nullptr;
+booth::Booth* BoothPassTest::booth_ = nullptr;
 colour::ChannelBasis* BoothPassTest::basis_ = nullptr;
 std::map<std::string, surface::SurfaceScene> BoothPassTest::scenes_;
 

@@ -70,7 +70,7 @@ protected:
     scene::SceneState state() const
     {
         scene::SceneState st;
-        st.illuminant = setup_.booth.lamps[0].spectrum;
+        st.illuminant = setup_.booth.lights[0].referenceSpectrum;
         st.emitterLuminanceCdM2 = 2000.0;
         st.tiltRad = 0.3;
         st.eyeBoothM = {0.25, 0.55, 0.35}; // off to one side and close: angles up to ~40 deg
@@ -86,13 +86,14 @@ protected:
         const glm::dvec3 p = pose.cornerM() + (x + 0.5) / f.width * pose.rightEdgeM() +
                              (y + 0.5) / f.height * pose.upEdgeM();
         double e = 0.0;
-        for (const auto& l : scene::uniformGridLights(setup_.booth.emitter, st.emitterLuminanceCdM2,
-                                                      setup_.lightsU, setup_.lightsV)) {
+        for (const auto& l :
+             scene::uniformGridLights(setup_.booth.ceiling(), st.emitterLuminanceCdM2,
+                                      setup_.lightsU, setup_.lightsV)) {
             const glm::dvec3 d = l.position - p;
             const double d2 = glm::dot(d, d);
             const glm::dvec3 dir = d / std::sqrt(d2);
             e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *
-                 std::max(glm::dot(setup_.booth.emitter.normal, -dir), 0.0) / d2;
+                 std::max(glm::dot(setup_.booth.ceiling().normal(), -dir), 0.0) / d2;
         }
         const colour::Xyz light = colour::spectrumToXyz(setup_.observer, st.illuminant);
         const glm::dvec3 flare = display::frontSurfaceFlareXyz(profile_, e, light / light.y);

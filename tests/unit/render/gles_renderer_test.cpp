@@ -61,13 +61,14 @@ protected:
         const double v = (y + 0.5) / setup_.height;
         const glm::dvec3 p = pose.cornerM() + u * pose.rightEdgeM() + v * pose.upEdgeM();
         double e = 0.0;
-        for (const auto& l : scene::uniformGridLights(setup_.booth.emitter, st.emitterLuminanceCdM2,
-                                                      setup_.lightsU, setup_.lightsV)) {
+        for (const auto& l :
+             scene::uniformGridLights(setup_.booth.ceiling(), st.emitterLuminanceCdM2,
+                                      setup_.lightsU, setup_.lightsV)) {
             const glm::dvec3 d = l.position - p;
             const double d2 = glm::dot(d, d);
             const glm::dvec3 dir = d / std::sqrt(d2);
             e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *
-                 std::max(glm::dot(setup_.booth.emitter.normal, -dir), 0.0) / d2;
+                 std::max(glm::dot(setup_.booth.ceiling().normal(), -dir), 0.0) / d2;
         }
         return e;
     }
@@ -75,7 +76,7 @@ protected:
     scene::SceneState state(double tilt) const
     {
         scene::SceneState st;
-        st.illuminant = setup_.booth.lamps[0].spectrum;
+        st.illuminant = setup_.booth.lights[0].referenceSpectrum;
         st.emitterLuminanceCdM2 = 2000.0;
         st.tiltRad = tilt;
         return st;

@@ -27,7 +27,7 @@ using reference::Vec3;
 // tilt, 32 x 20): what the relief-horizon tests below share, loaded once.
 struct GrazingPainting {
     surface::SurfaceScene scene;
-    booth::BoothModel booth;
+    booth::Booth booth;
     shading::View view;
     const booth::BoothLight& light(const std::string& name) const
     {

@@ -1,5 +1,5 @@
-// The appliance's booth (scene::Booth) and the booth model (data/booth) are one booth: the same
-// ceiling for the flat renderer, pass 2's flare and the booth renderer.
+// The appliance's booth is the booth model (data/booth) with its lamps' reference spectra and
+// nominal luminances: one ceiling for the flat renderer, pass 2's flare and the booth renderer.
 #include <filesystem>
 
 #include <glm/geometric.hpp>
@@ -14,41 +14,68 @@
 namespace replica::pipeline::scene {
 namespace {
 
-TEST(DefaultBooth, HasTheBoothModelsCeiling)
+TEST(DefaultBooth, IsTheBoothModelWithItsLampsInTheModelsOrder)
 {
     auto b = loadDefaultBooth(dataDir().string());
     ASSERT_TRUE(b) << b.error().message;
     auto model = booth::loadBooth(dataDir() / "booth");
     ASSERT_TRUE(model) << model.error().message;
-    ASSERT_FALSE(model->lights.empty());
-    for (const auto& l : model->lights) {
-        EXPECT_EQ(b->emitter.centreM, l.centre) << l.name;
-        EXPECT_EQ(b->emitter.edgeUM, l.edgeU) << l.name;
-        EXPECT_EQ(b->emitter.edgeVM, l.edgeV) << l.name;
-        EXPECT_EQ(b->emitter.normal, l.normal()) << l.name;
-        // Every lamp of the appliance has its light in the model.
+    EXPECT_EQ(b->id, "replica-booth-1");
+    // The lamp index is the index into booth.json's lights: tungsten, d50, d65.
+    ASSERT_EQ(b->lights.size(), 3u);
+    ASSERT_EQ(model->lights.size(), b->lights.size());
+    EXPECT_EQ(b->lights[0].name, "tungsten");
+    EXPECT_EQ(b->lights[1].name, "d50-fluorescent");
+    EXPECT_EQ(b->lights[2].name, "d65-fluorescent");
+    for (std::size_t i = 0; i < b->lights.size(); ++i) {
+        const auto& l = b->lights[i];
+        const auto& m = model->lights[i];
+        EXPECT_EQ(l.name, m.name);
+        EXPECT_EQ(l.centre, m.centre) << l.name;
+        EXPECT_EQ(l.edgeU, m.edgeU) << l.name;
+        EXPECT_EQ(l.edgeV, m.edgeV) << l.name;
+        EXPECT_EQ(l.spd.v, m.spd.v) << l.name;
+        EXPECT_EQ(l.luminance.cdM2, m.luminance.cdM2) << l.name;
+        // booth.json holds no lamp fields; the default booth fills them by name.
+        EXPECT_EQ(m.nominalLuminanceCdM2, 0.0);
+        EXPECT_GT(l.referenceSpectrum.sum(), 0.0) << l.name;
     }
-    for (const auto& lamp : b->lamps) {
-        EXPECT_NE(model->find(lamp.name), nullptr) << lamp.name;
+    // Nominal luminances: tungsten 2200, the fluorescent simulators 2600 cd/m^2; the luminance
+    // images of the shipped model (booth_generator.cpp) are scaled to these means.
+    EXPECT_EQ(b->lights[0].nominalLuminanceCdM2, 2200.0);
+    EXPECT_EQ(b->lights[1].nominalLuminanceCdM2, 2600.0);
+    EXPECT_EQ(b->lights[2].nominalLuminanceCdM2, 2600.0);
+    for (const auto& l : b->lights) {
+        const double mean = l.luminance.sum() / static_cast<double>(l.luminance.cdM2.size());
+        EXPECT_NEAR(mean, l.nominalLuminanceCdM2, 1e-3 * l.nominalLuminanceCdM2) << l.name;
     }
-    // The generator that made data/booth and the built-in default agree too.
+    // Reference spectra by name: CIE A rises through the visible (tungsten, 2856 K: S(730) /
+    // S(380) is 216.1 / 9.8 = 22 in the CIE table).
+    const auto& a = b->lights[0].referenceSpectrum;
+    EXPECT_GT(a.v.back() / a.v.front(), 20.0);
+    EXPECT_LT(a.v.back() / a.v.front(), 30.0);
+    EXPECT_EQ(b->lights[0].referenceColumn, "A");
+    EXPECT_EQ(b->lights[1].referenceColumn, "F8");
+    EXPECT_EQ(b->lights[2].referenceColumn, "F7");
+    // The reference spectrum is not the booth model's own SPD: both stay, for different uses.
+    EXPECT_NE(b->lights[1].referenceSpectrum.v, b->lights[1].spd.v);
+    // One ceiling, the generator's, emitting downwards into the booth.
     const booth::CeilingGeometry g;
-    const Emitter e;
-    EXPECT_EQ(e.centreM, g.centre);
-    EXPECT_DOUBLE_EQ(glm::length(e.edgeUM), g.widthM);
-    EXPECT_DOUBLE_EQ(glm::length(e.edgeVM), g.depthM);
-    EXPECT_EQ(e.centreM, b->emitter.centreM);
-    EXPECT_EQ(e.edgeUM, b->emitter.edgeUM);
-    EXPECT_EQ(e.edgeVM, b->emitter.edgeVM);
-    // Emits downwards into the booth.
-    EXPECT_DOUBLE_EQ(b->emitter.normal.y, -1.0);
+    const auto& c = b->ceiling();
+    EXPECT_EQ(c.centre, g.centre);
+    EXPECT_DOUBLE_EQ(glm::length(c.edgeU), g.widthM);
+    EXPECT_DOUBLE_EQ(glm::length(c.edgeV), g.depthM);
+    EXPECT_DOUBLE_EQ(c.normal().y, -1.0);
 }
 
 TEST(DefaultBooth, TheUniformGridTilesTheCeilingWithItsPower)
 {
     // 4 x 2 cells of a 1 x 0.5 m emitter at 2000 cd/m^2: each light L * a = 2000 * 0.0625 cd at
     // its cell's centre; the cells' rectangles tile the emitter.
-    Emitter e;
+    booth::BoothLight e;
+    e.centre = {0.0, 0.62, -0.05};
+    e.edgeU = {1.0, 0.0, 0.0};
+    e.edgeV = {0.0, 0.0, 0.5};
     const auto lights = uniformGridLights(e, 2000.0, 4, 2);
     ASSERT_EQ(lights.size(), 8u);
     double power = 0.0;
@@ -63,8 +90,8 @@ TEST(DefaultBooth, TheUniformGridTilesTheCeilingWithItsPower)
     }
     EXPECT_NEAR(power, 2000.0 * 0.5, 1e-9);
     // The first cell's centre: the emitter's corner plus half a cell along each edge.
-    EXPECT_NEAR(glm::length(lights[0].position - (e.centreM + glm::dvec3(-0.375, 0.0, -0.125))),
-                0.0, 1e-15);
+    EXPECT_NEAR(glm::length(lights[0].position - (e.centre + glm::dvec3(-0.375, 0.0, -0.125))), 0.0,
+                1e-15);
 }
 
 TEST(DefaultBooth, RefusesAModelWhoseLightsHaveTwoCeilings)
@@ -80,6 +107,24 @@ TEST(DefaultBooth, RefusesAModelWhoseLightsHaveTwoCeilings)
     auto b = loadDefaultBooth(dir.string());
     ASSERT_FALSE(b);
     EXPECT_NE(b.error().message.find("booth.json: light 'd65-fluorescent' has another ceiling"),
+              std::string::npos)
+            << b.error().message;
+    std::filesystem::remove_all(dir);
+}
+
+TEST(DefaultBooth, RefusesALightThatIsNotAKnownLamp)
+{
+    const auto dir = std::filesystem::temp_directory_path() / "replica_unknown_lamp";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy(dataDir() / "spectra", dir / "spectra");
+    auto model = booth::loadBooth(dataDir() / "booth");
+    ASSERT_TRUE(model);
+    model->lights[1].name = "neon";
+    ASSERT_TRUE(booth::saveBooth(dir / "booth", *model));
+    auto b = loadDefaultBooth(dir.string());
+    ASSERT_FALSE(b);
+    EXPECT_NE(b.error().message.find("booth.json: light 'neon' is not a lamp this build knows"),
               std::string::npos)
             << b.error().message;
     std::filesystem::remove_all(dir);

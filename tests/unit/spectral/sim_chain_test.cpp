@@ -15,7 +15,7 @@ namespace {
 using pipeline::colour::Spectrum;
 
 struct Bench {
-    pipeline::scene::Booth booth;
+    pipeline::booth::Booth booth;
     pipeline::spectral::SpectrometerCalibration cal;
 };
 
@@ -100,14 +100,16 @@ TEST(SignalChain, RecoversEachBoothLampShapeFromRawCounts)
         const auto& s = spectra[static_cast<std::size_t>(lamp * 10 + 5)];
         const Spectrum sensed = convert(s, b.cal);
         const double d = pipeline::spectral::LightClassifier::shapeDistance(
-                sensed, b.booth.lamps[static_cast<std::size_t>(lamp)].spectrum);
+                sensed, b.booth.lights[static_cast<std::size_t>(lamp)].referenceSpectrum);
         // Noise and the pixel-to-band integration leave a small residual; another lamp is far away.
         EXPECT_LT(d, 0.03) << "lamp " << lamp;
         for (int other = 0; other < 3; ++other) {
             if (other != lamp) {
-                EXPECT_GT(pipeline::spectral::LightClassifier::shapeDistance(
-                                  sensed, b.booth.lamps[static_cast<std::size_t>(other)].spectrum),
-                          0.15);
+                EXPECT_GT(
+                        pipeline::spectral::LightClassifier::shapeDistance(
+                                sensed,
+                                b.booth.lights[static_cast<std::size_t>(other)].referenceSpectrum),
+                        0.15);
             }
         }
     }
@@ -117,8 +119,8 @@ TEST(LightClassifier, NamesBoothLampsAndRejectsAForeignLight)
 {
     Bench b = load();
     std::vector<Spectrum> stored;
-    for (const auto& l : b.booth.lamps) {
-        stored.push_back(l.spectrum);
+    for (const auto& l : b.booth.lights) {
+        stored.push_back(l.referenceSpectrum);
     }
     pipeline::spectral::LightClassifier classifier(stored);
     std::vector<hal::sim::SimLamp> lamps = {
