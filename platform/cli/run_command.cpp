@@ -183,7 +183,7 @@ std::optional<std::pair<int, int>> parseSize(const std::string& s)
 }
 
 // The run's option that chooses a device kind's source: --spectrometer, --lamp-selector.
-std::string option(const recordings::DeviceKindBase& kind)
+std::string deviceOption(const recordings::DeviceKindBase& kind)
 {
     std::string s = kind.name();
     std::replace(s.begin(), s.end(), '_', '-');
@@ -311,8 +311,9 @@ makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock
         for (const auto* kind : recordings::deviceKinds()) {
             if (c.of(*kind) == "replay" && replayed.get(*kind) == nullptr) {
                 return makeError(ErrorCode::InvalidArgument,
-                                 fmt::format("--{} replay: {} has no {} channel", option(*kind),
-                                             o.replayFrom, kind->names().displayName));
+                                 fmt::format("--{} replay: {} has no {} channel",
+                                             deviceOption(*kind), o.replayFrom,
+                                             kind->names().displayName));
             }
         }
     }
