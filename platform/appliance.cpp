@@ -935,31 +935,32 @@ Expected<Sources> makeSimSources(const Appliance& appliance, const std::string& 
     spec.responsivity = cal->responsivity;
 
     Sources s;
-    s.spectrometer = hal::sim::makeSimSpectrometer(scenario, std::move(spec));
-    s.tracker = hal::sim::makeSimTracker(scenario, {});
-    s.accel = hal::sim::makeSimAccel(scenario, {});
+    s.set(recordings::spectrometerKind(), hal::sim::makeSimSpectrometer(scenario, std::move(spec)));
+    s.set(recordings::trackerKind(), hal::sim::makeSimTracker(scenario, {}));
+    s.set(recordings::accelKind(), hal::sim::makeSimAccel(scenario, {}));
     if (lampSelector != "none") {
         hal::sim::SimLampSelectorParams selector;
         if (lampSelector == "sim-miswired") {
             selector.wiring = {0, 2, 1};
         }
-        s.lampSelector = hal::sim::makeSimLampSelector(scenario, selector);
+        s.set(recordings::lampSelectorKind(), hal::sim::makeSimLampSelector(scenario, selector));
     }
     return s;
 }
 
-Sources makeReplaySources(const recordings::Recording& recording)
+Sources makeReplaySources(const recordings::Recording& recording,
+                          const recordings::DeviceKinds& kinds)
 {
     Sources s;
-    s.spectrometer = std::make_unique<hal::ReplaySource<hal::SpectrumSample>>(
-            recording.session.spectrometer, recording.spectra);
-    s.tracker = std::make_unique<hal::ReplaySource<hal::PoseSample>>(recording.session.tracker,
-                                                                     recording.poses);
-    s.accel = std::make_unique<hal::ReplaySource<hal::AccelSample>>(recording.session.accel,
-                                                                    recording.accel);
-    if (!recording.session.lampSelector.model.empty() || !recording.lampSelector.empty()) {
-        s.lampSelector = std::make_unique<hal::ReplaySource<hal::LampSample>>(
-                recording.session.lampSelector, recording.lampSelector);
+    for (const auto* kind : kinds) {
+        const auto it = recording.devices.find(kind->name());
+        const bool has = it != recording.devices.end() && it->second.has_value();
+        const auto& info = recording.session.device(*kind);
+        // An optional device the session did not have (no model, no samples) gets no source.
+        if (kind->names().optional && info.model.empty() && recording.count(*kind) == 0) {
+            continue;
+        }
+        s.set(*kind, kind->replaySource(info, has ? it->second : kind->emptySamples()));
     }
     return s;
 }

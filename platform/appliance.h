@@ -160,12 +160,9 @@ constexpr const char* kUncalibratedDisplay = "srgb-like-800";
 // nominal model's name marked uncalibrated.
 std::string displayProfileId(const RunConfig& config, const std::string& profileName);
 
-struct Sources {
-    std::unique_ptr<hal::SpectrometerSource> spectrometer;
-    std::unique_ptr<hal::TrackerSource> tracker;
-    std::unique_ptr<hal::AccelSource> accel;
-    std::unique_ptr<hal::LampSelectorSource> lampSelector; // null: the booth has none
-};
+// The run's sources, one per device kind present (recordings/device_kind.h); a booth without a
+// lamp selector has none.
+using recordings::Sources;
 
 struct Appliance {
     RunConfig config;
@@ -228,7 +225,9 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
 Expected<Sources> makeSimSources(const Appliance& appliance,
                                  const std::string& lampSelector = "none");
 
-// Sources that return exactly what the recording holds.
-Sources makeReplaySources(const recordings::Recording& recording);
+// Sources that return exactly what the recording holds, one per device kind it has (an optional
+// kind only when the session had it).
+Sources makeReplaySources(const recordings::Recording& recording,
+                          const recordings::DeviceKinds& kinds = recordings::deviceKinds());
 
 } // namespace replica::platform

@@ -97,27 +97,31 @@ void injectFaults(Sources& sources, const FaultPlan& plan)
     if (!plan.any()) {
         return;
     }
-    sources.spectrometer = std::make_unique<FaultySource<hal::SpectrumSample>>(
-            std::move(sources.spectrometer), [plan](hal::SpectrumSample& s) {
-                if (unplugged(plan, s.timestampNs)) {
-                    return false;
-                }
-                if (plan.saturateEvery > 0 && s.sequence % plan.saturateEvery == 0) {
-                    std::fill(s.counts.begin(), s.counts.end(), std::uint16_t{65535});
-                    s.saturated = true;
-                }
-                return true;
-            });
-    sources.tracker = std::make_unique<FaultySource<hal::PoseSample>>(
-            std::move(sources.tracker), [plan](hal::PoseSample& s) {
-                if (unplugged(plan, s.timestampNs)) {
-                    return false;
-                }
-                if (plan.nanPoseEvery > 0 && s.sequence % plan.nanPoseEvery == 0) {
-                    s.eyeTrackerM.x = std::numeric_limits<double>::quiet_NaN();
-                }
-                return true;
-            });
+    const auto& spectrometer = recordings::spectrometerKind();
+    sources.set(spectrometer,
+                std::make_unique<FaultySource<hal::SpectrumSample>>(
+                        sources.take(spectrometer), [plan](hal::SpectrumSample& s) {
+                            if (unplugged(plan, s.timestampNs)) {
+                                return false;
+                            }
+                            if (plan.saturateEvery > 0 && s.sequence % plan.saturateEvery == 0) {
+                                std::fill(s.counts.begin(), s.counts.end(), std::uint16_t{65535});
+                                s.saturated = true;
+                            }
+                            return true;
+                        }));
+    const auto& tracker = recordings::trackerKind();
+    sources.set(tracker,
+                std::make_unique<FaultySource<hal::PoseSample>>(
+                        sources.take(tracker), [plan](hal::PoseSample& s) {
+                            if (unplugged(plan, s.timestampNs)) {
+                                return false;
+                            }
+                            if (plan.nanPoseEvery > 0 && s.sequence % plan.nanPoseEvery == 0) {
+                                s.eyeTrackerM.x = std::numeric_limits<double>::quiet_NaN();
+                            }
+                            return true;
+                        }));
 }
 
 } // namespace replica::platform

@@ -69,7 +69,7 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
         if (!tracker) {
             return tl::unexpected(tracker.error());
         }
-        s.tracker = std::move(*tracker);
+        s.set(recordings::trackerKind(), std::move(*tracker));
     } else if (options.tracker == "hid") {
         hal::tracker::HidTrackerOptions hidOptions;
         auto axes = hal::accel::parseAxisMapping(options.trackerAxes);
@@ -81,8 +81,9 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
         hidOptions.axes = *axes;
         hidOptions.label = options.hidTracker.empty() ? "auto" : options.hidTracker;
         // Absent at start is not fatal: Lost, one error line, retry every second.
-        s.tracker = hal::tracker::makeHidTrackerSource(hal::hid::hidapiOpener(options.hidTracker),
-                                                       clock, std::move(hidOptions));
+        s.set(recordings::trackerKind(),
+              hal::tracker::makeHidTrackerSource(hal::hid::hidapiOpener(options.hidTracker), clock,
+                                                 std::move(hidOptions)));
     } else if (!options.tracker.empty()) {
         return makeError(
                 ErrorCode::InvalidArgument,
@@ -91,9 +92,10 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
     if (options.spectrometer) {
         hal::spectrometer::Usb2000SourceOptions specOptions;
         specOptions.nextIntegrationUs = autoIntegration;
-        s.spectrometer = hal::spectrometer::makeUsb2000Source(
-                hal::spectrometer::libusbUsb2000Opener(options.spectrometerSerial), clock,
-                std::move(specOptions));
+        s.set(recordings::spectrometerKind(),
+              hal::spectrometer::makeUsb2000Source(
+                      hal::spectrometer::libusbUsb2000Opener(options.spectrometerSerial), clock,
+                      std::move(specOptions)));
     }
     if (options.accel) {
         hal::accel::IioAccelSourceOptions accelOptions;
@@ -104,15 +106,17 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
         accelOptions.mounting = *mounting;
         accelOptions.root = options.iioRoot;
         accelOptions.name = options.accelName;
-        s.accel = hal::accel::makeIioAccelSource(clock, std::move(accelOptions));
+        s.set(recordings::accelKind(),
+              hal::accel::makeIioAccelSource(clock, std::move(accelOptions)));
     }
     if (lampLines) {
         // A chip that cannot be opened is not fatal: the source reports Lost and retries, and
         // the light comes from the spectrometer alone meanwhile.
         hal::lamp::GpioLampSourceOptions lampOptions;
         lampOptions.lines = std::move(*lampLines);
-        s.lampSelector = hal::lamp::makeGpioLampSource(hal::lamp::libgpiodOpener(), clock,
-                                                       std::move(lampOptions));
+        s.set(recordings::lampSelectorKind(),
+              hal::lamp::makeGpioLampSource(hal::lamp::libgpiodOpener(), clock,
+                                            std::move(lampOptions)));
     }
     return s;
 }

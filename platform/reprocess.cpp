@@ -45,7 +45,7 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
     // device-clock anchoring runs over the reports exactly as the live reader ran over them.
     std::shared_ptr<const std::vector<std::uint8_t>> descriptor;
     std::optional<hal::tracker::HidReportProcessor> hid;
-    for (auto& s : rec.poses) {
+    for (auto& s : rec.samples(recordings::trackerKind())) {
         ++report.poses;
         if (!s.raw) {
             continue;
@@ -111,7 +111,7 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         s.eyeTrackerM = eye;
         s.tracked = tracked;
     }
-    for (auto& s : rec.accel) {
+    for (auto& s : rec.samples(recordings::accelKind())) {
         ++report.accel;
         if (!s.raw) {
             continue;
@@ -125,7 +125,7 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         report.accelChanged += sameBits(g, s.gravity) ? 0 : 1;
         s.gravity = g;
     }
-    for (auto& s : rec.lampSelector) {
+    for (auto& s : rec.samples(recordings::lampSelectorKind())) {
         ++report.lamp;
         if (s.lamp == hal::kLampLost || s.lineCount == 0) {
             continue;

@@ -1,10 +1,12 @@
 // What a Replica recording holds and the API to write and read one (MCAP on disk; see README.md).
 #pragma once
 
+#include <any>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +17,7 @@
 #include <hal/device.h>
 #include <hal/samples.h>
 #include <pipeline/base/expected.h>
+#include <recordings/device_kind.h>
 
 namespace replica::recordings {
 
@@ -40,14 +43,26 @@ constexpr std::size_t kMaxMessageBytes = 1u << 20;
 constexpr std::size_t kMaxSpectrumCounts = 16384;
 
 // For each rendered frame: its tick time and exactly which sample of each device it consumed (by
-// the device's sequence number), so replay never has to guess timing. nullopt: no sample yet.
+// the device's sequence number), so replay never has to guess timing.
 struct FrameRecord {
     std::uint64_t frameIndex = 0;
     std::int64_t tickNs = 0;
-    std::optional<std::uint32_t> spectrumSequence;
-    std::optional<std::uint32_t> poseSequence;
-    std::optional<std::uint32_t> accelSequence;
-    std::optional<std::uint32_t> lampSequence; // format 3; none in earlier recordings
+    // Device kind name -> sequence number of the sample consumed; absent: no sample yet (or, in
+    // recordings before the device existed, none recorded).
+    std::map<std::string, std::uint32_t> sequences;
+    std::optional<std::uint32_t> sequence(const DeviceKindBase& kind) const
+    {
+        const auto it = sequences.find(kind.name());
+        return it != sequences.end() ? std::optional<std::uint32_t>(it->second) : std::nullopt;
+    }
+    void setSequence(const DeviceKindBase& kind, std::optional<std::uint32_t> seq)
+    {
+        if (seq) {
+            sequences[kind.name()] = *seq;
+        } else {
+            sequences.erase(kind.name());
+        }
+    }
 };
 
 // Format 4: a digest of the 8-bit frame that went to the panel (XXH3-64, seed 0).
@@ -103,17 +118,23 @@ struct SessionInfo {
     std::string scene;           // scene identifier
     std::string displayProfile;  // display profile identifier
     std::int64_t wallClockStartNs = 0; // Unix time (ns) at session time 0, for viewers' dates
-    hal::DeviceInfo spectrometer, tracker, accel;
-    hal::DeviceInfo lampSelector; // empty model: the session had no lamp selector (format < 3)
+    // Device kind name -> the source behind it. An optional kind without an entry (or with an
+    // empty model) was not there: e.g. no lamp selector, or a recording older than it.
+    std::map<std::string, hal::DeviceInfo> devices;
+    const hal::DeviceInfo& device(const DeviceKindBase& kind) const
+    {
+        static const hal::DeviceInfo kNone;
+        const auto it = devices.find(kind.name());
+        return it != devices.end() ? it->second : kNone;
+    }
 };
 
 struct Recording {
     int formatVersion = 0;
     SessionInfo session;
-    std::vector<hal::SpectrumSample> spectra;
-    std::vector<hal::PoseSample> poses;
-    std::vector<hal::AccelSample> accel;
-    std::vector<hal::LampSample> lampSelector;
+    // Device kind name -> its samples in time order (std::vector<Sample>, see device_kind.h);
+    // the reader puts an entry for every kind it knows, empty when the file has none.
+    std::map<std::string, std::any> devices;
     std::vector<FrameRecord> frames;
     std::vector<DisplayDigestRecord> displayDigests; // format 4; empty when none were recorded
     std::vector<LightRecord> lights;                 // format 4: the decided light, on change
@@ -122,9 +143,35 @@ struct Recording {
     std::uint64_t unmatchedRaw = 0;
     std::uint64_t droppedMessages = 0;   // what the writer recorded as dropped (queue full)
     std::uint64_t rejectedNonFinite = 0; // samples the writer refused: a value was NaN or infinite
+
+    template <typename Sample>
+    std::vector<Sample>& samples(const DeviceKind<Sample>& kind)
+    {
+        auto& a = devices[kind.name()];
+        if (!a.has_value()) {
+            a = std::vector<Sample>{};
+        }
+        return DeviceKind<Sample>::of(a);
+    }
+    template <typename Sample>
+    const std::vector<Sample>& samples(const DeviceKind<Sample>& kind) const
+    {
+        static const std::vector<Sample> kNone;
+        const auto it = devices.find(kind.name());
+        return it != devices.end() && it->second.has_value() ? DeviceKind<Sample>::of(it->second)
+                                                             : kNone;
+    }
+    // How many samples of this kind the recording holds.
+    std::size_t count(const DeviceKindBase& kind) const
+    {
+        const auto it = devices.find(kind.name());
+        return it != devices.end() && it->second.has_value() ? kind.count(it->second) : 0;
+    }
 };
 
 struct WriterOptions {
+    // The device kinds whose channels the file gets (the registry; a test adds its own).
+    DeviceKinds kinds = deviceKinds();
     // The open chunk is closed, written and fdatasync'ed at most this long after its first
     // message: a power cut loses at most about this much.
     std::chrono::milliseconds flushInterval{500};
@@ -150,7 +197,7 @@ struct WriterStats {
 // Appends samples and frame records to a recording. write() never blocks the caller: it puts the
 // sample on a bounded queue that a writer thread drains (a full queue drops the sample and counts
 // it on /replica/recorder). write() must be called from one thread at a time.
-class RecordingWriter
+class RecordingWriter : public DeviceSink
 {
 public:
     // Creates (truncates) the file and writes, and syncs, the header, every schema and channel and
@@ -160,10 +207,22 @@ public:
                                                              WriterOptions options = {});
     virtual ~RecordingWriter() = default;
 
-    virtual void write(const hal::SpectrumSample& s) = 0;
-    virtual void write(const hal::PoseSample& s) = 0;
-    virtual void write(const hal::AccelSample& s) = 0;
-    virtual void write(const hal::LampSample& s) = 0;
+    // A device's sample (DeviceSink::writeDevice); a kind the writer was not created with is
+    // counted as rejected.
+    template <typename Sample>
+    void write(const DeviceKind<Sample>& kind, const Sample& s)
+    {
+        writeDevice(kind, std::any(s));
+    }
+    // A sample of the first registered kind of its type (deviceKinds()).
+    template <typename Sample>
+    void write(const Sample& s)
+    {
+        const auto* kind = kindOfType(deviceKinds(), typeid(Sample));
+        if (kind != nullptr) {
+            writeDevice(*kind, std::any(s));
+        }
+    }
     virtual void write(const FrameRecord& f) = 0;
     virtual void write(const DisplayDigestRecord& d) = 0;
     virtual void write(const PosesRecord& p) = 0;
@@ -180,7 +239,9 @@ public:
 };
 
 // Reads a whole recording. Fails with a one-line reason (missing, empty, not a recording, damaged).
-Expected<Recording> readRecording(const std::filesystem::path& path);
+// 'kinds': the device kinds to read (the registry; a channel of no kind there is skipped).
+Expected<Recording> readRecording(const std::filesystem::path& path,
+                                  const DeviceKinds& kinds = deviceKinds());
 
 // What a file holds and what is wrong with it, for 'replica inspect'.
 struct ChannelReport {

@@ -35,24 +35,9 @@ Expected<std::string> slurp(const std::filesystem::path& path)
     return bytes;
 }
 
-// Gives each sample its raw input; returns how many raw inputs found no sample.
-template <typename Sample, typename Raw>
-std::uint64_t attachRaw(std::vector<Sample>& samples,
-                        std::map<std::uint32_t, std::shared_ptr<const Raw>>& raw)
-{
-    std::uint64_t matched = 0;
-    for (auto& s : samples) {
-        if (auto it = raw.find(s.sequence); it != raw.end()) {
-            s.raw = it->second;
-            ++matched;
-        }
-    }
-    return matched >= raw.size() ? 0 : raw.size() - matched;
-}
-
 } // namespace
 
-Expected<Recording> readRecording(const std::filesystem::path& path)
+Expected<Recording> readRecording(const std::filesystem::path& path, const DeviceKinds& kinds)
 {
     const std::string name = path.string();
     auto bytes = slurp(path);
@@ -76,10 +61,18 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
     }
     Recording rec;
     bool haveSession = false;
-    // Format 5: raw inputs, attached to their samples by sequence number once all are read.
-    std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>> descriptors;
-    std::map<std::uint32_t, std::shared_ptr<const hal::RawTrackerInput>> rawTracker;
-    std::map<std::uint32_t, std::shared_ptr<const hal::RawAccelInput>> rawAccel;
+    // Each device kind's samples, by its topic; format 5: its raw inputs, by its raw topic,
+    // attached to their samples by sequence number once all are read.
+    std::map<std::string, std::size_t> sampleTopics, rawTopics;
+    std::vector<std::any> rawState(kinds.size());
+    for (std::size_t i = 0; i < kinds.size(); ++i) {
+        const auto& n = kinds[i]->names();
+        rec.devices[n.name] = kinds[i]->emptySamples();
+        sampleTopics[n.channel.topic] = i;
+        if (n.rawChannel) {
+            rawTopics[n.rawChannel->topic] = i;
+        }
+    }
     std::uint64_t unusableRaw = 0;
     for (const auto& m : s.messages) {
         const std::string& topic = s.channels.at(m.channelId).topic;
@@ -98,36 +91,23 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                     !ok) {
                     return tl::unexpected(ok.error());
                 }
-                rec.session = decodeSession(j, rec.formatVersion);
+                rec.session = decodeSession(j, rec.formatVersion, kinds);
                 haveSession = true;
-            } else if (topic == kSpectrometerTopic) {
-                rec.spectra.push_back(decodeSpectrum(j));
-            } else if (topic == kTrackerTopic) {
-                rec.poses.push_back(decodePose(j));
-            } else if (topic == kAccelTopic) {
-                rec.accel.push_back(decodeAccel(j));
-            } else if (topic == kLampSelectorTopic) {
-                rec.lampSelector.push_back(decodeLamp(j));
+            } else if (auto k = sampleTopics.find(topic); k != sampleTopics.end()) {
+                const auto* kind = kinds[k->second];
+                kind->decode(j, rec.devices[kind->name()]);
+            } else if (auto rk = rawTopics.find(topic); rk != rawTopics.end()) { // format 5
+                if (!kinds[rk->second]->decodeRaw(j, rawState[rk->second])) {
+                    ++unusableRaw;
+                }
             } else if (topic == kFrameTopic) {
-                rec.frames.push_back(decodeFrame(j));
+                rec.frames.push_back(decodeFrame(j, kinds));
             } else if (topic == kDisplayDigestTopic) { // format 4
                 rec.displayDigests.push_back(decodeDisplayDigest(j));
             } else if (topic == kLightTopic) { // format 4
                 rec.lights.push_back(decodeLight(j));
-            } else if (topic == kRawTrackerTopic) { // format 5
-                auto r = decodeRawTracker(j, descriptors);
-                if (r.descriptorId) {
-                    descriptors[*r.descriptorId] = r.descriptor;
-                } else if (r.descriptorMissing) {
-                    ++unusableRaw;
-                } else {
-                    rawTracker[r.sequence] = std::move(r.raw);
-                }
-            } else if (topic == kRawAccelTopic) { // format 5
-                auto [seq, raw] = decodeRawAccel(j);
-                rawAccel[seq] = std::move(raw);
             } else if (topic == kRecorderTopic) {
-                const auto r = decodeRecorderStatus(j);
+                const auto r = decodeRecorderStatus(j, kinds);
                 rec.droppedMessages = r.droppedTotal();
                 rec.rejectedNonFinite = r.rejectedNonFinite;
             }
@@ -149,8 +129,12 @@ Expected<Recording> readRecording(const std::filesystem::path& path)
                                      "(up to {}); update replica",
                                      name, rec.formatVersion, kFormatVersion));
     }
-    rec.unmatchedRaw =
-            unusableRaw + attachRaw(rec.poses, rawTracker) + attachRaw(rec.accel, rawAccel);
+    rec.unmatchedRaw = unusableRaw;
+    for (std::size_t i = 0; i < kinds.size(); ++i) {
+        if (rawState[i].has_value()) {
+            rec.unmatchedRaw += kinds[i]->attachRaw(rec.devices[kinds[i]->name()], rawState[i]);
+        }
+    }
     return rec;
 }
 

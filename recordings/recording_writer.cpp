@@ -1,6 +1,7 @@
 // The recording writer: callers enqueue samples; a writer thread encodes them into chunks and
 // closes (and syncs) a chunk at least every flush interval, so a power cut loses at most that much.
 #include <algorithm>
+#include <any>
 #include <array>
 #include <condition_variable>
 #include <csignal>
@@ -19,14 +20,14 @@
 namespace replica::recordings {
 namespace {
 
-using Item = std::variant<hal::SpectrumSample,
-                          hal::PoseSample,
-                          hal::AccelSample,
-                          FrameRecord,
-                          hal::LampSample,
-                          DisplayDigestRecord,
-                          PosesRecord,
-                          LightRecord>;
+// A device's sample: its kind (an index into the writer's kinds) and the sample.
+struct DeviceItem {
+    std::size_t kind = 0;
+    std::any sample;
+};
+using Item = std::variant<DeviceItem, FrameRecord, DisplayDigestRecord, PosesRecord, LightRecord>;
+// The most device kinds a writer takes (each has its own drop counter).
+constexpr std::size_t kMaxDeviceKinds = 32;
 // Written from any thread (thumbnail encoder, log sink), through a mutex.
 using SharedItem = std::variant<ThumbnailRecord, LogRecord>;
 // What the shared queue holds at most: a minute of 1 Hz thumbnails and a burst of warnings.
@@ -50,7 +51,7 @@ public:
                    const SessionInfo& session,
                    WriterOptions options)
         : file_(std::move(file)), options_(std::move(options)), queue_(options_.queueCapacity),
-          wallStart_(session.wallClockStartNs)
+          wallStart_(session.wallClockStartNs), kindState_(options_.kinds.size())
     {
         status_.queueCapacity = queue_.capacity();
         bytes_ = file_->bytesWritten();
@@ -60,15 +61,16 @@ public:
     ~ThreadedWriter() override { (void)close(); }
 
     // Writes the chunk #0 (schemas, channels, session) synchronously, before the thread starts.
-    static Expected<void> begin(mcap::FileWriter& file, const SessionInfo& session)
+    static Expected<void>
+    begin(mcap::FileWriter& file, const SessionInfo& session, const DeviceKinds& kinds)
     {
-        const std::string sessionJson = encodeSession(session, kFormatVersion);
+        const std::string sessionJson = encodeSession(session, kFormatVersion, kinds);
         if (auto ok = file.addMetadata(
                     {std::string(kSessionMetadataName), {{"session", sessionJson}}});
             !ok) {
             return ok;
         }
-        for (const auto& d : channelDefinitions()) {
+        for (const auto& d : channelDefinitions(kinds)) {
             file.addSchema(d.schema);
             file.addChannel(d.channel);
         }
@@ -77,14 +79,22 @@ public:
         return file.closeChunk(true);
     }
 
-    void write(const hal::SpectrumSample& s) override { push(s, dropped_[0]); }
-    void write(const hal::PoseSample& s) override { push(s, dropped_[1]); }
-    void write(const hal::AccelSample& s) override { push(s, dropped_[2]); }
-    void write(const FrameRecord& f) override { push(f, dropped_[3]); }
-    void write(const hal::LampSample& s) override { push(s, dropped_[4]); }
-    void write(const DisplayDigestRecord& d) override { push(d, dropped_[5]); }
-    void write(const PosesRecord& p) override { push(p, dropped_[5]); }
-    void write(const LightRecord& l) override { push(l, dropped_[5]); }
+    using RecordingWriter::write;
+    void writeDevice(const DeviceKindBase& kind, std::any sample) override
+    {
+        const auto& kinds = options_.kinds;
+        const auto it = std::find(kinds.begin(), kinds.end(), &kind);
+        if (it == kinds.end()) {
+            rejected_.fetch_add(1, std::memory_order_relaxed); // no channel for it in this file
+            return;
+        }
+        const auto i = static_cast<std::size_t>(it - kinds.begin());
+        push(DeviceItem{i, std::move(sample)}, droppedDevice_[i]);
+    }
+    void write(const FrameRecord& f) override { push(f, droppedFrames_); }
+    void write(const DisplayDigestRecord& d) override { push(d, droppedShown_); }
+    void write(const PosesRecord& p) override { push(p, droppedShown_); }
+    void write(const LightRecord& l) override { push(l, droppedShown_); }
     void write(const ThumbnailRecord& t) override { pushShared(t); }
     void write(const LogRecord& l) override { pushShared(l); }
 
@@ -108,9 +118,10 @@ public:
     {
         WriterStats s;
         s.messages = messages_.load();
-        for (const auto& d : dropped_) {
+        for (const auto& d : droppedDevice_) {
             s.dropped += d.load();
         }
+        s.dropped += droppedFrames_.load() + droppedShown_.load();
         s.rejected = rejected_.load();
         s.chunks = chunks_.load();
         s.bytes = bytes_.load();
@@ -120,9 +131,9 @@ public:
 
 private:
     template <typename Sample>
-    void push(const Sample& sample, std::atomic<std::uint64_t>& dropCounter)
+    void push(Sample&& sample, std::atomic<std::uint64_t>& dropCounter)
     {
-        if (closed_ || !queue_.tryPush(sample)) {
+        if (closed_ || !queue_.tryPush(std::forward<Sample>(sample))) {
             dropCounter.fetch_add(1, std::memory_order_relaxed);
         }
         wake_.notify_one();
@@ -134,7 +145,7 @@ private:
         {
             std::lock_guard lock(sharedMutex_);
             if (closed_ || shared_.size() >= kSharedCapacity) {
-                dropped_[5].fetch_add(1, std::memory_order_relaxed);
+                droppedShown_.fetch_add(1, std::memory_order_relaxed);
                 return;
             }
             shared_.emplace_back(r);
@@ -226,28 +237,18 @@ private:
         if (failed_) {
             return; // keep draining so that the producer never sees a full queue for our sake
         }
+        if (const auto* d = std::get_if<DeviceItem>(&item)) {
+            addDevice(*d);
+            return;
+        }
         std::optional<std::string> payload;
         ChannelId channel{};
         std::int64_t t = 0;
         std::visit(
                 [&](const auto& s) {
                     using S = std::decay_t<decltype(s)>;
-                    if constexpr (std::is_same_v<S, hal::SpectrumSample>) {
-                        payload = encodeSpectrum(s);
-                        channel = ChannelId::Spectrometer;
-                        t = s.timestampNs;
-                    } else if constexpr (std::is_same_v<S, hal::PoseSample>) {
-                        payload = encodePose(s);
-                        channel = ChannelId::Tracker;
-                        t = s.timestampNs;
-                    } else if constexpr (std::is_same_v<S, hal::AccelSample>) {
-                        payload = encodeAccel(s);
-                        channel = ChannelId::Accel;
-                        t = s.timestampNs;
-                    } else if constexpr (std::is_same_v<S, hal::LampSample>) {
-                        payload = encodeLamp(s);
-                        channel = ChannelId::LampSelector;
-                        t = s.timestampNs;
+                    if constexpr (std::is_same_v<S, DeviceItem>) {
+                        // handled above
                     } else if constexpr (std::is_same_v<S, DisplayDigestRecord>) {
                         payload = encodeDisplayDigest(s);
                         channel = ChannelId::DisplayDigest;
@@ -265,7 +266,7 @@ private:
                             message(ChannelId::Transforms, t, std::move(*tf));
                         }
                     } else {
-                        payload = encodeFrame(s);
+                        payload = encodeFrame(s, options_.kinds);
                         channel = ChannelId::Frame;
                         t = s.tickNs;
                     }
@@ -277,33 +278,25 @@ private:
         }
         message(channel, t, std::move(*payload));
         lastTime_ = std::max(lastTime_, t);
-        addRaw(item);
     }
 
-    // Format 5: the raw input a sample was made from, on its own channel after the sample.
-    void addRaw(const Item& item)
+    // A device's sample: its kind's codec writes its messages (format 5: the raw input after
+    // the sample, on the kind's raw channel).
+    void addDevice(const DeviceItem& d)
     {
-        if (const auto* p = std::get_if<hal::PoseSample>(&item); p && p->raw) {
-            const auto& d = p->raw->hidDescriptor;
-            if (p->raw->kind == hal::RawTrackerInput::Kind::HidReport && d &&
-                d.get() != lastDescriptor_.get()) {
-                // A new opening of the device: its descriptor once, before its first report.
-                lastDescriptor_ = d;
-                ++descriptorId_;
-                message(ChannelId::RawTracker, p->raw->arrivalNs,
-                        encodeRawTrackerDescriptor(p->raw->arrivalNs, descriptorId_, *d));
-            }
-            if (auto raw = encodeRawTracker(*p, descriptorId_)) {
-                message(ChannelId::RawTracker, p->raw->arrivalNs, std::move(*raw));
-            } else {
-                rejected_.fetch_add(1, std::memory_order_relaxed);
-            }
-        } else if (const auto* a = std::get_if<hal::AccelSample>(&item); a && a->raw) {
-            if (auto raw = encodeRawAccel(*a)) {
-                message(ChannelId::RawAccel, a->timestampNs, std::move(*raw));
-            } else {
-                rejected_.fetch_add(1, std::memory_order_relaxed);
-            }
+        const DeviceKindBase& kind = *options_.kinds[d.kind];
+        bool first = true; // the sample's own message: its time is the recording's latest
+        const DeviceEmitter emit{[&](std::uint16_t channel, std::int64_t t, std::string payload) {
+                                     message(static_cast<ChannelId>(channel), t,
+                                             std::move(payload));
+                                     if (first) {
+                                         first = false;
+                                         lastTime_ = std::max(lastTime_, t);
+                                     }
+                                 },
+                                 [&] { rejected_.fetch_add(1, std::memory_order_relaxed); }};
+        if (!kind.encode(d.sample, kindState_[d.kind], emit)) {
+            rejected_.fetch_add(1, std::memory_order_relaxed);
         }
     }
 
@@ -322,12 +315,11 @@ private:
             return;
         }
         RecorderStatus now = status_;
-        now.droppedSpectra = dropped_[0].load();
-        now.droppedPoses = dropped_[1].load();
-        now.droppedAccel = dropped_[2].load();
-        now.droppedFrames = dropped_[3].load();
-        now.droppedLamp = dropped_[4].load();
-        now.droppedShown = dropped_[5].load();
+        for (std::size_t i = 0; i < options_.kinds.size(); ++i) {
+            now.droppedDevices[options_.kinds[i]->names().droppedKey] = droppedDevice_[i].load();
+        }
+        now.droppedFrames = droppedFrames_.load();
+        now.droppedShown = droppedShown_.load();
         now.rejectedNonFinite = rejected_.load();
         const bool changed = now.droppedTotal() != status_.droppedTotal() ||
                              now.rejectedNonFinite != status_.rejectedNonFinite;
@@ -367,11 +359,11 @@ private:
     std::int64_t wallStart_ = 0;
     std::int64_t lastTime_ = 0;
     std::map<std::uint16_t, std::uint32_t> sequence_;
-    std::shared_ptr<const std::vector<std::uint8_t>> lastDescriptor_; // HID, writer thread only
-    std::uint32_t descriptorId_ = 0;
+    std::vector<std::any> kindState_; // each device kind's codec state, writer thread only
     RecorderStatus status_;
-    // Spectra, poses, accel, frames, lamp selector, and the format 4 channels of what was shown.
-    std::array<std::atomic<std::uint64_t>, 6> dropped_{};
+    // Per device kind (options_.kinds), frames, and the format 4 channels of what was shown.
+    std::array<std::atomic<std::uint64_t>, kMaxDeviceKinds> droppedDevice_{};
+    std::atomic<std::uint64_t> droppedFrames_{0}, droppedShown_{0};
     std::mutex sharedMutex_;
     std::vector<SharedItem> shared_;
     std::atomic<std::uint64_t> rejected_{0}, messages_{0}, chunks_{0}, bytes_{0};
@@ -394,6 +386,11 @@ Expected<std::unique_ptr<RecordingWriter>> RecordingWriter::create(
     if (::sigaction(SIGXFSZ, nullptr, &current) == 0 && current.sa_handler == SIG_DFL) {
         std::signal(SIGXFSZ, SIG_IGN);
     }
+    if (options.kinds.size() > kMaxDeviceKinds) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: {} device kinds; a recording takes at most {}",
+                                     path.string(), options.kinds.size(), kMaxDeviceKinds));
+    }
     auto file = mcap::FileWriter::create(
             path,
             fmt::format("{} (format {})",
@@ -403,7 +400,7 @@ Expected<std::unique_ptr<RecordingWriter>> RecordingWriter::create(
     if (!file) {
         return tl::unexpected(file.error());
     }
-    if (auto ok = ThreadedWriter::begin(**file, session); !ok) {
+    if (auto ok = ThreadedWriter::begin(**file, session, options.kinds); !ok) {
         return tl::unexpected(ok.error());
     }
     return std::unique_ptr<RecordingWriter>(

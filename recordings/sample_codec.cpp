@@ -57,13 +57,6 @@ hal::DeviceInfo deviceFromJson(const json& j)
     return d;
 }
 
-// JSON Schema fragments shared by the channel schemas.
-constexpr const char* kTimeProps =
-        R"("t": {"type": "integer", "description": "session time (ns) when the loop received it"},
-    "seq": {"type": "integer", "description": "the device's own counter; gaps are drops"})";
-constexpr const char* kVec3 =
-        R"({"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"},
-      "z": {"type": "number"}}, "required": ["x", "y", "z"]})";
 constexpr const char* kDevice =
         R"({"type": "object", "properties": {"model": {"type": "string"},
       "serial": {"type": "string"}, "firmware": {"type": "string"},
@@ -74,9 +67,22 @@ std::string schemaText(const std::string& title,
                        const std::string& properties,
                        const std::string& required)
 {
-    return R"({"$schema": "https://json-schema.org/draft/2020-12/schema", "title": ")" + title +
-           R"(", "description": ")" + description + R"(", "type": "object", "properties": {)" +
-           properties + R"(}, "required": [)" + required + "]}";
+    return jsonSchemaText(title, description, properties, required);
+}
+
+// "key": {"type": "integer"} for each key, two to a line: a line break before the odd ones
+// (oddBreaks) or the even ones. The layout the format-5 schemas were written in, so that their
+// bytes stay the same.
+std::string integerProps(const std::vector<std::string>& keys, bool oddBreaks)
+{
+    std::string out;
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+        if (i > 0) {
+            out += (i % 2 == 1) == oddBreaks ? ",\n    " : ", ";
+        }
+        out += "\"" + keys[i] + R"(": {"type": "integer"})";
+    }
+    return out;
 }
 
 // Foxglove's published JSON Schemas (github.com/foxglove/schemas, schemas/jsonschema/), restated:
@@ -99,21 +105,35 @@ std::string foxgloveSchema(const std::string& title,
            R"(", "type": "object", "properties": {)" + properties + "}}";
 }
 
-std::vector<ChannelDefinition> makeDefinitions()
+std::vector<ChannelDefinition> makeDefinitions(const DeviceKinds& kinds)
 {
     const std::string time = kFoxgloveTime;
     const std::string v3 = kFoxgloveVector3;
     const std::string quat = kFoxgloveQuaternion;
-    const std::string timeProps = kTimeProps;
-    const std::string vec = kVec3;
     const std::string dev = kDevice;
+    // The composite channels name every device kind: the session its source, a frame the sample
+    // it consumed, the recorder what it dropped (frames after the first three devices: format 2's
+    // order).
+    std::string sessionDevices;
+    std::vector<std::string> frameKeys{"frame", "tick_ns"};
+    std::vector<std::string> droppedKeys;
+    for (const auto* k : kinds) {
+        sessionDevices += (sessionDevices.empty() ? "\"" : ", \"") + k->name() + "\": " + dev;
+        frameKeys.push_back(k->names().frameKey);
+        droppedKeys.push_back(k->names().droppedKey);
+    }
+    const auto framesAt = std::min<std::size_t>(3, droppedKeys.size());
+    droppedKeys.insert(droppedKeys.begin() + static_cast<std::ptrdiff_t>(framesAt),
+                       "dropped_frames");
+    droppedKeys.push_back("dropped_shown");
     struct Def {
-        ChannelId id;
-        std::string_view topic;
+        std::uint16_t id;
+        std::string topic;
         std::string name, schema;
     };
-    const std::vector<Def> defs = {
-            {ChannelId::Session, kSessionTopic, "replica.Session",
+    std::vector<Def> defs = {
+            {static_cast<std::uint16_t>(ChannelId::Session), std::string(kSessionTopic),
+             "replica.Session",
              schemaText(
                      "replica.Session",
                      "What was recorded: software, configuration, booth, scene, display, devices",
@@ -122,64 +142,25 @@ std::vector<ChannelDefinition> makeDefinitions()
     "booth": {"type": "string"}, "scene": {"type": "string"},
     "display_profile": {"type": "string"},
     "wall_clock_start_ns": {"type": "integer", "description": "Unix time (ns) at session time 0"},
-    "spectrometer": )" + dev +
-                             R"(, "tracker": )" + dev + R"(, "accel": )" + dev +
-                             R"(, "lamp_selector": )" + dev,
+    )" + sessionDevices,
                      R"("format_version", "software", "config", "wall_clock_start_ns")")},
-            {ChannelId::Spectrometer, kSpectrometerTopic, "replica.SpectrometerSample",
-             schemaText("replica.SpectrometerSample",
-                        "One raw spectrum with the device calibration needed to convert it",
-                        timeProps + R"(,
-    "integration_time_us": {"type": "integer"},
-    "counts": {"type": "array", "items": {"type": "integer", "minimum": 0, "maximum": 65535},
-      "description": "raw counts, pixel 0 first"},
-    "wavelength_coeffs": {"type": "array", "items": {"type": "number"}, "minItems": 4,
-      "maxItems": 4, "description": "wavelength (nm) of pixel p = c0 + c1 p + c2 p^2 + c3 p^3"},
-    "nonlinearity_coeffs": {"type": "array", "items": {"type": "number"}, "minItems": 8,
-      "maxItems": 8, "description": "counts correction polynomial, order 0..7"},
-    "saturated": {"type": "boolean"})",
-                        R"("t", "seq", "integration_time_us", "counts", "wavelength_coeffs",
-    "nonlinearity_coeffs", "saturated")")},
-            {ChannelId::Tracker, kTrackerTopic, "replica.TrackerPose",
-             schemaText("replica.TrackerPose",
-                        "The viewer's eye position in the tracker frame (m): x right, y up, z "
-                        "towards the viewer",
-                        timeProps + R"(, "tracked": {"type": "boolean"}, "eye": )" + vec,
-                        R"("t", "seq", "tracked", "eye")")},
-            {ChannelId::Accel, kAccelTopic, "replica.AccelSample",
-             schemaText("replica.AccelSample", "Gravity in the display's device frame (m/s^2)",
-                        timeProps + R"(, "gravity": )" + vec, R"("t", "seq", "gravity")")},
-            {ChannelId::Frame, kFrameTopic, "replica.Frame",
+            {static_cast<std::uint16_t>(ChannelId::Frame), std::string(kFrameTopic),
+             "replica.Frame",
              schemaText("replica.Frame",
                         "A rendered frame: its tick time and the device sequence numbers of the "
                         "samples it consumed (absent: none yet)",
-                        R"("frame": {"type": "integer"}, "tick_ns": {"type": "integer"},
-    "spectrum_seq": {"type": "integer"}, "pose_seq": {"type": "integer"},
-    "accel_seq": {"type": "integer"}, "lamp_seq": {"type": "integer"})",
-                        R"("frame", "tick_ns")")},
-            {ChannelId::Recorder, kRecorderTopic, "replica.RecorderStatus",
+                        integerProps(frameKeys, false), R"("frame", "tick_ns")")},
+            {static_cast<std::uint16_t>(ChannelId::Recorder), std::string(kRecorderTopic),
+             "replica.RecorderStatus",
              schemaText("replica.RecorderStatus",
                         "Samples the recorder could not write (queue full, or NaN/infinite "
                         "values), cumulative since the session start",
-                        R"("dropped_spectra": {"type": "integer"},
-    "dropped_poses": {"type": "integer"}, "dropped_accel": {"type": "integer"},
-    "dropped_frames": {"type": "integer"}, "dropped_lamp": {"type": "integer"},
-    "dropped_shown": {"type": "integer"},
+                        integerProps(droppedKeys, true) + R"(,
     "dropped_total": {"type": "integer"},
     "rejected_nonfinite": {"type": "integer"}, "queue_capacity": {"type": "integer"})",
                         R"("dropped_total")")},
-            {ChannelId::LampSelector, kLampSelectorTopic, "replica.LampSelectorSample",
-             schemaText("replica.LampSelectorSample",
-                        "The booth's lamp selector switch once its GPIO lines settled (debounced): "
-                        "one line per lamp, in the booth's lamp order",
-                        timeProps + R"(,
-    "lamp": {"type": "integer", "minimum": -3, "description":
-      "booth lamp index (line i alone active = lamp i); -1 off, -2 invalid (several lines), -3 lines lost"},
-    "state": {"type": "string", "enum": ["lamp", "off", "invalid", "lost"]},
-    "levels": {"type": "array", "items": {"type": "integer", "minimum": 0, "maximum": 1},
-      "maxItems": 32, "description": "debounced level of each line, 1 = active: the switch closes it"})",
-                        R"("t", "seq", "lamp", "levels")")},
-            {ChannelId::DisplayDigest, kDisplayDigestTopic, "replica.DisplayDigest",
+            {static_cast<std::uint16_t>(ChannelId::DisplayDigest), std::string(kDisplayDigestTopic),
+             "replica.DisplayDigest",
              schemaText("replica.DisplayDigest",
                         "A digest of the 8-bit frame that went to the panel, every frame: replay "
                         "recomputes it to check what the visitor saw",
@@ -187,13 +168,15 @@ std::vector<ChannelDefinition> makeDefinitions()
     "hash": {"type": "string", "enum": ["xxh3_64"]},
     "rgba": {"type": "string", "description": "XXH3-64 (seed 0) of the RGBA8 frame, rows bottom-up, 16 hex digits"})",
                         R"("frame", "tick_ns", "hash", "rgba")")},
-            {ChannelId::Thumbnail, kThumbnailTopic, "foxglove.CompressedImage",
+            {static_cast<std::uint16_t>(ChannelId::Thumbnail), std::string(kThumbnailTopic),
+             "foxglove.CompressedImage",
              foxgloveSchema("foxglove.CompressedImage", "A thumbnail of the frame the panel showed",
                             R"("timestamp": )" + time + R"(,
     "frame_id": {"type": "string"},
     "data": {"type": "string", "contentEncoding": "base64"},
     "format": {"type": "string"})")},
-            {ChannelId::Transforms, kTransformsTopic, "foxglove.FrameTransforms",
+            {static_cast<std::uint16_t>(ChannelId::Transforms), std::string(kTransformsTopic),
+             "foxglove.FrameTransforms",
              foxgloveSchema("foxglove.FrameTransforms",
                             "The booth's frames: panel (tilted), tracker and eye in the booth",
                             R"("transforms": {"type": "array", "items": {"title":
@@ -202,12 +185,14 @@ std::vector<ChannelDefinition> makeDefinitions()
       "parent_frame_id": {"type": "string"}, "child_frame_id": {"type": "string"},
       "translation": )" + v3 + R"(, "rotation": )" +
                                     quat + "}}}")},
-            {ChannelId::Eye, kEyeTopic, "foxglove.PoseInFrame",
+            {static_cast<std::uint16_t>(ChannelId::Eye), std::string(kEyeTopic),
+             "foxglove.PoseInFrame",
              foxgloveSchema("foxglove.PoseInFrame", "The viewer's eye in the booth frame (m)",
                             R"("timestamp": )" + time + R"(, "frame_id": {"type": "string"},
     "pose": {"title": "foxglove.Pose", "type": "object", "properties": {"position": )" +
                                     v3 + R"(, "orientation": )" + quat + "}}")},
-            {ChannelId::Light, kLightTopic, "replica.Light",
+            {static_cast<std::uint16_t>(ChannelId::Light), std::string(kLightTopic),
+             "replica.Light",
              schemaText("replica.Light",
                         "The light the appliance decided to render with, when it changes",
                         R"json("t": {"type": "integer", "description": "session time (ns)"},
@@ -220,7 +205,7 @@ std::vector<ChannelDefinition> makeDefinitions()
     "distance": {"type": "number", "description": "spectral shape distance to the nearest stored lamp"},
     "why": {"type": "string"})json",
                         R"("t", "frame", "mode", "lamp", "name", "why")")},
-            {ChannelId::Log, kLogTopic, "foxglove.Log",
+            {static_cast<std::uint16_t>(ChannelId::Log), std::string(kLogTopic), "foxglove.Log",
              foxgloveSchema("foxglove.Log", "The appliance's warnings and errors",
                             R"("timestamp": )" + time + R"(,
     "level": {"title": "foxglove.LogLevel", "oneOf": [{"title": "UNKNOWN", "const": 0},
@@ -229,39 +214,20 @@ std::vector<ChannelDefinition> makeDefinitions()
       {"title": "FATAL", "const": 5}]},
     "message": {"type": "string"}, "name": {"type": "string"}, "file": {"type": "string"},
     "line": {"type": "integer", "minimum": 0})")},
-            {ChannelId::RawTracker, kRawTrackerTopic, "replica.RawTracker",
-             schemaText(
-                     "replica.RawTracker",
-                     "Raw in, processed out: what the head tracker sent for pose seq, before "
-                     "processing, with the processing's parameters; or (kind hid-descriptor) "
-                     "the report descriptor of one opening of a HID tracker",
-                     R"json("t": {"type": "integer", "description": "session time (ns) the bytes arrived"},
-    "seq": {"type": "integer", "description": "the pose on /hal/tracker made from them"},
-    "kind": {"type": "string", "enum": ["opentrack", "hid", "hid-descriptor"]},
-    "bytes": {"type": "string", "contentEncoding": "base64", "description":
-      "opentrack: the 48-byte datagram; hid: the input report, report ID first when numbered; hid-descriptor: the report descriptor"},
-    "descriptor": {"type": "integer", "description": "hid, hid-descriptor: which descriptor"},
-    "z_sign": {"type": "number", "description": "opentrack: sign of z in the tracker frame"},
-    "eye_offset_head_m": )json" +
-                             vec +
-                             R"json(, "axes": {"type": "string", "description": "hid: device axes to the tracker frame, e.g. x,-y,z"},
-    "reanchor_ns": {"type": "integer", "description": "hid: device clock re-anchoring threshold"})json",
-                     R"("t", "kind", "bytes")")},
-            {ChannelId::RawAccel, kRawAccelTopic, "replica.RawAccel",
-             schemaText("replica.RawAccel",
-                        "Raw in, processed out: the accelerometer's sysfs reading for accel "
-                        "sample seq; gravity = -mounting((raw + offset) * scale)",
-                        timeProps + R"(,
-    "raw": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3,
-      "description": "in_accel_{x,y,z}_raw"},
-    "scale": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
-    "offset": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
-    "axes": {"type": "string", "description": "mounting: sensor axis for the panel's x, y, z"})",
-                        R"("t", "seq", "raw", "scale", "offset", "axes")")},
     };
+    for (const auto* k : kinds) {
+        const auto& n = k->names();
+        defs.push_back({n.channel.id, n.channel.topic, n.channel.schemaName, n.channel.schemaText});
+        if (n.rawChannel) {
+            defs.push_back({n.rawChannel->id, n.rawChannel->topic, n.rawChannel->schemaName,
+                            n.rawChannel->schemaText});
+        }
+    }
+    std::stable_sort(defs.begin(), defs.end(),
+                     [](const Def& a, const Def& b) { return a.id < b.id; });
     std::vector<ChannelDefinition> out;
     for (const auto& d : defs) {
-        const auto id = static_cast<std::uint16_t>(d.id);
+        const auto id = d.id;
         out.push_back({mcap::Schema{id, d.name, "jsonschema", d.schema},
                        mcap::Channel{id, id, std::string(d.topic), "json", {}}});
     }
@@ -272,24 +238,38 @@ std::vector<ChannelDefinition> makeDefinitions()
 
 const std::vector<ChannelDefinition>& channelDefinitions()
 {
-    static const std::vector<ChannelDefinition> defs = makeDefinitions();
+    static const std::vector<ChannelDefinition> defs = makeDefinitions(deviceKinds());
     return defs;
 }
 
-std::string encodeSession(const SessionInfo& s, int formatVersion)
+std::vector<ChannelDefinition> channelDefinitions(const DeviceKinds& kinds)
 {
-    return json{{"format_version", formatVersion},
-                {"software", s.softwareVersion},
-                {"config", s.configJson},
-                {"booth", s.boothModel},
-                {"scene", s.scene},
-                {"display_profile", s.displayProfile},
-                {"wall_clock_start_ns", s.wallClockStartNs},
-                {"spectrometer", deviceJson(s.spectrometer)},
-                {"tracker", deviceJson(s.tracker)},
-                {"accel", deviceJson(s.accel)},
-                {"lamp_selector", deviceJson(s.lampSelector)}}
-            .dump();
+    return makeDefinitions(kinds);
+}
+
+std::string jsonSchemaText(const std::string& title,
+                           const std::string& description,
+                           const std::string& properties,
+                           const std::string& required)
+{
+    return R"({"$schema": "https://json-schema.org/draft/2020-12/schema", "title": ")" + title +
+           R"(", "description": ")" + description + R"(", "type": "object", "properties": {)" +
+           properties + R"(}, "required": [)" + required + "]}";
+}
+
+std::string encodeSession(const SessionInfo& s, int formatVersion, const DeviceKinds& kinds)
+{
+    json j{{"format_version", formatVersion},
+           {"software", s.softwareVersion},
+           {"config", s.configJson},
+           {"booth", s.boothModel},
+           {"scene", s.scene},
+           {"display_profile", s.displayProfile},
+           {"wall_clock_start_ns", s.wallClockStartNs}};
+    for (const auto* k : kinds) {
+        j[k->name()] = deviceJson(s.device(*k));
+    }
+    return j.dump();
 }
 
 std::optional<std::string> encodeSpectrum(const hal::SpectrumSample& s)
@@ -341,32 +321,28 @@ std::string encodeLamp(const hal::LampSample& s)
             .dump();
 }
 
-std::string encodeFrame(const FrameRecord& f)
+std::string encodeFrame(const FrameRecord& f, const DeviceKinds& kinds)
 {
     json j{{"frame", f.frameIndex}, {"tick_ns", f.tickNs}};
-    if (f.spectrumSequence) {
-        j["spectrum_seq"] = *f.spectrumSequence;
-    }
-    if (f.poseSequence) {
-        j["pose_seq"] = *f.poseSequence;
-    }
-    if (f.accelSequence) {
-        j["accel_seq"] = *f.accelSequence;
-    }
-    if (f.lampSequence) {
-        j["lamp_seq"] = *f.lampSequence;
+    for (const auto* k : kinds) {
+        if (const auto seq = f.sequence(*k)) {
+            j[k->names().frameKey] = *seq;
+        }
     }
     return j.dump();
 }
 
 std::string encodeRecorderStatus(const RecorderStatus& r)
 {
-    return json{{"dropped_spectra", r.droppedSpectra}, {"dropped_poses", r.droppedPoses},
-                {"dropped_accel", r.droppedAccel},     {"dropped_frames", r.droppedFrames},
-                {"dropped_lamp", r.droppedLamp},       {"dropped_shown", r.droppedShown},
-                {"dropped_total", r.droppedTotal()},   {"rejected_nonfinite", r.rejectedNonFinite},
-                {"queue_capacity", r.queueCapacity}}
-            .dump();
+    json j{{"dropped_frames", r.droppedFrames},
+           {"dropped_shown", r.droppedShown},
+           {"dropped_total", r.droppedTotal()},
+           {"rejected_nonfinite", r.rejectedNonFinite},
+           {"queue_capacity", r.queueCapacity}};
+    for (const auto& [key, dropped] : r.droppedDevices) {
+        j[key] = dropped;
+    }
+    return j.dump();
 }
 
 namespace {
@@ -697,7 +673,7 @@ LightRecord decodeLight(const json& j)
     return l;
 }
 
-SessionInfo decodeSession(const json& j, int& formatVersion)
+SessionInfo decodeSession(const json& j, int& formatVersion, const DeviceKinds& kinds)
 {
     SessionInfo s;
     formatVersion = j.at("format_version");
@@ -707,11 +683,11 @@ SessionInfo decodeSession(const json& j, int& formatVersion)
     s.scene = j.at("scene");
     s.displayProfile = j.at("display_profile");
     s.wallClockStartNs = j.at("wall_clock_start_ns");
-    s.spectrometer = deviceFromJson(j.at("spectrometer"));
-    s.tracker = deviceFromJson(j.at("tracker"));
-    s.accel = deviceFromJson(j.at("accel"));
-    if (j.contains("lamp_selector")) { // format 3
-        s.lampSelector = deviceFromJson(j.at("lamp_selector"));
+    for (const auto* k : kinds) {
+        // An optional kind is absent from recordings made before it (the lamp selector: 1, 2).
+        if (!k->names().optional || j.contains(k->name())) {
+            s.devices[k->name()] = deviceFromJson(j.at(k->name()));
+        }
     }
     return s;
 }
@@ -769,38 +745,252 @@ hal::LampSample decodeLamp(const json& j)
     return s;
 }
 
-FrameRecord decodeFrame(const json& j)
+FrameRecord decodeFrame(const json& j, const DeviceKinds& kinds)
 {
     FrameRecord f;
     f.frameIndex = j.at("frame");
     f.tickNs = j.at("tick_ns");
-    if (j.contains("spectrum_seq")) {
-        f.spectrumSequence = j.at("spectrum_seq").get<std::uint32_t>();
-    }
-    if (j.contains("pose_seq")) {
-        f.poseSequence = j.at("pose_seq").get<std::uint32_t>();
-    }
-    if (j.contains("accel_seq")) {
-        f.accelSequence = j.at("accel_seq").get<std::uint32_t>();
-    }
-    if (j.contains("lamp_seq")) {
-        f.lampSequence = j.at("lamp_seq").get<std::uint32_t>();
+    for (const auto* k : kinds) {
+        if (j.contains(k->names().frameKey)) {
+            f.sequences[k->name()] = j.at(k->names().frameKey).get<std::uint32_t>();
+        }
     }
     return f;
 }
 
-RecorderStatus decodeRecorderStatus(const json& j)
+RecorderStatus decodeRecorderStatus(const json& j, const DeviceKinds& kinds)
 {
     RecorderStatus r;
-    r.droppedSpectra = j.value("dropped_spectra", std::uint64_t{0});
-    r.droppedPoses = j.value("dropped_poses", std::uint64_t{0});
-    r.droppedAccel = j.value("dropped_accel", std::uint64_t{0});
+    for (const auto* k : kinds) {
+        r.droppedDevices[k->names().droppedKey] = j.value(k->names().droppedKey, std::uint64_t{0});
+    }
     r.droppedFrames = j.value("dropped_frames", std::uint64_t{0});
-    r.droppedLamp = j.value("dropped_lamp", std::uint64_t{0});
     r.droppedShown = j.value("dropped_shown", std::uint64_t{0});
     r.rejectedNonFinite = j.value("rejected_nonfinite", std::uint64_t{0});
     r.queueCapacity = j.value("queue_capacity", std::uint64_t{0});
     return r;
+}
+
+// The device channels' schemas (device_kinds.cpp puts them on their channels).
+
+std::pair<std::string, std::string> spectrumSchema()
+{
+    return {"replica.SpectrometerSample",
+            schemaText("replica.SpectrometerSample",
+                       "One raw spectrum with the device calibration needed to convert it",
+                       std::string(kTimeSeqProps) + R"(,
+    "integration_time_us": {"type": "integer"},
+    "counts": {"type": "array", "items": {"type": "integer", "minimum": 0, "maximum": 65535},
+      "description": "raw counts, pixel 0 first"},
+    "wavelength_coeffs": {"type": "array", "items": {"type": "number"}, "minItems": 4,
+      "maxItems": 4, "description": "wavelength (nm) of pixel p = c0 + c1 p + c2 p^2 + c3 p^3"},
+    "nonlinearity_coeffs": {"type": "array", "items": {"type": "number"}, "minItems": 8,
+      "maxItems": 8, "description": "counts correction polynomial, order 0..7"},
+    "saturated": {"type": "boolean"})",
+                       R"("t", "seq", "integration_time_us", "counts", "wavelength_coeffs",
+    "nonlinearity_coeffs", "saturated")")};
+}
+
+std::pair<std::string, std::string> poseSchema()
+{
+    return {"replica.TrackerPose",
+            schemaText("replica.TrackerPose",
+                       "The viewer's eye position in the tracker frame (m): x right, y up, z "
+                       "towards the viewer",
+                       std::string(kTimeSeqProps) + R"(, "tracked": {"type": "boolean"}, "eye": )" +
+                               std::string(kVec3Schema),
+                       R"("t", "seq", "tracked", "eye")")};
+}
+
+std::pair<std::string, std::string> accelSchema()
+{
+    return {"replica.AccelSample",
+            schemaText("replica.AccelSample", "Gravity in the display's device frame (m/s^2)",
+                       std::string(kTimeSeqProps) + R"(, "gravity": )" + std::string(kVec3Schema),
+                       R"("t", "seq", "gravity")")};
+}
+
+std::pair<std::string, std::string> lampSchema()
+{
+    return {"replica.LampSelectorSample",
+            schemaText("replica.LampSelectorSample",
+                       "The booth's lamp selector switch once its GPIO lines settled (debounced): "
+                       "one line per lamp, in the booth's lamp order",
+                       std::string(kTimeSeqProps) + R"(,
+    "lamp": {"type": "integer", "minimum": -3, "description":
+      "booth lamp index (line i alone active = lamp i); -1 off, -2 invalid (several lines), -3 lines lost"},
+    "state": {"type": "string", "enum": ["lamp", "off", "invalid", "lost"]},
+    "levels": {"type": "array", "items": {"type": "integer", "minimum": 0, "maximum": 1},
+      "maxItems": 32, "description": "debounced level of each line, 1 = active: the switch closes it"})",
+                       R"("t", "seq", "lamp", "levels")")};
+}
+
+std::pair<std::string, std::string> rawTrackerSchema()
+{
+    return {"replica.RawTracker",
+            schemaText(
+                    "replica.RawTracker",
+                    "Raw in, processed out: what the head tracker sent for pose seq, before "
+                    "processing, with the processing's parameters; or (kind hid-descriptor) "
+                    "the report descriptor of one opening of a HID tracker",
+                    R"json("t": {"type": "integer", "description": "session time (ns) the bytes arrived"},
+    "seq": {"type": "integer", "description": "the pose on /hal/tracker made from them"},
+    "kind": {"type": "string", "enum": ["opentrack", "hid", "hid-descriptor"]},
+    "bytes": {"type": "string", "contentEncoding": "base64", "description":
+      "opentrack: the 48-byte datagram; hid: the input report, report ID first when numbered; hid-descriptor: the report descriptor"},
+    "descriptor": {"type": "integer", "description": "hid, hid-descriptor: which descriptor"},
+    "z_sign": {"type": "number", "description": "opentrack: sign of z in the tracker frame"},
+    "eye_offset_head_m": )json" +
+                            std::string(kVec3Schema) +
+                            R"json(, "axes": {"type": "string", "description": "hid: device axes to the tracker frame, e.g. x,-y,z"},
+    "reanchor_ns": {"type": "integer", "description": "hid: device clock re-anchoring threshold"})json",
+                    R"("t", "kind", "bytes")")};
+}
+
+std::pair<std::string, std::string> rawAccelSchema()
+{
+    return {"replica.RawAccel",
+            schemaText("replica.RawAccel",
+                       "Raw in, processed out: the accelerometer's sysfs reading for accel "
+                       "sample seq; gravity = -mounting((raw + offset) * scale)",
+                       std::string(kTimeSeqProps) + R"(,
+    "raw": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3,
+      "description": "in_accel_{x,y,z}_raw"},
+    "scale": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
+    "offset": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
+    "axes": {"type": "string", "description": "mounting: sensor axis for the panel's x, y, z"})",
+                       R"("t", "seq", "raw", "scale", "offset", "axes")")};
+}
+
+// The codecs of the device sample types.
+
+SampleCodec<hal::SpectrumSample> spectrumCodec()
+{
+    SampleCodec<hal::SpectrumSample> c;
+    c.encode = encodeSpectrum;
+    c.decode = decodeSpectrum;
+    return c;
+}
+
+namespace {
+
+// Writer state of the raw tracker channel: the HID descriptor written last and its id.
+struct RawTrackerWriterState {
+    std::shared_ptr<const std::vector<std::uint8_t>> lastDescriptor;
+    std::uint32_t descriptorId = 0;
+};
+// Reader state: descriptors by id, raw inputs by pose sequence.
+struct RawTrackerReaderState {
+    std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>> descriptors;
+    std::map<std::uint32_t, std::shared_ptr<const hal::RawTrackerInput>> raw;
+};
+using RawAccelReaderState = std::map<std::uint32_t, std::shared_ptr<const hal::RawAccelInput>>;
+
+template <typename State>
+State& stateOf(std::any& a)
+{
+    if (!a.has_value()) {
+        a = State{};
+    }
+    return std::any_cast<State&>(a);
+}
+
+// Gives each sample its raw input; returns how many raw inputs found no sample.
+template <typename Sample, typename Raw>
+std::uint64_t attachRawBySequence(std::vector<Sample>& samples,
+                                  const std::map<std::uint32_t, std::shared_ptr<const Raw>>& raw)
+{
+    std::uint64_t matched = 0;
+    for (auto& s : samples) {
+        if (auto it = raw.find(s.sequence); it != raw.end()) {
+            s.raw = it->second;
+            ++matched;
+        }
+    }
+    return matched >= raw.size() ? 0 : raw.size() - matched;
+}
+
+} // namespace
+
+SampleCodec<hal::PoseSample> poseCodec()
+{
+    SampleCodec<hal::PoseSample> c;
+    c.encode = encodePose;
+    c.decode = decodePose;
+    c.encodeRaw = [](const hal::PoseSample& p, std::uint16_t channel, std::any& state,
+                     const DeviceEmitter& emit) {
+        if (!p.raw) {
+            return;
+        }
+        auto& st = stateOf<RawTrackerWriterState>(state);
+        const auto& d = p.raw->hidDescriptor;
+        if (p.raw->kind == hal::RawTrackerInput::Kind::HidReport && d &&
+            d.get() != st.lastDescriptor.get()) {
+            // A new opening of the device: its descriptor once, before its first report.
+            st.lastDescriptor = d;
+            ++st.descriptorId;
+            emit.message(channel, p.raw->arrivalNs,
+                         encodeRawTrackerDescriptor(p.raw->arrivalNs, st.descriptorId, *d));
+        }
+        if (auto raw = encodeRawTracker(p, st.descriptorId)) {
+            emit.message(channel, p.raw->arrivalNs, std::move(*raw));
+        } else {
+            emit.rejectRaw();
+        }
+    };
+    c.decodeRaw = [](const json& j, std::any& state) {
+        auto& st = stateOf<RawTrackerReaderState>(state);
+        auto r = decodeRawTracker(j, st.descriptors);
+        if (r.descriptorId) {
+            st.descriptors[*r.descriptorId] = r.descriptor;
+        } else if (r.descriptorMissing) {
+            return false;
+        } else {
+            st.raw[r.sequence] = std::move(r.raw);
+        }
+        return true;
+    };
+    c.attachRaw = [](std::vector<hal::PoseSample>& poses, std::any& state) {
+        return attachRawBySequence(poses, stateOf<RawTrackerReaderState>(state).raw);
+    };
+    c.hasRaw = [](const hal::PoseSample& p) { return p.raw != nullptr; };
+    return c;
+}
+
+SampleCodec<hal::AccelSample> accelCodec()
+{
+    SampleCodec<hal::AccelSample> c;
+    c.encode = encodeAccel;
+    c.decode = decodeAccel;
+    c.encodeRaw = [](const hal::AccelSample& a, std::uint16_t channel, std::any&,
+                     const DeviceEmitter& emit) {
+        if (!a.raw) {
+            return;
+        }
+        if (auto raw = encodeRawAccel(a)) {
+            emit.message(channel, a.timestampNs, std::move(*raw));
+        } else {
+            emit.rejectRaw();
+        }
+    };
+    c.decodeRaw = [](const json& j, std::any& state) {
+        auto [seq, raw] = decodeRawAccel(j);
+        stateOf<RawAccelReaderState>(state)[seq] = std::move(raw);
+        return true;
+    };
+    c.attachRaw = [](std::vector<hal::AccelSample>& samples, std::any& state) {
+        return attachRawBySequence(samples, stateOf<RawAccelReaderState>(state));
+    };
+    c.hasRaw = [](const hal::AccelSample& a) { return a.raw != nullptr; };
+    return c;
+}
+
+SampleCodec<hal::LampSample> lampCodec()
+{
+    SampleCodec<hal::LampSample> c;
+    c.encode = [](const hal::LampSample& s) { return std::optional<std::string>(encodeLamp(s)); };
+    c.decode = decodeLamp;
+    return c;
 }
 
 } // namespace replica::recordings

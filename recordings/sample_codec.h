@@ -66,34 +66,66 @@ inline constexpr std::string_view kSessionMetadataName = "replica.session";
 
 // What the recorder itself reports on /replica/recorder: samples it could not write.
 struct RecorderStatus {
-    std::uint64_t droppedSpectra = 0, droppedPoses = 0, droppedAccel = 0, droppedFrames = 0;
-    std::uint64_t droppedLamp = 0;
+    // DeviceNames::droppedKey -> samples of that device dropped (every kind the writer has).
+    std::map<std::string, std::uint64_t> droppedDevices;
+    std::uint64_t droppedFrames = 0;
     std::uint64_t droppedShown = 0;      // format 4: thumbnails, poses, light, log, display digests
     std::uint64_t rejectedNonFinite = 0; // samples refused because a value was NaN or infinite
     std::uint64_t queueCapacity = 0;
     std::uint64_t droppedTotal() const
     {
-        return droppedSpectra + droppedPoses + droppedAccel + droppedFrames + droppedLamp +
-               droppedShown;
+        std::uint64_t n = droppedFrames + droppedShown;
+        for (const auto& [key, d] : droppedDevices) {
+            n += d;
+        }
+        return n;
     }
 };
 
-// The schema and channel of every channel of the current format, in id order.
+// The schema and channel of every channel of the current format with these device kinds, in id
+// order.
 struct ChannelDefinition {
     mcap::Schema schema;
     mcap::Channel channel;
 };
-const std::vector<ChannelDefinition>& channelDefinitions();
+const std::vector<ChannelDefinition>& channelDefinitions(); // with deviceKinds()
+std::vector<ChannelDefinition> channelDefinitions(const DeviceKinds& kinds);
+
+// JSON Schema text of a replica.* message, and fragments the device schemas share.
+std::string jsonSchemaText(const std::string& title,
+                           const std::string& description,
+                           const std::string& properties,
+                           const std::string& required);
+inline constexpr const char* kTimeSeqProps =
+        R"("t": {"type": "integer", "description": "session time (ns) when the loop received it"},
+    "seq": {"type": "integer", "description": "the device's own counter; gaps are drops"})";
+inline constexpr const char* kVec3Schema =
+        R"({"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"},
+      "z": {"type": "number"}}, "required": ["x", "y", "z"]})";
+
+// The codec of each device sample type (device_kinds.cpp names the devices that use them): the
+// encoders and decoders below, and the channel schema.
+SampleCodec<hal::SpectrumSample> spectrumCodec();
+SampleCodec<hal::PoseSample> poseCodec();   // with the raw tracker input (format 5)
+SampleCodec<hal::AccelSample> accelCodec(); // with the raw IIO reading (format 5)
+SampleCodec<hal::LampSample> lampCodec();
+std::pair<std::string, std::string> spectrumSchema(); // (name, JSON Schema text)
+std::pair<std::string, std::string> poseSchema();
+std::pair<std::string, std::string> accelSchema();
+std::pair<std::string, std::string> lampSchema();
+std::pair<std::string, std::string> rawTrackerSchema();
+std::pair<std::string, std::string> rawAccelSchema();
 
 // JSON payloads. Doubles are written in shortest round-trip form and parse back bit-identically;
 // encoders return nullopt when a double is NaN or infinite (JSON cannot spell them), and the
 // writer counts such samples as rejected instead of writing a value that would read back wrong.
-std::string encodeSession(const SessionInfo& s, int formatVersion);
+std::string
+encodeSession(const SessionInfo& s, int formatVersion, const DeviceKinds& kinds = deviceKinds());
 std::optional<std::string> encodeSpectrum(const hal::SpectrumSample& s);
 std::optional<std::string> encodePose(const hal::PoseSample& s);
 std::optional<std::string> encodeAccel(const hal::AccelSample& s);
 std::string encodeLamp(const hal::LampSample& s);
-std::string encodeFrame(const FrameRecord& f);
+std::string encodeFrame(const FrameRecord& f, const DeviceKinds& kinds = deviceKinds());
 std::string encodeRecorderStatus(const RecorderStatus& r);
 // Format 4. wallStartNs turns session time into the foxglove timestamps {sec, nsec} (Unix time).
 std::string encodeDisplayDigest(const DisplayDigestRecord& d);
@@ -116,13 +148,16 @@ std::optional<std::string> encodeRawTracker(const hal::PoseSample& s, std::uint3
 std::optional<std::string> encodeRawAccel(const hal::AccelSample& s);
 
 // Decoders throw nlohmann::json exceptions on missing or mistyped fields.
-SessionInfo decodeSession(const nlohmann::json& j, int& formatVersion);
+SessionInfo decodeSession(const nlohmann::json& j,
+                          int& formatVersion,
+                          const DeviceKinds& kinds = deviceKinds());
 hal::SpectrumSample decodeSpectrum(const nlohmann::json& j);
 hal::PoseSample decodePose(const nlohmann::json& j);
 hal::AccelSample decodeAccel(const nlohmann::json& j);
 hal::LampSample decodeLamp(const nlohmann::json& j);
-FrameRecord decodeFrame(const nlohmann::json& j);
-RecorderStatus decodeRecorderStatus(const nlohmann::json& j);
+FrameRecord decodeFrame(const nlohmann::json& j, const DeviceKinds& kinds = deviceKinds());
+RecorderStatus decodeRecorderStatus(const nlohmann::json& j,
+                                    const DeviceKinds& kinds = deviceKinds());
 DisplayDigestRecord decodeDisplayDigest(const nlohmann::json& j);
 LightRecord decodeLight(const nlohmann::json& j);
 // A raw tracker message: either a descriptor (returned in 'descriptor' with its id) or the raw

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstddef>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace replica::recordings {
@@ -15,14 +16,15 @@ public:
     explicit SampleQueue(std::size_t capacity) : slots_(capacity > 0 ? capacity : 1) {}
 
     // Producer side: constructs the item in place. False (and nothing stored) when full.
+    // (A forwarding reference: a device sample moved in is not copied again.)
     template <typename U>
-    bool tryPush(const U& value)
+    bool tryPush(U&& value)
     {
         const std::size_t tail = tail_.load(std::memory_order_relaxed);
         if (tail - head_.load(std::memory_order_acquire) == slots_.size()) {
             return false;
         }
-        slots_[tail % slots_.size()].emplace(value);
+        slots_[tail % slots_.size()].emplace(std::forward<U>(value));
         tail_.store(tail + 1, std::memory_order_release);
         return true;
     }

@@ -12,7 +12,7 @@ const JsonSchema& sessionSchema()
                                     {"serial", string(4096)},
                                     {"firmware", string(4096)},
                                     {"source", string(16)}});
-        return object({
+        std::vector<JsonSchemaField> fields{
                 // Any integer: a version this reader does not know is refused after decoding,
                 // with its own message (update replica).
                 {"format_version", integer(0, 65535)},
@@ -23,11 +23,12 @@ const JsonSchema& sessionSchema()
                 {"display_profile", string(4096)},
                 // Unix time in ns: from 1970 to the end of int64 (2262).
                 {"wall_clock_start_ns", integer(0, 9.2e18)},
-                {"spectrometer", device},
-                {"tracker", device},
-                {"accel", device},
-                {"lamp_selector", device.optional()}, // format 3 and later
-        });
+        };
+        // Each device kind's source; an optional kind is absent before it existed.
+        for (const auto* k : deviceKinds()) {
+            fields.push_back({k->name(), k->names().optional ? device.optional() : device});
+        }
+        return object(std::move(fields));
     }();
     return s;
 }

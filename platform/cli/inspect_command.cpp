@@ -63,7 +63,7 @@ nlohmann::json lampTimeline(const recordings::Recording& rec)
         }
         out.push_back(e);
     }
-    for (const auto& s : rec.lampSelector) {
+    for (const auto& s : rec.samples(recordings::lampSelectorKind())) {
         out.push_back({{"t_s", static_cast<double>(s.timestampNs) * 1e-9},
                        {"source", "selector"},
                        {"lamp", s.lamp},
@@ -75,31 +75,49 @@ nlohmann::json lampTimeline(const recordings::Recording& rec)
     return out;
 }
 
-template <typename Sample>
-nlohmann::json streamJson(const hal::DeviceInfo& info, const std::vector<Sample>& samples)
+nlohmann::json streamJson(const recordings::Recording& rec, const recordings::DeviceKindBase& kind)
 {
+    const auto& info = rec.session.device(kind);
+    const std::size_t count = rec.count(kind);
     nlohmann::json j{{"model", info.model},
                      {"serial", info.serial},
                      {"firmware", info.firmware},
                      {"source", hal::toString(info.kind)},
-                     {"count", samples.size()}};
-    if (!samples.empty()) {
-        j["first_ns"] = samples.front().timestampNs;
-        j["last_ns"] = samples.back().timestampNs;
+                     {"count", count}};
+    if (count > 0) {
+        const auto& samples = rec.devices.at(kind.name());
+        const auto t = kind.times(samples);
+        j["first_ns"] = t.front();
+        j["last_ns"] = t.back();
+        // The last decoded sample, as its channel's message (its own field names): lets
+        // independent MCAP readers check decoded values, not just counts.
+        if (auto last = kind.encodeAt(samples, count - 1)) {
+            j["last"] = nlohmann::json::parse(*last);
+        }
     }
     return j;
 }
 
-// Format 5: how many samples carry the device's raw input (/replica/raw/*).
+// What a kind's samples are called: its own word ("poses"), else its name ("accel").
+std::string samplesKey(const recordings::DeviceKindBase& kind)
+{
+    return kind.names().samplesNoun != "samples" ? kind.names().samplesNoun : kind.name();
+}
+
+// Format 5: how many samples carry the device's raw input (/replica/raw/*), for each device kind
+// with a raw channel.
 nlohmann::json rawInputsJson(const recordings::Recording& rec)
 {
-    const auto withRaw = [](const auto& samples) {
-        return static_cast<std::size_t>(std::count_if(
-                samples.begin(), samples.end(), [](const auto& s) { return s.raw != nullptr; }));
-    };
-    return {{"poses", withRaw(rec.poses)},
-            {"accel", withRaw(rec.accel)},
-            {"unmatched", rec.unmatchedRaw}};
+    nlohmann::json j{{"unmatched", rec.unmatchedRaw}};
+    for (const auto* kind : recordings::deviceKinds()) {
+        if (kind->names().rawChannel) {
+            const auto it = rec.devices.find(kind->name());
+            j[samplesKey(*kind)] = it != rec.devices.end() && it->second.has_value()
+                                           ? kind->countWithRaw(it->second)
+                                           : 0;
+        }
+    }
+    return j;
 }
 
 nlohmann::json channelsJson(const recordings::FileReport& report)
@@ -163,17 +181,13 @@ int inspectMain(const InspectOptions& o)
         first = std::min(first, t);
         last = std::max(last, t);
     };
-    for (const auto& s : rec->spectra) {
-        span(s.timestampNs);
-    }
-    for (const auto& s : rec->poses) {
-        span(s.timestampNs);
-    }
-    for (const auto& s : rec->accel) {
-        span(s.timestampNs);
-    }
-    for (const auto& s : rec->lampSelector) {
-        span(s.timestampNs);
+    for (const auto& [name, samples] : rec->devices) {
+        if (const auto* kind = recordings::kindNamed(recordings::deviceKinds(), name);
+            kind != nullptr && samples.has_value()) {
+            for (const auto t : kind->times(samples)) {
+                span(t);
+            }
+        }
     }
     for (const auto& f : rec->frames) {
         span(f.tickNs);
@@ -192,10 +206,6 @@ int inspectMain(const InspectOptions& o)
                      {"wall_clock_start", isoUtc(rec->session.wallClockStartNs)},
                      {"lamp_timeline", lampTimeline(*rec)},
                      {"display_digests", rec->displayDigests.size()},
-                     {"spectrometer", streamJson(rec->session.spectrometer, rec->spectra)},
-                     {"tracker", streamJson(rec->session.tracker, rec->poses)},
-                     {"accel", streamJson(rec->session.accel, rec->accel)},
-                     {"lamp_selector", streamJson(rec->session.lampSelector, rec->lampSelector)},
                      {"raw_inputs", rawInputsJson(*rec)},
                      {"frames", rec->frames.size()},
                      {"dropped_messages", rec->droppedMessages},
@@ -210,39 +220,8 @@ int inspectMain(const InspectOptions& o)
                      {"first_ns", first},
                      {"last_ns", last},
                      {"duration_s", static_cast<double>(last - first) * 1e-9}};
-    // The last decoded sample of each stream, in the channels' own field names: lets independent
-    // MCAP readers check decoded values, not just counts.
-    if (!rec->spectra.empty()) {
-        const auto& s = rec->spectra.back();
-        j["spectrometer"]["last"] = {{"seq", s.sequence},
-                                     {"integration_time_us", s.integrationTimeUs},
-                                     {"counts", s.counts},
-                                     {"wavelength_coeffs", s.wavelengthCoeffs},
-                                     {"nonlinearity_coeffs", s.nonlinearityCoeffs}};
-    }
-    if (!rec->poses.empty()) {
-        const auto& p = rec->poses.back();
-        j["tracker"]["last"] = {
-                {"seq", p.sequence},
-                {"tracked", p.tracked},
-                {"eye", {{"x", p.eyeTrackerM.x}, {"y", p.eyeTrackerM.y}, {"z", p.eyeTrackerM.z}}}};
-    }
-    if (!rec->accel.empty()) {
-        const auto& a = rec->accel.back();
-        j["accel"]["last"] = {
-                {"seq", a.sequence},
-                {"gravity", {{"x", a.gravity.x}, {"y", a.gravity.y}, {"z", a.gravity.z}}}};
-    }
-    if (!rec->lampSelector.empty()) {
-        const auto& l = rec->lampSelector.back();
-        std::vector<int> levels;
-        for (std::uint32_t i = 0; i < l.lineCount; ++i) {
-            levels.push_back((l.lineLevels >> i) & 1u ? 1 : 0);
-        }
-        j["lamp_selector"]["last"] = {{"seq", l.sequence},
-                                      {"lamp", l.lamp},
-                                      {"state", hal::lampStateName(l.lamp)},
-                                      {"levels", levels}};
+    for (const auto* kind : recordings::deviceKinds()) {
+        j[kind->name()] = streamJson(*rec, *kind);
     }
     if (!rec->frames.empty()) {
         j["last_frame"] = {{"frame", rec->frames.back().frameIndex},
@@ -283,17 +262,24 @@ int inspectMain(const InspectOptions& o)
         fmt::print("  {:<13} {:>7} samples  {} {} ({})\n", name, count, shown(info.model),
                    shown(info.serial), hal::toString(info.kind));
     };
-    line("spectrometer", rec->session.spectrometer, rec->spectra.size());
-    line("tracker", rec->session.tracker, rec->poses.size());
-    line("accelerometer", rec->session.accel, rec->accel.size());
-    if (!rec->session.lampSelector.model.empty() || !rec->lampSelector.empty()) {
-        line("lamp selector", rec->session.lampSelector, rec->lampSelector.size());
-    }
+    // Every device kind; an optional one only when the session had it.
     const auto raw = rawInputsJson(*rec);
-    fmt::print("  raw inputs    {} of {} poses, {} of {} accelerometer samples{} ('replay "
-               "--reprocess' re-derives them)\n",
-               raw.at("poses").get<std::size_t>(), rec->poses.size(),
-               raw.at("accel").get<std::size_t>(), rec->accel.size(),
+    std::string rawCounts;
+    for (const auto* kind : recordings::deviceKinds()) {
+        const auto& info = rec->session.device(*kind);
+        const std::size_t count = rec->count(*kind);
+        if (!kind->names().optional || !info.model.empty() || count > 0) {
+            line(kind->names().displayName.c_str(), info, count);
+        }
+        if (kind->names().rawChannel) {
+            const auto& noun = kind->names().samplesNoun;
+            rawCounts +=
+                    fmt::format("{}{} of {} {}", rawCounts.empty() ? "" : ", ",
+                                raw.at(samplesKey(*kind)).get<std::size_t>(), count,
+                                noun != "samples" ? noun : kind->names().displayName + " samples");
+        }
+    }
+    fmt::print("  raw inputs    {}{} ('replay --reprocess' re-derives them)\n", rawCounts,
                rec->unmatchedRaw > 0
                        ? fmt::format("; {} without their sample (dropped)", rec->unmatchedRaw)
                        : std::string());

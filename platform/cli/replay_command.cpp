@@ -287,12 +287,16 @@ int replayMain(const ReplayOptions& o)
                    lastS);
         return kExitUsage;
     }
-    log->info("replay {}: {} frames, {} spectra, {} poses, {} accel samples, {} lamp selector "
-              "samples (recorded by {}); clock={}; renderer={} on {}; {}x{}",
-              o.file, recording->frames.size(), recording->spectra.size(), recording->poses.size(),
-              recording->accel.size(), recording->lampSelector.size(),
-              recording->session.softwareVersion, o.clock, (*appliance)->renderer->description(),
-              (*appliance)->output->glRenderer(), config->width, config->height);
+    std::string counts;
+    for (const auto* kind : recordings::deviceKinds()) {
+        const auto& noun = kind->names().samplesNoun;
+        counts += fmt::format(", {} {}", recording->count(*kind),
+                              noun != "samples" ? noun : kind->names().displayName + " samples");
+    }
+    log->info("replay {}: {} frames{} (recorded by {}); clock={}; renderer={} on {}; {}x{}", o.file,
+              recording->frames.size(), counts, recording->session.softwareVersion, o.clock,
+              (*appliance)->renderer->description(), (*appliance)->output->glRenderer(),
+              config->width, config->height);
     if (o.fromS || o.toS) {
         log->info("slice: {} frames from {} s to {} s ({} frames before it rendered first, not "
                   "output)",

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <map>
 #include <numbers>
 #include <optional>
 #include <utility>
@@ -181,26 +182,37 @@ std::optional<std::pair<int, int>> parseSize(const std::string& s)
     return std::make_pair(w, h);
 }
 
+// The run's option that chooses a device kind's source: --spectrometer, --lamp-selector.
+std::string deviceOption(const recordings::DeviceKindBase& kind)
+{
+    std::string s = kind.name();
+    std::replace(s.begin(), s.end(), '_', '-');
+    return s;
+}
+
+// Where each device kind's source comes from (kind name -> "live", "opentrack", "hid", "gpio",
+// "sim", "sim-miswired", "replay" or "none").
 struct DeviceChoice {
-    std::string spectrometer;
-    std::string tracker;
-    std::string accel;
-    std::string lampSelector;
-    bool anyLive() const
+    std::map<std::string, std::string> from;
+    const std::string& of(const recordings::DeviceKindBase& kind) const
     {
-        return spectrometer == "live" || tracker == "opentrack" || tracker == "hid" ||
-               accel == "live" || lampSelector == "gpio";
+        static const std::string kNone = "none";
+        const auto it = from.find(kind.name());
+        return it != from.end() ? it->second : kNone;
     }
+    static bool isSim(const std::string& v) { return v.rfind("sim", 0) == 0; }
+    static bool isLive(const std::string& v) { return v != "none" && v != "replay" && !isSim(v); }
+    template <typename Pred>
+    bool any(Pred p) const
+    {
+        return std::any_of(from.begin(), from.end(), [&p](const auto& e) { return p(e.second); });
+    }
+    bool anyLive() const { return any(isLive); }
     bool anyReplay() const
     {
-        return spectrometer == "replay" || tracker == "replay" || accel == "replay" ||
-               lampSelector == "replay";
+        return any([](const std::string& v) { return v == "replay"; });
     }
-    bool anySim() const
-    {
-        return spectrometer == "sim" || tracker == "sim" || accel == "sim" ||
-               lampSelector.rfind("sim", 0) == 0;
-    }
+    bool anySim() const { return any(isSim); }
 };
 
 // Each device's source: --hal gives the default, --spectrometer/--tracker/--accel/--lamp-selector
@@ -215,10 +227,14 @@ Expected<DeviceChoice> chooseDevices(const RunOptions& o)
                                      o.hal));
     }
     DeviceChoice c;
-    c.spectrometer = o.spectrometer.empty() ? o.hal : o.spectrometer;
-    c.tracker = !o.tracker.empty() ? o.tracker : o.hal == "live" ? "opentrack" : o.hal;
-    c.accel = o.accel.empty() ? o.hal : o.accel;
-    c.lampSelector =
+    auto& spectrometer = c.from[recordings::spectrometerKind().name()];
+    auto& tracker = c.from[recordings::trackerKind().name()];
+    auto& accel = c.from[recordings::accelKind().name()];
+    auto& lampSelector = c.from[recordings::lampSelectorKind().name()];
+    spectrometer = o.spectrometer.empty() ? o.hal : o.spectrometer;
+    tracker = !o.tracker.empty() ? o.tracker : o.hal == "live" ? "opentrack" : o.hal;
+    accel = o.accel.empty() ? o.hal : o.accel;
+    lampSelector =
             !o.lampSelector.empty() ? o.lampSelector : (o.live.lampGpio.empty() ? "none" : "gpio");
     auto oneOf = [](const std::string& v, std::initializer_list<const char*> allowed) {
         for (const char* a : allowed) {
@@ -228,28 +244,28 @@ Expected<DeviceChoice> chooseDevices(const RunOptions& o)
         }
         return false;
     };
-    if (!oneOf(c.spectrometer, {"live", "sim", "replay"}) ||
-        !oneOf(c.tracker, {"opentrack", "hid", "sim", "replay"}) ||
-        !oneOf(c.accel, {"live", "sim", "replay"}) ||
-        !oneOf(c.lampSelector, {"none", "gpio", "sim", "sim-miswired", "replay"})) {
+    if (!oneOf(spectrometer, {"live", "sim", "replay"}) ||
+        !oneOf(tracker, {"opentrack", "hid", "sim", "replay"}) ||
+        !oneOf(accel, {"live", "sim", "replay"}) ||
+        !oneOf(lampSelector, {"none", "gpio", "sim", "sim-miswired", "replay"})) {
         return makeError(
                 ErrorCode::InvalidArgument,
                 fmt::format("sources spectrometer={} tracker={} accel={} lamp_selector={}: "
                             "expected spectrometer and accel live|sim|replay, tracker "
                             "opentrack|hid|sim|replay, lamp_selector "
                             "none|gpio|sim|sim-miswired|replay",
-                            c.spectrometer, c.tracker, c.accel, c.lampSelector));
+                            spectrometer, tracker, accel, lampSelector));
     }
-    if (c.lampSelector == "gpio" && o.live.lampGpio.empty()) {
+    if (lampSelector == "gpio" && o.live.lampGpio.empty()) {
         return makeError(ErrorCode::InvalidArgument,
                          "--lamp-selector gpio needs --lamp-gpio CHIP:OFFSET,OFFSET,... (one line "
                          "per lamp)");
     }
-    if (!o.live.lampGpio.empty() && c.lampSelector != "gpio") {
+    if (!o.live.lampGpio.empty() && lampSelector != "gpio") {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("--lamp-gpio {} and --lamp-selector {} contradict each other: "
                                      "the GPIO switch is --lamp-selector gpio",
-                                     o.live.lampGpio, c.lampSelector));
+                                     o.live.lampGpio, lampSelector));
     }
     if (c.anyLive() && o.fast) {
         return makeError(ErrorCode::InvalidArgument,
@@ -276,9 +292,10 @@ makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock
     const DeviceChoice& c = *choice;
     auto log = logger("replica");
     Sources sim;
+    const std::string& lampFrom = c.of(recordings::lampSelectorKind());
     if (c.anySim()) {
-        const bool simLamp = c.lampSelector == "sim" || c.lampSelector == "sim-miswired";
-        auto made = makeSimSources(appliance, simLamp ? c.lampSelector : std::string("none"));
+        const bool simLamp = DeviceChoice::isSim(lampFrom);
+        auto made = makeSimSources(appliance, simLamp ? lampFrom : std::string("none"));
         if (!made) {
             return tl::unexpected(made.error());
         }
@@ -291,20 +308,23 @@ makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock
             return tl::unexpected(recording.error());
         }
         replayed = makeReplaySources(*recording);
-        if (c.lampSelector == "replay" && !replayed.lampSelector) {
-            return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("--lamp-selector replay: {} has no lamp selector "
-                                         "channel",
-                                         o.replayFrom));
+        for (const auto* kind : recordings::deviceKinds()) {
+            if (c.of(*kind) == "replay" && replayed.get(*kind) == nullptr) {
+                return makeError(ErrorCode::InvalidArgument,
+                                 fmt::format("--{} replay: {} has no {} channel",
+                                             deviceOption(*kind), o.replayFrom,
+                                             kind->names().displayName));
+            }
         }
     }
     Sources live;
     if (c.anyLive()) {
         LiveOptions lo = o.live;
-        lo.spectrometer = c.spectrometer == "live";
-        lo.tracker = c.tracker == "opentrack" || c.tracker == "hid" ? c.tracker : std::string();
-        lo.accel = c.accel == "live";
-        if (c.lampSelector != "gpio") {
+        const std::string& trackerFrom = c.of(recordings::trackerKind());
+        lo.spectrometer = c.of(recordings::spectrometerKind()) == "live";
+        lo.tracker = DeviceChoice::isLive(trackerFrom) ? trackerFrom : std::string();
+        lo.accel = c.of(recordings::accelKind()) == "live";
+        if (lampFrom != "gpio") {
             lo.lampGpio.clear();
         }
         auto made = makeLiveSources(liveClock, lo, appliance.booth.lights.size());
@@ -313,25 +333,26 @@ makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock
         }
         live = std::move(*made);
     }
-    auto pick = [](const std::string& kind, auto& l, auto& s, auto& r) {
-        return kind == "sim" || kind.rfind("sim-", 0) == 0 ? std::move(s)
-               : kind == "replay"                          ? std::move(r)
-                                                           : std::move(l);
-    };
+    // Each device kind from where the choice says; "none": the run has no such device.
     Sources out;
-    out.spectrometer =
-            pick(c.spectrometer, live.spectrometer, sim.spectrometer, replayed.spectrometer);
-    out.tracker = pick(c.tracker, live.tracker, sim.tracker, replayed.tracker);
-    out.accel = pick(c.accel, live.accel, sim.accel, replayed.accel);
-    out.lampSelector = c.lampSelector == "none" ? nullptr
-                                                : pick(c.lampSelector, live.lampSelector,
-                                                       sim.lampSelector, replayed.lampSelector);
+    for (const auto* kind : recordings::deviceKinds()) {
+        const std::string& from = c.of(*kind);
+        Sources* src = from == "none"              ? nullptr
+                       : DeviceChoice::isSim(from) ? &sim
+                       : from == "replay"          ? &replayed
+                                                   : &live;
+        if (src != nullptr) {
+            out.set(*kind, src->take(*kind));
+        }
+    }
     // Say which devices do not come from the booth, so nobody mistakes a simulated one for it.
     if (c.anyLive()) {
-        for (const auto& [name, kind] :
-             {std::pair<const char*, const std::string&>{"spectrometer", c.spectrometer},
-              {"tracker", c.tracker},
-              {"accel", c.accel}}) {
+        for (const auto* device : recordings::deviceKinds()) {
+            const std::string& name = device->name();
+            const std::string& kind = c.of(*device);
+            if (device->names().optional) {
+                continue; // said only for the sensors every run has
+            }
             if (kind == "sim" || kind == "replay") {
                 log->warn("{} is {}: {}; the display follows it, not the booth's {}", name,
                           kind == "sim" ? "simulated" : "replayed",
@@ -549,13 +570,15 @@ int runMain(const RunOptions& given)
         log->warn("injecting faults into the sensor samples: {}", o.faults);
     }
     log->info("{}; data {}", versionString(), dataDir().string());
-    log->info("hal: spectrometer={} [{} {}], tracker={} [{} {}], accel={} [{} {}]; output={}; "
-              "renderer={} on {}; {}x{} at {} Hz; display {}",
-              hal::toString(sources->spectrometer->info().kind),
-              sources->spectrometer->info().model, sources->spectrometer->info().serial,
-              hal::toString(sources->tracker->info().kind), sources->tracker->info().model,
-              sources->tracker->info().serial, hal::toString(sources->accel->info().kind),
-              sources->accel->info().model, sources->accel->info().serial,
+    std::string devices;
+    for (const auto& e : sources->entries()) {
+        if (e.source) {
+            const auto& info = e.source->info();
+            devices += fmt::format("{}{}={} [{} {}]", devices.empty() ? "" : ", ", e.kind->name(),
+                                   hal::toString(info.kind), info.model, info.serial);
+        }
+    }
+    log->info("hal: {}; output={}; renderer={} on {}; {}x{} at {} Hz; display {}", devices,
               (*appliance)->output->name(), (*appliance)->renderer->description(),
               (*appliance)->output->glRenderer(), (*appliance)->config.width,
               (*appliance)->config.height, config.rateHz, (*appliance)->displayProfileId);
@@ -595,11 +618,10 @@ int runMain(const RunOptions& given)
         session.wallClockStartNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
                                            std::chrono::system_clock::now().time_since_epoch())
                                            .count();
-        session.spectrometer = sources->spectrometer->info();
-        session.tracker = sources->tracker->info();
-        session.accel = sources->accel->info();
-        if (sources->lampSelector) {
-            session.lampSelector = sources->lampSelector->info();
+        for (const auto& e : sources->entries()) {
+            if (e.source) {
+                session.devices[e.kind->name()] = e.source->info();
+            }
         }
         recordings::WriterOptions options;
         options.flushInterval = std::chrono::milliseconds(o.recordFlushMs);
@@ -757,17 +779,22 @@ int runMain(const RunOptions& given)
             fmt::print("snapshot: {}\n", o.snapshot);
         }
     }
-    if (sources->lampSelector) {
+    if (const auto* selector = sources->get(recordings::lampSelectorKind())) {
         log->info("lamp selector {} [{} {}]: overruled by the spectrometer {} times",
-                  hal::toString(sources->lampSelector->info().kind),
-                  sources->lampSelector->info().model, sources->lampSelector->info().serial,
-                  (*appliance)->updater->lampArbiter().overruled());
+                  hal::toString(selector->info().kind), selector->info().model,
+                  selector->info().serial, (*appliance)->updater->lampArbiter().overruled());
     }
-    log->info("{} frames; dropped samples: spectrometer {}, tracker {}, accel {}, lamp selector "
-              "{}; late frames {}, skipped ticks {}; out of gamut: mean {:.4f}, max {:.4f} of the "
-              "surface's pixels (above the panel's peak: mean {:.4f}, max {:.4f})",
-              stats->frames, stats->droppedSpectra, stats->droppedPoses, stats->droppedAccel,
-              stats->droppedLamp, stats->lateFrames, stats->skippedTicks,
+    std::string dropped;
+    for (const auto& e : sources->entries()) {
+        if (e.source) {
+            dropped += fmt::format("{}{} {}", dropped.empty() ? "" : ", ",
+                                   e.kind->names().displayName, stats->dropped[e.kind->name()]);
+        }
+    }
+    log->info("{} frames; dropped samples: {}; late frames {}, skipped ticks {}; out of gamut: "
+              "mean {:.4f}, max {:.4f} of the surface's pixels (above the panel's peak: mean "
+              "{:.4f}, max {:.4f})",
+              stats->frames, dropped, stats->lateFrames, stats->skippedTicks,
               stats->meanOutOfGamutFraction(), stats->maxOutOfGamutFraction,
               stats->meanOverPeakFraction(), stats->maxOverPeakFraction);
     const FrameTimes& t = stats->frameTimes;
@@ -786,10 +813,11 @@ int runMain(const RunOptions& given)
                                   "hashed, which a run without it does not do)");
     summary["exit_code"] = code;
     summary["late_frames"] = stats->lateFrames;
-    summary["dropped"] = {{"spectrometer", stats->droppedSpectra},
-                          {"tracker", stats->droppedPoses},
-                          {"accel", stats->droppedAccel},
-                          {"lamp_selector", stats->droppedLamp}};
+    summary["dropped"] = nlohmann::json::object();
+    for (const auto* kind : recordings::deviceKinds()) {
+        const auto it = stats->dropped.find(kind->name());
+        summary["dropped"][kind->name()] = it != stats->dropped.end() ? it->second : 0;
+    }
     summary["frame_time_ms"] = {{"mean", t.meanMs()},
                                 {"p50", t.percentileMs(0.50)},
                                 {"p95", t.percentileMs(0.95)},

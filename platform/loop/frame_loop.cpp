@@ -9,46 +9,10 @@
 
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
-#include <platform/loop/sample_latch.h>
+#include <recordings/device_kind.h>
 
 namespace replica::platform {
 namespace {
-
-template <typename Sample>
-const Sample* choose(const SampleLatch<Sample>& latch,
-                     const std::optional<std::uint32_t>& wanted,
-                     bool replaying,
-                     std::uint64_t& mismatches)
-{
-    if (!replaying) {
-        return latch.latest();
-    }
-    if (!wanted) {
-        return nullptr; // the original frame had no sample of this device yet
-    }
-    if (const Sample* s = latch.find(*wanted)) {
-        return s;
-    }
-    ++mismatches;
-    return latch.latest();
-}
-
-template <typename Sample>
-void recordAll(recordings::RecordingWriter* recorder, const std::vector<Sample>& fresh)
-{
-    if (recorder == nullptr) {
-        return;
-    }
-    for (const auto& s : fresh) {
-        recorder->write(s);
-    }
-}
-
-template <typename Sample>
-std::optional<std::uint32_t> sequenceOf(const Sample* s)
-{
-    return s != nullptr ? std::optional<std::uint32_t>(s->sequence) : std::nullopt;
-}
 
 volatile std::sig_atomic_t gStop = 0;
 
@@ -161,14 +125,29 @@ Expected<LoopStats> runFrames(Appliance& appliance,
 {
     auto log = logger("loop");
     LoopStats stats;
-    SampleLatch<hal::SpectrumSample> spectra;
-    SampleLatch<hal::PoseSample> poses;
-    SampleLatch<hal::AccelSample> accels;
-    SampleLatch<hal::LampSample> selector;
-    std::vector<hal::SpectrumSample> freshSpectra;
-    std::vector<hal::PoseSample> freshPoses;
-    std::vector<hal::AccelSample> freshAccel;
-    std::vector<hal::LampSample> freshLamp;
+    // One slot per device the run has, in the order they are polled and recorded; each polls its
+    // source through the recording decorator (RecordingSource), which writes what it polls to
+    // the current recorder ('recorder' changes when the recording rotates).
+    recordings::DeviceSink* tee = recorder;
+    std::vector<std::unique_ptr<recordings::DeviceSlot>> slots;
+    for (auto& e : sources.entries()) {
+        if (e.source) {
+            slots.push_back(e.kind->makeSlot(*e.source, &tee));
+            stats.dropped[e.kind->name()] = 0;
+        }
+    }
+    const auto slotOf = [&slots](const recordings::DeviceKindBase& kind) {
+        for (const auto& s : slots) {
+            if (&s->kind() == &kind) {
+                return static_cast<const recordings::DeviceSlot*>(s.get());
+            }
+        }
+        return static_cast<const recordings::DeviceSlot*>(nullptr);
+    };
+    const auto* spectrometer = slotOf(recordings::spectrometerKind());
+    const auto* tracker = slotOf(recordings::trackerKind());
+    const auto* accel = slotOf(recordings::accelKind());
+    const auto* lampSelector = slotOf(recordings::lampSelectorKind());
     pipeline::scene::SceneState state;
     pipeline::render::RenderedFrame image;
     bool stepping = pacing == Pacing::Step;
@@ -234,56 +213,27 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         }
 
         const auto workStart = std::chrono::steady_clock::now();
-        freshSpectra.clear();
-        freshPoses.clear();
-        freshAccel.clear();
-        freshLamp.clear();
-        sources.spectrometer->poll(tick.tickNs, freshSpectra);
-        sources.tracker->poll(tick.tickNs, freshPoses);
-        sources.accel->poll(tick.tickNs, freshAccel);
-        if (sources.lampSelector) {
-            sources.lampSelector->poll(tick.tickNs, freshLamp);
-        }
-        recordAll(recorder, freshSpectra);
-        recordAll(recorder, freshPoses);
-        recordAll(recorder, freshAccel);
-        recordAll(recorder, freshLamp);
-        if (auto d = spectra.push(freshSpectra); d > 0) {
-            stats.droppedSpectra += d;
-            log->warn("spectrometer {}: {} spectra dropped before t={} ns",
-                      sources.spectrometer->info().serial, d, tick.tickNs);
-        }
-        if (auto d = poses.push(freshPoses); d > 0) {
-            stats.droppedPoses += d;
-            log->warn("tracker {}: {} poses dropped before t={} ns", sources.tracker->info().serial,
-                      d, tick.tickNs);
-        }
-        if (auto d = accels.push(freshAccel); d > 0) {
-            stats.droppedAccel += d;
-            log->warn("accelerometer {}: {} samples dropped before t={} ns",
-                      sources.accel->info().serial, d, tick.tickNs);
-        }
-        if (auto d = selector.push(freshLamp); d > 0) {
-            stats.droppedLamp += d;
-            log->warn("lamp selector {}: {} samples dropped before t={} ns",
-                      sources.lampSelector->info().serial, d, tick.tickNs);
-        }
-
         const bool replaying = tick.recorded.has_value();
-        const auto& rec = tick.recorded;
-        const hal::SpectrumSample* s =
-                choose(spectra, replaying ? rec->spectrumSequence : std::nullopt, replaying,
-                       stats.replayMismatches);
-        const hal::PoseSample* p = choose(poses, replaying ? rec->poseSequence : std::nullopt,
-                                          replaying, stats.replayMismatches);
-        const hal::AccelSample* a = choose(accels, replaying ? rec->accelSequence : std::nullopt,
-                                           replaying, stats.replayMismatches);
-        const hal::LampSample* l = choose(selector, replaying ? rec->lampSequence : std::nullopt,
-                                          replaying, stats.replayMismatches);
+        for (auto& slot : slots) {
+            const auto& kind = slot->kind();
+            if (auto d = slot->poll(tick.tickNs); d > 0) {
+                stats.dropped[kind.name()] += d;
+                log->warn("{} {}: {} {} dropped before t={} ns", kind.names().displayName,
+                          slot->source().info().serial, d, kind.names().samplesNoun, tick.tickNs);
+            }
+        }
+        for (auto& slot : slots) {
+            slot->choose(replaying ? tick.recorded->sequence(slot->kind()) : std::nullopt,
+                         replaying, stats.replayMismatches);
+        }
 
         state.frameIndex = tick.frameIndex;
         state.tickNs = tick.tickNs;
-        appliance.updater->update(state, s, p, a, l);
+        appliance.updater->update(state,
+                                  recordings::chosenSample<hal::SpectrumSample>(spectrometer),
+                                  recordings::chosenSample<hal::PoseSample>(tracker),
+                                  recordings::chosenSample<hal::AccelSample>(accel),
+                                  recordings::chosenSample<hal::LampSample>(lampSelector));
         if (auto ok = appliance.renderer->render(state, image, readback); !ok) {
             return tl::unexpected(ok.error());
         }
@@ -307,8 +257,10 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             log->warn("output {}: {}", appliance.output->name(), ok.error().message);
         }
 
-        recordings::FrameRecord record{tick.frameIndex, tick.tickNs,   sequenceOf(s),
-                                       sequenceOf(p),   sequenceOf(a), sequenceOf(l)};
+        recordings::FrameRecord record{tick.frameIndex, tick.tickNs, {}};
+        for (const auto& slot : slots) {
+            record.setSequence(slot->kind(), slot->chosenSequence());
+        }
         if (recorder != nullptr) {
             recorder->write(record);
         }
@@ -328,21 +280,13 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             auto* next = options.nextRecorder(recorder);
             if (next != recorder && next != nullptr) {
                 // The new file starts with what the scene holds now.
-                if (const auto* x = spectra.latest()) {
-                    next->write(*x);
-                }
-                if (const auto* x = poses.latest()) {
-                    next->write(*x);
-                }
-                if (const auto* x = accels.latest()) {
-                    next->write(*x);
-                }
-                if (const auto* x = selector.latest()) {
-                    next->write(*x);
+                for (const auto& slot : slots) {
+                    slot->writeLatest(*next);
                 }
                 ++stats.recorderRotations;
             }
             recorder = next;
+            tee = recorder;
         }
     }
     if (stats.replayMismatches > 0) {

@@ -5,7 +5,9 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <pipeline/base/expected.h>
@@ -40,10 +42,8 @@ std::vector<TickPlan> replayPlan(const std::vector<recordings::FrameRecord>& fra
 
 struct LoopStats {
     std::uint64_t frames = 0;
-    std::uint64_t droppedSpectra = 0; // sequence gaps seen
-    std::uint64_t droppedPoses = 0;
-    std::uint64_t droppedAccel = 0;
-    std::uint64_t droppedLamp = 0;
+    // Device kind name -> samples lost (sequence gaps seen), for every device the run has.
+    std::map<std::string, std::uint64_t> dropped;
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
     std::uint64_t replayMismatches = 0;  // replay: a recorded sample was not found (latest used)
     std::uint64_t skippedTicks = 0;      // LoopOptions::skipLateTicks: ticks never rendered

@@ -130,8 +130,8 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
 {
     const bool lampChanged = s.lampIndex != lastLamp_;
     // In direct-sensor mode the light is each new spectrum: at most once a second.
-    const bool newSensed = s.lampIndex < 0 && frame.spectrumSequence &&
-                           frame.spectrumSequence != lastLightSpectrum_ &&
+    const bool newSensed = s.lampIndex < 0 && frame.sequence(recordings::spectrometerKind()) &&
+                           frame.sequence(recordings::spectrometerKind()) != lastLightSpectrum_ &&
                            frame.tickNs - lastLightNs_ >= 1'000'000'000;
     if (!lampChanged && !newSensed) {
         return;
@@ -157,7 +157,7 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
         l.mode = "direct-sensor";
         l.lamp = -1;
         l.name = "unknown";
-        l.why = !frame.spectrumSequence
+        l.why = !frame.sequence(recordings::spectrometerKind())
                         ? std::string("no spectrum yet: the starting light")
                         : fmt::format("no stored lamp matches the sensed spectrum (nearest "
                                       "shape distance {:.4f}): rendering the sensed light",
@@ -173,7 +173,7 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
     writer_.write(l);
     lastLamp_ = s.lampIndex;
     lastLightNs_ = frame.tickNs;
-    lastLightSpectrum_ = frame.spectrumSequence;
+    lastLightSpectrum_ = frame.sequence(recordings::spectrometerKind());
     std::lock_guard lock(mutex_);
     ++stats_.lightChanges;
 }

@@ -109,9 +109,12 @@ std::uint64_t feed(recordings::RecordingWriter& w, int seconds, bool realTime)
             ++written;
         }
         if (t == due(nF, kFrameHz)) {
-            w.write(recordings::FrameRecord{nF, t, nS ? std::optional(nS - 1) : std::nullopt,
-                                            nT - 1, nA ? std::optional(nA - 1) : std::nullopt,
-                                            std::nullopt});
+            recordings::FrameRecord f{nF, t, {}};
+            f.setSequence(recordings::spectrometerKind(),
+                          nS ? std::optional(nS - 1) : std::nullopt);
+            f.setSequence(recordings::trackerKind(), nT - 1);
+            f.setSequence(recordings::accelKind(), nA ? std::optional(nA - 1) : std::nullopt);
+            w.write(f);
             ++nF;
             ++written;
         }
@@ -272,9 +275,9 @@ void BM_ReplaySensorsOnly(benchmark::State& st)
         std::vector<hal::PoseSample> poses;
         std::vector<hal::AccelSample> accel;
         for (const auto& f : rec->frames) {
-            sources.spectrometer->poll(f.tickNs, spectra);
-            sources.tracker->poll(f.tickNs, poses);
-            sources.accel->poll(f.tickNs, accel);
+            sources.get(recordings::spectrometerKind())->poll(f.tickNs, spectra);
+            sources.get(recordings::trackerKind())->poll(f.tickNs, poses);
+            sources.get(recordings::accelKind())->poll(f.tickNs, accel);
         }
         consumed += spectra.size() + poses.size() + accel.size();
         benchmark::DoNotOptimize(consumed);

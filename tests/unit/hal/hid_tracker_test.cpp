@@ -512,20 +512,23 @@ TEST(HidTracker, RawReportsAreRecordedAndReprocessToTheSamePoses)
     auto rec = recordings::readRecording(path);
     std::filesystem::remove(path);
     ASSERT_TRUE(rec) << rec.error().message;
-    ASSERT_EQ(rec->poses.size(), live.size());
+    ASSERT_EQ(rec->samples(recordings::trackerKind()).size(), live.size());
     EXPECT_EQ(rec->unmatchedRaw, 0u);
     for (std::size_t i = 0; i < live.size(); ++i) {
-        ASSERT_TRUE(rec->poses[i].raw) << i;
-        EXPECT_EQ(rec->poses[i].raw->bytes, live[i].raw->bytes) << i;
-        EXPECT_EQ(rec->poses[i].raw->arrivalNs, live[i].raw->arrivalNs) << i;
+        ASSERT_TRUE(rec->samples(recordings::trackerKind())[i].raw) << i;
+        EXPECT_EQ(rec->samples(recordings::trackerKind())[i].raw->bytes, live[i].raw->bytes) << i;
+        EXPECT_EQ(rec->samples(recordings::trackerKind())[i].raw->arrivalNs, live[i].raw->arrivalNs)
+                << i;
     }
-    EXPECT_EQ(*rec->poses[0].raw->hidDescriptor, kDescriptorA);
-    EXPECT_EQ(rec->poses[0].raw->hidDescriptor, rec->poses[4].raw->hidDescriptor);
-    EXPECT_NE(rec->poses[4].raw->hidDescriptor, rec->poses[5].raw->hidDescriptor);
+    EXPECT_EQ(*rec->samples(recordings::trackerKind())[0].raw->hidDescriptor, kDescriptorA);
+    EXPECT_EQ(rec->samples(recordings::trackerKind())[0].raw->hidDescriptor,
+              rec->samples(recordings::trackerKind())[4].raw->hidDescriptor);
+    EXPECT_NE(rec->samples(recordings::trackerKind())[4].raw->hidDescriptor,
+              rec->samples(recordings::trackerKind())[5].raw->hidDescriptor);
 
     // The processed values wiped: reprocessing must compute them again, bit for bit.
     auto wiped = *rec;
-    for (auto& p : wiped.poses) {
+    for (auto& p : wiped.samples(recordings::trackerKind())) {
         p.eyeTrackerM = glm::dvec3(9.0);
         p.tracked = false;
     }
@@ -535,8 +538,10 @@ TEST(HidTracker, RawReportsAreRecordedAndReprocessToTheSamePoses)
     EXPECT_EQ(rep->posesChanged, live.size());
     EXPECT_EQ(rep->poseTimesDiffer, 0u); // the anchoring re-ran as live, reanchor included
     for (std::size_t i = 0; i < live.size(); ++i) {
-        EXPECT_TRUE(sameEyeBits(wiped.poses[i].eyeTrackerM, live[i].eyeTrackerM)) << i;
-        EXPECT_TRUE(wiped.poses[i].tracked);
+        EXPECT_TRUE(sameEyeBits(wiped.samples(recordings::trackerKind())[i].eyeTrackerM,
+                                live[i].eyeTrackerM))
+                << i;
+        EXPECT_TRUE(wiped.samples(recordings::trackerKind())[i].tracked);
     }
     auto same = *rec;
     rep = platform::reprocess(same, {});
@@ -553,26 +558,29 @@ TEST(HidTracker, RawReportsAreRecordedAndReprocessToTheSamePoses)
     EXPECT_EQ(rep->posesChanged, live.size());
     for (std::size_t i = 0; i < live.size(); ++i) {
         EXPECT_NEAR(live[i].eyeTrackerM.x, 0.0005 * static_cast<double>(i % 5 + 1), 1e-12);
-        EXPECT_NEAR(mirrored.poses[i].eyeTrackerM.x, -0.0005 * static_cast<double>(i % 5 + 1),
-                    1e-12);
-        EXPECT_EQ(mirrored.poses[i].eyeTrackerM.z, live[i].eyeTrackerM.z);
+        EXPECT_NEAR(mirrored.samples(recordings::trackerKind())[i].eyeTrackerM.x,
+                    -0.0005 * static_cast<double>(i % 5 + 1), 1e-12);
+        EXPECT_EQ(mirrored.samples(recordings::trackerKind())[i].eyeTrackerM.z,
+                  live[i].eyeTrackerM.z);
     }
 
     // Raw inputs that today's code cannot process: one line naming the pose, no crash.
     auto cut = *rec;
-    auto shortRaw = std::make_shared<hal::RawTrackerInput>(*cut.poses[2].raw);
+    auto shortRaw =
+            std::make_shared<hal::RawTrackerInput>(*cut.samples(recordings::trackerKind())[2].raw);
     shortRaw->bytes.resize(20);
-    cut.poses[2].raw = shortRaw;
+    cut.samples(recordings::trackerKind())[2].raw = shortRaw;
     rep = platform::reprocess(cut, {});
     ASSERT_FALSE(rep);
     EXPECT_NE(rep.error().message.find("pose 2: a 20-byte HID report that is too short"),
               std::string::npos)
             << rep.error().message;
     auto broken = *rec;
-    auto badDescriptor = std::make_shared<hal::RawTrackerInput>(*broken.poses[0].raw);
+    auto badDescriptor = std::make_shared<hal::RawTrackerInput>(
+            *broken.samples(recordings::trackerKind())[0].raw);
     badDescriptor->hidDescriptor =
             std::make_shared<const std::vector<std::uint8_t>>(std::vector<std::uint8_t>{0xC0});
-    broken.poses[0].raw = badDescriptor;
+    broken.samples(recordings::trackerKind())[0].raw = badDescriptor;
     rep = platform::reprocess(broken, {});
     ASSERT_FALSE(rep);
     EXPECT_NE(rep.error().message.find("pose 0: the recorded HID report descriptor"),

@@ -422,10 +422,10 @@ TEST(SessionFolder, ACrashedSessionIsRecoveredInPlace)
     EXPECT_TRUE(recordingFinished(dir / "crashed.mcap"));
     auto rec = recordings::readRecording(dir / "crashed.mcap");
     ASSERT_TRUE(rec) << rec.error().message;
-    EXPECT_GT(rec->poses.size(), 0u);
-    EXPECT_LE(rec->poses.size(), 3000u);
+    EXPECT_GT(rec->samples(recordings::trackerKind()).size(), 0u);
+    EXPECT_LE(rec->samples(recordings::trackerKind()).size(), 3000u);
     // Each kept pose is the one written with its sequence number.
-    for (const auto& p : rec->poses) {
+    for (const auto& p : rec->samples(recordings::trackerKind())) {
         EXPECT_EQ(p.eyeTrackerM.x, 0.001 * p.sequence);
     }
     // Nothing left to do at the next start.

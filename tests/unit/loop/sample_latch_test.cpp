@@ -1,6 +1,6 @@
 // The loop's latest-sample semantics: newest wins, held until replaced, gaps counted, history kept.
+#include <hal/sample_latch.h>
 #include <hal/samples.h>
-#include <platform/loop/sample_latch.h>
 
 #include <gtest/gtest.h>
 
@@ -18,7 +18,7 @@ hal::AccelSample sample(std::uint32_t seq, std::int64_t t)
 
 TEST(SampleLatch, EmptyUntilFirstSample)
 {
-    SampleLatch<hal::AccelSample> latch;
+    hal::SampleLatch<hal::AccelSample> latch;
     EXPECT_EQ(latch.latest(), nullptr);
     EXPECT_EQ(latch.push({}), 0u);
     EXPECT_EQ(latch.latest(), nullptr);
@@ -26,7 +26,7 @@ TEST(SampleLatch, EmptyUntilFirstSample)
 
 TEST(SampleLatch, LatestOfABatchWinsAndIsHeld)
 {
-    SampleLatch<hal::AccelSample> latch;
+    hal::SampleLatch<hal::AccelSample> latch;
     latch.push({sample(0, 10), sample(1, 20), sample(2, 30)});
     ASSERT_NE(latch.latest(), nullptr);
     EXPECT_EQ(latch.latest()->sequence, 2u);
@@ -38,7 +38,7 @@ TEST(SampleLatch, LatestOfABatchWinsAndIsHeld)
 
 TEST(SampleLatch, CountsSequenceGapsAsDrops)
 {
-    SampleLatch<hal::AccelSample> latch;
+    hal::SampleLatch<hal::AccelSample> latch;
     EXPECT_EQ(latch.push({sample(0, 0), sample(1, 1)}), 0u);
     EXPECT_EQ(latch.push({sample(5, 5)}), 3u); // 2, 3, 4 lost
     EXPECT_EQ(latch.push({sample(6, 6), sample(9, 9)}), 2u);
@@ -46,7 +46,7 @@ TEST(SampleLatch, CountsSequenceGapsAsDrops)
 
 TEST(SampleLatch, FindsRetainedSamplesBySequenceOnly)
 {
-    SampleLatch<hal::AccelSample> latch(4);
+    hal::SampleLatch<hal::AccelSample> latch(4);
     for (std::uint32_t i = 0; i < 10; ++i) {
         latch.push({sample(i, i)});
     }

@@ -123,16 +123,16 @@ TEST(CrashSafety, SigkillAtRandomMomentsLosesAtMostTheFlushInterval)
         ASSERT_TRUE(report) << report.error().message;
         auto rec = readRecording(out);
         ASSERT_TRUE(rec) << rec.error().message;
-        ASSERT_FALSE(rec->poses.empty());
+        ASSERT_FALSE(rec->samples(recordings::trackerKind()).empty());
         // Nothing in the middle is missing: the recovered samples are a gap-free prefix...
-        for (std::size_t i = 0; i < rec->poses.size(); ++i) {
-            ASSERT_EQ(rec->poses[i].sequence, i);
+        for (std::size_t i = 0; i < rec->samples(recordings::trackerKind()).size(); ++i) {
+            ASSERT_EQ(rec->samples(recordings::trackerKind())[i].sequence, i);
         }
-        for (std::size_t i = 0; i < rec->accel.size(); ++i) {
-            ASSERT_EQ(rec->accel[i].sequence, i);
+        for (std::size_t i = 0; i < rec->samples(recordings::accelKind()).size(); ++i) {
+            ASSERT_EQ(rec->samples(recordings::accelKind())[i].sequence, i);
         }
         // ...that reaches to within the flush interval (plus scheduling slack) of the kill.
-        const auto newest = rec->poses.back().timestampNs;
+        const auto newest = rec->samples(recordings::trackerKind()).back().timestampNs;
         EXPECT_GE(newest, c.killedAt - kFlush.count() * 1'000'000 - kSlackNs)
                 << "the last " << (c.killedAt - newest) / 1'000'000 << " ms before the kill "
                 << "were lost";
@@ -191,10 +191,11 @@ TEST(CrashSafety, DiskFullGivesOneErrorKeepsRunningAndKeepsWhatWasWritten)
     ASSERT_TRUE(report) << report.error().message;
     auto rec = readRecording(out);
     ASSERT_TRUE(rec) << rec.error().message;
-    ASSERT_FALSE(rec->spectra.empty());
-    for (std::size_t i = 0; i < rec->spectra.size(); ++i) {
-        ASSERT_EQ(rec->spectra[i].sequence, i);
-        ASSERT_EQ(rec->spectra[i].counts, noisyCounts(static_cast<std::uint32_t>(i)));
+    ASSERT_FALSE(rec->samples(recordings::spectrometerKind()).empty());
+    for (std::size_t i = 0; i < rec->samples(recordings::spectrometerKind()).size(); ++i) {
+        ASSERT_EQ(rec->samples(recordings::spectrometerKind())[i].sequence, i);
+        ASSERT_EQ(rec->samples(recordings::spectrometerKind())[i].counts,
+                  noisyCounts(static_cast<std::uint32_t>(i)));
     }
     std::filesystem::remove(path);
     std::filesystem::remove(out);

@@ -72,7 +72,8 @@ const Sample& sample()
                 (*w)->write(sp);
             }
             if (i % 2 == 0) {
-                (*w)->write(FrameRecord{i / 2, t, std::nullopt, i, i, std::nullopt});
+                (*w)->write(FrameRecord{
+                        i / 2, t, {{trackerKind().name(), i}, {accelKind().name(), i}}});
             }
         }
         EXPECT_TRUE((*w)->close());
@@ -119,13 +120,19 @@ std::size_t recoverAndCheck(std::string_view bytes, const std::string& label, bo
         auto rec = readRecording(out);
         EXPECT_TRUE(rec) << label << ": recovered file does not read: " << rec.error().message;
         if (rec) {
-            expectKept(rec->poses, sample().original.poses, prefix, "poses");
-            expectKept(rec->accel, sample().original.accel, prefix, "accel");
-            expectKept(rec->spectra, sample().original.spectra, prefix, "spectra");
-            for (const auto& p : rec->poses) {
-                EXPECT_EQ(p.eyeTrackerM, sample().original.poses[p.sequence].eyeTrackerM);
+            expectKept(rec->samples(recordings::trackerKind()),
+                       sample().original.samples(recordings::trackerKind()), prefix, "poses");
+            expectKept(rec->samples(recordings::accelKind()),
+                       sample().original.samples(recordings::accelKind()), prefix, "accel");
+            expectKept(rec->samples(recordings::spectrometerKind()),
+                       sample().original.samples(recordings::spectrometerKind()), prefix,
+                       "spectra");
+            for (const auto& p : rec->samples(recordings::trackerKind())) {
+                EXPECT_EQ(p.eyeTrackerM,
+                          sample().original.samples(recordings::trackerKind())[p.sequence]
+                                  .eyeTrackerM);
             }
-            kept = rec->poses.size();
+            kept = rec->samples(recordings::trackerKind()).size();
         }
     }
     std::filesystem::remove(in);
@@ -136,7 +143,7 @@ std::size_t recoverAndCheck(std::string_view bytes, const std::string& label, bo
 TEST(RecordingDamage, SampleHasManyChunks)
 {
     ASSERT_GE(sample().chunks.size(), 10u);
-    EXPECT_EQ(sample().original.poses.size(), 240u);
+    EXPECT_EQ(sample().original.samples(recordings::trackerKind()).size(), 240u);
 }
 
 TEST(RecordingDamage, TruncationAtEveryChunkBoundaryKeepsEveryEarlierChunk)
@@ -204,7 +211,7 @@ TEST(RecordingDamage, FlipThatMakesAMessageIndexAMessageIsNotRecoveredAsAFrame)
         const auto scan = mcap::scan(damaged);
         EXPECT_FALSE(scan.damage.empty()); // the data section's CRC
         EXPECT_EQ(recoverAndCheck(damaged, "index made a message", true),
-                  sample().original.poses.size());
+                  sample().original.samples(recordings::trackerKind()).size());
         ++flips;
     }
     EXPECT_GE(flips, 3u) << "the sample has too few message indexes to test";

@@ -117,35 +117,40 @@ TEST(RawInputs, DatagramsAndSysfsReadingsComeBackAndReprocessBitExactly)
     }
     EXPECT_EQ(counts["/replica/raw/tracker"], 5u);
     EXPECT_EQ(counts["/replica/raw/accel"], 4u);
-    ASSERT_EQ(rec->poses.size(), poses.size());
-    ASSERT_EQ(rec->accel.size(), accel.size());
+    ASSERT_EQ(rec->samples(recordings::trackerKind()).size(), poses.size());
+    ASSERT_EQ(rec->samples(recordings::accelKind()).size(), accel.size());
     for (std::size_t i = 0; i < poses.size(); ++i) {
-        ASSERT_EQ(rec->poses[i].raw != nullptr, poses[i].raw != nullptr) << i;
+        ASSERT_EQ(rec->samples(recordings::trackerKind())[i].raw != nullptr,
+                  poses[i].raw != nullptr)
+                << i;
         if (poses[i].raw) {
-            EXPECT_EQ(rec->poses[i].raw->bytes, poses[i].raw->bytes);
-            EXPECT_EQ(rec->poses[i].raw->arrivalNs, poses[i].raw->arrivalNs);
-            EXPECT_TRUE(bitsEqual(rec->poses[i].raw->eyeOffsetHeadM, mounting.eyeOffsetHeadM));
+            EXPECT_EQ(rec->samples(recordings::trackerKind())[i].raw->bytes, poses[i].raw->bytes);
+            EXPECT_EQ(rec->samples(recordings::trackerKind())[i].raw->arrivalNs,
+                      poses[i].raw->arrivalNs);
+            EXPECT_TRUE(bitsEqual(rec->samples(recordings::trackerKind())[i].raw->eyeOffsetHeadM,
+                                  mounting.eyeOffsetHeadM));
         }
     }
     for (std::size_t i = 0; i < accel.size(); ++i) {
-        ASSERT_EQ(rec->accel[i].raw != nullptr, accel[i].raw != nullptr) << i;
+        ASSERT_EQ(rec->samples(recordings::accelKind())[i].raw != nullptr, accel[i].raw != nullptr)
+                << i;
         if (accel[i].raw) {
-            EXPECT_EQ(rec->accel[i].raw->raw, accel[i].raw->raw);
-            EXPECT_EQ(rec->accel[i].raw->scale, accel[i].raw->scale);
-            EXPECT_EQ(rec->accel[i].raw->offset, accel[i].raw->offset);
-            EXPECT_EQ(rec->accel[i].raw->axes, "-y,x,z");
+            EXPECT_EQ(rec->samples(recordings::accelKind())[i].raw->raw, accel[i].raw->raw);
+            EXPECT_EQ(rec->samples(recordings::accelKind())[i].raw->scale, accel[i].raw->scale);
+            EXPECT_EQ(rec->samples(recordings::accelKind())[i].raw->offset, accel[i].raw->offset);
+            EXPECT_EQ(rec->samples(recordings::accelKind())[i].raw->axes, "-y,x,z");
         }
     }
 
     // Processed values wiped: reprocessing computes them again, bit for bit; the samples without
     // raw input stay as recorded.
     auto wiped = *rec;
-    for (auto& p : wiped.poses) {
+    for (auto& p : wiped.samples(recordings::trackerKind())) {
         if (p.raw) {
             p.eyeTrackerM = glm::dvec3(7.0);
         }
     }
-    for (auto& a : wiped.accel) {
+    for (auto& a : wiped.samples(recordings::accelKind())) {
         if (a.raw) {
             a.gravity = glm::dvec3(7.0);
         }
@@ -156,11 +161,14 @@ TEST(RawInputs, DatagramsAndSysfsReadingsComeBackAndReprocessBitExactly)
     EXPECT_EQ(r->posesReprocessed, 5u);
     EXPECT_EQ(r->accelReprocessed, 4u);
     for (std::size_t i = 0; i < poses.size(); ++i) {
-        EXPECT_TRUE(bitsEqual(wiped.poses[i].eyeTrackerM, poses[i].eyeTrackerM)) << i;
-        EXPECT_EQ(wiped.poses[i].tracked, poses[i].tracked) << i;
+        EXPECT_TRUE(bitsEqual(wiped.samples(recordings::trackerKind())[i].eyeTrackerM,
+                              poses[i].eyeTrackerM))
+                << i;
+        EXPECT_EQ(wiped.samples(recordings::trackerKind())[i].tracked, poses[i].tracked) << i;
     }
     for (std::size_t i = 0; i < accel.size(); ++i) {
-        EXPECT_TRUE(bitsEqual(wiped.accel[i].gravity, accel[i].gravity)) << i;
+        EXPECT_TRUE(bitsEqual(wiped.samples(recordings::accelKind())[i].gravity, accel[i].gravity))
+                << i;
     }
     auto same = *rec;
     r = platform::reprocess(same, {});
@@ -176,16 +184,21 @@ TEST(RawInputs, DatagramsAndSysfsReadingsComeBackAndReprocessBitExactly)
     ASSERT_TRUE(r);
     EXPECT_EQ(r->accelChanged, 4u);
     EXPECT_EQ(r->posesChanged, 0u);
-    EXPECT_DOUBLE_EQ(straight.accel[0].gravity.x, -(-12.0 + 0.0) * 0.00980665);
-    EXPECT_DOUBLE_EQ(straight.accel[0].gravity.y, -(1000.0 + 3.0) * 0.00980665);
-    EXPECT_DOUBLE_EQ(straight.accel[0].gravity.z, -(40.0 - 0.5) * 0.0095);
-    EXPECT_EQ(straight.accel[2].gravity, accel[2].gravity); // no raw input: as recorded
+    EXPECT_DOUBLE_EQ(straight.samples(recordings::accelKind())[0].gravity.x,
+                     -(-12.0 + 0.0) * 0.00980665);
+    EXPECT_DOUBLE_EQ(straight.samples(recordings::accelKind())[0].gravity.y,
+                     -(1000.0 + 3.0) * 0.00980665);
+    EXPECT_DOUBLE_EQ(straight.samples(recordings::accelKind())[0].gravity.z,
+                     -(40.0 - 0.5) * 0.0095);
+    EXPECT_EQ(straight.samples(recordings::accelKind())[2].gravity,
+              accel[2].gravity); // no raw input: as recorded
 
     // A datagram that is not a pose: one line naming the pose.
     auto bad = *rec;
-    auto cut = std::make_shared<hal::RawTrackerInput>(*bad.poses[1].raw);
+    auto cut =
+            std::make_shared<hal::RawTrackerInput>(*bad.samples(recordings::trackerKind())[1].raw);
     cut->bytes.resize(40);
-    bad.poses[1].raw = cut;
+    bad.samples(recordings::trackerKind())[1].raw = cut;
     r = platform::reprocess(bad, {});
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().message, "raw input of pose 1: a 40-byte datagram that is not an "
@@ -218,7 +231,7 @@ TEST(RawInputs, LampSelectorPositionsAreDecodedAgainFromTheirLineLevels)
         l.lineLevels = c.levels;
         l.lineCount = c.lines;
         l.lamp = c.recorded;
-        rec.lampSelector.push_back(l);
+        rec.samples(recordings::lampSelectorKind()).push_back(l);
     }
     auto r = platform::reprocess(rec, {});
     ASSERT_TRUE(r) << r.error().message;
@@ -226,7 +239,7 @@ TEST(RawInputs, LampSelectorPositionsAreDecodedAgainFromTheirLineLevels)
     EXPECT_EQ(r->lampReprocessed, 5u);
     EXPECT_EQ(r->lampChanged, 3u);
     for (std::size_t i = 0; i < std::size(cases); ++i) {
-        EXPECT_EQ(rec.lampSelector[i].lamp, cases[i].want) << i;
+        EXPECT_EQ(rec.samples(recordings::lampSelectorKind())[i].lamp, cases[i].want) << i;
     }
 }
 

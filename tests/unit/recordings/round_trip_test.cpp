@@ -31,11 +31,11 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     session.scene = "scene";
     session.displayProfile = "display";
     session.wallClockStartNs = 1'700'000'000'123'456'789;
-    session.spectrometer = {"USB2000+", "S1", "fw", hal::SourceKind::Live};
-    session.tracker = {"TrackIR", "T1", "", hal::SourceKind::Sim};
-    session.accel = {"accel", "A1", "", hal::SourceKind::Replay};
-    session.lampSelector = {"lamp selector (GPIO)", "gpiochip0:17,27,22", "",
-                            hal::SourceKind::Live};
+    session.devices["spectrometer"] = {"USB2000+", "S1", "fw", hal::SourceKind::Live};
+    session.devices["tracker"] = {"TrackIR", "T1", "", hal::SourceKind::Sim};
+    session.devices["accel"] = {"accel", "A1", "", hal::SourceKind::Replay};
+    session.devices["lamp_selector"] = {"lamp selector (GPIO)", "gpiochip0:17,27,22", "",
+                                        hal::SourceKind::Live};
 
     hal::SpectrumSample s;
     s.timestampNs = 100'000'000;
@@ -64,7 +64,11 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     invalid.sequence = 5;
     invalid.lamp = hal::kLampInvalid;
     invalid.lineLevels = 0b101;
-    FrameRecord f{3, 50'000'001, 7, std::nullopt, 2, 4};
+    FrameRecord f{3,
+                  50'000'001,
+                  {{spectrometerKind().name(), 7},
+                   {accelKind().name(), 2},
+                   {lampSelectorKind().name(), 4}}};
     {
         auto w = RecordingWriter::create(path, session);
         ASSERT_TRUE(w) << w.error().message;
@@ -81,40 +85,44 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     EXPECT_EQ(r->formatVersion, kFormatVersion);
     EXPECT_EQ(r->session.configJson, session.configJson);
     EXPECT_EQ(r->session.wallClockStartNs, session.wallClockStartNs);
-    EXPECT_EQ(r->session.spectrometer.serial, "S1");
-    EXPECT_EQ(r->session.accel.kind, hal::SourceKind::Replay);
-    ASSERT_EQ(r->spectra.size(), 1u);
-    EXPECT_EQ(r->spectra[0].counts, s.counts);
-    EXPECT_EQ(r->spectra[0].sequence, 7u);
-    EXPECT_TRUE(r->spectra[0].saturated);
+    EXPECT_EQ(r->session.device(recordings::spectrometerKind()).serial, "S1");
+    EXPECT_EQ(r->session.device(recordings::accelKind()).kind, hal::SourceKind::Replay);
+    ASSERT_EQ(r->samples(recordings::spectrometerKind()).size(), 1u);
+    EXPECT_EQ(r->samples(recordings::spectrometerKind())[0].counts, s.counts);
+    EXPECT_EQ(r->samples(recordings::spectrometerKind())[0].sequence, 7u);
+    EXPECT_TRUE(r->samples(recordings::spectrometerKind())[0].saturated);
     for (std::size_t i = 0; i < 4; ++i) {
-        EXPECT_EQ(std::bit_cast<std::uint64_t>(r->spectra[0].wavelengthCoeffs[i]),
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(
+                          r->samples(recordings::spectrometerKind())[0].wavelengthCoeffs[i]),
                   std::bit_cast<std::uint64_t>(s.wavelengthCoeffs[i]));
     }
     for (std::size_t i = 0; i < 8; ++i) {
-        EXPECT_EQ(std::bit_cast<std::uint64_t>(r->spectra[0].nonlinearityCoeffs[i]),
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(
+                          r->samples(recordings::spectrometerKind())[0].nonlinearityCoeffs[i]),
                   std::bit_cast<std::uint64_t>(s.nonlinearityCoeffs[i]));
     }
-    ASSERT_EQ(r->poses.size(), 1u);
-    EXPECT_EQ(r->poses[0].eyeTrackerM, p.eyeTrackerM);
-    ASSERT_EQ(r->accel.size(), 1u);
-    EXPECT_EQ(r->accel[0].gravity, a.gravity);
+    ASSERT_EQ(r->samples(recordings::trackerKind()).size(), 1u);
+    EXPECT_EQ(r->samples(recordings::trackerKind())[0].eyeTrackerM, p.eyeTrackerM);
+    ASSERT_EQ(r->samples(recordings::accelKind()).size(), 1u);
+    EXPECT_EQ(r->samples(recordings::accelKind())[0].gravity, a.gravity);
     ASSERT_EQ(r->frames.size(), 1u);
     EXPECT_EQ(r->frames[0].tickNs, f.tickNs);
-    EXPECT_EQ(r->frames[0].spectrumSequence, f.spectrumSequence);
-    EXPECT_FALSE(r->frames[0].poseSequence.has_value());
-    EXPECT_EQ(r->frames[0].accelSequence, f.accelSequence);
-    EXPECT_EQ(r->frames[0].lampSequence, f.lampSequence);
-    EXPECT_EQ(r->session.lampSelector.serial, "gpiochip0:17,27,22");
-    EXPECT_EQ(r->session.lampSelector.kind, hal::SourceKind::Live);
-    ASSERT_EQ(r->lampSelector.size(), 2u);
+    EXPECT_EQ(r->frames[0].sequence(recordings::spectrometerKind()),
+              f.sequence(recordings::spectrometerKind()));
+    EXPECT_FALSE(r->frames[0].sequence(recordings::trackerKind()).has_value());
+    EXPECT_EQ(r->frames[0].sequence(recordings::accelKind()), f.sequence(recordings::accelKind()));
+    EXPECT_EQ(r->frames[0].sequence(recordings::lampSelectorKind()),
+              f.sequence(recordings::lampSelectorKind()));
+    EXPECT_EQ(r->session.device(recordings::lampSelectorKind()).serial, "gpiochip0:17,27,22");
+    EXPECT_EQ(r->session.device(recordings::lampSelectorKind()).kind, hal::SourceKind::Live);
+    ASSERT_EQ(r->samples(recordings::lampSelectorKind()).size(), 2u);
     for (std::size_t i = 0; i < 2; ++i) {
         const auto& want = i == 0 ? l : invalid;
-        EXPECT_EQ(r->lampSelector[i].timestampNs, want.timestampNs);
-        EXPECT_EQ(r->lampSelector[i].sequence, want.sequence);
-        EXPECT_EQ(r->lampSelector[i].lamp, want.lamp);
-        EXPECT_EQ(r->lampSelector[i].lineLevels, want.lineLevels);
-        EXPECT_EQ(r->lampSelector[i].lineCount, want.lineCount);
+        EXPECT_EQ(r->samples(recordings::lampSelectorKind())[i].timestampNs, want.timestampNs);
+        EXPECT_EQ(r->samples(recordings::lampSelectorKind())[i].sequence, want.sequence);
+        EXPECT_EQ(r->samples(recordings::lampSelectorKind())[i].lamp, want.lamp);
+        EXPECT_EQ(r->samples(recordings::lampSelectorKind())[i].lineLevels, want.lineLevels);
+        EXPECT_EQ(r->samples(recordings::lampSelectorKind())[i].lineCount, want.lineCount);
     }
     std::filesystem::remove(path);
 }
@@ -209,9 +217,9 @@ TEST(RecordingRoundTrip, NonFiniteValuesAreRefusedAndCounted)
     }
     auto r = readRecording(path);
     ASSERT_TRUE(r) << r.error().message;
-    ASSERT_EQ(r->accel.size(), 1u);
-    EXPECT_EQ(r->accel[0].sequence, 2u);
-    EXPECT_TRUE(r->poses.empty());
+    ASSERT_EQ(r->samples(recordings::accelKind()).size(), 1u);
+    EXPECT_EQ(r->samples(recordings::accelKind())[0].sequence, 2u);
+    EXPECT_TRUE(r->samples(recordings::trackerKind()).empty());
     EXPECT_EQ(r->rejectedNonFinite, 2u); // recorded on /replica/recorder, not lost silently
     EXPECT_EQ(r->droppedMessages, 0u);
     std::filesystem::remove(path);
@@ -241,7 +249,7 @@ TEST(RecordingRoundTrip, FullQueueDropsAndRecordsTheDrops)
     ASSERT_TRUE(r) << r.error().message;
     EXPECT_GT(dropped, 0u);
     EXPECT_EQ(r->droppedMessages, dropped);
-    EXPECT_EQ(r->spectra.size(), 20000u - dropped);
+    EXPECT_EQ(r->samples(recordings::spectrometerKind()).size(), 20000u - dropped);
     std::filesystem::remove(path);
 }
 
@@ -254,8 +262,8 @@ TEST(RecordingRead, FormatVersionOneSampleStillOpens)
     ASSERT_TRUE(r) << r.error().message;
     EXPECT_EQ(r->formatVersion, 1);
     EXPECT_EQ(r->frames.size(), 90u);
-    EXPECT_FALSE(r->poses.empty());
-    EXPECT_FALSE(r->spectra.empty());
+    EXPECT_FALSE(r->samples(recordings::trackerKind()).empty());
+    EXPECT_FALSE(r->samples(recordings::spectrometerKind()).empty());
 }
 
 TEST(RecordingRead, FormatVersionTwoSampleHoldsTheSameSessionAsVersionOne)
@@ -271,25 +279,36 @@ TEST(RecordingRead, FormatVersionTwoSampleHoldsTheSameSessionAsVersionOne)
     ASSERT_TRUE(v2) << v2.error().message;
     EXPECT_EQ(v2->formatVersion, 2);
     ASSERT_EQ(v2->frames.size(), v1->frames.size());
-    ASSERT_EQ(v2->poses.size(), v1->poses.size());
-    ASSERT_EQ(v2->accel.size(), v1->accel.size());
-    ASSERT_EQ(v2->spectra.size(), v1->spectra.size());
+    ASSERT_EQ(v2->samples(recordings::trackerKind()).size(),
+              v1->samples(recordings::trackerKind()).size());
+    ASSERT_EQ(v2->samples(recordings::accelKind()).size(),
+              v1->samples(recordings::accelKind()).size());
+    ASSERT_EQ(v2->samples(recordings::spectrometerKind()).size(),
+              v1->samples(recordings::spectrometerKind()).size());
     for (std::size_t i = 0; i < v1->frames.size(); ++i) {
         EXPECT_EQ(v2->frames[i].tickNs, v1->frames[i].tickNs);
-        EXPECT_EQ(v2->frames[i].poseSequence, v1->frames[i].poseSequence);
-        EXPECT_EQ(v2->frames[i].spectrumSequence, v1->frames[i].spectrumSequence);
+        EXPECT_EQ(v2->frames[i].sequence(recordings::trackerKind()),
+                  v1->frames[i].sequence(recordings::trackerKind()));
+        EXPECT_EQ(v2->frames[i].sequence(recordings::spectrometerKind()),
+                  v1->frames[i].sequence(recordings::spectrometerKind()));
     }
-    for (std::size_t i = 0; i < v1->poses.size(); ++i) {
-        EXPECT_EQ(v2->poses[i].eyeTrackerM, v1->poses[i].eyeTrackerM);
-        EXPECT_EQ(v2->poses[i].timestampNs, v1->poses[i].timestampNs);
+    for (std::size_t i = 0; i < v1->samples(recordings::trackerKind()).size(); ++i) {
+        EXPECT_EQ(v2->samples(recordings::trackerKind())[i].eyeTrackerM,
+                  v1->samples(recordings::trackerKind())[i].eyeTrackerM);
+        EXPECT_EQ(v2->samples(recordings::trackerKind())[i].timestampNs,
+                  v1->samples(recordings::trackerKind())[i].timestampNs);
     }
-    for (std::size_t i = 0; i < v1->accel.size(); ++i) {
-        EXPECT_EQ(v2->accel[i].gravity, v1->accel[i].gravity);
+    for (std::size_t i = 0; i < v1->samples(recordings::accelKind()).size(); ++i) {
+        EXPECT_EQ(v2->samples(recordings::accelKind())[i].gravity,
+                  v1->samples(recordings::accelKind())[i].gravity);
     }
-    for (std::size_t i = 0; i < v1->spectra.size(); ++i) {
-        EXPECT_EQ(v2->spectra[i].timestampNs, v1->spectra[i].timestampNs);
-        EXPECT_EQ(v2->spectra[i].counts.size(), v1->spectra[i].counts.size());
-        EXPECT_EQ(v2->spectra[i].wavelengthCoeffs, v1->spectra[i].wavelengthCoeffs);
+    for (std::size_t i = 0; i < v1->samples(recordings::spectrometerKind()).size(); ++i) {
+        EXPECT_EQ(v2->samples(recordings::spectrometerKind())[i].timestampNs,
+                  v1->samples(recordings::spectrometerKind())[i].timestampNs);
+        EXPECT_EQ(v2->samples(recordings::spectrometerKind())[i].counts.size(),
+                  v1->samples(recordings::spectrometerKind())[i].counts.size());
+        EXPECT_EQ(v2->samples(recordings::spectrometerKind())[i].wavelengthCoeffs,
+                  v1->samples(recordings::spectrometerKind())[i].wavelengthCoeffs);
     }
 }
 
@@ -328,10 +347,10 @@ TEST(RecordingRead, RecordingsWithoutALampSelectorHaveNoneAndNoLampSequences)
     for (const char* name : {"walk-v1.mcap", "walk-v2.mcap"}) {
         auto r = readRecording(dir / name);
         ASSERT_TRUE(r) << r.error().message;
-        EXPECT_TRUE(r->lampSelector.empty()) << name;
-        EXPECT_TRUE(r->session.lampSelector.model.empty()) << name;
+        EXPECT_TRUE(r->samples(recordings::lampSelectorKind()).empty()) << name;
+        EXPECT_TRUE(r->session.device(recordings::lampSelectorKind()).model.empty()) << name;
         for (const auto& f : r->frames) {
-            EXPECT_FALSE(f.lampSequence.has_value()) << name;
+            EXPECT_FALSE(f.sequence(recordings::lampSelectorKind()).has_value()) << name;
         }
     }
 }
@@ -342,15 +361,15 @@ TEST(RecordingRead, FormatVersionThreeSampleHoldsTheSimulatedSwitch)
     auto r = readRecording(dir / "walk-v3.mcap");
     ASSERT_TRUE(r) << r.error().message;
     EXPECT_EQ(r->formatVersion, 3);
-    EXPECT_EQ(r->session.lampSelector.model, "lamp selector (simulated)");
+    EXPECT_EQ(r->session.device(recordings::lampSelectorKind()).model, "lamp selector (simulated)");
     // The position at t = 0 and the turn to lamp 1 at 2 s (debounced), as the scenario plays it.
-    ASSERT_EQ(r->lampSelector.size(), 2u);
-    EXPECT_EQ(r->lampSelector[0].lamp, 0);
-    EXPECT_EQ(r->lampSelector[1].lamp, 1);
-    EXPECT_GE(r->lampSelector[1].timestampNs, 2'030'000'000);
+    ASSERT_EQ(r->samples(recordings::lampSelectorKind()).size(), 2u);
+    EXPECT_EQ(r->samples(recordings::lampSelectorKind())[0].lamp, 0);
+    EXPECT_EQ(r->samples(recordings::lampSelectorKind())[1].lamp, 1);
+    EXPECT_GE(r->samples(recordings::lampSelectorKind())[1].timestampNs, 2'030'000'000);
     ASSERT_FALSE(r->frames.empty());
-    EXPECT_EQ(r->frames.back().lampSequence, 1u);
-    EXPECT_EQ(r->frames.front().lampSequence, 0u);
+    EXPECT_EQ(r->frames.back().sequence(recordings::lampSelectorKind()), 1u);
+    EXPECT_EQ(r->frames.front().sequence(recordings::lampSelectorKind()), 0u);
 }
 
 } // namespace

@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-namespace replica::platform {
+namespace replica::hal {
 
 template <typename Sample>
 class SampleLatch
@@ -55,4 +55,4 @@ private:
     std::optional<std::uint32_t> lastSequence_;
 };
 
-} // namespace replica::platform
+} // namespace replica::hal

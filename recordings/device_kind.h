@@ -1,0 +1,385 @@
+// Devices as data: one description per device kind (its sample type, names, channel, schema and
+// codec), and the generic pieces built from it that the loop, the recorder, the reader, replay and
+// inspect iterate over. deviceKinds() is the registry; adding a device kind is its HAL folder, its
+// codec, and one line there (recordings/README.md, "Device kinds").
+#pragma once
+
+#include <any>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <typeinfo>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <hal/replay/replay_source.h>
+#include <hal/sample_latch.h>
+#include <hal/sources.h>
+
+namespace replica::recordings {
+
+// One channel of a recording: fixed id, topic, and its JSON Schema.
+struct ChannelSpec {
+    std::uint16_t id = 0;
+    std::string topic;
+    std::string schemaName;
+    std::string schemaText;
+};
+
+// Everything about a device kind that is not code.
+struct DeviceNames {
+    std::string name;        // key in the session, the run's summary and 'inspect --json'
+    std::string displayName; // for people: "accelerometer"
+    std::string samplesNoun; // what its samples are called in log lines: "spectra", "poses"
+    ChannelSpec channel;     // its samples
+    std::optional<ChannelSpec> rawChannel; // format 5: what the device gave before processing
+    std::string frameKey;                  // /replica/frame: the sequence consumed, "accel_seq"
+    std::string droppedKey;                // /replica/recorder: samples dropped, "dropped_accel"
+    bool optional = false; // a session may have none: recordings before it, a booth without one
+};
+
+// Where the writer thread puts a device's encoded messages (in order), and how it reports a raw
+// input it could not encode.
+struct DeviceEmitter {
+    std::function<void(std::uint16_t channel, std::int64_t tNs, std::string payload)> message;
+    std::function<void()> rejectRaw;
+};
+
+class DeviceKindBase;
+
+// What a sample of any kind is written to: the recording writer, and in tests anything else.
+class DeviceSink
+{
+public:
+    virtual ~DeviceSink() = default;
+    virtual void writeDevice(const DeviceKindBase& kind, std::any sample) = 0;
+};
+
+// The loop's per-device slot: polls the source, keeps the latest samples (hal::SampleLatch),
+// chooses the one a frame uses (live: the latest; replay: the recorded one).
+class DeviceSlot
+{
+public:
+    virtual ~DeviceSlot() = default;
+    virtual const DeviceKindBase& kind() const = 0;
+    virtual hal::AnySource& source() = 0;
+    // Polls up to untilNs; returns how many samples the sequence numbers say were lost.
+    virtual std::uint64_t poll(std::int64_t untilNs) = 0;
+    // Live (!replaying): the latest sample. Replay: the sample 'wanted' (none: the recorded frame
+    // had none yet), else the latest, counting a mismatch.
+    virtual void choose(const std::optional<std::uint32_t>& wanted,
+                        bool replaying,
+                        std::uint64_t& mismatches) = 0;
+    virtual std::optional<std::uint32_t> chosenSequence() const = 0;
+    // A new recording file starts with what the scene holds now.
+    virtual void writeLatest(DeviceSink& sink) const = 0;
+};
+
+// The one description of a device kind, its sample type erased: what the recorder, reader,
+// replay and inspect need. Samples travel as std::any holding the kind's Sample; a recording's
+// samples of a kind as std::any holding std::vector<Sample>.
+class DeviceKindBase
+{
+public:
+    explicit DeviceKindBase(DeviceNames names) : names_(std::move(names)) {}
+    virtual ~DeviceKindBase() = default;
+    DeviceKindBase(const DeviceKindBase&) = delete;
+    DeviceKindBase& operator=(const DeviceKindBase&) = delete;
+
+    const DeviceNames& names() const { return names_; }
+    const std::string& name() const { return names_.name; }
+    virtual const std::type_info& sampleType() const = 0;
+
+    // Writer thread: the sample's messages through 'emit' (its own channel, then any raw input);
+    // false when the sample cannot be written (a NaN or infinite value). 'state' is the kind's
+    // own, kept by the writer from sample to sample (e.g. the HID descriptor written last).
+    virtual bool
+    encode(const std::any& sample, std::any& state, const DeviceEmitter& emit) const = 0;
+
+    // Reader. decode throws nlohmann::json exceptions on a missing or mistyped field.
+    virtual std::any emptySamples() const = 0;
+    virtual std::size_t count(const std::any& samples) const = 0;
+    virtual void decode(const nlohmann::json& j, std::any& samples) const = 0;
+    // A raw-channel message; returns false when it names what the file does not hold (unusable).
+    virtual bool decodeRaw(const nlohmann::json& j, std::any& state) const = 0;
+    // Gives each sample its raw input; returns how many raw inputs found no sample.
+    virtual std::uint64_t attachRaw(std::any& samples, std::any& state) const = 0;
+    // How many samples carry a raw input (inspect).
+    virtual std::uint64_t countWithRaw(const std::any& samples) const = 0;
+    // Each sample's time, in the recording's order.
+    virtual std::vector<std::int64_t> times(const std::any& samples) const = 0;
+    // Sample i as its channel's message (JSON); nullopt when it cannot be written.
+    virtual std::optional<std::string> encodeAt(const std::any& samples, std::size_t i) const = 0;
+
+    // Replay: a source that returns exactly these samples.
+    virtual std::unique_ptr<hal::AnySource> replaySource(const hal::DeviceInfo& recorded,
+                                                         const std::any& samples) const = 0;
+    // The loop: a slot polling 'source' (which must deliver this kind's Sample); with 'tee',
+    // every polled sample is also written there (recording as a decorator on the source).
+    virtual std::unique_ptr<DeviceSlot> makeSlot(hal::AnySource& source,
+                                                 DeviceSink* const* tee) const = 0;
+
+private:
+    DeviceNames names_;
+};
+
+// The codec of a sample type: plain functions, so that a second device of an existing type is
+// nothing but data (a DeviceKind with other names and the same codec).
+template <typename Sample>
+struct SampleCodec {
+    std::function<std::optional<std::string>(const Sample&)> encode; // nullopt: not finite
+    std::function<Sample(const nlohmann::json&)> decode;
+    // Format 5, optional: the raw input beside the sample, on DeviceNames::rawChannel.
+    std::function<void(const Sample&, std::uint16_t channel, std::any& state, const DeviceEmitter&)>
+            encodeRaw;
+    std::function<bool(const nlohmann::json&, std::any& state)> decodeRaw;
+    std::function<std::uint64_t(std::vector<Sample>&, std::any& state)> attachRaw;
+    std::function<bool(const Sample&)> hasRaw;
+};
+
+// Records a source: every sample polled from it is also written to *tee (when set). Record = tee
+// a source into a sink; replay = a source (hal::ReplaySource).
+template <typename Sample>
+class RecordingSource final : public hal::Source<Sample>
+{
+public:
+    RecordingSource(hal::Source<Sample>& inner, const DeviceKindBase& kind, DeviceSink* const* tee)
+        : inner_(inner), kind_(kind), tee_(tee)
+    {}
+    const hal::DeviceInfo& info() const override { return inner_.info(); }
+    hal::LinkState state() const override { return inner_.state(); }
+    void poll(std::int64_t untilNs, std::vector<Sample>& out) override
+    {
+        const std::size_t first = out.size();
+        inner_.poll(untilNs, out);
+        if (tee_ != nullptr && *tee_ != nullptr) {
+            for (std::size_t i = first; i < out.size(); ++i) {
+                (*tee_)->writeDevice(kind_, std::any(out[i]));
+            }
+        }
+    }
+
+private:
+    hal::Source<Sample>& inner_;
+    const DeviceKindBase& kind_;
+    DeviceSink* const* tee_;
+};
+
+template <typename Sample>
+class TypedDeviceSlot final : public DeviceSlot
+{
+public:
+    TypedDeviceSlot(const DeviceKindBase& kind, hal::Source<Sample>& source, DeviceSink* const* tee)
+        : kind_(kind), source_(source), polled_(source, kind, tee)
+    {}
+    const DeviceKindBase& kind() const override { return kind_; }
+    hal::AnySource& source() override { return source_; }
+    std::uint64_t poll(std::int64_t untilNs) override
+    {
+        fresh_.clear();
+        polled_.poll(untilNs, fresh_);
+        return latch_.push(fresh_);
+    }
+    void choose(const std::optional<std::uint32_t>& wanted,
+                bool replaying,
+                std::uint64_t& mismatches) override
+    {
+        if (!replaying) {
+            chosen_ = latch_.latest();
+        } else if (!wanted) {
+            chosen_ = nullptr; // the original frame had no sample of this device yet
+        } else if (const Sample* s = latch_.find(*wanted)) {
+            chosen_ = s;
+        } else {
+            ++mismatches;
+            chosen_ = latch_.latest();
+        }
+    }
+    std::optional<std::uint32_t> chosenSequence() const override
+    {
+        return chosen_ != nullptr ? std::optional<std::uint32_t>(chosen_->sequence) : std::nullopt;
+    }
+    void writeLatest(DeviceSink& sink) const override
+    {
+        if (const Sample* s = latch_.latest()) {
+            sink.writeDevice(kind_, std::any(*s));
+        }
+    }
+    const Sample* chosen() const { return chosen_; }
+
+private:
+    const DeviceKindBase& kind_;
+    hal::Source<Sample>& source_;
+    RecordingSource<Sample> polled_;
+    hal::SampleLatch<Sample> latch_;
+    std::vector<Sample> fresh_;
+    const Sample* chosen_ = nullptr;
+};
+
+// A device kind of one sample type: names plus that type's codec.
+template <typename Sample>
+class DeviceKind final : public DeviceKindBase
+{
+public:
+    DeviceKind(DeviceNames names, SampleCodec<Sample> codec)
+        : DeviceKindBase(std::move(names)), codec_(std::move(codec))
+    {}
+    const std::type_info& sampleType() const override { return typeid(Sample); }
+
+    bool encode(const std::any& sample, std::any& state, const DeviceEmitter& emit) const override
+    {
+        const auto& s = std::any_cast<const Sample&>(sample);
+        auto payload = codec_.encode(s);
+        if (!payload) {
+            return false;
+        }
+        emit.message(names().channel.id, s.timestampNs, std::move(*payload));
+        if (codec_.encodeRaw && names().rawChannel) {
+            codec_.encodeRaw(s, names().rawChannel->id, state, emit);
+        }
+        return true;
+    }
+    std::any emptySamples() const override { return std::vector<Sample>{}; }
+    std::size_t count(const std::any& samples) const override { return of(samples).size(); }
+    void decode(const nlohmann::json& j, std::any& samples) const override
+    {
+        of(samples).push_back(codec_.decode(j));
+    }
+    bool decodeRaw(const nlohmann::json& j, std::any& state) const override
+    {
+        return codec_.decodeRaw ? codec_.decodeRaw(j, state) : false;
+    }
+    std::uint64_t attachRaw(std::any& samples, std::any& state) const override
+    {
+        return codec_.attachRaw ? codec_.attachRaw(of(samples), state) : 0;
+    }
+    std::uint64_t countWithRaw(const std::any& samples) const override
+    {
+        std::uint64_t n = 0;
+        if (codec_.hasRaw) {
+            for (const auto& s : of(samples)) {
+                n += codec_.hasRaw(s) ? 1 : 0;
+            }
+        }
+        return n;
+    }
+    std::vector<std::int64_t> times(const std::any& samples) const override
+    {
+        std::vector<std::int64_t> t;
+        for (const auto& s : of(samples)) {
+            t.push_back(s.timestampNs);
+        }
+        return t;
+    }
+    std::optional<std::string> encodeAt(const std::any& samples, std::size_t i) const override
+    {
+        return codec_.encode(of(samples).at(i));
+    }
+    std::unique_ptr<hal::AnySource> replaySource(const hal::DeviceInfo& recorded,
+                                                 const std::any& samples) const override
+    {
+        return std::make_unique<hal::ReplaySource<Sample>>(recorded, of(samples));
+    }
+    std::unique_ptr<DeviceSlot> makeSlot(hal::AnySource& source,
+                                         DeviceSink* const* tee) const override
+    {
+        return std::make_unique<TypedDeviceSlot<Sample>>(
+                *this, dynamic_cast<hal::Source<Sample>&>(source), tee);
+    }
+
+    static std::vector<Sample>& of(std::any& samples)
+    {
+        return std::any_cast<std::vector<Sample>&>(samples);
+    }
+    static const std::vector<Sample>& of(const std::any& samples)
+    {
+        return std::any_cast<const std::vector<Sample>&>(samples);
+    }
+
+private:
+    SampleCodec<Sample> codec_;
+};
+
+// The registry: every device kind this build knows, in channel-id order. The order is the
+// order the loop polls and records them in.
+using DeviceKinds = std::vector<const DeviceKindBase*>;
+const DeviceKinds& deviceKinds();
+
+// The registered kinds by name (the four of format 5).
+const DeviceKind<hal::SpectrumSample>& spectrometerKind();
+const DeviceKind<hal::PoseSample>& trackerKind();
+const DeviceKind<hal::AccelSample>& accelKind();
+const DeviceKind<hal::LampSample>& lampSelectorKind();
+
+// The first registered kind of this sample type (what RecordingWriter::write(sample) and
+// Recording::samples<Sample>() use); null when none.
+const DeviceKindBase* kindOfType(const DeviceKinds& kinds, const std::type_info& type);
+const DeviceKindBase* kindNamed(const DeviceKinds& kinds, const std::string& name);
+
+// A DeviceSlot's chosen sample, typed; null when the slot is of another type or has none.
+template <typename Sample>
+const Sample* chosenSample(const DeviceSlot* slot)
+{
+    const auto* typed = dynamic_cast<const TypedDeviceSlot<Sample>*>(slot);
+    return typed != nullptr ? typed->chosen() : nullptr;
+}
+
+// The sources of a run, one per device kind present, kept in channel-id order (the order they
+// are polled and recorded in).
+class Sources
+{
+public:
+    void set(const DeviceKindBase& kind, std::unique_ptr<hal::AnySource> source);
+    template <typename Sample>
+    void set(const DeviceKind<Sample>& kind,
+             std::type_identity_t<std::unique_ptr<hal::Source<Sample>>> source)
+    {
+        set(static_cast<const DeviceKindBase&>(kind),
+            std::unique_ptr<hal::AnySource>(std::move(source)));
+    }
+    // Null when the run has no such device.
+    hal::AnySource* get(const DeviceKindBase& kind) const;
+    template <typename Sample>
+    hal::Source<Sample>* get(const DeviceKind<Sample>& kind) const
+    {
+        return static_cast<hal::Source<Sample>*>(get(static_cast<const DeviceKindBase&>(kind)));
+    }
+    // Takes the source out (to wrap it, e.g. fault injection); null when none.
+    std::unique_ptr<hal::AnySource> take(const DeviceKindBase& kind)
+    {
+        for (auto& e : entries_) {
+            if (e.kind == &kind) {
+                return std::move(e.source);
+            }
+        }
+        return nullptr;
+    }
+    template <typename Sample>
+    std::unique_ptr<hal::Source<Sample>> take(const DeviceKind<Sample>& kind)
+    {
+        for (auto& e : entries_) {
+            if (e.kind == &kind && e.source) {
+                return std::unique_ptr<hal::Source<Sample>>(
+                        static_cast<hal::Source<Sample>*>(e.source.release()));
+            }
+        }
+        return nullptr;
+    }
+    struct Entry {
+        const DeviceKindBase* kind = nullptr;
+        std::unique_ptr<hal::AnySource> source; // null: none
+    };
+    std::vector<Entry>& entries() { return entries_; }
+    const std::vector<Entry>& entries() const { return entries_; }
+
+private:
+    std::vector<Entry> entries_;
+};
+
+} // namespace replica::recordings

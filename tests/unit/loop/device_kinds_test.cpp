@@ -1,0 +1,210 @@
+// Devices as data: the registry writes exactly the channels format 5 always had, and a device kind
+// that is nothing but data (a second accelerometer: new names and channel, the accelerometer's
+// sample type and codec) is polled by the loop, recorded, read back, listed and replayed.
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <pipeline/base/data_dir.h>
+#include <platform/appliance.h>
+#include <platform/loop/frame_loop.h>
+#include <recordings/device_kind.h>
+#include <recordings/mcap/reader.h>
+#include <recordings/recording.h>
+#include <recordings/sample_codec.h>
+
+#include <gtest/gtest.h>
+
+namespace replica {
+namespace {
+
+using recordings::DeviceKind;
+using recordings::DeviceKinds;
+
+std::string slurp(const std::filesystem::path& p)
+{
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// The schemas and channels of the current format as the registry makes them, against those the
+// code before the registry wrote into the committed format-5 sample (byte for byte: a viewer and
+// 'recover' see the same file).
+TEST(DeviceKinds, WriteTheChannelsAndSchemasOfTheCommittedFormat5Sample)
+{
+    const std::string file =
+            slurp(std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples/walk-v5.mcap");
+    ASSERT_FALSE(file.empty());
+    const auto scan = recordings::mcap::scan(file);
+    ASSERT_TRUE(scan.damage.empty());
+    const auto& defs = recordings::channelDefinitions();
+    ASSERT_EQ(defs.size(), scan.channels.size());
+    for (const auto& d : defs) {
+        const auto c = scan.channels.find(d.channel.id);
+        ASSERT_NE(c, scan.channels.end()) << d.channel.topic;
+        EXPECT_EQ(c->second, d.channel) << d.channel.topic;
+        const auto s = scan.schemas.find(d.schema.id);
+        ASSERT_NE(s, scan.schemas.end()) << d.schema.name;
+        EXPECT_EQ(s->second, d.schema) << d.schema.name;
+    }
+    // One registration each: the four devices, in channel order.
+    const auto& kinds = recordings::deviceKinds();
+    ASSERT_EQ(kinds.size(), 4u);
+    EXPECT_EQ(kinds[0], &recordings::spectrometerKind());
+    EXPECT_EQ(kinds[3], &recordings::lampSelectorKind());
+}
+
+// Scripted samples of the second accelerometer: every 150 ms, with sequence 3 missing (a drop the
+// loop must count), gravity a function of the sequence so that values are checkable.
+std::vector<hal::AccelSample> secondAccelSamples()
+{
+    std::vector<hal::AccelSample> out;
+    for (std::uint32_t seq = 0; seq < 8; ++seq) {
+        if (seq == 3) {
+            continue;
+        }
+        hal::AccelSample s;
+        s.sequence = seq;
+        s.timestampNs = 50'000'000 + static_cast<std::int64_t>(seq) * 150'000'000;
+        s.gravity = {0.25 * seq, -9.81, 0.125};
+        out.push_back(s);
+    }
+    return out;
+}
+
+TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAndReplayed)
+{
+    // The whole addition: names, a channel, the existing sample type and codec.
+    const auto schema = recordings::accelSchema();
+    const DeviceKind<hal::AccelSample> secondAccel(
+            {"accel2",
+             "second accelerometer",
+             "samples",
+             {16, "/hal/accel2", schema.first, schema.second},
+             std::nullopt,
+             "accel2_seq",
+             "dropped_accel2",
+             true},
+            recordings::accelCodec());
+    DeviceKinds kinds = recordings::deviceKinds();
+    kinds.push_back(&secondAccel);
+
+    platform::RunConfig config;
+    config.width = 32;
+    config.height = 20;
+    config.rateHz = 10.0;
+    config.boothLights = 8;
+    config.specularSamples = 2;
+    config.horizonDirections = 4;
+    auto app = platform::buildAppliance(config);
+    if (!app) {
+        GTEST_SKIP() << app.error().message;
+    }
+    auto sources = platform::makeSimSources(**app);
+    ASSERT_TRUE(sources) << sources.error().message;
+    const auto scripted = secondAccelSamples();
+    sources->set(secondAccel,
+                 std::make_unique<hal::ReplaySource<hal::AccelSample>>(
+                         hal::DeviceInfo{"accel2 (scripted)", "A2", "", {}}, scripted));
+
+    const auto dir = std::filesystem::temp_directory_path() / "replica-device-kinds-test";
+    std::filesystem::create_directories(dir);
+    const auto path = dir / "accel2.mcap";
+    recordings::SessionInfo session;
+    session.softwareVersion = "test";
+    session.configJson = (*app)->config.toJson();
+    for (const auto& e : sources->entries()) {
+        session.devices[e.kind->name()] = e.source->info();
+    }
+    recordings::WriterOptions options;
+    options.kinds = kinds;
+    auto writer = recordings::RecordingWriter::create(path, session, options);
+    ASSERT_TRUE(writer) << writer.error().message;
+
+    // 10 frames at 10 Hz: ticks 0 .. 900 ms.
+    const auto plan = platform::fixedRatePlan((*app)->config.periodNs(), 10);
+    std::vector<recordings::FrameRecord> live;
+    auto stats = platform::runFrames(
+            **app, *sources, plan, platform::Pacing::Fast, writer->get(),
+            pipeline::render::Readback::None,
+            [&](const recordings::FrameRecord& f, const auto&, const auto&) { live.push_back(f); });
+    ASSERT_TRUE(stats) << stats.error().message;
+    ASSERT_TRUE((*writer)->close());
+
+    // Polled: each frame consumed the newest scripted sample at or before its tick.
+    ASSERT_EQ(live.size(), 10u);
+    std::size_t polled = 0;
+    for (const auto& f : live) {
+        std::optional<std::uint32_t> want;
+        for (const auto& s : scripted) {
+            if (s.timestampNs <= f.tickNs) {
+                want = s.sequence;
+            }
+        }
+        EXPECT_EQ(f.sequence(secondAccel), want) << "frame " << f.frameIndex;
+    }
+    for (const auto& s : scripted) {
+        polled += s.timestampNs <= live.back().tickNs ? 1 : 0;
+    }
+    EXPECT_EQ(polled, 5u); // t = 50, 200, 350, 650 and 800 ms (the last tick is 900 ms)
+    EXPECT_EQ(stats->dropped.at("accel2"), 1u); // sequence 3 never came
+
+    // Recorded and read back with the kinds: the samples bit for bit, the frames' sequences.
+    auto rec = recordings::readRecording(path, kinds);
+    ASSERT_TRUE(rec) << rec.error().message;
+    const auto& back = rec->samples(secondAccel);
+    ASSERT_EQ(back.size(), polled);
+    for (std::size_t i = 0; i < back.size(); ++i) {
+        EXPECT_EQ(back[i].sequence, scripted[i].sequence);
+        EXPECT_EQ(back[i].timestampNs, scripted[i].timestampNs);
+        EXPECT_EQ(back[i].gravity, scripted[i].gravity);
+    }
+    EXPECT_EQ(rec->session.device(secondAccel).model, "accel2 (scripted)");
+    ASSERT_EQ(rec->frames.size(), live.size());
+    for (std::size_t i = 0; i < live.size(); ++i) {
+        EXPECT_EQ(rec->frames[i].sequences, live[i].sequences) << i;
+    }
+    // The built-in devices are unaffected: the first accelerometer has its own samples.
+    EXPECT_GT(rec->samples(recordings::accelKind()).size(), 0u);
+
+    // Listed: inspect's channel table has it, with its schema and message count.
+    auto report = recordings::inspectRecording(path);
+    ASSERT_TRUE(report) << report.error().message;
+    bool listed = false;
+    for (const auto& c : report->channels) {
+        if (c.topic == "/hal/accel2") {
+            listed = true;
+            EXPECT_EQ(c.id, 16);
+            EXPECT_EQ(c.schemaName, "replica.AccelSample");
+            EXPECT_EQ(c.messages, polled);
+        }
+    }
+    EXPECT_TRUE(listed);
+
+    // A reader that does not know the kind still reads the file (the channel is skipped).
+    auto plain = recordings::readRecording(path);
+    ASSERT_TRUE(plain) << plain.error().message;
+    EXPECT_EQ(plain->frames.size(), live.size());
+    EXPECT_EQ(plain->count(secondAccel), 0u);
+
+    // Replayed: the replay sources include it and every recorded sample is found again.
+    auto replayed = platform::makeReplaySources(*rec, kinds);
+    ASSERT_NE(replayed.get(secondAccel), nullptr);
+    std::vector<recordings::FrameRecord> again;
+    auto replayStats =
+            platform::runFrames(**app, replayed, platform::replayPlan(rec->frames),
+                                platform::Pacing::Fast, nullptr, pipeline::render::Readback::None,
+                                [&](const recordings::FrameRecord& f, const auto&, const auto&) {
+                                    again.push_back(f);
+                                });
+    ASSERT_TRUE(replayStats) << replayStats.error().message;
+    EXPECT_EQ(replayStats->replayMismatches, 0u);
+    ASSERT_EQ(again.size(), live.size());
+    for (std::size_t i = 0; i < live.size(); ++i) {
+        EXPECT_EQ(again[i].sequences, live[i].sequences) << i;
+    }
+    std::filesystem::remove_all(dir);
+}
+
+} // namespace
+} // namespace replica
