@@ -197,7 +197,7 @@ namespace {
 // light, the digests and the appliance's settings for everything the planner does not choose.
 struct PlanInputs {
     pipeline::surface::SurfaceScene scene;
-    pipeline::booth::BoothModel booth;
+    pipeline::booth::Booth booth;
     pipeline::colour::Observer obs;
     std::string sceneDigest;
     std::string boothDigest;

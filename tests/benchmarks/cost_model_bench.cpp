@@ -71,11 +71,11 @@ bool timeSetting(const std::string& scene, Row& r, int frames, int w, int h)
         std::fprintf(stderr, "appliance: %s\n", app.error().message.c_str());
         return false;
     }
-    const auto& lamp = (*app)->booth.lamps.front();
+    const auto& lamp = (*app)->booth.lights.front();
     scene::SceneState state;
     state.lampIndex = 0;
-    state.illuminant = lamp.spectrum;
-    state.emitterLuminanceCdM2 = lamp.luminanceCdM2;
+    state.illuminant = lamp.referenceSpectrum;
+    state.emitterLuminanceCdM2 = lamp.nominalLuminanceCdM2;
     state.tiltRad = 30.0 * kPi / 180.0;
     render::RenderedFrame frame;
     for (int i = 0; i < 3; ++i) {

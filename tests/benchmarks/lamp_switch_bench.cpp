@@ -58,7 +58,7 @@ bool run(const std::string& sceneName, bool planner, bool warmUp, int frames, in
         return false;
     }
     const double buildMs = msSince(t0);
-    const auto& lamps = (*app)->booth.lamps;
+    const auto& lamps = (*app)->booth.lights;
     scene::SceneState state;
     state.tiltRad = 30.0 * 3.14159265358979323846 / 180.0;
     render::RenderedFrame frame;
@@ -71,8 +71,8 @@ bool run(const std::string& sceneName, bool planner, bool warmUp, int frames, in
     for (int round = 0; round < 2; ++round) {
         for (std::size_t l = 0; l < lamps.size(); ++l) {
             state.lampIndex = static_cast<int>(l);
-            state.illuminant = lamps[l].spectrum;
-            state.emitterLuminanceCdM2 = lamps[l].luminanceCdM2;
+            state.illuminant = lamps[l].referenceSpectrum;
+            state.emitterLuminanceCdM2 = lamps[l].nominalLuminanceCdM2;
             for (int i = 0; i < frames; ++i) {
                 t += 1.0 / 60.0;
                 state.eyeBoothM.x = 0.25 * std::sin(t);
