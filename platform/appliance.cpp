@@ -663,14 +663,19 @@ makeBoothScene(RunConfig& config,
         auto plan = loadOrComputeRenderPlan(dir, dataDir() / "booth", config.basis,
                                             config.plannerCache.empty()
                                                     ? defaultPlanCacheDir()
-                                                    : std::filesystem::path(config.plannerCache));
-        if (!plan) {
+                                                    : std::filesystem::path(config.plannerCache),
+                                            config.planIfMissing);
+        if (!plan && !config.planIfMissing && plan.error().code == ErrorCode::NotFound) {
+            // 'replica run''s default on a scene nobody planned: the fixed rules, said once.
+            logger("planner")->info("{}; the fixed rules until then", plan.error().message);
+        } else if (!plan) {
             return tl::unexpected(plan.error());
-        }
-        for (const auto& lamp : setup.lamps) {
-            const auto it = plan->lamps.find(lamp);
-            if (it != plan->lamps.end()) {
-                config.plannedLamps[lamp] = it->second;
+        } else {
+            for (const auto& lamp : setup.lamps) {
+                const auto it = plan->lamps.find(lamp);
+                if (it != plan->lamps.end()) {
+                    config.plannedLamps[lamp] = it->second;
+                }
             }
         }
     }
@@ -697,6 +702,15 @@ makeBoothScene(RunConfig& config,
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
     if (!pass) {
         return tl::unexpected(pass.error());
+    }
+    if (config.warmUp) {
+        // Each lamp's pass compiled now, not at the loop's first switch to it.
+        auto ms = (*pass)->warmUp(config.width, config.height);
+        if (!ms) {
+            return tl::unexpected(ms.error());
+        }
+        logger("render")->info("{} shading pass(es) warmed up in {:.0f} ms",
+                               (*pass)->variantCount(), *ms);
     }
     return std::shared_ptr<pipeline::render::BoothScenePass>(std::move(*pass));
 }

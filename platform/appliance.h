@@ -105,9 +105,16 @@ struct RunConfig {
     // folder); the per-lamp choice it takes is recorded as plannedLamps ("planned_lamps"), and a
     // lamp there draws with its own lights, specular samples and horizon directions. Recordings
     // made before have none and replay with the fixed rules above, bit for bit; a replay never
-    // plans again.
+    // plans again. Where the plan comes from: the cache folder, else the one shipped in the scene
+    // folder (same file name), else, with planIfMissing, computed now (minutes); without it (what
+    // 'replica run' asks when neither --planner, --no-planner nor the site's [render] planner
+    // says) a scene with no plan draws with the fixed rules and a log line says how to plan it.
     bool planner = false;
+    bool planIfMissing = true;
     std::string plannerCache;
+    // Not recorded (no pixel depends on it): draw every lamp's shading pass once at start
+    // (BoothScenePass::warmUp) so that no lamp switch waits for a shader compilation.
+    bool warmUp = true;
     std::map<std::string, LampPlan> plannedLamps;
     // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
     // light; recordings made with replica_k6 or box6 replay as such.

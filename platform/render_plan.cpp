@@ -11,6 +11,7 @@
 #include <pipeline/base/input_file.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/reference/reference_integrator.h>
 #include <pipeline/scene/stand.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/tuning/planner.h>
@@ -190,71 +191,107 @@ std::filesystem::path defaultPlanCacheDir()
     return "/var/tmp/replica-plans";
 }
 
-Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
-                                       const std::filesystem::path& boothDir,
-                                       const std::string& basisName)
+namespace {
+
+// What planning (and checking a plan) needs: the scene, the booth, the observer, the basis per
+// light, the digests and the appliance's settings for everything the planner does not choose.
+struct PlanInputs {
+    pipeline::surface::SurfaceScene scene;
+    pipeline::booth::Booth booth;
+    pipeline::colour::Observer obs;
+    std::string sceneDigest;
+    std::string boothDigest;
+    std::shared_ptr<pipeline::spectral::AdaptiveEncoder> encoder;
+    pipeline::colour::ChannelBasis fixed = pipeline::colour::boxBasis();
+    pipeline::shading::RenderSettings base;
+
+    Expected<pipeline::colour::ChannelBasis> basisFor(const pipeline::booth::BoothLight& l) const
+    {
+        return encoder ? encoder->basisFor(l.spd) : Expected<pipeline::colour::ChannelBasis>(fixed);
+    }
+};
+
+Expected<PlanInputs> loadPlanInputs(const std::filesystem::path& sceneDir,
+                                    const std::filesystem::path& boothDir,
+                                    const std::string& basisName)
 {
     namespace sh = pipeline::shading;
+    PlanInputs in;
     auto scene = pipeline::surface::loadScene(sceneDir);
     if (!scene) {
         return tl::unexpected(scene.error());
     }
+    in.scene = std::move(*scene);
     auto booth = pipeline::booth::loadBooth(boothDir);
     if (!booth) {
         return tl::unexpected(booth.error());
     }
+    in.booth = std::move(*booth);
     auto obs = pipeline::colour::loadCie1931(dataDir());
     if (!obs) {
         return tl::unexpected(obs.error());
     }
+    in.obs = std::move(*obs);
     auto sd = sceneDigest(sceneDir);
     if (!sd) {
         return tl::unexpected(sd.error());
     }
+    in.sceneDigest = *sd;
     auto bd = boothDigest(boothDir);
     if (!bd) {
         return tl::unexpected(bd.error());
     }
-    std::shared_ptr<pipeline::spectral::AdaptiveEncoder> encoder;
-    pipeline::colour::ChannelBasis fixed = pipeline::colour::boxBasis();
+    in.boothDigest = *bd;
     if (basisName == "adaptive_k6") {
         auto made = pipeline::spectral::AdaptiveEncoder::createDefault(dataDir());
         if (!made) {
             return tl::unexpected(made.error());
         }
-        encoder = std::make_shared<pipeline::spectral::AdaptiveEncoder>(std::move(*made));
+        in.encoder = std::make_shared<pipeline::spectral::AdaptiveEncoder>(std::move(*made));
     } else if (basisName != "box6") {
         auto fitted =
                 pipeline::colour::loadChannelBasis(dataDir() / "channels" / (basisName + ".csv"));
         if (!fitted) {
             return tl::unexpected(fitted.error());
         }
-        fixed = std::move(*fitted);
+        in.fixed = std::move(*fitted);
     }
-    // The appliance's settings for everything the planner does not choose.
-    sh::RenderSettings base;
-    base.specularGrid = sh::defaultSpecularGrid(*scene);
-    base.diffuseGrid = sh::defaultDiffuseGrid(*scene);
-    base.areaLights = sh::defaultAreaLights(*scene);
-    const auto views = sh::probeViews(pipeline::scene::StandModel{});
+    in.base.specularGrid = sh::defaultSpecularGrid(in.scene);
+    in.base.diffuseGrid = sh::defaultDiffuseGrid(in.scene);
+    in.base.areaLights = sh::defaultAreaLights(in.scene);
+    return in;
+}
+
+} // namespace
+
+Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
+                                       const std::filesystem::path& boothDir,
+                                       const std::string& basisName)
+{
+    namespace sh = pipeline::shading;
+    auto in = loadPlanInputs(sceneDir, boothDir, basisName);
+    if (!in) {
+        return tl::unexpected(in.error());
+    }
+    const auto views = sh::probeViews(pipeline::scene::StandModel{}, kPlanProbeWidth,
+                                      kPlanProbeHeight, kPlanProbeEyes);
     RenderPlan plan;
-    plan.sceneDigest = *sd;
-    plan.boothDigest = *bd;
+    plan.sceneDigest = in->sceneDigest;
+    plan.boothDigest = in->boothDigest;
     plan.basis = basisName;
-    for (const auto& light : booth->lights) {
-        pipeline::colour::ChannelBasis basis = fixed;
-        if (encoder) {
-            auto b = encoder->basisFor(light.spd);
-            if (!b) {
-                return tl::unexpected(b.error());
-            }
-            basis = std::move(*b);
+    for (const auto& light : in->booth.lights) {
+        auto basis = in->basisFor(light);
+        if (!basis) {
+            return tl::unexpected(basis.error());
         }
-        const sh::Plan p = sh::planRenderViews(*scene, light, views, *obs, {}, base, basis);
+        const sh::ErrorBudget probeBudget{kPlanBudget.p95 * kPlanMargin,
+                                          kPlanBudget.max * kPlanMargin};
+        const sh::Plan p = sh::planRenderViews(in->scene, light, views, in->obs, probeBudget,
+                                               in->base, *basis);
         LampPlan lp;
         lp.lights = p.settings.lights;
-        lp.specularSamples = scene->glossy() ? p.settings.specularSamples : 0;
-        lp.horizonDirections = scene->flat() ? 0 : p.settings.horizonDirections;
+        lp.specularSamples = in->scene.glossy() ? p.settings.specularSamples : 0;
+        lp.horizonDirections = in->scene.flat() ? 0 : p.settings.horizonDirections;
         lp.probeP95 = p.probeError.p95;
         lp.probeMax = p.probeError.max;
         lp.met = p.met;
@@ -263,10 +300,57 @@ Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
     return plan;
 }
 
+Expected<std::map<std::string, pipeline::reference::FrameError>>
+checkRenderPlan(const std::filesystem::path& sceneDir,
+                const std::filesystem::path& boothDir,
+                const RenderPlan& plan,
+                int probeX,
+                int probeY,
+                int eyes)
+{
+    namespace sh = pipeline::shading;
+    auto in = loadPlanInputs(sceneDir, boothDir, plan.basis);
+    if (!in) {
+        return tl::unexpected(in.error());
+    }
+    const auto views = sh::probeViews(pipeline::scene::StandModel{}, probeX, probeY, eyes);
+    std::map<std::string, pipeline::reference::FrameError> out;
+    for (const auto& light : in->booth.lights) {
+        const auto it = plan.lamps.find(light.name);
+        if (it == plan.lamps.end()) {
+            continue;
+        }
+        auto basis = in->basisFor(light);
+        if (!basis) {
+            return tl::unexpected(basis.error());
+        }
+        sh::RenderSettings s = in->base;
+        s.lights = it->second.lights;
+        s.specularSamples = it->second.specularSamples;
+        s.specularPass = in->scene.glossy();
+        s.horizonDirections = it->second.horizonDirections;
+        s.reliefPass = !in->scene.flat();
+        const auto pl = sh::prepareLight(light, in->obs, s.lights, *basis);
+        const auto ps = sh::prepareScene(in->scene, std::max(s.horizonDirections, 1), 0.01, *basis);
+        pipeline::reference::FrameError worst{0.0, 0.0, 0.0};
+        for (const auto& v : views) {
+            const auto ref = pipeline::reference::renderReference(in->scene, light, v, in->obs);
+            const auto e = pipeline::reference::compareFrames(
+                    ref, sh::renderRealtime(ps, pl, v, in->obs, s));
+            worst.mean = std::max(worst.mean, e.mean);
+            worst.p95 = std::max(worst.p95, e.p95);
+            worst.max = std::max(worst.max, e.max);
+        }
+        out[light.name] = worst;
+    }
+    return out;
+}
+
 Expected<RenderPlan> loadOrComputeRenderPlan(const std::filesystem::path& sceneDir,
                                              const std::filesystem::path& boothDir,
                                              const std::string& basis,
-                                             const std::filesystem::path& cacheDir)
+                                             const std::filesystem::path& cacheDir,
+                                             bool compute)
 {
     auto log = logger("planner");
     auto sd = sceneDigest(sceneDir);
@@ -278,9 +362,13 @@ Expected<RenderPlan> loadOrComputeRenderPlan(const std::filesystem::path& sceneD
         return tl::unexpected(bd.error());
     }
     const auto path = renderPlanPath(cacheDir, sceneDir.filename().string(), *sd, *bd, basis);
-    std::error_code ec;
-    if (std::filesystem::exists(path, ec)) {
-        auto plan = readRenderPlan(path);
+    // The cache first (a plan made here, or edited), then the one shipped with the scene.
+    for (const auto& candidate : {path, sceneDir / path.filename()}) {
+        std::error_code ec;
+        if (!std::filesystem::exists(candidate, ec)) {
+            continue;
+        }
+        auto plan = readRenderPlan(candidate);
         if (!plan) {
             return plan;
         }
@@ -288,10 +376,17 @@ Expected<RenderPlan> loadOrComputeRenderPlan(const std::filesystem::path& sceneD
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: the plan is for another scene, booth or basis than "
                                          "its name says; delete it and the appliance plans again",
-                                         path.string()));
+                                         candidate.string()));
         }
-        log->info("render plan: {}", path.string());
+        log->info("render plan: {}", candidate.string());
         return plan;
+    }
+    if (!compute) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("no render plan for {} (basis {}) in {} or with the scene: "
+                                     "'replica plan --scene {}' plans it (minutes, once)",
+                                     sceneDir.string(), basis, cacheDir.string(),
+                                     sceneDir.string()));
     }
     log->info("no render plan for {} at {}: planning every lamp now (minutes, once)",
               sceneDir.string(), path.string());

@@ -9,6 +9,8 @@
 #include <string>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/reference/frame_error.h>
+#include <pipeline/tuning/planner.h>
 
 namespace replica::platform {
 
@@ -55,6 +57,29 @@ std::filesystem::path renderPlanPath(const std::filesystem::path& cacheDir,
 // $HOME/.cache/replica/plans, else /var/tmp/replica-plans.
 std::filesystem::path defaultPlanCacheDir();
 
+// The planner's probe (pipeline/tuning/planner.h, probeViews) and budget for the appliance's
+// plans: the tilts 10, 30 and 50 degrees from kPlanProbeEyes eyes at kPlanProbeWidth x
+// kPlanProbeHeight pixels against the exact reference. The budget is ΔE00 p95 <= 1 and max <= 3
+// (kPlanBudget); the probe must meet it with the margin kPlanMargin (p95 <= 0.75, max <= 2.25),
+// because a coarse probe flatters: the ColorChecker's d65 pick at p95 0.962 on the 32x20 probe
+// is 1.192 on the 64x40 nine-view check ('replica plan --check 64x40'), 1.24 times as much.
+constexpr int kPlanProbeWidth = 32;
+constexpr int kPlanProbeHeight = 20;
+constexpr int kPlanProbeEyes = 3;
+inline constexpr pipeline::shading::ErrorBudget kPlanBudget{1.0, 3.0};
+constexpr double kPlanMargin = 0.75;
+
+// Each planned lamp's setting measured again on another probe (probeViews at probeX x probeY,
+// 'eyes' eyes) against the exact reference: the worst mean, p95 and max over its views, per lamp
+// name. 'replica plan --check' prints it; the plan's picks must hold on a finer probe too.
+Expected<std::map<std::string, pipeline::reference::FrameError>>
+checkRenderPlan(const std::filesystem::path& sceneDir,
+                const std::filesystem::path& boothDir,
+                const RenderPlan& plan,
+                int probeX,
+                int probeY,
+                int eyes);
+
 // Computes the plan for the scene folder and every light of the booth folder, with the
 // appliance's settings for the rest ('areaLights' as the appliance will draw). Minutes on a slow
 // CPU.
@@ -62,10 +87,14 @@ Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
                                        const std::filesystem::path& boothDir,
                                        const std::string& basis);
 
-// The cached plan for the scene, or computed once and written to the cache (a log line says so).
+// The plan for the scene: the cached one in 'cacheDir', else the one shipped with the scene (the
+// same file name in 'sceneDir': 'replica plan --scene S --plan-cache S --force' writes it), else,
+// with 'compute', computed once and written to the cache (a log line says so). Without 'compute'
+// and no plan: an error of code NotFound that says how to plan.
 Expected<RenderPlan> loadOrComputeRenderPlan(const std::filesystem::path& sceneDir,
                                              const std::filesystem::path& boothDir,
                                              const std::string& basis,
-                                             const std::filesystem::path& cacheDir);
+                                             const std::filesystem::path& cacheDir,
+                                             bool compute = true);
 
 } // namespace replica::platform

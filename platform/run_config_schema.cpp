@@ -78,6 +78,12 @@ const JsonSchema& runConfigSchema()
                 {"t_booth_tracker", object({{"rotation", array(number(-1.000001, 1.000001), 9, 9)},
                                             {"translation", metres3}})
                                             .optional()},
+                // The planner's choice per lamp name (platform/render_plan.h).
+                {"planned_lamps", map(object({{"lights", integer(1, 256)},
+                                              {"specular_samples", integer(0, 256)},
+                                              {"horizon_directions", integer(0, 32)}}),
+                                      64)
+                                          .optional()},
                 // What 'replica run' adds for people (never read back): any values.
                 {"run_options", map(any(), 64).optional()},
                 {"site", map(any(), 64).optional()},

@@ -358,6 +358,7 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     r.string("scene", "dir", c.sceneDir);
     r.string("scene", "renderer", c.renderer, {"booth", "flat"});
     r.boolean("render", "planner", c.renderPlanner);
+    c.renderPlannerSet = root.at_path("render.planner").as_boolean() != nullptr;
     r.string("display", "profile", c.displayProfile);
     r.boolean("display", "allow_synthetic", c.allowSynthetic);
     r.string("display", "output", c.output, {"kms", "headless"});
@@ -434,7 +435,9 @@ std::string SiteConfig::toJson() const
              {{"id", boothId},
               {"dimmer", boothDimmerAuto ? nlohmann::json("auto") : nlohmann::json(boothDimmer)}}},
             {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
-            {"render", {{"planner", renderPlanner}}},
+            {"render",
+             {{"planner",
+               renderPlannerSet ? nlohmann::json(renderPlanner) : nlohmann::json("auto")}}},
             {"display",
              {{"profile", displayProfile},
               {"allow_synthetic", allowSynthetic},

@@ -34,8 +34,11 @@ struct SiteConfig {
     // [scene]
     std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
     std::string renderer = "booth"; // or "flat"
-    // [render] planner = true: the planner in the loop (RunConfig::planner); absent: false.
+    // [render] planner = true: the planner in the loop (RunConfig::planner), planning a scene
+    // that has no plan yet at start; false: the fixed rules; absent (renderPlannerSet false):
+    // 'replica run''s default, the plan when the scene has one (cached or shipped).
     bool renderPlanner = false;
+    bool renderPlannerSet = false;
     // [display]
     std::string displayProfile;   // empty: the shipped synthetic profile
     bool allowSynthetic = false;  // the kiosk refuses a live run on the synthetic profile

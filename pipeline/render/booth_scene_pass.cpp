@@ -117,7 +117,7 @@ long BoothScenePass::cacheRefreshes() const
     for (const auto& v : variants_) {
         n += v.pass->cacheRefreshes();
     }
-    return n;
+    return n - warmUpRefreshes_;
 }
 
 void BoothScenePass::invalidateCache()

@@ -93,6 +93,18 @@ public:
 
     std::string description() const;
 
+    // Draws every shading pass once (one per distinct lamp setting, each with a lamp that uses
+    // it) into a width x height target of its own, so that the shaders' first-use compilation
+    // (llvmpipe compiles a program's code at its first draw, 0.7-10 s for the booth pass) happens
+    // here, before the loop's first frame, and not at the first switch to each lamp. Give it the
+    // frame's size: llvmpipe compiles a variant per texture shape (power-of-two sides or not), so
+    // a target of another shape may leave the frame's variant to compile at the switch. Leaves
+    // every frame as it would be without (each pass is given its lamp's light again before it
+    // draws; booth_warm_up_test.cpp) and cacheRefreshes() as it was. Returns how long it took, ms.
+    Expected<double> warmUp(int width, int height);
+    // How many shading passes there are (one per distinct setting).
+    std::size_t variantCount() const { return variants_.size(); }
+
     // The basis the surface is encoded in now, and how many times it has been re-encoded (0
     // without an adaptive encoder).
     const colour::ChannelBasis& basis() const { return setup_.basis; }
@@ -139,6 +151,7 @@ private:
     std::size_t tiltCount_ = 0;
     double heldTiltRad_ = 0.0;
     bool heldValid_ = false;
+    long warmUpRefreshes_ = 0; // cache refreshes of warmUp()'s draws, not counted
 };
 
 // A uniform emitter with the geometry of 'like', the given luminance and spectrum: what the booth

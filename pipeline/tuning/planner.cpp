@@ -1,6 +1,7 @@
 // Planner: enumerate settings by modelled cost, render the probe, stop at the first that meets the
 // budget.
 #include <algorithm>
+#include <map>
 
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/tuning/planner.h>
@@ -9,25 +10,41 @@ namespace replica::pipeline::shading {
 
 double settingCost(const RenderSettings& s, bool glossy, bool relief)
 {
-    // One point light with cosines ~ 1 unit; with relief a second normal-mapped evaluation plus the
-    // horizon interpolation ~ 1.5 units; one FIS sample (sampling, plane hit, trilinear mip read)
-    // ~ 6.
-    double c = s.lights * 1.0;
+    // Calibrated on the GL frame: CPU milliseconds (every llvmpipe thread) that each count adds
+    // to the appliance's 960x600 frame with the tilt moving (pass 1 recomputing its diffuse term
+    // in three bands; the frame the loop's deadline must hold while the panel moves), least
+    // squares over the grids of tests/benchmarks/cost_model_bench.cpp (flat surfaces: the
+    // ColorChecker, lights 8/32/128 x samples 4/16/48) and replica_bench_pareto (relief: the
+    // painting, lights 8/32/128 at 8 samples, samples 2/8/32 at 32 lights; horizon directions 8
+    // and 16 from cost_model_bench). On flat surfaces the specular term is shaded on the 8-texel
+    // grid, so a sample costs nothing measurable (fit -0.003 +- noise ms): 0.002 ms keeps the
+    // fewer samples first among settings of as many lights. Refit: run replica_bench_cost_model
+    // (docs/rendering.md, "Planner").
+    struct Coefficients {
+        double light;
+        double direction;
+        double sample;
+    };
+    constexpr Coefficients kFlat{0.082, 0.0, 0.002};  // area lights, specular and diffuse grids
+    constexpr Coefficients kRelief{0.43, 0.46, 1.35}; // point lights, per-pixel specular
+    const Coefficients& k = relief && s.reliefPass ? kRelief : kFlat;
+    double c = s.lights * k.light;
     if (relief && s.reliefPass) {
-        c += s.lights * 1.5 + 0.25 * s.horizonDirections;
+        c += s.horizonDirections * k.direction;
     }
     if (glossy && s.specularPass) {
-        c += s.specularSamples * 6.0 *
-             (relief && s.reliefPass && s.horizonDirections > 0 ? 1.3 : 1.0);
+        c += s.specularSamples * k.sample;
     }
     return c;
 }
 
-std::vector<View> probeViews(const scene::StandModel& stand, int probeX, int probeY)
+std::vector<View> probeViews(const scene::StandModel& stand, int probeX, int probeY, int eyes)
 {
+    const std::vector<Vec3> all{{0.0, 0.45, 0.60}, {-0.30, 0.40, 0.55}, {0.30, 0.40, 0.55}};
+    const std::vector<Vec3> used(all.begin(), all.begin() + std::clamp(eyes, 1, 3));
     std::vector<View> views;
     for (double tilt : {10.0, 30.0, 50.0}) {
-        for (const Vec3& eye : {Vec3{0.0, 0.45, 0.60}, Vec3{-0.30, 0.40, 0.55}}) {
+        for (const Vec3& eye : used) {
             View v;
             v.panel = scene::panelPose(stand, scene::degreesToRadians(tilt));
             v.eye = eye;
@@ -96,20 +113,26 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
                      [&](const RenderSettings& a, const RenderSettings& b) {
                          return settingCost(a, glossy, relief) < settingCost(b, glossy, relief);
                      });
-    int preparedLights = -1;
-    int preparedDirs = -1;
-    PreparedLight pl;
-    PreparedScene ps;
+    // Prepared once per light count and per horizon direction count: the candidates, in cost
+    // order, go back and forth between them (a painting's horizon map takes seconds).
+    std::map<int, PreparedLight> lightsPrepared;
+    std::map<int, PreparedScene> scenesPrepared;
     double bestP95 = 1e9;
     for (const RenderSettings& s : candidates) {
-        if (s.lights != preparedLights) {
-            pl = prepareLight(light, obs, s.lights, basis);
-            preparedLights = s.lights;
+        auto li = lightsPrepared.find(s.lights);
+        if (li == lightsPrepared.end()) {
+            li = lightsPrepared.emplace(s.lights, prepareLight(light, obs, s.lights, basis)).first;
         }
-        if (s.horizonDirections != preparedDirs) {
-            ps = prepareScene(scene, std::max(s.horizonDirections, 1), 0.01, basis);
-            preparedDirs = s.horizonDirections;
+        auto si = scenesPrepared.find(s.horizonDirections);
+        if (si == scenesPrepared.end()) {
+            si = scenesPrepared
+                         .emplace(
+                                 s.horizonDirections,
+                                 prepareScene(scene, std::max(s.horizonDirections, 1), 0.01, basis))
+                         .first;
         }
+        const PreparedLight& pl = li->second;
+        const PreparedScene& ps = si->second;
         // The worst over the views; a view past the budget ends the candidate early.
         reference::FrameError worst{0.0, 0.0, 0.0};
         bool within = true;

@@ -16,22 +16,25 @@ struct ErrorBudget {
     double max = 3.0;
 };
 
-// The probe's views: the panel at tilts 10, 30 and 50 degrees seen from two eyes (the centre and
-// off to the left, render_bench's --views eyes), so a setting must meet the budget at the
-// grazing tilt where the horizons matter and at the steep one where the highlights move, not on
-// one view. The worst p95 and the worst max over them decide.
-std::vector<View> probeViews(const scene::StandModel& stand, int probeX = 32, int probeY = 20);
+// The probe's views: the panel at tilts 10, 30 and 50 degrees seen from 'eyes' eyes (1-3: the
+// centre, off to the left, off to the right; two are render_bench's --views eyes), so a setting
+// must meet the budget at the grazing tilt where the horizons matter and at the steep one where
+// the highlights move, not on one view. The worst p95 and the worst max over them decide.
+std::vector<View>
+probeViews(const scene::StandModel& stand, int probeX = 32, int probeY = 20, int eyes = 2);
 
 struct Plan {
     RenderSettings settings;
     reference::FrameError probeError; // of the chosen setting: worst p95 and max over the views
-    double relativeCost = 0.0;        // cost model units per pixel (see planner.cpp)
+    double relativeCost = 0.0;        // settingCost: modelled ms (see planner.cpp)
     bool met = false;                 // false: nothing met the budget; settings = the most accurate
     std::vector<std::string> skipped; // passes not needed, with the reason
     int evaluated = 0;
 };
 
-// Cost model per pixel, in units of one point-light evaluation (calibrated on the CPU model).
+// Cost model: the milliseconds the setting's lights, horizon directions and specular samples add
+// to the appliance's 960x600 frame with the tilt moving, calibrated on llvmpipe's GL frame
+// (planner.cpp says how and how to refit). Only its order matters to the planner.
 double settingCost(const RenderSettings& s, bool glossy, bool relief);
 
 // The cheapest setting (by settingCost) whose worst p95 and max over 'views' meet the budget.

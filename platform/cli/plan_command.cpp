@@ -20,6 +20,8 @@ struct PlanArgs {
     std::string basis = "adaptive_k6";
     std::string cache;
     bool force = false;
+    std::string check; // WxH: the picks measured again on a probe of that size
+    int eyes = 3;
 };
 
 int runPlan(const PlanArgs& a)
@@ -54,6 +56,31 @@ int runPlan(const PlanArgs& a)
                     name.c_str(), p.lights, p.specularSamples, p.horizonDirections, p.probeP95,
                     p.probeMax, p.met ? "" : " (the budget is not met)");
     }
+    if (!a.check.empty()) {
+        int w = 0, h = 0;
+        if (std::sscanf(a.check.c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 1024 ||
+            h > 1024) {
+            std::fprintf(stderr, "replica plan: --check %s: expected WIDTHxHEIGHT, 2-1024 each\n",
+                         a.check.c_str());
+            return kExitUsage;
+        }
+        auto checked = checkRenderPlan(scene, booth, *plan, w, h, a.eyes);
+        if (!checked) {
+            std::fprintf(stderr, "replica plan: %s\n", checked.error().message.c_str());
+            return kExitFailure;
+        }
+        bool within = true;
+        for (const auto& [name, e] : *checked) {
+            const bool ok = e.p95 <= kPlanBudget.p95 && e.max <= kPlanBudget.max;
+            within = within && ok;
+            std::printf("check %dx%d, %d views: %s: worst dE00 mean %.3f, p95 %.3f, max %.3f%s\n",
+                        w, h, 3 * a.eyes, name.c_str(), e.mean, e.p95, e.max,
+                        ok ? "" : " (OVER the budget)");
+        }
+        if (!within) {
+            return kExitFailure;
+        }
+    }
     return kExitOk;
 }
 
@@ -73,6 +100,14 @@ void registerPlanCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--plan-cache", args->cache,
                     "folder of the cached plans (default as 'replica run --plan-cache')");
     cmd->add_flag("--force", args->force, "plan again even when a cached plan exists");
+    cmd->add_option(
+            "--check", args->check,
+            "measure each lamp's pick again against the exact reference on a probe of "
+            "WIDTHxHEIGHT pixels (tilts 10, 30, 50 degrees from --eyes eyes); exit 1 when a "
+            "pick is over the budget there");
+    cmd->add_option("--eyes", args->eyes, "eyes of the --check probe: 1-3")
+            ->check(CLI::Range(1, 3))
+            ->capture_default_str();
     cmd->callback([args, &exitCode] { exitCode = runPlan(*args); });
 }
 

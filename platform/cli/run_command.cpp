@@ -67,7 +67,8 @@ struct RunOptions {
     bool noViewing = false;
     bool noFlare = false;
     bool falseColour = false;
-    bool planner = false;
+    bool planner = false;   // --planner: plan a scene that has no plan yet
+    bool noPlanner = false; // --no-planner: the fixed rules
     std::string planCache;
     bool recordDigests = true; // format 4: XXH3-64 of every displayed frame in the recording
     double thumbnailHz = 1.0;
@@ -491,14 +492,21 @@ int runMain(const RunOptions& given)
     config.viewingCompensation = !o.noViewing;
     config.flareSubtraction = !o.noFlare;
     config.falseColour = o.falseColour;
-    config.planner = o.planner;
+    // The planner in the loop: by default each lamp draws with the plan cached or shipped with
+    // the scene (the fixed rules where there is none); --planner (or the site's planner = true)
+    // also plans a scene that has none, --no-planner (planner = false) keeps the fixed rules.
+    config.planner = !o.noPlanner;
+    config.planIfMissing = o.planner;
+    if (!o.planner && !o.noPlanner && o.site && o.site->renderPlannerSet) {
+        config.planner = o.site->renderPlanner;
+        config.planIfMissing = o.site->renderPlanner;
+    }
     config.plannerCache = o.planCache;
     if (o.site) {
         const SiteConfig& site = *o.site;
         config.booth = site.boothId;
         config.boothDimmer = site.boothDimmer;
         config.boothDimmerAuto = site.boothDimmerAuto;
-        config.planner = config.planner || site.renderPlanner;
         const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
         config.stand = site.stand;
         if (!o.panelSizeMm.empty()) { // the command line wins over the site file
@@ -1012,10 +1020,16 @@ void registerRunCommand(CLI::App& app, int& exitCode)
                   "drive every pixel as if seen on the panel normal");
     cmd->add_flag("--no-flare-subtraction", opts->noFlare,
                   "do not subtract the screen's own reflection of the booth light");
-    cmd->add_flag("--planner", opts->planner,
-                  "draw each lamp with the planner's lights, specular samples and horizon "
-                  "directions (cached per scene, computed once when missing; recorded); the site "
-                  "file's [render] planner = true asks the same");
+    auto* planner = cmd->add_flag(
+            "--planner", opts->planner,
+            "draw each lamp with the planner's lights, specular samples and horizon directions, "
+            "planning the scene now (minutes, once; cached) when it has no plan; without "
+            "--planner or --no-planner a scene's cached or shipped plan is used when there is one "
+            "(the choice is recorded); the site file's [render] planner = true asks the same");
+    cmd->add_flag("--no-planner", opts->noPlanner,
+                  "the fixed per-scene rules for every lamp (the site file's [render] planner = "
+                  "false asks the same)")
+            ->excludes(planner);
     cmd->add_option("--plan-cache", opts->planCache,
                     "folder of the planner's cached plans (default $REPLICA_PLAN_CACHE, else "
                     "$XDG_CACHE_HOME/replica/plans, else ~/.cache/replica/plans)");

@@ -108,6 +108,11 @@ TEST_F(SiteFile, TheShippedFileIsGoodAndHoldsTheCompiledInDefaults)
     EXPECT_FALSE(defaults.boothDimmerAuto);
     EXPECT_EQ(defaults.boothDimmer, 1.0);
     EXPECT_FALSE(c.allowSynthetic);
+    // The kiosk draws with the planner's choice (and plans a scene without one at start); a site
+    // file without the key leaves 'replica run''s default: a scene's plan when it has one.
+    EXPECT_TRUE(c.renderPlanner);
+    EXPECT_TRUE(c.renderPlannerSet);
+    EXPECT_FALSE(defaults.renderPlannerSet);
     // And the site's geometry defaults are the run configuration's, which are the constants
     // recordings made before the site file replay with.
     RunConfig run;

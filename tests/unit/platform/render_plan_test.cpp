@@ -1,7 +1,12 @@
 // The planner's plan file: what renderPlanJson writes reads back to the same choice, and the
-// reader refuses every malformed field with a line naming the file and the field.
+// reader refuses every malformed field with a line naming the file and the field. The plans
+// shipped with the scenes are current (their digests are the scene's, booth's and basis's of
+// today, so 'replica run' finds them) and a scene without a plan is not planned unasked.
+#include <filesystem>
 #include <string>
 
+#include <pipeline/base/data_dir.h>
+#include <platform/appliance.h>
 #include <platform/render_plan.h>
 
 #include <gtest/gtest.h>
@@ -67,6 +72,39 @@ TEST(RenderPlan, RefusesMalformedFilesNamingThem)
     std::string noLamps = good.substr(0, good.find("\"lamps\"")) +
                           "\"lamps\": {}, \"scene_digest\": \"0123456789abcdef\"}";
     refused(noLamps, "lamps");
+}
+
+TEST(RenderPlan, EveryShippedSceneCarriesItsCurrentPlan)
+{
+    const auto booth = dataDir() / "booth";
+    auto bd = boothDigest(booth);
+    ASSERT_TRUE(bd) << bd.error().message;
+    for (const char* name : {"colorchecker", "metamer", "painting"}) {
+        const auto dir = dataDir() / "scenes" / name;
+        auto sd = sceneDigest(dir);
+        ASSERT_TRUE(sd) << sd.error().message;
+        const auto file = dir / renderPlanPath("", name, *sd, *bd, "adaptive_k6").filename();
+        ASSERT_TRUE(std::filesystem::exists(file))
+                << name << ": no plan " << file << "; the scene or the booth changed since it was "
+                << "planned: replica plan --scene scenes/" << name << " --plan-cache "
+                << dir.string() << " --force";
+        // Found with an empty cache and without planning, every lamp of the booth in it.
+        const auto empty = std::filesystem::temp_directory_path() / "replica-no-plans";
+        auto plan = loadOrComputeRenderPlan(dir, booth, "adaptive_k6", empty, false);
+        ASSERT_TRUE(plan) << plan.error().message;
+        EXPECT_EQ(plan->lamps.size(), 3u) << name;
+        for (const auto& [lamp, p] : plan->lamps) {
+            EXPECT_TRUE(p.met) << name << " " << lamp;
+            EXPECT_LE(p.probeP95, kPlanBudget.p95 * kPlanMargin) << name << " " << lamp;
+            EXPECT_LE(p.probeMax, kPlanBudget.max * kPlanMargin) << name << " " << lamp;
+        }
+        // Another basis has no shipped plan: not found, and the message says how to plan.
+        auto none = loadOrComputeRenderPlan(dir, booth, "replica_k6", empty, false);
+        ASSERT_FALSE(none);
+        EXPECT_EQ(none.error().code, ErrorCode::NotFound);
+        EXPECT_NE(none.error().message.find("replica plan --scene"), std::string::npos)
+                << none.error().message;
+    }
 }
 
 } // namespace

@@ -1,0 +1,72 @@
+// BoothScenePass::warmUp: every shading pass drawn once into a small target before the loop starts,
+// so that no lamp switch pays for the shader's first-use compilation.
+#include <chrono>
+
+#include <GLES3/gl31.h>
+
+#include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/render/xyz_target.h>
+#include <pipeline/scene/stand.h>
+
+namespace replica::pipeline::render {
+
+Expected<double> BoothScenePass::warmUp(int width, int height)
+{
+    const auto start = std::chrono::steady_clock::now();
+    // What is bound now (before the target of our own, whose creation binds it) comes back.
+    GLint framebuffer = 0;
+    GLint viewport[4] = {0, 0, 0, 0};
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    const auto restore = [&] {
+        glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(framebuffer));
+        glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+    };
+    auto target = XyzTarget::create(width, height);
+    if (!target) {
+        restore();
+        return tl::unexpected(target.error());
+    }
+    const long before = cacheRefreshes() + warmUpRefreshes_;
+    // The view the loop starts from (the stand's default tilt and eye do not matter: the code
+    // compiled is the same for every view).
+    shading::View view;
+    view.panel = scene::panelPose(setup_.stand, scene::degreesToRadians(30.0));
+    view.eye = {0.0, 0.45, 0.60};
+    view.pixelsX = width;
+    view.pixelsY = height;
+    for (std::size_t v = 0; v < variants_.size(); ++v) {
+        // A lamp drawn with this pass (variant 0 may have none: the direct-sensor mode's).
+        const booth::BoothLight* light = &setup_.booth.lights.front();
+        for (std::size_t l = 0; l < lampVariant_.size(); ++l) {
+            if (lampVariant_[l] == v) {
+                light = setup_.booth.find(setup_.lamps[l]);
+                break;
+            }
+        }
+        BoothShadingPass& pass = *variants_[v].pass;
+        // light_ is the member every pass points at; selectLight replaces it (and calls setLight
+        // on the pass it draws with) before any frame, so the loop never draws this one.
+        light_ = shading::prepareLight(*light, setup_.observer, pass.settings().lights,
+                                       setup_.basis);
+        lightIndex_ = -2; // the next draw selects its light afresh
+        if (auto ok = pass.setLight(light_); !ok) {
+            restore();
+            return tl::unexpected(ok.error());
+        }
+        (*target)->bind();
+        if (auto ok = pass.draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand));
+            !ok) {
+            restore();
+            return tl::unexpected(ok.error());
+        }
+        glFinish(); // the compilation is done once the frame is
+        pass.invalidateCache();
+    }
+    restore();
+    warmUpRefreshes_ += cacheRefreshes() + warmUpRefreshes_ - before;
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count();
+}
+
+} // namespace replica::pipeline::render

@@ -1,0 +1,114 @@
+// BoothScenePass::warmUp: drawing every lamp's shading pass once at start changes no frame the loop
+// draws afterwards (bit for bit, across lamp switches between passes of different settings) and
+// no count the loop reports.
+#include <pipeline/base/data_dir.h>
+#include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/render/xyz_target.h>
+#include <platform/output/output.h>
+
+#include <gtest/gtest.h>
+
+namespace replica::pipeline::render {
+namespace {
+
+constexpr int kW = 48, kH = 30;
+
+class BoothWarmUpTest : public ::testing::Test
+{
+protected:
+    void SetUp() override
+    {
+        auto out = platform::createHeadlessOutput();
+        if (!out) {
+            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        }
+        output_ = std::move(*out);
+        setup_.booth = *booth::loadBooth(dataDir() / "booth");
+        setup_.lamps = {"tungsten", "d50-fluorescent", "d65-fluorescent"};
+        setup_.scene = *surface::loadScene(dataDir() / "scenes" / "colorchecker"); // glossy
+        setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
+        setup_.observer = *colour::loadCie1931(dataDir());
+        setup_.settings.lights = 16;
+        setup_.settings.specularSamples = 8;
+        setup_.settings.subtractFlare = false;
+        // Three passes: the setup's, and one of its own for each fluorescent.
+        setup_.perLamp["d50-fluorescent"] = LampSettings{8, 24, 0};
+        setup_.perLamp["d65-fluorescent"] = LampSettings{32, 4, 0};
+        auto t = XyzTarget::create(kW, kH);
+        ASSERT_TRUE(t);
+        target_ = std::move(*t);
+    }
+
+    // Lamp 0, 1, 2, 0, 2 with the eye and the tilt moving: every frame's floats, alpha too.
+    std::vector<std::vector<float>> run(BoothScenePass& pass)
+    {
+        std::vector<std::vector<float>> frames;
+        const int lamps[] = {0, 0, 1, 1, 2, 2, 0, 2};
+        for (int i = 0; i < 8; ++i) {
+            scene::SceneState st;
+            st.lampIndex = lamps[i];
+            st.tiltRad = 0.30 + 0.02 * i;
+            st.eyeBoothM = {-0.2 + 0.05 * i, 0.45, 0.60};
+            target_->bind();
+            auto ok = pass.draw(st, kW, kH);
+            EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
+            std::vector<float> px(static_cast<std::size_t>(kW) * kH * 4);
+            glPixelStorei(GL_PACK_ALIGNMENT, 1);
+            glReadPixels(0, 0, kW, kH, GL_RGBA, GL_FLOAT, px.data());
+            frames.push_back(std::move(px));
+        }
+        return frames;
+    }
+
+    std::unique_ptr<platform::Output> output_;
+    std::unique_ptr<XyzTarget> target_;
+    BoothSceneSetup setup_;
+};
+
+TEST_F(BoothWarmUpTest, ChangesNoFrameAndNoCount)
+{
+    auto cold = BoothScenePass::create(setup_);
+    auto warm = BoothScenePass::create(setup_);
+    ASSERT_TRUE(cold && warm);
+    ASSERT_EQ((*warm)->variantCount(), 3u);
+    // Warmed up into its own target, with a different viewport bound before: both come back.
+    target_->bind();
+    glViewport(1, 2, 7, 5);
+    auto ms = (*warm)->warmUp(20, 12); // another size than the frames: the cache follows
+    ASSERT_TRUE(ms) << ms.error().message;
+    EXPECT_GT(*ms, 0.0);
+    GLint fb = 0;
+    GLint vp[4] = {0, 0, 0, 0};
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fb);
+    glGetIntegerv(GL_VIEWPORT, vp);
+    GLint want = 0;
+    target_->bind();
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &want);
+    EXPECT_EQ(fb, want);
+    EXPECT_EQ(vp[0], 1);
+    EXPECT_EQ(vp[1], 2);
+    EXPECT_EQ(vp[2], 7);
+    EXPECT_EQ(vp[3], 5);
+    EXPECT_EQ((*warm)->cacheRefreshes(), 0);
+
+    const auto a = run(**cold);
+    const auto b = run(**warm);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t f = 0; f < a.size(); ++f) {
+        ASSERT_EQ(a[f].size(), b[f].size());
+        for (std::size_t i = 0; i < a[f].size(); ++i) {
+            ASSERT_EQ(a[f][i], b[f][i]) << "frame " << f << ", float " << i;
+        }
+    }
+    // The lamps' settings differ, so the passes do draw different frames (the test can fail).
+    bool switched = false;
+    for (std::size_t i = 0; i < a[3].size(); ++i) {
+        switched = switched || a[3][i] != a[1][i];
+    }
+    EXPECT_TRUE(switched);
+    EXPECT_EQ((*warm)->cacheRefreshes(), (*cold)->cacheRefreshes());
+    EXPECT_GT((*cold)->cacheRefreshes(), 0);
+}
+
+} // namespace
+} // namespace replica::pipeline::render
