@@ -140,12 +140,6 @@ void main() {
 }
 )";
 
-void setVec3(GLuint program, const char* name, const glm::dvec3& v)
-{
-    glUniform3f(glGetUniformLocation(program, name), static_cast<float>(v.x),
-                static_cast<float>(v.y), static_cast<float>(v.z));
-}
-
 void setInt(GLuint program, const char* name, int v)
 {
     glUniform1i(glGetUniformLocation(program, name), v);
@@ -294,7 +288,7 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
                      params.viewing.data());
     }
     setInt(program_.get(), "uDispLut3dSize", n);
-    setVec3(program_.get(), "uDispLut3dScale", latticeScale);
+    setUniform3(program_.get(), "uDispLut3dScale", latticeScale);
     setInt(program_.get(), "uXyz", 0);
     setInt(program_.get(), "uDispToneLut", 1);
     setInt(program_.get(), "uDispLut3d", 2);
@@ -345,12 +339,12 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
     glViewport(0, 0, width_, height_);
     glUseProgram(program_.get());
-    setVec3(program_.get(), "uDispEye", frame.eyeM);
-    setVec3(program_.get(), "uDispPanelOrigin", frame.pose.cornerM());
-    setVec3(program_.get(), "uDispPanelRight", frame.pose.rightEdgeM());
-    setVec3(program_.get(), "uDispPanelUp", frame.pose.upEdgeM());
-    setVec3(program_.get(), "uDispPanelNormal", frame.pose.normal);
-    setVec3(program_.get(), "uDispLightNormal", frame.lightNormal);
+    setUniform3(program_.get(), "uDispEye", frame.eyeM);
+    setUniform3(program_.get(), "uDispPanelOrigin", frame.pose.cornerM());
+    setUniform3(program_.get(), "uDispPanelRight", frame.pose.rightEdgeM());
+    setUniform3(program_.get(), "uDispPanelUp", frame.pose.upEdgeM());
+    setUniform3(program_.get(), "uDispPanelNormal", frame.pose.normal);
+    setUniform3(program_.get(), "uDispLightNormal", frame.lightNormal);
     setInt(program_.get(), "uDispIlluminanceInAlpha", frame.illuminanceInAlpha ? 1 : 0);
     const int lights = frame.lights != nullptr && !frame.illuminanceInAlpha ? frame.lightCount : 0;
     setInt(program_.get(), "uDispLightCount", lights);
@@ -358,8 +352,8 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
         glUniform4fv(glGetUniformLocation(program_.get(), "uDispLights"), lights,
                      frame.lights->data());
     }
-    setVec3(program_.get(), "uDispFlarePerLux",
-            static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
+    setUniform3(program_.get(), "uDispFlarePerLux",
+                static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, xyzTexture);
     glActiveTexture(GL_TEXTURE1);
