@@ -13,7 +13,8 @@ uniform vec4 uDispViewing[16];         // angle deg, gain X, Y, Z
 uniform highp sampler2D uDispViewingGrid; // kViewingGridNodes x 1, RGBA32F, GL_LINEAR
 
 // Linear interpolation in u = cbrt(r), done by hand so no float-filtering extension is needed.
-float displayToneLut(int channel, float r) {
+// DisplayInverse::countsFromLinear with ToneInverse::Lut.
+float countsFromLinear(int channel, float r) {
     float pos = pow(clamp(r, 0.0, 1.0), 1.0 / 3.0) * float(uDispLutSize - 1);
     int j = clamp(int(floor(pos)), 0, uDispLutSize - 2);
     float f = pos - float(j);
@@ -24,7 +25,8 @@ float displayToneLut(int channel, float r) {
 
 // Gamut classes: 0 in gamut, 1 chroma, 2 over peak, 3 below black (see gamut_map.h).
 // mode 0: hue-keeping; 1: per-channel clip.
-vec4 displayInverse(vec3 xyzIn, int mode) {
+// DisplayInverse::invert (mapToGamut, then countsFromLinear per channel).
+vec4 invert(vec3 xyzIn, int mode) {
     vec3 xyz = xyzIn;
     if (any(isnan(xyz)) || any(isinf(xyz))) {
         return vec4(0.0, 0.0, 0.0, 3.0);
@@ -68,6 +70,6 @@ vec4 displayInverse(vec3 xyzIn, int mode) {
         cls = 1.0;
     }
     r = clamp(r, 0.0, 1.0);
-    return vec4(displayToneLut(0, r.r), displayToneLut(1, r.g), displayToneLut(2, r.b), cls);
+    return vec4(countsFromLinear(0, r.r), countsFromLinear(1, r.g), countsFromLinear(2, r.b), cls);
 }
 

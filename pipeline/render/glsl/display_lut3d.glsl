@@ -1,11 +1,11 @@
 // The 3-D LUT inverse and the gamut class alone, for that path.
 
-// The 3-D LUT path (DisplayLut3d::counts): lattice over u = cbrt(XYZ / white), tetrahedral.
+// The 3-D LUT path (display_inverse.cpp DisplayLut3d::counts): lattice over u = cbrt(XYZ / white), tetrahedral.
 uniform highp sampler3D uDispLut3d;    // size^3, RGBA32F, counts in .rgb
 uniform int uDispLut3dSize;
 uniform vec3 uDispLut3dScale;          // 1 / white XYZ
 
-vec3 displayLut3dCounts(vec3 xyz) {
+vec3 counts(vec3 xyz) {
     float top = float(uDispLut3dSize - 1);
     vec3 pos = clamp(pow(max(xyz * uDispLut3dScale, vec3(0.0)), vec3(1.0 / 3.0)), 0.0, 1.0) * top;
     vec3 fl = min(floor(pos), vec3(top - 1.0));
@@ -38,8 +38,9 @@ vec3 displayLut3dCounts(vec3 xyz) {
     return c0 + w.x * (c1 - c0) + w.y * (c2 - c1) + w.z * (c3 - c2);
 }
 
-// The gamut class alone (what displayInverse reports in .w), for the LUT path.
-float displayGamutClass(vec3 xyz) {
+// The gamut class alone (what invert reports in .w; on the CPU InverseResult::gamutClass), for
+// the LUT path.
+float gamutClass(vec3 xyz) {
     if (any(isnan(xyz)) || any(isinf(xyz)) || !(xyz.y - uDispBlackY >= 0.0)) {
         return 3.0;
     }

@@ -29,19 +29,19 @@ void main() {
         float len = length(toEye);
         float c = len > 1e-6 ? dot(toEye, uDispPanelNormal) / len : 1.0;
         float angle = c > 0.0 ? degrees(acos(min(c, 1.0))) : 90.0;
-        xyz /= max(displayViewingGain(angle), vec3(1e-3));
+        xyz /= max(viewingGain(angle), vec3(1e-3));
     }
-    vec3 counts;
+    vec3 drive;
     float cls;
     if (uDispMethod == 1) {
-        cls = displayGamutClass(xyz);
-        counts = displayLut3dCounts(xyz);
+        cls = gamutClass(xyz);
+        drive = counts(xyz);
     } else {
-        vec4 inv = displayInverse(xyz, uDispGamutMode);
-        counts = inv.xyz;
+        vec4 inv = invert(xyz, uDispGamutMode);
+        drive = inv.xyz;
         cls = inv.w;
     }
-    vec3 q = displayQuantise(counts, px) / uDispMaxCount;
+    vec3 q = quantiseCount(drive, px) / uDispMaxCount;
     if (uDispFalseColour != 0 && cls > 0.0 && ((px.x + px.y) & 4) == 0) {
         q = kFalseColour[int(cls)];
     }

@@ -1,9 +1,9 @@
 // Ordered dither to integer counts (display/dither.cpp: ditherPattern, quantiseCount).
 
-// ditherPattern()'s threshold at the pixel, computed by the same bit interleaving: a dozen
+// display/dither.cpp ditherThreshold: ditherPattern()'s threshold at the pixel, computed by the same bit interleaving: a dozen
 // integer operations where a texel read was a gather per pixel on llvmpipe (3.5 M instructions
 // of the painting's frame). The same floats: v + 0.5 and the division by 256 are exact.
-float displayDitherThreshold(ivec2 pixel) {
+float ditherThreshold(ivec2 pixel) {
     int y = pixel.y & 15;
     int xy = (pixel.x & 15) ^ y;
     int v = 0;
@@ -13,7 +13,8 @@ float displayDitherThreshold(ivec2 pixel) {
     return (float(v) + 0.5) / 256.0;
 }
 
-vec3 displayQuantise(vec3 counts, ivec2 pixel) {
-    float t = displayDitherThreshold(pixel);
-    return clamp(floor(counts + vec3(t)), vec3(0.0), vec3(uDispMaxCount));
+// display/dither.cpp quantiseCount, three channels at once.
+vec3 quantiseCount(vec3 countsIn, ivec2 pixel) {
+    float t = ditherThreshold(pixel);
+    return clamp(floor(countsIn + vec3(t)), vec3(0.0), vec3(uDispMaxCount));
 }

@@ -6,7 +6,8 @@
 // i counts the inner rows at or below a. Counting costs a compare a row; only that segment is
 // interpolated (llvmpipe ran all eleven divisions and mixes when each row interpolated under its
 // own test). At or past the last angle, and for a NaN, the last row's gain.
-vec3 displayViewingGain(float angleDeg) {
+// display/viewing_angle.cpp viewingGain at angleDeg.
+vec3 viewingGain(float angleDeg) {
 #if DISP_VIEWING_ROWS <= 0
     return vec3(1.0);
 #elif DISP_VIEWING_ROWS == 1
