@@ -6,22 +6,21 @@ namespace replica::pipeline::render {
 void composeBoothFrame(const BoothPrograms& programs,
                        const BoothDiffuseCache& cache,
                        const BoothSpecular& specular,
-                       GLuint target,
-                       const PixelRect& rect,
-                       int width,
-                       int height,
+                       const BoothFrameTarget& target,
                        const shading::PanelPose& panel,
                        bool shadeSurface)
 {
+    const int w = target.width;
+    const int h = target.height;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, cache.frontFramebuffer());
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target);
-    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    glBindFramebuffer(GL_FRAMEBUFFER, target);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
     if (!shadeSurface) {
         return;
     }
     glEnable(GL_SCISSOR_TEST);
-    glScissor(rect.x, rect.y, rect.width, rect.height);
+    glScissor(target.rect.x, target.rect.y, target.rect.width, target.rect.height);
     programs.usePose(BoothMode::Compose, panel);
     glActiveTexture(GL_TEXTURE0 + kUnitCache);
     glBindTexture(GL_TEXTURE_2D, cache.frontTexture());

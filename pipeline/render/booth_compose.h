@@ -12,17 +12,22 @@
 
 namespace replica::pipeline::render {
 
-// Draws the frame into framebuffer 'target' (width x height): the cache copied whole (around the
-// surface (0, 0, 0) and E_geo) and, when 'shadeSurface' (a specular term or flare to add), the
-// surface's rectangle 'rect' composed by mode 1 at 'panel': the cached part, the specular term
-// (per pixel or from the grid), minus the flare. Leaves 'target' bound.
+// Where a frame goes: a framebuffer of width x height pixels, 'rect' the surface's part of it.
+struct BoothFrameTarget {
+    GLuint framebuffer = 0;
+    PixelRect rect;
+    int width = 0;
+    int height = 0;
+};
+
+// Draws the frame into 'target': the cache copied whole (around the surface (0, 0, 0) and E_geo)
+// and, when 'shadeSurface' (a specular term or flare to add), the surface's rectangle composed by
+// mode 1 at 'panel': the cached part, the specular term (per pixel or from the grid), minus the
+// flare. Leaves the target's framebuffer bound.
 void composeBoothFrame(const BoothPrograms& programs,
                        const BoothDiffuseCache& cache,
                        const BoothSpecular& specular,
-                       GLuint target,
-                       const PixelRect& rect,
-                       int width,
-                       int height,
+                       const BoothFrameTarget& target,
                        const shading::PanelPose& panel,
                        bool shadeSurface);
 

@@ -97,7 +97,7 @@ void BoothDiffuseCache::update(const BoothPrograms& programs,
         // Drawn whole: the first cache, a new light, size, layout, channels or surround (nothing
         // of the old cache would do), or any change with unsliced refreshes.
         pending_.reset();
-        drawSlice(programs, front_, pose, 0, 1, rect, width, height);
+        drawSlice(programs, front_, pose, {0, 1, rect, width, height});
         key_ = key;
         valid_ = true;
         ++refreshes_;
@@ -109,8 +109,8 @@ void BoothDiffuseCache::update(const BoothPrograms& programs,
     if (pending_) {
         // One band of the refresh into the back buffer; the last one makes it the front.
         const int back = 1 - front_;
-        drawSlice(programs, back, pending_->pose, pending_->nextSlice, slices_, rect, width,
-                  height);
+        drawSlice(programs, back, pending_->pose,
+                  {pending_->nextSlice, slices_, rect, width, height});
         if (++pending_->nextSlice == slices_) {
             front_ = back;
             key_ = pending_->key;
@@ -123,12 +123,13 @@ void BoothDiffuseCache::update(const BoothPrograms& programs,
 void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
                                   int buffer,
                                   const shading::PanelPose& pose,
-                                  int slice,
-                                  int slices,
-                                  const PixelRect& rect,
-                                  int width,
-                                  int height)
+                                  const Band& band)
 {
+    const int slice = band.slice;
+    const int slices = band.slices;
+    const PixelRect& rect = band.rect;
+    const int width = band.width;
+    const int height = band.height;
     Buffer& c = buffers_[static_cast<std::size_t>(buffer)];
     if (slice == 0 && diffuseNodes_.x > 0) {
         // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface (it stays

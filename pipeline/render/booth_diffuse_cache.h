@@ -77,16 +77,20 @@ private:
         shading::PanelPose pose;
         int nextSlice = 0;
     };
-    // Draws the eye-independent part at 'pose' into buffers_[buffer]: band 'slice' of 'slices'
-    // (slice 0 also draws the diffuse grid and clears what needs clearing).
+    // Band 'slice' of 'slices' of a refresh (slice 0 also draws the diffuse grid and clears what
+    // needs clearing), for a frame of width x height whose surface is 'rect'.
+    struct Band {
+        int slice = 0;
+        int slices = 1;
+        PixelRect rect;
+        int width = 0;
+        int height = 0;
+    };
+    // Draws the eye-independent part at 'pose' into buffers_[buffer], band 'band'.
     void drawSlice(const BoothPrograms& programs,
                    int buffer,
                    const shading::PanelPose& pose,
-                   int slice,
-                   int slices,
-                   const PixelRect& rect,
-                   int width,
-                   int height);
+                   const Band& band);
 
     int slices_ = 1;
     bool facetCache_ = false;

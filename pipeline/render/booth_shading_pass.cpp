@@ -192,8 +192,9 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                   height);
     specularTerm_.drawGrid(programs_, view.panel, width, height);
     // Without a specular term or flare to add the frame is the cache as it is.
-    composeBoothFrame(programs_, cache_, specularTerm_, static_cast<GLuint>(target), rect, width,
-                      height, view.panel, specular_ || settings_.subtractFlare);
+    composeBoothFrame(programs_, cache_, specularTerm_,
+                      {static_cast<GLuint>(target), rect, width, height}, view.panel,
+                      specular_ || settings_.subtractFlare);
     glActiveTexture(GL_TEXTURE0);
     return glCheck("drawing the booth pass");
 }

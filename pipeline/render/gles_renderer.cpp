@@ -24,14 +24,8 @@ public:
     Expected<void> init()
     {
         if (!setup_.boothScene) {
-            FlatSceneSetup flat;
-            flat.surface = setup_.surface;
-            flat.booth = setup_.booth;
-            flat.basis = setup_.basis;
-            flat.observer = setup_.observer;
-            flat.lightsU = setup_.lightsU;
-            flat.lightsV = setup_.lightsV;
-            auto pass = FlatScenePass::create(std::move(flat));
+            auto pass = FlatScenePass::create({setup_.surface, setup_.booth, setup_.basis,
+                                               setup_.observer, setup_.lightsU, setup_.lightsV});
             if (!pass) {
                 return tl::unexpected(pass.error());
             }

@@ -366,25 +366,6 @@ int runMain(const run_cli::RunOptions& given)
 
 } // namespace
 
-void addKmsOptions(CLI::App& cmd, KmsOptions& kms)
-{
-    cmd.add_option("--kms-device", kms.device, "kms: the DRM card to drive")->capture_default_str();
-    cmd.add_option("--kms-connector", kms.connector,
-                   "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
-    cmd.add_option("--kms-mode", kms.mode,
-                   "kms: the mode, WIDTHxHEIGHT or WIDTHxHEIGHT@HZ (default: the display's "
-                   "preferred mode)");
-    cmd.add_option("--kms-modeset", kms.modeset,
-                   "kms: auto (atomic where the driver has it, else legacy), atomic or legacy")
-            ->check(CLI::IsMember({"auto", "atomic", "legacy"}))
-            ->capture_default_str();
-    cmd.add_option("--kms-path", kms.path,
-                   "kms: auto (EGL on a GBM surface, else CPU copies into dumb buffers), gbm or "
-                   "dumb")
-            ->check(CLI::IsMember({"auto", "gbm", "dumb"}))
-            ->capture_default_str();
-}
-
 void registerRunCommand(CLI::App& app, int& exitCode)
 {
     auto opts = std::make_shared<run_cli::RunOptions>();
