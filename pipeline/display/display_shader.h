@@ -1,7 +1,7 @@
 // What the GPU display pass needs from a profile, as plain data (uniform values and float arrays
-// for textures), and the GLSL of the inverse model that reads them. The renderer owns the GL
-// objects; this file owns the maths, so the shader and the CPU reference (display_inverse.h) are
-// written side by side.
+// for textures). The renderer owns the GL objects and the GLSL that reads them
+// (pipeline/render/glsl/display_inverse.glsl and the pieces after it, each named for the CPU
+// function it mirrors: display_inverse.h, viewing_angle.h, dither.h).
 #pragma once
 
 #include <array>
@@ -46,15 +46,5 @@ struct DisplayShaderParams {
 };
 
 DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse);
-
-// GLSL ES 3.10 declarations and functions (no #version, no main; the includer defines
-// DISP_VIEWING_ROWS as viewingRows, DISP_VIEWING_FILTERED 0 or 1, DISP_VIEWING_GRID_PER_DEG and
-// DISP_VIEWING_GRID_NODES from the constants above): uniforms uDisp*, samplers uDispToneLut and
-// uDispViewingGrid (read only when filtered), and
-//   vec4 displayInverse(vec3 xyz, int mode)  // counts (real) in .xyz, gamut class in .w
-//   vec3 displayViewingGain(float angleDeg)
-//   vec3 displayQuantise(vec3 counts, ivec2 pixel) // integer counts as floats
-// mirroring mapToGamut, DisplayInverse::countsFromLinear (Lut), viewingGain and quantiseCount.
-extern const char* const kDisplayInverseGlsl;
 
 } // namespace replica::pipeline::display

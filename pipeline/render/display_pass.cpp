@@ -11,140 +11,14 @@
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_shader.h>
 #include <pipeline/render/display_pass.h>
+#include <pipeline/render/display_shaders.h>
 #include <pipeline/render/gl_program.h>
 
 namespace replica::pipeline::render {
 namespace {
 
-const char* const kFragmentHead = R"(
-precision highp float;
-precision highp int;
-precision highp sampler3D;
-in vec2 vUv;
-layout(location = 0) out vec4 outRgba;
-layout(location = 1) out float outClass;
-uniform highp sampler2D uXyz;
-// Fixed for the pass's life and compiled in (DisplayPass::init), so that the program carries
-// only the inverse, gamut mode and overlays it runs: llvmpipe executes an untaken branch under a
-// mask, and the 3-D LUT path cost every analytic frame its tetrahedral fetches.
-const int uDispMethod = DISP_METHOD;         // 0 analytic, 1 3-D LUT
-const int uDispGamutMode = DISP_GAMUT_MODE;  // 0 hue-keeping, 1 per-channel clip
-const int uDispViewingOn = DISP_VIEWING;
-const int uDispFalseColour = DISP_FALSE_COLOUR;
-uniform vec3 uDispEye;
-uniform vec3 uDispPanelOrigin;
-uniform vec3 uDispPanelRight;
-uniform vec3 uDispPanelUp;
-uniform vec3 uDispPanelNormal;
-uniform int uDispLightCount;
-uniform vec4 uDispLights[256];  // xyz: position (m); w: intensity (cd)
-uniform vec3 uDispLightNormal;
-uniform vec3 uDispFlarePerLux;  // rho_d / pi times the light's XYZ with Y = 1; 0 when off
-uniform int uDispIlluminanceInAlpha; // 1: E (lux) is the XYZ texel's alpha (pass 1 wrote it)
-)";
-
-// Flare first (the reflection reaches the eye whatever the panel emits), then the viewing-angle
-// gain (it scales only what the panel emits): eye = gain * emitted + flare.
-const char* const kFragmentMain = R"(
-const vec3 kFalseColour[4] = vec3[4](vec3(0.0), vec3(1.0, 0.0, 1.0), vec3(0.0, 1.0, 1.0),
-                                     vec3(0.0, 0.3, 1.0));
-void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 texel = texelFetch(uXyz, px, 0);
-    vec3 xyz = texel.xyz;
-    vec3 p = uDispPanelOrigin + vUv.x * uDispPanelRight + vUv.y * uDispPanelUp;
-    if (uDispIlluminanceInAlpha != 0) {
-        xyz -= texel.w * uDispFlarePerLux;
-    } else if (any(notEqual(uDispFlarePerLux, vec3(0.0)))) {
-        float e = 0.0;
-        for (int i = 0; i < uDispLightCount; ++i) {
-            vec3 d = uDispLights[i].xyz - p;
-            float d2 = max(dot(d, d), 1e-6);
-            vec3 dir = d * inversesqrt(d2);
-            e += uDispLights[i].w * max(dot(uDispPanelNormal, dir), 0.0)
-                 * max(dot(uDispLightNormal, -dir), 0.0) / d2;
-        }
-        xyz -= e * uDispFlarePerLux;
-    }
-    if (uDispViewingOn != 0) {
-        vec3 toEye = uDispEye - p;
-        float len = length(toEye);
-        float c = len > 1e-6 ? dot(toEye, uDispPanelNormal) / len : 1.0;
-        float angle = c > 0.0 ? degrees(acos(min(c, 1.0))) : 90.0;
-        xyz /= max(displayViewingGain(angle), vec3(1e-3));
-    }
-    vec3 counts;
-    float cls;
-    if (uDispMethod == 1) {
-        cls = displayGamutClass(xyz);
-        counts = displayLut3dCounts(xyz);
-    } else {
-        vec4 inv = displayInverse(xyz, uDispGamutMode);
-        counts = inv.xyz;
-        cls = inv.w;
-    }
-    vec3 q = displayQuantise(counts, px) / uDispMaxCount;
-    if (uDispFalseColour != 0 && cls > 0.0 && ((px.x + px.y) & 4) == 0) {
-        q = kFalseColour[int(cls)];
-    }
-    outRgba = vec4(q, 1.0);
-    outClass = cls / 255.0;
-}
-)";
-
-// One invocation per kCountRun x 2 pixels of the rectangle [uOrigin, uEnd): it reads the class
-// of a 2x2 block at a time with textureGather (one read where four texelFetch were), counts in
-// registers and adds each nonzero sum to the buffer once. The painting's highlights put 40 % of
-// its pixels over peak, and an atomic add per pixel (60 000 a frame on three words of one buffer)
-// cost llvmpipe's two threads about 3 ms of cache-line traffic. (Counting a workgroup's pixels in
-// shared memory instead was slower still: llvmpipe runs barrier() as a coroutine switch.)
+// Pixels a gamut-count invocation reads along a row (glsl/gamut_count.glsl).
 constexpr int kCountRun = 16;
-const char* const kCountShader = R"(
-layout(local_size_x = 8, local_size_y = 8) in;
-uniform highp sampler2D uClass;
-uniform ivec2 uOrigin;
-uniform ivec2 uEnd;
-layout(std430, binding = 0) buffer Counts { uint counts[4]; };
-uvec4 classCounts(vec4 cls, bvec4 in4) {
-    ivec4 c = ivec4(cls * 255.0 + 0.5);
-    uvec4 n = uvec4(0u);
-    for (int k = 0; k < 4; ++k) {
-        n += in4[k] ? uvec4(equal(ivec4(c[k]), ivec4(0, 1, 2, 3))) : uvec4(0u);
-    }
-    return n;
-}
-void main() {
-    ivec2 p = uOrigin + ivec2(gl_GlobalInvocationID.xy) * ivec2(COUNT_RUN, 2);
-    if (p.y >= uEnd.y) {
-        return;
-    }
-    vec2 size = vec2(textureSize(uClass, 0));
-    uvec4 n = uvec4(0u);
-    bool row1 = p.y + 1 < uEnd.y;
-    for (int k = 0; k < COUNT_RUN; k += 2) {
-        int x = p.x + k;
-        if (x < uEnd.x) {
-            // The block's shared corner: the gather takes texels x, x + 1 and y, y + 1 (the
-            // corner is half a texel from each texel centre, so rounding cannot move it).
-            vec4 cls = textureGather(uClass, vec2(float(x + 1), float(p.y + 1)) / size, 0);
-            // textureGather's order: (x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y).
-            bool col1 = x + 1 < uEnd.x;
-            n += classCounts(cls, bvec4(row1, row1 && col1, col1, true));
-        }
-    }
-    for (int c = 1; c < 4; ++c) {
-        if (n[c] > 0u) {
-            atomicAdd(counts[c], n[c]);
-        }
-    }
-}
-)";
-
-void setVec3(GLuint program, const char* name, const glm::dvec3& v)
-{
-    glUniform3f(glGetUniformLocation(program, name), static_cast<float>(v.x),
-                static_cast<float>(v.y), static_cast<float>(v.z));
-}
 
 void setInt(GLuint program, const char* name, int v)
 {
@@ -188,14 +62,14 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
                         setup.viewingCompensation ? 1 : 0, setup.falseColour ? 1 : 0,
                         params.viewingRows, filtered ? 1 : 0, 1.0 / display::kViewingGridStepDeg,
                         display::kViewingGridNodes) +
-            kFragmentHead + display::kDisplayInverseGlsl + kFragmentMain;
+            kDisplayFragmentShader;
     auto program = linkProgram(kFullscreenVertexShader, fragment.c_str(), "display");
     if (!program) {
         return tl::unexpected(program.error());
     }
     program_ = std::move(*program);
     const std::string countSource =
-            fmt::format("#version 310 es\n#define COUNT_RUN {}\n", kCountRun) + kCountShader;
+            fmt::format("#version 310 es\n#define COUNT_RUN {}\n", kCountRun) + kGamutCountShader;
     auto cs = compileShader(GL_COMPUTE_SHADER, countSource.c_str(), "gamut count");
     if (!cs) {
         return tl::unexpected(cs.error());
@@ -294,7 +168,7 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
                      params.viewing.data());
     }
     setInt(program_.get(), "uDispLut3dSize", n);
-    setVec3(program_.get(), "uDispLut3dScale", latticeScale);
+    setUniform3(program_.get(), "uDispLut3dScale", latticeScale);
     setInt(program_.get(), "uXyz", 0);
     setInt(program_.get(), "uDispToneLut", 1);
     setInt(program_.get(), "uDispLut3d", 2);
@@ -345,12 +219,12 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
     glViewport(0, 0, width_, height_);
     glUseProgram(program_.get());
-    setVec3(program_.get(), "uDispEye", frame.eyeM);
-    setVec3(program_.get(), "uDispPanelOrigin", frame.pose.cornerM());
-    setVec3(program_.get(), "uDispPanelRight", frame.pose.rightEdgeM());
-    setVec3(program_.get(), "uDispPanelUp", frame.pose.upEdgeM());
-    setVec3(program_.get(), "uDispPanelNormal", frame.pose.normal);
-    setVec3(program_.get(), "uDispLightNormal", frame.lightNormal);
+    setUniform3(program_.get(), "uDispEye", frame.eyeM);
+    setUniform3(program_.get(), "uDispPanelOrigin", frame.pose.cornerM());
+    setUniform3(program_.get(), "uDispPanelRight", frame.pose.rightEdgeM());
+    setUniform3(program_.get(), "uDispPanelUp", frame.pose.upEdgeM());
+    setUniform3(program_.get(), "uDispPanelNormal", frame.pose.normal);
+    setUniform3(program_.get(), "uDispLightNormal", frame.lightNormal);
     setInt(program_.get(), "uDispIlluminanceInAlpha", frame.illuminanceInAlpha ? 1 : 0);
     const int lights = frame.lights != nullptr && !frame.illuminanceInAlpha ? frame.lightCount : 0;
     setInt(program_.get(), "uDispLightCount", lights);
@@ -358,8 +232,8 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
         glUniform4fv(glGetUniformLocation(program_.get(), "uDispLights"), lights,
                      frame.lights->data());
     }
-    setVec3(program_.get(), "uDispFlarePerLux",
-            static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
+    setUniform3(program_.get(), "uDispFlarePerLux",
+                static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, xyzTexture);
     glActiveTexture(GL_TEXTURE1);

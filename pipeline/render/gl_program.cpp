@@ -98,4 +98,10 @@ linkProgram(const char* vertexSource, const char* fragmentSource, const char* wh
     return linkShaders({&*vs, &*fs}, what);
 }
 
+void setUniform3(GLuint program, const char* name, const glm::dvec3& v)
+{
+    glUniform3f(glGetUniformLocation(program, name), static_cast<float>(v.x),
+                static_cast<float>(v.y), static_cast<float>(v.z));
+}
+
 } // namespace replica::pipeline::render

@@ -5,6 +5,7 @@
 #include <initializer_list>
 
 #include <GLES3/gl31.h>
+#include <glm/vec3.hpp>
 
 #include <pipeline/base/expected.h>
 #include <pipeline/render/gl_handles.h>
@@ -24,6 +25,9 @@ Expected<GlProgram> linkShaders(std::initializer_list<const GlShader*> shaders, 
 // Vertex + fragment from source.
 Expected<GlProgram>
 linkProgram(const char* vertexSource, const char* fragmentSource, const char* what);
+
+// Sets vec3 uniform 'name' of the current program 'program' to 'v' rounded to float.
+void setUniform3(GLuint program, const char* name, const glm::dvec3& v);
 
 // Whether the current context lists the extension (e.g. "GL_OES_texture_float_linear").
 bool hasExtension(const char* name);

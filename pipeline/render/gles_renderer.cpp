@@ -1,63 +1,17 @@
-// GLES 3.1 implementation of the renderer.
-#include <array>
-#include <cmath>
-#include <numbers>
+// The GLES 3.1 renderer: pass 1 (the booth scene, or the flat patch image) into an RGBA32F XYZ
+// target, pass 2 (the display pass) into panel counts, and the read-back.
 #include <string>
 
 #include <GLES3/gl31.h>
 #include <fmt/format.h>
-#include <glm/matrix.hpp>
 
+#include <pipeline/render/flat_scene_pass.h>
 #include <pipeline/render/gl_handles.h>
 #include <pipeline/render/gl_program.h>
 #include <pipeline/render/gles_renderer.h>
 
 namespace replica::pipeline::render {
 namespace {
-
-constexpr int kMaxLights = 256;
-
-// Paper eq. (1) over point lights, eq. (2) per channel, summed into absolute XYZ (cd/m^2).
-const char* const kXyzShader = R"(#version 310 es
-precision highp float;
-precision highp int;
-in vec2 vUv;
-out vec4 outXyz;
-uniform highp sampler2D uCoeffA;   // channels 0..2
-uniform highp sampler2D uCoeffB;   // channels 3..5
-uniform vec3 uPanelOrigin;
-uniform vec3 uPanelRight;
-uniform vec3 uPanelUp;
-uniform vec3 uPanelNormal;
-uniform vec3 uLightNormal;
-uniform int uLightCount;
-uniform vec4 uLights[256];         // xyz: position (m); w: L * a (cd)
-uniform vec3 uChannelXyz[6];
-const float kPi = 3.14159265358979;
-void main() {
-    vec3 p = uPanelOrigin + vUv.x * uPanelRight + vUv.y * uPanelUp;
-    float e = 0.0;
-    for (int i = 0; i < uLightCount; ++i) {
-        vec3 d = uLights[i].xyz - p;
-        // Guard 1/d^2: a light touching the surface contributes a bounded amount.
-        float d2 = max(dot(d, d), 1e-6);
-        vec3 dir = d * inversesqrt(d2);
-        float cosSurface = max(dot(uPanelNormal, dir), 0.0);
-        float cosLight = max(dot(uLightNormal, -dir), 0.0);
-        e += uLights[i].w * cosSurface * cosLight / d2;
-    }
-    vec3 a = texture(uCoeffA, vUv).rgb;
-    vec3 b = texture(uCoeffB, vUv).rgb;
-    vec3 xyz = a.r * uChannelXyz[0] + a.g * uChannelXyz[1] + a.b * uChannelXyz[2]
-             + b.r * uChannelXyz[3] + b.g * uChannelXyz[4] + b.b * uChannelXyz[5];
-    outXyz = vec4(xyz * (e / kPi), 1.0);
-}
-)";
-
-glm::vec3 toFloat(const glm::dvec3& v)
-{
-    return glm::vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
-}
 
 class GlesRenderer final : public Renderer
 {
@@ -69,11 +23,14 @@ public:
 
     Expected<void> init()
     {
-        auto xyz = linkProgram(kFullscreenVertexShader, kXyzShader, "XYZ");
-        if (!xyz) {
-            return tl::unexpected(xyz.error());
+        if (!setup_.boothScene) {
+            auto pass = FlatScenePass::create({setup_.surface, setup_.booth, setup_.basis,
+                                               setup_.observer, setup_.lightsU, setup_.lightsV});
+            if (!pass) {
+                return tl::unexpected(pass.error());
+            }
+            flat_ = std::move(*pass);
         }
-        xyzProgram_ = std::move(*xyz);
         if (auto display = displayPass_.init(setup_.display, setup_.width, setup_.height);
             !display) {
             return tl::unexpected(display.error());
@@ -83,25 +40,7 @@ public:
             setup_.boothScene->setSurroundIlluminance(setup_.surroundIlluminance ||
                                                       !displayPass_.surroundConstant());
         }
-
-        const auto& s = setup_.surface;
-        const auto texels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
-        if (s.width <= 0 || s.height <= 0 || s.coeffs.size() != texels * colour::kChannels) {
-            return makeError(ErrorCode::InvalidArgument, "render: the surface image is empty or "
-                                                         "has the wrong number of coefficients");
-        }
-        std::vector<float> a(texels * 3);
-        std::vector<float> b(texels * 3);
-        for (std::size_t i = 0; i < texels; ++i) {
-            for (std::size_t c = 0; c < 3; ++c) {
-                a[i * 3 + c] = s.coeffs[i * colour::kChannels + c];
-                b[i * 3 + c] = s.coeffs[i * colour::kChannels + 3 + c];
-            }
-        }
-        coeffA_ = texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, a.data());
-        coeffB_ = texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, b.data());
         xyzTarget_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
-
         fbo_ = GlFramebuffer::make();
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
@@ -120,11 +59,7 @@ public:
 
     std::string description() const override
     {
-        if (setup_.boothScene) {
-            return setup_.boothScene->description();
-        }
-        return fmt::format("gles-diffuse ({}x{} point lights, basis {})", setup_.lightsU,
-                           setup_.lightsV, setup_.basis.name);
+        return setup_.boothScene ? setup_.boothScene->description() : flat_->description();
     }
 
     Expected<void>
@@ -136,22 +71,8 @@ public:
         // pass 2's flare estimate use them. The booth pass writes the illuminance on the panel
         // itself (the XYZ target's alpha), from the booth model's lights.
         const scene::PanelPose pose = scene::panelPose(setup_.stand, state.tiltRad);
-        std::vector<float> packed;
-        int count = 0;
-        if (!setup_.boothScene) {
-            const auto lights =
-                    scene::uniformGridLights(setup_.booth.ceiling(), state.emitterLuminanceCdM2,
-                                             setup_.lightsU, setup_.lightsV);
-            count = static_cast<int>(std::min<std::size_t>(lights.size(), kMaxLights));
-            packed.reserve(static_cast<std::size_t>(count) * 4);
-            for (int i = 0; i < count; ++i) {
-                const auto& l = lights[static_cast<std::size_t>(i)];
-                packed.insert(packed.end(),
-                              {static_cast<float>(l.position.x), static_cast<float>(l.position.y),
-                               static_cast<float>(l.position.z),
-                               static_cast<float>(l.intensityCd)});
-            }
-        }
+        const std::vector<float> packed = flat_ ? flat_->lights(state) : std::vector<float>{};
+        const int count = static_cast<int>(packed.size() / 4);
         glViewport(0, 0, w, h);
 
         // Pass 1: absolute XYZ.
@@ -161,7 +82,7 @@ public:
                 return ok;
             }
         } else {
-            drawFlatXyz(state, pose, packed, count);
+            flat_->draw(state, pose, packed);
         }
         glViewport(0, 0, w, h);
         glBindVertexArray(vao_.get());
@@ -215,55 +136,9 @@ public:
     }
 
 private:
-    // Pass 1 of the flat patch image: eq. (1) over a uniform grid of lights, eq. (2).
-    void drawFlatXyz(const scene::SceneState& state,
-                     const scene::PanelPose& pose,
-                     const std::vector<float>& packed,
-                     int count)
-    {
-        const colour::ChannelToXyz m =
-                colour::channelToXyz(setup_.basis, setup_.observer, state.illuminant);
-
-        glBindVertexArray(vao_.get());
-
-        glUseProgram(xyzProgram_.get());
-        setVec3(xyzProgram_.get(), "uPanelOrigin", pose.cornerM());
-        setVec3(xyzProgram_.get(), "uPanelRight", pose.rightEdgeM());
-        setVec3(xyzProgram_.get(), "uPanelUp", pose.upEdgeM());
-        setVec3(xyzProgram_.get(), "uPanelNormal", pose.normal);
-        setVec3(xyzProgram_.get(), "uLightNormal", setup_.booth.ceiling().normal());
-        glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uLightCount"), count);
-        if (count > 0) {
-            glUniform4fv(glGetUniformLocation(xyzProgram_.get(), "uLights"), count, packed.data());
-        }
-        std::array<float, colour::kChannels * 3> mf{};
-        for (std::size_t k = 0; k < colour::kChannels; ++k) {
-            for (int c = 0; c < 3; ++c) {
-                mf[k * 3 + static_cast<std::size_t>(c)] = static_cast<float>(m[k][c]);
-            }
-        }
-        glUniform3fv(glGetUniformLocation(xyzProgram_.get(), "uChannelXyz"),
-                     static_cast<GLsizei>(colour::kChannels), mf.data());
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, coeffA_.get());
-        glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uCoeffA"), 0);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, coeffB_.get());
-        glUniform1i(glGetUniformLocation(xyzProgram_.get(), "uCoeffB"), 1);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-    }
-
-    static void setVec3(GLuint program, const char* name, const glm::dvec3& v)
-    {
-        const glm::vec3 f = toFloat(v);
-        glUniform3f(glGetUniformLocation(program, name), f.x, f.y, f.z);
-    }
-
     GlesRendererSetup setup_;
-    GlProgram xyzProgram_;
+    std::unique_ptr<FlatScenePass> flat_; // pass 1 without a booth scene
     GlVertexArray vao_;
-    GlTexture coeffA_;
-    GlTexture coeffB_;
     GlTexture xyzTarget_;
     GlFramebuffer fbo_;
     DisplayPass displayPass_;

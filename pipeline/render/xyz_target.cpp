@@ -83,7 +83,7 @@ shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
     return f;
 }
 
-Expected<shading::XyzFrame> renderBoothFrame(const BoothShadingPass& pass,
+Expected<shading::XyzFrame> renderBoothFrame(BoothShadingPass& pass,
                                              const shading::PreparedLight& light,
                                              const shading::View& view)
 {

@@ -51,7 +51,7 @@ private:
 // The frame carries what shading::renderRealtime reports: whiteY from areas or points as the
 // pass's settings say, the pixels with the eye at or behind the surface (exit 3 in 'replica
 // render') and the flare's clamped components.
-Expected<shading::XyzFrame> renderBoothFrame(const BoothShadingPass& pass,
+Expected<shading::XyzFrame> renderBoothFrame(BoothShadingPass& pass,
                                              const shading::PreparedLight& light,
                                              const shading::View& view);
 

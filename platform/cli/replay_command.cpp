@@ -19,6 +19,7 @@
 #include <platform/cli/commands.h>
 #include <platform/cli/frame_compare.h>
 #include <platform/cli/frame_outputs.h>
+#include <platform/cli/loop_summary.h>
 #include <platform/image/png_writer.h>
 #include <platform/image/xyz_frame.h>
 #include <platform/logging.h>
@@ -518,6 +519,9 @@ int replayMain(const ReplayOptions& o)
             {"frames_output", outputs.digests().empty() ? sliceFrames : outputs.digests().size()},
             {"wall_s", wallS},
             {"replay_mismatches", stats->replayMismatches}};
+    // The loop's keys as 'run --json' writes them (frame times, drops, gamut); "frames" is
+    // frames_rendered.
+    summary.update(loopSummaryJson(*stats, 1000.0 / config->rateHz));
     if (o.fromS || o.toS) {
         summary["slice"] = {{"from_s", o.fromS.value_or(0.0)}, {"frames", sliceFrames}};
         if (o.toS) {
@@ -552,7 +556,7 @@ int replayMain(const ReplayOptions& o)
         }
     }
     if (!o.digests.empty()) {
-        summary["digests"] = {{"file", o.digests}, {"hash", digestHashName(hash)}};
+        summary["digests"] = digestsJson(o.digests, hash);
         say(fmt::format("digests: {}", o.digests));
     }
     if (!o.saveFrames.empty()) {

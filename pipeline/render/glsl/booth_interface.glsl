@@ -77,7 +77,7 @@ uniform sampler2D uSpecGrid;    // R32F, uGridNodes: what mode 2 wrote this fram
 uniform ivec2 uDiffNodes;
 uniform sampler2D uDiffGrid;    // R32F, uDiffNodes: what mode 3 wrote with the cache
 // BOOTH_FACET_CACHE (relief with a per-pixel specular term): mode 0 also writes each pixel's
-// facet normal (tangent frame, bilinearNormal's) beside the cache, and the compose reads it there:
+// facet normal (tangent frame, sampleNormal's) beside the cache, and the compose reads it there:
 // one texel a frame instead of four and a normalisation.
 #if BOOTH_FACET_CACHE && BOOTH_MODE == 0
 layout(location = 1) out vec4 outFacet;

@@ -47,7 +47,7 @@ void main() {
 #if BOOTH_FACET_CACHE && BOOTH_MODE == 1
         vec3 nl = texelFetch(uFacetCache, ivec2(gl_FragCoord.xy), 0).xyz;
 #else
-        vec3 nl = bilinearNormal(texX, texY);
+        vec3 nl = sampleNormal(texX, texY);
 #endif
 #if BOOTH_FACET_CACHE && BOOTH_MODE == 0
         outFacet = vec4(nl, 0.0);

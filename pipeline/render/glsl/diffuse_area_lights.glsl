@@ -104,7 +104,7 @@ void diffuseLight(int i, vec3 p, vec3 nShade, bool relief, inout float eGeo, ino
             if (d2 > 0.0) {
                 d *= inversesqrt(d2);
                 float cosG = dot(uNormal, d);
-                v = visibility(vec3(dot(d, uRight), dot(d, uUp), cosG),
+                v = horizonVisibility(vec3(dot(d, uRight), dot(d, uUp), cosG),
                                lightSoftness(i, d, cosG, d2));
             }
             e += es * v;

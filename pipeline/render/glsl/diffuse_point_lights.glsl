@@ -22,7 +22,7 @@ void diffuseLight(int i, vec3 p, vec3 nShade, bool relief, inout float eGeo, ino
         float cosS = dot(nShade, d);
         if (cosS > 0.0) {
             e += g * cosS *
-                 visibility(vec3(dot(d, uRight), dot(d, uUp), cosG),
+                 horizonVisibility(vec3(dot(d, uRight), dot(d, uUp), cosG),
                             lightSoftness(i, d, cosG, d2));
         }
     }

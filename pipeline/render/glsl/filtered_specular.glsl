@@ -100,7 +100,7 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
     float lobeSinB = 0.0;
     if (uHorizonDirs > 0) {
         vec3 mirror = 2.0 * co * n - o;
-        lobeSinB = horizonSine(vec3(dot(mirror, uRight), dot(mirror, uUp), 0.0));
+        lobeSinB = sinHorizon(vec3(dot(mirror, uRight), dot(mirror, uUp), 0.0));
     }
     // What the loop below needs of the pixel alone, once (the compiler does not hoist it): the
     // ceiling's plane and axes from p, and the horizon's smoothstep (an open horizon: always 1).

@@ -57,7 +57,7 @@ void bilinearHorizons(float x, float y) {
 #endif
 
 // surface::HorizonMap::sinHorizon: the horizon sine at the azimuth of l (tangent frame).
-float horizonSine(vec3 l) {
+float sinHorizon(vec3 l) {
     float phi = (abs(l.x) > 0.0 || abs(l.y) > 0.0) ? atan(l.y, l.x) : 0.0;
     if (phi < 0.0) {
         phi += 2.0 * kPi;
@@ -104,11 +104,11 @@ float elevationVisibility(float sinB, float lz, float softness) {
 }
 
 // realtime_model.cpp horizonVisibility.
-float visibility(vec3 l, float softness) {
+float horizonVisibility(vec3 l, float softness) {
     if (uHorizonDirs <= 0) {
         return 1.0;
     }
-    return elevationVisibility(horizonSine(l), l.z, softness);
+    return elevationVisibility(sinHorizon(l), l.z, softness);
 }
 
 // realtime_model.cpp lightSoftness: the horizon's softness for light i seen along the unit

@@ -1,7 +1,8 @@
 // Per-pixel lookups: the facet normal (surface::NormalMap's bilinear rule) and
 // shading/realtime_model.cpp gridValue (the diffuse and specular grids).
 
-vec3 bilinearNormal(float x, float y) {
+// shading/view.cpp sampleNormal: the facet normal bilinear at texel position (x, y), normalised.
+vec3 sampleNormal(float x, float y) {
     ivec2 c;
     vec2 a = bilinearTexel(x, y, c);
     float ax = a.x;

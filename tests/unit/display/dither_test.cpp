@@ -77,5 +77,22 @@ TEST(Dither, CountsStayInRangeForAnyInput)
     EXPECT_EQ(quantiseCount(-3.0, -5, -9, 255.0), 0); // negative pixel coordinates wrap
 }
 
+TEST(Dither, ThresholdRepeatsEverySixteenPixelsNegativesIncluded)
+{
+    // The 2x2 Bayer matrix's order at the tile's corner (index 0, 2, 3, 1 in units of 64, as the
+    // recursion's top level puts them): thresholds 0.5/256, 128.5/256, 192.5/256, 64.5/256.
+    EXPECT_EQ(ditherThreshold(0, 0), 0.5f / 256.0f);
+    EXPECT_EQ(ditherThreshold(1, 1), 64.5f / 256.0f);
+    for (int y = -20; y < 20; ++y) {
+        for (int x = -20; x < 20; ++x) {
+            const int ix = ((x % kDitherSize) + kDitherSize) % kDitherSize;
+            const int iy = ((y % kDitherSize) + kDitherSize) % kDitherSize;
+            ASSERT_EQ(ditherThreshold(x, y),
+                      ditherPattern()[static_cast<std::size_t>(iy * kDitherSize + ix)])
+                    << x << "," << y;
+        }
+    }
+}
+
 } // namespace
 } // namespace replica::pipeline::display

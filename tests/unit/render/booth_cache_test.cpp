@@ -322,7 +322,7 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         view.eye = {0.05, 0.45, 0.6};
         view.pixelsX = kCacheW;
         view.pixelsY = kCacheH;
-        const auto frame = [&](const BoothShadingPass& pass, double cacheTiltDeg) {
+        const auto frame = [&](BoothShadingPass& pass, double cacheTiltDeg) {
             const shading::PanelPose cachePose =
                     scene::panelPose(setup_.stand, scene::degreesToRadians(cacheTiltDeg));
             target_->bind();

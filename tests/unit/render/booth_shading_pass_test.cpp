@@ -104,7 +104,7 @@ protected:
     }
 
     // The GL pass's frame of 'light' (already set on the pass) against the exact reference's.
-    static reference::FrameError errorAgainstReference(const BoothShadingPass& pass,
+    static reference::FrameError errorAgainstReference(BoothShadingPass& pass,
                                                        const shading::PreparedLight& pl,
                                                        const surface::SurfaceScene& scene,
                                                        const booth::BoothLight& light,

@@ -1,0 +1,189 @@
+// The booth shading pass's cache of the eye-independent part.
+#include <algorithm>
+#include <array>
+
+#include <pipeline/render/booth_diffuse_cache.h>
+
+namespace replica::pipeline::render {
+
+Expected<void> BoothDiffuseCache::init(int slices,
+                                       bool facetCache,
+                                       shading::GridNodes diffuseGrid,
+                                       const BoothPrograms& programs)
+{
+    slices_ = std::max(slices, 1);
+    facetCache_ = facetCache;
+    diffuseNodes_ = diffuseGrid;
+    if (diffuseNodes_.x > 0) {
+        if (auto ok = booth_upload::nodeTarget(diffuseNodes_, kUnitDiffGrid, "diffuse",
+                                               diffuseTexture_, diffuseFbo_);
+            !ok) {
+            return ok;
+        }
+    }
+    programs.uniformAll(glProgramUniform2i, "uDiffNodes", diffuseNodes_.x, diffuseNodes_.y);
+    return {};
+}
+
+void BoothDiffuseCache::setSurroundIlluminance(bool on)
+{
+    if (on != surroundIlluminance_) {
+        surroundIlluminance_ = on;
+        valid_ = false;
+    }
+}
+
+Expected<void> BoothDiffuseCache::ensureTarget(int width, int height)
+{
+    if (buffers_[0].texture && width_ == width && height_ == height) {
+        return {};
+    }
+    for (Buffer& c : buffers_) {
+        c = Buffer{}; // a new texture holds nothing yet
+    }
+    facetTexture_.reset();
+    front_ = 0;
+    pending_.reset();
+    glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
+    if (facetCache_) {
+        facetTexture_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
+    }
+    // The back buffer only where refreshes are sliced: 9 MB at 960x600 that nothing else reads.
+    const int buffers = slices_ > 1 ? 2 : 1;
+    bool complete = true;
+    for (int b = 0; b < buffers; ++b) {
+        Buffer& c = buffers_[static_cast<std::size_t>(b)];
+        c.texture = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        c.fbo = GlFramebuffer::make();
+        glBindFramebuffer(GL_FRAMEBUFFER, c.fbo.get());
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, c.texture.get(),
+                               0);
+        if (facetCache_) {
+            // Mode 0 writes the facet normal beside the cached terms; the blit reads attachment 0.
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D,
+                                   facetTexture_.get(), 0);
+            const std::array<GLenum, 2> attachments{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+            glDrawBuffers(2, attachments.data());
+            glReadBuffer(GL_COLOR_ATTACHMENT0);
+        }
+        complete = complete && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    }
+    width_ = width;
+    height_ = height;
+    valid_ = false;
+    if (!complete) {
+        return makeError(ErrorCode::Unsupported,
+                         "render: the booth pass's RGBA32F cache is not renderable on this GL");
+    }
+    return booth_upload::glCheck("creating the booth pass's cache");
+}
+
+void BoothDiffuseCache::update(const BoothPrograms& programs,
+                               const shading::PanelPose& pose,
+                               const SurfaceLayout& layout,
+                               const PixelRect& rect,
+                               int width,
+                               int height)
+{
+    const Key key{pose.centre, pose.right, pose.up,       pose.normal,
+                  width,       height,     layout.offset, layout.scale};
+    // Only a new pose is drawn in bands: the compose places the surface by this draw's layout,
+    // and the facet normals (one texture behind both buffers) follow the layout too, so a cache
+    // of another layout or size is no frame to show meanwhile.
+    const bool samePlacement = key.width == key_.width && key.height == key_.height &&
+                               key.offset == key_.offset && key.scale == key_.scale;
+    if (!valid_ || (!(key == key_) && (slices_ == 1 || !samePlacement))) {
+        // Drawn whole: the first cache, a new light, size, layout, channels or surround (nothing
+        // of the old cache would do), or any change with unsliced refreshes.
+        pending_.reset();
+        drawSlice(programs, front_, pose, {0, 1, rect, width, height});
+        key_ = key;
+        valid_ = true;
+        ++refreshes_;
+        return;
+    }
+    if (!pending_ && !(key == key_)) {
+        pending_ = PendingRefresh{key, pose, 0};
+    }
+    if (pending_) {
+        // One band of the refresh into the back buffer; the last one makes it the front.
+        const int back = 1 - front_;
+        drawSlice(programs, back, pending_->pose,
+                  {pending_->nextSlice, slices_, rect, width, height});
+        if (++pending_->nextSlice == slices_) {
+            front_ = back;
+            key_ = pending_->key;
+            pending_.reset();
+            ++refreshes_;
+        }
+    }
+}
+
+void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
+                                  int buffer,
+                                  const shading::PanelPose& pose,
+                                  const Band& band)
+{
+    const int slice = band.slice;
+    const int slices = band.slices;
+    const PixelRect& rect = band.rect;
+    const int width = band.width;
+    const int height = band.height;
+    Buffer& c = buffers_[static_cast<std::size_t>(buffer)];
+    if (slice == 0 && diffuseNodes_.x > 0) {
+        // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface (it stays
+        // for the refresh's later bands: nothing else draws into it).
+        glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_.get());
+        glViewport(0, 0, diffuseNodes_.x, diffuseNodes_.y);
+        programs.usePose(BoothMode::DiffuseGrid, pose);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glViewport(0, 0, width, height);
+    }
+    if (diffuseNodes_.x > 0) {
+        glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
+        glBindTexture(GL_TEXTURE_2D, diffuseTexture_.get());
+        glActiveTexture(GL_TEXTURE0);
+    }
+    // Every pixel: the diffuse term on the surface, E_geo on the whole panel (the flare); or,
+    // without the surround's illuminance, the surface's rectangle and zero around it.
+    glBindFramebuffer(GL_FRAMEBUFFER, c.fbo.get());
+    PixelRect region{0, 0, width, height};
+    if (!surroundIlluminance_) {
+        // Mode 0 writes only the rectangle, so zero around it stays zero from one refresh to
+        // the next: cleared only when the buffer was not already zero there (a new target, a
+        // new rectangle, or the surround's illuminance drawn). On llvmpipe a clear of the
+        // RGBA32F cache is a pass over 9 MB at 960x600, a good part of a tilting frame.
+        if (slice == 0 && !(c.zeroAround && *c.zeroAround == rect)) {
+            const std::array<float, 4> zero{};
+            glClearBufferfv(GL_COLOR, 0, zero.data());
+            c.zeroAround = rect;
+        }
+        region = rect;
+    } else {
+        c.zeroAround.reset();
+    }
+    // Band 'slice' of the region's rows: the surface's rows split evenly (they carry nearly all
+    // the cost), the rows below it with the first band and those above with the last.
+    int y0 = region.y;
+    int y1 = region.y + region.height;
+    if (slices > 1) {
+        const auto edge = [&](int k) {
+            return rect.y + static_cast<int>(static_cast<long>(rect.height) * k / slices);
+        };
+        y0 = slice == 0 ? region.y : edge(slice);
+        y1 = slice == slices - 1 ? region.y + region.height : edge(slice + 1);
+    }
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(region.x, y0, region.width, std::max(y1 - y0, 0));
+    programs.usePose(BoothMode::Cache, pose);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisable(GL_SCISSOR_TEST);
+    if (diffuseNodes_.x > 0) {
+        glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);
+        glBindTexture(GL_TEXTURE_2D, 0); // not sampled while mode 3 draws into it
+        glActiveTexture(GL_TEXTURE0);
+    }
+}
+
+} // namespace replica::pipeline::render

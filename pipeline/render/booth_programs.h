@@ -1,0 +1,65 @@
+// The booth shading pass's programs: one per shader mode (booth_shaders.h), each compiled from the
+// same GLSL with the pass's BOOTH_* defines, and the texture units their samplers read.
+#pragma once
+
+#include <array>
+
+#include <GLES3/gl31.h>
+#include <glm/vec3.hpp>
+
+#include <pipeline/base/expected.h>
+#include <pipeline/render/booth_upload.h>
+#include <pipeline/render/gl_handles.h>
+#include <pipeline/shading/realtime_model.h>
+#include <pipeline/shading/view.h>
+
+namespace replica::pipeline::render {
+
+// The texture unit of each booth sampler (uCoeffA ... uDiffGrid).
+enum BoothTextureUnit : GLint {
+    kUnitCoeffA = 0,
+    kUnitCoeffB,
+    kUnitNormals,
+    kUnitHorizon,
+    kUnitLum,
+    kUnitCache,
+    kUnitSpecGrid,
+    kUnitFacet,
+    kUnitDiffGrid
+};
+
+// The shader's modes (BOOTH_MODE).
+enum class BoothMode : int { Cache = 0, Compose = 1, SpecularGrid = 2, DiffuseGrid = 3 };
+
+class BoothPrograms
+{
+public:
+    // Compiles modes 0 to modes - 1 from 'config' (its mode set for each) and the settings'
+    // switches, and points every sampler at its unit.
+    Expected<void> compile(booth_upload::BoothShaderConfig config,
+                           const shading::RenderSettings& settings,
+                           int modes);
+
+    // Sets a uniform in every mode's program (where that mode still has it).
+    template <typename Fn, typename... Args>
+    void uniformAll(Fn fn, const char* name, Args... args) const
+    {
+        for (const GlProgram& program : programs_) {
+            if (const GLuint p = program.get(); p != 0) {
+                fn(p, glGetUniformLocation(p, name), args...);
+            }
+        }
+    }
+    void set3All(const char* name, const glm::dvec3& v) const;
+    // Binds uniform block 'name' to 'binding' in every program that has it (a block a mode does
+    // not use is gone from its program).
+    void bindBlock(const char* name, GLuint binding) const;
+    // Sets the panel pose in one mode's program and makes that program current: each mode draws
+    // at its own pose (the cache at the held one).
+    void usePose(BoothMode mode, const shading::PanelPose& panel) const;
+
+private:
+    std::array<GlProgram, 4> programs_{};
+};
+
+} // namespace replica::pipeline::render

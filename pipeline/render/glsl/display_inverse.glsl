@@ -1,0 +1,75 @@
+// The inverse display model (Day et al.): XYZ -> linear drive by M^-1, the gamut mapped as
+// display/gamut_map.cpp's mapToGamut does, then counts by the inverse tone-curve LUT
+// (display/display_inverse.cpp: DisplayInverse::countsFromLinear).
+
+uniform mat3 uDispXyzToLinear;
+uniform vec3 uDispBlackXyz;
+uniform float uDispBlackY;
+uniform float uDispWhiteY;
+uniform float uDispMaxCount;
+uniform int uDispLutSize;
+uniform highp sampler2D uDispToneLut;  // (lutSize - 1) x 3, RG32F, texelFetch only
+uniform vec4 uDispViewing[16];         // angle deg, gain X, Y, Z
+uniform highp sampler2D uDispViewingGrid; // kViewingGridNodes x 1, RGBA32F, GL_LINEAR
+
+// Linear interpolation in u = cbrt(r), done by hand so no float-filtering extension is needed.
+// DisplayInverse::countsFromLinear with ToneInverse::Lut.
+float countsFromLinear(int channel, float r) {
+    float pos = pow(clamp(r, 0.0, 1.0), 1.0 / 3.0) * float(uDispLutSize - 1);
+    int j = clamp(int(floor(pos)), 0, uDispLutSize - 2);
+    float f = pos - float(j);
+    // Texel j holds entries j and j + 1: one fetch where two were (each a gather on llvmpipe).
+    vec2 ab = texelFetch(uDispToneLut, ivec2(j, channel), 0).rg;
+    return mix(ab.x, ab.y, f) * uDispMaxCount;
+}
+
+// Gamut classes: 0 in gamut, 1 chroma, 2 over peak, 3 below black (see gamut_map.h).
+// mode 0: hue-keeping; 1: per-channel clip.
+// DisplayInverse::invert (mapToGamut, then countsFromLinear per channel).
+vec4 invert(vec3 xyzIn, int mode) {
+    vec3 xyz = xyzIn;
+    if (any(isnan(xyz)) || any(isinf(xyz))) {
+        return vec4(0.0, 0.0, 0.0, 3.0);
+    }
+    float cls = 0.0;
+    if (xyz.y > uDispWhiteY) {
+        cls = 2.0;
+        if (mode == 0) {
+            xyz *= uDispWhiteY / xyz.y;
+        }
+    }
+    vec3 r = uDispXyzToLinear * (xyz - uDispBlackXyz);
+    float span = uDispWhiteY - uDispBlackY;
+    // Below black: class 3, and the channels clipped (mode 1) or black (mode 0). One tone-curve
+    // lookup below serves both cases (llvmpipe runs both sides of a branch, so a second set of
+    // lookups here cost every pixel six more texel fetches and cube roots).
+    bool below = !(xyz.y - uDispBlackY >= 0.0);
+    // float rounding in M^-1 must not flag in-gamut colours: a small tolerance, then clamp.
+    const float tol = 1e-5;
+    bool inside = all(greaterThanEqual(r, vec3(-tol))) && all(lessThanEqual(r, vec3(1.0 + tol)));
+    if (below) {
+        r = mode == 1 ? r : vec3(0.0);
+        cls = 3.0;
+    } else if (!inside && mode == 0) {
+        // As mapToGamut: towards the same-luminance neutral until no channel is negative, then
+        // scale down until none exceeds 1.
+        float s = clamp((xyz.y - uDispBlackY) / span, 0.0, 1.0);
+        float t = 1.0;
+        for (int c = 0; c < 3; ++c) {
+            if (r[c] < 0.0) {
+                t = min(t, s / (s - r[c]));
+            }
+        }
+        r = vec3(s) + clamp(t, 0.0, 1.0) * (r - vec3(s));
+        float top = max(r.x, max(r.y, r.z));
+        if (top > 1.0) {
+            r /= top;
+        }
+    }
+    if (!inside && cls == 0.0) {
+        cls = 1.0;
+    }
+    r = clamp(r, 0.0, 1.0);
+    return vec4(countsFromLinear(0, r.r), countsFromLinear(1, r.g), countsFromLinear(2, r.b), cls);
+}
+

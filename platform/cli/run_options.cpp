@@ -1,0 +1,433 @@
+// The options of 'replica run'.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <pipeline/base/data_dir.h>
+#include <pipeline/spectral/representation_catalogue.h>
+#include <platform/cli/commands.h>
+#include <platform/cli/run_options.h>
+#include <platform/logging.h>
+#include <platform/loop/frame_loop.h>
+#include <platform/output/display_geometry.h>
+#include <platform/site_file.h>
+
+namespace replica::platform::run_cli {
+namespace {
+
+// Whether the display profile is not a characterised panel: the nominal model, or a profile fitted
+// from synthetic measurements (its description says so, as 'replica display fit --synthetic'
+// writes it).
+bool syntheticDisplay(const RunConfig& config)
+{
+    if (config.display == kUncalibratedDisplay) {
+        return true;
+    }
+    std::ifstream in(dataPath(config.display));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    try {
+        const auto j = nlohmann::json::parse(text);
+        return j.value("description", std::string()).find("SYNTHETIC") != std::string::npos;
+    } catch (const std::exception&) {
+        return false; // buildAppliance reports an unreadable profile
+    }
+}
+
+} // namespace
+
+void addRunOptions(CLI::App& cmd, RunOptions& o)
+{
+    cmd.add_option("--config", o.config,
+                   "site file (TOML, docs/appliance.md); the command line overrides it. "
+                   "--kiosk reads " +
+                           defaultSiteConfigPath().string() + " when none is given");
+    cmd.add_flag("--kiosk", o.kiosk,
+                 "the gallery appliance: run until stopped, record sessions into the site "
+                 "file's recording.directory (rotated, oldest deleted beyond keep_bytes, a "
+                 "crashed session recovered at start); refuses a live run on a synthetic "
+                 "display profile unless display.allow_synthetic");
+    cmd.add_option("--hal", o.hal,
+                   "sensor sources: sim (built-in simulated sensors), live (USB2000+ over "
+                   "libusb, opentrack UDP head poses, IIO accelerometer) or replay (the samples "
+                   "of --replay-file, then the last state held)")
+            ->capture_default_str();
+    cmd.add_option("--replay-file", o.replayFile, "--hal replay: the recording to play");
+    cmd.add_option("--inject-faults", o.faults,
+                   "soak tests: nan-pose=N (every Nth head pose NaN), saturate=N (every Nth "
+                   "spectrum saturated), unplug=EVERY_S/FOR_S (spectrometer and tracker "
+                   "silent FOR_S of every EVERY_S)")
+            ->group("Testing");
+    cmd.add_option("--tracker-port", o.live.trackerPort,
+                   "live: UDP port opentrack sends head poses to")
+            ->capture_default_str();
+    cmd.add_option("--tracker-bind", o.live.trackerBind, "live: address to listen on")
+            ->capture_default_str();
+    cmd.add_option("--iio-root", o.live.iioRoot, "live: where IIO devices are listed")
+            ->capture_default_str();
+    cmd.add_option("--accel-name", o.live.accelName,
+                   "live: the accelerometer's IIO name (default: the first one)");
+    cmd.add_option("--accel-axes", o.live.accelAxes,
+                   "live: sensor axis for each panel axis (x right, y up, z out of the screen), "
+                   "e.g. -y,x,z")
+            ->capture_default_str();
+    cmd.add_option("--lamp-gpio", o.live.lampGpio,
+                   "live: the booth's lamp selector switch, CHIP:OFFSET,OFFSET,... with one GPIO "
+                   "line per lamp in the booth's lamp order (active low, pull-up), e.g. "
+                   "gpiochip0:17,27,22; without it the spectrometer alone decides the light");
+    cmd.add_option("--spectrometer-serial", o.live.spectrometerSerial,
+                   "live: open the USB2000+ whose USB serial number is this (as `lsusb -v` "
+                   "shows it); default: the first one found");
+    cmd.add_option("--lamp-selector", o.lampSelector,
+                   "the booth's lamp switch: none, gpio (the live switch on --lamp-gpio; the "
+                   "default when that is given), sim (follows the simulated lamps, with contact "
+                   "bounce), sim-miswired (its lines for lamps 1 and 2 swapped) or replay")
+            ->check(CLI::IsMember({"none", "gpio", "sim", "sim-miswired", "replay"}));
+    cmd.add_option("--spectrometer", o.spectrometer,
+                   "the spectrometer's source: live (USB2000+), sim or replay (default: --hal)")
+            ->check(CLI::IsMember({"live", "sim", "replay"}));
+    cmd.add_option("--tracker", o.tracker,
+                   "the head tracker's source: opentrack (UDP), hid (a USB HID eye/head tracker, "
+                   "usage page 0x12), sim or replay (default: opentrack with --hal live, else "
+                   "sim)")
+            ->check(CLI::IsMember({"opentrack", "hid", "sim", "replay"}));
+    cmd.add_option("--accel", o.accel,
+                   "the accelerometer's source: live (IIO), sim or replay (default: --hal)")
+            ->check(CLI::IsMember({"live", "sim", "replay"}));
+    cmd.add_option("--replay-from", o.replayFrom,
+                   "the recording that devices set to 'replay' play back (from its session "
+                   "start)");
+    cmd.add_option("--site", o.sitePath,
+                   "site configuration file (e.g. /etc/replica/replica.toml): [sources] "
+                   "spectrometer/tracker/accel/lamp_selector (the command line wins) and the "
+                   "calibrated tracker pose [tracker] T_booth_tracker from 'replica calibrate "
+                   "tracker'");
+    cmd.add_option("--hid-tracker", o.live.hidTracker,
+                   "--tracker hid: the hidraw node, e.g. /dev/hidraw3 (default: the first eye/head "
+                   "tracker found; 'replica probe' lists them)");
+    cmd.add_option("--tracker-axes", o.live.trackerAxes,
+                   "--tracker hid: the device axis for x right, y up, z towards the viewer, e.g. "
+                   "x,-y,z for a tracker whose y points down the screen")
+            ->capture_default_str();
+    cmd.add_option("--output", o.output,
+                   "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")
+            ->capture_default_str();
+    addKmsOptions(cmd, o.outputChoice.kms);
+    cmd.add_option("--frames", o.frames,
+                   "number of frames to run; 0 = until SIGINT/SIGTERM (the kiosk)")
+            ->check(CLI::Range(std::uint64_t{0}, kMaxFrames))
+            ->capture_default_str();
+    cmd.add_option("--size", o.size,
+                   "headless: frame size WIDTHxHEIGHT (default 960x600); on kms the frame is the "
+                   "mode's size");
+    cmd.add_option("--panel-size-mm", o.panelSizeMm,
+                   "the panel's active area WIDTHxHEIGHT in millimetres, which the frame covers "
+                   "(default: the display's EDID on kms, else 518x324, a 24-inch 16:10 panel)");
+    cmd.add_option("--rate", o.rateHz, "frame rate (Hz)")
+            ->check(CLI::Range(1.0, 1000.0))
+            ->capture_default_str();
+    cmd.add_option("--record", o.record, "write every sensor sample and frame input to FILE");
+    cmd.add_flag("--force", o.force,
+                 "--record: overwrite FILE if it exists (never through a symbolic link)");
+    cmd.add_option("--record-flush-ms", o.recordFlushMs,
+                   "close and sync the recording's open chunk at least this often (ms): a power "
+                   "cut loses at most about this much")
+            ->check(CLI::Range(10, 10000))
+            ->capture_default_str();
+    cmd.add_option("--record-digests", o.recordDigests,
+                   "with --record: an XXH3-64 digest of every frame sent to the panel in the "
+                   "recording (/replica/display_digest; replay checks it)")
+            ->capture_default_str();
+    cmd.add_option("--thumbnail-hz", o.thumbnailHz,
+                   "with --record: PNG thumbnails of the displayed frame per second of session "
+                   "time (/replica/thumbnail); 0: none")
+            ->check(CLI::Range(0.0, 60.0))
+            ->capture_default_str();
+    cmd.add_option("--thumbnail-width", o.thumbnailWidth, "thumbnail width (pixels)")
+            ->check(CLI::Range(16, 4096))
+            ->capture_default_str();
+    cmd.add_flag("--json", o.json,
+                 "print a JSON summary (frames, frame times, drops, recording, outputs) on "
+                 "standard output instead of the text lines");
+    cmd.add_option("--digests", o.digests, "write one digest per frame to FILE (JSON)");
+    cmd.add_option("--snapshot", o.snapshot, "write the last frame to FILE (PNG)");
+    cmd.add_option("--scene", o.scene,
+                   "surface scene folder (scene.json + EXRs); default: the shipped ColorChecker, "
+                   "data/scenes/colorchecker");
+    cmd.add_option("--renderer", o.renderer,
+                   "booth (the scene lit by the booth model) or flat (the first recordings' patch "
+                   "renderer)")
+            ->check(CLI::IsMember({"booth", "flat"}))
+            ->capture_default_str();
+    cmd.add_option("--basis", o.basis,
+                   "channel basis: adaptive_k6 (re-encoded for each light, exact for the light "
+                   "present; the default, booth renderer only), replica_k6 (fixed; the flat "
+                   "renderer's default), general_k6, pca6, box6 (docs/accuracy.md)")
+            ->check(CLI::IsMember(pipeline::spectral::channelBasisNames()));
+    cmd.add_flag("--fast", o.fast,
+                 "do not wait for each tick's wall-clock time (same frames, rendered as fast as "
+                 "possible)");
+    cmd.add_option("--display-profile", o.displayProfile,
+                   "display profile (JSON, from 'replica display fit'); default: the shipped "
+                   "data/displays/wide-ips-synthetic.json");
+    cmd.add_flag("--uncalibrated", o.uncalibrated,
+                 "run without a display profile, on a nominal sRGB-like model (colours are then "
+                 "not faithful)");
+    cmd.add_option("--display-inverse", o.displayInverse,
+                   "inverse display model in the shader: analytic or lut3d")
+            ->check(CLI::IsMember({"analytic", "lut3d"}))
+            ->capture_default_str();
+    cmd.add_option("--gamut", o.gamut,
+                   "out-of-gamut colours: hue (hue-keeping mapping) or clip (per channel; for "
+                   "comparison)")
+            ->check(CLI::IsMember({"hue", "clip"}))
+            ->capture_default_str();
+    cmd.add_flag("--no-viewing-compensation", o.noViewing,
+                 "drive every pixel as if seen on the panel normal");
+    cmd.add_flag("--no-flare-subtraction", o.noFlare,
+                 "do not subtract the screen's own reflection of the booth light");
+    auto* planner = cmd.add_flag(
+            "--planner", o.planner,
+            "draw each lamp with the planner's lights, specular samples and horizon directions, "
+            "planning the scene now (minutes, once; cached) when it has no plan; without "
+            "--planner or --no-planner a scene's cached or shipped plan is used when there is one "
+            "(the choice is recorded); the site file's [render] planner = true asks the same");
+    cmd.add_flag("--no-planner", o.noPlanner,
+                 "the fixed per-scene rules for every lamp (the site file's [render] planner = "
+                 "false asks the same)")
+            ->excludes(planner);
+    cmd.add_option("--plan-cache", o.planCache,
+                   "folder of the planner's cached plans (default $REPLICA_PLAN_CACHE, else "
+                   "$XDG_CACHE_HOME/replica/plans, else ~/.cache/replica/plans)");
+    cmd.add_flag("--false-colour", o.falseColour,
+                 "field-staff overlay: stripe out-of-gamut pixels (magenta: chroma, cyan: above "
+                 "peak, blue: below black)");
+}
+
+std::string dataPath(const std::string& p)
+{
+    const std::filesystem::path path(p);
+    return path.is_relative() ? (dataDir() / path).string() : path.string();
+}
+
+void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd)
+{
+    const auto unset = [&cmd](const char* name) { return cmd.get_option(name)->count() == 0; };
+    if (unset("--hal")) {
+        o.hal = s.hal;
+    }
+    if (unset("--replay-file")) {
+        o.replayFile = s.replayFile;
+    }
+    if (unset("--rate")) {
+        o.rateHz = s.rateHz;
+    }
+    if (unset("--output")) {
+        o.output = s.output;
+    }
+    if (unset("--size") && o.output != "kms") { // on KMS the frame is the mode's size
+        o.size = s.size;
+    }
+    if (unset("--kms-device")) {
+        o.outputChoice.kms.device = s.kmsDevice;
+    }
+    if (unset("--kms-connector")) {
+        o.outputChoice.kms.connector = s.kmsConnector;
+    }
+    if (unset("--scene") && !s.sceneDir.empty()) {
+        o.scene = dataPath(s.sceneDir);
+    }
+    if (unset("--renderer")) {
+        o.renderer = s.renderer;
+    }
+    if (unset("--display-profile") && unset("--uncalibrated") && !s.displayProfile.empty()) {
+        o.displayProfile = dataPath(s.displayProfile);
+    }
+    if (unset("--tracker-port")) {
+        o.live.trackerPort = s.trackerPort;
+    }
+    if (unset("--tracker-bind")) {
+        o.live.trackerBind = s.trackerBind;
+    }
+    if (unset("--iio-root")) {
+        o.live.iioRoot = s.iioRoot;
+    }
+    if (unset("--accel-name")) {
+        o.live.accelName = s.accelName;
+    }
+    if (unset("--accel-axes")) {
+        o.live.accelAxes = s.accelAxes;
+    }
+    if (unset("--lamp-gpio")) {
+        o.live.lampGpio = s.lampGpio;
+    }
+    if (unset("--spectrometer-serial")) {
+        o.live.spectrometerSerial = s.spectrometerSerial;
+    }
+    if (unset("--record-flush-ms")) {
+        o.recordFlushMs = s.flushMs;
+    }
+}
+
+std::optional<std::pair<int, int>> parseSize(const std::string& s)
+{
+    int w = 0;
+    int h = 0;
+    char x = 0;
+    char extra = 0;
+    if (std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
+        !frameSizeOk(w, h)) {
+        return std::nullopt;
+    }
+    return std::make_pair(w, h);
+}
+
+int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfig& config)
+{
+    auto log = logger("replica");
+    config.width = size.first;
+    config.height = size.second;
+    if (!o.panelSizeMm.empty()) {
+        auto panel = parseSizeMm(o.panelSizeMm);
+        if (!panel) {
+            log->error("--panel-size-mm: {}", panel.error().message);
+            return kExitUsage;
+        }
+        config.stand.panelWidthM = panel->width / 1000.0;
+        config.stand.panelHeightM = panel->height / 1000.0;
+    }
+    config.rateHz = o.rateHz;
+    config.renderer = o.renderer;
+    // The flat renderer has no 36-band scene to re-encode: it keeps the best fixed basis.
+    config.basis = !o.basis.empty() ? o.basis
+                                    : (o.renderer == "flat" ? std::string("replica_k6")
+                                                            : std::string(kAdaptiveBasis));
+    if (!o.scene.empty()) {
+        // Stored relative to the data folder when it is inside it, so that a recording replays on
+        // another installation.
+        std::error_code ec;
+        const auto abs = std::filesystem::weakly_canonical(o.scene, ec);
+        const auto data = std::filesystem::weakly_canonical(dataDir(), ec);
+        const auto rel = abs.lexically_relative(data);
+        config.sceneDir = !rel.empty() && *rel.begin() != ".." ? rel.string() : abs.string();
+        if (!std::filesystem::is_regular_file(abs / "scene.json", ec)) {
+            log->error("--scene {}: no scene.json there; name a scene folder such as {}", o.scene,
+                       (dataDir() / "scenes" / "painting").string());
+            return kExitUsage;
+        }
+    }
+    if (o.uncalibrated && !o.displayProfile.empty()) {
+        log->error("--uncalibrated and --display-profile {} contradict each other: give one",
+                   o.displayProfile);
+        return kExitUsage;
+    }
+    if (o.uncalibrated) {
+        config.display = kUncalibratedDisplay;
+        log->warn("--uncalibrated: driving a nominal sRGB-like {} cd/m^2 model, not a "
+                  "characterised panel; colours on screen are not the surface's",
+                  config.displayPeakCdM2);
+    } else if (!o.displayProfile.empty()) {
+        // Like the scene: relative to the data folder when inside it, so that replay (which
+        // opens only files inside the data folders) finds it on another installation.
+        std::error_code ec;
+        const auto abs = std::filesystem::weakly_canonical(
+                std::filesystem::absolute(o.displayProfile, ec), ec);
+        const auto data = std::filesystem::weakly_canonical(dataDir(), ec);
+        const auto rel = abs.lexically_relative(data);
+        config.display = !rel.empty() && *rel.begin() != ".."
+                                 ? rel.string()
+                                 : std::filesystem::absolute(o.displayProfile, ec).string();
+    }
+    config.displayInverse = o.displayInverse;
+    config.gamutMapping = o.gamut;
+    config.viewingCompensation = !o.noViewing;
+    config.flareSubtraction = !o.noFlare;
+    config.falseColour = o.falseColour;
+    // The planner in the loop: by default each lamp draws with the plan cached or shipped with
+    // the scene (the fixed rules where there is none); --planner (or the site's planner = true)
+    // also plans a scene that has none, --no-planner (planner = false) keeps the fixed rules.
+    config.planner = !o.noPlanner;
+    config.planIfMissing = o.planner;
+    if (!o.planner && !o.noPlanner && o.site && o.site->renderPlannerSet) {
+        config.planner = o.site->renderPlanner;
+        config.planIfMissing = o.site->renderPlanner;
+    }
+    config.plannerCache = o.planCache;
+    if (o.site) {
+        const SiteConfig& site = *o.site;
+        config.booth = site.boothId;
+        config.boothDimmer = site.boothDimmer;
+        config.boothDimmerAuto = site.boothDimmerAuto;
+        const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
+        config.stand = site.stand;
+        if (!o.panelSizeMm.empty()) { // the command line wins over the site file
+            config.stand.panelWidthM = panelW;
+            config.stand.panelHeightM = panelH;
+        }
+        config.trackerInBooth = site.trackerInBooth();
+        config.defaultLamp = site.defaultLamp;
+        config.defaultEyeM = site.defaultEyeM;
+        config.defaultTiltRad = site.defaultTiltDeg * std::numbers::pi / 180.0;
+    }
+    if (!o.sitePath.empty()) {
+        auto t = readTrackerTransform(o.sitePath);
+        if (!t && t.error().code != ErrorCode::NotFound) {
+            log->error("{}", t.error().message);
+            return kExitFailure;
+        }
+        if (t) {
+            config.trackerInBooth = *t; // the calibration wins over the site's angles
+            log->info("tracker pose in the booth from {} (T_booth_tracker)", o.sitePath);
+        } else {
+            log->warn("{}; using [tracker] rotation_deg and translation_m (absent: the fixed "
+                      "mounting)",
+                      t.error().message);
+        }
+    }
+    if (o.hal == "live" && syntheticDisplay(config)) {
+        const bool allowed = o.site && o.site->allowSynthetic;
+        for (int i = 0; i < 3; ++i) {
+            log->warn("!!! LIVE RUN ON A SYNTHETIC DISPLAY PROFILE ({}): the colours on this "
+                      "screen are not the surface's. Characterise the panel ('replica display "
+                      "fit') and set display.profile in the site file. !!!",
+                      config.display);
+        }
+        if (o.kiosk && !allowed) {
+            log->error("{}: the kiosk refuses a live run on a synthetic display profile; set "
+                       "display.profile to the panel's profile, or display.allow_synthetic = "
+                       "true to accept wrong colours",
+                       o.site ? o.site->source.string() : std::string("(no site file)"));
+            return kExitConfig;
+        }
+    }
+    return kExitOk;
+}
+
+} // namespace replica::platform::run_cli
+
+namespace replica::platform {
+
+void addKmsOptions(CLI::App& cmd, KmsOptions& kms)
+{
+    cmd.add_option("--kms-device", kms.device, "kms: the DRM card to drive")->capture_default_str();
+    cmd.add_option("--kms-connector", kms.connector,
+                   "kms: connector name, e.g. HDMI-A-1 (default: the first connected)");
+    cmd.add_option("--kms-mode", kms.mode,
+                   "kms: the mode, WIDTHxHEIGHT or WIDTHxHEIGHT@HZ (default: the display's "
+                   "preferred mode)");
+    cmd.add_option("--kms-modeset", kms.modeset,
+                   "kms: auto (atomic where the driver has it, else legacy), atomic or legacy")
+            ->check(CLI::IsMember({"auto", "atomic", "legacy"}))
+            ->capture_default_str();
+    cmd.add_option("--kms-path", kms.path,
+                   "kms: auto (EGL on a GBM surface, else CPU copies into dumb buffers), gbm or "
+                   "dumb")
+            ->check(CLI::IsMember({"auto", "gbm", "dumb"}))
+            ->capture_default_str();
+}
+
+} // namespace replica::platform

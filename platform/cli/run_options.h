@@ -1,0 +1,84 @@
+// The options of 'replica run': what the command line and the site file give, and how the site
+// file fills in what the command line leaves open.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include <CLI/CLI.hpp>
+
+#include <platform/appliance.h>
+#include <platform/live_sources.h>
+#include <platform/site_config.h>
+
+namespace replica::platform::run_cli {
+
+struct RunOptions {
+    std::string hal = "sim";
+    // Per device (empty: follow --hal): spectrometer live|sim|replay, tracker opentrack|hid|sim|
+    // replay, accel live|sim|replay, lamp selector none|sim|sim-miswired|gpio|replay.
+    std::string spectrometer;
+    std::string tracker;
+    std::string accel;
+    std::string lampSelector;
+    std::string replayFrom; // the recording that devices set to 'replay' play back
+    std::string sitePath;   // --site: [sources] and [tracker] T_booth_tracker (calibrate)
+    std::string output = "headless";
+    std::uint64_t frames = 180;
+    std::string size; // headless: 960x600 when not given; kms: the mode's size
+    std::string panelSizeMm;
+    double rateHz = 60.0;
+    std::string record;
+    bool force = false; // --force: overwrite an existing recording
+    int recordFlushMs = 500;
+    std::string digests;
+    std::string snapshot;
+    bool fast = false;
+    std::string scene;
+    std::string renderer = "booth";
+    std::string basis; // empty: adaptive_k6 for the booth renderer, replica_k6 for the flat one
+    std::string displayProfile;
+    bool uncalibrated = false;
+    std::string displayInverse = "analytic";
+    std::string gamut = "hue";
+    bool noViewing = false;
+    bool noFlare = false;
+    bool falseColour = false;
+    bool planner = false;   // --planner: plan a scene that has no plan yet
+    bool noPlanner = false; // --no-planner: the fixed rules
+    std::string planCache;
+    bool recordDigests = true; // format 4: XXH3-64 of every displayed frame in the recording
+    double thumbnailHz = 1.0;
+    int thumbnailWidth = 320;
+    bool json = false;
+    LiveOptions live;
+    OutputChoice outputChoice;
+    std::string replayFile; // --hal replay
+    std::string config;     // the site file
+    bool kiosk = false;
+    std::string faults; // --inject-faults
+    // From the site file only (no command-line option).
+    std::optional<SiteConfig> site;
+};
+
+constexpr int kExitConfig = 78; // EX_CONFIG: the unit's RestartPreventExitStatus
+
+// Declares every option of 'replica run' on 'cmd', each into its field of 'o'.
+void addRunOptions(CLI::App& cmd, RunOptions& o);
+
+// The site file's values for every option the command line did not give.
+void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd);
+
+// The run configuration the options ask for, at frame size 'size': logs what is wrong in one line
+// and returns the exit code (kExitOk when 'config' is built).
+int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfig& config);
+
+// A file name relative to the data folder (absolute ones as they are).
+std::string dataPath(const std::string& p);
+
+// "WIDTHxHEIGHT" within frameSizeOk, or nothing.
+std::optional<std::pair<int, int>> parseSize(const std::string& s);
+
+} // namespace replica::platform::run_cli

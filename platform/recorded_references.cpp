@@ -1,0 +1,182 @@
+// What a run configuration names on disk: the scene folder and its digest, the display profile's
+// name, and the checks that an untrusted recording names only files inside the data folders.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <numbers>
+#include <span>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <hal/replay/replay_source.h>
+#include <hal/sim/sim_devices.h>
+#include <pipeline/base/data_dir.h>
+#include <pipeline/base/input_file.h>
+#include <pipeline/booth/booth_model.h>
+#include <pipeline/colour/spectral_table.h>
+#include <pipeline/display/display_inverse.h>
+#include <pipeline/display/display_profile.h>
+#include <pipeline/display/nominal_display.h>
+#include <pipeline/render/gles_renderer.h>
+#include <pipeline/shading/realtime_model.h>
+#include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/spectral/representation_catalogue.h>
+#include <platform/appliance.h>
+#include <platform/booth_dimmer.h>
+#include <platform/logging.h>
+#include <platform/loop/frame_digest.h>
+#include <platform/run_config_schema.h>
+
+namespace replica::platform {
+
+std::filesystem::path resolveSceneDir(const std::string& sceneDir)
+{
+    const std::filesystem::path p(sceneDir);
+    return p.is_relative() ? dataDir() / p : p;
+}
+
+namespace {
+
+// 'p' lies inside 'root' once both are made absolute and '..' and links resolved as far as
+// they exist.
+bool inside(const std::filesystem::path& p, const std::filesystem::path& root)
+{
+    std::error_code ec;
+    const auto a = std::filesystem::weakly_canonical(std::filesystem::absolute(p, ec), ec);
+    if (ec) {
+        return false;
+    }
+    const auto r = std::filesystem::weakly_canonical(std::filesystem::absolute(root, ec), ec);
+    if (ec) {
+        return false;
+    }
+    const auto rel = a.lexically_relative(r);
+    return !rel.empty() && *rel.begin() != ".." && !rel.is_absolute();
+}
+
+Expected<void> checkReference(const std::string& key,
+                              const std::string& value,
+                              const std::vector<std::filesystem::path>& roots)
+{
+    const std::filesystem::path p(value);
+    bool dotdot = false;
+    for (const auto& part : p) {
+        dotdot = dotdot || part == "..";
+    }
+    std::string rootList = dataDir().string();
+    for (const auto& r : roots) {
+        rootList += ", " + r.string();
+    }
+    if (value.empty() || dotdot || value.find('\0') != std::string::npos) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("the recording's {} '{}' is not a name inside the data "
+                                     "folder ('..' or empty); refused",
+                                     key, value.substr(0, 200)));
+    }
+    if (p.is_relative()) {
+        return inside(dataDir() / p, dataDir())
+                       ? Expected<void>{}
+                       : makeError(ErrorCode::InvalidArgument,
+                                   fmt::format("the recording's {} '{}' leads out of the data "
+                                               "folder {} (a link?); refused",
+                                               key, value.substr(0, 200), dataDir().string()));
+    }
+    bool ok = inside(p, dataDir());
+    for (const auto& r : roots) {
+        ok = ok || inside(p, r);
+    }
+    if (!ok) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("the recording's {} is '{}', outside the data folders ({}); "
+                                     "replay opens only files there: copy it under one and pass "
+                                     "that folder with --data-root DIR",
+                                     key, value.substr(0, 200), rootList));
+    }
+    return {};
+}
+
+} // namespace
+
+Expected<void> checkRecordedReferences(const RunConfig& config,
+                                       const std::vector<std::filesystem::path>& roots,
+                                       bool allowUndigested)
+{
+    if (config.renderer == "booth") {
+        if (auto ok = checkReference("scene_dir", config.sceneDir, roots); !ok) {
+            return ok;
+        }
+        if (config.sceneDigest.empty() && !allowUndigested) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("the recording holds no digest of its scene '{}', so "
+                                         "the scene replayed cannot be checked against the one "
+                                         "recorded; pass --allow-undigested to replay it anyway",
+                                         config.sceneDir.substr(0, 200)));
+        }
+    }
+    if (config.display != kUncalibratedDisplay) {
+        if (auto ok = checkReference("display", config.display, roots); !ok) {
+            return ok;
+        }
+        if (config.displayDigest.empty() && !allowUndigested) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("the recording holds no digest of its display profile "
+                                         "'{}'; pass --allow-undigested to replay it anyway",
+                                         config.display.substr(0, 200)));
+        }
+    }
+    if (auto ok = checkReference("spectrometer_calibration", config.spectrometerCalibration, {});
+        !ok) {
+        return ok;
+    }
+    if (std::filesystem::path(config.spectrometerCalibration).is_absolute()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("the recording's spectrometer_calibration '{}' is not a "
+                                     "name inside the data folder; refused",
+                                     config.spectrometerCalibration.substr(0, 200)));
+    }
+    return {};
+}
+
+Expected<std::string> sceneDigest(const std::filesystem::path& dir)
+{
+    std::uint64_t h = 14695981039346656037ull;
+    for (const char* name : {"scene.json", "channels.exr", "height.exr", "material.exr"}) {
+        // Regular files only: a FIFO would block here and a directory throw from the stream.
+        if (auto ok = checkInputFile(dir / name, kMaxImageBytes, "scene"); !ok) {
+            if (ok.error().code == ErrorCode::NotFound) {
+                return makeError(ErrorCode::NotFound, fmt::format("{}: cannot read the scene file",
+                                                                  (dir / name).string()));
+            }
+            return tl::unexpected(ok.error());
+        }
+        std::ifstream in(dir / name, std::ios::binary);
+        if (!in) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot read the scene file", (dir / name).string()));
+        }
+        for (const char c : std::string(name)) {
+            h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+        }
+        std::array<char, 65536> buf{};
+        while (in.read(buf.data(), buf.size()) || in.gcount() > 0) {
+            for (std::streamsize i = 0; i < in.gcount(); ++i) {
+                h = (h ^ static_cast<unsigned char>(buf[static_cast<std::size_t>(i)])) *
+                    1099511628211ull;
+            }
+        }
+    }
+    return fmt::format("{:016x}", h);
+}
+
+std::string displayProfileId(const RunConfig& config, const std::string& profileName)
+{
+    if (config.display == kUncalibratedDisplay) {
+        return fmt::format("{} (uncalibrated nominal model)", kUncalibratedDisplay);
+    }
+    return fmt::format("{} ({}, fnv1a64 {})", profileName, config.display, config.displayDigest);
+}
+
+} // namespace replica::platform
