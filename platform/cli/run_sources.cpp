@@ -7,7 +7,7 @@
 #include <platform/cli/run_sources.h>
 #include <platform/live_sources.h>
 #include <platform/logging.h>
-#include <recordings/device_kinds.h>
+#include <recordings/device_kind.h>
 #include <recordings/recording.h>
 
 namespace replica::platform::run_cli {
