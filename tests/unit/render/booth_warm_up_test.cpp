@@ -11,7 +11,7 @@
 namespace replica::pipeline::render {
 namespace {
 
-constexpr int kW = 48, kH = 30;
+constexpr int kWarmW = 48, kWarmH = 30;
 
 class BoothWarmUpTest : public ::testing::Test
 {
@@ -34,7 +34,7 @@ protected:
         // Three passes: the setup's, and one of its own for each fluorescent.
         setup_.perLamp["d50-fluorescent"] = LampSettings{8, 24, 0};
         setup_.perLamp["d65-fluorescent"] = LampSettings{32, 4, 0};
-        auto t = XyzTarget::create(kW, kH);
+        auto t = XyzTarget::create(kWarmW, kWarmH);
         ASSERT_TRUE(t);
         target_ = std::move(*t);
     }
@@ -50,11 +50,11 @@ protected:
             st.tiltRad = 0.30 + 0.02 * i;
             st.eyeBoothM = {-0.2 + 0.05 * i, 0.45, 0.60};
             target_->bind();
-            auto ok = pass.draw(st, kW, kH);
+            auto ok = pass.draw(st, kWarmW, kWarmH);
             EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
-            std::vector<float> px(static_cast<std::size_t>(kW) * kH * 4);
+            std::vector<float> px(static_cast<std::size_t>(kWarmW) * kWarmH * 4);
             glPixelStorei(GL_PACK_ALIGNMENT, 1);
-            glReadPixels(0, 0, kW, kH, GL_RGBA, GL_FLOAT, px.data());
+            glReadPixels(0, 0, kWarmW, kWarmH, GL_RGBA, GL_FLOAT, px.data());
             frames.push_back(std::move(px));
         }
         return frames;
