@@ -40,6 +40,53 @@ glm::dvec3 tileReading(const glm::dvec3& counts,
     return sum / static_cast<double>(kDitherSize * kDitherSize);
 }
 
+// The screen's reflection of the booth light: what the pipeline subtracts from its targets (the
+// profile's estimate, none when it was measured in the lit booth) and what the screen's front
+// surface really adds to the reading (independent of the profile's note).
+struct BoothFlare {
+    FlareHandling handling = FlareHandling::Dark;
+    glm::dvec3 estimate{0.0};
+    glm::dvec3 real{0.0};
+
+    BoothFlare(const DisplayModel& model,
+               FlareHandling h,
+               double illuminanceLux,
+               const glm::dvec3& lightUnitY)
+        : handling(h)
+    {
+        if (h != FlareHandling::Dark) {
+            estimate = frontSurfaceFlareXyz(model, illuminanceLux, lightUnitY);
+            real = model.frontSurfaceReflectance * illuminanceLux / std::numbers::pi * lightUnitY;
+        }
+    }
+    // The XYZ the display is asked for when the render gives 'xyz'.
+    glm::dvec3 target(const glm::dvec3& xyz) const
+    {
+        return handling == FlareHandling::InBoothSubtract ? xyz - estimate : xyz;
+    }
+    // What a meter reads in front of the panel showing 'counts' (one dither tile).
+    glm::dvec3 reading(const glm::dvec3& counts,
+                       double maxCount,
+                       const std::function<glm::dvec3(const glm::dvec3&)>& panel) const
+    {
+        return tileReading(counts, maxCount, panel) + real;
+    }
+};
+
+// The renderer's XYZ (cd/m^2) of a reflectance through a six-channel basis under E lux.
+glm::dvec3 sixChannelXyz(const colour::ChannelBasis& basis,
+                         const colour::ChannelToXyz& toXyz,
+                         const colour::Spectrum& reflectance,
+                         double illuminanceLux)
+{
+    const colour::ChannelCoeffs c = colour::projectReflectance(basis, reflectance);
+    glm::dvec3 xyz(0.0);
+    for (std::size_t k = 0; k < colour::kChannels; ++k) {
+        xyz += c[k] * toXyz[k];
+    }
+    return xyz * (illuminanceLux / std::numbers::pi);
+}
+
 } // namespace
 
 std::vector<StudyLight> boothLights()
@@ -82,20 +129,17 @@ colorCheckerStudy(const DisplayInverse& inverse,
     if (!observer) {
         return tl::unexpected(observer.error());
     }
-    auto chart = colour::loadSpectralCsv(dataDir / "spectra" / kColorChecker);
+    auto chart = colorCheckerSamples(dataDir);
     if (!chart) {
         return tl::unexpected(chart.error());
     }
-    auto patches = chart->allSpectra();
-    if (!patches) {
-        return tl::unexpected(patches.error());
-    }
-    const auto whiteIt = std::find(chart->columns.begin(), chart->columns.end(), kWhitePatch);
-    if (whiteIt == chart->columns.end()) {
+    const std::vector<colour::Spectrum>* patches = &chart->reflectances;
+    const auto whiteIt = std::find(chart->names.begin(), chart->names.end(), kWhitePatch);
+    if (whiteIt == chart->names.end()) {
         return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: no column '{}'", chart->source, kWhitePatch));
+                         fmt::format("{}: no column '{}'", kColorChecker, kWhitePatch));
     }
-    const auto whiteIndex = static_cast<std::size_t>(whiteIt - chart->columns.begin());
+    const auto whiteIndex = static_cast<std::size_t>(whiteIt - chart->names.begin());
     const colour::ChannelBasis& basis = options.basis;
     const DisplayModel& model = inverse.model();
     const double maxCount = model.maxCount();
@@ -122,14 +166,7 @@ colorCheckerStudy(const DisplayInverse& inverse,
         const glm::dvec3 lightUnitY = lightXyz / lightXyz.y;
         const double scale = e / std::numbers::pi / lightXyz.y;
         const colour::ChannelToXyz toXyz = colour::channelToXyz(basis, *observer, *spd);
-        const glm::dvec3 flare = options.flare == FlareHandling::Dark
-                                         ? glm::dvec3(0.0)
-                                         : frontSurfaceFlareXyz(model, e, lightUnitY);
-        // What the screen's front surface really reflects (independent of the profile's note).
-        const glm::dvec3 realFlare =
-                options.flare == FlareHandling::Dark
-                        ? glm::dvec3(0.0)
-                        : model.frontSurfaceReflectance * e / std::numbers::pi * lightUnitY;
+        const BoothFlare flare(model, options.flare, e, lightUnitY);
 
         LightResult lr;
         lr.light = light.name;
@@ -146,21 +183,15 @@ colorCheckerStudy(const DisplayInverse& inverse,
         for (std::size_t p = 0; p < patches->size(); ++p) {
             const colour::Spectrum& refl = (*patches)[p];
             spectral.push_back(colour::spectrumToXyz(*observer, refl * *spd) * scale);
-            const colour::ChannelCoeffs c = colour::projectReflectance(basis, refl);
-            glm::dvec3 xyz(0.0);
-            for (std::size_t k = 0; k < colour::kChannels; ++k) {
-                xyz += c[k] * toXyz[k];
-            }
-            xyz *= e / std::numbers::pi;
+            const glm::dvec3 xyz = sixChannelXyz(basis, toXyz, refl, e);
             channel.push_back(xyz);
-            const glm::dvec3 target =
-                    options.flare == FlareHandling::InBoothSubtract ? xyz - flare : xyz;
+            const glm::dvec3 target = flare.target(xyz);
             const InverseResult mapped = inverse.invert(target, GamutMode::HueKeeping);
             const InverseResult clipped = inverse.invert(target, GamutMode::Clip);
-            shownMapped.push_back(tileReading(mapped.counts, maxCount, panel) + realFlare);
-            shownClipped.push_back(tileReading(clipped.counts, maxCount, panel) + realFlare);
+            shownMapped.push_back(flare.reading(mapped.counts, maxCount, panel));
+            shownClipped.push_back(flare.reading(clipped.counts, maxCount, panel));
             PatchResult pr;
-            pr.name = chart->columns[p];
+            pr.name = chart->names[p];
             pr.gamutClass = mapped.gamutClass;
             pr.targetXyz = target;
             if (options.paperSix != nullptr) {
@@ -168,10 +199,8 @@ colorCheckerStudy(const DisplayInverse& inverse,
                         spectral::shade(options.paperSix->encode(refl), paperVectors) * e /
                         std::numbers::pi;
                 paper.push_back(px);
-                const InverseResult pm = inverse.invert(
-                        options.flare == FlareHandling::InBoothSubtract ? px - flare : px,
-                        GamutMode::HueKeeping);
-                shownPaper.push_back(tileReading(pm.counts, maxCount, panel) + realFlare);
+                const InverseResult pm = inverse.invert(flare.target(px), GamutMode::HueKeeping);
+                shownPaper.push_back(flare.reading(pm.counts, maxCount, panel));
                 pr.paperSixGamutClass = pm.gamutClass;
             }
             lr.patches.push_back(pr);
@@ -316,12 +345,7 @@ sensedStudy(const DisplayInverse& inverse,
         const colour::ChannelToXyz toXyz = colour::channelToXyz(b, observer, spd);
         std::vector<glm::dvec3> out;
         for (const auto& refl : samples.reflectances) {
-            const colour::ChannelCoeffs c = colour::projectReflectance(b, refl);
-            glm::dvec3 xyz(0.0);
-            for (std::size_t k = 0; k < colour::kChannels; ++k) {
-                xyz += c[k] * toXyz[k];
-            }
-            out.push_back(xyz * (e / std::numbers::pi));
+            out.push_back(sixChannelXyz(b, toXyz, refl, e));
         }
         return out;
     };
@@ -339,13 +363,7 @@ sensedStudy(const DisplayInverse& inverse,
         for (const auto& refl : samples.reflectances) {
             truth.push_back(lab(colour::spectrumToXyz(observer, refl * real[li]) * scale));
         }
-        const glm::dvec3 flare = options.flare == FlareHandling::Dark
-                                         ? glm::dvec3(0.0)
-                                         : frontSurfaceFlareXyz(model, e, lightUnitY);
-        const glm::dvec3 realFlare =
-                options.flare == FlareHandling::Dark
-                        ? glm::dvec3(0.0)
-                        : model.frontSurfaceReflectance * e / std::numbers::pi * lightUnitY;
+        const BoothFlare flare(model, options.flare, e, lightUnitY);
         SensedLightStats st;
         st.light = lights[li].name;
         std::vector<double> dRender;
@@ -427,11 +445,9 @@ sensedStudy(const DisplayInverse& inverse,
             }
             for (std::size_t p = 0; p < xyz->size(); ++p) {
                 dRender.push_back(colour::ciede2000(truth[p], lab((*xyz)[p])));
-                const glm::dvec3 target = options.flare == FlareHandling::InBoothSubtract
-                                                  ? (*xyz)[p] - flare
-                                                  : (*xyz)[p];
-                const InverseResult mapped = inverse.invert(target, GamutMode::HueKeeping);
-                const glm::dvec3 shown = tileReading(mapped.counts, maxCount, panel) + realFlare;
+                const InverseResult mapped =
+                        inverse.invert(flare.target((*xyz)[p]), GamutMode::HueKeeping);
+                const glm::dvec3 shown = flare.reading(mapped.counts, maxCount, panel);
                 const double de = colour::ciede2000(truth[p], lab(shown));
                 (mapped.gamutClass == GamutClass::InGamut ? dIn : dOut).push_back(de);
             }

@@ -618,6 +618,77 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
             report.inverseCountsMax[c] = worst;
         }
 
+        // The fit's uncertainty of r at the gamut's corners (each primary and white at full
+        // drive): each channel's full-drive value (the bootstrap's spread, relative) and each
+        // primary's direction (rampPrimary's sum of readings, each with relative noise rho per
+        // XYZ component), carried through M^-1 into every channel. Three sigma of the largest is
+        // the mapping's edge tolerance: a colour the panel makes may lie that far outside the
+        // fitted gamut, and is then clamped per channel instead of gamut-mapped.
+        const glm::dmat3 mInv = glm::inverse(best.matrix);
+        double sigmaEdge = 0.0;
+        for (std::size_t c = 0; c < 3; ++c) {
+            const double topValue = best.fits[c](maxCount);
+            const double topRel = topValue > 0.0 ? topSpread[c] / topValue : 0.0;
+            const glm::dvec3 full = ramps[c].back().xyz - black;
+            const double fullSum = full.x + full.y + full.z;
+            glm::dvec3 sum(0.0);
+            glm::dvec3 sumSq(0.0);
+            for (const auto& p : ramps[c]) {
+                const glm::dvec3 above = p.xyz - black;
+                if (above.x + above.y + above.z > 0.2 * fullSum) {
+                    sum += above;
+                    sumSq += above * above;
+                }
+            }
+            const double len = glm::length(sum);
+            glm::dvec3 colSigma(0.0); // per XYZ component of the fitted column
+            if (len > 0.0) {
+                colSigma = glm::length(full) / len * rho * glm::sqrt(sumSq);
+            }
+            for (int k = 0; k < 3; ++k) {
+                double var = 0.0;
+                for (int j = 0; j < 3; ++j) {
+                    // Column c's error in r_k, relative to column c's length in r_c (1).
+                    const double e = mInv[j][k] * colSigma[j] *
+                                     (glm::length(best.matrix[static_cast<int>(c)]) /
+                                      std::max(glm::length(full), 1e-300));
+                    var += e * e;
+                }
+                if (k == static_cast<int>(c)) {
+                    var += topRel * topRel;
+                }
+                sigmaEdge = std::max(sigmaEdge, std::sqrt(var));
+            }
+        }
+        report.gamutEdgeSigma = sigmaEdge;
+        model.gamutEdgeTolerance = std::min(3.0 * sigmaEdge, 0.05);
+        // Black's uncertainty in r, which does not scale with the colour: the spread of the
+        // black readings over their count (or rho of black for a single reading), through M^-1.
+        std::vector<glm::dvec3> blacks;
+        for (const auto& m : set.rows) {
+            if (m.counts == glm::dvec3(0.0)) {
+                blacks.push_back(m.xyz);
+            }
+        }
+        glm::dvec3 blackSigma = rho * glm::abs(black);
+        if (blacks.size() >= 2) {
+            glm::dvec3 var(0.0);
+            for (const auto& b : blacks) {
+                var += (b - black) * (b - black);
+            }
+            const double nb = static_cast<double>(blacks.size());
+            blackSigma = glm::sqrt(var / (nb - 1.0) / nb);
+        }
+        double floorSigma = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            double var = 0.0;
+            for (int j = 0; j < 3; ++j) {
+                var += mInv[j][k] * mInv[j][k] * blackSigma[j] * blackSigma[j];
+            }
+            floorSigma = std::max(floorSigma, std::sqrt(var));
+        }
+        model.gamutEdgeFloor = std::min(3.0 * floorSigma, 0.05);
+
         // What the held-out readings' own noise gives against a perfect model.
         std::mt19937_64 rng(0xde00);
         double noiseDe = 0.0;

@@ -22,6 +22,8 @@ Expected<DisplayInverse> DisplayInverse::build(const DisplayModel& model, int lu
     inv.geometry_.blackXyz = model.blackXyz;
     inv.geometry_.blackY = model.blackXyz.y;
     inv.geometry_.whiteY = model.whiteXyz().y;
+    inv.geometry_.edgeTolerance = model.gamutEdgeTolerance;
+    inv.geometry_.edgeFloor = model.gamutEdgeFloor;
     inv.lutSize_ = lutSize;
     const double maxCount = model.maxCount();
     for (std::size_t c = 0; c < 3; ++c) {

@@ -44,6 +44,7 @@ struct FitReport {
     double additivityLuminanceSigmaPercent = -1.0; // 1 sigma of the luminance check from the noise
     double additivityNoiseDe00 = -1.0; // 99th percentile of the dE00 the noise alone gives
     bool additiveWithinNoise = false;
+    double gamutEdgeSigma = -1.0; // 1 sigma of r at the gamut's corners (the fit's uncertainty)
 };
 
 struct DisplayModel {
@@ -61,6 +62,15 @@ struct DisplayModel {
     double frontSurfaceReflectance = 0.002; // rho_d of the panel's front surface (paper)
     ViewingAngleTable viewing;
     FitReport fit;
+    // How far outside [0, 1] a channel's r may lie and still be shown per channel (clamped, counted
+    // in gamut) rather than gamut-mapped: the fit's own uncertainty at the gamut's corners (3
+    // sigma), so that a colour the panel makes, which the noisy fit puts a hair outside its gamut,
+    // is not moved along the hue-keeping line (that costs a bright primary up to 13 times the
+    // excursion). 0 (profiles without "gamut_edge_tolerance"): the mapping's rounding tolerance.
+    double gamutEdgeTolerance = 0.0;
+    // And its part that does not scale with the colour (black's uncertainty, in r): below 0 a
+    // channel may reach -(gamutEdgeTolerance max r + gamutEdgeFloor).
+    double gamutEdgeFloor = 0.0;
 
     double maxCount() const;
     glm::dvec3 whiteXyz() const { return blackXyz + matrix * glm::dvec3(1.0); }

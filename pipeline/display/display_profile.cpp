@@ -55,6 +55,8 @@ const JsonSchema& profileSchema()
                                       {"dy", angles}})
                                       .optional()},
             {"fit", map(any(), 256).optional()},
+            {"gamut_edge_tolerance", number(0.0, 0.05).optional()},
+            {"gamut_edge_floor", number(0.0, 0.05).optional()},
     });
     return s;
 }
@@ -85,6 +87,10 @@ std::string profileToJson(const DisplayModel& m)
                           {"luminance_ratio", m.viewing.luminanceRatio},
                           {"dx", m.viewing.dx},
                           {"dy", m.viewing.dy}};
+    if (m.gamutEdgeTolerance > 0.0) {
+        j["gamut_edge_tolerance"] = m.gamutEdgeTolerance;
+        j["gamut_edge_floor"] = m.gamutEdgeFloor;
+    }
     const auto& f = m.fit;
     j["fit"] = {{"training_colours", f.trainingColours},
                 {"held_out_colours", f.heldOutColours},
@@ -110,6 +116,7 @@ std::string profileToJson(const DisplayModel& m)
         jf["additivity_luminance_sigma_percent"] = f.additivityLuminanceSigmaPercent;
         jf["additivity_noise_de00"] = f.additivityNoiseDe00;
         jf["additive_within_noise"] = f.additiveWithinNoise;
+        jf["gamut_edge_sigma"] = f.gamutEdgeSigma;
     }
     return j.dump(2) + "\n";
 }
@@ -146,6 +153,8 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
         m.condition = cond == "dark" ? MeasurementCondition::Dark : MeasurementCondition::LitBooth;
         m.frontSurfaceReflectance = j.at("front_surface_reflectance").get<double>();
         m.blackXyz = vec3From(j.at("black_xyz_cd_m2"));
+        m.gamutEdgeTolerance = j.value("gamut_edge_tolerance", 0.0);
+        m.gamutEdgeFloor = j.value("gamut_edge_floor", 0.0);
         const auto& p = j.at("primaries_xyz_cd_m2");
         m.matrix = glm::dmat3(vec3From(p.at("r")), vec3From(p.at("g")), vec3From(p.at("b")));
         for (std::size_t c = 0; c < 3; ++c) {
@@ -199,6 +208,7 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
                         f.value("additivity_luminance_sigma_percent", -1.0);
                 m.fit.additivityNoiseDe00 = f.value("additivity_noise_de00", -1.0);
                 m.fit.additiveWithinNoise = f.value("additive_within_noise", false);
+                m.fit.gamutEdgeSigma = f.value("gamut_edge_sigma", -1.0);
             }
         }
     } catch (const std::exception& e) {

@@ -22,6 +22,8 @@ DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse)
     }
     p.blackY = static_cast<float>(g.blackY);
     p.whiteY = static_cast<float>(g.whiteY);
+    p.gamutEdgeTolerance = static_cast<float>(g.edgeTolerance);
+    p.gamutEdgeFloor = static_cast<float>(g.edgeFloor);
     p.maxCount = static_cast<float>(m.maxCount());
     p.lutSize = inverse.lutSize();
     p.lut.reserve(static_cast<std::size_t>(p.lutSize - 1) * 3 * 2);

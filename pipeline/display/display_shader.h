@@ -24,6 +24,10 @@ struct DisplayShaderParams {
     std::array<float, 3> blackXyz{};
     float blackY = 0.0f;
     float whiteY = 1.0f;
+    // DisplayModel::gamutEdgeTolerance (uniform uDispGamutEdgeTolerance; 0, the GL default of an
+    // unset uniform, is the mapping without it).
+    float gamutEdgeTolerance = 0.0f;
+    float gamutEdgeFloor = 0.0f; // uDispGamutEdgeFloor, likewise
     float maxCount = 255.0f;
     // Inverse tone LUTs: entry j = counts / maxCount at r = (j / (lutSize - 1))^3 (the cube-root
     // domain keeps near-black precision), as a (lutSize - 1) x 3 RG32F texture: row c = channel c,

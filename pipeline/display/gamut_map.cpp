@@ -56,10 +56,12 @@ mapToGamut(const GamutGeometry& g, const glm::dvec3& xyzIn, GamutMode mode, doub
     }
     glm::dvec3 xyz = xyzIn;
     bool overPeak = false;
+    const double edge = g.edgeTolerance;
     if (xyz.y > g.whiteY) {
-        // Scale to peak luminance: chromaticity kept. (Clip mode leaves it for the clip below.)
+        // Scale to peak luminance: chromaticity kept. (Clip mode leaves it for the clip below;
+        // within the edge tolerance of peak the channels are clamped below.)
         overPeak = true;
-        if (mode == GamutMode::HueKeeping) {
+        if (mode == GamutMode::HueKeeping && xyz.y > g.whiteY * (1.0 + edge)) {
             xyz *= g.whiteY / xyz.y;
         }
     }
@@ -74,7 +76,14 @@ mapToGamut(const GamutGeometry& g, const glm::dvec3& xyzIn, GamutMode mode, doub
     }
     const bool inside = r.x >= -tolerance && r.y >= -tolerance && r.z >= -tolerance &&
                         r.x <= 1.0 + tolerance && r.y <= 1.0 + tolerance && r.z <= 1.0 + tolerance;
-    if (inside || mode == GamutMode::Clip) {
+    // Within the fit's uncertainty of the gamut (the edge tolerance; below 0 relative to the
+    // colour's largest channel, since the fit's error in r scales with the colour): clamped per
+    // channel like an in-gamut colour, though still counted as outside.
+    const double low = std::max(tolerance, edge * std::max({r.x, r.y, r.z, 0.0}) + g.edgeFloor);
+    const double high = std::max(tolerance, edge);
+    const bool near = r.x >= -low && r.y >= -low && r.z >= -low && r.x <= 1.0 + high &&
+                      r.y <= 1.0 + high && r.z <= 1.0 + high;
+    if (inside || near || mode == GamutMode::Clip) {
         out.r = glm::clamp(r, 0.0, 1.0);
         out.gamutClass = overPeak ? GamutClass::OverPeak
                                   : (inside ? GamutClass::InGamut : GamutClass::Chroma);

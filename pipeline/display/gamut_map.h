@@ -61,11 +61,17 @@ struct GamutGeometry {
     glm::dvec3 blackXyz{0.0};
     double blackY = 0.0;
     double whiteY = 1.0;
+    // DisplayModel::gamutEdgeTolerance: within it of the gamut (below 0: times the colour's largest
+    // r; luminance: up to whiteY (1 + edgeTolerance)), r is clamped per channel instead of
+    // mapped; the class is still the strict one.
+    double edgeTolerance = 0.0;
+    double edgeFloor = 0.0; // DisplayModel::gamutEdgeFloor
 };
 
 // Maps an absolute XYZ (cd/m^2) into the display gamut. Non-finite input maps to black and counts
 // as below black. 'tolerance' is how far outside [0, 1] an r may be and still count as in gamut
-// (then it is clamped), so that rounding in the matrix does not flag in-gamut colours.
+// (then it is clamped), so that rounding in the matrix does not flag in-gamut colours; within the
+// geometry's edgeTolerance the channels are clamped too, but the class stays Chroma or OverPeak.
 MappedLinear
 mapToGamut(const GamutGeometry& g, const glm::dvec3& xyz, GamutMode mode, double tolerance = 1e-9);
 

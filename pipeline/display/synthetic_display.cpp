@@ -16,6 +16,59 @@ glm::dvec3 xyFull(const glm::dvec2& xy)
     return {xy.x / xy.y, 1.0, (1.0 - xy.x - xy.y) / xy.y};
 }
 
+// The R, G, B (and, for channels 4, grey) ramps at 'levels', in that order.
+void appendRamps(std::vector<glm::dvec3>& patches, const std::vector<double>& levels, int channels)
+{
+    for (int c = 0; c < channels; ++c) {
+        for (double v : levels) {
+            glm::dvec3 p(0.0);
+            if (c == 3) {
+                p = glm::dvec3(v);
+            } else {
+                p[c] = v;
+            }
+            patches.push_back(p);
+        }
+    }
+}
+
+// 'n' colours with every channel uniform over the counts 0..maxCount.
+void appendRandomColours(std::vector<glm::dvec3>& patches,
+                         int n,
+                         double maxCount,
+                         std::mt19937_64& rng)
+{
+    for (int i = 0; i < n; ++i) {
+        glm::dvec3 p;
+        for (int c = 0; c < 3; ++c) {
+            p[c] = std::floor(static_cast<double>(rng() >> 11) * 0x1.0p-53 * (maxCount + 1.0));
+        }
+        patches.push_back(p);
+    }
+}
+
+// Each patch read once: the panel's XYZ plus the meter's noise per component (sigma = relative
+// times the reading plus the absolute floor), drawn from 'rng' in patch order.
+std::vector<Measurement> readThroughMeter(const SyntheticDisplay& display,
+                                          const MeterNoise& noise,
+                                          const std::vector<glm::dvec3>& patches,
+                                          std::mt19937_64& rng)
+{
+    std::vector<Measurement> out;
+    out.reserve(patches.size());
+    for (const auto& p : patches) {
+        Measurement m;
+        m.counts = p;
+        const glm::dvec3 truth = display.forward(p);
+        for (int c = 0; c < 3; ++c) {
+            const double sigma = noise.relative * std::abs(truth[c]) + noise.absoluteCdM2;
+            m.xyz[c] = truth[c] + sigma * standardNormal(rng);
+        }
+        out.push_back(m);
+    }
+    return out;
+}
+
 } // namespace
 
 double standardNormal(std::mt19937_64& rng)
@@ -96,60 +149,24 @@ syntheticMeasurements(const SyntheticDisplay& display, const MeterNoise& noise, 
 {
     std::mt19937_64 rng(seed);
     const double maxCount = std::ldexp(1.0, display.bitDepth) - 1.0;
-    std::vector<glm::dvec3> patches;
-    for (int i = 0; i < 5; ++i) {
-        patches.emplace_back(0.0);
-    }
+    std::vector<glm::dvec3> patches(5, glm::dvec3(0.0));
     std::vector<double> levels{4.0};
     for (double v = 8.0; v < maxCount; v += 8.0) {
         levels.push_back(v);
     }
     levels.push_back(maxCount);
-    for (int c = 0; c < 4; ++c) {
-        for (double v : levels) {
-            glm::dvec3 p(0.0);
-            if (c == 3) {
-                p = glm::dvec3(v);
-            } else {
-                p[c] = v;
-            }
-            patches.push_back(p);
-        }
-    }
-    std::vector<glm::dvec3> colours;
+    appendRamps(patches, levels, 4);
+    // The fit alternates off-ramp colours between training and held-out, so both halves sample
+    // the grid and the random colours.
     for (int r = 0; r < 5; ++r) {
         for (int g = 0; g < 5; ++g) {
             for (int b = 0; b < 5; ++b) {
-                const glm::dvec3 p = glm::dvec3(r, g, b) * (maxCount / 4.0);
-                colours.push_back(glm::round(p));
+                patches.push_back(glm::round(glm::dvec3(r, g, b) * (maxCount / 4.0)));
             }
         }
     }
-    for (int i = 0; i < 60; ++i) {
-        glm::dvec3 p;
-        for (int c = 0; c < 3; ++c) {
-            p[c] = std::floor(static_cast<double>(rng() >> 11) * 0x1.0p-53 * (maxCount + 1.0));
-        }
-        colours.push_back(p);
-    }
-    // The fit alternates off-ramp colours between training and held-out, so both halves sample
-    // the grid and the random colours.
-    for (const auto& p : colours) {
-        patches.push_back(p);
-    }
-    std::vector<Measurement> out;
-    out.reserve(patches.size());
-    for (const auto& p : patches) {
-        Measurement m;
-        m.counts = p;
-        const glm::dvec3 truth = display.forward(p);
-        for (int c = 0; c < 3; ++c) {
-            const double sigma = noise.relative * std::abs(truth[c]) + noise.absoluteCdM2;
-            m.xyz[c] = truth[c] + sigma * standardNormal(rng);
-        }
-        out.push_back(m);
-    }
-    return out;
+    appendRandomColours(patches, 60, maxCount, rng);
+    return readThroughMeter(display, noise, patches, rng);
 }
 
 std::vector<Measurement> syntheticSession(const SyntheticDisplay& display,
@@ -159,49 +176,19 @@ std::vector<Measurement> syntheticSession(const SyntheticDisplay& display,
 {
     std::mt19937_64 rng(seed);
     const double maxCount = std::ldexp(1.0, display.bitDepth) - 1.0;
-    std::vector<glm::dvec3> patches;
-    for (int i = 0; i < plan.blackRepeats; ++i) {
-        patches.emplace_back(0.0);
-    }
+    std::vector<glm::dvec3> patches(static_cast<std::size_t>(std::max(plan.blackRepeats, 0)),
+                                    glm::dvec3(0.0));
     std::vector<double> levels;
     for (double v = plan.rampStep; v < maxCount; v += plan.rampStep) {
         levels.push_back(v);
     }
     levels.push_back(maxCount);
-    for (int c = 0; c < (plan.greyRamp ? 4 : 3); ++c) {
-        for (double v : levels) {
-            glm::dvec3 p(0.0);
-            if (c == 3) {
-                p = glm::dvec3(v);
-            } else {
-                p[c] = v;
-            }
-            patches.push_back(p);
-        }
-    }
+    appendRamps(patches, levels, plan.greyRamp ? 4 : 3);
     for (int i = plan.greyRamp ? 1 : 0; i < plan.whiteRepeats; ++i) {
         patches.emplace_back(maxCount);
     }
-    for (int i = 0; i < plan.randomColours; ++i) {
-        glm::dvec3 p;
-        for (int c = 0; c < 3; ++c) {
-            p[c] = std::floor(static_cast<double>(rng() >> 11) * 0x1.0p-53 * (maxCount + 1.0));
-        }
-        patches.push_back(p);
-    }
-    std::vector<Measurement> out;
-    out.reserve(patches.size());
-    for (const auto& p : patches) {
-        Measurement m;
-        m.counts = p;
-        const glm::dvec3 truth = display.forward(p);
-        for (int c = 0; c < 3; ++c) {
-            const double sigma = noise.relative * std::abs(truth[c]) + noise.absoluteCdM2;
-            m.xyz[c] = truth[c] + sigma * standardNormal(rng);
-        }
-        out.push_back(m);
-    }
-    return out;
+    appendRandomColours(patches, plan.randomColours, maxCount, rng);
+    return readThroughMeter(display, noise, patches, rng);
 }
 
 } // namespace replica::pipeline::display

@@ -161,6 +161,9 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     glUniform3fv(glGetUniformLocation(program_.get(), "uDispBlackXyz"), 1, params.blackXyz.data());
     glUniform1f(glGetUniformLocation(program_.get(), "uDispBlackY"), params.blackY);
     glUniform1f(glGetUniformLocation(program_.get(), "uDispWhiteY"), params.whiteY);
+    glUniform1f(glGetUniformLocation(program_.get(), "uDispGamutEdgeTolerance"),
+                params.gamutEdgeTolerance);
+    glUniform1f(glGetUniformLocation(program_.get(), "uDispGamutEdgeFloor"), params.gamutEdgeFloor);
     glUniform1f(glGetUniformLocation(program_.get(), "uDispMaxCount"), params.maxCount);
     setInt(program_.get(), "uDispLutSize", params.lutSize);
     if (params.viewingRows > 0) {

@@ -2,6 +2,7 @@
 // for scripts and field checks, and write the synthetic measurement set the shipped profile uses.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numbers>
@@ -102,6 +103,28 @@ int fitMain(const DisplayOptions& o)
         log->error("{}", set.error().message);
         return kExitFailure;
     }
+    // The outputs are checked before the fit, not after it: an unwritable --out or --icc fails at
+    // once, and a file that did not exist is not left behind.
+    for (const std::string& path : {o.out, o.icc}) {
+        if (path.empty()) {
+            continue;
+        }
+        std::error_code ec;
+        const bool existed = std::filesystem::exists(path, ec);
+        if (existed && !std::filesystem::is_regular_file(path, ec)) {
+            log->error("{}: not a regular file; give a file path to write", path);
+            return kExitFailure;
+        }
+        const bool writable =
+                static_cast<bool>(std::ofstream(path, std::ios::binary | std::ios::app));
+        if (!existed) {
+            std::filesystem::remove(path, ec);
+        }
+        if (!writable) {
+            log->error("{}: cannot write here (check the folder exists and is writable)", path);
+            return kExitFailure;
+        }
+    }
     pd::FitOptions fo;
     fo.name = o.name.empty() ? std::filesystem::path(o.out).stem().string() : o.name;
     fo.synthetic = o.synthetic;
@@ -162,7 +185,8 @@ int fitMain(const DisplayOptions& o)
                                   {"held_out_noise_mean_de00", f.heldOutNoiseMeanDe00},
                                   {"tone_shape", f.toneShape},
                                   {"inverse_counts_rms", f.inverseCountsRms},
-                                  {"inverse_counts_max", f.inverseCountsMax}}
+                                  {"inverse_counts_max", f.inverseCountsMax},
+                                  {"gamut_edge_tolerance", model->gamutEdgeTolerance}}
                            .dump());
     } else {
         const glm::dvec3 w = model->whiteXyz();
@@ -185,6 +209,10 @@ int fitMain(const DisplayOptions& o)
                        f.toneShape[0], f.toneShape[1], f.toneShape[2], f.inverseCountsRms[0],
                        f.inverseCountsRms[1], f.inverseCountsRms[2], f.inverseCountsMax[0],
                        f.inverseCountsMax[1], f.inverseCountsMax[2]);
+            fmt::print("gamut edge tolerance: {:.4f} in r (3 sigma of the fit at the gamut's "
+                       "corners; colours within it of the gamut are clamped per channel, not "
+                       "gamut-mapped)\n",
+                       model->gamutEdgeTolerance);
         }
         if (f.additivityDe00 >= 0.0 && f.additivityNoiseDe00 >= 0.0) {
             fmt::print("additivity: white vs black + R + G + B dE00 {:.3f} (the noise alone gives "

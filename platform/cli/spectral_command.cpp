@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -280,8 +282,24 @@ int runFit(const FitOptions& o)
     }
     const std::filesystem::path outDir =
             o.out.empty() ? data / "channels" : std::filesystem::path(o.out);
+    // The output folder is checked before the fits (minutes), not after them.
     std::error_code ec;
     std::filesystem::create_directories(outDir, ec);
+    if (ec || !std::filesystem::is_directory(outDir)) {
+        return fail(fmt::format("--out {}: cannot use it as the output folder ({}); give a "
+                                "writable folder",
+                                outDir.string(), ec ? ec.message() : "not a folder"));
+    }
+    {
+        const std::filesystem::path probe = outDir / ".replica-spectral-fit-write-test";
+        const bool writable = static_cast<bool>(std::ofstream(probe));
+        std::filesystem::remove(probe, ec);
+        if (!writable) {
+            return fail(fmt::format("--out {}: the folder is not writable; give a writable "
+                                    "folder",
+                                    outDir.string()));
+        }
+    }
     const std::string provenance =
             fmt::format("fitted by 'replica spectral fit' on {} reflectances ({}) and {} lights "
                         "({}); working grid "

@@ -6,6 +6,8 @@ uniform mat3 uDispXyzToLinear;
 uniform vec3 uDispBlackXyz;
 uniform float uDispBlackY;
 uniform float uDispWhiteY;
+uniform float uDispGamutEdgeTolerance; // the profile's (gamut_map.h); 0 when unset: none
+uniform float uDispGamutEdgeFloor;
 uniform float uDispMaxCount;
 uniform int uDispLutSize;
 uniform highp sampler2D uDispToneLut;  // (lutSize - 1) x 3, RG32F, texelFetch only
@@ -32,9 +34,10 @@ vec4 invert(vec3 xyzIn, int mode) {
         return vec4(0.0, 0.0, 0.0, 3.0);
     }
     float cls = 0.0;
+    float edge = uDispGamutEdgeTolerance;
     if (xyz.y > uDispWhiteY) {
         cls = 2.0;
-        if (mode == 0) {
+        if (mode == 0 && xyz.y > uDispWhiteY * (1.0 + edge)) {
             xyz *= uDispWhiteY / xyz.y;
         }
     }
@@ -47,10 +50,14 @@ vec4 invert(vec3 xyzIn, int mode) {
     // float rounding in M^-1 must not flag in-gamut colours: a small tolerance, then clamp.
     const float tol = 1e-5;
     bool inside = all(greaterThanEqual(r, vec3(-tol))) && all(lessThanEqual(r, vec3(1.0 + tol)));
+    // Within the profile's edge tolerance (relative to the largest channel below 0): clamped.
+    float low = max(tol, edge * max(max(r.x, max(r.y, r.z)), 0.0) + uDispGamutEdgeFloor);
+    bool near = all(greaterThanEqual(r, vec3(-low))) &&
+                all(lessThanEqual(r, vec3(1.0 + max(tol, edge))));
     if (below) {
         r = mode == 1 ? r : vec3(0.0);
         cls = 3.0;
-    } else if (!inside && mode == 0) {
+    } else if (!near && mode == 0) {
         // As mapToGamut: towards the same-luminance neutral until no channel is negative, then
         // scale down until none exceeds 1.
         float s = clamp((xyz.y - uDispBlackY) / span, 0.0, 1.0);

@@ -29,6 +29,24 @@ TEST(DisplayProfile, RoundTripsThroughJson)
     EXPECT_EQ(back->viewing.angleDeg, m.viewing.angleDeg);
     EXPECT_DOUBLE_EQ(back->fit.heldOutMeanDe00, m.fit.heldOutMeanDe00);
     EXPECT_EQ(back->condition, MeasurementCondition::Dark);
+    // The gamut edge tolerance travels with the profile; a profile without it has none.
+    EXPECT_DOUBLE_EQ(back->gamutEdgeTolerance, m.gamutEdgeTolerance);
+    EXPECT_DOUBLE_EQ(back->gamutEdgeFloor, m.gamutEdgeFloor);
+    DisplayModel none = m;
+    none.gamutEdgeTolerance = 0.0;
+    none.gamutEdgeFloor = 0.0;
+    const std::string noneText = profileToJson(none);
+    EXPECT_EQ(noneText.find("gamut_edge_tolerance"), std::string::npos);
+    auto noneBack = profileFromJson(noneText, "n.json");
+    ASSERT_TRUE(noneBack.has_value()) << noneBack.error().message;
+    EXPECT_EQ(noneBack->gamutEdgeTolerance, 0.0);
+    DisplayModel t = m;
+    t.gamutEdgeTolerance = 0.0042;
+    const std::string text = profileToJson(t);
+    EXPECT_NE(text.find("gamut_edge_tolerance"), std::string::npos);
+    auto withTolerance = profileFromJson(text, "t.json");
+    ASSERT_TRUE(withTolerance.has_value()) << withTolerance.error().message;
+    EXPECT_DOUBLE_EQ(withTolerance->gamutEdgeTolerance, 0.0042);
 }
 
 TEST(DisplayProfile, BadProfilesAreRejectedWithTheReason)

@@ -171,5 +171,49 @@ TEST_F(GamutMapTest, QuantisedCountsAlwaysInRange)
     }
 }
 
+TEST_F(GamutMapTest, WithinTheEdgeToleranceChannelsAreClampedNotMapped)
+{
+    // Full blue a hair outside the fitted gamut (red at -0.002): without a tolerance the
+    // hue-keeping mapping moves it towards the neutral of its luminance and blue drops by about
+    // s / (s + 0.002) of the way (s ~ 0.07, blue's share of white's luminance); with the profile's
+    // edge tolerance the channels are clamped (the class stays the strict one).
+    const glm::dvec3 target = xyzOfLinear({-0.002, 0.0005, 1.0015});
+    GamutGeometry g = inv_->geometry();
+    g.edgeTolerance = 0.0;
+    const auto mapped = mapToGamut(g, target, GamutMode::HueKeeping);
+    EXPECT_EQ(mapped.gamutClass, GamutClass::Chroma);
+    EXPECT_LT(mapped.r.z, 0.99);
+    g.edgeTolerance = 0.003;
+    const auto clamped = mapToGamut(g, target, GamutMode::HueKeeping);
+    EXPECT_EQ(clamped.gamutClass, GamutClass::Chroma);
+    EXPECT_DOUBLE_EQ(clamped.r.x, 0.0);
+    EXPECT_NEAR(clamped.r.y, 0.0005, 1e-9);
+    EXPECT_DOUBLE_EQ(clamped.r.z, 1.0);
+    // White 0.2 % above peak is within it too: clamped, not scaled.
+    const glm::dvec3 white = xyzOfLinear(glm::dvec3(1.002));
+    const auto peak = mapToGamut(g, white, GamutMode::HueKeeping);
+    EXPECT_EQ(peak.gamutClass, GamutClass::OverPeak);
+    EXPECT_EQ(peak.r, glm::dvec3(1.0));
+    // Relative to the colour below 0: a dark colour with the same excursion is mapped.
+    const glm::dvec3 dark = xyzOfLinear({-0.002, 0.0005, 0.1});
+    EXPECT_LT(mapToGamut(g, dark, GamutMode::HueKeeping).r.z, 0.099);
+    // Beyond the tolerance the mapping is as before.
+    const glm::dvec3 far = xyzOfLinear({-0.01, 0.0, 1.0});
+    g.edgeTolerance = 0.003;
+    const auto farMapped = mapToGamut(g, far, GamutMode::HueKeeping);
+    EXPECT_EQ(farMapped.gamutClass, GamutClass::Chroma);
+    EXPECT_NEAR(xyzOfLinear(farMapped.r).y, far.y, 1e-9 * far.y);
+    // The inverse takes the tolerance from the model (0 when a profile has none).
+    DisplayModel m = model();
+    m.gamutEdgeTolerance = 0.0;
+    auto none = DisplayInverse::build(m);
+    ASSERT_TRUE(none.has_value());
+    EXPECT_LT(none->invert(target, GamutMode::HueKeeping).linear.z, 0.99);
+    m.gamutEdgeTolerance = 0.003;
+    auto inv = DisplayInverse::build(m);
+    ASSERT_TRUE(inv.has_value());
+    EXPECT_EQ(inv->invert(target, GamutMode::HueKeeping).linear.z, 1.0);
+}
+
 } // namespace
 } // namespace replica::pipeline::display
