@@ -250,6 +250,14 @@ int replayMain(const ReplayOptions& o)
         log->error("{}", appliance.error().message);
         return kExitFailure;
     }
+    // A rotated session file starts where the one before it ended: its estimators' state.
+    if (auto ok = restoreStateAtStart(**appliance, recording->session.configJson); !ok) {
+        log->error("{}: {}", o.file, ok.error().message);
+        return kExitFailure;
+    } else if ((*appliance)->updater->started()) {
+        log->info("{}: a rotated session file: its estimators start from the state it carries",
+                  o.file);
+    }
     Sources sources = makeReplaySources(*recording);
     const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
                           : o.clock == "step"   ? Pacing::Step
