@@ -388,7 +388,8 @@ int replayMain(const ReplayOptions& o)
     const bool showProgress = !o.noProgress && (o.progress || ::isatty(STDERR_FILENO) == 1);
     const auto wallStart = std::chrono::steady_clock::now();
     auto lastProgress = wallStart;
-    std::uint64_t done = 0;
+    // The frames before a slice are only estimated (TickPlan::warmup): they reach no callback.
+    std::uint64_t done = plan.size() - sliceFrames;
     auto onFrame = [&](const recordings::FrameRecord& f, const pipeline::scene::SceneState& scene,
                        const pipeline::render::RenderedFrame& image) {
         ++done;
