@@ -9,6 +9,7 @@
 #include <hal/sim/sim_devices.h>
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/scene/booth.h>
 
 #include <gtest/gtest.h>
 
