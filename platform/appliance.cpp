@@ -431,12 +431,20 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     app->renderer = std::move(*renderer);
     app->displayProfileId = displayId;
 
-    SceneUpdaterSetup updaterSetup;
-    updaterSetup.booth = app->booth;
-    updaterSetup.calibration = *calibration;
-    updaterSetup.trackerInBooth = config.trackerInBooth;
-    updaterSetup.defaultEyeM = config.defaultEyeM;
-    updaterSetup.defaultTiltRad = config.defaultTiltRad;
+    // The state stage (state/): the light, eye and tilt estimators.
+    state::SceneEstimatorSetup updaterSetup;
+    updaterSetup.light.booth = app->booth;
+    updaterSetup.light.calibration = *calibration;
+    if (app->boothScene) {
+        // The re-encode decision and the diffuse term's sliced refresh are state: the estimators
+        // take the booth pass's encoder, lamp spectra and slice count.
+        updaterSetup.light.adaptive = encoder;
+        updaterSetup.light.encodeSpectra = app->boothScene->lampSpectra();
+        updaterSetup.tilt.cacheSlices = config.cacheSlices;
+    }
+    updaterSetup.eye.trackerInBooth = config.trackerInBooth;
+    updaterSetup.eye.defaultEyeM = config.defaultEyeM;
+    updaterSetup.tilt.defaultTiltRad = config.defaultTiltRad;
     if (!config.defaultLamp.empty()) {
         const auto& lamps = app->booth.lights;
         const auto it = std::find_if(lamps.begin(), lamps.end(),
@@ -446,14 +454,27 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
                              fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
                                          config.defaultLamp, config.booth, app->booth.names()));
         }
-        updaterSetup.defaultLamp = static_cast<int>(it - lamps.begin());
+        updaterSetup.light.defaultLamp = static_cast<int>(it - lamps.begin());
     }
-    auto updater = SceneUpdater::create(std::move(updaterSetup));
+    auto updater = state::SceneEstimator::create(std::move(updaterSetup));
     if (!updater) {
         return tl::unexpected(updater.error());
     }
-    app->updater = std::make_unique<SceneUpdater>(std::move(*updater));
+    app->updater = std::make_unique<state::SceneEstimator>(std::move(*updater));
     return app;
+}
+
+Expected<void> restoreStateAtStart(Appliance& appliance, const std::string& configJson)
+{
+    const auto config = nlohmann::json::parse(configJson, nullptr, false);
+    if (config.is_discarded() || !config.is_object() || !config.contains(kStateAtStartKey)) {
+        return {};
+    }
+    if (auto ok = appliance.updater->restore(config[kStateAtStartKey]); !ok) {
+        return makeError(ok.error().code, fmt::format("the run configuration's {}: {}",
+                                                      kStateAtStartKey, ok.error().message));
+    }
+    return {};
 }
 
 } // namespace replica::platform

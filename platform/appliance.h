@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+#include <state/scene_estimator.h>
 
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
@@ -19,7 +20,6 @@
 #include <pipeline/render/renderer.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/scene/stand.h>
-#include <platform/loop/scene_updater.h>
 #include <platform/output/output.h>
 #include <platform/render_plan.h>
 #include <recordings/recording.h>
@@ -180,8 +180,8 @@ struct Appliance {
     // The booth renderer's pass 1 (shared with the renderer), null with the flat renderer: what
     // tests ask about the adaptive encoding (its basis, how often it re-encoded).
     std::shared_ptr<pipeline::render::BoothScenePass> boothScene;
-    std::unique_ptr<SceneUpdater> updater;
-    std::string displayProfileId;    // as recorded in the session
+    std::unique_ptr<state::SceneEstimator> updater; // the state stage (state/)
+    std::string displayProfileId;                   // as recorded in the session
     glm::dvec3 displayWhiteXyz{0.0}; // the panel's full white (cd/m^2): Lab white of frame reports
     ~Appliance()
     {
@@ -229,6 +229,14 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
 // The built-in simulated sensors playing the scripted scenario. lampSelector: "none", "sim" (a
 // switch that follows the scenario's lamps), or "sim-miswired" (its lines for lamps 1 and 2
 // swapped, to exercise the disagreement path).
+// The run configuration's key for the estimators' state at the start of a rotated session file
+// (state::SceneEstimator::save), which files 2, 3, ... of a kiosk session carry so that each
+// replays alone; absent in the first file and in every recording made before.
+constexpr const char* kStateAtStartKey = "state_at_start";
+// Restores the appliance's estimators from a recording's configuration JSON when it has
+// kStateAtStartKey; nothing to do otherwise. Fails with one line naming what is wrong.
+Expected<void> restoreStateAtStart(Appliance& appliance, const std::string& configJson);
+
 Expected<Sources> makeSimSources(const Appliance& appliance,
                                  const std::string& lampSelector = "none");
 

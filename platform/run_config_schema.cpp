@@ -87,6 +87,9 @@ const JsonSchema& runConfigSchema()
                 // What 'replica run' adds for people (never read back): any values.
                 {"run_options", map(any(), 64).optional()},
                 {"site", map(any(), 64).optional()},
+                // The estimators' state at the head of a rotated session file
+                // (state::SceneEstimator::save; checked field by field by restore).
+                {"state_at_start", map(any(), 16).optional()},
         });
     }();
     return s;

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Checks the allowed dependency edges between layers (style guide section 1): pipeline and hal include
-# nothing of the other layers (hal may use pipeline/base only); recordings only hal and pipeline/base.
+# nothing of the other layers (hal may use pipeline/base only); recordings only hal and pipeline/base;
+# state/ (sensor samples -> SceneState) sits between hal and the renderer: it may include hal and the
+# pipeline below render/, and nothing but platform includes it (hal -> state -> render).
 # Inside pipeline/, its folders are in an order (pipeline/CMakeLists.txt): each may include only itself
 # and the folders before it; only render/ includes GL headers; no run-time file includes the header of
 # an offline tool (the list in pipeline/CMakeLists.txt).
@@ -17,9 +19,12 @@ check() {
         status=1
     fi
 }
-check pipeline 'hal|recordings|platform' "must not depend on device, recording or platform code"
-check hal 'recordings|platform' "must not depend on recordings or platform"
-check recordings 'platform' "must not depend on platform"
+check pipeline 'hal|recordings|platform|state' \
+    "must not depend on device, recording, state-stage or platform code"
+check hal 'recordings|platform|state' "must not depend on recordings, state or platform"
+check recordings 'platform|state' "must not depend on state or platform"
+check state 'recordings|platform|pipeline/render' \
+    "must not depend on recordings, platform or the renderer (hal -> state -> render)"
 # hal may include only the header-only vocabulary from pipeline/base.
 hits=$(grep -rnE '#include <pipeline/' "$root/hal" --include='*.h' --include='*.cpp' | grep -v '<pipeline/base/' || true)
 if [ -n "$hits" ]; then

@@ -1,12 +1,11 @@
-// Scene state to booth pass: light selection and caching, view from eye and tilt.
+// Scene state to booth pass: the state's light, encoding and tilts uploaded where the GPU holds
+// others, then drawn.
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include <fmt/format.h>
 
 #include <pipeline/render/booth_scene_pass.h>
-#include <pipeline/spectral/light_classifier.h>
 
 namespace replica::pipeline::render {
 
@@ -86,6 +85,7 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
         p->lampVariant_.push_back(index);
     }
     p->active_ = 0;
+    p->basis_ = s.basis;
     p->prepared_ = p->variants_[0].prepared.get();
     p->pass_ = p->variants_[0].pass.get();
     return p;
@@ -100,10 +100,12 @@ Expected<void> BoothScenePass::useVariant(std::size_t v)
             return ok;
         }
         var.encodings = encodings_;
+        var.holds.valid = false;
     }
     if (v != active_) {
         // Each pass holds its own light and cache: they must follow the variant drawn.
         var.pass->setSurroundIlluminance(pass_->surroundIlluminance());
+        var.holds.valid = false;
         active_ = v;
         prepared_ = var.prepared.get();
         pass_ = var.pass.get();
@@ -124,6 +126,7 @@ void BoothScenePass::invalidateCache()
 {
     for (auto& v : variants_) {
         v.pass->invalidateCache();
+        v.holds.valid = false;
     }
 }
 
@@ -131,6 +134,7 @@ void BoothScenePass::setSurroundIlluminance(bool on)
 {
     for (auto& v : variants_) {
         v.pass->setSurroundIlluminance(on);
+        v.holds.valid = false;
     }
 }
 
@@ -149,118 +153,141 @@ std::string BoothScenePass::description() const
     return fmt::format("gles-booth (scene {}, {} median-cut lights, {} specular samples, {} "
                        "horizon directions{}, basis {}{})",
                        setup_.scene.name, s.lights, glossy ? s.specularSamples : 0,
-                       flat ? 0 : s.horizonDirections, grids, setup_.basis.name,
+                       flat ? 0 : s.horizonDirections, grids, basis_.name,
                        setup_.adaptive ? ", re-encoded for each new light" : "");
 }
 
-Expected<void> BoothScenePass::selectLight(const scene::SceneState& state, bool& changed)
+std::vector<colour::Spectrum> BoothScenePass::lampSpectra() const
 {
-    changed = false;
+    std::vector<colour::Spectrum> out;
+    for (const auto& lamp : setup_.lamps) {
+        out.push_back(setup_.booth.find(lamp)->spd); // create() checked that each has a light
+    }
+    return out;
+}
+
+Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
+{
     const int lamp = state.lampIndex;
-    if (lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.lamps.size()) {
-        const booth::BoothLight* l =
-                setup_.booth.find(setup_.lamps[static_cast<std::size_t>(lamp)]);
-        const int index = static_cast<int>(l - setup_.booth.lights.data());
-        if (index == lightIndex_) {
-            return {};
-        }
-        if (auto ok = encodeFor(l->spd, true); !ok) {
-            return ok;
-        }
-        if (auto ok = useVariant(lampVariant_[static_cast<std::size_t>(lamp)]); !ok) {
-            return ok;
-        }
-        light_ = shading::prepareLight(*l, setup_.observer, pass_->settings().lights, setup_.basis);
-        lightIndex_ = index;
-        changed = true;
+    const bool isLamp = lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.lamps.size();
+    const booth::BoothLight* l =
+            isLamp ? setup_.booth.find(setup_.lamps[static_cast<std::size_t>(lamp)]) : nullptr;
+    const int index = isLamp ? static_cast<int>(l - setup_.booth.lights.data()) : -1;
+    const bool onGpu = index == lightIndex_ && state.encoding == encodings_ &&
+                       (isLamp || (state.illuminant.v == directSpd_.v &&
+                                   state.emitterLuminanceCdM2 == directLuminance_));
+    if (onGpu && !state.lightChanged) {
+        return {};
+    }
+    if (auto ok = applyEncoding(state); !ok) {
+        return ok;
+    }
+    if (auto ok = useVariant(isLamp ? lampVariant_[static_cast<std::size_t>(lamp)] : 0); !ok) {
+        return ok;
+    }
+    if (isLamp) {
+        light_ = shading::prepareLight(*l, setup_.observer, pass_->settings().lights, basis_);
     } else {
-        // Direct-sensor mode: rebuilt only when the sensed spectrum or luminance changes.
-        if (lightIndex_ == -1 && state.illuminant.v == directSpd_.v &&
-            state.emitterLuminanceCdM2 == directLuminance_) {
-            return {};
-        }
-        if (auto ok = encodeFor(state.illuminant, false); !ok) {
-            return ok;
-        }
-        if (auto ok = useVariant(0); !ok) {
-            return ok;
-        }
+        // Direct-sensor mode: a uniform emitter with the sensed spectrum.
         direct_ = uniformEmitter(setup_.booth.lights.front(),
                                  state.emitterLuminanceCdM2 * setup_.luminanceScale,
                                  state.illuminant);
-        light_ = shading::prepareLight(direct_, setup_.observer, pass_->settings().lights,
-                                       setup_.basis);
+        light_ = shading::prepareLight(direct_, setup_.observer, pass_->settings().lights, basis_);
         directSpd_ = state.illuminant;
         directLuminance_ = state.emitterLuminanceCdM2;
-        lightIndex_ = -1;
-        changed = true;
     }
+    lightIndex_ = index;
+    variants_[active_].holds.valid = false; // a new light draws the cache whole
     return pass_->setLight(light_);
 }
 
-Expected<void> BoothScenePass::encodeFor(const colour::Spectrum& spd, bool lampChange)
+Expected<void> BoothScenePass::applyEncoding(const scene::SceneState& state)
 {
-    if (!setup_.adaptive) {
+    if (state.encoding == encodings_) {
         return {};
     }
-    if (encoded_ && (lampChange ? spd.v == encodedFor_.v
-                                : spectral::spectralShapeDistance(spd, encodedFor_) <=
-                                          setup_.reencodeDistance)) {
-        return {};
+    if (state.encoding > 0 && !state.basis) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("render: encoding {} comes without its basis", state.encoding));
     }
-    auto basis = setup_.adaptive->basisFor(spd);
-    if (!basis) {
-        return {}; // no luminance or a non-finite band: keep rendering with the encoding we have
-    }
-    setup_.basis = std::move(*basis);
+    basis_ = state.encoding > 0 ? *state.basis : setup_.basis;
     // By linearity a texel's coefficients follow from its palette entries'
     // (SurfaceScene::channels).
     for (std::size_t i = 0; i < setup_.scene.palette.size(); ++i) {
-        prepared_->paletteCoeffs[i] =
-                colour::projectReflectance(setup_.basis, setup_.scene.palette[i]);
+        prepared_->paletteCoeffs[i] = colour::projectReflectance(basis_, setup_.scene.palette[i]);
     }
-    encodedFor_ = spd;
-    encoded_ = true;
-    ++encodings_;
+    encodings_ = state.encoding;
     variants_[active_].encodings = encodings_;
+    variants_[active_].holds.valid = false;
     return pass_->setChannels(*prepared_);
+}
+
+Expected<void> BoothScenePass::drawCached(const scene::SceneState& state,
+                                          const shading::View& view,
+                                          int width,
+                                          int height)
+{
+    Variant& var = variants_[active_];
+    const int k = std::max(var.settings.cacheSlices, 1);
+    const auto pose = [&](double tiltRad) { return scene::panelPose(setup_.stand, tiltRad); };
+    const SurfaceLayout layout = layoutOnPanel(setup_.scene, setup_.stand);
+    const double sensed = std::isfinite(state.tiltRad) ? state.tiltRad : state.heldTiltRad;
+    const scene::DiffuseTilt want =
+            state.diffuse ? *state.diffuse : scene::DiffuseTilt{sensed, std::nullopt, 0};
+    // The one draw that takes the cache from what it holds to what the state says, where there
+    // is one: the same diffuse term, the next band of a refresh, or its last band.
+    std::optional<double> next;
+    if (var.holds.valid) {
+        const scene::DiffuseTilt& had = var.holds.diffuse;
+        if (!want.refreshRad) {
+            if (!had.refreshRad && had.shownRad == want.shownRad) {
+                next = want.shownRad;
+            } else if (had.refreshRad && *had.refreshRad == want.shownRad &&
+                       had.refreshBands == k - 1) {
+                next = want.shownRad;
+            }
+        } else if (had.shownRad == want.shownRad && ((!had.refreshRad && want.refreshBands == 1) ||
+                                                     (had.refreshRad == want.refreshRad &&
+                                                      had.refreshBands == want.refreshBands - 1))) {
+            next = *want.refreshRad;
+        }
+    }
+    var.holds = {true, want};
+    if (next) {
+        const scene::PanelPose p = pose(*next);
+        return pass_->draw(view, width, height, layout, &p);
+    }
+    // Otherwise (a fresh pass, a new light, frame N drawn alone): the shown diffuse term whole,
+    // then a refresh's bands so far; the last draw is the frame.
+    pass_->invalidateCache();
+    const scene::PanelPose shown = pose(want.shownRad);
+    if (auto ok = pass_->draw(view, width, height, layout, &shown); !ok || !want.refreshRad) {
+        return ok;
+    }
+    const scene::PanelPose target = pose(*want.refreshRad);
+    for (int band = 0; band < want.refreshBands; ++band) {
+        if (auto ok = pass_->draw(view, width, height, layout, &target); !ok) {
+            return ok;
+        }
+    }
+    return {};
 }
 
 Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, int height)
 {
-    bool lightChanged = false;
-    if (auto ok = selectLight(state, lightChanged); !ok) {
+    if (auto ok = selectLight(state); !ok) {
         return ok;
     }
-    // The cached diffuse term's tilt: the mean of the last kTiltWindow sensed tilts, taken when
-    // the light changes (the cache is recomputed anyway) or when that mean has moved more than
-    // kTiltHoldRad from the held tilt. Non-finite tilts are left out.
-    if (std::isfinite(state.tiltRad)) {
-        tiltWindow_[tiltNext_] = state.tiltRad;
-        tiltNext_ = (tiltNext_ + 1) % tiltWindow_.size();
-        tiltCount_ = std::min(tiltCount_ + 1, tiltWindow_.size());
-    }
-    if (tiltCount_ > 0) {
-        double sum = 0.0;
-        for (std::size_t i = 0; i < tiltCount_; ++i) {
-            sum += tiltWindow_[i];
-        }
-        const double mean = sum / static_cast<double>(tiltCount_);
-        if (lightChanged || !heldValid_ || std::abs(mean - heldTiltRad_) > kTiltHoldRad) {
-            heldTiltRad_ = mean;
-            heldValid_ = true;
-        }
-    }
-    const auto pose = [&](double tiltRad) { return scene::panelPose(setup_.stand, tiltRad); };
-    const shading::PanelPose held = pose(heldTiltRad_);
     shading::View view;
     // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel);
     // a non-finite one falls back to the held tilt.
-    view.panel = std::isfinite(state.tiltRad) ? pose(state.tiltRad) : held;
+    view.panel = scene::panelPose(setup_.stand,
+                                  std::isfinite(state.tiltRad) ? state.tiltRad : state.heldTiltRad);
     view.eye = state.eyeBoothM;
     view.pixelsX = width;
     view.pixelsY = height;
-    return pass_->draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand), &held);
+    return drawCached(state, view, width, height);
 }
 
 PixelRect BoothScenePass::surfaceRect(int width, int height) const

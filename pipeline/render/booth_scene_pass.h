@@ -1,9 +1,11 @@
-// The booth pass driven by the loop's scene state: the classified lamp picks the booth light (its
-// measured luminance image), an unknown light becomes a uniform emitter with the sensed spectrum
-// (the paper's direct-sensor mode); the eye comes from the tracker, the panel pose from the tilt
-// through the stand's hinge model. With a light-adaptive encoder (basis "adaptive_k6") the surface
-// is re-encoded for each new light, synchronously, inside the draw that first sees it, so that
-// which frame shows the new encoding follows from the scene states alone (replay stays bit-exact).
+// The booth pass driven by the frame's scene state, upload + draw: the classified lamp picks the
+// booth light (its measured luminance image), an unknown light becomes a uniform emitter with the
+// sensed spectrum (the paper's direct-sensor mode); the eye comes from the tracker, the panel pose
+// from the tilt through the stand's hinge model, the cached diffuse term's from the state's
+// diffuse tilt; with a light-adaptive encoder the surface is in the state's encoding. It keeps no
+// history: what it holds on the GPU (light, encoding, caches) is a cache of earlier states, and
+// a fresh pass given any frame's state draws that frame bit for bit (the state stage, state/,
+// decides everything that used to carry from frame to frame here).
 // Needs a current GLES 3.1 context for every call.
 #pragma once
 
@@ -37,11 +39,10 @@ struct BoothSceneSetup {
     colour::Observer observer;
     scene::StandModel stand;
     shading::RenderSettings settings;
-    // Basis "adaptive_k6": when set, 'basis' is the encoder's general basis until the first light
-    // with luminance, and every new lamp (or a sensed shape moved by more than reencodeDistance)
-    // gets a basis of its own and a re-encoded surface (pipeline/spectral/adaptive_encoding.h).
+    // Basis "adaptive_k6": when set, 'basis' is the encoder's general basis, what a state of
+    // encoding 0 draws with; a state of encoding n > 0 carries its basis (the light estimator
+    // decides, state/light_estimator.h), and the surface is re-encoded for it.
     std::shared_ptr<const spectral::AdaptiveEncoder> adaptive;
-    double reencodeDistance = spectral::kAdaptiveReencodeDistance;
     // The booth dimmer (platform/booth_dimmer.h) for the direct-sensor mode's uniform emitter:
     // the sensed luminance times this. The booth's own lamps come already scaled in 'booth'.
     double luminanceScale = 1.0;
@@ -51,16 +52,6 @@ struct BoothSceneSetup {
     std::map<std::string, LampSettings> perLamp;
 };
 
-// The cached diffuse term's tilt is the mean of the last kTiltWindow sensed tilts (the
-// accelerometer's 0.02 m/s^2 noise is 0.12 degrees a sample, 0.03 degrees in the mean), re-taken
-// when it moves more than kTiltHoldRad: 0.15 degrees, 3.5 standard deviations of the difference
-// of two such means, so noise alone almost never recomputes the cache. Holding the diffuse term
-// 0.15 degrees off costs at most ΔE00 p95 0.25 at a 5-degree tilt (the ceiling light grazes the
-// panel there; the painting's relief) and 0.11 from 20 degrees up, on every shipped scene and
-// light (CPU model, booth_cache_test.cpp; docs/rendering.md): about what one sample's noise costs.
-constexpr std::size_t kTiltWindow = 16;
-constexpr double kTiltHoldRad = 0.15 * 3.14159265358979323846 / 180.0;
-
 class BoothScenePass
 {
 public:
@@ -68,21 +59,21 @@ public:
 
     // Draws the state's frame into the bound RGBA32F framebuffer (viewport width x height, the
     // whole panel; the surface at its physical size in the middle, black around it; alpha: the
-    // illuminance on the panel, lux). The cached diffuse term is drawn at heldTiltRad(), so that
-    // sensor noise on the tilt does not recompute it every frame (with settings.cacheSlices = K >
-    // 1 a new held tilt shows once its K bands are drawn, K - 1 to 2K - 2 draws later:
-    // BoothShadingPass::draw); the specular term at the state's tilt and eye.
+    // illuminance on the panel, lux). The cached diffuse term shows state.diffuse.shownRad (the
+    // tilt estimator's hold filter and sliced refresh: state/tilt_estimator.h); a refresh under
+    // way draws its next band (BoothShadingPass::draw); the specular term is drawn at the state's
+    // tilt and eye. Where the caches do not hold what the state says (a fresh pass, frame N of a
+    // recording drawn alone) they are drawn first: the frame is the same.
     Expected<void> draw(const scene::SceneState& state, int width, int height);
+
+    // The spectrum of each lamp's booth light (by lampIndex): what a light-adaptive encoder
+    // encodes a lamp for (state::LightEstimatorSetup::encodeSpectra).
+    std::vector<colour::Spectrum> lampSpectra() const;
 
     // The pixels of a width x height frame that can show the surface; draw() writes XYZ (0, 0, 0)
     // everywhere else (render::surfaceRect).
     PixelRect surfaceRect(int width, int height) const;
 
-    // The tilt of the cached diffuse term: the mean of the last kTiltWindow sensed tilts as it
-    // was at the last light change or the last time that mean moved more than kTiltHoldRad away
-    // from it. A deterministic function of the states drawn so far, so replay renders the same
-    // frames.
-    double heldTiltRad() const { return heldTiltRad_; }
     // The pass's cache of the eye-independent part (booth_shading_pass.h): how often it was
     // recomputed, and a way to force it (e.g. after the channel encoding changed).
     long cacheRefreshes() const;
@@ -105,31 +96,39 @@ public:
     // How many shading passes there are (one per distinct setting).
     std::size_t variantCount() const { return variants_.size(); }
 
-    // The basis the surface is encoded in now, and how many times it has been re-encoded (0
-    // without an adaptive encoder).
-    const colour::ChannelBasis& basis() const { return setup_.basis; }
+    // The basis the surface is encoded in now, and the encoding it is (SceneState::encoding: 0
+    // without an adaptive encoder or before its first light).
+    const colour::ChannelBasis& basis() const { return basis_; }
     int encodings() const { return encodings_; }
 
 private:
     BoothScenePass() = default;
-    // Uploads the state's light when it differs from the one on the GPU; 'changed' says so.
-    Expected<void> selectLight(const scene::SceneState& state, bool& changed);
-    // With an adaptive encoder: a new basis for 'spd' and the palette re-projected onto it, the
-    // coefficient textures replaced. A lamp change always re-encodes (unless already encoded for
-    // exactly that spectrum); direct-sensor mode only past reencodeDistance. A light the encoder
-    // refuses (no luminance, a non-finite band) keeps the encoding it has.
-    Expected<void> encodeFor(const colour::Spectrum& spd, bool lampChange);
+    // Uploads the state's light when it changed or differs from the one on the GPU.
+    Expected<void> selectLight(const scene::SceneState& state);
+    // Re-encodes the surface in the state's encoding when the GPU holds another (the palette
+    // re-projected onto the state's basis, the coefficient textures replaced).
+    Expected<void> applyEncoding(const scene::SceneState& state);
 
+    // What a shading pass's diffuse cache holds, as far as this pass drew it: the tilt of its
+    // front cache and a sliced refresh's progress (none: unknown, e.g. after a new light).
+    struct CacheHolds {
+        bool valid = false;
+        scene::DiffuseTilt diffuse;
+    };
     // One shading pass per distinct setting (variants_[0]: setup_.settings), each with the scene
-    // prepared for its horizon directions; 'encodings' is the encodings_ its channels hold.
+    // prepared for its horizon directions; 'encodings' is the encoding its channels hold.
     struct Variant {
         shading::RenderSettings settings;
         std::unique_ptr<shading::PreparedScene> prepared;
         std::unique_ptr<BoothShadingPass> pass;
         int encodings = 0;
+        CacheHolds holds;
     };
     // Makes variant v the one drawn, its channels brought up to date.
     Expected<void> useVariant(std::size_t v);
+    // Draws the frame with the active pass, its cache brought to what the state says.
+    Expected<void>
+    drawCached(const scene::SceneState& state, const shading::View& view, int width, int height);
 
     BoothSceneSetup setup_;
     std::vector<Variant> variants_;
@@ -143,14 +142,9 @@ private:
     double directLuminance_ = -1.0;
     booth::BoothLight direct_;
     shading::PreparedLight light_;
-    bool encoded_ = false; // encodedFor_ holds the light of the current adaptive basis
-    colour::Spectrum encodedFor_{};
+    // The encoding on the GPU (SceneState::encoding) and its basis.
+    colour::ChannelBasis basis_;
     int encodings_ = 0;
-    std::array<double, kTiltWindow> tiltWindow_{};
-    std::size_t tiltNext_ = 0;
-    std::size_t tiltCount_ = 0;
-    double heldTiltRad_ = 0.0;
-    bool heldValid_ = false;
     long warmUpRefreshes_ = 0; // cache refreshes of warmUp()'s draws, not counted
 };
 

@@ -140,4 +140,17 @@ void LightClassifier::reset()
     candidateCount_ = 0;
 }
 
+void LightClassifier::restore(const LightClassifierState& s)
+{
+    const int n = static_cast<int>(lights_.size());
+    current_ = s.current;
+    if (current_.index < -1 || current_.index >= n) {
+        current_ = Classification{};
+    }
+    // The candidate may be -1 too: "unknown" on its way to replacing a lamp.
+    const bool valid = s.candidate >= -1 && s.candidate < n;
+    candidate_ = valid ? s.candidate : -1;
+    candidateCount_ = valid ? std::max(s.candidateCount, 0) : 0;
+}
+
 } // namespace replica::pipeline::spectral

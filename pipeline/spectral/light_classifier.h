@@ -42,6 +42,15 @@ struct Classification {
     double distance = 0.0;        // shape distance to that lamp (to the nearest one when unknown)
 };
 
+// What the hysteresis remembers between samples: the answer, and a different one on its way to
+// replacing it (how many samples in a row it has won). Saved at the head of a rotated session file
+// and restored when that file is replayed alone (state/scene_estimator.h).
+struct LightClassifierState {
+    Classification current;
+    int candidate = -1;
+    int candidateCount = 0;
+};
+
 class LightClassifier
 {
 public:
@@ -73,6 +82,9 @@ public:
     const std::vector<StoredLight>& lights() const { return lights_; }
     const LightClassifierParams& params() const { return params_; }
     void reset();
+    LightClassifierState state() const { return {current_, candidate_, candidateCount_}; }
+    // Restores a saved state; an index beyond the stored lamps is taken as unknown.
+    void restore(const LightClassifierState& s);
 
 private:
     LightClassifier(std::vector<StoredLight> lights, const LightClassifierParams& params)

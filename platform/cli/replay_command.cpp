@@ -251,6 +251,14 @@ int replayMain(const ReplayOptions& o)
         log->error("{}", appliance.error().message);
         return kExitFailure;
     }
+    // A rotated session file starts where the one before it ended: its estimators' state.
+    if (auto ok = restoreStateAtStart(**appliance, recording->session.configJson); !ok) {
+        log->error("{}: {}", o.file, ok.error().message);
+        return kExitFailure;
+    } else if ((*appliance)->updater->started()) {
+        log->info("{}: a rotated session file: its estimators start from the state it carries",
+                  o.file);
+    }
     Sources sources = makeReplaySources(*recording);
     const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
                           : o.clock == "step"   ? Pacing::Step
@@ -381,7 +389,8 @@ int replayMain(const ReplayOptions& o)
     const bool showProgress = !o.noProgress && (o.progress || ::isatty(STDERR_FILENO) == 1);
     const auto wallStart = std::chrono::steady_clock::now();
     auto lastProgress = wallStart;
-    std::uint64_t done = 0;
+    // The frames before a slice are only estimated (TickPlan::warmup): they reach no callback.
+    std::uint64_t done = plan.size() - sliceFrames;
     auto onFrame = [&](const recordings::FrameRecord& f, const pipeline::scene::SceneState& scene,
                        const pipeline::render::RenderedFrame& image) {
         ++done;

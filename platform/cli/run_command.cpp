@@ -211,9 +211,20 @@ int runMain(const run_cli::RunOptions& given)
             policy.rotateBytes = site.rotateBytes;
             policy.rotateAge = std::chrono::seconds(site.rotateSeconds);
             policy.keepBytes = site.keepBytes;
+            // Each rotated file starts with the estimators' state ("state_at_start": the
+            // classifier's hysteresis, the lamp selector's arbitration, the encoding, the held
+            // eye and tilts), so that it replays alone, bit for bit, as the panel showed it.
+            const state::SceneEstimator* estimator = (*appliance)->updater.get();
             sessions = std::make_unique<SessionRecorder>(
-                    dir, policy, [session, options](const std::filesystem::path& path) {
-                        return recordings::RecordingWriter::create(path, session, options);
+                    dir, policy, [session, options, estimator](const std::filesystem::path& path) {
+                        if (!estimator->started()) {
+                            return recordings::RecordingWriter::create(path, session, options);
+                        }
+                        recordings::SessionInfo withState = session;
+                        auto resolvedJson = nlohmann::json::parse(session.configJson);
+                        resolvedJson[kStateAtStartKey] = estimator->save();
+                        withState.configJson = resolvedJson.dump();
+                        return recordings::RecordingWriter::create(path, withState, options);
                     });
             if (auto ok = sessions->open(); !ok) {
                 log->error("{}; running without recording", ok.error().message);

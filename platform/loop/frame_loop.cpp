@@ -234,6 +234,12 @@ Expected<LoopStats> runFrames(Appliance& appliance,
                                   recordings::chosenSample<hal::PoseSample>(tracker),
                                   recordings::chosenSample<hal::AccelSample>(accel),
                                   recordings::chosenSample<hal::LampSample>(lampSelector));
+        if (tick.warmup) {
+            // Before a replayed slice: the state stage alone. A frame is a function of its
+            // SceneState (the renderer keeps no history), so nothing before the slice is drawn.
+            ++stats.estimatedOnly;
+            continue;
+        }
         if (auto ok = appliance.renderer->render(state, image, readback); !ok) {
             return tl::unexpected(ok.error());
         }

@@ -29,9 +29,10 @@ struct TickPlan {
     std::uint64_t frameIndex = 0;
     std::int64_t tickNs = 0;
     std::optional<recordings::FrameRecord> recorded;
-    // Replay of a slice ('replay --from'): a frame before the slice, rendered only so that the
-    // state carried from frame to frame (classifier, held samples, caches) is the recording's. It
-    // never waits for its tick or for a step; the first frame after it anchors the pacing.
+    // Replay of a slice ('replay --from'): a frame before the slice, run through the state stage
+    // only (state/: classifier, held samples, held tilt, encoding), not rendered, so that the
+    // slice's first frame has the recording's state. It never waits for its tick or for a step;
+    // the first frame after it anchors the pacing.
     bool warmup = false;
 };
 
@@ -47,6 +48,7 @@ struct LoopStats {
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
     std::uint64_t replayMismatches = 0;  // replay: a recorded sample was not found (latest used)
     std::uint64_t skippedTicks = 0;      // LoopOptions::skipLateTicks: ticks never rendered
+    std::uint64_t estimatedOnly = 0;     // TickPlan::warmup: ticks only estimated, never drawn
     std::uint64_t recorderRotations = 0; // LoopOptions::nextRecorder returned a new recorder
     // Each frame's work on the wall clock, from polling the sources to handing the frame on
     // (not the wait for its tick): what says whether the machine keeps the rate.

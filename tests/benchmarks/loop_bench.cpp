@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include <benchmark/benchmark.h>
+#include <state/tilt_estimator.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/booth/booth_model.h>
@@ -89,6 +90,14 @@ void BM_ApplianceFrame(benchmark::State& st)
     state.emitterLuminanceCdM2 = app->booth.lights[2].nominalLuminanceCdM2;
     state.tiltRad = 0.35;
     pipeline::render::RenderedFrame frame;
+    // The tilt estimator's held and diffuse tilts, as the appliance's state stage gives them.
+    state::TiltEstimator tilts({0.0, app->config.cacheSlices});
+    const auto estimate = [&](bool lightChanged) {
+        state.lightChanged = lightChanged;
+        tilts.sense(state.tiltRad);
+        tilts.write(state);
+    };
+    estimate(true);
     if (!app->renderer->render(state, frame, pipeline::render::Readback::Display)) {
         st.SkipWithError("first frame failed");
         return;
@@ -105,6 +114,7 @@ void BM_ApplianceFrame(benchmark::State& st)
             const double deg = 10.0 + (phase < 20 ? phase : 40 - phase);
             state.tiltRad = deg * 3.14159265358979 / 180.0;
         }
+        estimate(false);
         auto ok = app->renderer->render(state, frame, pipeline::render::Readback::Display);
         benchmark::DoNotOptimize(ok);
     }

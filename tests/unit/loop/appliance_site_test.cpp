@@ -9,13 +9,13 @@
 #include <random>
 
 #include <nlohmann/json.hpp>
+#include <state/scene_estimator.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/scene/booth.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 #include <platform/appliance.h>
 #include <platform/loop/frame_loop.h>
-#include <platform/loop/scene_updater.h>
 #include <platform/session_files.h>
 #include <platform/site_config.h>
 #include <platform/site_file.h>
@@ -267,7 +267,7 @@ TEST(RunConfigSite, GeometryRoundTripsAndOldRecordingsGetTodaysConstants)
     EXPECT_EQ(old->stand.hingeM, today.hingeM);
     EXPECT_EQ(old->stand.panelWidthM, today.panelWidthM);
     EXPECT_EQ(old->trackerInBooth, pipeline::defaultTrackerInBooth());
-    EXPECT_EQ(old->trackerInBooth, SceneUpdaterSetup{}.trackerInBooth);
+    EXPECT_EQ(old->trackerInBooth, state::EyeEstimatorSetup{}.trackerInBooth);
     EXPECT_EQ(old->defaultLamp, "");
     EXPECT_EQ(old->defaultEyeM, pipeline::scene::SceneState{}.eyeBoothM);
 
@@ -315,16 +315,16 @@ protected:
         auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
                                                                    "sim_usb2000_responsivity.csv");
         ASSERT_TRUE(cal);
-        setup_.booth = *booth;
-        setup_.calibration = *cal;
+        setup_.light.booth = *booth;
+        setup_.light.calibration = *cal;
     }
-    SceneUpdaterSetup setup_;
+    state::SceneEstimatorSetup setup_;
 };
 
 TEST_F(SiteUpdater, TrackerRotationIsXThenYThenZ)
 {
-    setup_.trackerInBooth = pipeline::rigidFromDegrees({90.0, 0.0, 90.0}, {1.0, 2.0, 3.0});
-    auto u = SceneUpdater::create(setup_);
+    setup_.eye.trackerInBooth = pipeline::rigidFromDegrees({90.0, 0.0, 90.0}, {1.0, 2.0, 3.0});
+    auto u = state::SceneEstimator::create(setup_);
     ASSERT_TRUE(u);
     pipeline::scene::SceneState st;
     hal::PoseSample p;
@@ -340,29 +340,29 @@ TEST_F(SiteUpdater, TrackerRotationIsXThenYThenZ)
     p.sequence = 2;
     p.eyeTrackerM = {0.3, -0.4, 1.2};
     u->update(st, nullptr, &p, nullptr);
-    const glm::dvec3 d = st.eyeBoothM - setup_.trackerInBooth.translation;
+    const glm::dvec3 d = st.eyeBoothM - setup_.eye.trackerInBooth.translation;
     EXPECT_NEAR(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z), 1.3, 1e-12);
 }
 
 TEST_F(SiteUpdater, MissingSensorsShowTheDefaultLampEyeAndTilt)
 {
-    setup_.defaultLamp = 2;
-    setup_.defaultEyeM = {0.1, 0.5, 0.7};
-    setup_.defaultTiltRad = 0.2;
-    auto u = SceneUpdater::create(setup_);
+    setup_.light.defaultLamp = 2;
+    setup_.eye.defaultEyeM = {0.1, 0.5, 0.7};
+    setup_.tilt.defaultTiltRad = 0.2;
+    auto u = state::SceneEstimator::create(setup_);
     ASSERT_TRUE(u);
     pipeline::scene::SceneState st;
     u->update(st, nullptr, nullptr, nullptr);
     EXPECT_EQ(st.lampIndex, 2);
-    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.booth.lights[2].nominalLuminanceCdM2);
+    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.light.booth.lights[2].nominalLuminanceCdM2);
     EXPECT_GT(st.emitterLuminanceCdM2, 0.0); // a light: not a black screen
-    EXPECT_EQ(st.illuminant.v, setup_.booth.lights[2].referenceSpectrum.v);
-    EXPECT_EQ(st.eyeBoothM, setup_.defaultEyeM);
+    EXPECT_EQ(st.illuminant.v, setup_.light.booth.lights[2].referenceSpectrum.v);
+    EXPECT_EQ(st.eyeBoothM, setup_.eye.defaultEyeM);
     EXPECT_EQ(st.tiltRad, 0.2);
 
     // Without a default lamp: no light until the first spectrum, as before the site file.
-    setup_.defaultLamp = -1;
-    auto dark = SceneUpdater::create(setup_);
+    setup_.light.defaultLamp = -1;
+    auto dark = state::SceneEstimator::create(setup_);
     ASSERT_TRUE(dark);
     pipeline::scene::SceneState st2;
     dark->update(st2, nullptr, nullptr, nullptr);

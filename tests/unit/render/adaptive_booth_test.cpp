@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <state/light_estimator.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/reference/frame_error.h>
@@ -17,6 +18,8 @@
 #include <platform/output/output.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/state_sequence.h"
 
 namespace replica::pipeline::render {
 namespace {
@@ -49,6 +52,12 @@ protected:
         setup_.settings.specularSamples = 4;
     }
 
+    // The state stage for hand-made states, with the light estimator's re-encode decision.
+    static tests::StateSequence sequence(const BoothScenePass& pass)
+    {
+        return tests::StateSequence(1, state::EncodingDecision(encoder_, pass.lampSpectra()));
+    }
+
     static colour::Spectrum cie(const char* name)
     {
         auto l = spectral::loadCieIlluminant(dataDir(), name);
@@ -76,7 +85,10 @@ protected:
         fixed.basis = *encoder_->basisFor(encodedFor);
         auto pass = BoothScenePass::create(fixed);
         EXPECT_TRUE(pass);
-        return frame(**pass, st);
+        scene::SceneState own = st; // in the pass's own basis
+        own.encoding = 0;
+        own.basis.reset();
+        return frame(**pass, own);
     }
 
     static void expectSame(const std::vector<colour::Xyz>& a, const std::vector<colour::Xyz>& b)
@@ -175,29 +187,30 @@ TEST_F(AdaptiveBooth, LampChangeReencodesAtThatFrameAndMatchesTheNewLight)
     auto pass = BoothScenePass::create(setup_);
     ASSERT_TRUE(pass) << pass.error().message;
     EXPECT_EQ((*pass)->encodings(), 0);
-    scene::SceneState st;
+    auto seq = sequence(**pass);
+    scene::SceneState st, cur;
     st.tiltRad = 0.4;
     st.lampIndex = 0;
     const auto& tungsten = setup_.booth.find("tungsten")->spd;
     const auto& d65f = setup_.booth.find("d65-fluorescent")->spd;
-    const auto first = frame(**pass, st);
+    const auto first = frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 1);
     EXPECT_LT(offIdentity(**pass, tungsten), 1e-9);
-    expectSame(first, freshFrame(tungsten, st));
-    frame(**pass, st);
+    expectSame(first, freshFrame(tungsten, cur));
+    frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 1);
 
     st.lampIndex = 2;
-    const auto switched = frame(**pass, st);
+    const auto switched = frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 2);
     EXPECT_LT(offIdentity(**pass, d65f), 1e-9);
     EXPECT_GT(offIdentity(**pass, tungsten), 1e-3);
-    expectSame(switched, freshFrame(d65f, st));
+    expectSame(switched, freshFrame(d65f, cur));
     // Not a vacuous comparison: still encoded for tungsten, the new lamp renders differently.
-    EXPECT_TRUE(differs(switched, freshFrame(tungsten, st)));
+    EXPECT_TRUE(differs(switched, freshFrame(tungsten, cur)));
 
     st.lampIndex = 0;
-    expectSame(frame(**pass, st), first);
+    expectSame(frame(**pass, cur = seq.next(st)), first);
     EXPECT_EQ((*pass)->encodings(), 3);
 }
 
@@ -207,43 +220,44 @@ TEST_F(AdaptiveBooth, DirectSensorModeReencodesPastTheShapeThreshold)
 {
     auto pass = BoothScenePass::create(setup_);
     ASSERT_TRUE(pass);
-    scene::SceneState st;
+    auto seq = sequence(**pass);
+    scene::SceneState st, cur;
     st.lampIndex = -1;
     st.emitterLuminanceCdM2 = 1500.0;
     // Nothing sensed yet: no luminance, nothing to encode for; the general basis renders black.
-    frame(**pass, st);
+    frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 0);
 
     const colour::Spectrum f11 = cie("F11");
     st.illuminant = f11 * 3.0;
-    const auto a = frame(**pass, st);
+    const auto a = frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 1);
-    expectSame(a, freshFrame(f11 * 3.0, st));
+    expectSame(a, freshFrame(f11 * 3.0, cur));
 
     // Half the threshold towards LED-B4: the light is re-prepared (a new frame) but the surface
     // stays encoded for F11.
     const auto near = *spectral::shiftedLight(setup_.observer, f11, cie("LED-B4"),
                                               0.5 * spectral::kAdaptiveReencodeDistance);
     st.illuminant = near;
-    const auto b = frame(**pass, st);
+    const auto b = frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 1);
     EXPECT_TRUE(differs(a, b));
-    expectSame(b, freshFrame(f11 * 3.0, st));
+    expectSame(b, freshFrame(f11 * 3.0, cur));
 
     // Past the threshold: re-encoded for the new shape, exactly as a pass built for it.
     const auto far = *spectral::shiftedLight(setup_.observer, f11, cie("LED-B4"),
                                              1.5 * spectral::kAdaptiveReencodeDistance);
     st.illuminant = far;
-    const auto c = frame(**pass, st);
+    const auto c = frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 2);
     EXPECT_LT(offIdentity(**pass, far), 1e-9);
-    expectSame(c, freshFrame(far, st));
+    expectSame(c, freshFrame(far, cur));
 
     // A reading with a non-finite band: the encoder refuses it, the encoding for 'far' stays.
     st.illuminant[5] = std::nan("");
     st.illuminant[6] = 0.0;
     st.emitterLuminanceCdM2 = 1400.0;
-    frame(**pass, st);
+    frame(**pass, cur = seq.next(st));
     EXPECT_EQ((*pass)->encodings(), 2);
     EXPECT_LT(offIdentity(**pass, far), 1e-9);
 }

@@ -6,12 +6,16 @@
 #include <cstdio>
 #include <numbers>
 
+#include <state/tilt_estimator.h>
+
 #include <pipeline/base/data_dir.h>
 #include <pipeline/reference/frame_error.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <platform/output/output.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/state_sequence.h"
 
 namespace replica::pipeline::render {
 namespace {
@@ -75,15 +79,6 @@ protected:
         return readAll(*target_);
     }
 
-    static scene::SceneState state(double tiltRad, glm::dvec3 eye, int lamp = 2)
-    {
-        scene::SceneState st;
-        st.lampIndex = lamp;
-        st.tiltRad = tiltRad;
-        st.eyeBoothM = eye;
-        return st;
-    }
-
     std::unique_ptr<platform::Output> output_;
     std::unique_ptr<XyzTarget> target_;
     BoothSceneSetup setup_;
@@ -96,10 +91,11 @@ TEST_F(BoothCacheTest, AFrameFromTheCacheEqualsOneThatRecomputesIt)
     ASSERT_TRUE(a && b);
     const glm::dvec3 eye1{-0.15, 0.45, 0.60};
     const glm::dvec3 eye2{0.20, 0.40, 0.55};
-    const auto first = draw(**a, state(0.35, eye1));
-    const auto cached = draw(**a, state(0.35, eye2)); // the eye moved: only the specular term
+    tests::StateSequence seqA, seqB;
+    const auto first = draw(**a, seqA.next(0.35, eye1));
+    const auto cached = draw(**a, seqA.next(0.35, eye2)); // the eye moved: only the specular term
     EXPECT_EQ((*a)->cacheRefreshes(), 1);
-    const auto fresh = draw(**b, state(0.35, eye2));
+    const auto fresh = draw(**b, seqB.next(0.35, eye2));
     EXPECT_EQ((*b)->cacheRefreshes(), 1);
     ASSERT_EQ(cached.size(), fresh.size());
     long differ = 0;
@@ -118,65 +114,87 @@ TEST_F(BoothCacheTest, TiltNoiseIsHeldAndLightPoseAndInvalidationRefresh)
     const glm::dvec3 eye{0.0, 0.45, 0.60};
     const double deg = std::numbers::pi / 180.0;
     const double tilt0 = 0.35;
-    draw(**pass, state(tilt0, eye));
+    // The tilt estimator holds the diffuse term's tilt (state/tilt_estimator.h); the pass draws
+    // it.
+    tests::StateSequence seq;
+    scene::SceneState st = seq.next(tilt0, eye);
+    draw(**pass, st);
     EXPECT_EQ((*pass)->cacheRefreshes(), 1);
-    EXPECT_EQ((*pass)->heldTiltRad(), tilt0);
+    EXPECT_EQ(st.heldTiltRad, tilt0);
+    EXPECT_EQ(st.diffuse->shownRad, tilt0);
     // Sensor noise of +-0.25 degrees (twice the accelerometer's): the mean stays within the hold.
     std::vector<float> held;
     for (int i = 0; i < 24; ++i) {
-        held = draw(**pass, state(tilt0 + (i % 2 == 0 ? 0.25 : -0.25) * deg, eye));
+        st = seq.next(tilt0 + (i % 2 == 0 ? 0.25 : -0.25) * deg, eye);
+        held = draw(**pass, st);
     }
     EXPECT_EQ((*pass)->cacheRefreshes(), 1);
-    EXPECT_EQ((*pass)->heldTiltRad(), tilt0);
+    EXPECT_EQ(st.heldTiltRad, tilt0);
+    EXPECT_EQ(st.diffuse->shownRad, tilt0);
     // The held frame's cached part (alpha: E_geo) is that of the held tilt, whatever the sensed
     // one was; its specular part follows the sensed tilt.
     auto fresh = BoothScenePass::create(setup_);
     ASSERT_TRUE(fresh);
-    const auto want = draw(**fresh, state(tilt0, eye));
+    const auto want = draw(**fresh, tests::StateSequence().next(tilt0, eye));
     ASSERT_EQ(want.size(), held.size());
     for (std::size_t i = 3; i < want.size(); i += 4) {
         ASSERT_EQ(want[i], held[i]) << "pixel " << i / 4;
     }
     // A real move of 1 degree: recomputed, and held within the hold of the new tilt.
     for (int i = 0; i < 24; ++i) {
-        draw(**pass, state(tilt0 + 1.0 * deg, eye));
+        st = seq.next(tilt0 + 1.0 * deg, eye);
+        draw(**pass, st);
     }
     const long afterMove = (*pass)->cacheRefreshes();
     EXPECT_GE(afterMove, 2);
-    EXPECT_LE(std::abs((*pass)->heldTiltRad() - (tilt0 + 1.0 * deg)), kTiltHoldRad);
+    EXPECT_LE(std::abs(st.heldTiltRad - (tilt0 + 1.0 * deg)), state::kTiltHoldRad);
+    EXPECT_EQ(st.diffuse->shownRad, st.heldTiltRad);
     // A non-finite tilt changes nothing.
-    draw(**pass, state(std::nan(""), eye));
+    draw(**pass, seq.next(std::nan(""), eye));
     EXPECT_EQ((*pass)->cacheRefreshes(), afterMove);
     // A lamp change recomputes.
-    draw(**pass, state(tilt0 + 1.0 * deg, eye, 0));
+    draw(**pass, seq.next(tilt0 + 1.0 * deg, eye, 0));
     EXPECT_EQ((*pass)->cacheRefreshes(), afterMove + 1);
     // An explicit invalidation (a new channel encoding) recomputes.
     (*pass)->invalidateCache();
-    draw(**pass, state(tilt0 + 1.0 * deg, eye, 0));
+    draw(**pass, seq.next(tilt0 + 1.0 * deg, eye, 0));
     EXPECT_EQ((*pass)->cacheRefreshes(), afterMove + 2);
 }
 
-TEST_F(BoothCacheTest, TheHeldTiltIsADeterministicFunctionOfTheStates)
+TEST_F(BoothCacheTest, AFreshPassDrawsAnyFrameFromItsStateAlone)
 {
     // What replay relies on: two passes fed the same states draw the same frames, with the
-    // cache recomputed whole or in bands over several frames.
+    // cache recomputed whole or in bands over several frames; and a fresh pass given frame i's
+    // state alone (replay --from) draws frame i, a sliced refresh under way included.
     for (const int slices : {1, 3}) {
         setup_.settings.cacheSlices = slices;
         auto a = BoothScenePass::create(setup_);
         auto b = BoothScenePass::create(setup_);
         ASSERT_TRUE(a && b);
+        tests::StateSequence seq(slices);
         std::uint32_t x = 12345u;
+        int refreshing = 0, alone = 0;
         for (int i = 0; i < 40; ++i) {
             x = x * 1664525u + 1013904223u; // a fixed pseudo-random walk of tilt and eye
             const double jitter = (static_cast<double>(x >> 8) / 16777216.0 - 0.5) * 0.02;
-            const scene::SceneState st = state(0.3 + 0.004 * i + jitter, {0.01 * i, 0.45, 0.6});
+            const scene::SceneState st = seq.next(0.3 + 0.004 * i + jitter, {0.01 * i, 0.45, 0.6});
+            refreshing += st.diffuse->refreshRad ? 1 : 0;
             const auto fa = draw(**a, st);
             const auto fb = draw(**b, st);
             ASSERT_TRUE(sameFrame(fa, fb)) << "frame " << i << ", " << slices << " slices";
+            if (i % 4 == 1 || (st.diffuse->refreshRad && alone < 4)) {
+                auto fresh = BoothScenePass::create(setup_);
+                ASSERT_TRUE(fresh);
+                ASSERT_TRUE(sameFrame(draw(**fresh, st), fa))
+                        << "frame " << i << " drawn alone, " << slices << " slices";
+                ++alone;
+            }
         }
         EXPECT_EQ((*a)->cacheRefreshes(), (*b)->cacheRefreshes());
         EXPECT_GT((*a)->cacheRefreshes(), 1);
         EXPECT_LT((*a)->cacheRefreshes(), 40);
+        // With bands, some of the frames drawn alone were in the middle of a refresh.
+        EXPECT_EQ(refreshing > 0, slices > 1);
     }
 }
 
@@ -184,7 +202,7 @@ TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
 {
     auto pass = BoothScenePass::create(setup_);
     ASSERT_TRUE(pass);
-    const scene::SceneState st = state(0.35, {0.0, 0.45, 0.60});
+    const scene::SceneState st = tests::StateSequence().next(0.35, {0.0, 0.45, 0.60});
     const auto px = draw(**pass, st);
     // Independent value: eq. (1) with the macro normal over the same median-cut lights, in
     // double, at the pixel centre on the panel plane (around the surface too).
@@ -263,7 +281,8 @@ TiltOffsetCost diffuseCostOfTiltOffset(double offsetDeg)
 // The hold's price.
 TEST(TiltHold, CostsTheDiffuseTermAFifthOfADeltaE00AtMost)
 {
-    const TiltOffsetCost c = diffuseCostOfTiltOffset(kTiltHoldRad * 180.0 / std::numbers::pi);
+    const TiltOffsetCost c =
+            diffuseCostOfTiltOffset(state::kTiltHoldRad * 180.0 / std::numbers::pi);
     // Measured 0.234 and 0.117, max 0.257, with the horizon settings of 2026-12-02 (0.248, 0.108
     // and 1.13 before them: a facet's horizon shadow edge moved at 5 degrees; docs/rendering.md).
     EXPECT_LT(c.p95, 0.25);
@@ -276,7 +295,7 @@ TEST(TiltHold, CostsTheDiffuseTermAFifthOfADeltaE00AtMost)
 // cost grows with the lag, and the hold's bound above is the cost of its own offset only.
 TEST(TiltHold, ALaggingDiffuseTermCostsMoreTheFurtherItLags)
 {
-    double last = diffuseCostOfTiltOffset(kTiltHoldRad * 180.0 / std::numbers::pi).p95;
+    double last = diffuseCostOfTiltOffset(state::kTiltHoldRad * 180.0 / std::numbers::pi).p95;
     for (const double lagDeg : {0.5, 1.0, 2.0}) {
         const double p95 = diffuseCostOfTiltOffset(lagDeg).p95;
         EXPECT_GT(p95, last) << lagDeg << " degrees";
@@ -386,8 +405,9 @@ TEST_F(BoothCacheTest, WithoutTheSurroundOnlyTheSurfaceRectangleIsShaded)
     const PixelRect r = (*with)->surfaceRect(kCacheW, kCacheH);
     ASSERT_GT(r.width, 0);
     ASSERT_LT(r.width * r.height, kCacheW * kCacheH); // the surface does not fill the panel
-    for (const double tilt : {0.35, 0.6}) {           // the second recomputes the cache
-        const auto st = state(tilt, {0.1, 0.5, 0.5});
+    tests::StateSequence seq;
+    for (const double tilt : {0.35, 0.6}) { // the second recomputes the cache
+        const auto st = seq.next(tilt, {0.1, 0.5, 0.5});
         const auto a = draw(**with, st);
         const auto b = draw(**without, st);
         long inside = 0, outsideLit = 0;
@@ -416,7 +436,7 @@ TEST_F(BoothCacheTest, WithoutTheSurroundOnlyTheSurfaceRectangleIsShaded)
     EXPECT_EQ((*without)->cacheRefreshes(), 2);
     // Turning it back on recomputes the cache (it was drawn without the surround).
     (*without)->setSurroundIlluminance(true);
-    const auto st = state(0.6, {0.1, 0.5, 0.5});
+    const auto st = seq.next(0.6, {0.1, 0.5, 0.5});
     EXPECT_EQ(draw(**with, st), draw(**without, st));
     EXPECT_EQ((*without)->cacheRefreshes(), 3);
     // And off again: the cache held E_geo around the surface, so it is cleared there once more

@@ -5,17 +5,20 @@
 #include <cmath>
 #include <limits>
 
+#include <nlohmann/json.hpp>
+#include <state/scene_estimator.h>
+
 #include <hal/sim/sim_devices.h>
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/spectral_table.h>
-#include <platform/loop/scene_updater.h>
+#include <pipeline/scene/booth.h>
 
 #include <gtest/gtest.h>
 
-namespace replica::platform {
+namespace replica::state {
 namespace {
 
-class SceneUpdaterTest : public ::testing::Test
+class SceneEstimatorTest : public ::testing::Test
 {
 protected:
     void SetUp() override
@@ -25,8 +28,8 @@ protected:
         auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
                                                                    "sim_usb2000_responsivity.csv");
         ASSERT_TRUE(cal);
-        setup_.booth = *booth;
-        setup_.calibration = *cal;
+        setup_.light.booth = *booth;
+        setup_.light.calibration = *cal;
         // Raw counts of the D65 simulator (lamp 2) and of tungsten (lamp 0) from the simulated
         // spectrometer, six of each (1.2 s at five spectra a second).
         auto f = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" /
@@ -64,21 +67,21 @@ protected:
         return out;
     }
 
-    SceneUpdater make() const
+    SceneEstimator make() const
     {
-        auto u = SceneUpdater::create(setup_);
+        auto u = SceneEstimator::create(setup_);
         EXPECT_TRUE(u) << u.error().message;
         return std::move(*u);
     }
 
-    SceneUpdaterSetup setup_;
+    SceneEstimatorSetup setup_;
     std::vector<hal::SpectrumSample> f7_;
     std::vector<hal::SpectrumSample> tungsten_;
 };
 
-TEST_F(SceneUpdaterTest, ClassifiesTheLampAndUsesItsStoredSpectrumAndLuminance)
+TEST_F(SceneEstimatorTest, ClassifiesTheLampAndUsesItsStoredSpectrumAndLuminance)
 {
-    SceneUpdater u = make();
+    SceneEstimator u = make();
     pipeline::scene::SceneState st;
     const int confirm = pipeline::spectral::LightClassifierParams{}.confirmSamples;
     ASSERT_GE(confirm, 2);
@@ -88,23 +91,23 @@ TEST_F(SceneUpdaterTest, ClassifiesTheLampAndUsesItsStoredSpectrumAndLuminance)
         u.update(st, &f7_[static_cast<std::size_t>(i)], nullptr, nullptr);
         EXPECT_EQ(st.lampIndex, -1);
         EXPECT_EQ(u.classification().name, "unknown");
-        EXPECT_NE(st.illuminant.v, setup_.booth.lights[2].referenceSpectrum.v);
+        EXPECT_NE(st.illuminant.v, setup_.light.booth.lights[2].referenceSpectrum.v);
         EXPECT_GT(st.illuminant[20], 0.0);
         EXPECT_DOUBLE_EQ(st.emitterLuminanceCdM2, (2200.0 + 2600.0 + 2600.0) / 3.0);
     }
     u.update(st, &f7_[static_cast<std::size_t>(confirm - 1)], nullptr, nullptr);
     EXPECT_EQ(st.lampIndex, 2);
     EXPECT_EQ(u.classification().name, "d65-fluorescent");
-    EXPECT_EQ(st.illuminant.v, setup_.booth.lights[2].referenceSpectrum.v);
-    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.booth.lights[2].nominalLuminanceCdM2);
+    EXPECT_EQ(st.illuminant.v, setup_.light.booth.lights[2].referenceSpectrum.v);
+    EXPECT_EQ(st.emitterLuminanceCdM2, setup_.light.booth.lights[2].nominalLuminanceCdM2);
     // The same sample again changes nothing (sequence numbers).
     u.update(st, &f7_[static_cast<std::size_t>(confirm - 1)], nullptr, nullptr);
     EXPECT_EQ(st.lampIndex, 2);
 }
 
-TEST_F(SceneUpdaterTest, HysteresisIgnoresOneStraySpectrumAndSwitchesOnConfirmation)
+TEST_F(SceneEstimatorTest, HysteresisIgnoresOneStraySpectrumAndSwitchesOnConfirmation)
 {
-    SceneUpdater u = make();
+    SceneEstimator u = make();
     pipeline::scene::SceneState st;
     std::uint32_t seq = 100;
     auto feed = [&](hal::SpectrumSample s) {
@@ -128,26 +131,28 @@ TEST_F(SceneUpdaterTest, HysteresisIgnoresOneStraySpectrumAndSwitchesOnConfirmat
     }
     feed(tungsten_[static_cast<std::size_t>(confirm)]);
     EXPECT_EQ(st.lampIndex, 0);
-    EXPECT_EQ(st.illuminant.v, setup_.booth.lights[0].referenceSpectrum.v);
+    EXPECT_EQ(st.illuminant.v, setup_.light.booth.lights[0].referenceSpectrum.v);
     EXPECT_EQ(st.emitterLuminanceCdM2, 2200.0);
 }
 
-TEST_F(SceneUpdaterTest, BadBoothsAreRefusedAndAnEmptyOneIsDirectSensorMode)
+TEST_F(SceneEstimatorTest, BadBoothsAreRefusedAndAnEmptyOneIsDirectSensorMode)
 {
-    SceneUpdaterSetup dark = setup_;
-    dark.booth.lights[1].referenceSpectrum = pipeline::colour::Spectrum::constant(0.0);
-    auto bad = SceneUpdater::create(dark);
+    SceneEstimatorSetup dark = setup_;
+    dark.light.booth.lights[1].referenceSpectrum = pipeline::colour::Spectrum::constant(0.0);
+    auto bad = SceneEstimator::create(dark);
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error().message,
               "booth 'replica-booth-1': light classifier: stored light 'd50-fluorescent' has no "
               "energy");
     pipeline::spectral::LightClassifierParams params;
     params.releaseDistance = params.acceptDistance / 2.0;
-    EXPECT_FALSE(SceneUpdater::create(setup_, params));
+    SceneEstimatorSetup disordered = setup_;
+    disordered.light.classifier = params;
+    EXPECT_FALSE(SceneEstimator::create(disordered));
 
-    SceneUpdaterSetup empty = setup_;
-    empty.booth.lights.clear();
-    auto u = SceneUpdater::create(empty);
+    SceneEstimatorSetup empty = setup_;
+    empty.light.booth.lights.clear();
+    auto u = SceneEstimator::create(empty);
     ASSERT_TRUE(u);
     pipeline::scene::SceneState st;
     for (const auto& s : f7_) {
@@ -157,9 +162,9 @@ TEST_F(SceneUpdaterTest, BadBoothsAreRefusedAndAnEmptyOneIsDirectSensorMode)
     EXPECT_GT(st.illuminant[20], 0.0);
 }
 
-TEST_F(SceneUpdaterTest, SaturatedSpectrumKeepsTheLastLight)
+TEST_F(SceneEstimatorTest, SaturatedSpectrumKeepsTheLastLight)
 {
-    SceneUpdater u = make();
+    SceneEstimator u = make();
     pipeline::scene::SceneState st;
     for (int i = 0; i < 3; ++i) {
         u.update(st, &f7_[static_cast<std::size_t>(i)], nullptr, nullptr);
@@ -173,9 +178,9 @@ TEST_F(SceneUpdaterTest, SaturatedSpectrumKeepsTheLastLight)
     EXPECT_EQ(u.rejectedSpectra(), 1u);
 }
 
-TEST_F(SceneUpdaterTest, EyeMovesIntoTheBoothFrameAndHoldsThroughNaNAndLostTracking)
+TEST_F(SceneEstimatorTest, EyeMovesIntoTheBoothFrameAndHoldsThroughNaNAndLostTracking)
 {
-    SceneUpdater u = make();
+    SceneEstimator u = make();
     pipeline::scene::SceneState st;
     hal::PoseSample p;
     p.sequence = 1;
@@ -201,9 +206,9 @@ TEST_F(SceneUpdaterTest, EyeMovesIntoTheBoothFrameAndHoldsThroughNaNAndLostTrack
     EXPECT_EQ(u.rejectedPoses(), 2u);
 }
 
-TEST_F(SceneUpdaterTest, TiltHoldsWhenGravityIsAlongTheHinge)
+TEST_F(SceneEstimatorTest, TiltHoldsWhenGravityIsAlongTheHinge)
 {
-    SceneUpdater u = make();
+    SceneEstimator u = make();
     pipeline::scene::SceneState st;
     hal::AccelSample a;
     a.sequence = 1;
@@ -219,4 +224,114 @@ TEST_F(SceneUpdaterTest, TiltHoldsWhenGravityIsAlongTheHinge)
 }
 
 } // namespace
-} // namespace replica::platform
+} // namespace replica::state
+
+namespace replica::state {
+namespace {
+
+// What the rotation fix rests on: an estimator restored from another's save() (through its JSON
+// text) estimates every later frame bit for bit as the original does, here with the classifier
+// half-way through confirming a new lamp and the tilt half-way through a sliced refresh; a fresh
+// estimator fed the same later samples does not.
+TEST_F(SceneEstimatorTest, ARestoredEstimatorContinuesBitForBit)
+{
+    setup_.tilt.cacheSlices = 3;
+    SceneEstimator a = make();
+    std::uint32_t seq = 0;
+    pipeline::scene::SceneState sa;
+    const auto tiltSample = [&](double t) {
+        hal::AccelSample s;
+        s.sequence = ++seq;
+        s.gravity = {0.0, -9.80665 * std::cos(t), -9.80665 * std::sin(t)};
+        return s;
+    };
+    const auto poseSample = [&](double x) {
+        hal::PoseSample p;
+        p.sequence = ++seq;
+        p.tracked = true;
+        p.eyeTrackerM = {x, 0.05, 0.5};
+        return p;
+    };
+    const auto step = [&](SceneEstimator& e, pipeline::scene::SceneState& st, int i,
+                          const hal::SpectrumSample* spectrum) {
+        // Frame i's samples: the same for every estimator (sequence numbers from i).
+        hal::AccelSample acc = tiltSample(0.30 + 0.002 * i);
+        acc.sequence = static_cast<std::uint32_t>(1000 + i);
+        hal::PoseSample pose = poseSample(0.01 * i);
+        pose.sequence = static_cast<std::uint32_t>(2000 + i);
+        st.frameIndex = static_cast<std::uint64_t>(i);
+        e.update(st, spectrum, &pose, &acc);
+    };
+    std::vector<hal::SpectrumSample> spectra;
+    for (std::size_t i = 0; i < 3; ++i) {
+        spectra.push_back(f7_[i]);
+    }
+    for (std::size_t i = 0; i < 5; ++i) {
+        spectra.push_back(tungsten_[i]);
+    }
+    for (std::size_t i = 0; i < spectra.size(); ++i) {
+        spectra[i].sequence = static_cast<std::uint32_t>(3000 + i);
+    }
+    // Frame i sees spectrum i / 2.
+    const auto spectrumAt = [&](int i) { return &spectra[static_cast<std::size_t>(i / 2)]; };
+    const int saveAt = 8; // D65 confirmed; tungsten has won 2 of the 3 spectra it needs
+    for (int i = 0; i <= saveAt; ++i) {
+        step(a, sa, i, spectrumAt(i));
+    }
+    ASSERT_EQ(sa.lampIndex, 2);
+    ASSERT_EQ(a.classification().name, "d65-fluorescent");
+    const std::string text = a.save().dump();
+    SceneEstimator b = make();
+    ASSERT_TRUE(b.restore(nlohmann::json::parse(text)));
+    EXPECT_EQ(b.save().dump(), text);
+    SceneEstimator fresh = make();
+    pipeline::scene::SceneState sb, sf;
+    int freshDiffers = 0;
+    bool refreshSeen = false, lampChangeSeen = false;
+    for (int i = saveAt + 1; i < 16; ++i) {
+        step(a, sa, i, spectrumAt(i));
+        step(b, sb, i, spectrumAt(i));
+        step(fresh, sf, i, spectrumAt(i));
+        EXPECT_EQ(sb.lampIndex, sa.lampIndex) << i;
+        EXPECT_EQ(sb.illuminant.v, sa.illuminant.v) << i;
+        EXPECT_EQ(sb.emitterLuminanceCdM2, sa.emitterLuminanceCdM2) << i;
+        EXPECT_EQ(sb.lightChanged, sa.lightChanged) << i;
+        EXPECT_EQ(sb.encoding, sa.encoding) << i;
+        EXPECT_EQ(sb.eyeBoothM, sa.eyeBoothM) << i;
+        EXPECT_EQ(sb.tiltRad, sa.tiltRad) << i;
+        EXPECT_EQ(sb.heldTiltRad, sa.heldTiltRad) << i;
+        EXPECT_EQ(sb.diffuse, sa.diffuse) << i;
+        refreshSeen = refreshSeen || sa.diffuse->refreshRad.has_value();
+        lampChangeSeen = lampChangeSeen || (sa.lightChanged && sa.lampIndex == 0);
+        freshDiffers += sf.lampIndex != sa.lampIndex || sf.diffuse != sa.diffuse ? 1 : 0;
+    }
+    EXPECT_TRUE(refreshSeen);    // the tilt moved on far enough to refresh in bands
+    EXPECT_TRUE(lampChangeSeen); // tungsten confirmed after the restore
+    EXPECT_GT(freshDiffers, 0);  // without the saved state the frames are not the same
+}
+
+TEST_F(SceneEstimatorTest, ARestoreOfAnotherVersionOrBoothIsRefusedWithOneLine)
+{
+    SceneEstimator a = make();
+    pipeline::scene::SceneState st;
+    a.update(st, &f7_[0], nullptr, nullptr);
+    auto saved = a.save();
+    SceneEstimator b = make();
+    auto wrongVersion = saved;
+    wrongVersion["version"] = 2;
+    auto v = b.restore(wrongVersion);
+    ASSERT_FALSE(v);
+    EXPECT_EQ(v.error().message,
+              "the saved estimator state is not version 1 (replay it with the build that made it)");
+    auto wrongLamp = saved;
+    wrongLamp["light"]["lamp"] = 7;
+    auto l = b.restore(wrongLamp);
+    ASSERT_FALSE(l);
+    EXPECT_EQ(l.error().message, "light: lamp 7 is not one of the booth's 3 lamps");
+    auto noEye = saved;
+    noEye.erase("eye");
+    EXPECT_FALSE(b.restore(noEye));
+}
+
+} // namespace
+} // namespace replica::state

@@ -12,7 +12,7 @@
 
 #include <hal/samples.h>
 
-namespace replica::platform {
+namespace replica::state {
 
 struct LampArbiterParams {
     // About twice what the classifier needs to confirm a change (3 spectra at 5 Hz after the
@@ -20,6 +20,15 @@ struct LampArbiterParams {
     // believed for long (and shorter than the simulator's 2 s between lamp changes, so that
     // 'replica run --lamp-selector sim-miswired' shows the overruling).
     std::int64_t disagreeNs = 1'500'000'000;
+};
+
+// What the arbiter remembers (saved at the head of a rotated session file: scene_estimator.h).
+struct LampArbiterState {
+    int selected = -1;
+    bool trusted = false;
+    std::optional<std::int64_t> disagreeSinceNs;
+    std::uint64_t overruled = 0;
+    bool warned = false;
 };
 
 class LampArbiter
@@ -42,6 +51,13 @@ public:
     // A warning to log, once per session, the first time the selector is overruled.
     std::optional<std::string> takeWarning();
 
+    LampArbiterState state() const
+    {
+        return {selected_, trusted_, disagreeSinceNs_, overruled_, warned_};
+    }
+    // A selected lamp beyond the booth's is taken as none.
+    void restore(const LampArbiterState& s);
+
 private:
     int lampCount_;
     LampArbiterParams params_;
@@ -53,4 +69,4 @@ private:
     bool warned_ = false;
 };
 
-} // namespace replica::platform
+} // namespace replica::state

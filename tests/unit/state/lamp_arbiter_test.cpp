@@ -3,15 +3,17 @@
 // "off"/"lost"/no selector leave today's classifier behaviour untouched.
 #include <algorithm>
 
+#include <state/lamp_arbiter.h>
+#include <state/scene_estimator.h>
+
 #include <hal/sim/sim_devices.h>
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/spectral_table.h>
-#include <platform/loop/lamp_arbiter.h>
-#include <platform/loop/scene_updater.h>
+#include <pipeline/scene/booth.h>
 
 #include <gtest/gtest.h>
 
-namespace replica::platform {
+namespace replica::state {
 namespace {
 
 constexpr std::int64_t kS = 1'000'000'000;
@@ -93,8 +95,8 @@ protected:
         auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
                                                                    "sim_usb2000_responsivity.csv");
         ASSERT_TRUE(cal);
-        setup_.booth = *booth;
-        setup_.calibration = *cal;
+        setup_.light.booth = *booth;
+        setup_.light.calibration = *cal;
         hal::sim::SimSpectrometerParams p;
         for (const auto& lamp : booth->lights) {
             auto t = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" / lamp.referenceFile);
@@ -116,7 +118,7 @@ protected:
 
     // Runs the updater over the spectra with the given selector samples, at 20 frames a second;
     // returns the lamp shown at each frame.
-    std::vector<int> run(SceneUpdater& u, const std::vector<hal::LampSample>& selector) const
+    std::vector<int> run(SceneEstimator& u, const std::vector<hal::LampSample>& selector) const
     {
         std::vector<int> shown;
         pipeline::scene::SceneState st;
@@ -139,7 +141,7 @@ protected:
         return shown;
     }
 
-    SceneUpdaterSetup setup_;
+    SceneEstimatorSetup setup_;
     std::vector<hal::SpectrumSample> spectra_;
 };
 
@@ -154,8 +156,8 @@ std::vector<hal::LampSample> simSelector(std::vector<int> wiring)
 
 TEST_F(SelectorSceneTest, TheSwitchShowsTheNewLampBeforeTheClassifierWould)
 {
-    auto plain = SceneUpdater::create(setup_);
-    auto withSwitch = SceneUpdater::create(setup_);
+    auto plain = SceneEstimator::create(setup_);
+    auto withSwitch = SceneEstimator::create(setup_);
     ASSERT_TRUE(plain && withSwitch);
     const auto before = run(*plain, {});
     const auto after = run(*withSwitch, simSelector({}));
@@ -181,7 +183,7 @@ TEST_F(SelectorSceneTest, TheSwitchShowsTheNewLampBeforeTheClassifierWould)
 
 TEST_F(SelectorSceneTest, AMisWiredSwitchIsOverruledByTheSpectrometer)
 {
-    auto u = SceneUpdater::create(setup_);
+    auto u = SceneEstimator::create(setup_);
     ASSERT_TRUE(u);
     const auto shown = run(*u, simSelector({0, 2, 1}));
     EXPECT_EQ(shown[41], 2) << "believed at first: the turn shows at once";
@@ -192,8 +194,8 @@ TEST_F(SelectorSceneTest, AMisWiredSwitchIsOverruledByTheSpectrometer)
 
 TEST_F(SelectorSceneTest, OffLeavesTodaysBehaviour)
 {
-    auto plain = SceneUpdater::create(setup_);
-    auto off = SceneUpdater::create(setup_);
+    auto plain = SceneEstimator::create(setup_);
+    auto off = SceneEstimator::create(setup_);
     ASSERT_TRUE(plain && off);
     const auto before = run(*plain, {});
     const auto after = run(*off, {selectorAt(0, hal::kLampOff)});
@@ -201,4 +203,4 @@ TEST_F(SelectorSceneTest, OffLeavesTodaysBehaviour)
 }
 
 } // namespace
-} // namespace replica::platform
+} // namespace replica::state

@@ -1,9 +1,8 @@
 // The lamp selector and the classifier, reconciled.
 #include <fmt/format.h>
+#include <state/lamp_arbiter.h>
 
-#include <platform/loop/lamp_arbiter.h>
-
-namespace replica::platform {
+namespace replica::state {
 
 LampArbiter::LampArbiter(int lampCount, LampArbiterParams params)
     : lampCount_(lampCount), params_(params)
@@ -54,6 +53,17 @@ int LampArbiter::onClassified(int classified, std::int64_t tNs)
     return classified;
 }
 
+void LampArbiter::restore(const LampArbiterState& s)
+{
+    const bool valid = s.selected >= 0 && s.selected < lampCount_;
+    selected_ = valid ? s.selected : -1;
+    trusted_ = valid && s.trusted;
+    disagreeSinceNs_ = s.disagreeSinceNs;
+    overruled_ = s.overruled;
+    warned_ = s.warned;
+    warning_.reset();
+}
+
 std::optional<std::string> LampArbiter::takeWarning()
 {
     auto w = std::move(warning_);
@@ -61,4 +71,4 @@ std::optional<std::string> LampArbiter::takeWarning()
     return w;
 }
 
-} // namespace replica::platform
+} // namespace replica::state

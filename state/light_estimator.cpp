@@ -1,0 +1,264 @@
+// Spectrum -> classified (or sensed) light -> encoding decision.
+#include <nlohmann/json.hpp>
+#include <state/json_state.h>
+#include <state/light_estimator.h>
+
+namespace replica::state {
+namespace {
+
+std::vector<pipeline::spectral::StoredLight> lampLights(const pipeline::booth::Booth& booth)
+{
+    std::vector<pipeline::spectral::StoredLight> out;
+    for (const auto& lamp : booth.lights) {
+        out.push_back({lamp.name, lamp.referenceSpectrum});
+    }
+    return out;
+}
+
+double meanLuminance(const pipeline::booth::Booth& booth)
+{
+    double sum = 0.0;
+    for (const auto& lamp : booth.lights) {
+        sum += lamp.nominalLuminanceCdM2;
+    }
+    return booth.lights.empty() ? 0.0 : sum / static_cast<double>(booth.lights.size());
+}
+
+} // namespace
+
+Expected<LightEstimator> LightEstimator::create(LightEstimatorSetup setup)
+{
+    if (setup.booth.lights.empty()) {
+        return LightEstimator(std::move(setup), std::nullopt);
+    }
+    auto classifier =
+            pipeline::spectral::LightClassifier::create(lampLights(setup.booth), setup.classifier);
+    if (!classifier) {
+        return makeError(classifier.error().code,
+                         "booth '" + setup.booth.id + "': " + classifier.error().message);
+    }
+    return LightEstimator(std::move(setup), std::move(*classifier));
+}
+
+pipeline::spectral::Classification LightEstimator::classification() const
+{
+    return classifier_ ? classifier_->currentClassification()
+                       : pipeline::spectral::Classification{};
+}
+
+void LightEstimator::showLamp(int lamp)
+{
+    const auto& l = setup_.booth.lights[static_cast<std::size_t>(lamp)];
+    lamp_ = lamp;
+    spd_ = l.referenceSpectrum;
+    luminance_ = l.nominalLuminanceCdM2;
+}
+
+void LightEstimator::start()
+{
+    if (setup_.defaultLamp >= 0 &&
+        setup_.defaultLamp < static_cast<int>(setup_.booth.lights.size())) {
+        showLamp(setup_.defaultLamp);
+    }
+}
+
+void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::LampSample* selector)
+{
+    if (selector != nullptr && selector->sequence != lastSelector_) {
+        lastSelector_ = selector->sequence;
+        if (const auto lamp = arbiter_.onSelector(*selector)) {
+            showLamp(*lamp); // a turn of the switch shows at once
+        }
+    }
+    if (spectrum != nullptr && spectrum->sequence != lastSpectrum_) {
+        lastSpectrum_ = spectrum->sequence;
+        pipeline::spectral::RawSpectrum raw{spectrum->counts, spectrum->integrationTimeUs,
+                                            spectrum->wavelengthCoeffs,
+                                            spectrum->nonlinearityCoeffs};
+        auto spd = pipeline::spectral::countsToSpectrum(raw, setup_.calibration);
+        // A saturated spectrum has lost its peaks: its shape cannot be trusted, keep the last
+        // light.
+        if (spd && !spectrum->saturated) {
+            const int lamp = arbiter_.onClassified(classifier_ ? classifier_->classify(*spd) : -1,
+                                                   spectrum->timestampNs);
+            haveSpectrum_ = true;
+            if (lamp >= 0) {
+                showLamp(lamp);
+            } else {
+                // Direct-sensor mode: the sensed shape, at the booth's typical luminance.
+                lamp_ = -1;
+                spd_ = *spd;
+                luminance_ = meanLuminance(setup_.booth);
+            }
+        } else {
+            ++rejected_;
+        }
+    }
+}
+
+std::vector<pipeline::colour::Spectrum> LightEstimator::encodeSpectra(const LightEstimatorSetup& s)
+{
+    std::vector<pipeline::colour::Spectrum> out;
+    for (std::size_t i = 0; i < s.booth.lights.size(); ++i) {
+        out.push_back(i < s.encodeSpectra.size() ? s.encodeSpectra[i]
+                                                 : s.booth.lights[i].referenceSpectrum);
+    }
+    return out;
+}
+
+void EncodingDecision::write(pipeline::scene::SceneState& state)
+{
+    if (adaptive_ && state.lightChanged) {
+        const bool lamp = state.lampIndex >= 0 &&
+                          static_cast<std::size_t>(state.lampIndex) < lampSpectra_.size();
+        const pipeline::colour::Spectrum& spd =
+                lamp ? lampSpectra_[static_cast<std::size_t>(state.lampIndex)] : state.illuminant;
+        // A lamp change always re-encodes (unless already encoded for exactly that spectrum);
+        // the direct-sensor mode only past reencodeDistance.
+        const bool keep = encoding_ > 0 && (lamp ? spd.v == encodedFor_.v
+                                                 : pipeline::spectral::spectralShapeDistance(
+                                                           spd, encodedFor_) <= reencodeDistance_);
+        if (!keep) {
+            // No luminance or a non-finite band: keep the encoding there is.
+            if (auto basis = adaptive_->basisFor(spd)) {
+                basis_ = std::make_shared<const pipeline::colour::ChannelBasis>(std::move(*basis));
+                encodedFor_ = spd;
+                ++encoding_;
+            }
+        }
+    }
+    state.encoding = encoding_;
+    state.basis = basis_;
+    state.encodedFor = encodedFor_;
+}
+
+nlohmann::json EncodingDecision::save() const
+{
+    return {{"encoding", encoding_}, {"encoded_for", encodedFor_.v}};
+}
+
+Expected<void> EncodingDecision::restore(const nlohmann::json& j)
+{
+    try {
+        encoding_ = j.at("encoding").get<int>();
+        encodedFor_ = spectrumFromJson(j.at("encoded_for"));
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::InvalidArgument, fmt::format("encoding: {}", e.what()));
+    }
+    basis_.reset();
+    if (encoding_ < 0 || (encoding_ > 0 && !adaptive_)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("encoding {} without a light-adaptive encoder", encoding_));
+    }
+    if (encoding_ > 0) {
+        auto basis = adaptive_->basisFor(encodedFor_);
+        if (!basis) {
+            return makeError(ErrorCode::InvalidArgument,
+                             "the saved encoding's light makes no basis: " + basis.error().message);
+        }
+        basis_ = std::make_shared<const pipeline::colour::ChannelBasis>(std::move(*basis));
+    }
+    return {};
+}
+
+void LightEstimator::write(pipeline::scene::SceneState& state)
+{
+    // Changed as the renderer sees it: another lamp, or in direct-sensor mode another spectrum or
+    // luminance.
+    const bool changed =
+            !written_ || lamp_ != writtenLamp_ ||
+            (lamp_ < 0 && (spd_.v != writtenSpd_.v || luminance_ != writtenLuminance_));
+    written_ = true;
+    writtenLamp_ = lamp_;
+    writtenSpd_ = spd_;
+    writtenLuminance_ = luminance_;
+    state.lampIndex = lamp_;
+    state.illuminant = spd_;
+    state.emitterLuminanceCdM2 = luminance_;
+    state.lightChanged = changed;
+    encoding_.write(state);
+}
+
+nlohmann::json LightEstimator::save() const
+{
+    const auto c = classifier_ ? classifier_->state() : pipeline::spectral::LightClassifierState{};
+    const auto a = arbiter_.state();
+    return {{"last_spectrum", optionalJson(lastSpectrum_)},
+            {"last_selector", optionalJson(lastSelector_)},
+            {"have_spectrum", haveSpectrum_},
+            {"rejected", rejected_},
+            {"lamp", lamp_},
+            {"spd", spd_.v},
+            {"luminance", luminance_},
+            {"written", written_},
+            {"written_lamp", writtenLamp_},
+            {"written_spd", writtenSpd_.v},
+            {"written_luminance", writtenLuminance_},
+            {"classifier",
+             {{"current", c.current.index},
+              {"distance", c.current.distance},
+              {"candidate", c.candidate},
+              {"count", c.candidateCount}}},
+            {"arbiter",
+             {{"selected", a.selected},
+              {"trusted", a.trusted},
+              {"disagree_since_ns", optionalJson(a.disagreeSinceNs)},
+              {"overruled", a.overruled},
+              {"warned", a.warned}}},
+            {"encoding", encoding_.save()}};
+}
+
+Expected<void> LightEstimator::restore(const nlohmann::json& j)
+{
+    try {
+        const int lamps = static_cast<int>(setup_.booth.lights.size());
+        const auto lampIndex = [&](const nlohmann::json& v, const char* what) {
+            const int i = v.get<int>();
+            if (i < -1 || i >= lamps) {
+                throw std::out_of_range(
+                        fmt::format("{} {} is not one of the booth's {} lamps", what, i, lamps));
+            }
+            return i;
+        };
+        lastSpectrum_ = optionalFromJson<std::uint32_t>(j.at("last_spectrum"));
+        lastSelector_ = optionalFromJson<std::uint32_t>(j.at("last_selector"));
+        haveSpectrum_ = j.at("have_spectrum").get<bool>();
+        rejected_ = j.at("rejected").get<std::uint64_t>();
+        lamp_ = lampIndex(j.at("lamp"), "lamp");
+        spd_ = spectrumFromJson(j.at("spd"));
+        luminance_ = finiteFromJson(j.at("luminance"));
+        written_ = j.at("written").get<bool>();
+        writtenLamp_ = lampIndex(j.at("written_lamp"), "lamp");
+        writtenSpd_ = spectrumFromJson(j.at("written_spd"));
+        writtenLuminance_ = finiteFromJson(j.at("written_luminance"));
+        const auto& c = j.at("classifier");
+        if (classifier_) {
+            pipeline::spectral::LightClassifierState s;
+            const int current = lampIndex(c.at("current"), "classified lamp");
+            if (current >= 0) {
+                s.current.index = current;
+                s.current.name = setup_.booth.lights[static_cast<std::size_t>(current)].name;
+            }
+            s.current.distance = finiteFromJson(c.at("distance"));
+            s.candidate = lampIndex(c.at("candidate"), "candidate lamp");
+            s.candidateCount = c.at("count").get<int>();
+            classifier_->restore(s);
+        }
+        const auto& a = j.at("arbiter");
+        LampArbiterState s;
+        s.selected = lampIndex(a.at("selected"), "selected lamp");
+        s.trusted = a.at("trusted").get<bool>();
+        s.disagreeSinceNs = optionalFromJson<std::int64_t>(a.at("disagree_since_ns"));
+        s.overruled = a.at("overruled").get<std::uint64_t>();
+        s.warned = a.at("warned").get<bool>();
+        arbiter_.restore(s);
+        if (auto ok = encoding_.restore(j.at("encoding")); !ok) {
+            return makeError(ok.error().code, "light: " + ok.error().message);
+        }
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::InvalidArgument, fmt::format("light: {}", e.what()));
+    }
+    return {};
+}
+
+} // namespace replica::state

@@ -1,0 +1,126 @@
+// The light estimator: spectrometer counts -> spectrum (the calibration chain) -> the classifier's
+// lamp (with its hysteresis) reconciled with the lamp selector (LampArbiter) -> the light to render
+// with, and, with a light-adaptive encoder, whether the surface is re-encoded for it. Every
+// decision depends only on the samples it was given, so replay reproduces it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+#include <state/lamp_arbiter.h>
+
+#include <hal/samples.h>
+#include <pipeline/base/expected.h>
+#include <pipeline/booth/booth_model.h>
+#include <pipeline/scene/scene_state.h>
+#include <pipeline/spectral/adaptive_encoding.h>
+#include <pipeline/spectral/light_classifier.h>
+#include <pipeline/spectral/spectrometer_chain.h>
+
+namespace replica::state {
+
+// The re-encode decision of a light-adaptive encoder (basis "adaptive_k6"): each new lamp (unless
+// already encoded for exactly its spectrum) or a sensed shape moved by more than reencodeDistance
+// gets a basis of its own (pipeline/spectral/adaptive_encoding.h); a light the encoder refuses (no
+// luminance, a non-finite band) keeps the encoding there is.
+class EncodingDecision
+{
+public:
+    EncodingDecision() = default;
+    // lampSpectra[i]: what lamp i is encoded for (the renderer's booth light of that lamp).
+    EncodingDecision(std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
+                     std::vector<pipeline::colour::Spectrum> lampSpectra,
+                     double reencodeDistance = pipeline::spectral::kAdaptiveReencodeDistance)
+        : adaptive_(std::move(adaptive)), lampSpectra_(std::move(lampSpectra)),
+          reencodeDistance_(reencodeDistance)
+    {}
+    // For a frame whose light changed (state.lightChanged; its lamp, illuminant): decides, then
+    // writes the encoding into the state (every frame).
+    void write(pipeline::scene::SceneState& state);
+
+    nlohmann::json save() const;
+    Expected<void> restore(const nlohmann::json& j);
+
+private:
+    std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive_;
+    std::vector<pipeline::colour::Spectrum> lampSpectra_;
+    double reencodeDistance_ = pipeline::spectral::kAdaptiveReencodeDistance;
+    // How many re-encodes, and the light the last one was made for.
+    int encoding_ = 0;
+    pipeline::colour::Spectrum encodedFor_{};
+    std::shared_ptr<const pipeline::colour::ChannelBasis> basis_;
+};
+
+struct LightEstimatorSetup {
+    pipeline::booth::Booth booth;
+    pipeline::spectral::SpectrometerCalibration calibration;
+    pipeline::spectral::LightClassifierParams classifier;
+    // Shown until the first usable spectrum: a booth lamp index (-1: no light).
+    int defaultLamp = -1;
+    // A light-adaptive encoder (basis "adaptive_k6"), none for a fixed basis: each new lamp (or a
+    // sensed shape moved by more than reencodeDistance) gets a basis of its own, made for
+    // encodeSpectra[lamp] (the renderer's booth light of that lamp; the lamp's own spectrum where
+    // it is missing) or for the sensed spectrum (pipeline/spectral/adaptive_encoding.h).
+    std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive;
+    double reencodeDistance = pipeline::spectral::kAdaptiveReencodeDistance;
+    std::vector<pipeline::colour::Spectrum> encodeSpectra;
+};
+
+class LightEstimator
+{
+public:
+    // Fails for a lamp without energy or classifier thresholds out of order. A booth without
+    // lamps is always in direct-sensor mode.
+    static Expected<LightEstimator> create(LightEstimatorSetup setup);
+
+    // The first frame's light: the default lamp, else none.
+    void start();
+    // A new selector sample and/or spectrum (nullptr = none; a sequence number already used
+    // changes nothing).
+    void update(const hal::SpectrumSample* spectrum, const hal::LampSample* selector);
+    // Writes the light, whether it changed since the previous frame's, and the encoding.
+    void write(pipeline::scene::SceneState& state);
+
+    bool sensed() const { return haveSpectrum_; }
+    std::uint64_t rejectedSpectra() const { return rejected_; }
+    pipeline::spectral::Classification classification() const;
+    const LampArbiter& lampArbiter() const { return arbiter_; }
+    // A warning to log (the arbiter's), once.
+    std::optional<std::string> takeWarning() { return arbiter_.takeWarning(); }
+
+    nlohmann::json save() const;
+    Expected<void> restore(const nlohmann::json& j);
+
+private:
+    explicit LightEstimator(LightEstimatorSetup setup,
+                            std::optional<pipeline::spectral::LightClassifier> classifier)
+        : setup_(std::move(setup)), classifier_(std::move(classifier)),
+          arbiter_(static_cast<int>(setup_.booth.lights.size())),
+          encoding_(setup_.adaptive, encodeSpectra(setup_), setup_.reencodeDistance)
+    {}
+    static std::vector<pipeline::colour::Spectrum> encodeSpectra(const LightEstimatorSetup& s);
+    void showLamp(int lamp);
+
+    LightEstimatorSetup setup_;
+    std::optional<pipeline::spectral::LightClassifier> classifier_; // none: no lamps
+    LampArbiter arbiter_;
+    std::optional<std::uint32_t> lastSpectrum_;
+    std::optional<std::uint32_t> lastSelector_;
+    bool haveSpectrum_ = false;
+    std::uint64_t rejected_ = 0;
+    // The light now, and the one the previous frame rendered (none before the first frame).
+    int lamp_ = -1;
+    pipeline::colour::Spectrum spd_{};
+    double luminance_ = 0.0;
+    bool written_ = false;
+    int writtenLamp_ = -1;
+    pipeline::colour::Spectrum writtenSpd_{};
+    double writtenLuminance_ = 0.0;
+    EncodingDecision encoding_;
+};
+
+} // namespace replica::state

@@ -1,0 +1,134 @@
+// Gravity -> tilt; the hold filter and the sliced refresh of the diffuse term's tilt.
+#include <algorithm>
+#include <cmath>
+
+#include <state/json_state.h>
+#include <state/tilt_estimator.h>
+
+#include <pipeline/scene/stand.h>
+
+namespace replica::state {
+
+TiltEstimator::TiltEstimator(TiltEstimatorSetup setup) : setup_(setup), tilt_(setup.defaultTiltRad)
+{
+    setup_.cacheSlices = std::max(setup_.cacheSlices, 1);
+}
+
+void TiltEstimator::update(const hal::AccelSample* accel)
+{
+    if (accel == nullptr || accel->sequence == lastAccel_) {
+        return;
+    }
+    lastAccel_ = accel->sequence;
+    if (auto tilt = pipeline::scene::tiltFromGravity(accel->gravity)) {
+        sense(*tilt);
+    } else {
+        ++rejected_;
+    }
+}
+
+void TiltEstimator::write(pipeline::scene::SceneState& state)
+{
+    // The held tilt: the mean of the last kTiltWindow frames' tilts, taken when the light changes
+    // (the cache is drawn whole anyway) or when that mean has moved more than kTiltHoldRad from
+    // the held tilt. Non-finite tilts are left out.
+    if (std::isfinite(tilt_)) {
+        window_[next_] = tilt_;
+        next_ = (next_ + 1) % window_.size();
+        count_ = std::min(count_ + 1, window_.size());
+    }
+    if (count_ > 0) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < count_; ++i) {
+            sum += window_[i];
+        }
+        const double mean = sum / static_cast<double>(count_);
+        if (state.lightChanged || !heldValid_ || std::abs(mean - held_) > kTiltHoldRad) {
+            held_ = mean;
+            heldValid_ = true;
+        }
+    }
+    // The diffuse term's tilt, as the booth pass refreshes its cache (BoothShadingPass::draw):
+    // a new light (or the first frame) draws it whole at the held tilt; otherwise a new held tilt
+    // is drawn in K bands, one a frame, into a second cache that the K-th frame shows; a held
+    // tilt that moves meanwhile waits for those K frames.
+    const int k = setup_.cacheSlices;
+    if (state.lightChanged || !shown_) {
+        shown_ = held_;
+        refresh_.reset();
+        refreshBands_ = 0;
+    } else {
+        if (!refresh_ && held_ != *shown_) {
+            if (k == 1) {
+                shown_ = held_;
+            } else {
+                refresh_ = held_;
+                refreshBands_ = 0;
+            }
+        }
+        if (refresh_ && ++refreshBands_ == k) {
+            shown_ = *refresh_;
+            refresh_.reset();
+            refreshBands_ = 0;
+        }
+    }
+    state.tiltRad = tilt_;
+    state.heldTiltRad = held_;
+    state.diffuse = pipeline::scene::DiffuseTilt{*shown_, refresh_, refreshBands_};
+}
+
+nlohmann::json TiltEstimator::save() const
+{
+    return {{"last_accel", optionalJson(lastAccel_)},
+            {"have_tilt", haveTilt_},
+            {"rejected", rejected_},
+            {"tilt_rad", tilt_},
+            {"window", window_},
+            {"next", next_},
+            {"count", count_},
+            {"held_rad", held_},
+            {"held_valid", heldValid_},
+            {"shown_rad", optionalJson(shown_)},
+            {"refresh_rad", optionalJson(refresh_)},
+            {"refresh_bands", refreshBands_}};
+}
+
+Expected<void> TiltEstimator::restore(const nlohmann::json& j)
+{
+    try {
+        lastAccel_ = optionalFromJson<std::uint32_t>(j.at("last_accel"));
+        haveTilt_ = j.at("have_tilt").get<bool>();
+        rejected_ = j.at("rejected").get<std::uint64_t>();
+        tilt_ = finiteFromJson(j.at("tilt_rad"));
+        const auto& w = j.at("window");
+        if (!w.is_array() || w.size() != window_.size()) {
+            throw std::out_of_range(fmt::format("the window needs {} tilts", window_.size()));
+        }
+        for (std::size_t i = 0; i < window_.size(); ++i) {
+            window_[i] = finiteFromJson(w[i]);
+        }
+        next_ = j.at("next").get<std::size_t>();
+        count_ = j.at("count").get<std::size_t>();
+        if (next_ >= window_.size() || count_ > window_.size()) {
+            throw std::out_of_range("window position out of range");
+        }
+        held_ = finiteFromJson(j.at("held_rad"));
+        heldValid_ = j.at("held_valid").get<bool>();
+        const auto shown = j.at("shown_rad");
+        shown_ = shown.is_null() ? std::nullopt : std::optional<double>(finiteFromJson(shown));
+        const auto refresh = j.at("refresh_rad");
+        refresh_ =
+                refresh.is_null() ? std::nullopt : std::optional<double>(finiteFromJson(refresh));
+        refreshBands_ = j.at("refresh_bands").get<int>();
+        if (refreshBands_ < 0 || refreshBands_ >= setup_.cacheSlices ||
+            (!refresh_ && refreshBands_ != 0)) {
+            throw std::out_of_range(fmt::format("{} bands drawn of a refresh in {}", refreshBands_,
+                                                setup_.cacheSlices));
+        }
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::InvalidArgument, fmt::format("tilt: {}", e.what()));
+    }
+    return {};
+}
+
+} // namespace replica::state
