@@ -140,6 +140,46 @@ TEST_F(DisplayPassTest, AnalyticPassMatchesTheCpuModelWithFlareAndViewingAngle)
     EXPECT_NEAR(static_cast<double>(f.gamut.outOfGamut()), static_cast<double>(cpuOut), 4.0);
 }
 
+// A profile fitted from noisy readings carries a gamut-edge tolerance (display_fit.cpp): colours
+// within it of the fitted gamut are clamped per channel, not hue-mapped. The GL pass must apply
+// the same tolerance as the CPU inverse (it is two uniforms the pass uploads), so a wide
+// tolerance, which changes what the CPU drives for many of the red half's pixels, is checked
+// pixel by pixel as above.
+TEST_F(DisplayPassTest, AnalyticPassAppliesTheProfilesGamutEdgeTolerance)
+{
+    profile_.gamutEdgeTolerance = 0.4;
+    profile_.gamutEdgeFloor = 0.05;
+    auto r = make(InverseMethod::Analytic, 0.35);
+    ASSERT_TRUE(r);
+    RenderedFrame f;
+    ASSERT_TRUE(r->render(state(), f));
+    auto inv = display::DisplayInverse::build(profile_);
+    ASSERT_TRUE(inv);
+    display::DisplayModel strict = profile_;
+    strict.gamutEdgeTolerance = 0.0;
+    strict.gamutEdgeFloor = 0.0;
+    auto strictInv = display::DisplayInverse::build(strict);
+    ASSERT_TRUE(strictInv);
+    int changed = 0; // pixels the tolerance moves by more than the dither's one count
+    for (int y = 0; y < f.height; ++y) {
+        for (int x = 0; x < f.width; ++x) {
+            const auto want = expected(*inv, f, x, y);
+            const auto without = expected(*strictInv, f, x, y);
+            bool moved = false;
+            const std::size_t i =
+                    (static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x)) * 4;
+            for (int c = 0; c < 3; ++c) {
+                moved = moved || std::abs(want.counts[c] - without.counts[c]) > 2.0;
+                const double got = f.rgba[i + static_cast<std::size_t>(c)];
+                ASSERT_GE(got, std::floor(want.counts[c] - 0.02) - 1e-9) << x << "," << y;
+                ASSERT_LE(got, std::ceil(want.counts[c] + 0.02) + 1e-9) << x << "," << y;
+            }
+            changed += moved ? 1 : 0;
+        }
+    }
+    EXPECT_GT(changed, 0) << "the tolerance changes no pixel: the test cannot tell";
+}
+
 TEST_F(DisplayPassTest, CompensationChangesWhatIsDrivenInTheRightDirection)
 {
     auto r = make(InverseMethod::Analytic, 0.35);
