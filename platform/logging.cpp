@@ -16,8 +16,8 @@ namespace replica::platform {
 namespace {
 
 const char* const kAreas[] = {
-        "hal.spectrometer", "hal.tracker", "hal.accel", "hal.lamp", "pipeline",
-        "render",           "output",      "rec",       "loop",     "replica"};
+        "hal.spectrometer", "hal.tracker", "hal.accel", "hal.lamp", "pipeline", "render",
+        "output",           "rec",         "loop",      "replica",  "planner",  "booth"};
 
 std::mutex& registryMutex()
 {
@@ -90,6 +90,11 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
     }
     auto created = spdlog::stderr_color_mt(area);
     created->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
+    // An area first used after --log-level was applied follows the general level, not spdlog's
+    // default (info): 'replay --log-level warn' must not print a late area's info lines.
+    if (auto general = spdlog::get("replica"); general && general != created) {
+        created->set_level(general->level());
+    }
     for (const auto& t : taps()) {
         created->sinks().push_back(t);
     }
