@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <numbers>
@@ -253,7 +254,14 @@ makeBoothScene(RunConfig& config,
     if (!pass) {
         return tl::unexpected(pass.error());
     }
-    if (config.warmUp) {
+    // REPLICA_WARM_UP=0 skips it (frames are the same either way): under software emulation
+    // (the boot test's TCG guest) compiling every pass before the first frame takes minutes.
+    const char* warmEnv = std::getenv("REPLICA_WARM_UP");
+    const bool warmUp = config.warmUp && !(warmEnv != nullptr && std::string(warmEnv) == "0");
+    if (!warmUp && config.warmUp) {
+        logger("render")->info("REPLICA_WARM_UP=0: shading passes compile at their first use");
+    }
+    if (warmUp) {
         // Each lamp's pass compiled now, not at the loop's first switch to it.
         auto ms = (*pass)->warmUp(config.width, config.height);
         if (!ms) {
