@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include <tests/benchmarks/frame_bench_args.h>
 #include <time.h>
 
 #include <pipeline/base/data_dir.h>
@@ -158,33 +159,18 @@ bool leastSquares(const std::vector<std::vector<double>>& x,
 
 int main(int argc, char** argv)
 {
-    int frames = 9;
-    int w = 960;
-    int h = 600;
-    std::string only;
-    for (int a = 1; a < argc; ++a) {
-        const std::string arg = argv[a];
-        if (arg == "--help" || arg == "-h") {
-            std::printf("usage: %s [--frames N] [--size WxH] [--scene NAME]\n"
-                        "Times the appliance's frame over a grid of planner settings on every "
-                        "shipped scene and fits the planner's cost model to it.\n",
-                        argv[0]);
-            return 0;
-        }
-        if (a + 1 < argc && arg == "--frames") {
-            frames = std::max(3, std::atoi(argv[++a]));
-        } else if (a + 1 < argc && arg == "--size") {
-            if (std::sscanf(argv[++a], "%dx%d", &w, &h) != 2) {
-                std::fprintf(stderr, "--size: expected WIDTHxHEIGHT, got %s\n", argv[a]);
-                return 2;
-            }
-        } else if (a + 1 < argc && arg == "--scene") {
-            only = argv[++a];
-        } else {
-            std::fprintf(stderr, "unknown argument %s (see --help)\n", arg.c_str());
-            return 2;
-        }
+    replica::bench::FrameBenchArgs args;
+    args.frames = 9;
+    if (auto stop = replica::bench::parseFrameBenchArgs(
+                argc, argv, args, 3,
+                "Times the appliance's frame over a grid of planner settings on every shipped "
+                "scene and fits the planner's cost model to it.")) {
+        return *stop;
     }
+    const int frames = args.frames;
+    const int w = args.width;
+    const int h = args.height;
+    const std::string only = args.scene;
     std::printf("%dx%d, median of %d frames; ms\n", w, h, frames);
     for (const char* sceneName : {"metamer", "colorchecker", "painting"}) {
         if (!only.empty() && only != sceneName) {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <tests/benchmarks/frame_bench_args.h>
 
 #include <pipeline/base/data_dir.h>
 #include <platform/appliance.h>
@@ -116,33 +117,18 @@ bool run(const std::string& sceneName, bool planner, bool warmUp, int frames, in
 
 int main(int argc, char** argv)
 {
-    int frames = 8;
-    int w = 960;
-    int h = 600;
-    std::string only;
-    for (int a = 1; a < argc; ++a) {
-        const std::string arg = argv[a];
-        if (arg == "--help" || arg == "-h") {
-            std::printf("usage: %s [--frames N] [--size WxH] [--scene NAME]\n"
-                        "Frame times (ms) around lamp switches, planner and fixed rules, with and "
-                        "without the start-up warm-up; one table row each.\n",
-                        argv[0]);
-            return 0;
-        }
-        if (a + 1 < argc && arg == "--frames") {
-            frames = std::max(2, std::atoi(argv[++a]));
-        } else if (a + 1 < argc && arg == "--size") {
-            if (std::sscanf(argv[++a], "%dx%d", &w, &h) != 2) {
-                std::fprintf(stderr, "--size: expected WIDTHxHEIGHT, got %s\n", argv[a]);
-                return 2;
-            }
-        } else if (a + 1 < argc && arg == "--scene") {
-            only = argv[++a];
-        } else {
-            std::fprintf(stderr, "unknown argument %s (see --help)\n", arg.c_str());
-            return 2;
-        }
+    replica::bench::FrameBenchArgs args;
+    args.frames = 8;
+    if (auto stop = replica::bench::parseFrameBenchArgs(
+                argc, argv, args, 2,
+                "Frame times (ms) around lamp switches, planner and fixed rules, with and without "
+                "the start-up warm-up; one table row each.")) {
+        return *stop;
     }
+    const int frames = args.frames;
+    const int w = args.width;
+    const int h = args.height;
+    const std::string only = args.scene;
     std::printf("%dx%d, %d frames a lamp, lamps visited twice in turn; ms, wall clock\n\n", w, h,
                 frames);
     std::printf(
