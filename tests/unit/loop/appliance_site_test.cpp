@@ -76,6 +76,12 @@ protected:
         std::ofstream(f) << text;
         return f;
     }
+    // The scratch folder would otherwise outlive the run in /tmp, one per test process.
+    void TearDown() override
+    {
+        std::error_code ignored;
+        fs::remove_all(fs::temp_directory_path() / ("site-" + std::to_string(::getpid())), ignored);
+    }
 };
 
 TEST_F(SiteFile, TheShippedFileIsGoodAndHoldsTheCompiledInDefaults)

@@ -82,6 +82,9 @@ const Sample& sample()
         EXPECT_TRUE(rec) << rec.error().message;
         out.original = *rec;
         out.chunks = mcap::scan(out.bytes).chunks;
+        // The tests work on the bytes; the file would outlive the process in /tmp (one per run).
+        std::error_code ignored;
+        std::filesystem::remove(out.path, ignored);
         return out;
     }();
     return s;
