@@ -100,20 +100,16 @@ void chooseBoothDimmer(RunConfig& config,
     auto log = logger("booth");
     std::vector<sh::XyzFrame> frames; // per lamp, the frame of its brightest tilt
     std::vector<std::string> names;
-    for (const auto& name : setup.lamps) {
-        const pipeline::booth::BoothLight* light = setup.booth.find(name);
-        if (light == nullptr) {
-            continue;
-        }
+    for (const auto& light : setup.booth.lights) {
         pipeline::colour::ChannelBasis basis = setup.basis;
         if (setup.adaptive) {
-            if (auto b = setup.adaptive->basisFor(light->spd)) {
+            if (auto b = setup.adaptive->basisFor(light.spd)) {
                 basis = std::move(*b);
             }
         }
         const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
                                          0.01, basis);
-        const auto pl = sh::prepareLight(*light, setup.observer, setup.settings.lights, basis);
+        const auto pl = sh::prepareLight(light, setup.observer, setup.settings.lights, basis);
         double brightest = -1.0;
         sh::XyzFrame keep;
         for (const double tiltDeg : {0.0, 15.0, 30.0, 45.0, 60.0}) {
@@ -131,7 +127,7 @@ void chooseBoothDimmer(RunConfig& config,
             }
         }
         frames.push_back(std::move(keep));
-        names.push_back(name);
+        names.push_back(light.name);
     }
     const double peakY = displayModel.whiteXyz().y;
     double scale = 1.0;
@@ -187,9 +183,6 @@ makeBoothScene(RunConfig& config,
     pipeline::render::BoothSceneSetup setup;
     setup.stand = config.stand;
     setup.booth = booth;
-    for (const auto& light : booth.lights) {
-        setup.lamps.push_back(light.name);
-    }
     setup.scene = std::move(*scene);
     setup.basis = basis;
     setup.adaptive = std::move(adaptive);
@@ -222,10 +215,10 @@ makeBoothScene(RunConfig& config,
         } else if (!plan) {
             return tl::unexpected(plan.error());
         } else {
-            for (const auto& lamp : setup.lamps) {
-                const auto it = plan->lamps.find(lamp);
+            for (const auto& lamp : setup.booth.lights) {
+                const auto it = plan->lamps.find(lamp.name);
                 if (it != plan->lamps.end()) {
-                    config.plannedLamps[lamp] = it->second;
+                    config.plannedLamps[lamp.name] = it->second;
                 }
             }
         }

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include <pipeline/booth/booth_generator.h>
+#include <pipeline/booth/lamp_kinds.h>
 #include <pipeline/colour/spectral_table.h>
 
 namespace replica::pipeline::booth {
@@ -78,15 +79,8 @@ Expected<Booth> generateShippedBooth(const std::filesystem::path& dataDir, const
         return tl::unexpected(table.error());
     }
     Booth booth;
-    // Names and mean luminances as in scene::loadDefaultBooth, so the loop and the booth model
-    // agree.
-    struct Spec {
-        const char* name;
-        const char* column;
-        double meanCdM2;
-    };
-    for (const Spec s : {Spec{"tungsten", "A", 2200.0}, Spec{"d50-fluorescent", "F8", 2600.0},
-                         Spec{"d65-fluorescent", "F7", 2600.0}}) {
+    // One light per lamp kind, named and as bright as scene::loadDefaultBooth says the lamp is.
+    for (const LampKind& s : kLampKinds) {
         auto spd = table->spectrum(s.column);
         if (!spd) {
             return tl::unexpected(spd.error());
@@ -106,7 +100,7 @@ Expected<Booth> generateShippedBooth(const std::filesystem::path& dataDir, const
         }
         const double mean = l.luminance.sum() / static_cast<double>(l.luminance.cdM2.size());
         for (double& v : l.luminance.cdM2) {
-            v *= s.meanCdM2 / mean;
+            v *= s.nominalLuminanceCdM2 / mean;
         }
         booth.lights.push_back(std::move(l));
     }

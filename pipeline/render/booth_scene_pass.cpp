@@ -28,14 +28,6 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
     if (setup.booth.lights.empty()) {
         return makeError(ErrorCode::InvalidArgument, "render: the booth model has no lights");
     }
-    for (const auto& lamp : setup.lamps) {
-        if (setup.booth.find(lamp) == nullptr) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("render: lamp '{}' has no light in the booth model "
-                                         "(it has {})",
-                                         lamp, setup.booth.names()));
-        }
-    }
     std::unique_ptr<BoothScenePass> p(new BoothScenePass());
     p->setup_ = std::move(setup);
     const auto& s = p->setup_;
@@ -55,9 +47,9 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
     if (auto ok = makeVariant(s.settings); !ok) {
         return tl::unexpected(ok.error());
     }
-    for (const auto& lamp : s.lamps) {
+    for (const auto& lamp : s.booth.lights) {
         std::size_t index = 0;
-        const auto it = s.perLamp.find(lamp);
+        const auto it = s.perLamp.find(lamp.name);
         if (it != s.perLamp.end()) {
             shading::RenderSettings settings = s.settings;
             settings.lights = it->second.lights;
@@ -160,8 +152,8 @@ std::string BoothScenePass::description() const
 std::vector<colour::Spectrum> BoothScenePass::lampSpectra() const
 {
     std::vector<colour::Spectrum> out;
-    for (const auto& lamp : setup_.lamps) {
-        out.push_back(setup_.booth.find(lamp)->spd); // create() checked that each has a light
+    for (const auto& lamp : setup_.booth.lights) {
+        out.push_back(lamp.spd);
     }
     return out;
 }
@@ -169,10 +161,10 @@ std::vector<colour::Spectrum> BoothScenePass::lampSpectra() const
 Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
 {
     const int lamp = state.lampIndex;
-    const bool isLamp = lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.lamps.size();
+    const bool isLamp = lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.booth.lights.size();
     const booth::BoothLight* l =
-            isLamp ? setup_.booth.find(setup_.lamps[static_cast<std::size_t>(lamp)]) : nullptr;
-    const int index = isLamp ? static_cast<int>(l - setup_.booth.lights.data()) : -1;
+            isLamp ? &setup_.booth.lights[static_cast<std::size_t>(lamp)] : nullptr;
+    const int index = isLamp ? lamp : -1;
     const bool onGpu = index == lightIndex_ && state.encoding == encodings_ &&
                        (isLamp || (state.illuminant.v == directSpd_.v &&
                                    state.emitterLuminanceCdM2 == directLuminance_));

@@ -32,8 +32,7 @@ struct LampSettings {
 };
 
 struct BoothSceneSetup {
-    booth::Booth booth;             // lights with luminance images (data/booth)
-    std::vector<std::string> lamps; // the scene state's lamp names, by lampIndex
+    booth::Booth booth; // lights with luminance images (data/booth); lampIndex indexes them
     surface::SurfaceScene scene;
     colour::ChannelBasis basis;
     colour::Observer observer;

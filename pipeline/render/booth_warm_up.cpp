@@ -40,7 +40,7 @@ Expected<double> BoothScenePass::warmUp(int width, int height)
         const booth::BoothLight* light = &setup_.booth.lights.front();
         for (std::size_t l = 0; l < lampVariant_.size(); ++l) {
             if (lampVariant_[l] == v) {
-                light = setup_.booth.find(setup_.lamps[l]);
+                light = &setup_.booth.lights[l];
                 break;
             }
         }

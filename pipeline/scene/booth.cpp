@@ -1,33 +1,18 @@
 // The shipped booth and its simplest point-light decomposition.
 #include <algorithm>
-#include <array>
 #include <filesystem>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
 #include <pipeline/booth/booth_model.h>
+#include <pipeline/booth/lamp_kinds.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/scene/booth.h>
 
 namespace replica::pipeline::scene {
-namespace {
-
-// The lamps this build knows, by the booth model's light names.
-struct LampKind {
-    const char* name;
-    const char* file; // under data/spectra/
-    const char* column;
-    double nominalLuminanceCdM2;
-};
-
-constexpr std::array<LampKind, 3> kLampKinds = {{
-        {"tungsten", "cie_illuminants_A_D50_D65_5nm_300_780.csv", "A", 2200.0},
-        {"d50-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F8", 2600.0},
-        {"d65-fluorescent", "cie_illuminants_F1_F12_5nm_380_780.csv", "F7", 2600.0},
-}};
-
-} // namespace
+using booth::kLampKinds;
+using booth::LampKind;
 
 Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir)
 {

@@ -273,7 +273,6 @@ void BM_BoothLampChange(benchmark::State& st)
     const bool adaptive = st.range(0) == 2;
     pr::BoothSceneSetup s;
     s.booth = *pipeline::booth::loadBooth(dataDir() / "booth");
-    s.lamps = {"tungsten", "d50-fluorescent", "d65-fluorescent"};
     s.scene = *pipeline::surface::loadScene(dataDir() / "scenes" / "colorchecker");
     s.observer = *pipeline::colour::loadCie1931(dataDir());
     if (adaptive) {

@@ -43,7 +43,6 @@ protected:
         }
         output_ = std::move(*out);
         setup_.booth = *booth::loadBooth(dataDir() / "booth");
-        setup_.lamps = {"tungsten", "d50-fluorescent", "d65-fluorescent"};
         setup_.scene = *surface::loadScene(dataDir() / "scenes" / "colorchecker");
         setup_.observer = *colour::loadCie1931(dataDir());
         setup_.basis = encoder_->generalBasis();

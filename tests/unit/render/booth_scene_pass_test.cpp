@@ -27,7 +27,6 @@ protected:
         }
         output_ = std::move(*out);
         setup_.booth = *booth::loadBooth(dataDir() / "booth");
-        setup_.lamps = {"tungsten", "d50-fluorescent", "d65-fluorescent"};
         setup_.scene = *surface::loadScene(dataDir() / "scenes" / "metamer");
         setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
         setup_.observer = *colour::loadCie1931(dataDir());
@@ -109,16 +108,6 @@ TEST_F(BoothScenePassTest, UnknownLightIsTheSensedSpectrumOnAUniformEmitter)
     const auto e = uniformEmitter(setup_.booth.lights[0], 1000.0, st.illuminant);
     EXPECT_EQ(e.centre, setup_.booth.lights[0].centre);
     EXPECT_DOUBLE_EQ(e.luminance.max(), 1000.0);
-}
-
-TEST_F(BoothScenePassTest, LampWithoutABoothLightIsRefused)
-{
-    setup_.lamps.push_back("neon");
-    auto pass = BoothScenePass::create(setup_);
-    ASSERT_FALSE(pass);
-    EXPECT_NE(pass.error().message.find("lamp 'neon' has no light in the booth model"),
-              std::string::npos)
-            << pass.error().message;
 }
 
 TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested)

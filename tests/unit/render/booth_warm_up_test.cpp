@@ -24,7 +24,6 @@ protected:
         }
         output_ = std::move(*out);
         setup_.booth = *booth::loadBooth(dataDir() / "booth");
-        setup_.lamps = {"tungsten", "d50-fluorescent", "d65-fluorescent"};
         setup_.scene = *surface::loadScene(dataDir() / "scenes" / "colorchecker"); // glossy
         setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
         setup_.observer = *colour::loadCie1931(dataDir());
