@@ -5,6 +5,7 @@
 #include <state/json_state.h>
 #include <state/tilt_estimator.h>
 
+#include <pipeline/scene/diffuse_schedule.h>
 #include <pipeline/scene/stand.h>
 
 namespace replica::state {
@@ -48,33 +49,12 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
             heldValid_ = true;
         }
     }
-    // The diffuse term's tilt, as the booth pass refreshes its cache (BoothShadingPass::draw):
-    // a new light (or the first frame) draws it whole at the held tilt; otherwise a new held tilt
-    // is drawn in K bands, one a frame, into a second cache that the K-th frame shows; a held
-    // tilt that moves meanwhile waits for those K frames.
-    const int k = setup_.cacheSlices;
-    if (state.lightChanged || !shown_) {
-        shown_ = held_;
-        refresh_.reset();
-        refreshBands_ = 0;
-    } else {
-        if (!refresh_ && held_ != *shown_) {
-            if (k == 1) {
-                shown_ = held_;
-            } else {
-                refresh_ = held_;
-                refreshBands_ = 0;
-            }
-        }
-        if (refresh_ && ++refreshBands_ == k) {
-            shown_ = *refresh_;
-            refresh_.reset();
-            refreshBands_ = 0;
-        }
-    }
+    // The diffuse term's tilt: one frame of the cache's refresh schedule.
+    diffuse_ =
+            pipeline::scene::nextDiffuse(diffuse_, held_, state.lightChanged, setup_.cacheSlices);
     state.tiltRad = tilt_;
     state.heldTiltRad = held_;
-    state.diffuse = pipeline::scene::DiffuseTilt{*shown_, refresh_, refreshBands_};
+    state.diffuse = diffuse_;
 }
 
 nlohmann::json TiltEstimator::save() const
@@ -88,9 +68,9 @@ nlohmann::json TiltEstimator::save() const
             {"count", count_},
             {"held_rad", held_},
             {"held_valid", heldValid_},
-            {"shown_rad", optionalJson(shown_)},
-            {"refresh_rad", optionalJson(refresh_)},
-            {"refresh_bands", refreshBands_}};
+            {"shown_rad", diffuse_ ? nlohmann::json(diffuse_->shownRad) : nlohmann::json()},
+            {"refresh_rad", optionalJson(diffuse_ ? diffuse_->refreshRad : std::nullopt)},
+            {"refresh_bands", diffuse_ ? diffuse_->refreshBands : 0}};
 }
 
 Expected<void> TiltEstimator::restore(const nlohmann::json& j)
@@ -115,15 +95,21 @@ Expected<void> TiltEstimator::restore(const nlohmann::json& j)
         held_ = finiteFromJson(j.at("held_rad"));
         heldValid_ = j.at("held_valid").get<bool>();
         const auto shown = j.at("shown_rad");
-        shown_ = shown.is_null() ? std::nullopt : std::optional<double>(finiteFromJson(shown));
         const auto refresh = j.at("refresh_rad");
-        refresh_ =
+        pipeline::scene::DiffuseTilt d;
+        d.refreshRad =
                 refresh.is_null() ? std::nullopt : std::optional<double>(finiteFromJson(refresh));
-        refreshBands_ = j.at("refresh_bands").get<int>();
-        if (refreshBands_ < 0 || refreshBands_ >= setup_.cacheSlices ||
-            (!refresh_ && refreshBands_ != 0)) {
-            throw std::out_of_range(fmt::format("{} bands drawn of a refresh in {}", refreshBands_,
+        d.refreshBands = j.at("refresh_bands").get<int>();
+        if (d.refreshBands < 0 || d.refreshBands >= setup_.cacheSlices ||
+            (!d.refreshRad && d.refreshBands != 0) || (shown.is_null() && d.refreshRad)) {
+            throw std::out_of_range(fmt::format("{} bands drawn of a refresh in {}", d.refreshBands,
                                                 setup_.cacheSlices));
+        }
+        if (shown.is_null()) {
+            diffuse_.reset();
+        } else {
+            d.shownRad = finiteFromJson(shown);
+            diffuse_ = d;
         }
     } catch (const std::exception& e) {
         return makeError(ErrorCode::InvalidArgument, fmt::format("tilt: {}", e.what()));

@@ -66,10 +66,9 @@ private:
     std::size_t count_ = 0;
     double held_ = 0.0;
     bool heldValid_ = false;
-    // The diffuse term shown (none before the first frame) and a sliced refresh under way.
-    std::optional<double> shown_;
-    std::optional<double> refresh_;
-    int refreshBands_ = 0;
+    // The diffuse term of the last frame (none before the first):
+    // pipeline/scene/diffuse_schedule.h.
+    std::optional<pipeline::scene::DiffuseTilt> diffuse_;
 };
 
 } // namespace replica::state

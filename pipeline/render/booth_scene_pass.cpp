@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/scene/diffuse_schedule.h>
 
 namespace replica::pipeline::render {
 
@@ -227,27 +228,13 @@ Expected<void> BoothScenePass::drawCached(const scene::SceneState& state,
     const double sensed = std::isfinite(state.tiltRad) ? state.tiltRad : state.heldTiltRad;
     const scene::DiffuseTilt want =
             state.diffuse ? *state.diffuse : scene::DiffuseTilt{sensed, std::nullopt, 0};
-    // The one draw that takes the cache from what it holds to what the state says, where there
-    // is one: the same diffuse term, the next band of a refresh, or its last band.
-    std::optional<double> next;
-    if (var.holds.valid) {
-        const scene::DiffuseTilt& had = var.holds.diffuse;
-        if (!want.refreshRad) {
-            if (!had.refreshRad && had.shownRad == want.shownRad) {
-                next = want.shownRad;
-            } else if (had.refreshRad && *had.refreshRad == want.shownRad &&
-                       had.refreshBands == k - 1) {
-                next = want.shownRad;
-            }
-        } else if (had.shownRad == want.shownRad && ((!had.refreshRad && want.refreshBands == 1) ||
-                                                     (had.refreshRad == want.refreshRad &&
-                                                      had.refreshBands == want.refreshBands - 1))) {
-            next = *want.refreshRad;
-        }
-    }
+    // The one draw that takes the cache from what it holds to what the state says, where the
+    // state is the schedule's next frame after it (the same diffuse term, the next band of a
+    // refresh, or its last band): the cache at diffuseTarget(want) draws that band.
+    const bool oneDraw = var.holds.valid && scene::diffuseFollows(var.holds.diffuse, want, k);
     var.holds = {true, want};
-    if (next) {
-        const scene::PanelPose p = pose(*next);
+    if (oneDraw) {
+        const scene::PanelPose p = pose(scene::diffuseTarget(want));
         return pass_->draw(view, width, height, layout, &p);
     }
     // Otherwise (a fresh pass, a new light, frame N drawn alone): the shown diffuse term whole,
