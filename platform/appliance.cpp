@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <numbers>
@@ -247,14 +246,11 @@ makeBoothScene(RunConfig& config,
     if (!pass) {
         return tl::unexpected(pass.error());
     }
-    // REPLICA_WARM_UP=0 skips it (frames are the same either way): under software emulation
-    // (the boot test's TCG guest) compiling every pass before the first frame takes minutes.
-    const char* warmEnv = std::getenv("REPLICA_WARM_UP");
-    const bool warmUp = config.warmUp && !(warmEnv != nullptr && std::string(warmEnv) == "0");
-    if (!warmUp && config.warmUp) {
-        logger("render")->info("REPLICA_WARM_UP=0: shading passes compile at their first use");
-    }
-    if (warmUp) {
+    // --no-warm-up skips it (frames are the same either way): under software emulation (the boot
+    // test's TCG guest) compiling every pass before the first frame takes minutes.
+    if (!config.warmUp) {
+        logger("render")->info("no warm-up: shading passes compile at their first use");
+    } else {
         // Each lamp's pass compiled now, not at the loop's first switch to it.
         auto ms = (*pass)->warmUp(config.width, config.height);
         if (!ms) {

@@ -46,8 +46,13 @@ std::uint32_t autoIntegration(const hal::SpectrumSample& s)
 Expected<Sources>
 makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t lampCount)
 {
+    const auto live = [&options](const recordings::DeviceKindBase& kind) {
+        const auto it = options.devices.find(kind.name());
+        return it != options.devices.end() ? it->second : std::string();
+    };
+    const std::string trackerFrom = live(recordings::trackerKind());
     std::optional<hal::lamp::GpioLineSpec> lampLines;
-    if (!options.lampGpio.empty()) {
+    if (live(recordings::lampSelectorKind()) == "gpio" && !options.lampGpio.empty()) {
         auto spec = hal::lamp::parseGpioLineSpec(options.lampGpio);
         if (!spec) {
             return tl::unexpected(spec.error());
@@ -61,7 +66,7 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
         lampLines = std::move(*spec);
     }
     Sources s;
-    if (options.tracker == "opentrack") {
+    if (trackerFrom == "opentrack") {
         hal::tracker::OpentrackSourceOptions trackerOptions;
         trackerOptions.port = options.trackerPort;
         trackerOptions.bindAddress = options.trackerBind;
@@ -70,7 +75,7 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
             return tl::unexpected(tracker.error());
         }
         s.set(recordings::trackerKind(), std::move(*tracker));
-    } else if (options.tracker == "hid") {
+    } else if (trackerFrom == "hid") {
         hal::tracker::HidTrackerOptions hidOptions;
         auto axes = hal::accel::parseAxisMapping(options.trackerAxes);
         if (!axes) {
@@ -84,12 +89,11 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
         s.set(recordings::trackerKind(),
               hal::tracker::makeHidTrackerSource(hal::hid::hidapiOpener(options.hidTracker), clock,
                                                  std::move(hidOptions)));
-    } else if (!options.tracker.empty()) {
-        return makeError(
-                ErrorCode::InvalidArgument,
-                fmt::format("live tracker '{}': expected opentrack or hid", options.tracker));
+    } else if (!trackerFrom.empty()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("live tracker '{}': expected opentrack or hid", trackerFrom));
     }
-    if (options.spectrometer) {
+    if (live(recordings::spectrometerKind()) == "live") {
         hal::spectrometer::Usb2000SourceOptions specOptions;
         specOptions.nextIntegrationUs = autoIntegration;
         s.set(recordings::spectrometerKind(),
@@ -97,7 +101,7 @@ makeLiveSources(const hal::Clock& clock, const LiveOptions& options, std::size_t
                       hal::spectrometer::libusbUsb2000Opener(options.spectrometerSerial), clock,
                       std::move(specOptions)));
     }
-    if (options.accel) {
+    if (live(recordings::accelKind()) == "live") {
         hal::accel::IioAccelSourceOptions accelOptions;
         auto mounting = hal::accel::parseAxisMapping(options.accelAxes);
         if (!mounting) {

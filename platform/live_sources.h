@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include <hal/clock.h>
@@ -14,13 +15,13 @@
 namespace replica::platform {
 
 struct LiveOptions {
-    // Which implementation each device uses ('replica run --spectrometer/--tracker/--accel/
-    // --lamp-selector'): a site with a missing device runs that one on simulation (or on a
-    // recording) and the rest live. makeLiveSources opens only the devices marked live here.
-    bool spectrometer = true;
+    // The devices opened live, by device kind name, and their live driver ('replica run
+    // --spectrometer live --tracker hid ...'): spectrometer "live", tracker "opentrack" or "hid",
+    // accel "live", lamp_selector "gpio". A site with a missing device runs that one on
+    // simulation (or on a recording) and the rest live: makeLiveSources opens only these.
+    std::map<std::string, std::string> devices{
+            {"spectrometer", "live"}, {"tracker", "opentrack"}, {"accel", "live"}};
     std::string spectrometerSerial;    // the USB2000+ with this USB serial; empty = the first found
-    std::string tracker = "opentrack"; // "opentrack", "hid" or "" (not live)
-    bool accel = true;
     std::string hidTracker;            // --tracker hid: /dev/hidrawN; empty = the first found
     std::string trackerAxes = "x,y,z"; // --tracker hid: device axis for x right, y up, z to viewer
     std::uint16_t trackerPort = 4242;

@@ -359,6 +359,7 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     r.string("scene", "renderer", c.renderer, {"booth", "flat"});
     r.boolean("render", "planner", c.renderPlanner);
     c.renderPlannerSet = root.at_path("render.planner").as_boolean() != nullptr;
+    r.boolean("render", "warm_up", c.warmUp);
     r.string("display", "profile", c.displayProfile);
     r.boolean("display", "allow_synthetic", c.allowSynthetic);
     r.string("display", "output", c.output, {"kms", "headless"});
@@ -437,7 +438,8 @@ std::string SiteConfig::toJson() const
             {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
             {"render",
              {{"planner",
-               renderPlannerSet ? nlohmann::json(renderPlanner) : nlohmann::json("auto")}}},
+               renderPlannerSet ? nlohmann::json(renderPlanner) : nlohmann::json("auto")},
+              {"warm_up", warmUp}}},
             {"display",
              {{"profile", displayProfile},
               {"allow_synthetic", allowSynthetic},

@@ -39,6 +39,8 @@ struct SiteConfig {
     // 'replica run''s default, the plan when the scene has one (cached or shipped).
     bool renderPlanner = false;
     bool renderPlannerSet = false;
+    // [render] warm_up = false: 'replica run --no-warm-up' (RunConfig::warmUp).
+    bool warmUp = true;
     // [display]
     std::string displayProfile;   // empty: the shipped synthetic profile
     bool allowSynthetic = false;  // the kiosk refuses a live run on the synthetic profile

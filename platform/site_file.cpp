@@ -11,6 +11,7 @@
 
 #include <platform/site_config.h>
 #include <platform/site_file.h>
+#include <recordings/device_kind.h>
 
 namespace replica::platform {
 namespace {
@@ -178,11 +179,8 @@ Expected<SiteSources> readSiteSources(const std::filesystem::path& file)
     if (table == nullptr) {
         return s;
     }
-    for (const auto& [key, field] :
-         {std::pair<const char*, std::string*>{"spectrometer", &s.spectrometer},
-          {"tracker", &s.tracker},
-          {"accel", &s.accel},
-          {"lamp_selector", &s.lampSelector}}) {
+    for (const auto* kind : recordings::deviceKinds()) {
+        const std::string& key = kind->name();
         const auto& node = (*table)[key];
         if (!node) {
             continue;
@@ -193,7 +191,7 @@ Expected<SiteSources> readSiteSources(const std::filesystem::path& file)
                              fmt::format("{}: [sources] {} must be a string, e.g. \"sim\"",
                                          file.string(), key));
         }
-        *field = *v;
+        s[key] = *v;
     }
     return s;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include <pipeline/base/expected.h>
@@ -26,15 +27,11 @@ std::string trackerSection(const pipeline::scene::RigidFit& fit, std::size_t poi
 // [stand] hinge_m, hinge_to_panel_m, panel_width_m, panel_height_m, hinge_axis_panel, fit figures.
 std::string standSection(const pipeline::scene::StandFit& fit);
 
-// [sources]: which implementation each device uses at this site (spectrometer, tracker, accel,
-// lamp_selector; the values of 'replica run --spectrometer' etc.). Absent keys stay empty; a site
-// file without [sources] gives all empty.
-struct SiteSources {
-    std::string spectrometer;
-    std::string tracker;
-    std::string accel;
-    std::string lampSelector;
-};
+// [sources]: which implementation each device uses at this site, by device kind name
+// (recordings::deviceKinds(): spectrometer, tracker, accel, lamp_selector; the values of 'replica
+// run --spectrometer' etc.). Absent keys are not in the map; a site file without [sources] gives
+// an empty one.
+using SiteSources = std::map<std::string, std::string>;
 Expected<SiteSources> readSiteSources(const std::filesystem::path& file);
 
 // Reads T_booth_tracker back from a site file (nullopt-like NotFound when it has none).

@@ -42,6 +42,13 @@ struct DeviceNames {
     std::string frameKey;                  // /replica/frame: the sequence consumed, "accel_seq"
     std::string droppedKey;                // /replica/recorder: samples dropped, "dropped_accel"
     bool optional = false; // a session may have none: recordings before it, a booth without one
+    // 'replica run --<name, '_' as '-'>' (and the site file's [sources] <name>): where a run takes
+    // the kind's samples from. 'sources' are the option's values: "sim..." simulated, "replay",
+    // "none" (optional kinds), any other a live driver; 'liveSource' is what --hal live means
+    // for the kind (an optional kind has none unless asked); 'sourceHelp' the option's help.
+    std::vector<std::string> sources{};
+    std::string liveSource{};
+    std::string sourceHelp{};
 };
 
 // Where the writer thread puts a device's encoded messages (in order), and how it reports a raw

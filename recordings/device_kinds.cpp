@@ -19,9 +19,17 @@ channel(ChannelId id, std::string_view topic, const std::pair<std::string, std::
 const DeviceKind<hal::SpectrumSample>& spectrometerKind()
 {
     static const DeviceKind<hal::SpectrumSample> kind(
-            {"spectrometer", "spectrometer", "spectra",
-             channel(ChannelId::Spectrometer, kSpectrometerTopic, spectrumSchema()), std::nullopt,
-             "spectrum_seq", "dropped_spectra", false},
+            {"spectrometer",
+             "spectrometer",
+             "spectra",
+             channel(ChannelId::Spectrometer, kSpectrometerTopic, spectrumSchema()),
+             std::nullopt,
+             "spectrum_seq",
+             "dropped_spectra",
+             false,
+             {"live", "sim", "replay"},
+             "live",
+             "the spectrometer's source: live (USB2000+), sim or replay (default: --hal)"},
             spectrumCodec());
     return kind;
 }
@@ -29,10 +37,18 @@ const DeviceKind<hal::SpectrumSample>& spectrometerKind()
 const DeviceKind<hal::PoseSample>& trackerKind()
 {
     static const DeviceKind<hal::PoseSample> kind(
-            {"tracker", "tracker", "poses",
+            {"tracker",
+             "tracker",
+             "poses",
              channel(ChannelId::Tracker, kTrackerTopic, poseSchema()),
-             channel(ChannelId::RawTracker, kRawTrackerTopic, rawTrackerSchema()), "pose_seq",
-             "dropped_poses", false},
+             channel(ChannelId::RawTracker, kRawTrackerTopic, rawTrackerSchema()),
+             "pose_seq",
+             "dropped_poses",
+             false,
+             {"opentrack", "hid", "sim", "replay"},
+             "opentrack",
+             "the head tracker's source: opentrack (UDP), hid (a USB HID eye/head tracker, "
+             "usage page 0x12), sim or replay (default: opentrack with --hal live, else sim)"},
             poseCodec());
     return kind;
 }
@@ -40,10 +56,17 @@ const DeviceKind<hal::PoseSample>& trackerKind()
 const DeviceKind<hal::AccelSample>& accelKind()
 {
     static const DeviceKind<hal::AccelSample> kind(
-            {"accel", "accelerometer", "samples",
+            {"accel",
+             "accelerometer",
+             "samples",
              channel(ChannelId::Accel, kAccelTopic, accelSchema()),
-             channel(ChannelId::RawAccel, kRawAccelTopic, rawAccelSchema()), "accel_seq",
-             "dropped_accel", false},
+             channel(ChannelId::RawAccel, kRawAccelTopic, rawAccelSchema()),
+             "accel_seq",
+             "dropped_accel",
+             false,
+             {"live", "sim", "replay"},
+             "live",
+             "the accelerometer's source: live (IIO), sim or replay (default: --hal)"},
             accelCodec());
     return kind;
 }
@@ -51,9 +74,19 @@ const DeviceKind<hal::AccelSample>& accelKind()
 const DeviceKind<hal::LampSample>& lampSelectorKind()
 {
     static const DeviceKind<hal::LampSample> kind(
-            {"lamp_selector", "lamp selector", "samples",
-             channel(ChannelId::LampSelector, kLampSelectorTopic, lampSchema()), std::nullopt,
-             "lamp_seq", "dropped_lamp", true},
+            {"lamp_selector",
+             "lamp selector",
+             "samples",
+             channel(ChannelId::LampSelector, kLampSelectorTopic, lampSchema()),
+             std::nullopt,
+             "lamp_seq",
+             "dropped_lamp",
+             true,
+             {"none", "gpio", "sim", "sim-miswired", "replay"},
+             "gpio",
+             "the booth's lamp switch: none, gpio (the live switch on --lamp-gpio; the "
+             "default when that is given), sim (follows the simulated lamps, with contact "
+             "bounce), sim-miswired (its lines for lamps 1 and 2 swapped) or replay"},
             lampCodec());
     return kind;
 }

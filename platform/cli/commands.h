@@ -1,6 +1,8 @@
 // Registration of each 'replica' subcommand; each sets exitCode when it runs.
 #pragma once
 
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 #include <platform/output/output.h>
@@ -29,5 +31,8 @@ void registerConfigCommand(CLI::App& app, int& exitCode);
 
 // --kms-device, --kms-connector, --kms-mode, --kms-modeset, --kms-path (run and replay).
 void addKmsOptions(CLI::App& cmd, KmsOptions& kms);
+
+// --no-warm-up (run and replay): RunConfig::warmUp false. 'also' ends the help text.
+void addWarmUpOption(CLI::App& cmd, bool& noWarmUp, const std::string& also = "");
 
 } // namespace replica::platform

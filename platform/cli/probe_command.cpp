@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iostream>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,6 +27,7 @@
 #include <pipeline/scene/stand.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
+#include <recordings/device_kind.h>
 
 namespace replica::platform {
 namespace {
@@ -260,26 +263,134 @@ nlohmann::json probeLampSelector(const ProbeOptions& o)
     return j;
 }
 
+// The report's entry as text, after the device's name: one line per entry.
+std::string spectrometerText(const nlohmann::json& s)
+{
+    if (!s.value("ok", false)) {
+        return fmt::format("MISSING: {}", s["error"].get<std::string>());
+    }
+    return fmt::format("USB2000+ serial {} at {}: peak {} counts at {:.1f} nm ({} us){}",
+                       s["serial"].get<std::string>(), s["where"].get<std::string>(),
+                       s["peak_counts"].get<int>(), s["peak_nm"].get<double>(),
+                       s["integration_us"].get<std::uint32_t>(),
+                       s["saturated"].get<bool>() ? ", SATURATED" : "");
+}
+
+std::string accelText(const nlohmann::json& a)
+{
+    if (!a.value("ok", false)) {
+        return fmt::format("MISSING: {}", a["error"].get<std::string>());
+    }
+    return fmt::format("'{}' at {}: |g| = {:.2f} m/s^2, tilt {}", a["name"].get<std::string>(),
+                       a["where"].get<std::string>(), a["magnitude_ms2"].get<double>(),
+                       a["tilt_deg"].is_null()
+                               ? std::string("undefined")
+                               : fmt::format("{:.1f} deg", a["tilt_deg"].get<double>()));
+}
+
+std::string trackerText(const nlohmann::json& t)
+{
+    if (!t.value("found", false)) {
+        return fmt::format("MISSING: {}", t["error"].get<std::string>());
+    }
+    return fmt::format("{} poses at {:.0f} Hz on {}", t["poses"].get<std::size_t>(),
+                       t["rate_hz"].get<double>(), t["listening"].get<std::string>());
+}
+
+std::string hidTrackerText(const nlohmann::json& h)
+{
+    const std::string which = fmt::format("{} {} [{}]", h["node"].get<std::string>(),
+                                          h["name"].get<std::string>(), h["id"].get<std::string>());
+    if (!h.value("ok", false)) {
+        return fmt::format("{}: UNUSABLE: {}", which, h["error"].get<std::string>());
+    }
+    return fmt::format("{}: {}; status {}{}", which, h["layout"].get<std::string>(),
+                       h["status"].get<std::string>(),
+                       h.contains("eye_tracker_m") ? "" : ", no tracked report yet");
+}
+
+std::string lampSelectorText(const nlohmann::json& lamp, const ProbeOptions& o)
+{
+    std::string chipList;
+    for (const auto& c : lamp["chips"]) {
+        chipList += fmt::format("{}{} [{}] {} lines{}", chipList.empty() ? "" : ", ",
+                                c["name"].get<std::string>(), c["label"].get<std::string>(),
+                                c["lines"].get<unsigned>(),
+                                c.contains("error") ? " (cannot open: permission?)" : "");
+    }
+    if (chipList.empty()) {
+        chipList = fmt::format("none under {}", o.gpioDev);
+    }
+    if (!lamp["configured"].get<bool>()) {
+        return fmt::format("not configured (--lamp-gpio CHIP:OFFSETS); GPIO chips: {}", chipList);
+    }
+    if (!lamp.value("ok", false)) {
+        return fmt::format("MISSING: {}; GPIO chips: {}", lamp["error"].get<std::string>(),
+                           chipList);
+    }
+    std::string levels;
+    for (const auto& v : lamp["levels"]) {
+        levels += v.get<int>() != 0 ? '1' : '0';
+    }
+    const int l = lamp["lamp"].get<int>();
+    return fmt::format("{}: {} (line levels {})", lamp["where"].get<std::string>(),
+                       l >= 0 ? fmt::format("lamp {}", l) : lamp["state"].get<std::string>(),
+                       levels);
+}
+
+// What probe knows of a device kind's live hardware: each of its report's entries (the first
+// one the device's own, under the kind's display name; others, e.g. a listing, beside it), each
+// made by opening the hardware as 'replica run --hal live' would, and one text line per entry.
+struct ProbeEntry {
+    std::string key;  // in the report
+    std::string name; // before its text, for people
+    std::function<nlohmann::json(const ProbeOptions&)> probe;
+    std::function<std::string(const nlohmann::json&, const ProbeOptions&)> text;
+    bool list = false; // a JSON array: a text line per element
+};
+
+// By device kind name (recordings::deviceKinds()); a kind with no live hardware has none.
+const std::map<std::string, std::vector<ProbeEntry>>& deviceProbes()
+{
+    const auto plain = [](std::string (*f)(const nlohmann::json&)) {
+        return [f](const nlohmann::json& j, const ProbeOptions&) { return f(j); };
+    };
+    static const std::map<std::string, std::vector<ProbeEntry>> probes{
+            {"spectrometer",
+             {{"spectrometer", "spectrometer",
+               [](const ProbeOptions&) { return probeSpectrometer(); }, plain(spectrometerText)}}},
+            {"tracker",
+             {{"tracker", "tracker", probeTracker, plain(trackerText)},
+              {"hid_trackers", "hid tracker", probeHidTrackers, plain(hidTrackerText), true}}},
+            {"accel", {{"accelerometer", "accelerometer", probeAccel, plain(accelText)}}},
+            {"lamp_selector",
+             {{"lamp_selector", "lamp selector", probeLampSelector, lampSelectorText}}},
+    };
+    return probes;
+}
+
 int runProbe(const ProbeOptions& o)
 {
-    nlohmann::json report{{"spectrometer", probeSpectrometer()},
-                          {"accelerometer", probeAccel(o)},
-                          {"tracker", probeTracker(o)},
-                          {"hid_trackers", probeHidTrackers(o)},
-                          {"lamp_selector", probeLampSelector(o)}};
+    nlohmann::json report = nlohmann::json::object();
+    std::vector<const ProbeEntry*> entries; // in the registry's order
     bool all = true;
     std::vector<std::string> missing;
-    for (const char* k : {"spectrometer", "accelerometer", "tracker"}) {
-        const auto& d = report[k];
-        if (!(d.value("found", false) && d.value("ok", true))) {
-            all = false;
-            missing.emplace_back(k);
+    for (const auto* kind : recordings::deviceKinds()) {
+        const auto it = deviceProbes().find(kind->name());
+        if (it == deviceProbes().end()) {
+            continue; // no live hardware to look for
         }
-    }
-    const auto& lamp = report["lamp_selector"];
-    if (lamp["configured"].get<bool>() && !(lamp.value("found", false) && lamp.value("ok", true))) {
-        all = false;
-        missing.emplace_back("lamp selector");
+        for (const ProbeEntry& e : it->second) {
+            report[e.key] = e.probe(o);
+            entries.push_back(&e);
+        }
+        // The device's own entry: every run needs it; an optional one only where configured.
+        const auto& d = report[it->second.front().key];
+        const bool wanted = !kind->names().optional || d.value("configured", false);
+        if (wanted && !(d.value("found", false) && d.value("ok", true))) {
+            all = false;
+            missing.push_back(kind->names().displayName);
+        }
     }
     report["all_found"] = all;
     // The report goes to standard output; a failing probe also says so in one line on standard
@@ -296,71 +407,15 @@ int runProbe(const ProbeOptions& o)
         }
         return all ? kExitOk : kExitFailure;
     }
-    const auto& s = report["spectrometer"];
-    if (s.value("ok", false)) {
-        fmt::print("spectrometer   USB2000+ serial {} at {}: peak {} counts at {:.1f} nm "
-                   "({} us){}\n",
-                   s["serial"].get<std::string>(), s["where"].get<std::string>(),
-                   s["peak_counts"].get<int>(), s["peak_nm"].get<double>(),
-                   s["integration_us"].get<std::uint32_t>(),
-                   s["saturated"].get<bool>() ? ", SATURATED" : "");
-    } else {
-        fmt::print("spectrometer   MISSING: {}\n", s["error"].get<std::string>());
-    }
-    const auto& a = report["accelerometer"];
-    if (a.value("ok", false)) {
-        fmt::print("accelerometer  '{}' at {}: |g| = {:.2f} m/s^2, tilt {}\n",
-                   a["name"].get<std::string>(), a["where"].get<std::string>(),
-                   a["magnitude_ms2"].get<double>(),
-                   a["tilt_deg"].is_null()
-                           ? std::string("undefined")
-                           : fmt::format("{:.1f} deg", a["tilt_deg"].get<double>()));
-    } else {
-        fmt::print("accelerometer  MISSING: {}\n", a["error"].get<std::string>());
-    }
-    const auto& t = report["tracker"];
-    if (t.value("found", false)) {
-        fmt::print("tracker        {} poses at {:.0f} Hz on {}\n", t["poses"].get<std::size_t>(),
-                   t["rate_hz"].get<double>(), t["listening"].get<std::string>());
-    } else {
-        fmt::print("tracker        MISSING: {}\n", t["error"].get<std::string>());
-    }
-    for (const auto& h : report["hid_trackers"]) {
-        if (h.value("ok", false)) {
-            fmt::print("hid tracker    {} {} [{}]: {}; status {}{}\n", h["node"].get<std::string>(),
-                       h["name"].get<std::string>(), h["id"].get<std::string>(),
-                       h["layout"].get<std::string>(), h["status"].get<std::string>(),
-                       h.contains("eye_tracker_m") ? "" : ", no tracked report yet");
-        } else {
-            fmt::print("hid tracker    {} {} [{}]: UNUSABLE: {}\n", h["node"].get<std::string>(),
-                       h["name"].get<std::string>(), h["id"].get<std::string>(),
-                       h["error"].get<std::string>());
+    for (const ProbeEntry* e : entries) {
+        const auto& j = report[e->key];
+        if (!e->list) {
+            fmt::print("{:<15}{}\n", e->name, e->text(j, o));
+            continue;
         }
-    }
-    std::string chipList;
-    for (const auto& c : lamp["chips"]) {
-        chipList += fmt::format("{}{} [{}] {} lines{}", chipList.empty() ? "" : ", ",
-                                c["name"].get<std::string>(), c["label"].get<std::string>(),
-                                c["lines"].get<unsigned>(),
-                                c.contains("error") ? " (cannot open: permission?)" : "");
-    }
-    if (chipList.empty()) {
-        chipList = fmt::format("none under {}", o.gpioDev);
-    }
-    if (!lamp["configured"].get<bool>()) {
-        fmt::print("lamp selector  not configured (--lamp-gpio CHIP:OFFSETS); GPIO chips: {}\n",
-                   chipList);
-    } else if (lamp.value("ok", false)) {
-        std::string levels;
-        for (const auto& v : lamp["levels"]) {
-            levels += v.get<int>() != 0 ? '1' : '0';
+        for (const auto& item : j) {
+            fmt::print("{:<15}{}\n", e->name, e->text(item, o));
         }
-        const int l = lamp["lamp"].get<int>();
-        fmt::print("lamp selector  {}: {} (line levels {})\n", lamp["where"].get<std::string>(),
-                   l >= 0 ? fmt::format("lamp {}", l) : lamp["state"].get<std::string>(), levels);
-    } else {
-        fmt::print("lamp selector  MISSING: {}; GPIO chips: {}\n", lamp["error"].get<std::string>(),
-                   chipList);
     }
     if (!all) {
         std::fflush(stdout);

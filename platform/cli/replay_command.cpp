@@ -53,6 +53,7 @@ struct ReplayOptions {
     std::optional<std::string> trackerAxes, accelAxes; // with --reprocess: instead of recorded
     KmsOptions kms;
     bool hold = false; // keep the last frame on the display until SIGTERM/SIGINT
+    bool noWarmUp = false;
 };
 
 // The reference frame of `frame` in dir: .exr (committed goldens) or .pfm (local).
@@ -246,6 +247,7 @@ int replayMain(const ReplayOptions& o)
         outputChoice.kms.mode = fmt::format("{}x{}", config->width, config->height);
         outputChoice.kms.modeOrPreferred = true;
     }
+    config->warmUp = !o.noWarmUp; // not recorded: the frames are the same either way
     auto appliance = buildAppliance(*config, outputChoice);
     if (!appliance) {
         log->error("{}", appliance.error().message);
@@ -728,6 +730,7 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
             ->check(CLI::IsMember({"headless", "kms"}))
             ->capture_default_str();
     addKmsOptions(*cmd, opts->kms);
+    addWarmUpOption(*cmd, opts->noWarmUp);
     cmd->add_flag("--hold", opts->hold,
                   "after the last frame, keep it on the display until SIGTERM or SIGINT (a still "
                   "for a demo, or for a screen check: with --from T --to T the display shows "

@@ -50,12 +50,9 @@ int runMain(const run_cli::RunOptions& given)
             log->error("{}", site.error().message);
             return kExitUsage;
         }
-        for (auto [cli, fromSite] :
-             {std::pair{&o.spectrometer, &site->spectrometer},
-              std::pair{&o.tracker, &site->tracker}, std::pair{&o.accel, &site->accel},
-              std::pair{&o.lampSelector, &site->lampSelector}}) {
-            if (cli->empty()) {
-                *cli = *fromSite;
+        for (const auto& [kind, from] : *site) {
+            if (o.sources[kind].empty()) {
+                o.sources[kind] = from;
             }
         }
     }

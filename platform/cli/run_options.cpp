@@ -1,4 +1,6 @@
 // The options of 'replica run'.
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -37,6 +39,57 @@ bool syntheticDisplay(const RunConfig& config)
         return false; // buildAppliance reports an unreadable profile
     }
 }
+
+// Copies the site file's value into the run's option: Site a SiteConfig member, Path the
+// RunOptions member (or a path of members into it).
+template <auto Site, auto... Path>
+void fromSite(const SiteConfig& s, RunOptions& o)
+{
+    (o.*....*Path) = s.*Site;
+}
+
+// The run settings the site file gives as they are, each taken when the command line leaves its
+// option unset: a new one is one row (and its key in site_config.cpp).
+struct SiteDefault {
+    const char* option;
+    void (*fill)(const SiteConfig&, RunOptions&);
+};
+constexpr std::array kSiteDefaults = {
+        SiteDefault{"--hal", fromSite<&SiteConfig::hal, &RunOptions::hal>},
+        SiteDefault{"--replay-file", fromSite<&SiteConfig::replayFile, &RunOptions::replayFile>},
+        SiteDefault{"--rate", fromSite<&SiteConfig::rateHz, &RunOptions::rateHz>},
+        SiteDefault{"--output", fromSite<&SiteConfig::output, &RunOptions::output>},
+        SiteDefault{"--kms-device", fromSite<&SiteConfig::kmsDevice,
+                                             &RunOptions::outputChoice,
+                                             &OutputChoice::kms,
+                                             &KmsOptions::device>},
+        SiteDefault{"--kms-connector", fromSite<&SiteConfig::kmsConnector,
+                                                &RunOptions::outputChoice,
+                                                &OutputChoice::kms,
+                                                &KmsOptions::connector>},
+        SiteDefault{"--renderer", fromSite<&SiteConfig::renderer, &RunOptions::renderer>},
+        SiteDefault{
+                "--tracker-port",
+                fromSite<&SiteConfig::trackerPort, &RunOptions::live, &LiveOptions::trackerPort>},
+        SiteDefault{
+                "--tracker-bind",
+                fromSite<&SiteConfig::trackerBind, &RunOptions::live, &LiveOptions::trackerBind>},
+        SiteDefault{"--iio-root",
+                    fromSite<&SiteConfig::iioRoot, &RunOptions::live, &LiveOptions::iioRoot>},
+        SiteDefault{"--accel-name",
+                    fromSite<&SiteConfig::accelName, &RunOptions::live, &LiveOptions::accelName>},
+        SiteDefault{"--accel-axes",
+                    fromSite<&SiteConfig::accelAxes, &RunOptions::live, &LiveOptions::accelAxes>},
+        SiteDefault{"--lamp-gpio",
+                    fromSite<&SiteConfig::lampGpio, &RunOptions::live, &LiveOptions::lampGpio>},
+        SiteDefault{"--spectrometer-serial", fromSite<&SiteConfig::spectrometerSerial,
+                                                      &RunOptions::live,
+                                                      &LiveOptions::spectrometerSerial>},
+        SiteDefault{"--record-flush-ms",
+                    fromSite<&SiteConfig::flushMs, &RunOptions::recordFlushMs>},
+        SiteDefault{"--no-warm-up",
+                    [](const SiteConfig& s, RunOptions& o) { o.noWarmUp = !s.warmUp; }},
+};
 
 } // namespace
 
@@ -82,22 +135,11 @@ void addRunOptions(CLI::App& cmd, RunOptions& o)
     cmd.add_option("--spectrometer-serial", o.live.spectrometerSerial,
                    "live: open the USB2000+ whose USB serial number is this (as `lsusb -v` "
                    "shows it); default: the first one found");
-    cmd.add_option("--lamp-selector", o.lampSelector,
-                   "the booth's lamp switch: none, gpio (the live switch on --lamp-gpio; the "
-                   "default when that is given), sim (follows the simulated lamps, with contact "
-                   "bounce), sim-miswired (its lines for lamps 1 and 2 swapped) or replay")
-            ->check(CLI::IsMember({"none", "gpio", "sim", "sim-miswired", "replay"}));
-    cmd.add_option("--spectrometer", o.spectrometer,
-                   "the spectrometer's source: live (USB2000+), sim or replay (default: --hal)")
-            ->check(CLI::IsMember({"live", "sim", "replay"}));
-    cmd.add_option("--tracker", o.tracker,
-                   "the head tracker's source: opentrack (UDP), hid (a USB HID eye/head tracker, "
-                   "usage page 0x12), sim or replay (default: opentrack with --hal live, else "
-                   "sim)")
-            ->check(CLI::IsMember({"opentrack", "hid", "sim", "replay"}));
-    cmd.add_option("--accel", o.accel,
-                   "the accelerometer's source: live (IIO), sim or replay (default: --hal)")
-            ->check(CLI::IsMember({"live", "sim", "replay"}));
+    for (const auto* kind : recordings::deviceKinds()) { // --spectrometer, ..., --lamp-selector
+        cmd.add_option("--" + deviceOption(*kind), o.sources[kind->name()],
+                       kind->names().sourceHelp)
+                ->check(CLI::IsMember(kind->names().sources));
+    }
     cmd.add_option("--replay-from", o.replayFrom,
                    "the recording that devices set to 'replay' play back (from its session "
                    "start)");
@@ -203,9 +245,17 @@ void addRunOptions(CLI::App& cmd, RunOptions& o)
     cmd.add_option("--plan-cache", o.planCache,
                    "folder of the planner's cached plans (default $REPLICA_PLAN_CACHE, else "
                    "$XDG_CACHE_HOME/replica/plans, else ~/.cache/replica/plans)");
+    addWarmUpOption(cmd, o.noWarmUp, "; the site file's [render] warm_up = false asks the same");
     cmd.add_flag("--false-colour", o.falseColour,
                  "field-staff overlay: stripe out-of-gamut pixels (magenta: chroma, cyan: above "
                  "peak, blue: below black)");
+}
+
+std::string deviceOption(const recordings::DeviceKindBase& kind)
+{
+    std::string s = kind.name();
+    std::replace(s.begin(), s.end(), '_', '-');
+    return s;
 }
 
 std::string dataPath(const std::string& p)
@@ -217,59 +267,20 @@ std::string dataPath(const std::string& p)
 void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd)
 {
     const auto unset = [&cmd](const char* name) { return cmd.get_option(name)->count() == 0; };
-    if (unset("--hal")) {
-        o.hal = s.hal;
+    for (const auto& row : kSiteDefaults) {
+        if (unset(row.option)) {
+            row.fill(s, o);
+        }
     }
-    if (unset("--replay-file")) {
-        o.replayFile = s.replayFile;
-    }
-    if (unset("--rate")) {
-        o.rateHz = s.rateHz;
-    }
-    if (unset("--output")) {
-        o.output = s.output;
-    }
+    // The three whose site value is not taken as it is.
     if (unset("--size") && o.output != "kms") { // on KMS the frame is the mode's size
         o.size = s.size;
-    }
-    if (unset("--kms-device")) {
-        o.outputChoice.kms.device = s.kmsDevice;
-    }
-    if (unset("--kms-connector")) {
-        o.outputChoice.kms.connector = s.kmsConnector;
     }
     if (unset("--scene") && !s.sceneDir.empty()) {
         o.scene = dataPath(s.sceneDir);
     }
-    if (unset("--renderer")) {
-        o.renderer = s.renderer;
-    }
     if (unset("--display-profile") && unset("--uncalibrated") && !s.displayProfile.empty()) {
         o.displayProfile = dataPath(s.displayProfile);
-    }
-    if (unset("--tracker-port")) {
-        o.live.trackerPort = s.trackerPort;
-    }
-    if (unset("--tracker-bind")) {
-        o.live.trackerBind = s.trackerBind;
-    }
-    if (unset("--iio-root")) {
-        o.live.iioRoot = s.iioRoot;
-    }
-    if (unset("--accel-name")) {
-        o.live.accelName = s.accelName;
-    }
-    if (unset("--accel-axes")) {
-        o.live.accelAxes = s.accelAxes;
-    }
-    if (unset("--lamp-gpio")) {
-        o.live.lampGpio = s.lampGpio;
-    }
-    if (unset("--spectrometer-serial")) {
-        o.live.spectrometerSerial = s.spectrometerSerial;
-    }
-    if (unset("--record-flush-ms")) {
-        o.recordFlushMs = s.flushMs;
     }
 }
 
@@ -357,6 +368,7 @@ int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfi
         config.planIfMissing = o.site->renderPlanner;
     }
     config.plannerCache = o.planCache;
+    config.warmUp = !o.noWarmUp;
     if (o.site) {
         const SiteConfig& site = *o.site;
         config.booth = site.boothId;
@@ -410,6 +422,16 @@ int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfi
 } // namespace replica::platform::run_cli
 
 namespace replica::platform {
+
+void addWarmUpOption(CLI::App& cmd, bool& noWarmUp, const std::string& also)
+{
+    cmd.add_flag("--no-warm-up", noWarmUp,
+                 "do not draw every lamp's shading pass once before the first frame: each then "
+                 "compiles at its first use, and the first switch to a lamp waits for it (the "
+                 "frames are the same; for software emulation, where the warm-up takes "
+                 "minutes)" +
+                         also);
+}
 
 void addKmsOptions(CLI::App& cmd, KmsOptions& kms)
 {

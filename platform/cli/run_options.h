@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -12,17 +13,15 @@
 #include <platform/appliance.h>
 #include <platform/live_sources.h>
 #include <platform/site_config.h>
+#include <recordings/device_kind.h>
 
 namespace replica::platform::run_cli {
 
 struct RunOptions {
     std::string hal = "sim";
-    // Per device (empty: follow --hal): spectrometer live|sim|replay, tracker opentrack|hid|sim|
-    // replay, accel live|sim|replay, lamp selector none|sim|sim-miswired|gpio|replay.
-    std::string spectrometer;
-    std::string tracker;
-    std::string accel;
-    std::string lampSelector;
+    // Per device kind name (recordings::deviceKinds()), its source: --spectrometer, --tracker,
+    // --accel, --lamp-selector (DeviceNames::sources; absent or empty: follow --hal).
+    std::map<std::string, std::string> sources;
     std::string replayFrom; // the recording that devices set to 'replay' play back
     std::string sitePath;   // --site: [sources] and [tracker] T_booth_tracker (calibrate)
     std::string output = "headless";
@@ -49,6 +48,7 @@ struct RunOptions {
     bool planner = false;   // --planner: plan a scene that has no plan yet
     bool noPlanner = false; // --no-planner: the fixed rules
     std::string planCache;
+    bool noWarmUp = false;     // --no-warm-up: RunConfig::warmUp false
     bool recordDigests = true; // format 4: XXH3-64 of every displayed frame in the recording
     double thumbnailHz = 1.0;
     int thumbnailWidth = 320;
@@ -74,6 +74,10 @@ void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd);
 // The run configuration the options ask for, at frame size 'size': logs what is wrong in one line
 // and returns the exit code (kExitOk when 'config' is built).
 int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfig& config);
+
+// The run's option that chooses a device kind's source, without its dashes: "spectrometer",
+// "lamp-selector".
+std::string deviceOption(const recordings::DeviceKindBase& kind);
 
 // A file name relative to the data folder (absolute ones as they are).
 std::string dataPath(const std::string& p);

@@ -1,8 +1,10 @@
 // Where 'replica run' takes each device's samples from.
-#include <initializer_list>
+#include <algorithm>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <platform/cli/run_sources.h>
 #include <platform/live_sources.h>
@@ -11,14 +13,6 @@
 #include <recordings/recording.h>
 
 namespace replica::platform::run_cli {
-
-// The run's option that chooses a device kind's source: --spectrometer, --lamp-selector.
-std::string deviceOption(const recordings::DeviceKindBase& kind)
-{
-    std::string s = kind.name();
-    std::replace(s.begin(), s.end(), '_', '-');
-    return s;
-}
 
 // Each device's source: --hal gives the default, --spectrometer/--tracker/--accel/--lamp-selector
 // override it per device. Usage errors come back as InvalidArgument.
@@ -31,35 +25,35 @@ Expected<DeviceChoice> chooseDevices(const RunOptions& o)
                                      "(the samples of --replay-file)",
                                      o.hal));
     }
-    DeviceChoice c;
-    auto& spectrometer = c.from[recordings::spectrometerKind().name()];
-    auto& tracker = c.from[recordings::trackerKind().name()];
-    auto& accel = c.from[recordings::accelKind().name()];
-    auto& lampSelector = c.from[recordings::lampSelectorKind().name()];
-    spectrometer = o.spectrometer.empty() ? o.hal : o.spectrometer;
-    tracker = !o.tracker.empty() ? o.tracker : o.hal == "live" ? "opentrack" : o.hal;
-    accel = o.accel.empty() ? o.hal : o.accel;
-    lampSelector =
-            !o.lampSelector.empty() ? o.lampSelector : (o.live.lampGpio.empty() ? "none" : "gpio");
-    auto oneOf = [](const std::string& v, std::initializer_list<const char*> allowed) {
-        for (const char* a : allowed) {
-            if (v == a) {
-                return true;
-            }
-        }
-        return false;
+    const auto givenFor = [&o](const recordings::DeviceKindBase& kind) {
+        const auto it = o.sources.find(kind.name());
+        return it != o.sources.end() ? it->second : std::string();
     };
-    if (!oneOf(spectrometer, {"live", "sim", "replay"}) ||
-        !oneOf(tracker, {"opentrack", "hid", "sim", "replay"}) ||
-        !oneOf(accel, {"live", "sim", "replay"}) ||
-        !oneOf(lampSelector, {"none", "gpio", "sim", "sim-miswired", "replay"})) {
-        return makeError(
-                ErrorCode::InvalidArgument,
-                fmt::format("sources spectrometer={} tracker={} accel={} lamp_selector={}: "
-                            "expected spectrometer and accel live|sim|replay, tracker "
-                            "opentrack|hid|sim|replay, lamp_selector "
-                            "none|gpio|sim|sim-miswired|replay",
-                            spectrometer, tracker, accel, lampSelector));
+    DeviceChoice c;
+    std::vector<std::string> given, expected;
+    bool allKnown = true;
+    for (const auto* kind : recordings::deviceKinds()) {
+        const auto& names = kind->names();
+        std::string from = givenFor(*kind);
+        if (from.empty()) {
+            // --hal's: the kind's live driver with --hal live; an optional kind none.
+            from = names.optional ? "none" : o.hal == "live" ? names.liveSource : o.hal;
+        }
+        allKnown = allKnown && std::find(names.sources.begin(), names.sources.end(), from) !=
+                                       names.sources.end();
+        given.push_back(fmt::format("{}={}", kind->name(), from));
+        expected.push_back(fmt::format("{} {}", kind->name(), fmt::join(names.sources, "|")));
+        c.from[kind->name()] = std::move(from);
+    }
+    // The lamp selector's switch, when its lines are given: the GPIO one unless told otherwise.
+    std::string& lampSelector = c.from[recordings::lampSelectorKind().name()];
+    if (!o.live.lampGpio.empty() && givenFor(recordings::lampSelectorKind()).empty()) {
+        lampSelector = "gpio";
+    }
+    if (!allKnown) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("sources {}: expected {}", fmt::join(given, " "),
+                                     fmt::join(expected, ", ")));
     }
     if (lampSelector == "gpio" && o.live.lampGpio.empty()) {
         return makeError(ErrorCode::InvalidArgument,
@@ -125,12 +119,11 @@ makeRunSources(const RunOptions& o, const Appliance& appliance, const hal::Clock
     Sources live;
     if (c.anyLive()) {
         LiveOptions lo = o.live;
-        const std::string& trackerFrom = c.of(recordings::trackerKind());
-        lo.spectrometer = c.of(recordings::spectrometerKind()) == "live";
-        lo.tracker = DeviceChoice::isLive(trackerFrom) ? trackerFrom : std::string();
-        lo.accel = c.of(recordings::accelKind()) == "live";
-        if (lampFrom != "gpio") {
-            lo.lampGpio.clear();
+        lo.devices.clear();
+        for (const auto& [kind, from] : c.from) {
+            if (DeviceChoice::isLive(from)) {
+                lo.devices[kind] = from;
+            }
         }
         auto made = makeLiveSources(liveClock, lo, appliance.booth.lights.size());
         if (!made) {

@@ -14,9 +14,6 @@
 
 namespace replica::platform::run_cli {
 
-// The run's option that chooses a device kind's source: --spectrometer, --lamp-selector.
-std::string deviceOption(const recordings::DeviceKindBase& kind);
-
 // Where each device kind's source comes from (kind name -> "live", "opentrack", "hid", "gpio",
 // "sim", "sim-miswired", "replay" or "none").
 struct DeviceChoice {

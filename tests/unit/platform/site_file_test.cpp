@@ -75,9 +75,9 @@ TEST_F(CalibrationSiteFile, SourcesAreReadWhenPresent)
     std::ofstream(file) << "[sources]\ntracker = \"hid\"\nlamp_selector = \"gpio\"\n";
     auto s = readSiteSources(file);
     ASSERT_TRUE(s) << s.error().message;
-    EXPECT_EQ(s->tracker, "hid");
-    EXPECT_EQ(s->lampSelector, "gpio");
-    EXPECT_TRUE(s->spectrometer.empty());
+    EXPECT_EQ(s->at("tracker"), "hid");
+    EXPECT_EQ(s->at("lamp_selector"), "gpio");
+    EXPECT_EQ(s->count("spectrometer"), 0u);
     std::ofstream(file) << "[sources]\ntracker = 3\n";
     s = readSiteSources(file);
     ASSERT_FALSE(s);
