@@ -23,7 +23,7 @@ using namespace platform;
 using namespace platform::run_cli;
 
 // Parses 'args' as 'replica run' does and applies the site file 'toml' (none when empty).
-RunOptions parse(std::vector<std::string> args, const std::string& toml)
+RunOptions parseRun(std::vector<std::string> args, const std::string& toml)
 {
     CLI::App app;
     RunOptions o;
@@ -54,7 +54,7 @@ TEST(RunOptions, TheSiteFileFillsOnlyWhatTheCommandLineLeavesOpen)
                              "[display]\noutput = \"headless\"\nkms_connector = \"HDMI-A-1\"\n"
                              "[devices]\naccel_name = \"lis3dh\"\nlamp_gpio = \"gpiochip0:1,2,3\"\n"
                              "[recording]\nflush_ms = 250\n[render]\nwarm_up = false\n";
-    const RunOptions o = parse({"--rate", "50", "--accel-name", "bma280"}, site);
+    const RunOptions o = parseRun({"--rate", "50", "--accel-name", "bma280"}, site);
     EXPECT_EQ(o.hal, "sim");
     EXPECT_DOUBLE_EQ(o.rateHz, 50.0);              // the command line wins
     EXPECT_EQ(o.live.accelName, "bma280");         // the command line wins
@@ -67,12 +67,12 @@ TEST(RunOptions, TheSiteFileFillsOnlyWhatTheCommandLineLeavesOpen)
     EXPECT_FALSE(config.warmUp);
 
     // Without the key the warm-up stays on; --no-warm-up alone turns it off.
-    const RunOptions plain = parse({}, "[run]\nhal = \"sim\"\n");
+    const RunOptions plain = parseRun({}, "[run]\nhal = \"sim\"\n");
     EXPECT_FALSE(plain.noWarmUp);
     EXPECT_EQ(plain.rateHz, 60.0); // the site file's default, as the command line's
     ASSERT_EQ(runConfigFromOptions(plain, {64, 40}, config), kExitOk);
     EXPECT_TRUE(config.warmUp);
-    EXPECT_TRUE(parse({"--no-warm-up"}, "").noWarmUp);
+    EXPECT_TRUE(parseRun({"--no-warm-up"}, "").noWarmUp);
 }
 
 TEST(RunOptions, EveryDeviceKindHasItsSourceOptionDefaultedFromHal)
@@ -85,7 +85,7 @@ TEST(RunOptions, EveryDeviceKindHasItsSourceOptionDefaultedFromHal)
     }
     EXPECT_EQ(deviceOption(recordings::lampSelectorKind()), "lamp-selector");
     // --hal live: each kind's live driver, the optional lamp selector none.
-    auto live = chooseDevices(parse({"--hal", "live"}, ""));
+    auto live = chooseDevices(parseRun({"--hal", "live"}, ""));
     ASSERT_TRUE(live) << live.error().message;
     EXPECT_EQ(live->of(recordings::spectrometerKind()), "live");
     EXPECT_EQ(live->of(recordings::trackerKind()), "opentrack");
@@ -93,13 +93,13 @@ TEST(RunOptions, EveryDeviceKindHasItsSourceOptionDefaultedFromHal)
     EXPECT_EQ(live->of(recordings::lampSelectorKind()), "none");
     // --hal sim with one device overridden, and the lamp lines that make the selector gpio.
     auto mixed = chooseDevices(
-            parse({"--hal", "sim", "--tracker", "hid", "--lamp-gpio", "gpiochip0:1,2,3"}, ""));
+            parseRun({"--hal", "sim", "--tracker", "hid", "--lamp-gpio", "gpiochip0:1,2,3"}, ""));
     ASSERT_TRUE(mixed) << mixed.error().message;
     EXPECT_EQ(mixed->of(recordings::spectrometerKind()), "sim");
     EXPECT_EQ(mixed->of(recordings::trackerKind()), "hid");
     EXPECT_EQ(mixed->of(recordings::lampSelectorKind()), "gpio");
     // A value no kind knows (as the site file's [sources] could give) is named with the choices.
-    RunOptions bad = parse({"--hal", "sim"}, "");
+    RunOptions bad = parseRun({"--hal", "sim"}, "");
     bad.sources["accel"] = "hid";
     auto refused = chooseDevices(bad);
     ASSERT_FALSE(refused);
