@@ -54,41 +54,32 @@ struct SiteDefault {
     const char* option;
     void (*fill)(const SiteConfig&, RunOptions&);
 };
+using S = SiteConfig;
+using O = RunOptions;
+using L = LiveOptions;
 constexpr std::array kSiteDefaults = {
-        SiteDefault{"--hal", fromSite<&SiteConfig::hal, &RunOptions::hal>},
-        SiteDefault{"--replay-file", fromSite<&SiteConfig::replayFile, &RunOptions::replayFile>},
-        SiteDefault{"--rate", fromSite<&SiteConfig::rateHz, &RunOptions::rateHz>},
-        SiteDefault{"--output", fromSite<&SiteConfig::output, &RunOptions::output>},
-        SiteDefault{"--kms-device", fromSite<&SiteConfig::kmsDevice,
-                                             &RunOptions::outputChoice,
-                                             &OutputChoice::kms,
-                                             &KmsOptions::device>},
-        SiteDefault{"--kms-connector", fromSite<&SiteConfig::kmsConnector,
-                                                &RunOptions::outputChoice,
+        SiteDefault{"--hal", fromSite<&S::hal, &O::hal>},
+        SiteDefault{"--replay-file", fromSite<&S::replayFile, &O::replayFile>},
+        SiteDefault{"--rate", fromSite<&S::rateHz, &O::rateHz>},
+        SiteDefault{"--output", fromSite<&S::output, &O::output>},
+        SiteDefault{
+                "--kms-device",
+                fromSite<&S::kmsDevice, &O::outputChoice, &OutputChoice::kms, &KmsOptions::device>},
+        SiteDefault{"--kms-connector", fromSite<&S::kmsConnector,
+                                                &O::outputChoice,
                                                 &OutputChoice::kms,
                                                 &KmsOptions::connector>},
-        SiteDefault{"--renderer", fromSite<&SiteConfig::renderer, &RunOptions::renderer>},
-        SiteDefault{
-                "--tracker-port",
-                fromSite<&SiteConfig::trackerPort, &RunOptions::live, &LiveOptions::trackerPort>},
-        SiteDefault{
-                "--tracker-bind",
-                fromSite<&SiteConfig::trackerBind, &RunOptions::live, &LiveOptions::trackerBind>},
-        SiteDefault{"--iio-root",
-                    fromSite<&SiteConfig::iioRoot, &RunOptions::live, &LiveOptions::iioRoot>},
-        SiteDefault{"--accel-name",
-                    fromSite<&SiteConfig::accelName, &RunOptions::live, &LiveOptions::accelName>},
-        SiteDefault{"--accel-axes",
-                    fromSite<&SiteConfig::accelAxes, &RunOptions::live, &LiveOptions::accelAxes>},
-        SiteDefault{"--lamp-gpio",
-                    fromSite<&SiteConfig::lampGpio, &RunOptions::live, &LiveOptions::lampGpio>},
-        SiteDefault{"--spectrometer-serial", fromSite<&SiteConfig::spectrometerSerial,
-                                                      &RunOptions::live,
-                                                      &LiveOptions::spectrometerSerial>},
-        SiteDefault{"--record-flush-ms",
-                    fromSite<&SiteConfig::flushMs, &RunOptions::recordFlushMs>},
-        SiteDefault{"--no-warm-up",
-                    [](const SiteConfig& s, RunOptions& o) { o.noWarmUp = !s.warmUp; }},
+        SiteDefault{"--renderer", fromSite<&S::renderer, &O::renderer>},
+        SiteDefault{"--tracker-port", fromSite<&S::trackerPort, &O::live, &L::trackerPort>},
+        SiteDefault{"--tracker-bind", fromSite<&S::trackerBind, &O::live, &L::trackerBind>},
+        SiteDefault{"--iio-root", fromSite<&S::iioRoot, &O::live, &L::iioRoot>},
+        SiteDefault{"--accel-name", fromSite<&S::accelName, &O::live, &L::accelName>},
+        SiteDefault{"--accel-axes", fromSite<&S::accelAxes, &O::live, &L::accelAxes>},
+        SiteDefault{"--lamp-gpio", fromSite<&S::lampGpio, &O::live, &L::lampGpio>},
+        SiteDefault{"--spectrometer-serial",
+                    fromSite<&S::spectrometerSerial, &O::live, &L::spectrometerSerial>},
+        SiteDefault{"--record-flush-ms", fromSite<&S::flushMs, &O::recordFlushMs>},
+        SiteDefault{"--no-warm-up", [](const S& s, O& o) { o.noWarmUp = !s.warmUp; }},
 };
 
 } // namespace
