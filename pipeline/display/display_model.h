@@ -42,7 +42,7 @@ struct FitReport {
     std::array<double, 3> inverseCountsMax{}; // and its maximum (where r >= 0.1 % of full)
     double heldOutNoiseMeanDe00 = -1.0;       // mean dE00 the held-out readings' noise alone gives
     double additivityLuminanceSigmaPercent = -1.0; // 1 sigma of the luminance check from the noise
-    double additivityNoiseDe00 = -1.0; // 99th percentile of the dE00 the noise alone gives
+    double additivityNoiseDe00 = -1.0; // 99.9th percentile of the dE00 the noise alone gives
     bool additiveWithinNoise = false;
     double gamutEdgeSigma = -1.0; // 1 sigma of r at the gamut's corners (the fit's uncertainty)
 };
@@ -63,7 +63,7 @@ struct DisplayModel {
     ViewingAngleTable viewing;
     FitReport fit;
     // How far outside [0, 1] a channel's r may lie and still be shown per channel (clamped, counted
-    // in gamut) rather than gamut-mapped: the fit's own uncertainty at the gamut's corners (3
+    // in gamut) rather than gamut-mapped: the fit's own uncertainty at the gamut's corners (4
     // sigma), so that a colour the panel makes, which the noisy fit puts a hair outside its gamut,
     // is not moved along the hue-keeping line (that costs a bright primary up to 13 times the
     // excursion). 0 (profiles without "gamut_edge_tolerance"): the mapping's rounding tolerance.

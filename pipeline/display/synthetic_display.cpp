@@ -182,7 +182,9 @@ std::vector<Measurement> syntheticSession(const SyntheticDisplay& display,
     for (double v = plan.rampStep; v < maxCount; v += plan.rampStep) {
         levels.push_back(v);
     }
-    levels.push_back(maxCount);
+    for (int i = 0; i < std::max(plan.fullDriveRepeats, 1); ++i) {
+        levels.push_back(maxCount);
+    }
     appendRamps(patches, levels, plan.greyRamp ? 4 : 3);
     for (int i = plan.greyRamp ? 1 : 0; i < plan.whiteRepeats; ++i) {
         patches.emplace_back(maxCount);

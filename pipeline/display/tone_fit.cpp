@@ -222,7 +222,8 @@ std::vector<double> smoothSpline(const std::vector<double>& x,
                                  const std::vector<double>& e,
                                  const std::vector<double>& w,
                                  double lambda,
-                                 int order)
+                                 int order,
+                                 const Penalty& pen)
 {
     const std::size_t n = x.size();
     const std::size_t k = static_cast<std::size_t>(order);
@@ -232,7 +233,6 @@ std::vector<double> smoothSpline(const std::vector<double>& x,
     for (std::size_t i = 0; i < n; ++i) {
         a[i * bw] = w[i];
     }
-    const Penalty pen = penaltyRows(x, order);
     for (std::size_t j = 0; j < pen.rows.size(); ++j) {
         const double s = lambda * pen.length[j];
         for (std::size_t r = 0; r <= k; ++r) {
@@ -277,10 +277,9 @@ std::vector<double> smoothSpline(const std::vector<double>& x,
 }
 
 // The penalty's scale, so that the lambda grid is dimensionless: trace(W) / trace(P).
-double lambdaScale(const std::vector<double>& x, const std::vector<double>& w, int order)
+double lambdaScale(const std::vector<double>& w, const Penalty& pen)
 {
     double trP = 0.0;
-    const Penalty pen = penaltyRows(x, order);
     for (std::size_t j = 0; j < pen.rows.size(); ++j) {
         for (double q : pen.rows[j]) {
             trP += pen.length[j] * q * q;
@@ -341,6 +340,58 @@ struct Sorted {
     std::vector<double> w;
 };
 
+// The GOGO's linearised domain: y = g^-1((v - offset) / scale) with g(y) = sign(y) |y|^gamma, in
+// which the GOG part is the straight line max(gain x + 1 - gain, 0).
+double linearise(const std::array<double, 4>& p, double v)
+{
+    const double q = (v - p[3]) / p[0];
+    return q >= 0.0 ? std::pow(q, 1.0 / p[2]) : -std::pow(-q, 1.0 / p[2]);
+}
+
+double delinearise(const std::array<double, 4>& p, double y)
+{
+    return p[3] + p[0] * (y >= 0.0 ? std::pow(y, p[2]) : -std::pow(-y, p[2]));
+}
+
+double linearBase(const std::array<double, 4>& p, double x)
+{
+    return std::max(p[1] * x + (1.0 - p[1]), 0.0);
+}
+
+// dy/dv, with |v - offset| held above 1e-4 of the scale so that a reading at black keeps a finite
+// (tiny) weight instead of an infinite slope.
+double lineariseSlope(const std::array<double, 4>& p, double v)
+{
+    const double q = std::max(std::abs((v - p[3]) / p[0]), 1e-4);
+    return std::pow(q, 1.0 / p[2] - 1.0) / (p[2] * p[0]);
+}
+
+// The residual of v from the GOGO in the linearised domain, and its weights (the value domain's
+// weights through the slope).
+void linearisedResidual(const std::array<double, 4>& p,
+                        const std::vector<double>& x,
+                        const std::vector<double>& v,
+                        const std::vector<double>& w,
+                        std::vector<double>& e,
+                        std::vector<double>& wl)
+{
+    e.resize(x.size());
+    wl.resize(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        e[i] = linearise(p, v[i]) - linearBase(p, x[i]);
+        const double d = lineariseSlope(p, v[i]);
+        wl[i] = w[i] / (d * d);
+    }
+}
+
+// The splines cross-validated: the domain of the residual and the penalised derivative.
+struct SplineKind {
+    bool linearised = false;
+    int order = 2;
+};
+constexpr std::array<SplineKind, 5> kSplineKinds{
+        {{false, 2}, {false, 3}, {true, 2}, {true, 3}, {true, 4}}};
+
 Sorted sortSamples(const std::vector<ToneSample>& samples, double maxCount)
 {
     Sorted s;
@@ -375,7 +426,14 @@ void fitFixed(const Sorted& s,
         for (std::size_t i = 0; i < e.size(); ++i) {
             e[i] = s.v[i] - gogoEval(params, s.x[i], ToneShape::Gogo);
         }
-        correction = smoothSpline(s.x, e, w, lambda * lambdaScale(s.x, w, order), order);
+        const Penalty pen = penaltyRows(s.x, order);
+        correction = smoothSpline(s.x, e, w, lambda * lambdaScale(w, pen), order, pen);
+    } else if (shape == ToneShape::LinearisedSpline) {
+        std::vector<double> e;
+        std::vector<double> wl;
+        linearisedResidual(params, s.x, s.v, w, e, wl);
+        const Penalty pen = penaltyRows(s.x, order);
+        correction = smoothSpline(s.x, e, wl, lambda * lambdaScale(wl, pen), order, pen);
     }
 }
 
@@ -390,6 +448,8 @@ const char* toneShapeName(ToneShape s)
         return "gogo";
     case ToneShape::Spline:
         return "gogo+spline";
+    case ToneShape::LinearisedSpline:
+        return "gogo+linearised spline";
     }
     return "?";
 }
@@ -397,6 +457,9 @@ const char* toneShapeName(ToneShape s)
 double ToneFit::operator()(double count) const
 {
     const double x = count / maxCount;
+    if (shape == ToneShape::LinearisedSpline) {
+        return delinearise(gogo, linearBase(gogo, x) + hermite(knots, correction, count));
+    }
     double v = gogoEval(gogo, x, shape == ToneShape::Gog ? ToneShape::Gog : ToneShape::Gogo);
     if (shape == ToneShape::Spline) {
         v += hermite(knots, correction, count);
@@ -436,16 +499,53 @@ ToneFit fitTone(const std::vector<ToneSample>& samples, double maxCount, const T
     ToneFit fit;
     fit.maxCount = maxCount;
     fit.knots = s.count;
+    const std::size_t n = s.x.size();
+    if (o.forceShape && o.lambda >= 0.0 && o.warmStart) {
+        // A refit of nearby data with everything fixed but the values: one least-squares fit from
+        // the previous parameters.
+        fit.shape = o.shape;
+        const bool spline = o.shape == ToneShape::Spline || o.shape == ToneShape::LinearisedSpline;
+        fit.lambda = spline ? o.lambda : 0.0;
+        fit.order = o.order != 0 ? o.order : 2;
+        fitFixed(s, s.w, o.shape, fit.lambda, fit.order, o.start, fit.gogo, fit.correction);
+        if (o.shape == ToneShape::Gog) {
+            fit.gogo[3] = 0.0;
+        }
+        fit.residual.assign(n, 0.0);
+        for (std::size_t i = 0; i < n; ++i) {
+            fit.residual[s.order[i]] = s.v[i] - fit(s.count[i]);
+        }
+        fit.cvResidual = fit.residual;
+        return fit;
+    }
     const std::array<double, 4> start = gogoStart(s.x, s.v);
     const std::array<double, 4> gog = fitGogo(s.x, s.v, s.w, ToneShape::Gog, start);
     const std::array<double, 4> gogoAll = fitGogo(s.x, s.v, s.w, ToneShape::Gogo, gog);
-    const std::size_t n = s.x.size();
 
     const auto grid = lambdaGrid();
-    constexpr std::array<int, 2> kOrders{2, 3};
-    std::vector<std::vector<double>> cvErr(2 + kOrders.size() * grid.size(),
+    // Which spline kinds take part: forcing the value-domain or the linearised spline keeps to
+    // its domain; 'order' keeps to one penalty.
+    auto kindUsed = [&](const SplineKind& k) {
+        if (o.order != 0 && o.order != k.order) {
+            return false;
+        }
+        if (o.forceShape && o.shape == ToneShape::Spline && k.linearised) {
+            return false;
+        }
+        if (o.forceShape && o.shape == ToneShape::LinearisedSpline && !k.linearised) {
+            return false;
+        }
+        return static_cast<std::size_t>(k.order) + 1 < n;
+    };
+    std::vector<std::vector<double>> cvErr(2 + kSplineKinds.size() * grid.size(),
                                            std::vector<double>(n, 0.0));
-    const bool cv = !(o.forceShape && (o.shape != ToneShape::Spline || o.lambda >= 0.0));
+    const bool cv = !(o.forceShape &&
+                      ((o.shape != ToneShape::Spline && o.shape != ToneShape::LinearisedSpline) ||
+                       o.lambda >= 0.0));
+    std::vector<Penalty> penalties;
+    for (const SplineKind& kind : kSplineKinds) {
+        penalties.push_back(kindUsed(kind) ? penaltyRows(s.x, kind.order) : Penalty{});
+    }
     if (cv) {
         // Interleaved folds over the levels between the end points (black and full drive stay
         // in every training set: leaving them out would test extrapolation).
@@ -468,19 +568,29 @@ ToneFit fitTone(const std::vector<ToneSample>& samples, double maxCount, const T
             for (std::size_t i = 0; i < n; ++i) {
                 e[i] = s.v[i] - gogoEval(po, s.x[i], ToneShape::Gogo);
             }
+            std::vector<double> el;
+            std::vector<double> wl;
+            linearisedResidual(po, s.x, s.v, w, el, wl);
             for (std::size_t i : out) {
                 cvErr[0][i] = s.v[i] - gogoEval(pg, s.x[i], ToneShape::Gog);
                 cvErr[1][i] = e[i];
             }
-            for (std::size_t oi = 0; oi < kOrders.size(); ++oi) {
-                if (o.order != 0 && o.order != kOrders[oi]) {
+            for (std::size_t ki = 0; ki < kSplineKinds.size(); ++ki) {
+                const SplineKind& kind = kSplineKinds[ki];
+                if (!kindUsed(kind)) {
                     continue;
                 }
-                const double scale = lambdaScale(s.x, w, kOrders[oi]);
+                const auto& ee = kind.linearised ? el : e;
+                const auto& ww = kind.linearised ? wl : w;
+                const Penalty& pen = penalties[ki];
+                const double scale = lambdaScale(ww, pen);
                 for (std::size_t k = 0; k < grid.size(); ++k) {
-                    const auto c = smoothSpline(s.x, e, w, grid[k] * scale, kOrders[oi]);
+                    const auto c = smoothSpline(s.x, ee, ww, grid[k] * scale, kind.order, pen);
                     for (std::size_t i : out) {
-                        cvErr[2 + oi * grid.size() + k][i] = e[i] - c[i];
+                        cvErr[2 + ki * grid.size() + k][i] =
+                                kind.linearised
+                                        ? s.v[i] - delinearise(po, linearBase(po, s.x[i]) + c[i])
+                                        : e[i] - c[i];
                     }
                 }
             }
@@ -493,51 +603,88 @@ ToneFit fitTone(const std::vector<ToneSample>& samples, double maxCount, const T
         }
         return acc;
     };
-    std::size_t bestK = 0;
-    std::size_t bestO = 0;
-    double bestSpline = std::numeric_limits<double>::infinity();
-    for (std::size_t oi = 0; oi < kOrders.size(); ++oi) {
-        if (o.order != 0 && o.order != kOrders[oi]) {
+    // The best smoothing and order of each domain.
+    std::array<std::size_t, 2> bestRow{0, 0};
+    std::array<double, 2> bestScore{std::numeric_limits<double>::infinity(),
+                                    std::numeric_limits<double>::infinity()};
+    for (std::size_t ki = 0; ki < kSplineKinds.size(); ++ki) {
+        if (!kindUsed(kSplineKinds[ki])) {
             continue;
         }
+        const std::size_t d = kSplineKinds[ki].linearised ? 1 : 0;
         for (std::size_t k = 0; k < grid.size(); ++k) {
-            const double sc = score(2 + oi * grid.size() + k);
-            if (sc < bestSpline) {
-                bestSpline = sc;
-                bestK = k;
-                bestO = oi;
+            const std::size_t r = 2 + ki * grid.size() + k;
+            const double sc = score(r);
+            if (sc < bestScore[d]) {
+                bestScore[d] = sc;
+                bestRow[d] = r;
             }
         }
     }
-    fit.cvScore = {score(0), score(1), bestSpline};
-    ToneShape shape = ToneShape::Spline;
-    double lambda = grid[bestK];
-    int order = o.order != 0 ? o.order : kOrders[bestO];
-    std::size_t row = 2 + bestO * grid.size() + bestK;
+    // The standard error of the difference between two rows' scores (paired over the samples):
+    // a row within 'oneSe' of them of the best is not told apart from it by these readings.
+    auto scoreSe = [&](std::size_t a, std::size_t b) {
+        double sum = 0.0;
+        double sum2 = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double d = s.w[i] * (cvErr[a][i] * cvErr[a][i] - cvErr[b][i] * cvErr[b][i]);
+            sum += d;
+            sum2 += d * d;
+        }
+        const double nn = static_cast<double>(n);
+        return std::sqrt(std::max(0.0, sum2 - sum * sum / nn) * nn / std::max(nn - 1.0, 1.0));
+    };
+    fit.cvScore = {score(0), score(1), bestScore[0], bestScore[1]};
+    const std::size_t bestDomain = bestScore[1] < bestScore[0] ? 1 : 0;
+    ToneShape shape = bestDomain == 1 ? ToneShape::LinearisedSpline : ToneShape::Spline;
+    std::size_t row = bestRow[bestDomain];
+    auto rowKind = [&](std::size_t r) { return kSplineKinds[(r - 2) / grid.size()]; };
+    auto rowLambda = [&](std::size_t r) { return grid[(r - 2) % grid.size()]; };
     if (o.forceShape) {
         shape = o.shape;
-        row = shape == ToneShape::Gog ? 0 : shape == ToneShape::Gogo ? 1 : row;
-        if (o.lambda >= 0.0) {
-            lambda = o.lambda;
+        if (shape == ToneShape::Gog || shape == ToneShape::Gogo) {
+            row = shape == ToneShape::Gog ? 0 : 1;
+        } else {
+            row = bestRow[shape == ToneShape::LinearisedSpline ? 1 : 0];
         }
     } else {
-        // The simplest shape within 2 % of the best cross-validated error.
+        // The simplest shape within 2 % (and within the one-standard-error rule) of the best
+        // cross-validated error.
         double scale = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
             scale += s.w[i] * s.v[i] * s.v[i];
         }
-        const double best = std::min({fit.cvScore[0], fit.cvScore[1], fit.cvScore[2]});
-        const double tol = best * 1.02 + 1e-24 * scale;
-        if (fit.cvScore[0] <= tol) {
+        std::size_t bestAll = row;
+        for (std::size_t r : {std::size_t{1}, std::size_t{0}}) {
+            if (score(r) < score(bestAll)) {
+                bestAll = r;
+            }
+        }
+        const double best = score(bestAll);
+        auto within = [&](std::size_t r) {
+            return score(r) <= best * 1.02 + 1e-24 * scale ||
+                   score(r) <= best + o.oneSe * scoreSe(r, bestAll);
+        };
+        if (within(0)) {
             shape = ToneShape::Gog;
             row = 0;
-        } else if (fit.cvScore[1] <= tol) {
+        } else if (within(1)) {
             shape = ToneShape::Gogo;
             row = 1;
         }
     }
+    const bool spline = shape == ToneShape::Spline || shape == ToneShape::LinearisedSpline;
+    double lambda = 0.0;
+    int order = o.order != 0 ? o.order : 2;
+    if (spline && row >= 2) {
+        lambda = rowLambda(row);
+        order = rowKind(row).order;
+    }
+    if (o.forceShape && o.lambda >= 0.0) {
+        lambda = o.lambda;
+    }
     fit.shape = shape;
-    fit.lambda = shape == ToneShape::Spline ? lambda : 0.0;
+    fit.lambda = spline ? lambda : 0.0;
     fit.order = order;
     std::vector<double> corr;
     fitFixed(s, s.w, shape, lambda, order, shape == ToneShape::Gog ? gog : gogoAll, fit.gogo, corr);
@@ -580,6 +727,8 @@ std::vector<double> toneCountSpread(const std::vector<ToneSample>& samples,
     o.shape = fit.shape;
     o.lambda = fit.lambda;
     o.order = fit.order;
+    o.warmStart = true;
+    o.start = fit.gogo;
     for (int b = 0; b < replicates; ++b) {
         std::vector<ToneSample> sim = samples;
         for (std::size_t i = 0; i < sim.size(); ++i) {

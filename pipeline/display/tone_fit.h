@@ -1,9 +1,14 @@
 // Tone curves fitted through measurement noise: a parametric gain-offset-gamma model (GOG, and
 // GOGO with an output offset; Berns 1996) fitted by weighted least squares, and the GOGO model
-// plus a smoothing spline on its residual (a penalty on the second or third derivative), its
-// smoothing and order chosen by k-fold cross-validation. The shape with the lowest cross-validated
-// error is kept, the simplest within 2 %. With exact data the parametric fit is exact on a GOG
-// panel and the spline's smoothing falls to interpolation elsewhere.
+// plus a smoothing spline on its residual, its smoothing and order chosen by k-fold
+// cross-validation. The spline's residual lives either in the value domain (a penalty on the
+// second or third derivative) or in the GOGO's linearised domain, y = ((v - offset) / scale)^(1 /
+// gamma), where the GOG model is a straight line and a curve that bends where the light is
+// brightest (an S-shaped panel's shoulder) is a low-order polynomial, free under a penalty on the
+// third or fourth derivative: smoothing there averages the noise without flattening the shoulder.
+// The shape with the lowest cross-validated error is kept, the simplest within 2 %. With exact
+// data the parametric fit is exact on a GOG panel and the spline's smoothing falls to
+// interpolation elsewhere.
 #pragma once
 
 #include <array>
@@ -15,7 +20,12 @@
 
 namespace replica::pipeline::display {
 
-enum class ToneShape { Gog, Gogo, Spline };
+enum class ToneShape {
+    Gog,
+    Gogo,
+    Spline,           // GOGO plus a smoothing spline on its residual in the value domain
+    LinearisedSpline, // the same in the GOGO's linearised domain
+};
 
 const char* toneShapeName(ToneShape s);
 
@@ -32,12 +42,14 @@ struct ToneFit {
     double maxCount = 255.0;
     std::array<double, 4> gogo{1.0, 1.0, 2.2, 0.0}; // scale, gain, gamma, offset
     double lambda = 0.0;                            // Spline: the penalty weight chosen
-    int order = 2; // Spline: the derivative penalised (2: cubic-like, 3: quadratics are free)
-    std::vector<double> knots;       // Spline: sample counts
-    std::vector<double> correction;  // Spline: residual correction at the knots
-    std::array<double, 3> cvScore{}; // weighted CV error per shape (GOG, GOGO, spline)
-    std::vector<double> residual;    // value - fit at each sample (the samples' order)
-    std::vector<double> cvResidual;  // the same with the sample's fold left out of the fit
+    int order = 2; // Spline: the derivative penalised (2: cubic-like, 3: quadratics are free,
+                   // 4: cubics are free)
+    std::vector<double> knots;      // Spline: sample counts
+    std::vector<double> correction; // Spline: residual correction at the knots
+    // Weighted CV error per shape (GOG, GOGO, spline, linearised spline), in the value domain.
+    std::array<double, 4> cvScore{};
+    std::vector<double> residual;   // value - fit at each sample (the samples' order)
+    std::vector<double> cvResidual; // the same with the sample's fold left out of the fit
 
     double operator()(double count) const;
     // The fit sampled at every count (at most 1024 knots, both ends included) and made
@@ -52,7 +64,16 @@ struct ToneFitOptions {
     bool forceShape = false;
     ToneShape shape = ToneShape::Spline;
     double lambda = -1.0;
-    int order = 0; // the spline's penalised derivative, 2 or 3; 0 chooses by cross-validation
+    int order = 0; // the spline's penalised derivative, 2 to 4; 0 chooses by cross-validation
+    // The one-standard-error rule (Breiman et al. 1984): the simplest shape whose
+    // cross-validated error is within this many standard errors of the best (paired over the
+    // samples) or within 2 % of it. (Applied to the smoothing too it flattened the S-shaped
+    // panel's shoulder.)
+    double oneSe = 1.0;
+    // A forced shape with its smoothing set (no cross-validation) starts the parametric part's
+    // least squares here when 'warmStart' (a previous fit's 'gogo', for refits of nearby data).
+    bool warmStart = false;
+    std::array<double, 4> start{1.0, 1.0, 2.2, 0.0};
 };
 
 // Samples need not be sorted; counts must be distinct and include at least four non-zero levels.

@@ -209,14 +209,14 @@ int fitMain(const DisplayOptions& o)
                        f.toneShape[0], f.toneShape[1], f.toneShape[2], f.inverseCountsRms[0],
                        f.inverseCountsRms[1], f.inverseCountsRms[2], f.inverseCountsMax[0],
                        f.inverseCountsMax[1], f.inverseCountsMax[2]);
-            fmt::print("gamut edge tolerance: {:.4f} in r (3 sigma of the fit at the gamut's "
+            fmt::print("gamut edge tolerance: {:.4f} in r (4 sigma of the fit at the gamut's "
                        "corners; colours within it of the gamut are clamped per channel, not "
                        "gamut-mapped)\n",
                        model->gamutEdgeTolerance);
         }
         if (f.additivityDe00 >= 0.0 && f.additivityNoiseDe00 >= 0.0) {
             fmt::print("additivity: white vs black + R + G + B dE00 {:.3f} (the noise alone gives "
-                       "up to {:.3f}, 99th percentile), luminance {:+.2f}% +- {:.2f}% (1 sigma): "
+                       "up to {:.3f}, 99.9th percentile), luminance {:+.2f}% +- {:.2f}% (1 sigma): "
                        "{}\n",
                        f.additivityDe00, f.additivityNoiseDe00, f.additivityLuminancePercent,
                        f.additivityLuminanceSigmaPercent,

@@ -196,7 +196,8 @@ TEST(RobustFit, DISABLED_Table)
 // hue-keeping and clipped), the worst model-vs-panel dE00 on 400 unmeasured colours, and the worst
 // held-out dE00 the fit reports against its noisy held-out readings; and the same fits' inverse
 // through the mapping without the edge tolerance (what the inverse was before it). The figures
-// of docs/display.md; about 4 minutes; run with
+// of docs/display.md (and docs/display_noise.csv and .png, through
+// tools/display_noise_plot.sh); about 3 minutes; run with
 // --gtest_also_run_disabled_tests --gtest_filter=RobustFit.DISABLED_Seeds.
 TEST(RobustFit, DISABLED_Seeds)
 {
@@ -206,7 +207,7 @@ TEST(RobustFit, DISABLED_Seeds)
             {"s-shaped", sShapedPanel()},
             {"crosstalk", crosstalkPanel()}};
     for (const auto& [name, panel] : panels) {
-        for (double noise : {0.0, 0.002, 0.005, 0.01}) {
+        for (double noise : {0.0, 0.001, 0.002, 0.005, 0.0075, 0.01}) {
             Figures worst;
             double withoutTolerance = 0.0; // the same fits, the mapping without the edge tolerance
             double heldOut = 0.0;
@@ -264,10 +265,8 @@ TEST(RobustFit, AveragesAColorimetersNoise)
     // 0.2 % per XYZ component (plus 0.0025 cd/m^2): the goal is held-out dE00 max <= 0.5
     // and the inverse within 0.5 counts. Against the truth on 400 unmeasured colours, and every
     // count of the R, G, B and grey ramps where the light is at least 0.1 % of full drive.
-    for (const auto& [panel, inverseLimit] :
-         {std::pair{gogPanel(), 0.5}, std::pair{srgbPanel(), 0.5},
-          std::pair{sShapedPanel(), 0.75}}) { // seed 17: 0.60 at full blue; 0.6-1.5 over six seeds
-                                              // (DISABLED_SShapedSeeds, docs/display.md)
+    for (const auto& panel : {gogPanel(), srgbPanel(), sShapedPanel()}) {
+        const double inverseLimit = 0.5;
         const Figures robust = evaluate(fit(panel, 0.002, 17), panel);
         const Figures old = evaluate(fit(panel, 0.002, 17, ToneMethod::Interpolate), panel);
         EXPECT_LE(robust.truthMax, 0.5);
@@ -282,16 +281,18 @@ TEST(RobustFit, AveragesAColorimetersNoise)
 
 TEST(RobustFit, InverseAcrossSeedsAndShapes)
 {
-    // 0.2 % noise, eight seeds per tone-curve shape (the goal is 0.5 counts and dE00 0.5).
-    // The targets are the panel's own XYZ at every count of the R, G, B and grey ramps (where the
+    // 0.2 % noise, eight seeds per panel (the goal is 0.5 counts and dE00 0.5). The
+    // targets are the panel's own XYZ at every count of the R, G, B and grey ramps (where the
     // light is at least 0.1 % of full drive), inverted through the fitted model, against the count
     // that made them; dE00 is the fitted model against the panel on 400 colours never measured.
+    // Over seeds 1001..1020 the worst is GOG 0.18, sRGB-like 0.25, S-shaped 0.35 counts
+    // (DISABLED_Seeds). The crosstalk panel's grey ramp stays near 0.8 counts: its 0.5 % loss at
+    // white is outside the additive model (0.7 counts without noise), so its limit is that.
     // The hue-keeping mapping must cost nothing over per-channel clipping on colours the panel
-    // makes: without the edge tolerance the GOG panel's full blue missed by 3.1 counts where
-    // clipping gave 0.37 (a fitted gamut edge a hair inside the panel's).
+    // makes (the edge tolerance).
     for (const auto& [panel, inverseLimit] :
-         {std::pair{gogPanel(), 0.5}, std::pair{srgbPanel(), 0.75},
-          std::pair{sShapedPanel(), 1.5}}) { // the S-shape's top end: docs/display.md
+         {std::pair{gogPanel(), 0.5}, std::pair{srgbPanel(), 0.5}, std::pair{sShapedPanel(), 0.5},
+          std::pair{crosstalkPanel(), 1.2}}) {
         for (std::uint64_t seed = 1001; seed <= 1008; ++seed) {
             const DisplayModel m = fit(panel, 0.002, seed);
             const Figures f = evaluate(m, panel);
