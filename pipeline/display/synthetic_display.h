@@ -62,8 +62,8 @@ syntheticMeasurements(const SyntheticDisplay& display, const MeterNoise& noise, 
 // A measurement session of another plan: black 'blackRepeats' times, R, G and B ramps every
 // 'rampStep' counts and full drive (read 'fullDriveRepeats' times), white 'whiteRepeats' times, a
 // grey ramp when asked, and 'randomColours' pseudo-random colours, each read once through the
-// meter noise. The defaults are `replica display patches --make-set`'s plan (348 patches at 8
-// bits): a reading's error in counts grows with the count (relative noise over a slope that
+// meter noise. The defaults have the ramps of `replica display patches --make-set` (348 patches at
+// 8 bits): a reading's error in counts grows with the count (relative noise over a slope that
 // grows more slowly), so the ramps are dense and the full drive, which sets each primary's scale
 // and with it every count near the top, is read ten times.
 struct SessionPlan {

@@ -727,10 +727,16 @@ void registerDisplayCommand(CLI::App& app, int& exitCode)
             ->check(CLI::Range(1, 16))
             ->capture_default_str();
     patCmd->add_option("--make-set", pat->makeSet,
-                       "write the default set (3 blacks, R, G, B ramps every --step counts, 2 "
-                       "whites, --colours random colours) to this .ti1 and stop");
+                       "write the default set (3 blacks, R, G, B ramps every --step counts with "
+                       "full drive --full-repeats times, 2 whites, --colours random colours) to "
+                       "this .ti1 and stop");
     patCmd->add_option("--step", pat->step, "ramp step for --make-set")
             ->check(CLI::Range(1, 64))
+            ->capture_default_str();
+    patCmd->add_option("--full-repeats", pat->fullDriveRepeats,
+                       "readings of each primary's full drive for --make-set (their mean sets the "
+                       "primary's scale)")
+            ->check(CLI::Range(1, 100))
             ->capture_default_str();
     patCmd->add_option("--colours", pat->colours, "random colours for --make-set")
             ->check(CLI::Range(6, 10000))

@@ -43,16 +43,24 @@ bool writeAtomically(const std::filesystem::path& path, const std::string& text)
     return !ec;
 }
 
-// The default set: black three times, R, G and B ramps every 'step' counts and full drive, white
-// twice, and pseudo-random colours: what 'display fit' needs, in the order it is shown.
-std::vector<glm::dvec3> defaultSet(int bits, int step, int colours, std::uint64_t seed)
+// The default set: black three times, R, G and B ramps every 'step' counts and full drive (read
+// 'fullRepeats' times: their mean sets the primary's scale, and with it every count near the
+// top), white twice, and pseudo-random colours: what 'display fit' needs, in the order it is
+// shown. At the defaults (step 3, 10, 60 colours) 347 patches: docs/display.md says why.
+std::vector<glm::dvec3>
+defaultSet(int bits, int step, int fullRepeats, int colours, std::uint64_t seed)
 {
     const double maxCount = std::ldexp(1.0, bits) - 1.0;
     std::vector<glm::dvec3> p(3, glm::dvec3(0.0));
     for (int c = 0; c < 3; ++c) {
-        for (double v = step; v < maxCount + step; v += step) {
+        for (double v = step; v < maxCount; v += step) {
             glm::dvec3 q(0.0);
-            q[c] = std::min(v, maxCount);
+            q[c] = v;
+            p.push_back(q);
+        }
+        for (int i = 0; i < std::max(fullRepeats, 1); ++i) {
+            glm::dvec3 q(0.0);
+            q[c] = maxCount;
             p.push_back(q);
         }
     }
@@ -157,7 +165,7 @@ int patchesMain(const PatchesOptions& o)
 {
     auto log = logger("replica");
     if (!o.makeSet.empty()) {
-        const auto set = defaultSet(o.bits, o.step, o.colours, o.seed);
+        const auto set = defaultSet(o.bits, o.step, o.fullDriveRepeats, o.colours, o.seed);
         if (!writeAtomically(o.makeSet, pd::ti1Text(set, o.bits, "Replica display patches"))) {
             log->error("{}: cannot write the patch set", o.makeSet);
             return kExitFailure;

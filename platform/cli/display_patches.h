@@ -19,7 +19,8 @@ struct PatchesOptions {
     std::string makeSet;      // write the default patch set here and stop
     int bits = 8;
     int settleMs = 0;
-    int step = 5;
+    int step = 3;
+    int fullDriveRepeats = 10; // each primary's full drive, read this many times
     int colours = 60;
     std::uint64_t seed = 1;
 };

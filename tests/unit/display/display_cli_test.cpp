@@ -273,9 +273,15 @@ TEST_F(DisplayCli, PatchesDriveSpotreadAndResumeAfterAnInterruption)
     const std::string out = (dir_ / "r.ti3").string();
     const std::string show = (dir_ / "show").string();
     const std::string fake = write("spotread.sh", kFakeSpotread);
-    const auto made = run("display patches --make-set " + set + " --step 32 --colours 6");
+    const auto made =
+            run("display patches --make-set " + set + " --step 32 --full-repeats 1 --colours 6");
     ASSERT_EQ(made.exitCode, 0) << made.err;
     EXPECT_NE(made.out.find("35 patches"), std::string::npos) << made.out; // 3 + 3 x 8 + 2 + 6
+    // The default set: 3 blacks, ramps every 3 counts (84 levels below full drive) and full drive
+    // read 10 times per channel, 2 whites, 60 colours.
+    const auto byDefault = run("display patches --make-set " + (dir_ / "default.ti1").string());
+    ASSERT_EQ(byDefault.exitCode, 0) << byDefault.err;
+    EXPECT_NE(byDefault.out.find("347 patches"), std::string::npos) << byDefault.out;
     const auto stopped = run("display patches " + set + " --out " + out + " --show-dir " + show +
                              " --spotread 'FAKE_STOP=5 SHOW_DIR=" + show + " bash " + fake + "'");
     EXPECT_EQ(stopped.exitCode, 1);
@@ -322,7 +328,9 @@ TEST_F(DisplayCli, PatchesOnThePanelThroughKms)
 {
     const std::string set = (dir_ / "set.ti1").string();
     const std::string out = (dir_ / "r.ti3").string();
-    ASSERT_EQ(run("display patches --make-set " + set + " --step 32 --colours 6").exitCode, 0);
+    ASSERT_EQ(run("display patches --make-set " + set + " --step 32 --full-repeats 1 --colours 6")
+                      .exitCode,
+              0);
     // Argument handling: an unknown output, and the headless display's folder with kms.
     const auto unknown = run("display patches " + set + " --out " + out + " --output x11");
     EXPECT_EQ(unknown.exitCode, 2);
