@@ -380,22 +380,39 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
     }
 
     // Monotonicity, judged on the direct-primaries derivation: small dips are meter noise and are
-    // pooled; a drop beyond the tolerance is a broken ramp.
+    // pooled; a drop beyond the tolerance is a broken ramp. The tolerance grows with the noise the
+    // ramp itself shows (six sigma of a reading, from the median of its relative second
+    // differences, which dense levels leave to the noise): at 1 % noise dense ramps dip by more
+    // than 2 % between neighbouring levels.
     {
         const glm::dmat3 inv = glm::inverse(m0);
         for (std::size_t c = 0; c < 3; ++c) {
+            std::vector<double> rs;
+            for (const auto& p : ramps[c]) {
+                rs.push_back((inv * (p.xyz - black))[static_cast<int>(c)]);
+            }
+            std::vector<double> second;
+            for (std::size_t i = 1; i + 1 < rs.size(); ++i) {
+                if (rs[i] > 0.1) {
+                    second.push_back(std::abs(rs[i + 1] - 2.0 * rs[i] + rs[i - 1]) / rs[i]);
+                }
+            }
+            const double sigmaRel = 1.4826 * percentile(second, 0.5) / std::sqrt(6.0);
             double runMax = 0.0;
             double runMaxCount = 0.0;
-            for (const auto& p : ramps[c]) {
-                const double r = (inv * (p.xyz - black))[static_cast<int>(c)];
-                if (runMax - r > options.monotonicTolerance) {
+            for (std::size_t i = 0; i < ramps[c].size(); ++i) {
+                const auto& p = ramps[c][i];
+                const double r = rs[i];
+                const double tolerance =
+                        std::max(options.monotonicTolerance, 6.0 * sigmaRel * runMax);
+                if (runMax - r > tolerance) {
                     return makeError(ErrorCode::InvalidArgument,
                                      fmt::format("{}:{}: channel {} response is not monotonic: "
                                                  "r drops from {:.3f} at count {} to {:.3f} at "
-                                                 "count {} (more than {:.0f}% of full drive); a "
+                                                 "count {} (more than {:.1f}% of full drive); a "
                                                  "stuck or mis-ordered ramp?",
                                                  src, p.line, kChannelNames[c], runMax, runMaxCount,
-                                                 r, p.count, 100.0 * options.monotonicTolerance));
+                                                 r, p.count, 100.0 * tolerance));
                 }
                 if (r > runMax) {
                     runMax = r;

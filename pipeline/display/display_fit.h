@@ -30,7 +30,8 @@ struct FitOptions {
     MeasurementCondition condition = MeasurementCondition::Dark;
     int minRampLevels = 8; // distinct non-zero levels per channel ramp, full drive included
     int minColours = 6;    // off-ramp colours (training + held-out)
-    double monotonicTolerance = 0.02;   // a ramp may dip by this fraction of its range (noise)
+    double monotonicTolerance = 0.02;   // a ramp may dip by this fraction of its range (noise), or
+                                        // by six sigma of the noise the ramp shows where larger
     double deadChannelFraction = 0.005; // X+Y+Z of a primary below this share of all three: dead
     int maxEvaluations = 4000; // Nelder-Mead evaluations of the matrix; 0 keeps direct primaries
     ToneMethod toneMethod = ToneMethod::Robust;
