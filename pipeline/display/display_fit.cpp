@@ -647,15 +647,13 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
         for (std::size_t c = 0; c < 3; ++c) {
             const auto& smp = best.samples[c];
             const auto& tf = best.fits[c];
-            // The weights are 1 / variance up to the factor rc^2 estimated here.
-            double a = 0.0;
-            for (std::size_t i = 1; i < smp.size(); ++i) {
-                a += smp[i].weight * tf.residual[i] * tf.cvResidual[i];
-            }
-            const double rc = std::sqrt(std::max(0.0, a / static_cast<double>(smp.size() - 1)));
+            // The weights are 1 / variance in units of the relative noise per XYZ component
+            // (deriveRobust), so a sample's sigma is rho / sqrt(weight). (Each curve's own
+            // residuals, rather than rho from all three ramps, read near 0 where the
+            // cross-validated smoothing is light.)
             std::vector<double> sigma;
             for (const auto& sm : smp) {
-                sigma.push_back(rc / std::sqrt(std::max(sm.weight, 1e-300)));
+                sigma.push_back(rho / std::sqrt(std::max(sm.weight, 1e-300)));
             }
             const auto spread = toneCountSpread(smp, tf, sigma, options.bootstrapReplicates,
                                                 0x5eed + c, &topSpread[c]);

@@ -236,7 +236,7 @@ TEST(RobustFit, DISABLED_Seeds)
                 heldOut = std::max(heldOut, m.fit.heldOutMaxDe00);
                 tolerance = std::max(tolerance, m.gamutEdgeTolerance);
             }
-            std::printf("%-10s %4.1f%%: inverse max %.2f (seed %llu, %d@%d) clipped %.2f, "
+            std::printf("%-10s %4.2f%%: inverse max %.2f (seed %llu, %d@%d) clipped %.2f, "
                         "without the edge tolerance %.2f | "
                         "colours p95 %.2f | truth dE00 max %.3f | held-out (noisy readings) max "
                         "%.3f | edge tolerance up to %.4f\n",
