@@ -4,8 +4,9 @@
 // out for the reported accuracy. Degenerate sets fail with a message saying what to measure.
 //
 // The tone curves average the meter's noise (pipeline/display/tone_fit.h: GOG, GOGO, or GOGO plus a
-// smoothing spline, chosen per channel by cross-validation) and the primaries' directions come from
-// every ramp reading above a fifth of full drive, not from the one full-drive reading. The
+// smoothing spline, chosen per channel by cross-validation) of the ramp readings each fitted along
+// its primary by weighted least squares, and the primaries' directions come from every ramp
+// reading above a fifth of full drive, not from the one full-drive reading. The
 // interpolating fit of the first profiles (every ramp reading interpolated; the shipped synthetic
 // profile) stays as ToneMethod::Interpolate.
 #pragma once
@@ -35,8 +36,9 @@ struct FitOptions {
     double deadChannelFraction = 0.005; // X+Y+Z of a primary below this share of all three: dead
     int maxEvaluations = 4000; // Nelder-Mead evaluations of the matrix; 0 keeps direct primaries
     ToneMethod toneMethod = ToneMethod::Robust;
-    // Robust: reading weights 1 / (v^2 + (floor v_full)^2), a relative noise with an absolute
-    // floor at this share of full drive.
+    // Robust: each XYZ component of a ramp reading has a relative noise with an absolute floor at
+    // this share of its primary's length (the reading's weight is 1 / the variance of its fit
+    // along the primary).
     double noiseFloor = 0.002;
     int bootstrapReplicates = 24; // for the inverse's expected error in counts
 };
