@@ -174,7 +174,7 @@ TEST(RobustFit, DISABLED_Table)
                 std::printf("%-10s %5.1f%% %-5s truth dE mean %.3f max %.3f | inverse ramps max "
                             "%.2f (%d@%d) clip %.2f in-gamut %.2f colours p95 %.2f max %.2f | "
                             "heldout %.3f/%.3f noiseDe %.3f "
-                            "noise %.3f%% shapes %s %s %s expInv %.2f %.2f %.2f add %.3f (p99 "
+                            "noise %.3f%% shapes %s %s %s expInv %.2f %.2f %.2f add %.3f (p99.9 "
                             "%.3f) %+.3f%% +- %.3f %s\n",
                             name, 100 * noise,
                             method == 0   ? "rob"
