@@ -2,8 +2,6 @@
 // that is nothing but data (a second accelerometer: new names and channel, the accelerometer's
 // sample type and codec) is polled by the loop, recorded, read back, listed and replayed.
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
 #include <pipeline/base/data_dir.h>
 #include <platform/appliance.h>
@@ -15,25 +13,22 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/files.h"
+#include "../support/headless_gl.h"
+
 namespace replica {
 namespace {
 
 using recordings::DeviceKind;
 using recordings::DeviceKinds;
 
-std::string slurp(const std::filesystem::path& p)
-{
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), {}};
-}
-
 // The schemas and channels of the current format as the registry makes them, against those the
 // code before the registry wrote into the committed format-5 sample (byte for byte: a viewer and
 // 'recover' see the same file).
 TEST(DeviceKinds, WriteTheChannelsAndSchemasOfTheCommittedFormat5Sample)
 {
-    const std::string file =
-            slurp(std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples/walk-v5.mcap");
+    const std::string file = tests::slurp(std::filesystem::path(REPLICA_SOURCE_DIR) /
+                                          "recordings/samples/walk-v5.mcap");
     ASSERT_FALSE(file.empty());
     const auto scan = recordings::mcap::scan(file);
     ASSERT_TRUE(scan.damage.empty());
@@ -89,14 +84,7 @@ TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAnd
     DeviceKinds kinds = recordings::deviceKinds();
     kinds.push_back(&secondAccel);
 
-    platform::RunConfig config;
-    config.width = 32;
-    config.height = 20;
-    config.rateHz = 10.0;
-    config.boothLights = 8;
-    config.specularSamples = 2;
-    config.horizonDirections = 4;
-    auto app = platform::buildAppliance(config);
+    auto app = platform::buildAppliance(tests::smallSimRun());
     if (!app) {
         GTEST_SKIP() << app.error().message;
     }

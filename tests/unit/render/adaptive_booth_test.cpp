@@ -15,16 +15,16 @@
 #include <pipeline/spectral/reference_sets.h>
 #include <platform/appliance.h>
 #include <platform/loop/frame_loop.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
 
+#include "../support/headless_gl.h"
 #include "../support/state_sequence.h"
 
 namespace replica::pipeline::render {
 namespace {
 
-class AdaptiveBooth : public ::testing::Test
+class AdaptiveBooth : public tests::HeadlessGlTest
 {
 protected:
     static void SetUpTestSuite()
@@ -37,17 +37,13 @@ protected:
 
     void SetUp() override
     {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        tests::HeadlessGlTest::SetUp();
+        if (IsSkipped()) {
+            return;
         }
-        output_ = std::move(*out);
-        setup_.booth = *booth::loadBooth(dataDir() / "booth");
-        setup_.scene = *surface::loadScene(dataDir() / "scenes" / "colorchecker");
-        setup_.observer = *colour::loadCie1931(dataDir());
+        setup_ = tests::boothPassSetup("colorchecker");
         setup_.basis = encoder_->generalBasis();
         setup_.adaptive = encoder_;
-        setup_.settings.lights = 16;
         setup_.settings.specularSamples = 4;
     }
 
@@ -64,14 +60,9 @@ protected:
         return l ? *l : colour::Spectrum{};
     }
 
-    std::vector<colour::Xyz> frame(BoothScenePass& pass, const scene::SceneState& st)
+    static std::vector<colour::Xyz> frame(BoothScenePass& pass, const scene::SceneState& st)
     {
-        auto target = XyzTarget::create(kW, kH);
-        EXPECT_TRUE(target);
-        (*target)->bind();
-        auto ok = pass.draw(st, kW, kH);
-        EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
-        return (*target)->read({}, {}).xyz;
+        return tests::drawXyz(pass, st, kW, kH);
     }
 
     // A pass that was never adaptive, created with the basis built for 'light': what the adaptive
@@ -127,7 +118,6 @@ protected:
 
     static constexpr int kW = 48, kH = 30;
     static std::shared_ptr<const spectral::AdaptiveEncoder> encoder_;
-    std::unique_ptr<platform::Output> output_;
     BoothSceneSetup setup_;
 };
 
@@ -266,14 +256,8 @@ TEST_F(AdaptiveBooth, DirectSensorModeReencodesPastTheShapeThreshold)
 // that lamp, and the frames between confirmations carry no re-encode.
 TEST(AdaptiveAppliance, SimRunReencodesAtEachConfirmedLampChange)
 {
-    platform::RunConfig config;
+    platform::RunConfig config = tests::smallSimRun();
     ASSERT_EQ(config.basis, "adaptive_k6"); // the default for new runs
-    config.width = 32;
-    config.height = 20;
-    config.rateHz = 10.0;
-    config.boothLights = 8;
-    config.specularSamples = 2;
-    config.horizonDirections = 4;
     auto app = platform::buildAppliance(config);
     if (!app) {
         GTEST_SKIP() << app.error().message;

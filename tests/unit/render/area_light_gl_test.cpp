@@ -12,10 +12,10 @@
 
 #include <pipeline/render/booth_shaders.h>
 #include <pipeline/render/booth_shading_pass.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
 
+#include "../support/headless_gl.h"
 #include "render_fixtures.h"
 
 namespace replica::pipeline::render {
@@ -48,19 +48,7 @@ double quadrature(const Vec3& origin,
     return lum * sum * area / (static_cast<double>(cells) * cells);
 }
 
-class AreaLightGl : public ::testing::Test
-{
-protected:
-    void SetUp() override
-    {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
-        }
-        output_ = std::move(*out);
-    }
-    std::unique_ptr<platform::Output> output_;
-};
+using AreaLightGl = tests::HeadlessGlTest;
 
 TEST_F(AreaLightGl, MatteFramesMatchTheQuadratureAtEveryTilt)
 {

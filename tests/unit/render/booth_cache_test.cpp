@@ -11,10 +11,10 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/reference/frame_error.h>
 #include <pipeline/render/booth_scene_pass.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
 
+#include "../support/headless_gl.h"
 #include "../support/state_sequence.h"
 
 namespace replica::pipeline::render {
@@ -22,47 +22,16 @@ namespace {
 
 constexpr int kCacheW = 60, kCacheH = 36;
 
-// Every float of the RGBA32F target (alpha included), rows as GL has them.
-std::vector<float> readAll(const XyzTarget& t)
-{
-    std::vector<float> px(static_cast<std::size_t>(t.width()) * t.height() * 4);
-    t.bind();
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, t.width(), t.height(), GL_RGBA, GL_FLOAT, px.data());
-    return px;
-}
-
-// Bit for bit the same frame, or where the first float differs (a whole frame in a failure
-// message is thousands of numbers).
-::testing::AssertionResult sameFrame(const std::vector<float>& got, const std::vector<float>& want)
-{
-    if (got.size() != want.size()) {
-        return ::testing::AssertionFailure() << "sizes " << got.size() << " and " << want.size();
-    }
-    for (std::size_t i = 0; i < got.size(); ++i) {
-        if (!(got[i] == want[i])) {
-            return ::testing::AssertionFailure() << "pixel " << i / 4 << " channel " << i % 4
-                                                 << ": " << got[i] << " against " << want[i];
-        }
-    }
-    return ::testing::AssertionSuccess();
-}
-
-class BoothCacheTest : public ::testing::Test
+class BoothCacheTest : public tests::HeadlessGlTest
 {
 protected:
     void SetUp() override
     {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        tests::HeadlessGlTest::SetUp();
+        if (IsSkipped()) {
+            return;
         }
-        output_ = std::move(*out);
-        setup_.booth = *booth::loadBooth(dataDir() / "booth");
-        setup_.scene = *surface::loadScene(dataDir() / "scenes" / "colorchecker"); // glossy
-        setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
-        setup_.observer = *colour::loadCie1931(dataDir());
-        setup_.settings.lights = 16;
+        setup_ = tests::boothPassSetup("colorchecker"); // glossy
         setup_.settings.specularSamples = 8;
         setup_.settings.subtractFlare = false; // as in the appliance: pass 2 subtracts it
         auto t = XyzTarget::create(kCacheW, kCacheH);
@@ -75,10 +44,9 @@ protected:
         target_->bind();
         auto ok = pass.draw(st, kCacheW, kCacheH);
         EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
-        return readAll(*target_);
+        return tests::readFloats(*target_);
     }
 
-    std::unique_ptr<platform::Output> output_;
     std::unique_ptr<XyzTarget> target_;
     BoothSceneSetup setup_;
 };
@@ -180,11 +148,11 @@ TEST_F(BoothCacheTest, AFreshPassDrawsAnyFrameFromItsStateAlone)
             refreshing += st.diffuse->refreshRad ? 1 : 0;
             const auto fa = draw(**a, st);
             const auto fb = draw(**b, st);
-            ASSERT_TRUE(sameFrame(fa, fb)) << "frame " << i << ", " << slices << " slices";
+            ASSERT_TRUE(tests::sameFloats(fa, fb)) << "frame " << i << ", " << slices << " slices";
             if (i % 4 == 1 || (st.diffuse->refreshRad && alone < 4)) {
                 auto fresh = BoothScenePass::create(setup_);
                 ASSERT_TRUE(fresh);
-                ASSERT_TRUE(sameFrame(draw(**fresh, st), fa))
+                ASSERT_TRUE(tests::sameFloats(draw(**fresh, st), fa))
                         << "frame " << i << " drawn alone, " << slices << " slices";
                 ++alone;
             }
@@ -346,7 +314,7 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
             target_->bind();
             auto ok = pass.draw(view, kCacheW, kCacheH, layout, &cachePose);
             EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
-            return readAll(*target_);
+            return tests::readFloats(*target_);
         };
         // The unsliced pass's frames with the cache at 20, 23 and 27 degrees (recomputed whole).
         const auto w20 = frame(**whole, 20.0);
@@ -358,39 +326,40 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         }
         EXPECT_GT(moved, kCacheW * kCacheH / 2); // the cache's pose shows in the frame
         BoothShadingPass& s = **sliced;
-        EXPECT_TRUE(sameFrame(frame(s, 20.0), w20)); // the first cache is drawn whole
+        EXPECT_TRUE(tests::sameFloats(frame(s, 20.0), w20)); // the first cache is drawn whole
         EXPECT_EQ(s.cacheRefreshes(), 1);
         EXPECT_FALSE(s.cacheRefreshPending());
-        EXPECT_TRUE(sameFrame(frame(s, 23.0), w20)); // band 1 of 3 drawn behind the frame
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0), w20)); // band 1 of 3 drawn behind the frame
         EXPECT_TRUE(s.cacheRefreshPending());
-        EXPECT_TRUE(sameFrame(frame(s, 23.0), w20)); // band 2
-        EXPECT_TRUE(sameFrame(frame(s, 27.0), w23)); // band 3 completes 23; 27 waits for it
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0), w20)); // band 2
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w23)); // band 3 completes 23; 27 waits for it
         EXPECT_EQ(s.cacheRefreshes(), 2);
         EXPECT_FALSE(s.cacheRefreshPending());
-        EXPECT_TRUE(sameFrame(frame(s, 27.0), w23));
-        EXPECT_TRUE(sameFrame(frame(s, 27.0), w23));
-        EXPECT_TRUE(sameFrame(frame(s, 27.0), w27)); // held still: the unsliced frame, bit for bit
-        EXPECT_TRUE(sameFrame(frame(s, 27.0), w27));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w23));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w23));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0),
+                                      w27)); // held still: the unsliced frame, bit for bit
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w27));
         EXPECT_EQ(s.cacheRefreshes(), 3);
         EXPECT_FALSE(s.cacheRefreshPending());
         // A new light in the middle of a refresh: drawn whole at once, at the pose asked for.
-        EXPECT_TRUE(sameFrame(frame(s, 20.0), w27));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 20.0), w27));
         EXPECT_TRUE(s.cacheRefreshPending());
         ASSERT_TRUE((*whole)->setLight(tungsten));
         ASSERT_TRUE(s.setLight(tungsten));
         const auto t23 = frame(**whole, 23.0);
-        EXPECT_TRUE(sameFrame(frame(s, 23.0), t23));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0), t23));
         EXPECT_FALSE(s.cacheRefreshPending());
-        EXPECT_FALSE(sameFrame(t23, w23));
+        EXPECT_FALSE(tests::sameFloats(t23, w23));
         // A new layout in the middle of a refresh: drawn whole at once too (the compose places
         // the surface by the new one, and the facet normals follow it).
-        EXPECT_TRUE(sameFrame(frame(s, 27.0), t23));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), t23));
         EXPECT_TRUE(s.cacheRefreshPending());
         layout.offset.x += 0.125;
         const auto moved27 = frame(**whole, 27.0);
-        EXPECT_TRUE(sameFrame(frame(s, 27.0), moved27));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), moved27));
         EXPECT_FALSE(s.cacheRefreshPending());
-        EXPECT_FALSE(sameFrame(moved27, frame(**whole, 23.0)));
+        EXPECT_FALSE(tests::sameFloats(moved27, frame(**whole, 23.0)));
     }
 }
 

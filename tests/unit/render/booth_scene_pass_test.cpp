@@ -9,41 +9,32 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <platform/appliance.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/headless_gl.h"
 
 namespace replica::pipeline::render {
 namespace {
 
-class BoothScenePassTest : public ::testing::Test
+class BoothScenePassTest : public tests::HeadlessGlTest
 {
 protected:
     void SetUp() override
     {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        tests::HeadlessGlTest::SetUp();
+        if (IsSkipped()) {
+            return;
         }
-        output_ = std::move(*out);
-        setup_.booth = *booth::loadBooth(dataDir() / "booth");
-        setup_.scene = *surface::loadScene(dataDir() / "scenes" / "metamer");
-        setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
-        setup_.observer = *colour::loadCie1931(dataDir());
-        setup_.settings.lights = 16;
+        setup_ = tests::boothPassSetup("metamer");
     }
 
-    std::vector<colour::Xyz> frame(BoothScenePass& pass, const scene::SceneState& st)
+    static std::vector<colour::Xyz> frame(BoothScenePass& pass, const scene::SceneState& st)
     {
-        auto target = XyzTarget::create(kW, kH);
-        EXPECT_TRUE(target);
-        (*target)->bind();
-        EXPECT_TRUE(pass.draw(st, kW, kH));
-        return (*target)->read({}, {}).xyz;
+        return tests::drawXyz(pass, st, kW, kH);
     }
 
     static constexpr int kW = 52, kH = 32;
-    std::unique_ptr<platform::Output> output_;
     BoothSceneSetup setup_;
 };
 

@@ -18,10 +18,10 @@
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/spectral/adaptive_encoding.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
 
+#include "../support/headless_gl.h"
 #include "render_fixtures.h"
 
 namespace replica::pipeline::render {
@@ -55,7 +55,7 @@ Agreement agree(const shading::XyzFrame& cpu, const shading::XyzFrame& gl)
     return a;
 }
 
-class BoothPassTest : public ::testing::Test
+class BoothPassTest : public tests::HeadlessGlTest
 {
 protected:
     static void SetUpTestSuite()
@@ -76,15 +76,6 @@ protected:
         delete basis_;
         scenes_.clear();
     }
-    void SetUp() override
-    {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
-        }
-        output_ = std::move(*out);
-    }
-
     // The default settings with the painting's specular sample count: what the horizon tests
     // below vary one setting of.
     static shading::RenderSettings paintingSettings()
@@ -199,7 +190,6 @@ protected:
     static booth::Booth* booth_;
     static colour::ChannelBasis* basis_;
     static std::map<std::string, surface::SurfaceScene> scenes_;
-    std::unique_ptr<platform::Output> output_;
 };
 
 colour::Observer* BoothPassTest::obs_ = nullptr;

@@ -1,33 +1,28 @@
 // BoothScenePass::warmUp: drawing every lamp's shading pass once at start changes no frame the loop
 // draws afterwards (bit for bit, across lamp switches between passes of different settings) and
 // no count the loop reports.
-#include <pipeline/base/data_dir.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/xyz_target.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/headless_gl.h"
 
 namespace replica::pipeline::render {
 namespace {
 
 constexpr int kWarmW = 48, kWarmH = 30;
 
-class BoothWarmUpTest : public ::testing::Test
+class BoothWarmUpTest : public tests::HeadlessGlTest
 {
 protected:
     void SetUp() override
     {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        tests::HeadlessGlTest::SetUp();
+        if (IsSkipped()) {
+            return;
         }
-        output_ = std::move(*out);
-        setup_.booth = *booth::loadBooth(dataDir() / "booth");
-        setup_.scene = *surface::loadScene(dataDir() / "scenes" / "colorchecker"); // glossy
-        setup_.basis = *colour::loadDefaultChannelBasis(dataDir());
-        setup_.observer = *colour::loadCie1931(dataDir());
-        setup_.settings.lights = 16;
+        setup_ = tests::boothPassSetup("colorchecker"); // glossy
         setup_.settings.specularSamples = 8;
         setup_.settings.subtractFlare = false;
         // Three passes: the setup's, and one of its own for each fluorescent.
@@ -51,15 +46,11 @@ protected:
             target_->bind();
             auto ok = pass.draw(st, kWarmW, kWarmH);
             EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
-            std::vector<float> px(static_cast<std::size_t>(kWarmW) * kWarmH * 4);
-            glPixelStorei(GL_PACK_ALIGNMENT, 1);
-            glReadPixels(0, 0, kWarmW, kWarmH, GL_RGBA, GL_FLOAT, px.data());
-            frames.push_back(std::move(px));
+            frames.push_back(tests::readFloats(*target_));
         }
         return frames;
     }
 
-    std::unique_ptr<platform::Output> output_;
     std::unique_ptr<XyzTarget> target_;
     BoothSceneSetup setup_;
 };
@@ -94,10 +85,7 @@ TEST_F(BoothWarmUpTest, ChangesNoFrameAndNoCount)
     const auto b = run(**warm);
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t f = 0; f < a.size(); ++f) {
-        ASSERT_EQ(a[f].size(), b[f].size());
-        for (std::size_t i = 0; i < a[f].size(); ++i) {
-            ASSERT_EQ(a[f][i], b[f][i]) << "frame " << f << ", float " << i;
-        }
+        ASSERT_TRUE(tests::sameFloats(a[f], b[f])) << "frame " << f;
     }
     // The lamps' settings differ, so the passes do draw different frames (the test can fail).
     bool switched = false;

@@ -14,23 +14,23 @@
 #include <pipeline/render/display_pass.h>
 #include <pipeline/render/gl_program.h>
 #include <pipeline/render/gles_renderer.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/headless_gl.h"
 
 namespace replica::pipeline::render {
 namespace {
 
-class DisplayPassTest : public ::testing::Test
+class DisplayPassTest : public tests::HeadlessGlTest
 {
 protected:
     void SetUp() override
     {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        tests::HeadlessGlTest::SetUp();
+        if (IsSkipped()) {
+            return;
         }
-        output_ = std::move(*out);
         auto profile = display::loadProfile(dataDir() / "displays" / "wide-ips-synthetic.json");
         ASSERT_TRUE(profile) << profile.error().message;
         profile_ = *profile;
@@ -38,12 +38,7 @@ protected:
 
     std::unique_ptr<Renderer> make(InverseMethod method, double reflectance)
     {
-        GlesRendererSetup s;
-        s.width = 64;
-        s.height = 40;
-        s.booth = *scene::loadDefaultBooth(dataDir().string());
-        s.basis = colour::boxBasis();
-        s.observer = *colour::loadCie1931(dataDir());
+        GlesRendererSetup s = tests::flatRendererSetup();
         // Left half grey, right half a saturated red (out of gamut at the booth's light level).
         s.surface.width = 2;
         s.surface.height = 1;
@@ -85,16 +80,8 @@ protected:
         const auto pose = scene::panelPose(setup_.stand, st.tiltRad);
         const glm::dvec3 p = pose.cornerM() + (x + 0.5) / f.width * pose.rightEdgeM() +
                              (y + 0.5) / f.height * pose.upEdgeM();
-        double e = 0.0;
-        for (const auto& l :
-             scene::uniformGridLights(setup_.booth.ceiling(), st.emitterLuminanceCdM2,
-                                      setup_.lightsU, setup_.lightsV)) {
-            const glm::dvec3 d = l.position - p;
-            const double d2 = glm::dot(d, d);
-            const glm::dvec3 dir = d / std::sqrt(d2);
-            e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *
-                 std::max(glm::dot(setup_.booth.ceiling().normal(), -dir), 0.0) / d2;
-        }
+        const double e = tests::gridIlluminance(setup_.booth, st.emitterLuminanceCdM2,
+                                                setup_.lightsU, setup_.lightsV, pose, p);
         const colour::Xyz light = colour::spectrumToXyz(setup_.observer, st.illuminant);
         const glm::dvec3 flare = display::frontSurfaceFlareXyz(profile_, e, light / light.y);
         const double angle = display::viewingAngleDeg(p, pose.normal, st.eyeBoothM);
@@ -106,7 +93,6 @@ protected:
         return inv.invert((xyz - flare) / gain);
     }
 
-    std::unique_ptr<platform::Output> output_;
     display::DisplayModel profile_;
     GlesRendererSetup setup_;
 };

@@ -12,9 +12,10 @@
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/display_pass.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/headless_gl.h"
 
 namespace replica::pipeline::render {
 namespace {
@@ -52,16 +53,15 @@ struct Drawn {
     display::GamutCounters counts;
 };
 
-class DisplaySurroundTest : public ::testing::Test
+class DisplaySurroundTest : public tests::HeadlessGlTest
 {
 protected:
     void SetUp() override
     {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
+        tests::HeadlessGlTest::SetUp();
+        if (IsSkipped()) {
+            return;
         }
-        output_ = std::move(*out);
         const std::vector<float> px = xyzFrame();
         glGenTextures(1, &xyz_);
         glBindTexture(GL_TEXTURE_2D, xyz_);
@@ -136,7 +136,6 @@ protected:
         return pass.surroundConstant();
     }
 
-    std::unique_ptr<platform::Output> output_;
     GLuint xyz_ = 0;
 };
 

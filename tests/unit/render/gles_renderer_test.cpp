@@ -8,37 +8,20 @@
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
-#include <platform/output/output.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/headless_gl.h"
 
 namespace replica::pipeline::render {
 namespace {
 
-class GlesRendererTest : public ::testing::Test
+class GlesRendererTest : public tests::HeadlessGlTest
 {
 protected:
-    void SetUp() override
-    {
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            GTEST_SKIP() << "no EGL/GLES 3.1 context: " << out.error().message;
-        }
-        output_ = std::move(*out);
-    }
-
     std::unique_ptr<Renderer> make(double reflectance, int lightsU, int lightsV)
     {
-        GlesRendererSetup s;
-        s.width = 64;
-        s.height = 40;
-        auto booth = scene::loadDefaultBooth(dataDir().string());
-        EXPECT_TRUE(booth);
-        s.booth = *booth;
-        s.basis = colour::boxBasis();
-        auto obs = colour::loadCie1931(dataDir());
-        EXPECT_TRUE(obs);
-        s.observer = *obs;
+        GlesRendererSetup s = tests::flatRendererSetup();
         s.surface.width = 2;
         s.surface.height = 2;
         s.surface.coeffs.assign(2 * 2 * colour::kChannels, static_cast<float>(reflectance));
@@ -60,17 +43,8 @@ protected:
         const double u = (x + 0.5) / setup_.width;
         const double v = (y + 0.5) / setup_.height;
         const glm::dvec3 p = pose.cornerM() + u * pose.rightEdgeM() + v * pose.upEdgeM();
-        double e = 0.0;
-        for (const auto& l :
-             scene::uniformGridLights(setup_.booth.ceiling(), st.emitterLuminanceCdM2,
-                                      setup_.lightsU, setup_.lightsV)) {
-            const glm::dvec3 d = l.position - p;
-            const double d2 = glm::dot(d, d);
-            const glm::dvec3 dir = d / std::sqrt(d2);
-            e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *
-                 std::max(glm::dot(setup_.booth.ceiling().normal(), -dir), 0.0) / d2;
-        }
-        return e;
+        return tests::gridIlluminance(setup_.booth, st.emitterLuminanceCdM2, setup_.lightsU,
+                                      setup_.lightsV, pose, p);
     }
 
     scene::SceneState state(double tilt) const
@@ -82,7 +56,6 @@ protected:
         return st;
     }
 
-    std::unique_ptr<platform::Output> output_;
     GlesRendererSetup setup_;
 };
 
