@@ -12,6 +12,7 @@
 #include <glm/vec3.hpp>
 #include <state/scene_estimator.h>
 
+#include <hal/sim/sim_devices.h>
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
 #include <pipeline/base/rigid_transform.h>
@@ -226,9 +227,6 @@ struct OutputChoice {
 Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& config,
                                                     const OutputChoice& output = {});
 
-// The built-in simulated sensors playing the scripted scenario. lampSelector: "none", "sim" (a
-// switch that follows the scenario's lamps), or "sim-miswired" (its lines for lamps 1 and 2
-// swapped, to exercise the disagreement path).
 // The run configuration's key for the estimators' state at the start of a rotated session file
 // (state::SceneEstimator::save), which files 2, 3, ... of a kiosk session carry so that each
 // replays alone; absent in the first file and in every recording made before.
@@ -237,6 +235,13 @@ constexpr const char* kStateAtStartKey = "state_at_start";
 // kStateAtStartKey; nothing to do otherwise. Fails with one line naming what is wrong.
 Expected<void> restoreStateAtStart(Appliance& appliance, const std::string& configJson);
 
+// The booth's lamps as the simulated spectrometer sees them: each lamp's reference column at its
+// table's own resolution, not the working grid; fails naming a missing file or column.
+Expected<std::vector<hal::sim::SimLamp>> simLamps(const pipeline::booth::Booth& booth);
+
+// The built-in simulated sensors playing the scripted scenario. lampSelector: "none", "sim" (a
+// switch that follows the scenario's lamps), or "sim-miswired" (its lines for lamps 1 and 2
+// swapped, to exercise the disagreement path).
 Expected<Sources> makeSimSources(const Appliance& appliance,
                                  const std::string& lampSelector = "none");
 

@@ -32,6 +32,23 @@
 
 namespace replica::platform {
 
+Expected<std::vector<hal::sim::SimLamp>> simLamps(const pipeline::booth::Booth& booth)
+{
+    std::vector<hal::sim::SimLamp> lamps;
+    for (const auto& lamp : booth.lights) {
+        auto table = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" / lamp.referenceFile);
+        if (!table) {
+            return tl::unexpected(table.error());
+        }
+        auto power = table->values(lamp.referenceColumn);
+        if (!power) {
+            return tl::unexpected(power.error());
+        }
+        lamps.push_back({lamp.name, table->wavelengthNm, std::move(*power)});
+    }
+    return lamps;
+}
+
 Expected<Sources> makeSimSources(const Appliance& appliance, const std::string& lampSelector)
 {
     if (lampSelector != "none" && lampSelector != "sim" && lampSelector != "sim-miswired") {
@@ -39,35 +56,17 @@ Expected<Sources> makeSimSources(const Appliance& appliance, const std::string& 
                          fmt::format("--lamp-selector {}: expected none, sim or sim-miswired",
                                      lampSelector));
     }
-    const std::filesystem::path dir = dataDir();
     hal::sim::ScenarioParams scenario;
     scenario.lampCount = static_cast<int>(appliance.booth.lights.size());
 
     hal::sim::SimSpectrometerParams spec;
-    for (const auto& lamp : appliance.booth.lights) {
-        // The simulator sees each lamp at its table's own resolution, not the working grid.
-        auto table = pipeline::colour::loadSpectralCsv(dir / "spectra" / lamp.referenceFile);
-        if (!table) {
-            return tl::unexpected(table.error());
-        }
-        hal::sim::SimLamp sim{lamp.name, table->wavelengthNm, {}};
-        std::size_t column = table->columns.size();
-        for (std::size_t c = 0; c < table->columns.size(); ++c) {
-            if (table->columns[c] == lamp.referenceColumn) {
-                column = c;
-            }
-        }
-        if (column == table->columns.size()) {
-            return makeError(ErrorCode::NotFound, fmt::format("{}: no column '{}'", table->source,
-                                                              lamp.referenceColumn));
-        }
-        for (const auto& row : table->rows) {
-            sim.power.push_back(row[column]);
-        }
-        spec.lamps.push_back(std::move(sim));
+    auto lamps = simLamps(appliance.booth);
+    if (!lamps) {
+        return tl::unexpected(lamps.error());
     }
+    spec.lamps = std::move(*lamps);
     auto cal = pipeline::spectral::loadSpectrometerCalibration(
-            dir / appliance.config.spectrometerCalibration);
+            dataDir() / appliance.config.spectrometerCalibration);
     if (!cal) {
         return tl::unexpected(cal.error());
     }

@@ -1,4 +1,5 @@
 // Spectral CSV parsing with file:line error messages.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -104,35 +105,44 @@ Expected<SpectralTable> loadSpectralCsv(const std::filesystem::path& path)
     return parseSpectralCsv(*text, path.string());
 }
 
+Expected<std::vector<double>> SpectralTable::values(const std::string& column) const
+{
+    const auto it = std::find(columns.begin(), columns.end(), column);
+    if (it == columns.end()) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}:{}: no column named '{}' in the header", source,
+                                     headerLine, column));
+    }
+    const auto c = static_cast<std::size_t>(it - columns.begin());
+    std::vector<double> out;
+    out.reserve(rows.size());
+    for (const auto& row : rows) {
+        out.push_back(row[c]);
+    }
+    return out;
+}
+
 Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
 {
-    for (std::size_t c = 0; c < columns.size(); ++c) {
-        if (columns[c] != column) {
-            continue;
-        }
-        // Name the offending line when the data stop short of the working grid.
-        if (!wavelengthNm.empty() && wavelengthNm.front() > kFirstNm) {
-            return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("{}:{}: data start at {} nm but must cover {}-{} nm",
-                                         source, rowLines.empty() ? 0 : rowLines.front(),
-                                         wavelengthNm.front(), kFirstNm, kLastNm));
-        }
-        if (!wavelengthNm.empty() && wavelengthNm.back() < kLastNm) {
-            return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("{}:{}: data end at {} nm but must cover {}-{} nm", source,
-                                         rowLines.empty() ? 0 : rowLines.back(),
-                                         wavelengthNm.back(), kFirstNm, kLastNm));
-        }
-        SampledSpectrum s;
-        s.wavelengthNm = wavelengthNm;
-        s.value.reserve(rows.size());
-        for (const auto& row : rows) {
-            s.value.push_back(row[c]);
-        }
-        return resampleToWorkingGrid(s, fmt::format("{}: column '{}'", source, column));
+    auto v = values(column);
+    if (!v) {
+        return tl::unexpected(v.error());
     }
-    return makeError(ErrorCode::NotFound, fmt::format("{}:{}: no column named '{}' in the header",
-                                                      source, headerLine, column));
+    // Name the offending line when the data stop short of the working grid.
+    if (!wavelengthNm.empty() && wavelengthNm.front() > kFirstNm) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}:{}: data start at {} nm but must cover {}-{} nm", source,
+                                     rowLines.empty() ? 0 : rowLines.front(), wavelengthNm.front(),
+                                     kFirstNm, kLastNm));
+    }
+    if (!wavelengthNm.empty() && wavelengthNm.back() < kLastNm) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}:{}: data end at {} nm but must cover {}-{} nm", source,
+                                     rowLines.empty() ? 0 : rowLines.back(), wavelengthNm.back(),
+                                     kFirstNm, kLastNm));
+    }
+    return resampleToWorkingGrid(SampledSpectrum{wavelengthNm, std::move(*v)},
+                                 fmt::format("{}: column '{}'", source, column));
 }
 
 Expected<std::vector<Spectrum>> SpectralTable::allSpectra() const

@@ -19,6 +19,8 @@ struct SpectralTable {
     int headerLine = 0;                    // 1-based line numbers, for messages
     std::vector<int> rowLines;
 
+    // The named column at the table's own wavelengths, or an error naming the file and column.
+    Expected<std::vector<double>> values(const std::string& column) const;
     // The named column resampled to the working grid, or an error naming the file and column.
     Expected<Spectrum> spectrum(const std::string& column) const;
     // Every column resampled to the working grid, in header order.

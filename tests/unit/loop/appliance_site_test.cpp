@@ -24,6 +24,7 @@
 #include <gtest/gtest.h>
 
 #include "../support/files.h"
+#include "../support/shipped_light.h"
 
 namespace replica::platform {
 namespace {
@@ -314,16 +315,7 @@ TEST(RunConfigSite, RecordingsWithTheTrackerAnglesInDegreesReplayWithTheSameTran
 class SiteUpdater : public ::testing::Test
 {
 protected:
-    void SetUp() override
-    {
-        auto booth = pipeline::scene::loadDefaultBooth(dataDir().string());
-        ASSERT_TRUE(booth);
-        auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
-                                                                   "sim_usb2000_responsivity.csv");
-        ASSERT_TRUE(cal);
-        setup_.light.booth = *booth;
-        setup_.light.calibration = *cal;
-    }
+    void SetUp() override { setup_ = tests::shippedEstimatorSetup(); }
     state::SceneEstimatorSetup setup_;
 };
 

@@ -9,42 +9,26 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/shipped_light.h"
+
 namespace replica {
 namespace {
 
 using pipeline::colour::Spectrum;
 
-struct Bench {
-    pipeline::booth::Booth booth;
-    pipeline::spectral::SpectrometerCalibration cal;
-};
-
-Bench load()
+// The shipped booth and the sim spectrometer's calibration.
+state::LightEstimatorSetup load()
 {
-    Bench b;
-    auto booth = pipeline::scene::loadDefaultBooth(dataDir().string());
-    EXPECT_TRUE(booth) << booth.error().message;
-    b.booth = *booth;
-    auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
-                                                               "sim_usb2000_responsivity.csv");
-    EXPECT_TRUE(cal) << cal.error().message;
-    b.cal = *cal;
-    return b;
+    return tests::shippedEstimatorSetup().light;
 }
 
 hal::sim::SimLamp rawLamp(const std::string& file, const std::string& column)
 {
     auto t = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" / file);
     EXPECT_TRUE(t);
-    hal::sim::SimLamp lamp{column, t->wavelengthNm, {}};
-    for (std::size_t c = 0; c < t->columns.size(); ++c) {
-        if (t->columns[c] == column) {
-            for (const auto& row : t->rows) {
-                lamp.power.push_back(row[c]);
-            }
-        }
-    }
-    return lamp;
+    auto power = t->values(column);
+    EXPECT_TRUE(power) << power.error().message;
+    return {column, t->wavelengthNm, power ? *power : std::vector<double>{}};
 }
 
 // Spectra measured from a sim spectrometer that shows the given lamps in turn (2 s each).
@@ -75,9 +59,9 @@ Spectrum convert(const hal::SpectrumSample& s,
 
 TEST(SimSpectrometer, FiveSpectraPerSecondWithSequenceAndCalibration)
 {
-    Bench b = load();
-    auto spectra = measure({rawLamp("cie_illuminants_A_D50_D65_5nm_300_780.csv", "A")}, b.cal,
-                           1'000'000'000);
+    const auto b = load();
+    auto spectra = measure({rawLamp("cie_illuminants_A_D50_D65_5nm_300_780.csv", "A")},
+                           b.calibration, 1'000'000'000);
     ASSERT_EQ(spectra.size(), 5u); // available at 0.1, 0.3, 0.5, 0.7, 0.9 s
     for (std::size_t i = 0; i < spectra.size(); ++i) {
         EXPECT_EQ(spectra[i].sequence, i);
@@ -89,16 +73,16 @@ TEST(SimSpectrometer, FiveSpectraPerSecondWithSequenceAndCalibration)
 
 TEST(SignalChain, RecoversEachBoothLampShapeFromRawCounts)
 {
-    Bench b = load();
+    const auto b = load();
     std::vector<hal::sim::SimLamp> lamps = {
             rawLamp("cie_illuminants_A_D50_D65_5nm_300_780.csv", "A"),
             rawLamp("cie_illuminants_F1_F12_5nm_380_780.csv", "F8"),
             rawLamp("cie_illuminants_F1_F12_5nm_380_780.csv", "F7")};
     // One spectrum in the middle of each lamp's 2 s slot.
-    auto spectra = measure(lamps, b.cal, 6'000'000'000);
+    auto spectra = measure(lamps, b.calibration, 6'000'000'000);
     for (int lamp = 0; lamp < 3; ++lamp) {
         const auto& s = spectra[static_cast<std::size_t>(lamp * 10 + 5)];
-        const Spectrum sensed = convert(s, b.cal);
+        const Spectrum sensed = convert(s, b.calibration);
         const double d = pipeline::spectral::LightClassifier::shapeDistance(
                 sensed, b.booth.lights[static_cast<std::size_t>(lamp)].referenceSpectrum);
         // Noise and the pixel-to-band integration leave a small residual; another lamp is far away.
@@ -117,7 +101,7 @@ TEST(SignalChain, RecoversEachBoothLampShapeFromRawCounts)
 
 TEST(LightClassifier, NamesBoothLampsAndRejectsAForeignLight)
 {
-    Bench b = load();
+    const auto b = load();
     std::vector<Spectrum> stored;
     for (const auto& l : b.booth.lights) {
         stored.push_back(l.referenceSpectrum);
@@ -128,28 +112,31 @@ TEST(LightClassifier, NamesBoothLampsAndRejectsAForeignLight)
             rawLamp("cie_illuminants_F1_F12_5nm_380_780.csv", "F8"),
             rawLamp("cie_illuminants_F1_F12_5nm_380_780.csv", "F7"),
             rawLamp("cie_illuminants_LED_5nm_380_780.csv", "LED-V1")};
-    auto spectra = measure(lamps, b.cal, 8'000'000'000);
+    auto spectra = measure(lamps, b.calibration, 8'000'000'000);
     for (const auto& s : spectra) {
         // The lamp slot the spectrum was integrated in (2 s per lamp).
         const auto lamp = static_cast<int>(((s.timestampNs - 50'000'000) / 2'000'000'000) % 4);
         const int expected = lamp < 3 ? lamp : -1;
-        EXPECT_EQ(classifier.classify(convert(s, b.cal)), expected) << "t=" << s.timestampNs;
+        EXPECT_EQ(classifier.classify(convert(s, b.calibration)), expected)
+                << "t=" << s.timestampNs;
     }
 }
 
 TEST(SignalChain, RejectsMalformedRawSpectra)
 {
-    Bench b = load();
+    const auto b = load();
     std::vector<std::uint16_t> few(10, 100);
-    auto r = pipeline::spectral::countsToSpectrum({few, 1000, {339, 0.38, 0, 0}, {1}}, b.cal);
+    auto r = pipeline::spectral::countsToSpectrum({few, 1000, {339, 0.38, 0, 0}, {1}},
+                                                  b.calibration);
     EXPECT_FALSE(r);
     std::vector<std::uint16_t> counts(2048, 100);
-    auto z = pipeline::spectral::countsToSpectrum({counts, 0, {339, 0.38, 0, 0}, {1}}, b.cal);
+    auto z = pipeline::spectral::countsToSpectrum({counts, 0, {339, 0.38, 0, 0}, {1}},
+                                                  b.calibration);
     ASSERT_FALSE(z);
     EXPECT_NE(z.error().message.find("integration time"), std::string::npos);
     // A calibration that does not reach 730 nm cannot fill the working grid.
-    auto narrow =
-            pipeline::spectral::countsToSpectrum({counts, 1000, {339, 0.1, 0, 0}, {1}}, b.cal);
+    auto narrow = pipeline::spectral::countsToSpectrum({counts, 1000, {339, 0.1, 0, 0}, {1}},
+                                                       b.calibration);
     ASSERT_FALSE(narrow);
     EXPECT_NE(narrow.error().message.find("730"), std::string::npos);
 }

@@ -7,11 +7,11 @@
 #include <state/scene_estimator.h>
 
 #include <hal/sim/sim_devices.h>
-#include <pipeline/base/data_dir.h>
-#include <pipeline/colour/spectral_table.h>
-#include <pipeline/scene/booth.h>
+#include <platform/appliance.h>
 
 #include <gtest/gtest.h>
+
+#include "../support/shipped_light.h"
 
 namespace replica::state {
 namespace {
@@ -90,28 +90,13 @@ class SelectorSceneTest : public ::testing::Test
 protected:
     void SetUp() override
     {
-        auto booth = pipeline::scene::loadDefaultBooth(dataDir().string());
-        ASSERT_TRUE(booth);
-        auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
-                                                                   "sim_usb2000_responsivity.csv");
-        ASSERT_TRUE(cal);
-        setup_.light.booth = *booth;
-        setup_.light.calibration = *cal;
+        setup_ = tests::shippedEstimatorSetup();
         hal::sim::SimSpectrometerParams p;
-        for (const auto& lamp : booth->lights) {
-            auto t = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" / lamp.referenceFile);
-            ASSERT_TRUE(t);
-            const auto c = static_cast<std::size_t>(
-                    std::find(t->columns.begin(), t->columns.end(), lamp.referenceColumn) -
-                    t->columns.begin());
-            hal::sim::SimLamp sim{lamp.name, t->wavelengthNm, {}};
-            for (const auto& row : t->rows) {
-                sim.power.push_back(row[c]);
-            }
-            p.lamps.push_back(std::move(sim));
-        }
-        p.responsivityNm = cal->wavelengthNm;
-        p.responsivity = cal->responsivity;
+        auto lamps = platform::simLamps(setup_.light.booth);
+        ASSERT_TRUE(lamps) << lamps.error().message;
+        p.lamps = std::move(*lamps);
+        p.responsivityNm = setup_.light.calibration.wavelengthNm;
+        p.responsivity = setup_.light.calibration.responsivity;
         // The scenario: lamp 0 for 2 s, lamp 1 for 2 s, lamp 2 ...
         hal::sim::makeSimSpectrometer({}, p)->poll(6 * kS, spectra_);
     }

@@ -15,6 +15,8 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/shipped_light.h"
+
 namespace replica::state {
 namespace {
 
@@ -23,13 +25,8 @@ class SceneEstimatorTest : public ::testing::Test
 protected:
     void SetUp() override
     {
-        auto booth = pipeline::scene::loadDefaultBooth(dataDir().string());
-        ASSERT_TRUE(booth);
-        auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() / "spectrometer" /
-                                                                   "sim_usb2000_responsivity.csv");
-        ASSERT_TRUE(cal);
-        setup_.light.booth = *booth;
-        setup_.light.calibration = *cal;
+        setup_ = tests::shippedEstimatorSetup();
+        const auto& cal = setup_.light.calibration;
         // Raw counts of the D65 simulator (lamp 2) and of tungsten (lamp 0) from the simulated
         // spectrometer, six of each (1.2 s at five spectra a second).
         auto f = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" /
@@ -38,8 +35,8 @@ protected:
                                                    "cie_illuminants_A_D50_D65_5nm_300_780.csv");
         ASSERT_TRUE(f);
         ASSERT_TRUE(a);
-        f7_ = sense(*f, "F7", *cal);
-        tungsten_ = sense(*a, "A", *cal);
+        f7_ = sense(*f, "F7", cal);
+        tungsten_ = sense(*a, "A", cal);
         ASSERT_EQ(f7_.size(), 6u);
         ASSERT_EQ(tungsten_.size(), 6u);
     }
@@ -49,13 +46,9 @@ protected:
           const std::string& column,
           const pipeline::spectral::SpectrometerCalibration& cal)
     {
-        hal::sim::SimLamp lamp{column, table.wavelengthNm, {}};
-        const auto c = static_cast<std::size_t>(
-                std::find(table.columns.begin(), table.columns.end(), column) -
-                table.columns.begin());
-        for (const auto& row : table.rows) {
-            lamp.power.push_back(c < row.size() ? row[c] : 0.0);
-        }
+        auto power = table.values(column);
+        EXPECT_TRUE(power) << power.error().message;
+        hal::sim::SimLamp lamp{column, table.wavelengthNm, power ? *power : std::vector<double>{}};
         hal::sim::ScenarioParams scenario;
         scenario.lampCount = 1;
         hal::sim::SimSpectrometerParams p;
