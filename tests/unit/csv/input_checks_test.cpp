@@ -12,25 +12,13 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/temp_dir.h"
+
 namespace replica {
 namespace {
 namespace fs = std::filesystem;
 
-class InputFile : public ::testing::Test
-{
-protected:
-    void SetUp() override
-    {
-        dir_ = fs::temp_directory_path() /
-               ("replica-input-" +
-                std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    fs::path dir_;
-};
+using InputFile = tests::TempDirTest;
 
 TEST_F(InputFile, ReadsRegularFilesAndRefusesEverythingElse)
 {

@@ -9,7 +9,6 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
@@ -21,54 +20,18 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/cli.h"
+#include "../support/temp_dir.h"
+
 namespace replica::pipeline::display {
 namespace {
 
-struct RunResult {
-    int exitCode = -1;
-    std::string out;
-    std::string err;
-};
-
-class DisplayCli : public ::testing::Test
+class DisplayCli : public tests::TempDirTest
 {
 protected:
-    void SetUp() override
+    tests::CliResult run(const std::string& args) const
     {
-        dir_ = std::filesystem::temp_directory_path() /
-               ("replica_display_cli_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::create_directories(dir_);
-    }
-    void TearDown() override { std::filesystem::remove_all(dir_); }
-
-    RunResult run(const std::string& args) const
-    {
-        const auto errPath = dir_ / "stderr.txt";
-        const std::string cmd = std::string(REPLICA_BINARY) + " --log-level warn " + args + " 2>" +
-                                errPath.string();
-        RunResult r;
-        FILE* pipe = popen(cmd.c_str(), "r");
-        if (pipe == nullptr) {
-            return r;
-        }
-        char buf[4096];
-        std::size_t n = 0;
-        while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) {
-            r.out.append(buf, n);
-        }
-        const int status = pclose(pipe);
-        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        std::ifstream e(errPath);
-        r.err.assign(std::istreambuf_iterator<char>(e), std::istreambuf_iterator<char>());
-        return r;
-    }
-
-    std::string write(const std::string& name, const std::string& text) const
-    {
-        const auto p = dir_ / name;
-        std::ofstream(p) << text;
-        return p.string();
+        return tests::runReplica("--log-level warn " + args, dir_);
     }
 
     static std::string shippedMeasurements()
@@ -79,8 +42,6 @@ protected:
     {
         return (dataDir() / "displays" / "wide-ips-synthetic.json").string();
     }
-
-    std::filesystem::path dir_;
 };
 
 TEST_F(DisplayCli, FitThenForwardThenInverseRoundTrips)

@@ -1,14 +1,11 @@
 // Tests of 'replica color de2000' and 'replica spectral eval' run as the built binary, and of the
 // channel-data file formats: bad files must fail naming file, line and problem.
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/channel_basis.h>
@@ -19,55 +16,14 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/cli.h"
+#include "../support/temp_dir.h"
+
 namespace replica::pipeline::spectral {
 namespace {
 
-struct RunResult {
-    int exitCode = -1;
-    std::string out; // stdout
-    std::string err; // stderr
-};
-
-RunResult runReplica(const std::string& args, const std::filesystem::path& dir)
-{
-    const auto errPath = dir / "stderr.txt";
-    const std::string cmd = std::string(REPLICA_BINARY) + " " + args + " 2>" + errPath.string();
-    RunResult r;
-    FILE* pipe = popen(cmd.c_str(), "r");
-    if (pipe == nullptr) {
-        return r;
-    }
-    char buf[4096];
-    std::size_t n = 0;
-    while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) {
-        r.out.append(buf, n);
-    }
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream e(errPath);
-    r.err.assign(std::istreambuf_iterator<char>(e), std::istreambuf_iterator<char>());
-    return r;
-}
-
-class CliFiles : public ::testing::Test
-{
-protected:
-    void SetUp() override
-    {
-        dir_ = std::filesystem::temp_directory_path() /
-               ("replica_spectral_cli_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::create_directories(dir_);
-    }
-    void TearDown() override { std::filesystem::remove_all(dir_); }
-    std::string write(const std::string& name, const std::string& text)
-    {
-        const auto p = dir_ / name;
-        std::ofstream(p) << text;
-        return p.string();
-    }
-    std::filesystem::path dir_;
-};
+using CliFiles = tests::TempDirTest;
+using tests::runReplica;
 
 TEST_F(CliFiles, De2000PrintsRowsWithTheirDifference)
 {
