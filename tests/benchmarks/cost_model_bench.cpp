@@ -12,7 +12,6 @@
 // Usage: replica_bench_cost_model [--frames N] [--size WxH] [--scene NAME]
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -20,7 +19,7 @@
 #include <vector>
 
 #include <tests/benchmarks/frame_bench_args.h>
-#include <time.h>
+#include <tests/benchmarks/frame_timing.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/tuning/planner.h>
@@ -30,22 +29,6 @@ using namespace replica;
 using namespace replica::pipeline;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-double cpuMs()
-{
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
-
-double median(std::vector<double> v)
-{
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : (n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
 
 struct Row {
     int lights = 0;
@@ -72,43 +55,14 @@ bool timeSetting(const std::string& scene, Row& r, int frames, int w, int h)
         std::fprintf(stderr, "appliance: %s\n", app.error().message.c_str());
         return false;
     }
-    const auto& lamp = (*app)->booth.lights.front();
-    scene::SceneState state;
-    state.lampIndex = 0;
-    state.illuminant = lamp.referenceSpectrum;
-    state.emitterLuminanceCdM2 = lamp.nominalLuminanceCdM2;
-    state.tiltRad = 30.0 * kPi / 180.0;
-    render::RenderedFrame frame;
-    for (int i = 0; i < 3; ++i) {
-        if (!(*app)->renderer->render(state, frame, render::Readback::Display)) {
-            return false;
-        }
+    bench::FrameTimes eye, tilt;
+    if (!bench::timeFrames(**app, 0, frames, eye, tilt)) {
+        return false;
     }
-    std::vector<double> eyeWall, eyeCpu, tiltWall, tiltCpu;
-    const auto timed = [&](std::vector<double>& wall, std::vector<double>& cpu) {
-        const double c0 = cpuMs();
-        const auto t0 = std::chrono::steady_clock::now();
-        (void)(*app)->renderer->render(state, frame, render::Readback::Display);
-        wall.push_back(
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                        .count());
-        cpu.push_back(cpuMs() - c0);
-    };
-    double t = 0.0;
-    for (int i = 0; i < frames; ++i) {
-        t += 1.0 / 60.0;
-        state.eyeBoothM.x = 0.25 * std::sin(t);
-        timed(eyeWall, eyeCpu);
-    }
-    for (int i = 0; i < frames; ++i) {
-        const int phase = i % 40;
-        state.tiltRad = (20.0 + (phase < 20 ? phase : 40 - phase)) * kPi / 180.0;
-        timed(tiltWall, tiltCpu);
-    }
-    r.eyeWall = median(eyeWall);
-    r.eyeCpu = median(eyeCpu);
-    r.tiltWall = median(tiltWall);
-    r.tiltCpu = median(tiltCpu);
+    r.eyeWall = eye.wall.median;
+    r.eyeCpu = eye.cpu.median;
+    r.tiltWall = tilt.wall.median;
+    r.tiltCpu = tilt.cpu.median;
     return true;
 }
 

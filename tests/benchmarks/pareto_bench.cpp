@@ -11,7 +11,6 @@
 // error"). Usage: replica_bench_pareto [--out CSV] [--frames N] [--size WxH] [--error-size WxH]
 //                             [--scene NAME] [--light NAME] [--quick]
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,8 +18,7 @@
 #include <string>
 #include <vector>
 
-#include <state/tilt_estimator.h>
-#include <time.h>
+#include <tests/benchmarks/frame_timing.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/booth/booth_model.h>
@@ -58,48 +56,13 @@ struct Setting {
     bool isDefault = false;
 };
 
-struct Timing {
-    double median = 0.0;
-    double p10 = 0.0;
-    double p90 = 0.0;
-};
-
-Timing summarise(std::vector<double> ms)
-{
-    std::sort(ms.begin(), ms.end());
-    const auto at = [&](double q) {
-        const double r = q * static_cast<double>(ms.size() - 1);
-        const auto i = static_cast<std::size_t>(std::floor(r));
-        const std::size_t j = std::min(i + 1, ms.size() - 1);
-        return ms[i] + (r - static_cast<double>(i)) * (ms[j] - ms[i]);
-    };
-    return {at(0.5), at(0.1), at(0.9)};
-}
-
-constexpr double kPi = 3.14159265358979323846;
-
-// CPU time of the whole process (every llvmpipe thread), ms: unlike the wall clock it does not
-// count the time other processes on a shared machine take from this one.
-double cpuMs()
-{
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
-
-struct FrameTimes {
-    Timing wall;
-    Timing cpu;
-};
-
-// The appliance's frame for 'c', timed: 'frames' frames after three warm-up frames, eye moving
-// with the tilt still at 30 degrees, then the tilt moving one degree a frame between 20 and 40.
-// Returns the configuration as the appliance resolved it (the scene's defaults filled in).
+// The appliance's frame for 'c', timed (bench::timeFrames). Returns the configuration as the
+// appliance resolved it (the scene's defaults filled in).
 bool timeAppliance(const platform::RunConfig& c,
                    int lampIndex,
                    int frames,
-                   FrameTimes& eye,
-                   FrameTimes& tilt,
+                   bench::FrameTimes& eye,
+                   bench::FrameTimes& tilt,
                    platform::RunConfig& resolved)
 {
     auto app = platform::buildAppliance(c);
@@ -108,53 +71,7 @@ bool timeAppliance(const platform::RunConfig& c,
         return false;
     }
     resolved = (*app)->config;
-    const auto& lamp = (*app)->booth.lights[static_cast<std::size_t>(lampIndex)];
-    scene::SceneState state;
-    state.lampIndex = lampIndex;
-    state.illuminant = lamp.referenceSpectrum;
-    state.emitterLuminanceCdM2 = lamp.nominalLuminanceCdM2;
-    state.tiltRad = 30.0 * kPi / 180.0;
-    render::RenderedFrame frame;
-    // The tilt estimator's held and diffuse tilts, as the appliance's state stage gives them.
-    state::TiltEstimator tilts({0.0, resolved.cacheSlices});
-    const auto estimate = [&](bool lightChanged) {
-        state.lightChanged = lightChanged;
-        tilts.sense(state.tiltRad);
-        tilts.write(state);
-    };
-    for (int i = 0; i < 3; ++i) {
-        estimate(i == 0);
-        if (!(*app)->renderer->render(state, frame, render::Readback::Display)) {
-            std::fprintf(stderr, "frame failed\n");
-            return false;
-        }
-    }
-    std::vector<double> eyeMs, tiltMs, eyeCpu, tiltCpu;
-    const auto timed = [&](std::vector<double>& wall, std::vector<double>& cpu) {
-        estimate(false);
-        const double c0 = cpuMs();
-        const auto t0 = std::chrono::steady_clock::now();
-        (void)(*app)->renderer->render(state, frame, render::Readback::Display);
-        wall.push_back(
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                        .count());
-        cpu.push_back(cpuMs() - c0);
-    };
-    double t = 0.0;
-    for (int i = 0; i < frames; ++i) {
-        t += 1.0 / 60.0;
-        state.eyeBoothM.x = 0.25 * std::sin(t); // the viewer walks past
-        timed(eyeMs, eyeCpu);
-    }
-    for (int i = 0; i < frames; ++i) {
-        const int phase = i % 40;
-        const double deg = 20.0 + (phase < 20 ? phase : 40 - phase);
-        state.tiltRad = deg * kPi / 180.0;
-        timed(tiltMs, tiltCpu);
-    }
-    eye = {summarise(eyeMs), summarise(eyeCpu)};
-    tilt = {summarise(tiltMs), summarise(tiltCpu)};
-    return true;
+    return bench::timeFrames(**app, lampIndex, frames, eye, tilt);
 }
 
 } // namespace
@@ -285,7 +202,7 @@ int main(int argc, char** argv)
                 c.boothLights = s.lights;
                 c.areaLights = s.areaLights;
                 c.specularSamples = s.samples;
-                FrameTimes eye, tilt;
+                bench::FrameTimes eye, tilt;
                 platform::RunConfig resolved;
                 if (!timeAppliance(c, static_cast<int>(li), o.frames, eye, tilt, resolved)) {
                     return 1;
