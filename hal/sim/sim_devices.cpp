@@ -7,24 +7,10 @@
 #include <hal/lamp/lamp_debouncer.h>
 #include <hal/sim/noise.h>
 #include <hal/sim/sim_devices.h>
+#include <pipeline/base/interpolate.h>
 
 namespace replica::hal::sim {
 namespace {
-
-// Linear interpolation on an increasing grid; zero outside it (no light, no response).
-double interpolate(const std::vector<double>& x, const std::vector<double>& y, double at)
-{
-    if (x.size() < 2 || at < x.front() || at > x.back()) {
-        return 0.0;
-    }
-    const auto it = std::upper_bound(x.begin(), x.end(), at);
-    if (it == x.end()) {
-        return y.back();
-    }
-    const auto i = static_cast<std::size_t>(it - x.begin());
-    const double t = (at - x[i - 1]) / (x[i] - x[i - 1]);
-    return y[i - 1] + t * (y[i] - y[i - 1]);
-}
 
 double pixelWavelength(int p)
 {
@@ -49,8 +35,10 @@ public:
             for (int p = kSimDarkPixelLast + 1; p < kSimPixels; ++p) {
                 const double wl = pixelWavelength(p);
                 signal[static_cast<std::size_t>(p)] =
-                        interpolate(lamp.wavelengthNm, lamp.power, wl) *
-                        interpolate(params_.responsivityNm, params_.responsivity, wl);
+                        pipeline::interpolateLinear(lamp.wavelengthNm, lamp.power, wl,
+                                                    pipeline::Outside::Zero) *
+                        pipeline::interpolateLinear(params_.responsivityNm, params_.responsivity,
+                                                    wl, pipeline::Outside::Zero);
                 peak = std::max(peak, signal[static_cast<std::size_t>(p)]);
             }
             const double scale = peak > 0.0 ? params_.peakCounts / peak : 0.0;

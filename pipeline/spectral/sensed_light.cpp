@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/interpolate.h>
 #include <pipeline/colour/xyz.h>
 #include <pipeline/spectral/band_noise.h>
 #include <pipeline/spectral/sensed_light.h>
@@ -40,20 +41,6 @@ double responsivity(double nm)
 {
     const double x = (nm - 550.0) / 150.0;
     return 0.2 + 0.8 * std::exp(-0.5 * x * x * 1.6);
-}
-
-double linear(const std::vector<double>& x, const std::vector<double>& y, double at)
-{
-    if (at <= x.front()) {
-        return y.front();
-    }
-    if (at >= x.back()) {
-        return y.back();
-    }
-    const auto it = std::upper_bound(x.begin(), x.end(), at);
-    const auto i = static_cast<std::size_t>(it - x.begin());
-    const double t = (at - x[i - 1]) / (x[i] - x[i - 1]);
-    return y[i - 1] + t * (y[i] - y[i - 1]);
 }
 
 double normalCdf(double z)
@@ -115,7 +102,8 @@ Expected<colour::Spectrum> fineLightToWorkingGrid(const FineLight& light)
     for (std::size_t i = 0; i <= steps; ++i) {
         const double nm = first + 0.05 * static_cast<double>(i);
         s.wavelengthNm.push_back(nm);
-        s.value.push_back(linear(light.wavelengthNm, light.continuum, nm));
+        s.value.push_back(
+                interpolateLinear(light.wavelengthNm, light.continuum, nm, Outside::Clamp));
     }
     auto out = colour::resampleToWorkingGrid(s, light.name);
     if (!out) {
@@ -189,12 +177,14 @@ Expected<SensedLight> senseLight(const FineLight& light,
             for (int k = -6; k <= 6; ++k) {
                 const double z = k * 0.5;
                 const double w = std::exp(-0.5 * z * z);
-                cont += w * linear(light.wavelengthNm, light.continuum, centre[i] + z * sigma);
+                cont += w * interpolateLinear(light.wavelengthNm, light.continuum,
+                                              centre[i] + z * sigma, Outside::Clamp);
                 wsum += w;
             }
             cont /= wsum;
         } else {
-            cont = linear(light.wavelengthNm, light.continuum, centre[i]);
+            cont = interpolateLinear(light.wavelengthNm, light.continuum, centre[i],
+                                     Outside::Clamp);
         }
         // Lines: the part of the line-spread function that falls on this pixel.
         double lines = 0.0;

@@ -4,27 +4,11 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/interpolate.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 
 namespace replica::pipeline::spectral {
-namespace {
-
-double interpolate(const std::vector<double>& x, const std::vector<double>& y, double at)
-{
-    if (x.size() < 2 || at < x.front() || at > x.back()) {
-        return 0.0;
-    }
-    const auto it = std::upper_bound(x.begin(), x.end(), at);
-    if (it == x.end()) {
-        return y.back();
-    }
-    const auto i = static_cast<std::size_t>(it - x.begin());
-    const double t = (at - x[i - 1]) / (x[i] - x[i - 1]);
-    return y[i - 1] + t * (y[i] - y[i - 1]);
-}
-
-} // namespace
 
 Expected<SpectrometerCalibration> loadSpectrometerCalibration(const std::filesystem::path& path)
 {
@@ -135,7 +119,8 @@ Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
         }
     }
     for (std::size_t i = 0; i < s.value.size(); ++i) {
-        const double r = interpolate(cal.wavelengthNm, cal.responsivity, s.wavelengthNm[i]);
+        const double r = interpolateLinear(cal.wavelengthNm, cal.responsivity, s.wavelengthNm[i],
+                                           Outside::Zero);
         s.value[i] = r > 1e-9 ? s.value[i] / (seconds * r) : 0.0;
     }
     return colour::resampleToWorkingGrid(s, "spectrometer");
