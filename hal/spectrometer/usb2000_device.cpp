@@ -1,6 +1,7 @@
 // USB2000+ device session over a UsbTransport.
 #include <algorithm>
 #include <chrono>
+#include <span>
 #include <thread>
 
 #include <fmt/format.h>
@@ -114,17 +115,24 @@ Expected<void> Usb2000Device::readCalibration()
         return tl::unexpected(serial.error());
     }
     calibration_.serial = usb2000::slotText(*serial);
-    for (int i = 0; i < 4; ++i) {
-        const auto slot = static_cast<std::uint8_t>(usb2000::kSlotWavelength0 + i);
-        auto data = querySlot(slot);
-        if (!data) {
-            return tl::unexpected(data.error());
+    // Slots first, first + 1, ... as numbers into out[0], out[1], ...
+    const auto numbers = [this](int first, std::span<double> out) -> Expected<void> {
+        for (std::size_t i = 0; i < out.size(); ++i) {
+            const auto slot = static_cast<std::uint8_t>(first + static_cast<int>(i));
+            auto data = querySlot(slot);
+            if (!data) {
+                return tl::unexpected(data.error());
+            }
+            auto value = usb2000::slotNumber(*data, slot);
+            if (!value) {
+                return tl::unexpected(value.error());
+            }
+            out[i] = *value;
         }
-        auto value = usb2000::slotNumber(*data, slot);
-        if (!value) {
-            return tl::unexpected(value.error());
-        }
-        calibration_.wavelengthCoeffs[static_cast<std::size_t>(i)] = *value;
+        return {};
+    };
+    if (auto ok = numbers(usb2000::kSlotWavelength0, calibration_.wavelengthCoeffs); !ok) {
+        return ok;
     }
     auto orderData = querySlot(usb2000::kSlotNonlinearityOrder);
     if (!orderData) {
@@ -139,17 +147,12 @@ Expected<void> Usb2000Device::readCalibration()
     }
     calibration_.nonlinearityOrder = static_cast<int>(*order);
     calibration_.nonlinearityCoeffs.fill(0.0);
-    for (int i = 0; i <= calibration_.nonlinearityOrder; ++i) {
-        const auto slot = static_cast<std::uint8_t>(usb2000::kSlotNonlinearity0 + i);
-        auto data = querySlot(slot);
-        if (!data) {
-            return tl::unexpected(data.error());
-        }
-        auto value = usb2000::slotNumber(*data, slot);
-        if (!value) {
-            return tl::unexpected(value.error());
-        }
-        calibration_.nonlinearityCoeffs[static_cast<std::size_t>(i)] = *value;
+    if (auto ok = numbers(
+                usb2000::kSlotNonlinearity0,
+                std::span(calibration_.nonlinearityCoeffs)
+                        .first(static_cast<std::size_t>(calibration_.nonlinearityOrder) + 1));
+        !ok) {
+        return ok;
     }
     auto sat = querySlot(usb2000::kSlotSaturation);
     if (!sat) {
