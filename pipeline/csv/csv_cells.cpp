@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <sstream>
 
 #include <pipeline/csv/csv_cells.h>
 
@@ -103,6 +104,24 @@ bool parseFiniteNumber(std::string_view cell, double& v)
     }
     v = parsed;
     return true;
+}
+
+std::vector<CsvLine> csvLines(const std::string& text)
+{
+    std::vector<CsvLine> out;
+    std::istringstream in(text);
+    std::string raw;
+    int number = 0;
+    while (std::getline(in, raw)) {
+        ++number;
+        std::string line = trimCell(raw);
+        if (line.empty() || line[0] == '#') {
+            continue;
+        }
+        auto cells = splitCsvRow(line);
+        out.push_back({number, std::move(line), std::move(cells)});
+    }
+    return out;
 }
 
 } // namespace replica::pipeline::csv

@@ -26,4 +26,16 @@ std::vector<std::string> splitCsvRow(std::string_view line);
 // same files), and hexadecimal, "inf" and "nan" are refused. 'v' is written only on success.
 bool parseFiniteNumber(std::string_view cell, double& v);
 
+// One data line of a CSV text: its 1-based line number, the line trimmed (trimCell) and its
+// cells (splitCsvRow).
+struct CsvLine {
+    int number = 0;
+    std::string text;
+    std::vector<std::string> cells;
+};
+
+// The data lines of 'text' (lines end at '\n'): each line trimmed, blank lines and '#' comment
+// lines left out.
+std::vector<CsvLine> csvLines(const std::string& text);
+
 } // namespace replica::pipeline::csv

@@ -17,18 +17,9 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
 {
     MeasurementSet set;
     set.source = source;
-    std::istringstream in(text);
-    std::string raw;
-    int lineNo = 0;
     bool header = false;
     double maxSeen = 0.0;
-    while (std::getline(in, raw)) {
-        ++lineNo;
-        const std::string line = csv::trimCell(raw);
-        if (line.empty() || line[0] == '#') {
-            continue;
-        }
-        const auto cells = csv::splitCsvRow(line);
+    for (const auto& [lineNo, line, cells] : csv::csvLines(text)) {
         if (!header) {
             const std::vector<std::string> want{"R", "G", "B", "X", "Y", "Z"};
             if (cells != want) {

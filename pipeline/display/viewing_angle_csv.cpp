@@ -15,20 +15,11 @@ namespace replica::pipeline::display {
 Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const std::string& source)
 {
     ViewingAngleTable t;
-    std::istringstream in(text);
-    std::string raw;
-    int lineNo = 0;
     bool header = false;
     double x0 = 0.0;
     double y0 = 0.0;
     double lum0 = 0.0;
-    while (std::getline(in, raw)) {
-        ++lineNo;
-        const std::string line = csv::trimCell(raw);
-        if (line.empty() || line[0] == '#') {
-            continue;
-        }
-        const auto cells = csv::splitCsvRow(line);
+    for (const auto& [lineNo, line, cells] : csv::csvLines(text)) {
         if (!header) {
             if (cells != std::vector<std::string>{"angle_deg", "X", "Y", "Z"}) {
                 return makeError(ErrorCode::Corrupt,

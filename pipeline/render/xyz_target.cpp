@@ -72,12 +72,7 @@ shading::XyzFrame XyzTarget::read(const shading::PreparedLight& light,
         }
     }
     if (light.light != nullptr) {
-        const booth::BoothLight& bl = *light.light;
-        const shading::Vec3 n = view.panel.normal;
-        f.whiteY = shading::pointLightIrradiance(light.points, bl.normal(), bl.texelAreaM2(),
-                                                 view.panel.centre, n, n, nullptr, 0, 0,
-                                                 view.panel.right, view.panel.up, 0.0) /
-                   std::numbers::pi;
+        f.whiteY = shading::panelWhiteY(light, view.panel, false);
         f.whiteXyz = light.white * f.whiteY;
     }
     return f;
