@@ -8,11 +8,8 @@ node_dir="$3"
 work="$4"
 here="$(cd "$(dirname "$0")" && pwd)"
 rm -rf "$work" && mkdir -p "$work"
-export NODE_PATH="$node_dir/node_modules"
-if [ ! -f "$NODE_PATH/@mcap/core/package.json" ]; then
-    echo "SKIP: @mcap/core is not available (interop.install_mcap_core says why; deploy/install-deps installs it)" >&2
-    exit 77
-fi
+# shellcheck source=need_mcap_core.sh
+source "$here/need_mcap_core.sh"
 
 check() {
     local rec="$1" name

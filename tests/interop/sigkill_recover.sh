@@ -9,11 +9,8 @@ work="$3"
 kills="${4:-4}"
 here="$(cd "$(dirname "$0")" && pwd)"
 rm -rf "$work" && mkdir -p "$work"
-export NODE_PATH="$node_dir/node_modules"
-if [ ! -f "$NODE_PATH/@mcap/core/package.json" ]; then
-    echo "SKIP: @mcap/core is not available (interop.install_mcap_core says why; deploy/install-deps installs it)" >&2
-    exit 77
-fi
+# shellcheck source=need_mcap_core.sh
+source "$here/need_mcap_core.sh"
 flush_ms=200
 slack_ms=1000 # a loaded 2-core CI machine may delay the writer thread
 for k in $(seq "$kills"); do
