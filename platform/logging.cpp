@@ -36,8 +36,17 @@ std::optional<spdlog::level::level_enum> parseLevel(const std::string& name)
     return level;
 }
 
-void applySpec(const std::string& spec)
+// One item of a --log-level spec ("level" for every area, or "name=level"; items are comma
+// separated, empty ones skipped).
+struct SpecItem {
+    std::string text;
+    std::optional<std::string> name; // none: every area
+    std::string level;
+};
+
+std::vector<SpecItem> specItems(const std::string& spec)
 {
+    std::vector<SpecItem> items;
     std::istringstream in(spec);
     std::string item;
     while (std::getline(in, item, ',')) {
@@ -46,12 +55,25 @@ void applySpec(const std::string& spec)
         }
         const auto eq = item.find('=');
         if (eq == std::string::npos) {
-            const auto level = *parseLevel(item);
+            items.push_back({item, std::nullopt, item});
+        } else {
+            items.push_back({item, item.substr(0, eq), item.substr(eq + 1)});
+        }
+    }
+    return items;
+}
+
+// 'spec' has passed checkLogSpec.
+void applySpec(const std::string& spec)
+{
+    for (const auto& item : specItems(spec)) {
+        const auto level = *parseLevel(item.level);
+        if (!item.name) {
             for (const char* area : kAreas) {
                 logger(area)->set_level(level);
             }
         } else {
-            logger(item.substr(0, eq))->set_level(*parseLevel(item.substr(eq + 1)));
+            logger(*item.name)->set_level(level);
         }
     }
 }
@@ -103,23 +125,16 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
 
 std::string checkLogSpec(const std::string& spec)
 {
-    std::istringstream in(spec);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        if (item.empty()) {
-            continue;
-        }
-        const auto eq = item.find('=');
-        const std::string level = eq == std::string::npos ? item : item.substr(eq + 1);
-        if (eq == 0) {
+    for (const auto& item : specItems(spec)) {
+        if (item.name && item.name->empty()) {
             return fmt::format("'{}' names no logger; write 'name=level', e.g. hal.tracker=debug",
-                               item);
+                               item.text);
         }
-        if (!parseLevel(level)) {
+        if (!parseLevel(item.level)) {
             return fmt::format("unknown log level '{}'; use one of trace, debug, info, warn, "
                                "error, critical, off (for all loggers, or per logger as "
                                "'hal.tracker=debug,rec=info')",
-                               level);
+                               item.level);
         }
     }
     return {};
