@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <tests/benchmarks/flat_renderer_setup.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/display/display_inverse.h>
@@ -122,20 +123,13 @@ Gpu* gpu()
         }
         fx->output = std::move(*out);
         for (int v = 0; v < 3; ++v) {
-            pipeline::render::GlesRendererSetup s;
-            s.width = 960;
-            s.height = 600;
-            s.booth = *pipeline::scene::loadDefaultBooth(dataDir().string());
-            s.basis = pipeline::colour::boxBasis();
-            s.observer = *pipeline::colour::loadCie1931(dataDir());
-            s.surface = *pipeline::render::makeColorCheckerSurface(dataDir().string(), s.basis, 600,
-                                                                   400);
+            pipeline::render::GlesRendererSetup s = bench::flatColorCheckerSetup();
             s.display.model = profile();
             s.display.method = v == 1 ? pipeline::render::InverseMethod::Lut3d
                                       : pipeline::render::InverseMethod::Analytic;
             s.display.flareSubtraction = v != 2;
             s.display.viewingCompensation = v != 2;
-            fx->state.illuminant = s.booth.lights[0].referenceSpectrum;
+            fx->state = bench::flatState(s);
             auto r = pipeline::render::createGlesRenderer(std::move(s));
             if (!r) {
                 std::fprintf(stderr, "renderer: %s\n", r.error().message.c_str());
@@ -143,8 +137,6 @@ Gpu* gpu()
             }
             fx->renderers.push_back(std::move(*r));
         }
-        fx->state.emitterLuminanceCdM2 = 2200.0;
-        fx->state.tiltRad = 0.35;
         return fx;
     }();
     return g;

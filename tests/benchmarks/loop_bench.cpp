@@ -13,6 +13,7 @@
 
 #include <benchmark/benchmark.h>
 #include <state/tilt_estimator.h>
+#include <tests/benchmarks/flat_renderer_setup.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/booth/booth_model.h>
@@ -184,18 +185,9 @@ FlatFixture* flatFixture()
             return fx;
         }
         fx->output = std::move(*out);
-        pipeline::render::GlesRendererSetup s;
-        s.width = 960;
-        s.height = 600;
-        s.booth = *pipeline::scene::loadDefaultBooth(dataDir().string());
-        s.basis = pipeline::colour::boxBasis();
-        s.observer = *pipeline::colour::loadCie1931(dataDir());
-        s.surface =
-                *pipeline::render::makeColorCheckerSurface(dataDir().string(), s.basis, 600, 400);
+        pipeline::render::GlesRendererSetup s = bench::flatColorCheckerSetup();
         s.display.model = pipeline::display::nominalDisplayModel("srgb-like-800", 800.0, 0.4);
-        fx->state.illuminant = s.booth.lights[0].referenceSpectrum;
-        fx->state.emitterLuminanceCdM2 = 2200.0;
-        fx->state.tiltRad = 0.35;
+        fx->state = bench::flatState(s);
         auto r = pipeline::render::createGlesRenderer(std::move(s));
         if (r) {
             fx->renderer = std::move(*r);
