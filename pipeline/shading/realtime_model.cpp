@@ -66,11 +66,31 @@ double horizonVisibility(const surface::HorizonMap* horizon,
 // light's direction in the macro tangent frame (right, up, nGeo), its horizon softness
 // (lightSoftness) and the horizon test at the texel or, with 'at', bilinear at that fractional
 // texel position. 1 without a horizon map (what horizonVisibility returns there).
+// sp with its facet normal set to the macro normal: eq. (1) without the relief.
+ShadingPoint withMacroNormal(ShadingPoint sp)
+{
+    sp.nShade = sp.nGeo;
+    return sp;
+}
+
 struct ReliefLightVisibility {
+    // The horizon at sp: its texel's, or with 'bilinear' the bilinear one at (texX, texY)
+    // (RenderSettings::horizonBilinear).
+    ReliefLightVisibility(const ShadingPoint& sp,
+                          const surface::HorizonMap* map,
+                          bool bilinear,
+                          double texelArea,
+                          double horizonSoftness)
+        : horizon(map), tx(sp.tx), ty(sp.ty),
+          at(bilinear ? std::optional<glm::dvec2>({sp.texX, sp.texY}) : std::nullopt),
+          right(sp.right), up(sp.up), nGeo(sp.nGeo), texelAreaM2(texelArea),
+          softness(horizonSoftness)
+    {}
+
     const surface::HorizonMap* horizon;
     int tx;
     int ty;
-    const std::optional<glm::dvec2>& at;
+    std::optional<glm::dvec2> at;
     const Vec3& right;
     const Vec3& up;
     const Vec3& nGeo;
@@ -157,19 +177,15 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
 double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             const Vec3& lightNormal,
                             double texelAreaM2,
-                            const Vec3& p,
-                            const Vec3& nGeo,
-                            const Vec3& nShade,
+                            const ShadingPoint& sp,
                             const surface::HorizonMap* horizon,
-                            int tx,
-                            int ty,
-                            const Vec3& right,
-                            const Vec3& up,
                             double softness,
-                            const std::optional<glm::dvec2>& bilinearAt)
+                            bool bilinear)
 {
-    const ReliefLightVisibility vis{horizon, tx,   ty,          bilinearAt, right,
-                                    up,      nGeo, texelAreaM2, softness};
+    const Vec3& p = sp.p;
+    const Vec3& nGeo = sp.nGeo;
+    const Vec3& nShade = sp.nShade;
+    const ReliefLightVisibility vis(sp, horizon, bilinear, texelAreaM2, softness);
     double e = 0.0;
     for (const booth::PointLight& l : lights) {
         Vec3 d = l.position - p;
@@ -258,26 +274,19 @@ double regionIrradiance(const booth::PointLight& region,
 double areaLightIrradiance(const std::vector<booth::PointLight>& lights,
                            const Vec3& lightNormal,
                            double texelAreaM2,
-                           const Vec3& p,
-                           const Vec3& nGeo,
-                           const Vec3& nShade,
+                           const ShadingPoint& sp,
                            const surface::HorizonMap* horizon,
-                           int tx,
-                           int ty,
-                           const Vec3& right,
-                           const Vec3& up,
                            double softness,
-                           const std::optional<glm::dvec2>& bilinearAt)
+                           bool bilinear)
 {
-    const ReliefLightVisibility vis{horizon, tx,   ty,          bilinearAt, right,
-                                    up,      nGeo, texelAreaM2, softness};
+    const ReliefLightVisibility vis(sp, horizon, bilinear, texelAreaM2, softness);
     double e = 0.0;
     for (const booth::PointLight& l : lights) {
-        const double er = regionIrradiance(l, lightNormal, p, nGeo, nShade);
+        const double er = regionIrradiance(l, lightNormal, sp.p, sp.nGeo, sp.nShade);
         if (!(er > 0.0)) {
             continue;
         }
-        e += er * vis.towards(l, p);
+        e += er * vis.towards(l, sp.p);
     }
     return e;
 }
@@ -285,33 +294,26 @@ double areaLightIrradiance(const std::vector<booth::PointLight>& lights,
 double panelWhiteY(const PreparedLight& light, const PanelPose& panel, bool areaLights)
 {
     const booth::BoothLight& bl = *light.light;
-    const Vec3 n = panel.normal;
-    const double e = areaLights ? areaLightIrradiance(light.points, bl.normal(), bl.texelAreaM2(),
-                                                      panel.centre, n, n, nullptr, 0, 0,
-                                                      panel.right, panel.up, 0.0)
-                                : pointLightIrradiance(light.points, bl.normal(), bl.texelAreaM2(),
-                                                       panel.centre, n, n, nullptr, 0, 0,
-                                                       panel.right, panel.up, 0.0);
-    return e / std::numbers::pi;
+    const ShadingPoint centre{panel.centre, panel.normal, panel.normal, panel.right, panel.up};
+    const auto irradiance = areaLights ? areaLightIrradiance : pointLightIrradiance;
+    return irradiance(light.points, bl.normal(), bl.texelAreaM2(), centre, nullptr, 0.0, false) /
+           std::numbers::pi;
 }
 
 double filteredSpecular(const PreparedLight& light,
-                        const Vec3& p,
-                        const Vec3& nGeo,
-                        const Vec3& nShade,
+                        const ShadingPoint& sp,
                         const Vec3& toEye,
                         brdf::WardModel model,
                         double alpha,
                         int samples,
                         const surface::HorizonMap* horizon,
-                        int tx,
-                        int ty,
-                        const Vec3& right,
-                        const Vec3& up,
                         double softness,
                         double lodBias,
                         bool nearestLevel)
 {
+    const Vec3& p = sp.p;
+    const Vec3& nGeo = sp.nGeo;
+    const Vec3& nShade = sp.nShade;
     const booth::BoothLight& bl = *light.light;
     const Vec3 nl = bl.normal();
     const double a = bl.texelAreaM2();
@@ -325,8 +327,8 @@ double filteredSpecular(const PreparedLight& light,
     double lobeSinB = 0.0;
     if (horizon != nullptr && horizon->directions > 0) {
         const Vec3 mirror = 2.0 * glm::dot(nShade, toEye) * nShade - toEye;
-        lobeSinB = horizon->sinHorizon(tx, ty,
-                                       Vec3(glm::dot(mirror, right), glm::dot(mirror, up), 0.0));
+        lobeSinB = horizon->sinHorizon(
+                sp.tx, sp.ty, Vec3(glm::dot(mirror, sp.right), glm::dot(mirror, sp.up), 0.0));
     }
     // The ceiling's plane and axes from p, once (the shader hoists them out of its loop too).
     const Vec3 pc = p - bl.centre;
@@ -472,10 +474,9 @@ XyzFrame renderRealtime(const PreparedScene& ps,
         return eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
     };
     const auto specularAt = [&](const ShadingPoint& sp, const Vec3& toEye) {
-        return filteredSpecular(light, sp.p, sp.nGeo, sp.nShade, toEye, scene.model, scene.alpha,
-                                settings.specularSamples, horizon, sp.tx, sp.ty, sp.right, sp.up,
-                                settings.horizonSoftness, settings.specularLodBias,
-                                settings.specularNearestLevel);
+        return filteredSpecular(light, sp, toEye, scene.model, scene.alpha,
+                                settings.specularSamples, horizon, settings.horizonSoftness,
+                                settings.specularLodBias, settings.specularNearestLevel);
     };
 
     // The specular grid, when used: every node first (as the GL pass's mode 2 does).
@@ -509,8 +510,8 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                     const ShadingPoint sp = shadingPointAt(
                             view, scene, normals, static_cast<double>(i) / (diffuseNodes.x - 1),
                             static_cast<double>(j) / (diffuseNodes.y - 1));
-                    const double e = diffuse(points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr, 0, 0,
-                                             sp.right, sp.up, 0.0, std::nullopt);
+                    const double e =
+                            diffuse(points, nl, a, withMacroNormal(sp), nullptr, 0.0, false);
                     diffuseGrid[static_cast<std::size_t>(j) *
                                         static_cast<std::size_t>(diffuseNodes.x) +
                                 static_cast<std::size_t>(i)] = std::isfinite(e) ? e : 0.0;
@@ -533,15 +534,11 @@ XyzFrame renderRealtime(const PreparedScene& ps,
                         diffuseNodes.x > 0
                                 ? gridValue(diffuseGrid, diffuseNodes, (px + 0.5) / view.pixelsX,
                                             (py + 0.5) / view.pixelsY)
-                                : diffuse(points, nl, a, sp.p, sp.nGeo, sp.nGeo, nullptr, 0, 0,
-                                          sp.right, sp.up, 0.0, std::nullopt);
+                                : diffuse(points, nl, a, withMacroNormal(sp), nullptr, 0.0, false);
                 double e = eGeo;
                 if (relief) {
-                    e = diffuse(points, nl, a, sp.p, sp.nGeo, sp.nShade, horizon, sp.tx, sp.ty,
-                                sp.right, sp.up, settings.horizonSoftness,
-                                settings.horizonBilinear
-                                        ? std::optional<glm::dvec2>({sp.texX, sp.texY})
-                                        : std::nullopt);
+                    e = diffuse(points, nl, a, sp, horizon, settings.horizonSoftness,
+                                settings.horizonBilinear);
                 }
                 if (!settings.diffusePass) {
                     e = 0.0;

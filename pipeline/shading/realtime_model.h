@@ -226,25 +226,20 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
                            double horizonDistanceM = 0.01,
                            const colour::ChannelBasis& basis = colour::boxBasis());
 
-// Diffuse illuminance from point lights (eq. 1): both cosines clamped at 0, 1/d^2 clamped at one
-// texel area; vis(light direction) in [0, 1] multiplies each light: a smoothstep across the
-// relief's horizon whose half-width is 'softness' or sqrt(3) times the spread of the light's
-// elevation sine over its ceiling region (booth::PointLight::spreadU/V), whichever is wider.
-// The horizon is the texel (tx, ty)'s, or with bilinearAt the bilinear one at that fractional
-// texel position (RenderSettings::horizonBilinear).
+// Diffuse illuminance from point lights (eq. 1) at the shading point sp (its position p, macro
+// normal nGeo and facet normal nShade): both cosines clamped at 0, 1/d^2 clamped at one texel
+// area; vis(light direction) in [0, 1] multiplies each light: a smoothstep across the relief's
+// horizon whose half-width is 'softness' or sqrt(3) times the spread of the light's elevation sine
+// over its ceiling region (booth::PointLight::spreadU/V), whichever is wider. The horizon (none
+// when null) is the texel (sp.tx, sp.ty)'s, or with 'bilinear' the bilinear one at (sp.texX,
+// sp.texY) (RenderSettings::horizonBilinear), its azimuths in sp's frame (right, up).
 double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             const Vec3& lightNormal,
                             double texelAreaM2,
-                            const Vec3& p,
-                            const Vec3& nGeo,
-                            const Vec3& nShade,
-                            const surface::HorizonMap* horizon,
-                            int tx,
-                            int ty,
-                            const Vec3& right,
-                            const Vec3& up,
-                            double softness,
-                            const std::optional<glm::dvec2>& bilinearAt = std::nullopt);
+                            const ShadingPoint& sp,
+                            const surface::HorizonMap* horizon = nullptr,
+                            double softness = 0.0,
+                            bool bilinear = false);
 
 // The area-light diffuse term (RenderSettings::areaLights), one function per equation. Vertices
 // are vectors from the shading point to the polygon's corners, in order.
@@ -284,37 +279,26 @@ double regionIrradiance(const booth::PointLight& region,
 double areaLightIrradiance(const std::vector<booth::PointLight>& lights,
                            const Vec3& lightNormal,
                            double texelAreaM2,
-                           const Vec3& p,
-                           const Vec3& nGeo,
-                           const Vec3& nShade,
-                           const surface::HorizonMap* horizon,
-                           int tx,
-                           int ty,
-                           const Vec3& right,
-                           const Vec3& up,
-                           double softness,
-                           const std::optional<glm::dvec2>& bilinearAt = std::nullopt);
+                           const ShadingPoint& sp,
+                           const surface::HorizonMap* horizon = nullptr,
+                           double softness = 0.0,
+                           bool bilinear = false);
 
 // Y of a perfect white diffuser at the panel's centre under the light (XyzFrame::whiteY): eq. (1)
 // from areas or from points as the settings say.
 double panelWhiteY(const PreparedLight& light, const PanelPose& panel, bool areaLights);
 
-// Specular radiance (cd/m^2, rho_s = 1) by FIS with N Hammersley samples (u1 = (k + 1/2) / N).
-// The horizon shadows the lobe with one sine, read at the mirror direction's azimuth; each sample
-// is tested against it at its own elevation.
+// Specular radiance (cd/m^2, rho_s = 1) at sp, seen along toEye, by FIS with N Hammersley samples
+// (u1 = (k + 1/2) / N). The horizon (none when null) shadows the lobe with one sine, read at the
+// texel (sp.tx, sp.ty) at the mirror direction's azimuth; each sample is tested against it at its
+// own elevation.
 double filteredSpecular(const PreparedLight& light,
-                        const Vec3& p,
-                        const Vec3& nGeo,
-                        const Vec3& nShade,
+                        const ShadingPoint& sp,
                         const Vec3& toEye,
                         brdf::WardModel model,
                         double alpha,
                         int samples,
                         const surface::HorizonMap* horizon,
-                        int tx,
-                        int ty,
-                        const Vec3& right,
-                        const Vec3& up,
                         double softness,
                         double lodBias,
                         bool nearestLevel);

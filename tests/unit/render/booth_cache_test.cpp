@@ -189,9 +189,9 @@ TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
                                     panel.up * ((0.5 - v) * setup_.scene.heightM);
             const auto irradiance = setup_.settings.areaLights ? shading::areaLightIrradiance
                                                                : shading::pointLightIrradiance;
-            const double e = irradiance(light.points, bl.normal(), bl.texelAreaM2(), p,
-                                        panel.normal, panel.normal, nullptr, 0, 0, panel.right,
-                                        panel.up, 0.0, std::nullopt);
+            const double e = irradiance(light.points, bl.normal(), bl.texelAreaM2(),
+                                        {p, panel.normal, panel.normal, panel.right, panel.up},
+                                        nullptr, 0.0, false);
             const float got = px[(static_cast<std::size_t>(y) * kCacheW + x) * 4 + 3];
             ASSERT_GT(e, 0.0);
             worst = std::max(worst, std::abs(got - e) / e);

@@ -112,8 +112,8 @@ TEST(PointLights, HotTexelEqualsThePointSourceFormula)
     const double expected =
             2.0e6 * light.texelAreaM2() * glm::dot(n, i) * glm::dot(light.normal(), -i) / d2;
     const double e =
-            shading::pointLightIrradiance(prepared.points, light.normal(), light.texelAreaM2(), p,
-                                          n, n, nullptr, 0, 0, Vec3(1, 0, 0), Vec3(0, 0, -1), 0.0);
+            shading::pointLightIrradiance(prepared.points, light.normal(), light.texelAreaM2(),
+                                          {p, n, n, Vec3(1, 0, 0), Vec3(0, 0, -1)});
     EXPECT_NEAR(e, expected, 1e-9 * expected);
     // The point light's intensity is L * a of the texel (the flat renderer's uniform grid gives
     // the same field): the one whose region holds the hot texel carries at least it.
@@ -166,9 +166,9 @@ TEST(PointLights, ThirtyTwoLightsAreWithinTheMeasuredErrorOfTheReference)
     for (int a = 0; a < 9; ++a) {
         for (int b = 0; b < 7; ++b) {
             const Vec3 p(-0.2 + 0.05 * a, 0.0, -0.15 + 0.05 * b);
-            const double e = shading::pointLightIrradiance(prepared.points, light.normal(),
-                                                           light.texelAreaM2(), p, n, n, nullptr, 0,
-                                                           0, Vec3(1, 0, 0), Vec3(0, 0, -1), 0.0);
+            const double e = shading::pointLightIrradiance(
+                    prepared.points, light.normal(), light.texelAreaM2(),
+                    {p, n, n, Vec3(1, 0, 0), Vec3(0, 0, -1)});
             const double r =
                     reference::integrateTexels(cloud, p, n, n, n, brdf::WardModel::WardDur, 0.1,
                                                false, nullptr, Vec3(1, 0, 0), Vec3(0, 0, -1))
@@ -429,8 +429,8 @@ TEST(RealtimeModel, SpecularLobeIsShadowedByTheHorizonAtItsMirrorAzimuth)
     map.width = map.height = 1;
     map.directions = 8;
     const auto specular = [&](const surface::HorizonMap* h) {
-        return shading::filteredSpecular(pl, p, n, n, toEye, brdf::WardModel::WardDurGuarded, 0.1,
-                                         48, h, 0, 0, right, up, 0.02,
+        return shading::filteredSpecular(pl, {p, n, n, right, up}, toEye,
+                                         brdf::WardModel::WardDurGuarded, 0.1, 48, h, 0.02,
                                          shading::kDefaultSpecularLodBias, true);
     };
     const double unshadowed = specular(nullptr);
