@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/common.hpp>
 #include <glm/matrix.hpp>
 
 #include <pipeline/display/display_inverse.h>
@@ -63,12 +64,30 @@ double DisplayInverse::countsFromLinear(int channel, double r, ToneInverse tone)
 
 InverseResult DisplayInverse::invert(const glm::dvec3& xyz, GamutMode mode, ToneInverse tone) const
 {
-    const MappedLinear m = mapToGamut(geometry_, xyz, mode);
     InverseResult out;
-    out.linear = m.r;
+    if (model_.hasCrosstalk()) {
+        // With crosstalk the gamut is the cube in r, not in y = M^-1 (XYZ - black): a colour
+        // whose r (the crosstalk undone) lies in [0, 1]^3 is in gamut as it is. (The uniform
+        // loss puts some colours the panel makes a hair outside the y cube.)
+        const glm::dvec3 r =
+                model_.deinteracted(geometry_.xyzToLinear * (xyz - geometry_.blackXyz), false);
+        constexpr double kTol = 1e-9; // mapToGamut's
+        if (r.x >= -kTol && r.y >= -kTol && r.z >= -kTol && r.x <= 1.0 + kTol &&
+            r.y <= 1.0 + kTol && r.z <= 1.0 + kTol && xyz.y >= geometry_.blackY) {
+            out.linear = glm::clamp(r, 0.0, 1.0);
+            for (int c = 0; c < 3; ++c) {
+                out.counts[c] = countsFromLinear(c, out.linear[c], tone);
+            }
+            return out;
+        }
+    }
+    const MappedLinear m = mapToGamut(geometry_, xyz, mode);
+    // The mapping works on the additive part, y = M^-1 (XYZ - black); the crosstalk is undone
+    // after it (C = 0: r = y).
+    out.linear = model_.deinteracted(m.r);
     out.gamutClass = m.gamutClass;
     for (int c = 0; c < 3; ++c) {
-        out.counts[c] = countsFromLinear(c, m.r[c], tone);
+        out.counts[c] = countsFromLinear(c, out.linear[c], tone);
     }
     return out;
 }

@@ -1,6 +1,8 @@
 // The inverse display model: absolute XYZ -> real-valued counts, by the analytic path (M^-1, then
 // per-channel inverse tone curves tabulated densely in the cube-root domain) with hue-keeping
-// gamut mapping, and a 3-D LUT alternative kept for comparison (docs/display.md has both measured).
+// gamut mapping (on y = M^-1 (XYZ - black); a crosstalk term is then undone by fixed-point steps,
+// DisplayModel::deinteracted), and a 3-D LUT alternative kept for comparison (docs/display.md has
+// both measured).
 #pragma once
 
 #include <array>
@@ -21,7 +23,7 @@ enum class ToneInverse {
 
 struct InverseResult {
     glm::dvec3 counts{0.0}; // real-valued, in [0, maxCount], before quantisation
-    glm::dvec3 linear{0.0}; // r after gamut mapping
+    glm::dvec3 linear{0.0}; // r after gamut mapping (and the crosstalk undone)
     GamutClass gamutClass = GamutClass::InGamut;
     bool inGamut() const { return gamutClass == GamutClass::InGamut; }
 };

@@ -3,6 +3,7 @@
 #include <numbers>
 
 #include <fmt/format.h>
+#include <glm/common.hpp>
 #include <glm/matrix.hpp>
 
 #include <pipeline/display/display_model.h>
@@ -19,9 +20,36 @@ glm::dvec3 DisplayModel::linearFromCounts(const glm::dvec3& counts) const
     return {tone[0](counts.x), tone[1](counts.y), tone[2](counts.z)};
 }
 
+glm::dvec3 crosstalkProducts(const glm::dvec3& r)
+{
+    return {r.x * r.y, r.y * r.z, r.z * r.x};
+}
+
+glm::dvec3 DisplayModel::interacted(const glm::dvec3& r) const
+{
+    return hasCrosstalk() ? r + crosstalk * crosstalkProducts(r) : r;
+}
+
+glm::dvec3 DisplayModel::deinteracted(const glm::dvec3& y, bool clamp) const
+{
+    if (!hasCrosstalk()) {
+        return y;
+    }
+    // |d(C p)/dr| <= 2 kMaxCrosstalk per row inside the cube: each step shrinks the error at least
+    // 2.5-fold (by about 100-fold at a real panel's 0.5 %).
+    glm::dvec3 r = clamp ? glm::clamp(y, 0.0, 1.0) : y;
+    for (int i = 0; i < kCrosstalkSteps; ++i) {
+        r = y - crosstalk * crosstalkProducts(r);
+        if (clamp) {
+            r = glm::clamp(r, 0.0, 1.0);
+        }
+    }
+    return r;
+}
+
 glm::dvec3 DisplayModel::forward(const glm::dvec3& counts) const
 {
-    return blackXyz + matrix * linearFromCounts(counts);
+    return blackXyz + matrix * interacted(linearFromCounts(counts));
 }
 
 Expected<void> DisplayModel::validate() const
@@ -61,6 +89,19 @@ Expected<void> DisplayModel::validate() const
                          fmt::format("display profile '{}': front-surface reflectance {} is "
                                      "outside [0, 0.2)",
                                      name, frontSurfaceReflectance));
+    }
+    for (int row = 0; row < 3; ++row) {
+        double sum = 0.0;
+        for (int col = 0; col < 3; ++col) {
+            sum += std::abs(crosstalk[col][row]);
+        }
+        if (!(sum <= kMaxCrosstalk)) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("display profile '{}': crosstalk row {} has absolute sum "
+                                         "{} (must be finite and at most {})",
+                                         name, kNames[static_cast<std::size_t>(row)], sum,
+                                         kMaxCrosstalk));
+        }
     }
     return viewing.validate();
 }

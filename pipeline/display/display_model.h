@@ -1,5 +1,8 @@
 // The characterised display (Day, Taplin & Berns 2004): per-channel tone curves, a 3x3 primaries
-// matrix and a black/flare offset, XYZ = M r(d) + XYZ_k, in absolute cd/m^2.
+// matrix and a black/flare offset, XYZ = M r(d) + XYZ_k, in absolute cd/m^2; with channel
+// interaction (crosstalk) XYZ = XYZ_k + M (r + C p(r)), p = (r_R r_G, r_G r_B, r_B r_R): each pair
+// of driven channels changes each channel's light in proportion to the two drives' product (zero
+// on the single-channel ramps, largest at white). C = 0 is the additive model.
 #pragma once
 
 #include <array>
@@ -45,6 +48,10 @@ struct FitReport {
     double additivityNoiseDe00 = -1.0; // 99.9th percentile of the dE00 the noise alone gives
     bool additiveWithinNoise = false;
     double gamutEdgeSigma = -1.0; // 1 sigma of r at the gamut's corners (the fit's uncertainty)
+    // The crosstalk family cross-validation chose ("none", "uniform" or "full"; empty before it)
+    // and its held-out mean dE00 gain over the additive model.
+    std::string crosstalkModel;
+    double crosstalkGainDe00 = 0.0;
 };
 
 struct DisplayModel {
@@ -71,16 +78,34 @@ struct DisplayModel {
     // And its part that does not scale with the colour (black's uncertainty, in r): below 0 a
     // channel may reach -(gamutEdgeTolerance max r + gamutEdgeFloor).
     double gamutEdgeFloor = 0.0;
+    // Crosstalk C (columns: the r-space change per unit of r_R r_G, r_G r_B, r_B r_R); zero, the
+    // additive model, for profiles without "crosstalk". Each row's absolute sum is at most
+    // kMaxCrosstalk (validate), so the inverse's fixed point contracts.
+    glm::dmat3 crosstalk{0.0};
+    static constexpr double kMaxCrosstalk = 0.2;
 
     double maxCount() const;
+    // The additive white, black + M (1, 1, 1): the gamut mapping's peak (without crosstalk the
+    // panel's white; with it the white the panel would show without the interaction).
     glm::dvec3 whiteXyz() const { return blackXyz + matrix * glm::dvec3(1.0); }
+    bool hasCrosstalk() const { return crosstalk != glm::dmat3(0.0); }
     // r for real-valued counts.
     glm::dvec3 linearFromCounts(const glm::dvec3& counts) const;
+    // The channel drives with the interaction, r + C p(r): XYZ = black + M interacted(r).
+    glm::dvec3 interacted(const glm::dvec3& r) const;
+    // Its inverse: the r with interacted(r) = y, by kCrosstalkSteps fixed-point steps
+    // r <- y - C p(r) from r = y (the GLSL runs the same), each clamped to [0, 1] when 'clamp'
+    // (a mapped colour), unclamped otherwise (the in-gamut test); y itself when C = 0.
+    glm::dvec3 deinteracted(const glm::dvec3& y, bool clamp = true) const;
+    static constexpr int kCrosstalkSteps = 12;
     // Absolute XYZ on the panel normal for real-valued counts.
     glm::dvec3 forward(const glm::dvec3& counts) const;
     // Checks the invariants a loaded or fitted model must hold; fails with the reason.
     Expected<void> validate() const;
 };
+
+// (r_R r_G, r_G r_B, r_B r_R): the products the crosstalk matrix multiplies.
+glm::dvec3 crosstalkProducts(const glm::dvec3& r);
 
 // The screen's own diffuse reflection of the booth light reaching the eye: rho_d E / pi in the
 // light's colour (lightXyz scaled so that its Y is 1), zero when the profile was measured in the

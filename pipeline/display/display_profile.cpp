@@ -37,6 +37,7 @@ const JsonSchema& profileSchema()
     static const JsonSchema curve = object({{"counts", array(number(0.0, 1e6), 2, 65536)},
                                             {"r", array(number(-1e3, 1e3), 2, 65536)}});
     static const JsonSchema angles = array(number(-1e6, 1e6), 0, 4096);
+    static const JsonSchema crossCol = array(number(-1.0, 1.0), 3, 3);
     static const JsonSchema s = object({
             {"format", string(64)},
             {"version", integer(0, 1e6)},
@@ -57,6 +58,8 @@ const JsonSchema& profileSchema()
             {"fit", map(any(), 256).optional()},
             {"gamut_edge_tolerance", number(0.0, 0.05).optional()},
             {"gamut_edge_floor", number(0.0, 0.05).optional()},
+            {"crosstalk",
+             object({{"rg", crossCol}, {"gb", crossCol}, {"br", crossCol}}).optional()},
     });
     return s;
 }
@@ -91,6 +94,11 @@ std::string profileToJson(const DisplayModel& m)
         j["gamut_edge_tolerance"] = m.gamutEdgeTolerance;
         j["gamut_edge_floor"] = m.gamutEdgeFloor;
     }
+    if (m.hasCrosstalk()) {
+        j["crosstalk"] = {{"rg", vec3Json(m.crosstalk[0])},
+                          {"gb", vec3Json(m.crosstalk[1])},
+                          {"br", vec3Json(m.crosstalk[2])}};
+    }
     const auto& f = m.fit;
     j["fit"] = {{"training_colours", f.trainingColours},
                 {"held_out_colours", f.heldOutColours},
@@ -117,6 +125,10 @@ std::string profileToJson(const DisplayModel& m)
         jf["additivity_noise_de00"] = f.additivityNoiseDe00;
         jf["additive_within_noise"] = f.additiveWithinNoise;
         jf["gamut_edge_sigma"] = f.gamutEdgeSigma;
+        if (!f.crosstalkModel.empty()) {
+            jf["crosstalk_model"] = f.crosstalkModel;
+            jf["crosstalk_gain_de00"] = f.crosstalkGainDe00;
+        }
     }
     return j.dump(2) + "\n";
 }
@@ -155,6 +167,12 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
         m.blackXyz = vec3From(j.at("black_xyz_cd_m2"));
         m.gamutEdgeTolerance = j.value("gamut_edge_tolerance", 0.0);
         m.gamutEdgeFloor = j.value("gamut_edge_floor", 0.0);
+        if (j.contains("crosstalk")) {
+            // Absent (every profile before it): additive, C = 0.
+            const auto& x = j.at("crosstalk");
+            m.crosstalk =
+                    glm::dmat3(vec3From(x.at("rg")), vec3From(x.at("gb")), vec3From(x.at("br")));
+        }
         const auto& p = j.at("primaries_xyz_cd_m2");
         m.matrix = glm::dmat3(vec3From(p.at("r")), vec3From(p.at("g")), vec3From(p.at("b")));
         for (std::size_t c = 0; c < 3; ++c) {
@@ -209,6 +227,8 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
                 m.fit.additivityNoiseDe00 = f.value("additivity_noise_de00", -1.0);
                 m.fit.additiveWithinNoise = f.value("additive_within_noise", false);
                 m.fit.gamutEdgeSigma = f.value("gamut_edge_sigma", -1.0);
+                m.fit.crosstalkModel = f.value("crosstalk_model", std::string());
+                m.fit.crosstalkGainDe00 = f.value("crosstalk_gain_de00", 0.0);
             }
         }
     } catch (const std::exception& e) {

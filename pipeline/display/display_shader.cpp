@@ -24,6 +24,16 @@ DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse)
     p.whiteY = static_cast<float>(g.whiteY);
     p.gamutEdgeTolerance = static_cast<float>(g.edgeTolerance);
     p.gamutEdgeFloor = static_cast<float>(g.edgeFloor);
+    const DisplayModel& model = inverse.model();
+    if (model.hasCrosstalk()) {
+        for (int col = 0; col < 3; ++col) {
+            for (int row = 0; row < 3; ++row) {
+                p.crosstalk[static_cast<std::size_t>(col * 3 + row)] =
+                        static_cast<float>(model.crosstalk[col][row]);
+            }
+        }
+        p.crosstalkSteps = DisplayModel::kCrosstalkSteps;
+    }
     p.maxCount = static_cast<float>(m.maxCount());
     p.lutSize = inverse.lutSize();
     p.lut.reserve(static_cast<std::size_t>(p.lutSize - 1) * 3 * 2);

@@ -28,6 +28,11 @@ struct DisplayShaderParams {
     // unset uniform, is the mapping without it).
     float gamutEdgeTolerance = 0.0f;
     float gamutEdgeFloor = 0.0f; // uDispGamutEdgeFloor, likewise
+    // DisplayModel::crosstalk, column-major (uDispCrosstalk), and the fixed-point steps that undo
+    // it (uDispCrosstalkSteps): DisplayModel::kCrosstalkSteps, 0 (no loop, the additive pixels
+    // unchanged) without crosstalk.
+    std::array<float, 9> crosstalk{};
+    int crosstalkSteps = 0;
     float maxCount = 255.0f;
     // Inverse tone LUTs: entry j = counts / maxCount at r = (j / (lutSize - 1))^3 (the cube-root
     // domain keeps near-black precision), as a (lutSize - 1) x 3 RG32F texture: row c = channel c,

@@ -52,6 +52,7 @@ Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
                                          const std::filesystem::path& path)
 {
     IccWriteReport report;
+    report.crosstalkOmitted = model.hasCrosstalk();
     const glm::dvec3 white = model.whiteXyz();
     if (!(white.y > 0.0)) {
         return makeError(ErrorCode::InvalidArgument,

@@ -3,7 +3,9 @@
 // b = M^-1 XYZ_k (the black in channel units, all >= 0 when black's chromaticity lies inside the
 // primaries' triangle) it is XYZ = M diag(1 + b) TRC(d) with TRC_c = (r_c + b_c) / (1 + b_c), which
 // a matrix/TRC profile holds exactly. The colorants are adapted to the D50 PCS with Bradford (a
-// chad tag records it) and white's absolute luminance goes in the lumi tag.
+// chad tag records it) and white's absolute luminance goes in the lumi tag. A crosstalk term
+// (DisplayModel::crosstalk) does not fit the matrix/TRC form: the profile holds the additive part
+// (C = 0) and the report says so.
 #pragma once
 
 #include <filesystem>
@@ -18,6 +20,7 @@ namespace replica::pipeline::display {
 struct IccWriteReport {
     glm::dvec3 blackChannels{0.0}; // b = M^-1 XYZ_k
     bool blackClipped = false;     // some b_c < 0 was set to 0 (black outside the triangle)
+    bool crosstalkOmitted = false; // the model's crosstalk term is not in the profile
 };
 
 Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,

@@ -164,6 +164,9 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     glUniform1f(glGetUniformLocation(program_.get(), "uDispGamutEdgeTolerance"),
                 params.gamutEdgeTolerance);
     glUniform1f(glGetUniformLocation(program_.get(), "uDispGamutEdgeFloor"), params.gamutEdgeFloor);
+    glUniformMatrix3fv(glGetUniformLocation(program_.get(), "uDispCrosstalk"), 1, GL_FALSE,
+                       params.crosstalk.data());
+    glUniform1i(glGetUniformLocation(program_.get(), "uDispCrosstalkSteps"), params.crosstalkSteps);
     glUniform1f(glGetUniformLocation(program_.get(), "uDispMaxCount"), params.maxCount);
     setInt(program_.get(), "uDispLutSize", params.lutSize);
     if (params.viewingRows > 0) {

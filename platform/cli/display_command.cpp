@@ -166,6 +166,15 @@ int fitMain(const DisplayOptions& o)
                       "the nearest the matrix/TRC form holds",
                       o.icc);
         }
+        if (icc->crosstalkOmitted) {
+            log->warn("{}: the fit's crosstalk term (white {:.2f} % from R+G+B) is left out: a "
+                      "matrix/TRC profile holds only the additive part; the JSON profile has it",
+                      o.icc,
+                      100.0 *
+                              (model->forward(glm::dvec3(model->maxCount())).y -
+                               model->whiteXyz().y) /
+                              model->whiteXyz().y);
+        }
     }
     const auto& f = model->fit;
     if (o.json) {

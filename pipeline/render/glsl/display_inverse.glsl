@@ -1,5 +1,6 @@
 // The inverse display model (Day et al.): XYZ -> linear drive by M^-1, the gamut mapped as
-// display/gamut_map.cpp's mapToGamut does, then counts by the inverse tone-curve LUT
+// display/gamut_map.cpp's mapToGamut does, the crosstalk undone (DisplayModel::deinteracted; no
+// steps without it), then counts by the inverse tone-curve LUT
 // (display/display_inverse.cpp: DisplayInverse::countsFromLinear).
 
 uniform mat3 uDispXyzToLinear;
@@ -8,6 +9,8 @@ uniform float uDispBlackY;
 uniform float uDispWhiteY;
 uniform float uDispGamutEdgeTolerance; // the profile's (gamut_map.h); 0 when unset: none
 uniform float uDispGamutEdgeFloor;
+uniform mat3 uDispCrosstalk;     // DisplayModel::crosstalk
+uniform int uDispCrosstalkSteps; // 0 without crosstalk: r is then the mapping's, untouched
 uniform float uDispMaxCount;
 uniform int uDispLutSize;
 uniform highp sampler2D uDispToneLut;  // (lutSize - 1) x 3, RG32F, texelFetch only
@@ -32,6 +35,22 @@ vec4 invert(vec3 xyzIn, int mode) {
     vec3 xyz = xyzIn;
     if (any(isnan(xyz)) || any(isinf(xyz))) {
         return vec4(0.0, 0.0, 0.0, 3.0);
+    }
+    // DisplayInverse::invert with crosstalk: r with the crosstalk undone (unclamped steps) in
+    // the cube is in gamut as it is. No steps, and this is skipped, without crosstalk.
+    if (uDispCrosstalkSteps > 0) {
+        vec3 y0 = uDispXyzToLinear * (xyz - uDispBlackXyz);
+        vec3 q = y0;
+        for (int i = 0; i < uDispCrosstalkSteps; ++i) {
+            q = y0 - uDispCrosstalk * vec3(q.x * q.y, q.y * q.z, q.z * q.x);
+        }
+        const float tolX = 1e-5;
+        if (all(greaterThanEqual(q, vec3(-tolX))) && all(lessThanEqual(q, vec3(1.0 + tolX))) &&
+            xyz.y >= uDispBlackY) {
+            q = clamp(q, 0.0, 1.0);
+            return vec4(countsFromLinear(0, q.r), countsFromLinear(1, q.g),
+                        countsFromLinear(2, q.b), 0.0);
+        }
     }
     float cls = 0.0;
     float edge = uDispGamutEdgeTolerance;
@@ -77,6 +96,11 @@ vec4 invert(vec3 xyzIn, int mode) {
         cls = 1.0;
     }
     r = clamp(r, 0.0, 1.0);
+    // DisplayModel::deinteracted: r + C p(r) = y by fixed-point steps from r = y.
+    vec3 y = r;
+    for (int i = 0; i < uDispCrosstalkSteps; ++i) {
+        r = clamp(y - uDispCrosstalk * vec3(r.x * r.y, r.y * r.z, r.z * r.x), 0.0, 1.0);
+    }
     return vec4(countsFromLinear(0, r.r), countsFromLinear(1, r.g), countsFromLinear(2, r.b), cls);
 }
 

@@ -211,12 +211,21 @@ TEST(IccProfile, BradfordMatchesThePublishedMatrix)
 
 TEST(IccProfile, ReadsBackAsTheModelThroughLittleCms)
 {
-    const DisplayModel& model = test::fittedSyntheticIps();
+    // The synthetic IPS panel's fit has a crosstalk term (0.5 % loss at white), which a
+    // matrix/TRC profile cannot hold: the profile is the model's additive part, and says so.
+    const DisplayModel& fitted = test::fittedSyntheticIps();
+    ASSERT_TRUE(fitted.hasCrosstalk());
+    DisplayModel model = fitted;
+    model.crosstalk = glm::dmat3(0.0);
     const auto path = std::filesystem::temp_directory_path() /
                       ("replica_icc_" + std::to_string(::getpid()) + ".icc");
+    auto withCrosstalk = writeIccProfile(fitted, path);
+    ASSERT_TRUE(withCrosstalk.has_value()) << withCrosstalk.error().message;
+    EXPECT_TRUE(withCrosstalk->crosstalkOmitted);
     auto written = writeIccProfile(model, path);
     ASSERT_TRUE(written.has_value()) << written.error().message;
     EXPECT_FALSE(written->blackClipped);
+    EXPECT_FALSE(written->crosstalkOmitted);
     auto info = readIccInfo(path);
     ASSERT_TRUE(info.has_value()) << info.error().message;
     EXPECT_GE(info->version, 4.0);

@@ -65,6 +65,42 @@ TEST(DisplayInverse, ForwardOfInverseIsIdentityInGamut)
     EXPECT_NEAR(k.counts.x + k.counts.y + k.counts.z, 0.0, 1e-6);
 }
 
+// With crosstalk the inverse undoes it: counts -> the model's forward -> counts again, for colours
+// inside the gamut (each channel driven enough that y = r + C p(r) stays in [0, 1]), at a
+// crosstalk twenty times a real panel's and of mixed sign.
+TEST(DisplayInverse, InvertsTheCrosstalkTerm)
+{
+    DisplayModel m = test::fittedSyntheticIps();
+    m.crosstalk = glm::dmat3(glm::dvec3(-0.05, 0.02, -0.03), glm::dvec3(-0.04, -0.06, 0.01),
+                             glm::dvec3(0.03, -0.05, -0.07));
+    m.gamutEdgeTolerance = 0.0;
+    auto inv = DisplayInverse::build(m);
+    ASSERT_TRUE(inv.has_value()) << inv.error().message;
+    auto additive = m;
+    additive.crosstalk = glm::dmat3(0.0);
+    auto invAdd = DisplayInverse::build(additive);
+    ASSERT_TRUE(invAdd.has_value());
+    double worst = 0.0;
+    double moved = 0.0;
+    for (double r : {110.0, 180.0, 250.0}) {
+        for (double g : {100.0, 170.0, 230.0}) {
+            for (double b : {120.0, 180.0, 240.0}) {
+                const glm::dvec3 counts(r, g, b);
+                const glm::dvec3 xyz = m.forward(counts);
+                const auto out = inv->invert(xyz, GamutMode::Clip, ToneInverse::Exact);
+                worst = std::max(worst, glm::length(out.counts - counts));
+                moved = std::max(
+                        moved,
+                        glm::length(
+                                invAdd->invert(xyz, GamutMode::Clip, ToneInverse::Exact).counts -
+                                counts));
+            }
+        }
+    }
+    EXPECT_LT(worst, 1e-3);
+    EXPECT_GT(moved, 3.0) << "the additive inverse gets these right: the test cannot tell";
+}
+
 TEST(DisplayInverse, ThreeDimensionalLutIsFiniteAndClose)
 {
     const DisplayModel& model = test::fittedSyntheticIps();

@@ -49,6 +49,40 @@ TEST(DisplayProfile, RoundTripsThroughJson)
     EXPECT_DOUBLE_EQ(withTolerance->gamutEdgeTolerance, 0.0042);
 }
 
+// The crosstalk term travels with the profile under its own key; a profile without the key (every
+// profile before it) is additive, C = 0, and an additive model writes no key.
+TEST(DisplayProfile, CrosstalkRoundTripsAndIsZeroWhenAbsent)
+{
+    DisplayModel m = test::fittedSyntheticIps();
+    m.crosstalk = glm::dmat3(0.0);
+    const std::string plain = profileToJson(m);
+    EXPECT_EQ(plain.find("\"crosstalk\""), std::string::npos);
+    auto plainBack = profileFromJson(plain, "p.json");
+    ASSERT_TRUE(plainBack.has_value()) << plainBack.error().message;
+    EXPECT_EQ(plainBack->crosstalk, glm::dmat3(0.0));
+    DisplayModel c = m;
+    c.crosstalk = glm::dmat3(glm::dvec3(-0.004, 0.001, 0.0), glm::dvec3(0.0, -0.002, 0.003),
+                             glm::dvec3(0.0005, 0.0, -0.006));
+    auto back = profileFromJson(profileToJson(c), "c.json");
+    ASSERT_TRUE(back.has_value()) << back.error().message;
+    EXPECT_EQ(back->crosstalk, c.crosstalk);
+    // White: r = 1 everywhere, so XYZ = black + M (1 + C (1, 1, 1)), the column sums.
+    const glm::dvec3 want =
+            c.blackXyz + c.matrix * (glm::dvec3(1.0) + glm::dvec3(-0.0035, -0.001, -0.003));
+    const glm::dvec3 got = back->forward(glm::dvec3(255.0));
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(got[k], want[k], 1e-9 * want[k]);
+    }
+    // Beyond the bound the fixed-point inverse needs: refused, naming the row.
+    DisplayModel big = m;
+    big.crosstalk[0][1] = 0.15;
+    big.crosstalk[2][1] = -0.1;
+    auto bad = profileFromJson(profileToJson(big), "big.json");
+    ASSERT_FALSE(bad.has_value());
+    EXPECT_NE(bad.error().message.find("crosstalk row G"), std::string::npos)
+            << bad.error().message;
+}
+
 TEST(DisplayProfile, BadProfilesAreRejectedWithTheReason)
 {
     auto err = [](const std::string& text) {

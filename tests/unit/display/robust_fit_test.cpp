@@ -290,14 +290,15 @@ TEST(RobustFit, InverseAcrossSeedsAndShapes)
     // light is at least 0.1 % of full drive), inverted through the fitted model, against the count
     // that made them; dE00 is the fitted model against the panel on 400 colours never measured.
     // Over seeds 1001..1020 the worst is GOG 0.18, sRGB-like 0.25, S-shaped 0.35 counts
-    // (DISABLED_Seeds). The crosstalk panel misses at white, 0.72-1.08 counts over those seeds
-    // (0.78 without noise): its 0.5 % loss at white is outside the additive model, so its limit
-    // is what the additive model reaches (docs/display.md).
+    // (DISABLED_Seeds). The crosstalk panel (0.5 % loss at white) gets its crosstalk term on
+    // seven of seeds 1001..1008 (worst 0.30 counts); on 1003 cross-validation does not find the
+    // term's gain beyond two standard errors, and the additive model misses white by 0.77 counts
+    // (docs/display.md).
     // The hue-keeping mapping must cost nothing over per-channel clipping on colours the panel
     // makes (the edge tolerance).
     for (const auto& [panel, inverseLimit] :
          {std::pair{gogPanel(), 0.5}, std::pair{srgbPanel(), 0.5}, std::pair{sShapedPanel(), 0.5},
-          std::pair{crosstalkPanel(), 1.2}}) {
+          std::pair{crosstalkPanel(), 0.8}}) {
         for (std::uint64_t seed = 1001; seed <= 1008; ++seed) {
             const DisplayModel m = fit(panel, 0.002, seed);
             const Figures f = evaluate(m, panel);
@@ -313,6 +314,31 @@ TEST(RobustFit, InverseAcrossSeedsAndShapes)
     const DisplayModel exact = fit(gogPanel(), 0.0, 1001);
     EXPECT_LT(exact.gamutEdgeTolerance, 1e-6);
     EXPECT_LT(evaluate(exact, gogPanel()).rampInverseMax, 1e-3);
+}
+
+// The crosstalk term is kept only where cross-validation says it predicts better: additive panels
+// stay additive (C = 0 exactly, with and without noise); the crosstalk panel's loss, 0.5 % of white
+// spread over the three products in the white's colour (synthetic_display.cpp), is C = -0.005 / 3
+// in every entry, recovered noise-free by the one-parameter family.
+TEST(RobustFit, CrosstalkOnlyWhereHeldOutErrorSaysSo)
+{
+    for (const auto& panel : {gogPanel(), srgbPanel(), sShapedPanel()}) {
+        EXPECT_FALSE(fit(panel, 0.0, 1001).hasCrosstalk());
+        for (std::uint64_t seed = 1001; seed <= 1008; ++seed) {
+            const DisplayModel m = fit(panel, 0.002, seed);
+            EXPECT_EQ(m.crosstalk, glm::dmat3(0.0)) << seed;
+            EXPECT_EQ(m.fit.crosstalkModel, "none") << seed;
+        }
+    }
+    const DisplayModel exact = fit(crosstalkPanel(), 0.0, 1001);
+    EXPECT_EQ(exact.fit.crosstalkModel, "uniform");
+    for (int col = 0; col < 3; ++col) {
+        for (int row = 0; row < 3; ++row) {
+            EXPECT_NEAR(exact.crosstalk[col][row], -0.005 / 3.0, 0.02 * 0.005 / 3.0);
+        }
+    }
+    // And it makes the noise-free inverse exact where the additive model missed by 0.78 counts.
+    EXPECT_LT(evaluate(exact, crosstalkPanel()).rampInverseMax, 0.02);
 }
 
 TEST(RobustFit, EstimatesTheMetersNoise)

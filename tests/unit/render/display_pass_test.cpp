@@ -166,6 +166,43 @@ TEST_F(DisplayPassTest, AnalyticPassAppliesTheProfilesGamutEdgeTolerance)
     EXPECT_GT(changed, 0) << "the tolerance changes no pixel: the test cannot tell";
 }
 
+// A profile with channel interaction (DisplayModel::crosstalk): the GL pass undoes it with the same
+// fixed-point steps as the CPU inverse (two uniforms), pixel by pixel as above. The crosstalk is
+// ten times a real panel's (each product takes 5 % of r from every channel), so that it moves
+// many pixels by several counts; and the fixed point must invert the model's own forward.
+TEST_F(DisplayPassTest, AnalyticPassUndoesTheProfilesCrosstalk)
+{
+    profile_.crosstalk = glm::dmat3(glm::dvec3(-0.05), glm::dvec3(-0.05), glm::dvec3(-0.05));
+    auto r = make(InverseMethod::Analytic, 0.35);
+    ASSERT_TRUE(r);
+    RenderedFrame f;
+    ASSERT_TRUE(r->render(state(), f));
+    auto inv = display::DisplayInverse::build(profile_);
+    ASSERT_TRUE(inv);
+    display::DisplayModel additive = profile_;
+    additive.crosstalk = glm::dmat3(0.0);
+    auto additiveInv = display::DisplayInverse::build(additive);
+    ASSERT_TRUE(additiveInv);
+    int changed = 0; // pixels the crosstalk moves by more than the dither's one count
+    for (int y = 0; y < f.height; ++y) {
+        for (int x = 0; x < f.width; ++x) {
+            const auto want = expected(*inv, f, x, y);
+            const auto without = expected(*additiveInv, f, x, y);
+            bool moved = false;
+            const std::size_t i =
+                    (static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x)) * 4;
+            for (int c = 0; c < 3; ++c) {
+                moved = moved || std::abs(want.counts[c] - without.counts[c]) > 2.0;
+                const double got = f.rgba[i + static_cast<std::size_t>(c)];
+                ASSERT_GE(got, std::floor(want.counts[c] - 0.02) - 1e-9) << x << "," << y;
+                ASSERT_LE(got, std::ceil(want.counts[c] + 0.02) + 1e-9) << x << "," << y;
+            }
+            changed += moved ? 1 : 0;
+        }
+    }
+    EXPECT_GT(changed, 64 * 40 / 4) << "the crosstalk changes too few pixels: the test cannot tell";
+}
+
 TEST_F(DisplayPassTest, CompensationChangesWhatIsDrivenInTheRightDirection)
 {
     auto r = make(InverseMethod::Analytic, 0.35);
