@@ -195,10 +195,13 @@ int fitMain(const DisplayOptions& o)
                                   {"tone_shape", f.toneShape},
                                   {"inverse_counts_rms", f.inverseCountsRms},
                                   {"inverse_counts_max", f.inverseCountsMax},
-                                  {"gamut_edge_tolerance", model->gamutEdgeTolerance}}
+                                  {"gamut_edge_tolerance", model->gamutEdgeTolerance},
+                                  {"crosstalk_model", f.crosstalkModel},
+                                  {"crosstalk_gain_de00", f.crosstalkGainDe00}}
                            .dump());
     } else {
-        const glm::dvec3 w = model->whiteXyz();
+        // The model's white (with a crosstalk term, below black + R + G + B).
+        const glm::dvec3 w = model->forward(glm::dvec3(model->maxCount()));
         fmt::print("profile: {}{}\n", o.out,
                    o.icc.empty() ? std::string() : fmt::format(" (and ICC v4: {})", o.icc));
         fmt::print("white {:.1f} cd/m^2, black {:.3f} cd/m^2, {}-bit\n", w.y, model->blackXyz.y,
@@ -222,6 +225,18 @@ int fitMain(const DisplayOptions& o)
                        "corners; colours within it of the gamut are clamped per channel, not "
                        "gamut-mapped)\n",
                        model->gamutEdgeTolerance);
+            if (model->hasCrosstalk()) {
+                const glm::dmat3& c = model->crosstalk;
+                fmt::print("crosstalk ({}, cross-validated gain dE00 {:.4f}): r + C (rg, gb, br), "
+                           "C rows R {:+.5f} {:+.5f} {:+.5f} G {:+.5f} {:+.5f} {:+.5f} B {:+.5f} "
+                           "{:+.5f} {:+.5f}; white {:+.2f}% from black + R + G + B\n",
+                           f.crosstalkModel, f.crosstalkGainDe00, c[0][0], c[1][0], c[2][0],
+                           c[0][1], c[1][1], c[2][1], c[0][2], c[1][2], c[2][2],
+                           100.0 * (w.y - model->whiteXyz().y) / model->whiteXyz().y);
+            } else if (!f.crosstalkModel.empty()) {
+                fmt::print("crosstalk: none (cross-validation finds no gain beyond two standard "
+                           "errors)\n");
+            }
         }
         if (f.additivityDe00 >= 0.0 && f.additivityNoiseDe00 >= 0.0) {
             fmt::print("additivity: white vs black + R + G + B dE00 {:.3f} (the noise alone gives "
