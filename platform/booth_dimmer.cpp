@@ -67,7 +67,7 @@ DimmerEffect boothDimmerEffect(const pipeline::shading::XyzFrame& frame,
         const pd::InverseResult r = inverse.invert(want, pd::GamutMode::HueKeeping);
         over += r.gamutClass == pd::GamutClass::OverPeak ? 1 : 0;
         out += r.inGamut() ? 0 : 1;
-        const glm::dvec3 shown = m.blackXyz + m.matrix * r.linear;
+        const glm::dvec3 shown = m.blackXyz + m.matrix * m.interacted(r.linear);
         de.push_back(pipeline::colour::ciede2000(pipeline::colour::xyzToLab(want, white),
                                                  pipeline::colour::xyzToLab(shown, white)));
     }
