@@ -52,6 +52,7 @@ struct FitReport {
     // and its held-out mean dE00 gain over the additive model.
     std::string crosstalkModel;
     double crosstalkGainDe00 = 0.0;
+    double crosstalkZ = 0.0; // the uniform coefficient over its standard error
 };
 
 struct DisplayModel {
