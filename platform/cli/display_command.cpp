@@ -227,15 +227,17 @@ int fitMain(const DisplayOptions& o)
                        model->gamutEdgeTolerance);
             if (model->hasCrosstalk()) {
                 const glm::dmat3& c = model->crosstalk;
-                fmt::print("crosstalk ({}, cross-validated gain dE00 {:.4f}): r + C (rg, gb, br), "
+                fmt::print("crosstalk ({}; one-parameter coefficient {:.1f} standard errors from "
+                           "zero, cross-validated gain dE00 {:.4f}): r + C (rg, gb, br), "
                            "C rows R {:+.5f} {:+.5f} {:+.5f} G {:+.5f} {:+.5f} {:+.5f} B {:+.5f} "
                            "{:+.5f} {:+.5f}; white {:+.2f}% from black + R + G + B\n",
-                           f.crosstalkModel, f.crosstalkGainDe00, c[0][0], c[1][0], c[2][0],
-                           c[0][1], c[1][1], c[2][1], c[0][2], c[1][2], c[2][2],
+                           f.crosstalkModel, f.crosstalkZ, f.crosstalkGainDe00, c[0][0], c[1][0],
+                           c[2][0], c[0][1], c[1][1], c[2][1], c[0][2], c[1][2], c[2][2],
                            100.0 * (w.y - model->whiteXyz().y) / model->whiteXyz().y);
             } else if (!f.crosstalkModel.empty()) {
-                fmt::print("crosstalk: none (cross-validation finds no gain beyond two standard "
-                           "errors)\n");
+                fmt::print("crosstalk: none (one-parameter coefficient {:.1f} standard errors from "
+                           "zero, needs 3; cross-validated gain dE00 {:.4f}, needs 0.001)\n",
+                           f.crosstalkZ, f.crosstalkGainDe00);
             }
         }
         if (f.additivityDe00 >= 0.0 && f.additivityNoiseDe00 >= 0.0) {
