@@ -42,6 +42,12 @@ namespace {
 int runMain(const run_cli::RunOptions& given)
 {
     auto log = logger("replica");
+    // --frames 0 runs until SIGINT/SIGTERM (the kiosk), closing the recording properly. Routed to
+    // the loop's stop flag before anything is opened: a signal during start-up (the recording is
+    // created before the shading passes are built and warmed up) then ends the run cleanly at its
+    // first frame instead of killing it (SIGTERM) or being lost (SIGINT is ignored in a
+    // background job of a non-interactive shell until a handler is installed).
+    installStopSignals();
     run_cli::RunOptions o = given;
     if (!o.sitePath.empty()) {
         // The site file's [sources] fill in what the command line leaves open.
@@ -249,8 +255,6 @@ int runMain(const run_cli::RunOptions& given)
         shown = std::make_unique<ShownRecorder>(*recorder, **appliance, so);
     }
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
-    // --frames 0: run until SIGINT/SIGTERM (the kiosk), closing the recording properly.
-    installStopSignals();
     const TickSource ticks = o.frames == 0 ? endlessTicks(config.periodNs())
                                            : fixedRateTicks(config.periodNs(), o.frames);
     // Scan-out needs the display pixels of every frame, digests or not.

@@ -11,9 +11,11 @@ for sig in TERM INT; do
     "$replica" run --hal sim --frames 0 --fast --size 96x60 --record "$rec" \
         --digests "$work/live-$sig.json" 2>"$work/run-$sig.log" &
     pid=$!
-    # Wait until some frames exist, then stop it.
-    for _ in $(seq 1 100); do
-        [ -s "$rec" ] && break
+    # Wait until the loop is drawing (its first line is frame 0's; the recording file itself
+    # exists from before the shading passes are built, which under ASan on a loaded machine took
+    # over a second), then stop it.
+    for _ in $(seq 1 600); do
+        grep '\[loop\]' "$work/run-$sig.log" >/dev/null 2>&1 && break
         sleep 0.1
     done
     sleep 1
