@@ -93,6 +93,35 @@ protected:
         return inv.invert((xyz - flare) / gain);
     }
 
+    // Every pixel of `f` drives what `inv` says (within the dither's one count); `moved` counts
+    // the pixels where `other` would drive a channel more than two counts differently, so that a
+    // test can show its setting changes the frame at all.
+    void expectDrivenBy(const display::DisplayInverse& inv,
+                        const display::DisplayInverse& other,
+                        const RenderedFrame& f,
+                        int& moved) const
+    {
+        moved = 0;
+        for (int y = 0; y < f.height; ++y) {
+            for (int x = 0; x < f.width; ++x) {
+                const auto want = expected(inv, f, x, y);
+                const auto without = expected(other, f, x, y);
+                bool differs = false;
+                const std::size_t i =
+                        (static_cast<std::size_t>(y) * static_cast<std::size_t>(f.width) +
+                         static_cast<std::size_t>(x)) *
+                        4;
+                for (int c = 0; c < 3; ++c) {
+                    differs = differs || std::abs(want.counts[c] - without.counts[c]) > 2.0;
+                    const double got = f.rgba[i + static_cast<std::size_t>(c)];
+                    ASSERT_GE(got, std::floor(want.counts[c] - 0.02) - 1e-9) << x << "," << y;
+                    ASSERT_LE(got, std::ceil(want.counts[c] + 0.02) + 1e-9) << x << "," << y;
+                }
+                moved += differs ? 1 : 0;
+            }
+        }
+    }
+
     display::DisplayModel profile_;
     GlesRendererSetup setup_;
 };
@@ -147,22 +176,7 @@ TEST_F(DisplayPassTest, AnalyticPassAppliesTheProfilesGamutEdgeTolerance)
     auto strictInv = display::DisplayInverse::build(strict);
     ASSERT_TRUE(strictInv);
     int changed = 0; // pixels the tolerance moves by more than the dither's one count
-    for (int y = 0; y < f.height; ++y) {
-        for (int x = 0; x < f.width; ++x) {
-            const auto want = expected(*inv, f, x, y);
-            const auto without = expected(*strictInv, f, x, y);
-            bool moved = false;
-            const std::size_t i =
-                    (static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x)) * 4;
-            for (int c = 0; c < 3; ++c) {
-                moved = moved || std::abs(want.counts[c] - without.counts[c]) > 2.0;
-                const double got = f.rgba[i + static_cast<std::size_t>(c)];
-                ASSERT_GE(got, std::floor(want.counts[c] - 0.02) - 1e-9) << x << "," << y;
-                ASSERT_LE(got, std::ceil(want.counts[c] + 0.02) + 1e-9) << x << "," << y;
-            }
-            changed += moved ? 1 : 0;
-        }
-    }
+    ASSERT_NO_FATAL_FAILURE(expectDrivenBy(*inv, *strictInv, f, changed));
     EXPECT_GT(changed, 0) << "the tolerance changes no pixel: the test cannot tell";
 }
 
@@ -184,22 +198,7 @@ TEST_F(DisplayPassTest, AnalyticPassUndoesTheProfilesCrosstalk)
     auto additiveInv = display::DisplayInverse::build(additive);
     ASSERT_TRUE(additiveInv);
     int changed = 0; // pixels the crosstalk moves by more than the dither's one count
-    for (int y = 0; y < f.height; ++y) {
-        for (int x = 0; x < f.width; ++x) {
-            const auto want = expected(*inv, f, x, y);
-            const auto without = expected(*additiveInv, f, x, y);
-            bool moved = false;
-            const std::size_t i =
-                    (static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x)) * 4;
-            for (int c = 0; c < 3; ++c) {
-                moved = moved || std::abs(want.counts[c] - without.counts[c]) > 2.0;
-                const double got = f.rgba[i + static_cast<std::size_t>(c)];
-                ASSERT_GE(got, std::floor(want.counts[c] - 0.02) - 1e-9) << x << "," << y;
-                ASSERT_LE(got, std::ceil(want.counts[c] + 0.02) + 1e-9) << x << "," << y;
-            }
-            changed += moved ? 1 : 0;
-        }
-    }
+    ASSERT_NO_FATAL_FAILURE(expectDrivenBy(*inv, *additiveInv, f, changed));
     EXPECT_GT(changed, 64 * 40 / 4) << "the crosstalk changes too few pixels: the test cannot tell";
 }
 
