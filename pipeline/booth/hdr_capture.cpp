@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/linear_solve.h>
 #include <pipeline/booth/hdr_capture.h>
 
 namespace replica::pipeline::booth {
@@ -12,51 +13,6 @@ namespace {
 double hatWeight(int z)
 {
     return z <= 127 ? static_cast<double>(z) : static_cast<double>(255 - z);
-}
-
-// Solves the dense symmetric positive (semi)definite system a x = b in place by Gaussian
-// elimination with partial pivoting. Returns false if singular.
-bool solveDense(std::vector<double>& a, std::vector<double>& b, int n)
-{
-    for (int c = 0; c < n; ++c) {
-        int piv = c;
-        for (int r = c + 1; r < n; ++r) {
-            if (std::abs(a[static_cast<std::size_t>(r) * n + c]) >
-                std::abs(a[static_cast<std::size_t>(piv) * n + c])) {
-                piv = r;
-            }
-        }
-        if (!(std::abs(a[static_cast<std::size_t>(piv) * n + c]) > 1e-300)) {
-            return false;
-        }
-        if (piv != c) {
-            for (int k = 0; k < n; ++k) {
-                std::swap(a[static_cast<std::size_t>(c) * n + k],
-                          a[static_cast<std::size_t>(piv) * n + k]);
-            }
-            std::swap(b[static_cast<std::size_t>(c)], b[static_cast<std::size_t>(piv)]);
-        }
-        const double d = a[static_cast<std::size_t>(c) * n + c];
-        for (int r = c + 1; r < n; ++r) {
-            const double f = a[static_cast<std::size_t>(r) * n + c] / d;
-            if (f == 0.0) {
-                continue;
-            }
-            for (int k = c; k < n; ++k) {
-                a[static_cast<std::size_t>(r) * n + k] -=
-                        f * a[static_cast<std::size_t>(c) * n + k];
-            }
-            b[static_cast<std::size_t>(r)] -= f * b[static_cast<std::size_t>(c)];
-        }
-    }
-    for (int r = n - 1; r >= 0; --r) {
-        double s = b[static_cast<std::size_t>(r)];
-        for (int k = r + 1; k < n; ++k) {
-            s -= a[static_cast<std::size_t>(r) * n + k] * b[static_cast<std::size_t>(k)];
-        }
-        b[static_cast<std::size_t>(r)] = s / a[static_cast<std::size_t>(r) * n + r];
-    }
-    return true;
 }
 
 Expected<void> checkSeries(const std::vector<Exposure>& series)
@@ -126,7 +82,7 @@ recoverResponse(const std::vector<Exposure>& series, int samplePixels, double la
         const double s = lambda * hatWeight(z);
         addRow({{z - 1, s}, {z, -2.0 * s}, {z + 1, s}}, 0.0);
     }
-    if (!solveDense(ata, atb, n)) {
+    if (!solveLinear(ata, atb, static_cast<std::size_t>(n))) {
         return makeError(ErrorCode::InvalidArgument,
                          "camera response: the exposure series does not determine it "
                          "(use exposures that overlap in range)");
@@ -195,7 +151,7 @@ Expected<Homography> homographyFromCorners(const std::array<glm::dvec2, 4>& corn
         b[static_cast<std::size_t>(2 * k)] = x;
         b[static_cast<std::size_t>(2 * k + 1)] = y;
     }
-    if (!solveDense(a, b, 8)) {
+    if (!solveLinear(a, b, 8)) {
         return makeError(ErrorCode::InvalidArgument,
                          "the four ceiling corners are degenerate (three on a line?)");
     }

@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
+#include <pipeline/base/linear_solve.h>
 #include <pipeline/display/display_fit.h>
 #include <pipeline/display/synthetic_display.h>
 #include <pipeline/display/tone_fit.h>
@@ -241,35 +242,24 @@ glm::dmat3 fitCrosstalkTerm(const DisplayModel& model,
             }
         }
     }
-    // Gaussian elimination with partial pivoting.
+    // The normal equations, singular when a pivot falls below 1e-12 of the largest diagonal.
     const auto nn = static_cast<std::size_t>(n);
+    std::vector<double> lhs(nn * nn);
+    std::vector<double> coef(nn);
     double scale = 0.0;
     for (std::size_t i = 0; i < nn; ++i) {
+        for (std::size_t j = 0; j < nn; ++j) {
+            lhs[i * nn + j] = a[i][j];
+        }
+        coef[i] = a[i][nn];
         scale = std::max(scale, std::abs(a[i][i]));
     }
-    for (std::size_t i = 0; i < nn; ++i) {
-        std::size_t piv = i;
-        for (std::size_t r = i + 1; r < nn; ++r) {
-            if (std::abs(a[r][i]) > std::abs(a[piv][i])) {
-                piv = r;
-            }
-        }
-        if (!(std::abs(a[piv][i]) > 1e-12 * scale)) {
-            return glm::dmat3(0.0);
-        }
-        std::swap(a[i], a[piv]);
-        for (std::size_t r = 0; r < nn; ++r) {
-            if (r != i) {
-                const double f = a[r][i] / a[i][i];
-                for (std::size_t c = i; c <= nn; ++c) {
-                    a[r][c] -= f * a[i][c];
-                }
-            }
-        }
+    if (!solveLinear(lhs, coef, nn, 1e-12 * scale)) {
+        return glm::dmat3(0.0);
     }
     glm::dmat3 c(0.0);
     for (std::size_t k = 0; k < nn; ++k) {
-        c += (a[k][nn] / a[k][k]) * crosstalkBasis(family, static_cast<int>(k));
+        c += coef[k] * crosstalkBasis(family, static_cast<int>(k));
     }
     DisplayModel check = model;
     check.crosstalk = c;

@@ -7,6 +7,7 @@
 #include <random>
 
 #include <pipeline/base/assert.h>
+#include <pipeline/base/linear_solve.h>
 #include <pipeline/display/tone_fit.h>
 
 namespace replica::pipeline::display {
@@ -17,44 +18,6 @@ double gogoEval(const std::array<double, 4>& p, double x, ToneShape shape)
     const double u = p[1] * x + (1.0 - p[1]);
     const double base = u > 0.0 ? p[0] * std::pow(u, p[2]) : 0.0;
     return shape == ToneShape::Gog ? base : base + p[3];
-}
-
-// Solves the n x n system a x = b (row-major) by Gaussian elimination with partial pivoting;
-// false when singular.
-bool solveSmall(std::vector<double> a, std::vector<double>& b, std::size_t n)
-{
-    for (std::size_t col = 0; col < n; ++col) {
-        std::size_t piv = col;
-        for (std::size_t r = col + 1; r < n; ++r) {
-            if (std::abs(a[r * n + col]) > std::abs(a[piv * n + col])) {
-                piv = r;
-            }
-        }
-        if (!(std::abs(a[piv * n + col]) > 1e-300)) {
-            return false;
-        }
-        if (piv != col) {
-            for (std::size_t k = 0; k < n; ++k) {
-                std::swap(a[col * n + k], a[piv * n + k]);
-            }
-            std::swap(b[col], b[piv]);
-        }
-        for (std::size_t r = col + 1; r < n; ++r) {
-            const double f = a[r * n + col] / a[col * n + col];
-            for (std::size_t k = col; k < n; ++k) {
-                a[r * n + k] -= f * a[col * n + k];
-            }
-            b[r] -= f * b[col];
-        }
-    }
-    for (std::size_t i = n; i-- > 0;) {
-        double s = b[i];
-        for (std::size_t k = i + 1; k < n; ++k) {
-            s -= a[i * n + k] * b[k];
-        }
-        b[i] = s / a[i * n + i];
-    }
-    return true;
 }
 
 double weightedCost(const std::array<double, 4>& p,
@@ -145,7 +108,7 @@ std::array<double, 4> fitGogo(const std::vector<double>& x,
                 a[d * np + d] += mu * std::max(jtj[d * np + d], 1e-300);
             }
             std::vector<double> step = jtr;
-            if (!solveSmall(a, step, np)) {
+            if (std::vector<double> lhs = a; !solveLinear(lhs, step, np)) {
                 mu *= 10.0;
                 continue;
             }
