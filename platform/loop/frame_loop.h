@@ -85,9 +85,8 @@ TickSource fixedRateTicks(std::int64_t periodNs, std::uint64_t frames);
 // int64 nanoseconds, and 0 already means "without end".
 constexpr std::uint64_t kMaxFrames = 1'000'000'000;
 
-// Asks a running loop to stop after the frame in hand (async-signal-safe: SIGINT/SIGTERM handlers
-// call it), so that recordings are closed properly. installStopSignals() routes both signals here.
-void requestStop();
+// Whether SIGINT/SIGTERM asked a running loop to stop after the frame in hand, so that recordings
+// are closed properly; installStopSignals() routes both signals to an async-signal-safe flag.
 bool stopRequested();
 void installStopSignals();
 
