@@ -429,19 +429,19 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     app->displayProfileId = displayId;
 
     // The state stage (state/): the light, eye and tilt estimators.
-    state::SceneEstimatorSetup updaterSetup;
-    updaterSetup.light.booth = app->booth;
-    updaterSetup.light.calibration = *calibration;
+    state::SceneEstimatorSetup estimatorSetup;
+    estimatorSetup.light.booth = app->booth;
+    estimatorSetup.light.calibration = *calibration;
     if (app->boothScene) {
         // The re-encode decision and the diffuse term's sliced refresh are state: the estimators
         // take the booth pass's encoder, lamp spectra and slice count.
-        updaterSetup.light.adaptive = encoder;
-        updaterSetup.light.encodeSpectra = app->boothScene->lampSpectra();
-        updaterSetup.tilt.cacheSlices = config.cacheSlices;
+        estimatorSetup.light.adaptive = encoder;
+        estimatorSetup.light.encodeSpectra = app->boothScene->lampSpectra();
+        estimatorSetup.tilt.cacheSlices = config.cacheSlices;
     }
-    updaterSetup.eye.trackerInBooth = config.trackerInBooth;
-    updaterSetup.eye.defaultEyeM = config.defaultEyeM;
-    updaterSetup.tilt.defaultTiltRad = config.defaultTiltRad;
+    estimatorSetup.eye.trackerInBooth = config.trackerInBooth;
+    estimatorSetup.eye.defaultEyeM = config.defaultEyeM;
+    estimatorSetup.tilt.defaultTiltRad = config.defaultTiltRad;
     if (!config.defaultLamp.empty()) {
         const auto& lamps = app->booth.lights;
         const auto it = std::find_if(lamps.begin(), lamps.end(),
@@ -451,13 +451,13 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
                              fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
                                          config.defaultLamp, config.booth, app->booth.names()));
         }
-        updaterSetup.light.defaultLamp = static_cast<int>(it - lamps.begin());
+        estimatorSetup.light.defaultLamp = static_cast<int>(it - lamps.begin());
     }
-    auto updater = state::SceneEstimator::create(std::move(updaterSetup));
-    if (!updater) {
-        return tl::unexpected(updater.error());
+    auto estimator = state::SceneEstimator::create(std::move(estimatorSetup));
+    if (!estimator) {
+        return tl::unexpected(estimator.error());
     }
-    app->updater = std::make_unique<state::SceneEstimator>(std::move(*updater));
+    app->sceneEstimator = std::make_unique<state::SceneEstimator>(std::move(*estimator));
     return app;
 }
 
@@ -467,7 +467,7 @@ Expected<void> restoreStateAtStart(Appliance& appliance, const std::string& conf
     if (config.is_discarded() || !config.is_object() || !config.contains(kStateAtStartKey)) {
         return {};
     }
-    if (auto ok = appliance.updater->restore(config[kStateAtStartKey]); !ok) {
+    if (auto ok = appliance.sceneEstimator->restore(config[kStateAtStartKey]); !ok) {
         return makeError(ok.error().code, fmt::format("the run configuration's {}: {}",
                                                       kStateAtStartKey, ok.error().message));
     }

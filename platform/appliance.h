@@ -1,5 +1,5 @@
 // Builds the appliance's parts from a run configuration: output (GL context), renderer, scene
-// updater, and the HAL sources (simulated or replayed).
+// estimator (the state stage), and the HAL sources (simulated or replayed).
 #pragma once
 
 #include <filesystem>
@@ -181,8 +181,8 @@ struct Appliance {
     // The booth renderer's pass 1 (shared with the renderer), null with the flat renderer: what
     // tests ask about the adaptive encoding (its basis, how often it re-encoded).
     std::shared_ptr<pipeline::render::BoothScenePass> boothScene;
-    std::unique_ptr<state::SceneEstimator> updater; // the state stage (state/)
-    std::string displayProfileId;                   // as recorded in the session
+    std::unique_ptr<state::SceneEstimator> sceneEstimator; // the state stage (state/)
+    std::string displayProfileId;                          // as recorded in the session
     glm::dvec3 displayWhiteXyz{0.0}; // the panel's full white (cd/m^2): Lab white of frame reports
     ~Appliance()
     {

@@ -39,7 +39,6 @@ struct JsonSchema {
     std::shared_ptr<const JsonSchema> items; // arrays: every element
 
     JsonSchema optional() const;
-    JsonSchema orNull() const;
 };
 
 struct JsonSchemaField {
@@ -51,13 +50,6 @@ inline JsonSchema JsonSchema::optional() const
 {
     JsonSchema s = *this;
     s.required = false;
-    return s;
-}
-
-inline JsonSchema JsonSchema::orNull() const
-{
-    JsonSchema s = *this;
-    s.nullable = true;
     return s;
 }
 

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/display/display_inverse.h>
-#include <pipeline/display/display_shader.h>
+#include <pipeline/display/display_pass_params.h>
 #include <pipeline/render/display_pass.h>
 #include <pipeline/render/display_shaders.h>
 #include <pipeline/render/gl_program.h>
@@ -44,7 +44,7 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     if (!inverse) {
         return tl::unexpected(inverse.error());
     }
-    const display::DisplayShaderParams params = display::makeDisplayShaderParams(*inverse);
+    const display::DisplayPassParams params = display::makeDisplayPassParams(*inverse);
     white_ = setup.model.whiteXyz();
     flarePerLux_ = setup.flareSubtraction ? params.flarePerLux : 0.0f;
 

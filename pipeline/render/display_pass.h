@@ -2,7 +2,7 @@
 // profile's inverse model, with front-surface flare subtraction and viewing-angle compensation per
 // pixel, hue-keeping gamut mapping, ordered dither to the panel's bit depth, an optional
 // false-colour overlay of out-of-gamut pixels, and a GPU count of those pixels per frame. Needs a
-// current GLES 3.1 context; the maths is pipeline/display's (display_shader.h mirrors
+// current GLES 3.1 context; the maths is pipeline/display's (display_pass_params.h mirrors
 // display_inverse.h).
 #pragma once
 

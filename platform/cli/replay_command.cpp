@@ -257,7 +257,7 @@ int replayMain(const ReplayOptions& o)
     if (auto ok = restoreStateAtStart(**appliance, recording->session.configJson); !ok) {
         log->error("{}: {}", o.file, ok.error().message);
         return kExitFailure;
-    } else if ((*appliance)->updater->started()) {
+    } else if ((*appliance)->sceneEstimator->started()) {
         log->info("{}: a rotated session file: its estimators start from the state it carries",
                   o.file);
     }
@@ -284,8 +284,8 @@ int replayMain(const ReplayOptions& o)
             break;
         }
         TickPlan t{f.frameIndex, f.tickNs, f};
-        t.warmup = !inSlice(f.tickNs);
-        sliceFrames += t.warmup ? 0 : 1;
+        t.estimateOnly = !inSlice(f.tickNs);
+        sliceFrames += t.estimateOnly ? 0 : 1;
         plan.push_back(t);
     }
     if ((o.fromS || o.toS) && sliceFrames == 0) {
@@ -391,7 +391,8 @@ int replayMain(const ReplayOptions& o)
     const bool showProgress = !o.noProgress && (o.progress || ::isatty(STDERR_FILENO) == 1);
     const auto wallStart = std::chrono::steady_clock::now();
     auto lastProgress = wallStart;
-    // The frames before a slice are only estimated (TickPlan::warmup): they reach no callback.
+    // The frames before a slice are only estimated (TickPlan::estimateOnly): they reach no
+    // callback.
     std::uint64_t done = plan.size() - sliceFrames;
     auto onFrame = [&](const recordings::FrameRecord& f, const pipeline::scene::SceneState& scene,
                        const pipeline::render::RenderedFrame& image) {

@@ -217,7 +217,7 @@ int runMain(const run_cli::RunOptions& given)
             // Each rotated file starts with the estimators' state ("state_at_start": the
             // classifier's hysteresis, the lamp selector's arbitration, the encoding, the held
             // eye and tilts), so that it replays alone, bit for bit, as the panel showed it.
-            const state::SceneEstimator* estimator = (*appliance)->updater.get();
+            const state::SceneEstimator* estimator = (*appliance)->sceneEstimator.get();
             sessions = std::make_unique<SessionRecorder>(
                     dir, policy, [session, options, estimator](const std::filesystem::path& path) {
                         if (!estimator->started()) {
@@ -365,7 +365,7 @@ int runMain(const run_cli::RunOptions& given)
     if (const auto* selector = sources->get(recordings::lampSelectorKind())) {
         log->info("lamp selector {} [{} {}]: overruled by the spectrometer {} times",
                   hal::toString(selector->info().kind), selector->info().model,
-                  selector->info().serial, (*appliance)->updater->lampArbiter().overruled());
+                  selector->info().serial, (*appliance)->sceneEstimator->lampArbiter().overruled());
     }
     const double periodMs = 1000.0 / o.rateHz;
     logLoopSummary(*stats, periodMs, !o.digests.empty());

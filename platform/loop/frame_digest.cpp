@@ -112,24 +112,4 @@ Expected<DigestFile> readDigestFile(const std::filesystem::path& path)
     return file;
 }
 
-Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path)
-{
-    auto file = readDigestFile(path);
-    if (!file) {
-        return tl::unexpected(file.error());
-    }
-    return std::move(file->frames);
-}
-
-long firstDifference(const std::vector<FrameDigest>& a, const std::vector<FrameDigest>& b)
-{
-    const std::size_t n = std::min(a.size(), b.size());
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!(a[i] == b[i])) {
-            return static_cast<long>(i);
-        }
-    }
-    return a.size() == b.size() ? -1 : static_cast<long>(n);
-}
-
 } // namespace replica::platform

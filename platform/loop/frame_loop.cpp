@@ -23,11 +23,6 @@ extern "C" void onStopSignal(int)
 
 } // namespace
 
-void requestStop()
-{
-    gStop = 1;
-}
-
 bool stopRequested()
 {
     return gStop != 0;
@@ -182,7 +177,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
             }
         }
         const TickPlan& tick = *nextTick;
-        if (tick.warmup) {
+        if (tick.estimateOnly) {
             afterWarmup = true;
         } else if (pacing == Pacing::Realtime) {
             if (afterWarmup) {
@@ -229,12 +224,12 @@ Expected<LoopStats> runFrames(Appliance& appliance,
 
         state.frameIndex = tick.frameIndex;
         state.tickNs = tick.tickNs;
-        appliance.updater->update(state,
-                                  recordings::chosenSample<hal::SpectrumSample>(spectrometer),
-                                  recordings::chosenSample<hal::PoseSample>(tracker),
-                                  recordings::chosenSample<hal::AccelSample>(accel),
-                                  recordings::chosenSample<hal::LampSample>(lampSelector));
-        if (tick.warmup) {
+        appliance.sceneEstimator->update(
+                state, recordings::chosenSample<hal::SpectrumSample>(spectrometer),
+                recordings::chosenSample<hal::PoseSample>(tracker),
+                recordings::chosenSample<hal::AccelSample>(accel),
+                recordings::chosenSample<hal::LampSample>(lampSelector));
+        if (tick.estimateOnly) {
             // Before a replayed slice: the state stage alone. A frame is a function of its
             // SceneState (the renderer keeps no history), so nothing before the slice is drawn.
             ++stats.estimatedOnly;

@@ -115,8 +115,9 @@ void ShownRecorder::onFrame(const recordings::FrameRecord& frame,
     const bool moved = !lastPose_ || lastPose_->eyeBoothM != state.eyeBoothM ||
                        lastPose_->tiltRad != state.tiltRad;
     if (moved && (!lastPose_ || state.tickNs - lastPoseNs_ >= options_.posePeriodNs)) {
-        writer_.write(recordings::PosesRecord{frame.tickNs, state.eyeBoothM, state.tiltRad,
-                                              appliance_.updater->trackerInBooth().translation});
+        writer_.write(
+                recordings::PosesRecord{frame.tickNs, state.eyeBoothM, state.tiltRad,
+                                        appliance_.sceneEstimator->trackerInBooth().translation});
         lastPose_ = state;
         lastPoseNs_ = state.tickNs;
         std::lock_guard lock(mutex_);
@@ -139,14 +140,14 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
     recordings::LightRecord l;
     l.tNs = frame.tickNs;
     l.frameIndex = frame.frameIndex;
-    const auto c = appliance_.updater->classification();
+    const auto c = appliance_.sceneEstimator->classification();
     l.distance = c.distance;
     const auto& lamps = appliance_.booth.lights;
     if (s.lampIndex >= 0 && static_cast<std::size_t>(s.lampIndex) < lamps.size()) {
         l.mode = "lamp";
         l.lamp = s.lampIndex;
         l.name = lamps[static_cast<std::size_t>(s.lampIndex)].name;
-        const int trusted = appliance_.updater->lampArbiter().trustedLamp();
+        const int trusted = appliance_.sceneEstimator->lampArbiter().trustedLamp();
         l.why = trusted == s.lampIndex
                         ? fmt::format("the booth's lamp selector is set to {} (lamp {})", l.name,
                                       l.lamp)

@@ -19,7 +19,7 @@ constexpr int kMaxViewingRows = 16;
 constexpr double kViewingGridStepDeg = 0.5;
 constexpr int kViewingGridNodes = 181;
 
-struct DisplayShaderParams {
+struct DisplayPassParams {
     std::array<float, 9> xyzToLinear{}; // M^-1, column-major (glUniformMatrix3fv, transpose false)
     std::array<float, 3> blackXyz{};
     float blackY = 0.0f;
@@ -54,6 +54,6 @@ struct DisplayShaderParams {
     float flarePerLux = 0.0f;
 };
 
-DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse);
+DisplayPassParams makeDisplayPassParams(const DisplayInverse& inverse);
 
 } // namespace replica::pipeline::display
