@@ -154,13 +154,14 @@ void chooseBoothDimmer(RunConfig& config,
     }
 }
 
-Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
-makeBoothScene(RunConfig& config,
-               const pipeline::booth::Booth& booth,
-               const pipeline::colour::ChannelBasis& basis,
-               const pipeline::colour::Observer& observer,
-               std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
-               const pipeline::display::DisplayModel& displayModel)
+// The booth pass's setup: the scene folder (its digest checked against a recording's), the
+// booth, the bases, and the counts chosen for the scene (recorded in 'config').
+Expected<pipeline::render::BoothSceneSetup>
+boothSceneSetup(RunConfig& config,
+                const pipeline::booth::Booth& booth,
+                const pipeline::colour::ChannelBasis& basis,
+                const pipeline::colour::Observer& observer,
+                std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive)
 {
     const auto dir = resolveSceneDir(config.sceneDir);
     auto digest = sceneDigest(dir);
@@ -180,7 +181,6 @@ makeBoothScene(RunConfig& config,
     }
     config.scene = scene->name;
     pipeline::render::BoothSceneSetup setup;
-    setup.stand = config.stand;
     setup.booth = booth;
     setup.scene = std::move(*scene);
     setup.basis = basis;
@@ -201,13 +201,19 @@ makeBoothScene(RunConfig& config,
         config.areaLights = pipeline::shading::defaultAreaLights(setup.scene) ? 1 : 0;
     }
     setup.settings = boothRenderSettings(config);
-    // The planner in the loop: the scene's cached plan (computed once when missing), recorded.
+    return setup;
+}
+
+// The planner in the loop: the scene's cached plan (computed once when missing), recorded in
+// config.plannedLamps, and each planned lamp's counts in the setup.
+Expected<void> applyRenderPlan(RunConfig& config, pipeline::render::BoothSceneSetup& setup)
+{
     if (config.planner && config.plannedLamps.empty()) {
-        auto plan = loadOrComputeRenderPlan(dir, dataDir() / "booth", config.basis,
-                                            config.plannerCache.empty()
-                                                    ? defaultPlanCacheDir()
-                                                    : std::filesystem::path(config.plannerCache),
-                                            config.planIfMissing);
+        auto plan = loadOrComputeRenderPlan(
+                resolveSceneDir(config.sceneDir), dataDir() / "booth", config.basis,
+                config.plannerCache.empty() ? defaultPlanCacheDir()
+                                            : std::filesystem::path(config.plannerCache),
+                config.planIfMissing);
         if (!plan && !config.planIfMissing && plan.error().code == ErrorCode::NotFound) {
             // 'replica run''s default on a scene nobody planned: the fixed rules, said once.
             logger("planner")->info("{}; the fixed rules until then", plan.error().message);
@@ -231,17 +237,13 @@ makeBoothScene(RunConfig& config,
         logger("planner")->info("lamp {}: {} lights, {} specular samples, {} horizon directions",
                                 name, p.lights, p.specularSamples, p.horizonDirections);
     }
-    if (config.boothDimmerAuto) {
-        chooseBoothDimmer(config, setup, displayModel);
-    }
-    setup.luminanceScale = config.boothDimmer;
-    if (config.boothDimmer != 1.0) {
-        for (auto& light : setup.booth.lights) {
-            for (double& t : light.luminance.cdM2) {
-                t *= config.boothDimmer;
-            }
-        }
-    }
+    return {};
+}
+
+// The booth pass, its shading passes compiled before the first frame unless --no-warm-up.
+Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
+createBoothScene(const RunConfig& config, pipeline::render::BoothSceneSetup setup)
+{
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
     if (!pass) {
         return tl::unexpected(pass.error());
@@ -260,6 +262,35 @@ makeBoothScene(RunConfig& config,
                                (*pass)->variantCount(), *ms);
     }
     return std::shared_ptr<pipeline::render::BoothScenePass>(std::move(*pass));
+}
+
+Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
+makeBoothScene(RunConfig& config,
+               const pipeline::booth::Booth& booth,
+               const pipeline::colour::ChannelBasis& basis,
+               const pipeline::colour::Observer& observer,
+               std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
+               const pipeline::display::DisplayModel& displayModel)
+{
+    auto setup = boothSceneSetup(config, booth, basis, observer, std::move(adaptive));
+    if (!setup) {
+        return tl::unexpected(setup.error());
+    }
+    if (auto ok = applyRenderPlan(config, *setup); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    if (config.boothDimmerAuto) {
+        chooseBoothDimmer(config, *setup, displayModel);
+    }
+    setup->luminanceScale = config.boothDimmer;
+    if (config.boothDimmer != 1.0) {
+        for (auto& light : setup->booth.lights) {
+            for (double& t : light.luminance.cdM2) {
+                t *= config.boothDimmer;
+            }
+        }
+    }
+    return createBoothScene(config, std::move(*setup));
 }
 
 // The display pass's setup from the configuration: the profile (checked against the digest a
@@ -318,22 +349,11 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
 
 } // namespace
 
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
-                                                    const OutputChoice& outputChoice)
+namespace {
+
+// The booth, scene and basis a configuration names must be ones this build has.
+Expected<void> checkBuildHas(const RunConfig& config)
 {
-    RunConfig config = configIn;
-    std::string displayId;
-    auto display = displaySetup(config, displayId);
-    if (!display) {
-        return tl::unexpected(display.error());
-    }
-    const std::string dir = dataDir().string();
-    auto app = std::make_unique<Appliance>();
-    app->config = config;
-    // Channel bases: adaptive_k6 (re-encoded for each light; the default), box6 (built in; what
-    // the first recordings used) or one fitted by 'replica spectral fit' under data/channels/
-    // (docs/accuracy.md).
-    const bool adaptive = config.basis == kAdaptiveBasis;
     const std::vector<std::string> bases = pipeline::spectral::channelBasisNames();
     const bool knownBasis = std::find(bases.begin(), bases.end(), config.basis) != bases.end();
     const bool knownScene = config.renderer == "booth" || config.scene == "colorchecker";
@@ -344,11 +364,151 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
                                      config.booth, config.scene, config.basis,
                                      fmt::join(bases, ", ")));
     }
-    if (adaptive && config.renderer != "booth") {
+    if (config.basis == kAdaptiveBasis && config.renderer != "booth") {
         return makeError(ErrorCode::InvalidArgument,
                          "basis adaptive_k6 re-encodes the booth renderer's surface scene; the "
                          "flat renderer needs a fixed basis (--basis replica_k6)");
     }
+    return {};
+}
+
+// The channel basis the surface is drawn in, and with adaptive_k6 the encoder that re-encodes it
+// for each light (its general basis then): adaptive_k6 (the default), box6 (built in; what the
+// first recordings used) or one fitted by 'replica spectral fit' under data/channels/
+// (docs/accuracy.md).
+struct Encoding {
+    pipeline::colour::ChannelBasis basis = pipeline::colour::boxBasis();
+    std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive;
+};
+
+Expected<Encoding> loadEncoding(const RunConfig& config, const std::string& dir)
+{
+    Encoding e;
+    if (config.basis == kAdaptiveBasis) {
+        auto made = pipeline::spectral::AdaptiveEncoder::createDefault(dir);
+        if (!made) {
+            return tl::unexpected(made.error());
+        }
+        e.adaptive = std::make_shared<const pipeline::spectral::AdaptiveEncoder>(std::move(*made));
+        e.basis = e.adaptive->generalBasis();
+    } else if (config.basis != "box6") {
+        auto fitted = pipeline::colour::loadChannelBasis(std::filesystem::path(dir) / "channels" /
+                                                         (config.basis + ".csv"));
+        if (!fitted) {
+            return tl::unexpected(fitted.error());
+        }
+        e.basis = std::move(*fitted);
+    }
+    return e;
+}
+
+// The state stage (state/): the light, eye and tilt estimators, from the booth data and the
+// configuration alone (nothing of the renderer): the lamps and their spectra are the booth's.
+Expected<std::unique_ptr<state::SceneEstimator>> makeStateStage(const RunConfig& config,
+                                                                const pipeline::booth::Booth& booth,
+                                                                const Encoding& encoding,
+                                                                const std::string& dir)
+{
+    auto calibration = pipeline::spectral::loadSpectrometerCalibration(
+            std::filesystem::path(dir) / config.spectrometerCalibration);
+    if (!calibration) {
+        return tl::unexpected(calibration.error());
+    }
+    state::SceneEstimatorSetup setup;
+    setup.light.booth = booth;
+    setup.light.calibration = *calibration;
+    if (config.renderer == "booth") {
+        // The re-encode decision and the diffuse term's sliced refresh are state.
+        setup.light.adaptive = encoding.adaptive;
+        setup.tilt.cacheSlices = config.cacheSlices;
+    }
+    setup.eye.trackerInBooth = config.trackerInBooth;
+    setup.eye.defaultEyeM = config.defaultEyeM;
+    setup.tilt.defaultTiltRad = config.defaultTiltRad;
+    if (!config.defaultLamp.empty()) {
+        const auto& lamps = booth.lights;
+        const auto it = std::find_if(lamps.begin(), lamps.end(),
+                                     [&](const auto& l) { return l.name == config.defaultLamp; });
+        if (it == lamps.end()) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
+                                         config.defaultLamp, config.booth, booth.names()));
+        }
+        setup.light.defaultLamp = static_cast<int>(it - lamps.begin());
+    }
+    auto estimator = state::SceneEstimator::create(std::move(setup));
+    if (!estimator) {
+        return tl::unexpected(estimator.error());
+    }
+    return std::make_unique<state::SceneEstimator>(std::move(*estimator));
+}
+
+// The renderer, in the output's GL context: the booth pass (booth renderer) and the display pass.
+Expected<void> makeRenderer(Appliance& app,
+                            pipeline::render::DisplayPassSetup display,
+                            const Encoding& encoding,
+                            const pipeline::colour::Observer& observer,
+                            const std::string& dir)
+{
+    const RunConfig& config = app.config;
+    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches. The
+    // booth renderer does not read it (its scene has its own textures).
+    auto surface =
+            config.renderer == "flat"
+                    ? pipeline::render::makeColorCheckerSurface(dir, encoding.basis, 600, 400)
+                    : pipeline::render::makeColorCheckerSurface(dir, encoding.basis, 6, 4);
+    if (!surface) {
+        return tl::unexpected(surface.error());
+    }
+    pipeline::render::GlesRendererSetup setup;
+    setup.width = config.width;
+    setup.height = config.height;
+    setup.stand = config.stand;
+    setup.booth = app.booth;
+    setup.surface = std::move(*surface);
+    setup.basis = encoding.basis;
+    setup.observer = observer;
+    app.displayWhiteXyz = display.model.whiteXyz();
+    setup.display = std::move(display);
+    setup.lightsU = config.lightsU;
+    setup.lightsV = config.lightsV;
+    setup.surroundIlluminance = config.switches.surroundIlluminance;
+    if (config.renderer == "booth") {
+        auto boothScene = makeBoothScene(app.config, app.booth, encoding.basis, observer,
+                                         encoding.adaptive, setup.display.model);
+        if (!boothScene) {
+            return tl::unexpected(boothScene.error());
+        }
+        app.boothScene = *boothScene;
+        setup.boothScene = std::move(*boothScene);
+    }
+    auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
+    if (!renderer) {
+        return tl::unexpected(renderer.error());
+    }
+    app.renderer = std::move(*renderer);
+    return {};
+}
+
+} // namespace
+
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
+                                                    const OutputChoice& outputChoice)
+{
+    // In the order the data flows: the booth data, the state stage, then the output (the display
+    // and the GL context the renderer draws in) and the renderer.
+    RunConfig config = configIn;
+    if (auto ok = checkBuildHas(config); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    std::string displayId;
+    auto display = displaySetup(config, displayId);
+    if (!display) {
+        return tl::unexpected(display.error());
+    }
+    const std::string dir = dataDir().string();
+    auto app = std::make_unique<Appliance>();
+    app->displayProfileId = displayId;
     auto booth = pipeline::scene::loadDefaultBooth(dir);
     if (!booth) {
         return tl::unexpected(booth.error());
@@ -358,36 +518,15 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     if (!observer) {
         return tl::unexpected(observer.error());
     }
-    auto calibration = pipeline::spectral::loadSpectrometerCalibration(
-            std::filesystem::path(dir) / config.spectrometerCalibration);
-    if (!calibration) {
-        return tl::unexpected(calibration.error());
+    auto encoding = loadEncoding(config, dir);
+    if (!encoding) {
+        return tl::unexpected(encoding.error());
     }
-    pipeline::colour::ChannelBasis basis = pipeline::colour::boxBasis();
-    std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> encoder;
-    if (adaptive) {
-        auto made = pipeline::spectral::AdaptiveEncoder::createDefault(dir);
-        if (!made) {
-            return tl::unexpected(made.error());
-        }
-        encoder = std::make_shared<const pipeline::spectral::AdaptiveEncoder>(std::move(*made));
-        basis = encoder->generalBasis();
-    } else if (config.basis != "box6") {
-        auto fitted = pipeline::colour::loadChannelBasis(std::filesystem::path(dir) / "channels" /
-                                                         (config.basis + ".csv"));
-        if (!fitted) {
-            return tl::unexpected(fitted.error());
-        }
-        basis = std::move(*fitted);
+    auto estimator = makeStateStage(config, app->booth, *encoding, dir);
+    if (!estimator) {
+        return tl::unexpected(estimator.error());
     }
-    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches. The
-    // booth renderer does not read it (its scene has its own textures).
-    auto surface = config.renderer == "flat"
-                           ? pipeline::render::makeColorCheckerSurface(dir, basis, 600, 400)
-                           : pipeline::render::makeColorCheckerSurface(dir, basis, 6, 4);
-    if (!surface) {
-        return tl::unexpected(surface.error());
-    }
+    app->sceneEstimator = std::move(*estimator);
 
     auto output =
             outputChoice.kind == "kms" ? createKmsOutput(outputChoice.kms) : createHeadlessOutput();
@@ -397,67 +536,9 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     app->output = std::move(*output);
     applyDisplayGeometry(config, *app->output, outputChoice);
     app->config = config;
-
-    pipeline::render::GlesRendererSetup setup;
-    setup.stand = config.stand;
-    setup.width = config.width;
-    setup.height = config.height;
-    setup.stand = config.stand;
-    setup.booth = app->booth;
-    setup.surface = std::move(*surface);
-    setup.basis = basis;
-    setup.observer = *observer;
-    app->displayWhiteXyz = display->model.whiteXyz();
-    setup.display = std::move(*display);
-    setup.lightsU = config.lightsU;
-    setup.lightsV = config.lightsV;
-    setup.surroundIlluminance = config.switches.surroundIlluminance;
-    if (config.renderer == "booth") {
-        auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer, encoder,
-                                         setup.display.model);
-        if (!boothScene) {
-            return tl::unexpected(boothScene.error());
-        }
-        app->boothScene = *boothScene;
-        setup.boothScene = std::move(*boothScene);
+    if (auto ok = makeRenderer(*app, std::move(*display), *encoding, *observer, dir); !ok) {
+        return tl::unexpected(ok.error());
     }
-    auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
-    if (!renderer) {
-        return tl::unexpected(renderer.error());
-    }
-    app->renderer = std::move(*renderer);
-    app->displayProfileId = displayId;
-
-    // The state stage (state/): the light, eye and tilt estimators.
-    state::SceneEstimatorSetup estimatorSetup;
-    estimatorSetup.light.booth = app->booth;
-    estimatorSetup.light.calibration = *calibration;
-    if (app->boothScene) {
-        // The re-encode decision and the diffuse term's sliced refresh are state: the estimators
-        // take the booth pass's encoder, lamp spectra and slice count.
-        estimatorSetup.light.adaptive = encoder;
-        estimatorSetup.light.encodeSpectra = app->boothScene->lampSpectra();
-        estimatorSetup.tilt.cacheSlices = config.cacheSlices;
-    }
-    estimatorSetup.eye.trackerInBooth = config.trackerInBooth;
-    estimatorSetup.eye.defaultEyeM = config.defaultEyeM;
-    estimatorSetup.tilt.defaultTiltRad = config.defaultTiltRad;
-    if (!config.defaultLamp.empty()) {
-        const auto& lamps = app->booth.lights;
-        const auto it = std::find_if(lamps.begin(), lamps.end(),
-                                     [&](const auto& l) { return l.name == config.defaultLamp; });
-        if (it == lamps.end()) {
-            return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
-                                         config.defaultLamp, config.booth, app->booth.names()));
-        }
-        estimatorSetup.light.defaultLamp = static_cast<int>(it - lamps.begin());
-    }
-    auto estimator = state::SceneEstimator::create(std::move(estimatorSetup));
-    if (!estimator) {
-        return tl::unexpected(estimator.error());
-    }
-    app->sceneEstimator = std::make_unique<state::SceneEstimator>(std::move(*estimator));
     return app;
 }
 

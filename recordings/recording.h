@@ -212,7 +212,7 @@ public:
     template <typename Sample>
     void write(const DeviceKind<Sample>& kind, const Sample& s)
     {
-        writeDevice(kind, std::any(s));
+        writeDevice(kind, AnySample(s));
     }
     // A sample of the first registered kind of its type (deviceKinds()).
     template <typename Sample>
@@ -220,7 +220,7 @@ public:
     {
         const auto* kind = kindOfType(deviceKinds(), typeid(Sample));
         if (kind != nullptr) {
-            writeDevice(*kind, std::any(s));
+            writeDevice(*kind, AnySample(s));
         }
     }
     virtual void write(const FrameRecord& f) = 0;

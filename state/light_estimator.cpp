@@ -98,10 +98,10 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
 
 std::vector<pipeline::colour::Spectrum> LightEstimator::encodeSpectra(const LightEstimatorSetup& s)
 {
+    // What the booth pass draws each lamp with: its booth light's spectrum (the booth data).
     std::vector<pipeline::colour::Spectrum> out;
-    for (std::size_t i = 0; i < s.booth.lights.size(); ++i) {
-        out.push_back(i < s.encodeSpectra.size() ? s.encodeSpectra[i]
-                                                 : s.booth.lights[i].referenceSpectrum);
+    for (const auto& lamp : s.booth.lights) {
+        out.push_back(lamp.spd);
     }
     return out;
 }
@@ -163,11 +163,11 @@ Expected<void> EncodingDecision::restore(const nlohmann::json& j)
 
 void LightEstimator::write(pipeline::scene::SceneState& state)
 {
-    // Changed as the renderer sees it: another lamp, or in direct-sensor mode another spectrum or
-    // luminance.
-    const bool changed =
-            !written_ || lamp_ != writtenLamp_ ||
-            (lamp_ < 0 && (spd_.v != writtenSpd_.v || luminance_ != writtenLuminance_));
+    // Changed: another content key (pipeline::scene::lightKey: another lamp, or in direct-sensor
+    // mode another spectrum or luminance), the key the renderer labels the light it holds with.
+    const bool changed = !written_ || pipeline::scene::lightKey(lamp_, spd_, luminance_) !=
+                                              pipeline::scene::lightKey(writtenLamp_, writtenSpd_,
+                                                                        writtenLuminance_);
     written_ = true;
     writtenLamp_ = lamp_;
     writtenSpd_ = spd_;

@@ -31,7 +31,7 @@ class EncodingDecision
 {
 public:
     EncodingDecision() = default;
-    // lampSpectra[i]: what lamp i is encoded for (the renderer's booth light of that lamp).
+    // lampSpectra[i]: what lamp i is encoded for (the spectrum of its booth light).
     EncodingDecision(std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
                      std::vector<pipeline::colour::Spectrum> lampSpectra,
                      double reencodeDistance = pipeline::spectral::kAdaptiveReencodeDistance)
@@ -62,12 +62,11 @@ struct LightEstimatorSetup {
     // Shown until the first usable spectrum: a booth lamp index (-1: no light).
     int defaultLamp = -1;
     // A light-adaptive encoder (basis "adaptive_k6"), none for a fixed basis: each new lamp (or a
-    // sensed shape moved by more than reencodeDistance) gets a basis of its own, made for
-    // encodeSpectra[lamp] (the renderer's booth light of that lamp; the lamp's own spectrum where
-    // it is missing) or for the sensed spectrum (pipeline/spectral/adaptive_encoding.h).
+    // sensed shape moved by more than reencodeDistance) gets a basis of its own, made for the
+    // spectrum of the lamp's booth light (booth.lights[lamp].spd, what the booth pass draws it
+    // with) or for the sensed spectrum (pipeline/spectral/adaptive_encoding.h).
     std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive;
     double reencodeDistance = pipeline::spectral::kAdaptiveReencodeDistance;
-    std::vector<pipeline::colour::Spectrum> encodeSpectra;
 };
 
 class LightEstimator

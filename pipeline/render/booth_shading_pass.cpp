@@ -149,7 +149,7 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
                                       int width,
                                       int height,
                                       const SurfaceLayout& layout,
-                                      const shading::PanelPose* cachePose)
+                                      const CacheWant* cache)
 {
     if (light_ == nullptr) {
         return makeError(ErrorCode::InvalidArgument, "render: booth pass drawn before setLight");
@@ -188,8 +188,8 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     // What the surface can light (the whole viewport for a layout that does not scale): what the
     // compose draws, and all the cache holds without the surround's illuminance.
     const PixelRect rect = surfaceRect(layout, width, height);
-    cache_.update(programs_, cachePose != nullptr ? *cachePose : view.panel, layout, rect, width,
-                  height);
+    cache_.update(programs_, cache != nullptr ? *cache : CacheWant{view.panel, std::nullopt},
+                  layout, rect, width, height);
     specularTerm_.drawGrid(programs_, view.panel, width, height);
     // Without a specular term or flare to add the frame is the cache as it is.
     composeBoothFrame(programs_, cache_, specularTerm_,
