@@ -39,7 +39,6 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.specularGrid = config.specularGrid;
     s.diffuseGrid = config.diffuseGrid;
     s.horizonDirections = config.horizonDirections;
-    pipeline::render::applyRenderSwitches(config.switches, s);
     s.areaLights = config.areaLights != 0;
     s.cacheSlices = config.cacheSlices;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
@@ -340,7 +339,6 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
                                                 : pipeline::render::InverseMethod::Analytic;
     d.gamut = config.gamutMapping == "clip" ? pd::GamutMode::Clip : pd::GamutMode::HueKeeping;
     d.viewingCompensation = config.viewingCompensation;
-    d.viewingFiltered = config.switches.viewingFiltered;
     d.flareSubtraction = config.flareSubtraction;
     d.falseColour = config.falseColour;
     id = displayProfileId(config, d.model.name);
@@ -469,10 +467,10 @@ Expected<void> makeRenderer(Appliance& app,
     setup.basis = encoding.basis;
     setup.observer = observer;
     app.displayWhiteXyz = display.model.whiteXyz();
+    app.displayModel = display.model;
     setup.display = std::move(display);
     setup.lightsU = config.lightsU;
     setup.lightsV = config.lightsV;
-    setup.surroundIlluminance = config.switches.surroundIlluminance;
     if (config.renderer == "booth") {
         auto boothScene = makeBoothScene(app.config, app.booth, encoding.basis, observer,
                                          encoding.adaptive, setup.display.model);

@@ -16,6 +16,7 @@
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
 #include <pipeline/base/rigid_transform.h>
+#include <pipeline/display/display_model.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/render_profile.h>
 #include <pipeline/render/renderer.h>
@@ -56,8 +57,7 @@ struct RunConfig {
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
     // "booth": the surface scene in sceneDir lit by the booth model (pass 1 from
-    // render/booth_scene_pass.h); "flat": the flat patch image under a uniform grid of lights, what
-    // recordings made before the booth renderer hold (a configuration without "renderer").
+    // render/booth_scene_pass.h); "flat": the flat patch image under a uniform grid of lights.
     std::string renderer = "booth";
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
@@ -77,13 +77,11 @@ struct RunConfig {
     // have none: they replay per pixel.
     int diffuseGrid = kAutoDiffuseGrid;
     int horizonDirections = 8;
-    // How the renderer evaluates the equations (pipeline/render/render_profile.h): a new run
-    // the current profile's switches. Recorded as the profile's number ("render_profile"), or,
-    // where the switches match no profile, one key each; recordings made before profiles hold the
-    // keys, absent keys replaying as before each switch existed (profile 1 when all are absent).
-    pipeline::render::RenderSwitches switches = pipeline::render::currentRenderSwitches();
-    // The profile these switches are (kExplicitRenderProfile: none).
-    int renderProfile() const { return pipeline::render::matchRenderProfile(switches); }
+    // The render path that drew the frames (pipeline/render/render_profile.h): a new run's is
+    // kRenderProfile; a recording's is the number it holds (0 without the key). Only
+    // kRenderProfile is rendered; an older number marks a recording whose frames this build
+    // reproduces approximately (replay compares them with what the recording showed).
+    int renderProfile = pipeline::render::kRenderProfile;
     // shading::RenderSettings::areaLights: 1 eq. (1) from the median-cut regions' areas, 0 from
     // point lights; kAutoAreaLights: shading::defaultAreaLights for the scene (areas on a flat
     // surface, points on relief), chosen when the appliance is built and recorded as chosen.
@@ -184,6 +182,7 @@ struct Appliance {
     std::unique_ptr<state::SceneEstimator> sceneEstimator; // the state stage (state/)
     std::string displayProfileId;                          // as recorded in the session
     glm::dvec3 displayWhiteXyz{0.0}; // the panel's full white (cd/m^2): Lab white of frame reports
+    pipeline::display::DisplayModel displayModel; // the panel: drive values to XYZ (replay)
     ~Appliance()
     {
         boothScene.reset();

@@ -1,5 +1,5 @@
 // Reading recordings of every known format version (1: unchunked, 2: chunked, 3: lamp selector,
-// 4: what was shown; of its channels replay needs only the display digests) and
+// 4: what was shown; of its channels replay reads the display digests and the thumbnails) and
 // inspecting files.
 #include <fstream>
 #include <iterator>
@@ -33,6 +33,43 @@ Expected<std::string> slurp(const std::filesystem::path& path)
                          fmt::format("{}: file is empty, not a recording", path.string()));
     }
     return bytes;
+}
+
+// A format this build reads, or one line saying it is newer.
+Expected<void> checkFormatVersion(const std::string& name, int formatVersion)
+{
+    if (formatVersion < 1 || formatVersion > kFormatVersion) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("{}: recording format {} is newer than this replica reads "
+                                     "(up to {}); update replica",
+                                     name, formatVersion, kFormatVersion));
+    }
+    return {};
+}
+
+// A thumbnail message (foxglove.CompressedImage): its PNG, tNs its Unix time until
+// placeThumbnails.
+ThumbnailRecord decodeThumbnailMessage(const nlohmann::json& j)
+{
+    ThumbnailRecord t;
+    t.tNs = j.at("timestamp").at("sec").get<std::int64_t>() * 1'000'000'000 +
+            j.at("timestamp").at("nsec").get<std::int64_t>();
+    t.png = base64Decode(j.at("data").get<std::string>());
+    return t;
+}
+
+// A thumbnail's time is its frame's tick after the session's wall-clock start.
+void placeThumbnails(Recording& rec)
+{
+    std::map<std::int64_t, std::uint64_t> frameAtTick;
+    for (const FrameRecord& f : rec.frames) {
+        frameAtTick.emplace(f.tickNs, f.frameIndex);
+    }
+    for (ThumbnailRecord& t : rec.thumbnails) {
+        t.tNs -= rec.session.wallClockStartNs;
+        const auto it = frameAtTick.find(t.tNs);
+        t.frameIndex = it != frameAtTick.end() ? it->second : 0;
+    }
 }
 
 } // namespace
@@ -106,6 +143,8 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                 rec.displayDigests.push_back(decodeDisplayDigest(j));
             } else if (topic == kLightTopic) { // format 4
                 rec.lights.push_back(decodeLight(j));
+            } else if (topic == kThumbnailTopic) { // format 4
+                rec.thumbnails.push_back(decodeThumbnailMessage(j));
             } else if (topic == kRecorderTopic) {
                 const auto r = decodeRecorderStatus(j, kinds);
                 rec.droppedMessages = r.droppedTotal();
@@ -123,12 +162,10 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                 fmt::format("{}: MCAP file without a replica session; not a replica recording",
                             name));
     }
-    if (rec.formatVersion < 1 || rec.formatVersion > kFormatVersion) {
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("{}: recording format {} is newer than this replica reads "
-                                     "(up to {}); update replica",
-                                     name, rec.formatVersion, kFormatVersion));
+    if (auto ok = checkFormatVersion(name, rec.formatVersion); !ok) {
+        return tl::unexpected(ok.error());
     }
+    placeThumbnails(rec);
     rec.unmatchedRaw = unusableRaw;
     for (std::size_t i = 0; i < kinds.size(); ++i) {
         if (rawState[i].has_value()) {

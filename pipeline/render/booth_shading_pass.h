@@ -83,8 +83,8 @@ public:
 
     const shading::RenderSettings& settings() const { return settings_; }
     const shading::PreparedScene& scene() const { return *scene_; }
-    // Whether the luminance chain is filtered by the sampler (settings.hardwareFilter and the
-    // GL's float-filtering and border-clamp extensions) or by hand in the shader.
+    // Whether the luminance chain is filtered by the sampler (where the GL has the
+    // float-filtering and border-clamp extensions) or by hand in the shader.
     bool hardwareFilter() const { return hwFilter_; }
 
 private:
