@@ -179,6 +179,24 @@ nlohmann::json renderSummary(const RenderArgs& a,
     return j;
 }
 
+// One frame of the GL pass (in the current context).
+Expected<pipeline::shading::XyzFrame> renderGl(const pipeline::shading::PreparedScene& ps,
+                                               const pipeline::shading::PreparedLight& pl,
+                                               const pipeline::shading::View& view,
+                                               const pipeline::colour::Observer& obs,
+                                               const pipeline::shading::RenderSettings& settings)
+{
+    using namespace pipeline;
+    auto pass = render::BoothShadingPass::create(ps, settings, obs);
+    if (!pass) {
+        return tl::unexpected(pass.error());
+    }
+    if (auto ok = (*pass)->setLight(pl); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return render::renderBoothFrame(**pass, pl, view);
+}
+
 int runRender(const RenderArgs& a)
 {
     using namespace pipeline;
@@ -248,14 +266,7 @@ int runRender(const RenderArgs& a)
                                               *basis);
         if (a.gl) {
             mode = "realtime-gles";
-            auto pass = render::BoothShadingPass::create(ps, settings, *obs);
-            if (!pass) {
-                return fail(kExitFailure, pass.error().message);
-            }
-            if (auto ok = (*pass)->setLight(pl); !ok) {
-                return fail(kExitFailure, ok.error().message);
-            }
-            auto f = render::renderBoothFrame(**pass, pl, view);
+            auto f = renderGl(ps, pl, view, *obs, settings);
             if (!f) {
                 return fail(kExitFailure, f.error().message);
             }
