@@ -432,6 +432,8 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     state::SceneEstimatorSetup updaterSetup;
     updaterSetup.light.booth = app->booth;
     updaterSetup.light.calibration = *calibration;
+    updaterSetup.light.chain = config.sensing;
+    updaterSetup.light.instrument = config.instrument;
     if (app->boothScene) {
         // The re-encode decision and the diffuse term's sliced refresh are state: the estimators
         // take the booth pass's encoder, lamp spectra and slice count.

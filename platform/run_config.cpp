@@ -102,6 +102,12 @@ std::string RunConfig::toJson() const
         const glm::dvec3& t = trackerInBooth.translation;
         j["t_booth_tracker"] = {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}};
     }
+    j["sensing"] = {{"stray_light", sensing.strayLight},
+                    {"wavelength_lines", sensing.wavelengthLines},
+                    {"average_spectra", sensing.averageSpectra},
+                    {"steady_distance", sensing.steadyDistance},
+                    {"stray_light_fraction", instrument.strayLightFraction},
+                    {"wavelength_offset_nm", instrument.wavelengthOffsetNm}};
     if (!plannedLamps.empty()) {
         nlohmann::json lamps = nlohmann::json::object();
         for (const auto& [name, p] : plannedLamps) {
@@ -259,6 +265,18 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
         c.defaultLamp = j.value("default_lamp", std::string());
         vec3("default_eye_m", c.defaultEyeM);
         c.defaultTiltRad = j.value("default_tilt_rad", c.defaultTiltRad);
+        // Absent before the live chain's corrections: none, one spectrum at a time.
+        c.sensing = pipeline::spectral::LiveChainOptions::none();
+        c.instrument = {};
+        if (j.contains("sensing")) {
+            const auto& s = j.at("sensing");
+            c.sensing.strayLight = s.at("stray_light").get<bool>();
+            c.sensing.wavelengthLines = s.at("wavelength_lines").get<bool>();
+            c.sensing.averageSpectra = s.at("average_spectra").get<int>();
+            c.sensing.steadyDistance = s.at("steady_distance").get<double>();
+            c.instrument.strayLightFraction = s.at("stray_light_fraction").get<double>();
+            c.instrument.wavelengthOffsetNm = s.at("wavelength_offset_nm").get<double>();
+        }
         // Absent before the planner in the loop: the fixed rules.
         if (j.contains("planned_lamps")) {
             for (const auto& [name, l] : j.at("planned_lamps").items()) {
