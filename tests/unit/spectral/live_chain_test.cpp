@@ -136,35 +136,6 @@ TEST(LiveChain, StateRestoresTheRunningAverage)
 namespace replica {
 namespace {
 
-TEST(CalibrateSpectrometer, FindsAKnownShiftOfTheWavelengthPolynomial)
-{
-    // An EEPROM that reports every pixel 0.3 nm short is off by 0.3 nm more (true - reported)
-    // than the same instrument's right one. (The sim lamps' tables lump each mercury line into
-    // a 5 nm sample, so their peaks sit on the 5 nm grid: the shift found for the right
-    // polynomial is not 0, which is why the test compares the two.)
-    const auto setup = tests::shippedEstimatorSetup().light;
-    auto spectra = lampSwitches(setup.calibration);
-    std::vector<spectral::RawSpectrum> f7;
-    std::vector<hal::SpectrumSample> shifted(spectra.begin() + 20, spectra.begin() + 30);
-    std::vector<spectral::RawSpectrum> f7Shifted;
-    for (std::size_t i = 0; i < shifted.size(); ++i) {
-        f7.push_back(raw(spectra[20 + i]));
-        shifted[i].wavelengthCoeffs[0] -= 0.3;
-        f7Shifted.push_back(raw(shifted[i]));
-    }
-    const auto right = spectral::calibrateWavelengthShift(f7, setup.calibration, 5);
-    const auto shift = spectral::calibrateWavelengthShift(f7Shifted, setup.calibration, 5);
-    ASSERT_TRUE(right && shift);
-    EXPECT_EQ(shift->runs, 2);
-    EXPECT_NEAR(shift->offsetNm - right->offsetNm, 0.3, 0.05);
-    // Tungsten has no lines: nothing to calibrate against.
-    std::vector<spectral::RawSpectrum> a;
-    for (std::size_t i = 0; i < 10; ++i) {
-        a.push_back(raw(spectra[i]));
-    }
-    EXPECT_FALSE(spectral::calibrateWavelengthShift(a, setup.calibration, 5));
-}
-
 TEST(CalibrateSpectrometer, StrayLightIsWhatReachesBelowALongPassCutOn)
 {
     // Dark 1500 counts; 40 000 counts above dark beyond 550 nm, 20 below it: 20 / 40 000.
