@@ -6,6 +6,7 @@
 #include <iterator>
 #include <numbers>
 #include <span>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -85,71 +86,107 @@ void applyDisplayGeometry(RunConfig& config, const Output& output, const OutputC
     }
 }
 
-// The site's [booth] dimmer = "auto": the scale that brings the surface's 99th percentile of Y,
-// under the brightest of the booth's lamps at the stand's brightest tilt of 0, 15, 30, 45 and 60
-// degrees (the CPU model on a 32 x 20 probe frame from the default eye, each lamp's own adaptive
-// basis), to the panel's peak. Logs the scale and what it does to the display's error on the
-// probe (over-peak share, dE00 against the dimmed scene), per lamp at its brightest tilt.
+// The views the automatic dimmer probes: the stand's tilts of 0, 15, 30, 45 and 60 degrees, each
+// seen from the default eye and from 0.4 m to either side of it (a visitor walking past: the
+// simulated scenario's walk), on a 32 x 20 probe frame.
+constexpr std::array<double, 5> kDimmerTiltsDeg{0.0, 15.0, 30.0, 45.0, 60.0};
+constexpr std::array<double, 3> kDimmerEyeOffsetsM{-0.4, 0.0, 0.4};
+
+// Each probe view of one lamp (the CPU model, the lamp's own adaptive basis), as the display pass
+// meets it.
+std::vector<DimmerView> dimmerViews(const RunConfig& config,
+                                    const pipeline::render::BoothSceneSetup& setup,
+                                    const pipeline::booth::BoothLight& light)
+{
+    namespace sh = pipeline::shading;
+    pipeline::colour::ChannelBasis basis = setup.basis;
+    if (setup.adaptive) {
+        if (auto b = setup.adaptive->basisFor(light.spd)) {
+            basis = std::move(*b);
+        }
+    }
+    const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
+                                     0.01, basis);
+    const auto pl = sh::prepareLight(light, setup.observer, setup.settings.lights, basis);
+    std::vector<DimmerView> views;
+    for (const double tiltDeg : kDimmerTiltsDeg) {
+        for (const double offsetM : kDimmerEyeOffsetsM) {
+            sh::View view;
+            view.panel = pipeline::scene::panelPose(config.stand,
+                                                    pipeline::scene::degreesToRadians(tiltDeg));
+            view.eye = config.defaultEyeM + glm::dvec3(offsetM, 0.0, 0.0);
+            view.pixelsX = 32;
+            view.pixelsY = 20;
+            DimmerView v;
+            v.frame = sh::renderRealtime(ps, pl, view, setup.observer, setup.settings);
+            for (int py = 0; py < view.pixelsY; ++py) {
+                for (int px = 0; px < view.pixelsX; ++px) {
+                    v.pixelM.push_back(sh::shadingPoint(view, setup.scene, {}, px, py).p);
+                }
+            }
+            v.normal = view.panel.normal;
+            v.eyeM = view.eye;
+            views.push_back(std::move(v));
+        }
+    }
+    return views;
+}
+
+// The site's [booth] dimmer = "auto": the largest scale at which, for every lamp, at most 1 % of
+// the surface over all its probe views together, and at most 5 % in any one view, is above the
+// panel's peak as the display pass meets it (pass 1's Y over the viewing-angle gain at each
+// pixel's angle to the eye: the run summary's "above the panel's peak"). Logs the scale and, per
+// lamp, that share (mean over the views, worst view) and the display's error at the worst view,
+// before and after.
 void chooseBoothDimmer(RunConfig& config,
                        const pipeline::render::BoothSceneSetup& setup,
                        const pipeline::display::DisplayModel& displayModel)
 {
-    namespace sh = pipeline::shading;
     auto log = logger("booth");
-    std::vector<sh::XyzFrame> frames; // per lamp, the frame of its brightest tilt
-    std::vector<std::string> names;
-    for (const auto& light : setup.booth.lights) {
-        pipeline::colour::ChannelBasis basis = setup.basis;
-        if (setup.adaptive) {
-            if (auto b = setup.adaptive->basisFor(light.spd)) {
-                basis = std::move(*b);
-            }
-        }
-        const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
-                                         0.01, basis);
-        const auto pl = sh::prepareLight(light, setup.observer, setup.settings.lights, basis);
-        double brightest = -1.0;
-        sh::XyzFrame keep;
-        for (const double tiltDeg : {0.0, 15.0, 30.0, 45.0, 60.0}) {
-            sh::View view;
-            view.panel = pipeline::scene::panelPose(config.stand,
-                                                    pipeline::scene::degreesToRadians(tiltDeg));
-            view.eye = config.defaultEyeM;
-            view.pixelsX = 32;
-            view.pixelsY = 20;
-            sh::XyzFrame f = sh::renderRealtime(ps, pl, view, setup.observer, setup.settings);
-            const double q = quantileY({f}, 0.99);
-            if (q > brightest) {
-                brightest = q;
-                keep = std::move(f);
-            }
-        }
-        frames.push_back(std::move(keep));
-        names.push_back(light.name);
-    }
     const double peakY = displayModel.whiteXyz().y;
+    std::vector<std::vector<pipeline::shading::XyzFrame>> demand; // per lamp, per view
     double scale = 1.0;
-    for (const auto& f : frames) {
-        scale = std::min(scale, autoBoothDimmer({f}, peakY));
+    for (const auto& light : setup.booth.lights) {
+        auto& lamp = demand.emplace_back();
+        for (const auto& v : dimmerViews(config, setup, light)) {
+            lamp.push_back(panelDemand(v, displayModel, config.viewingCompensation));
+            scale = std::min(scale, autoBoothDimmer({lamp.back()}, peakY, 0.95));
+        }
+        scale = std::min(scale, autoBoothDimmer(lamp, peakY, 0.99));
     }
     config.boothDimmer = scale;
     config.boothDimmerAuto = false;
     config.boothDimmerChosenAuto = true;
     auto inverse = pipeline::display::DisplayInverse::build(displayModel);
-    if (!inverse) {
-        log->info("booth dimmer (auto): {:.4f} for the panel's peak {:.0f} cd/m^2",
-                  config.boothDimmer, peakY);
-        return;
-    }
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-        const DimmerEffect before = boothDimmerEffect(frames[i], 1.0, *inverse);
-        const DimmerEffect after = boothDimmerEffect(frames[i], config.boothDimmer, *inverse);
-        log->info("booth dimmer (auto) {:.4f} for the panel's peak {:.0f} cd/m^2; lamp {} at its "
-                  "brightest tilt: surface above the peak {:.1f}% -> {:.1f}%, display dE00 mean "
-                  "/ p95 / max {:.2f} / {:.2f} / {:.2f} -> {:.2f} / {:.2f} / {:.2f}",
-                  config.boothDimmer, peakY, names[i], 100.0 * before.overPeakFraction,
-                  100.0 * after.overPeakFraction, before.de00Mean, before.de00P95, before.de00Max,
-                  after.de00Mean, after.de00P95, after.de00Max);
+    for (std::size_t i = 0; i < demand.size(); ++i) {
+        const auto share = [&](double s) {
+            double sum = 0.0, worst = 0.0;
+            std::size_t at = 0;
+            for (std::size_t k = 0; k < demand[i].size(); ++k) {
+                const double f = overPeakFraction(demand[i][k], s, peakY);
+                sum += f;
+                at = f > worst ? k : at;
+                worst = std::max(worst, f);
+            }
+            return std::make_tuple(sum / static_cast<double>(demand[i].size()), worst, at);
+        };
+        const auto [before, beforeWorst, at] = share(1.0);
+        const auto [after, afterWorst, unused] = share(scale);
+        std::string effect;
+        if (inverse) {
+            const DimmerEffect b = boothDimmerEffect(demand[i][at], 1.0, *inverse);
+            const DimmerEffect a = boothDimmerEffect(demand[i][at], scale, *inverse);
+            effect =
+                    fmt::format("; display dE00 mean / p95 / max there {:.2f} / {:.2f} / {:.2f} -> "
+                                "{:.2f} / {:.2f} / {:.2f}",
+                                b.de00Mean, b.de00P95, b.de00Max, a.de00Mean, a.de00P95, a.de00Max);
+        }
+        log->info("booth dimmer (auto) {:.4f} for the panel's peak {:.0f} cd/m^2; lamp {}: surface "
+                  "above the panel's peak{} over {} probe views: mean {:.1f}% -> {:.1f}%, worst "
+                  "view {:.1f}% -> {:.1f}%{}",
+                  scale, peakY, setup.booth.lights[i].name,
+                  config.viewingCompensation ? " (viewing gain included)" : "", demand[i].size(),
+                  100.0 * before, 100.0 * after, 100.0 * beforeWorst, 100.0 * afterWorst, effect);
     }
 }
 
@@ -415,6 +452,8 @@ Expected<std::unique_ptr<state::SceneEstimator>> makeStateStage(const RunConfig&
     state::SceneEstimatorSetup setup;
     setup.light.booth = booth;
     setup.light.calibration = *calibration;
+    setup.light.chain = config.sensing;
+    setup.light.instrument = config.instrument;
     if (config.renderer == "booth") {
         // The re-encode decision and the diffuse term's sliced refresh are state.
         setup.light.adaptive = encoding.adaptive;

@@ -22,6 +22,7 @@
 #include <pipeline/render/renderer.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/scene/stand.h>
+#include <pipeline/spectral/live_chain.h>
 #include <platform/output/output.h>
 #include <platform/render_plan.h>
 #include <recordings/recording.h>
@@ -121,6 +122,12 @@ struct RunConfig {
     int lightsU = 8;
     int lightsV = 4;
     std::string spectrometerCalibration = "spectrometer/sim_usb2000_responsivity.csv";
+    // The live spectrometer chain (pipeline/spectral/live_chain.h): its corrections and averaging,
+    // and the instrument's calibration (stray light, wavelength shift) they use, recorded as
+    // "sensing". Recordings made before it have none and replay with LiveChainOptions::none()
+    // (countsToSpectrum with default options, one spectrum at a time), spectrum for spectrum.
+    pipeline::spectral::LiveChainOptions sensing;
+    pipeline::spectral::InstrumentCalibration instrument;
     // The display profile: a path under data/ (or absolute), or kUncalibratedDisplay for the
     // nominal sRGB-like model of displayPeakCdM2/displayBlackCdM2 ('replica run --uncalibrated';
     // also what recordings made before profiles existed replay with).

@@ -87,6 +87,12 @@ std::string RunConfig::toJson() const
         const glm::dvec3& t = trackerInBooth.translation;
         j["t_booth_tracker"] = {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}};
     }
+    j["sensing"] = {{"stray_light", sensing.strayLight},
+                    {"wavelength_lines", sensing.wavelengthLines},
+                    {"average_spectra", sensing.averageSpectra},
+                    {"steady_distance", sensing.steadyDistance},
+                    {"stray_light_fraction", instrument.strayLightFraction},
+                    {"wavelength_offset_nm", instrument.wavelengthOffsetNm}};
     if (!plannedLamps.empty()) {
         nlohmann::json lamps = nlohmann::json::object();
         for (const auto& [name, p] : plannedLamps) {
@@ -212,6 +218,23 @@ Expected<void> readGeometry(const nlohmann::json& j, RunConfig& c)
     return {};
 }
 
+// The live spectrometer chain's options and the instrument's calibration. Absent before the
+// live chain's corrections: none, one spectrum at a time.
+void readSensing(const nlohmann::json& j, RunConfig& c)
+{
+    c.sensing = pipeline::spectral::LiveChainOptions::none();
+    c.instrument = {};
+    if (j.contains("sensing")) {
+        const auto& s = j.at("sensing");
+        c.sensing.strayLight = s.at("stray_light").get<bool>();
+        c.sensing.wavelengthLines = s.at("wavelength_lines").get<bool>();
+        c.sensing.averageSpectra = s.at("average_spectra").get<int>();
+        c.sensing.steadyDistance = s.at("steady_distance").get<double>();
+        c.instrument.strayLightFraction = s.at("stray_light_fraction").get<double>();
+        c.instrument.wavelengthOffsetNm = s.at("wavelength_offset_nm").get<double>();
+    }
+}
+
 // The checks across fields and ranges the schema cannot state.
 Expected<void> checkRanges(const RunConfig& c)
 {
@@ -291,6 +314,7 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
         }
         readRequired(j, c);
         readRendering(j, c);
+        readSensing(j, c);
         if (auto ok = readGeometry(j, c); !ok) {
             return tl::unexpected(ok.error());
         }

@@ -80,6 +80,14 @@ const JsonSchema& runConfigSchema()
                 {"t_booth_tracker", object({{"rotation", array(number(-1.000001, 1.000001), 9, 9)},
                                             {"translation", metres3}})
                                             .optional()},
+                // The live spectrometer chain (pipeline/spectral/live_chain.h).
+                {"sensing", object({{"stray_light", boolean()},
+                                    {"wavelength_lines", boolean()},
+                                    {"average_spectra", integer(1, 1000)},
+                                    {"steady_distance", number(0.0, 10.0)},
+                                    {"stray_light_fraction", number(0.0, 0.5)},
+                                    {"wavelength_offset_nm", number(-5.0, 5.0)}})
+                                    .optional()},
                 // The planner's choice per lamp name (platform/render_plan.h).
                 {"planned_lamps", map(object({{"lights", integer(1, 256)},
                                               {"specular_samples", integer(0, 256)},

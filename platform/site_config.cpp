@@ -394,6 +394,13 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     r.string("devices", "accel_axes", c.accelAxes);
     r.string("devices", "lamp_gpio", c.lampGpio);
     r.string("devices", "spectrometer_serial", c.spectrometerSerial);
+    r.number("spectrometer", "stray_light_fraction", c.spectrometerStrayLight, 0.0, 0.05);
+    r.number("spectrometer", "wavelength_offset_nm", c.spectrometerWavelengthOffsetNm, -5.0, 5.0);
+    {
+        double unused = 0.0; // the calibration's figures, for people
+        r.number("spectrometer", "calibration_spectra", unused, 0.0, 1e9);
+        r.number("spectrometer", "calibration_spread_nm", unused, 0.0, 100.0);
+    }
     r.string("run", "hal", c.hal, {"live", "sim", "replay"});
     r.string("run", "replay_file", c.replayFile);
     r.number("run", "rate_hz", c.rateHz, 1.0, 240.0);
@@ -435,6 +442,9 @@ std::string SiteConfig::toJson() const
             {"booth",
              {{"id", boothId},
               {"dimmer", boothDimmerAuto ? nlohmann::json("auto") : nlohmann::json(boothDimmer)}}},
+            {"spectrometer",
+             {{"stray_light_fraction", spectrometerStrayLight},
+              {"wavelength_offset_nm", spectrometerWavelengthOffsetNm}}},
             {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
             {"render",
              {{"planner",

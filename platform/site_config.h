@@ -31,6 +31,11 @@ struct SiteConfig {
     // dimmer = <number in (0, 1]> | "auto" (platform/booth_dimmer.h); absent: 1, undimmed.
     double boothDimmer = 1.0;
     bool boothDimmerAuto = false;
+    // [spectrometer]: the instrument's calibration ('replica calibrate spectrometer';
+    // pipeline/spectral/live_chain.h InstrumentCalibration): absent, the data sheet's stray light
+    // and no shift.
+    double spectrometerStrayLight = 5e-4;
+    double spectrometerWavelengthOffsetNm = 0.0;
     // [scene]
     std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
     std::string renderer = "booth"; // or "flat"

@@ -19,6 +19,7 @@
 #include <pipeline/scene/scene_state.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/light_classifier.h>
+#include <pipeline/spectral/live_chain.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 
 namespace replica::state {
@@ -58,6 +59,10 @@ private:
 struct LightEstimatorSetup {
     pipeline::booth::Booth booth;
     pipeline::spectral::SpectrometerCalibration calibration;
+    // The live chain's corrections and averaging, and the instrument's calibration they use
+    // (pipeline/spectral/live_chain.h; the run configuration's "sensing").
+    pipeline::spectral::LiveChainOptions chain = pipeline::spectral::LiveChainOptions::none();
+    pipeline::spectral::InstrumentCalibration instrument;
     pipeline::spectral::LightClassifierParams classifier;
     // Shown until the first usable spectrum: a booth lamp index (-1: no light).
     int defaultLamp = -1;
@@ -99,6 +104,7 @@ private:
                             std::optional<pipeline::spectral::LightClassifier> classifier)
         : setup_(std::move(setup)), classifier_(std::move(classifier)),
           arbiter_(static_cast<int>(setup_.booth.lights.size())),
+          chain_(setup_.calibration, setup_.instrument, setup_.chain),
           encoding_(setup_.adaptive, encodeSpectra(setup_), setup_.reencodeDistance)
     {}
     static std::vector<pipeline::colour::Spectrum> encodeSpectra(const LightEstimatorSetup& s);
@@ -107,6 +113,7 @@ private:
     LightEstimatorSetup setup_;
     std::optional<pipeline::spectral::LightClassifier> classifier_; // none: no lamps
     LampArbiter arbiter_;
+    pipeline::spectral::LiveSpectrometerChain chain_;
     std::optional<std::uint32_t> lastSpectrum_;
     std::optional<std::uint32_t> lastSelector_;
     bool haveSpectrum_ = false;

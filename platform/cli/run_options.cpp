@@ -365,6 +365,8 @@ int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfi
         config.booth = site.boothId;
         config.boothDimmer = site.boothDimmer;
         config.boothDimmerAuto = site.boothDimmerAuto;
+        config.instrument.strayLightFraction = site.spectrometerStrayLight;
+        config.instrument.wavelengthOffsetNm = site.spectrometerWavelengthOffsetNm;
         const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
         config.stand = site.stand;
         if (!o.panelSizeMm.empty()) { // the command line wins over the site file
