@@ -216,6 +216,12 @@ int replayMain(const ReplayOptions& o)
             return kExitFailure;
         }
         reprocessed = *r;
+        if (r->posesNonFinite + r->accelNonFinite > 0) {
+            log->warn("{}: --reprocess: {} poses and {} accelerometer samples came out not finite "
+                      "(a recorded scale or raw value out of range); the loop ignores them as it "
+                      "does a device's NaN",
+                      o.file, r->posesNonFinite, r->accelNonFinite);
+        }
         if (r->posesReprocessed + r->accelReprocessed == 0) {
             log->warn("{}: --reprocess: the recording holds no raw inputs of the tracker or "
                       "accelerometer (format {}; they are recorded from format 5 on, from live "
@@ -550,7 +556,9 @@ int replayMain(const ReplayOptions& o)
                                 {"accel_changed", r.accelChanged},
                                 {"lamp", r.lamp},
                                 {"lamp_reprocessed", r.lampReprocessed},
-                                {"lamp_changed", r.lampChanged}};
+                                {"lamp_changed", r.lampChanged},
+                                {"poses_non_finite", r.posesNonFinite},
+                                {"accel_non_finite", r.accelNonFinite}};
         say(fmt::format("reprocessed: {} of {} poses ({} changed) and {} of {} accelerometer "
                         "samples ({} changed) from their raw inputs; the rest as recorded",
                         r.posesReprocessed, r.poses, r.posesChanged, r.accelReprocessed, r.accel,
