@@ -31,11 +31,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             __builtin_trap(); // a field outside its report
         }
         // Every field of a report as long as the descriptor says reads back what is written.
-        const auto data = std::span(report).first(d->reportBytes(f.type, f.reportId));
+        const auto wire = std::span(report).first(d->reportBytes(f.type, f.reportId));
         if (!f.constant && f.bitSize <= 63) {
             const std::int64_t v = f.isSigned() ? -1 : 1;
-            insertField(f, data, v);
-            const auto back = extractField(f, data);
+            insertField(f, wire, v);
+            const auto back = extractField(f, wire);
             if (!back || *back != v) {
                 __builtin_trap();
             }
