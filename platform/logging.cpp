@@ -7,9 +7,11 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 
+#include <pipeline/base/printable.h>
 #include <platform/logging.h>
 
 namespace replica::platform {
@@ -18,6 +20,25 @@ namespace {
 const char* const kAreas[] = {
         "hal.spectrometer", "hal.tracker", "hal.accel", "hal.lamp", "pipeline", "render",
         "output",           "rec",         "loop",      "replica",  "planner",  "booth"};
+
+// The message of a log line with its control characters escaped (pipeline/base/printable.h):
+// a log line may carry text from a recording or a device, and a terminal must not obey it.
+class PrintableMessage final : public spdlog::custom_flag_formatter
+{
+public:
+    void format(const spdlog::details::log_msg& msg,
+                const std::tm& /*time*/,
+                spdlog::memory_buf_t& dest) override
+    {
+        const auto text = printable(std::string_view(msg.payload.data(), msg.payload.size()),
+                                    std::string_view::npos, true);
+        dest.append(text.data(), text.data() + text.size());
+    }
+    std::unique_ptr<custom_flag_formatter> clone() const override
+    {
+        return std::make_unique<PrintableMessage>();
+    }
+};
 
 std::mutex& registryMutex()
 {
@@ -111,7 +132,9 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
         return existing;
     }
     auto created = spdlog::stderr_color_mt(area);
-    created->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
+    auto formatter = std::make_unique<spdlog::pattern_formatter>();
+    formatter->add_flag<PrintableMessage>('*').set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %*");
+    created->set_formatter(std::move(formatter));
     // An area first used after --log-level was applied follows the general level, not spdlog's
     // default (info): 'replay --log-level warn' must not print a late area's info lines.
     if (auto general = spdlog::get("replica"); general && general != created) {

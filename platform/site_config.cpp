@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <toml++/toml.h>
 
+#include <pipeline/base/input_file.h>
 #include <platform/site_config.h>
 
 namespace replica::platform {
@@ -334,19 +335,26 @@ std::filesystem::path defaultSiteConfigPath()
 
 Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
 {
+    // Read as any input file (a regular file, at most kMaxTomlBytes, never waiting on a FIFO).
+    auto text = readInputFile(file, kMaxTomlBytes, "site");
+    if (!text) {
+        return makeError(text.error().code,
+                         fmt::format("{}; give a readable site file (a commented example is "
+                                     "installed as /usr/share/replica/replica.toml)",
+                                     text.error().message));
+    }
+    return parseSiteConfig(*text, file);
+}
+
+Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesystem::path& file)
+{
     SiteLoad out;
     out.config.source = file;
     toml::table root;
     try {
-        root = toml::parse_file(file.string());
+        root = toml::parse(text, file.string());
     } catch (const toml::parse_error& e) {
         const auto& where = e.source();
-        if (where.begin.line == 0) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("{}: {}; give a readable site file (a commented example "
-                                         "is installed as /usr/share/replica/replica.toml)",
-                                         file.string(), e.description()));
-        }
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("{}:{}: not valid TOML: {}", file.string(), where.begin.line,
                                      e.description()));

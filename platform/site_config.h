@@ -113,6 +113,8 @@ struct SiteLoad {
 // is a problem (the values that are good are kept). Fails only when the file cannot be read or
 // is not TOML at all (the error names the line).
 Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file);
+// The same for the text of 'file' already read (the fuzz target, tests/fuzz/site_file_fuzz.cpp).
+Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesystem::path& file);
 
 // "FILE:LINE: key: what" (LINE left out when 0).
 std::string formatProblem(const std::filesystem::path& file, const SiteProblem& p);

@@ -1,6 +1,7 @@
 // Reading recordings of every known format version (1: unchunked, 2: chunked, 3: lamp selector,
 // 4: what was shown; of its channels replay reads the display digests and the thumbnails) and
 // inspecting files.
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -8,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <recordings/mcap/reader.h>
 #include <recordings/recording.h>
 #include <recordings/sample_codec.h>
@@ -43,6 +45,34 @@ Expected<void> checkFormatVersion(const std::string& name, int formatVersion)
                          fmt::format("{}: recording format {} is newer than this replica reads "
                                      "(up to {}); update replica",
                                      name, formatVersion, kFormatVersion));
+    }
+    return {};
+}
+
+// One session per recording: a second /replica/session channel or message would change the
+// configuration (the frame size, the scene) part way through the file, whichever came last.
+Expected<void> checkOneSession(const mcap::Scan& s, const std::string& name)
+{
+    std::vector<std::uint16_t> ids;
+    for (const auto& [id, channel] : s.channels) {
+        if (channel.topic == kSessionTopic) {
+            ids.push_back(id);
+        }
+    }
+    if (ids.size() > 1) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: {} channels carry {} (ids {} and {}); a recording has "
+                                     "one session: not a recording Replica wrote",
+                                     name, ids.size(), kSessionTopic, ids[0], ids[1]));
+    }
+    const auto sessions = std::count_if(s.messages.begin(), s.messages.end(), [&](const auto& m) {
+        return !ids.empty() && m.channelId == ids[0];
+    });
+    if (sessions > 1) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: {} {} messages; a recording has one session: not a "
+                                     "recording Replica wrote",
+                                     name, sessions, kSessionTopic));
     }
     return {};
 }
@@ -96,6 +126,9 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                                                        : "",
                                      name));
     }
+    if (auto ok = checkOneSession(s, name); !ok) {
+        return tl::unexpected(ok.error());
+    }
     Recording rec;
     bool haveSession = false;
     // Each device kind's samples, by its topic; format 5: its raw inputs, by its raw topic,
@@ -120,6 +153,11 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                                          name, topic, m.sequence, m.data.size(),
                                          kMaxMessageBytes >> 10));
         }
+        if (auto ok = checkJsonLimits(
+                    m.data, fmt::format("{}: {} message (sequence {})", name, topic, m.sequence));
+            !ok) {
+            return tl::unexpected(ok.error());
+        }
         try {
             const auto j = nlohmann::json::parse(m.data);
             if (topic == kSessionTopic) {
@@ -129,6 +167,13 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                     return tl::unexpected(ok.error());
                 }
                 rec.session = decodeSession(j, rec.formatVersion, kinds);
+                // The run configuration is JSON inside the session's JSON: held to the same
+                // limits before anything (replay, inspect --json) parses it.
+                if (auto ok = checkJsonLimits(rec.session.configJson,
+                                              fmt::format("{}: run configuration", name));
+                    !ok) {
+                    return tl::unexpected(ok.error());
+                }
                 haveSession = true;
             } else if (auto k = sampleTopics.find(topic); k != sampleTopics.end()) {
                 const auto* kind = kinds[k->second];

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/base/json_limits.h>
 
 namespace replica {
 
@@ -300,6 +301,9 @@ inline Expected<nlohmann::json> parseJsonChecked(const std::string& text,
                                                  const std::string& file,
                                                  std::vector<std::string>* warnings = nullptr)
 {
+    if (auto ok = checkJsonLimits(text, file); !ok) {
+        return tl::unexpected(ok.error());
+    }
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(text);

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <pipeline/base/input_file.h>
 #include <pipeline/csv/csv_cells.h>
 #include <pipeline/display/cgats.h>
 
@@ -304,6 +305,9 @@ private:
 
 Expected<CgatsTable> parseCgats(const std::string& text, const std::string& source)
 {
+    if (auto ok = checkTableLimits(text, source, ' '); !ok) {
+        return tl::unexpected(ok.error());
+    }
     CgatsParser parser(source);
     std::istringstream in(text);
     std::string line;
@@ -496,14 +500,15 @@ Expected<MeasurementSet> loadMeasurements(const std::filesystem::path& path, int
     if (ext != ".ti3") {
         return loadMeasurementCsv(path, bitDepth);
     }
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open the measurement file", path.string()));
+    auto text = readInputFile(path, kMaxCsvBytes, "measurement");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open the measurement file", path.string()));
+        }
+        return tl::unexpected(text.error());
     }
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return parseTi3(ss.str(), path.string(), bitDepth == 0 ? 8 : bitDepth);
+    return parseTi3(*text, path.string(), bitDepth == 0 ? 8 : bitDepth);
 }
 
 } // namespace replica::pipeline::display

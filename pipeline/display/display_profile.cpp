@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <pipeline/base/json_schema.h>
 #include <pipeline/display/display_profile.h>
 
@@ -175,6 +176,9 @@ FitReport fitReportFromJson(const nlohmann::json& f)
 Expected<DisplayModel> profileFromJson(const std::string& text, const std::string& source)
 {
     DisplayModel m;
+    if (auto ok = checkJsonLimits(text, source); !ok) {
+        return tl::unexpected(ok.error());
+    }
     try {
         const auto j = nlohmann::json::parse(text);
         if (!j.is_object() || j.value("format", "") != "replica-display-profile") {

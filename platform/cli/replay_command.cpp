@@ -73,6 +73,12 @@ std::variant<LoadedReplay, int> loadReplay(const ReplayOptions& o)
             return kExitFailure;
         }
         loaded.reprocessed = *r;
+        if (r->posesNonFinite + r->accelNonFinite > 0) {
+            log->warn("{}: --reprocess: {} poses and {} accelerometer samples came out not finite "
+                      "(a recorded scale or raw value out of range); the loop ignores them as it "
+                      "does a device's NaN",
+                      o.file, r->posesNonFinite, r->accelNonFinite);
+        }
         if (r->posesReprocessed + r->accelReprocessed == 0) {
             log->warn("{}: --reprocess: the recording holds no raw inputs of the tracker or "
                       "accelerometer (format {}; they are recorded from format 5 on, from live "

@@ -36,7 +36,9 @@ void reportReprocess(const ReprocessReport& r,
                             {"accel_changed", r.accelChanged},
                             {"lamp", r.lamp},
                             {"lamp_reprocessed", r.lampReprocessed},
-                            {"lamp_changed", r.lampChanged}};
+                            {"lamp_changed", r.lampChanged},
+                            {"poses_non_finite", r.posesNonFinite},
+                            {"accel_non_finite", r.accelNonFinite}};
     say(fmt::format("reprocessed: {} of {} poses ({} changed) and {} of {} accelerometer "
                     "samples ({} changed) from their raw inputs; the rest as recorded",
                     r.posesReprocessed, r.poses, r.posesChanged, r.accelReprocessed, r.accel,

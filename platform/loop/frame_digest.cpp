@@ -7,6 +7,7 @@
 #include <xxhash.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <platform/loop/frame_digest.h>
 
 namespace replica::platform {
@@ -77,6 +78,9 @@ Expected<DigestFile> readDigestFile(const std::filesystem::path& path)
                              fmt::format("{}: cannot open digests", path.string()));
         }
         return tl::unexpected(in.error());
+    }
+    if (auto ok = checkJsonLimits(*in, path.string()); !ok) {
+        return tl::unexpected(ok.error());
     }
     DigestFile file;
     auto& out = file.frames;
