@@ -83,7 +83,7 @@ for n, (name, kind, body) in enumerate(cases):
     with open(site, "w") as f:
         f.write("\n".join(body) + "\n")
     check = subprocess.run([replica, "config", "check", site], capture_output=True, text=True)
-    run = subprocess.run([replica, "run", "--kiosk", "--config", site, "--frames", "1", "--fast"],
+    run = subprocess.run([replica, "run", "--kiosk", "--config", site, "--frames", "1"],
                          capture_output=True, text=True, timeout=600)
     ok = check.returncode == 0
     what = f"{name} = {kind} ({site})"
