@@ -1,6 +1,7 @@
 // Area loggers and level parsing.
 #include <algorithm>
 #include <cstdlib>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <sstream>
@@ -84,21 +85,6 @@ std::vector<SpecItem> specItems(const std::string& spec)
     return items;
 }
 
-// 'spec' has passed checkLogSpec.
-void applySpec(const std::string& spec)
-{
-    for (const auto& item : specItems(spec)) {
-        const auto level = *parseLevel(item.level);
-        if (!item.name) {
-            for (const char* area : kAreas) {
-                logger(area)->set_level(level);
-            }
-        } else {
-            logger(*item.name)->set_level(level);
-        }
-    }
-}
-
 class TapSink final : public spdlog::sinks::base_sink<std::mutex>
 {
 public:
@@ -123,6 +109,101 @@ std::vector<spdlog::sink_ptr>& taps()
     return t;
 }
 
+bool isTap(const spdlog::sink_ptr& s)
+{
+    const auto& t = taps();
+    return std::find(t.begin(), t.end(), s) != t.end();
+}
+
+// The level a logger's console shows: its own, or its console sink's when that is higher (a
+// logger held open for a tap).
+spdlog::level::level_enum consoleLevel(const spdlog::logger& l)
+{
+    for (const auto& s : l.sinks()) {
+        if (!isTap(s)) {
+            return std::max(s->level(), l.level());
+        }
+    }
+    return l.level();
+}
+
+// Shows 'level' on the logger's console while the logger lets every tap's level through (a
+// quieter console must not hide warnings from a recording). Under registryMutex().
+void setLevelLocked(spdlog::logger& l, spdlog::level::level_enum level)
+{
+    auto open = level;
+    for (const auto& t : taps()) {
+        open = std::min(open, t->level());
+    }
+    for (const auto& s : l.sinks()) {
+        if (!isTap(s)) {
+            s->set_level(level);
+        }
+    }
+    l.set_level(open);
+}
+
+// 'spec' has passed checkLogSpec.
+void applySpec(const std::string& spec)
+{
+    for (const auto& item : specItems(spec)) {
+        const auto level = *parseLevel(item.level);
+        std::vector<std::shared_ptr<spdlog::logger>> loggers;
+        if (!item.name) {
+            for (const char* area : kAreas) {
+                loggers.push_back(logger(area));
+            }
+        } else {
+            loggers.push_back(logger(*item.name));
+        }
+        std::lock_guard lock(registryMutex());
+        for (const auto& l : loggers) {
+            setLevelLocked(*l, level);
+        }
+    }
+}
+
+// The process's warnings and errors (followLogs).
+struct LogHistory {
+    std::mutex mutex;
+    std::deque<LoggedMessage> kept;
+    std::vector<std::shared_ptr<LogFollower>> followers;
+    std::shared_ptr<void> tap;
+};
+
+LogHistory& history()
+{
+    static LogHistory h;
+    return h;
+}
+
+void startLogHistory()
+{
+    auto& h = history();
+    {
+        std::lock_guard lock(h.mutex);
+        if (h.tap) {
+            return;
+        }
+    }
+    auto tap =
+            tapLogs(spdlog::level::warn, [](spdlog::level::level_enum level,
+                                            const std::string& area, const std::string& message) {
+                auto& hist = history();
+                const LoggedMessage m{std::chrono::steady_clock::now(), level, area, message};
+                std::lock_guard lock(hist.mutex);
+                hist.kept.push_back(m);
+                if (hist.kept.size() > kLogHistoryLimit) {
+                    hist.kept.pop_front();
+                }
+                for (const auto& f : hist.followers) {
+                    (*f)(m);
+                }
+            });
+    std::lock_guard lock(h.mutex);
+    h.tap = std::move(tap);
+}
+
 } // namespace
 
 std::shared_ptr<spdlog::logger> logger(const std::string& area)
@@ -137,12 +218,14 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
     created->set_formatter(std::move(formatter));
     // An area first used after --log-level was applied follows the general level, not spdlog's
     // default (info): 'replay --log-level warn' must not print a late area's info lines.
+    auto console = consoleLevel(*created);
     if (auto general = spdlog::get("replica"); general && general != created) {
-        created->set_level(general->level());
+        console = consoleLevel(*general);
     }
     for (const auto& t : taps()) {
         created->sinks().push_back(t);
     }
+    setLevelLocked(*created, console);
     return created;
 }
 
@@ -171,15 +254,10 @@ std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap)
         std::lock_guard lock(registryMutex());
         taps().push_back(sink);
         spdlog::apply_all([&](const std::shared_ptr<spdlog::logger>& l) {
-            // A quieter console (--log-level error) must not hide warnings from the tap: the
-            // console sinks take the logger's level, the logger lets the tap's level through.
-            if (l->level() > minLevel) {
-                for (auto& existing : l->sinks()) {
-                    existing->set_level(std::max(existing->level(), l->level()));
-                }
-                l->set_level(minLevel);
-            }
+            // A quieter console (--log-level error) must not hide warnings from the tap.
+            const auto console = consoleLevel(*l);
             l->sinks().push_back(sink);
+            setLevelLocked(*l, console);
         });
     }
     spdlog::sink_ptr held = sink;
@@ -194,11 +272,31 @@ std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap)
     });
 }
 
+std::shared_ptr<void> followLogs(LogFollower follower)
+{
+    auto& h = history();
+    auto f = std::make_shared<LogFollower>(std::move(follower));
+    {
+        std::lock_guard lock(h.mutex);
+        for (const auto& m : h.kept) {
+            (*f)(m);
+        }
+        h.followers.push_back(f);
+    }
+    return std::shared_ptr<void>(nullptr, [f](void*) {
+        auto& hist = history();
+        std::lock_guard lock(hist.mutex);
+        auto& v = hist.followers;
+        v.erase(std::remove(v.begin(), v.end(), f), v.end());
+    });
+}
+
 void setupLogging(const std::string& spec, bool fromCommandLine)
 {
     for (const char* area : kAreas) {
         logger(area);
     }
+    startLogHistory();
     // The default, then the environment, then the command line: the command line wins.
     applySpec("info");
     if (const char* env = std::getenv("REPLICA_LOG"); env != nullptr && checkLogSpec(env).empty()) {

@@ -45,8 +45,8 @@ long lineOf(const toml::node& n)
 class Reader
 {
 public:
-    Reader(const toml::table& root, std::vector<SiteProblem>& problems)
-        : root_(root), problems_(problems)
+    Reader(const toml::table& root, std::vector<SiteProblem>& problems, SiteConfig& config)
+        : root_(root), problems_(problems), config_(config)
     {}
 
     void string(const char* section,
@@ -266,7 +266,11 @@ private:
         sections_.insert(section);
         known_.insert(std::string(section) + "." + key);
         const auto* t = root_.get_as<toml::table>(section);
-        return t != nullptr ? t->get(key) : nullptr;
+        const toml::node* n = t != nullptr ? t->get(key) : nullptr;
+        if (n != nullptr) {
+            config_.lines[std::string(section) + "." + key] = lineOf(*n);
+        }
+        return n;
     }
 
     bool toDouble(const char* section, const char* key, const toml::node& n, double& v)
@@ -307,6 +311,7 @@ private:
 
     const toml::table& root_;
     std::vector<SiteProblem>& problems_;
+    SiteConfig& config_;
     std::set<std::string> sections_;
     std::set<std::string> known_;
 };
@@ -360,7 +365,7 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
                                      e.description()));
     }
     SiteConfig& c = out.config;
-    Reader r(root, out.problems);
+    Reader r(root, out.problems, c);
     r.string("booth", "id", c.boothId);
     r.numberOrAuto("booth", "dimmer", c.boothDimmer, c.boothDimmerAuto, 0.0, 1.0);
     r.string("scene", "dir", c.sceneDir);

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -93,6 +94,15 @@ struct SiteConfig {
     std::string defaultLamp; // a booth lamp's name; empty: black until the first spectrum
     glm::dvec3 defaultEyeM{0.0, 0.45, 0.60};
     double defaultTiltDeg = 0.0;
+
+    // The line of each key the file gives ("display.size" -> 12), for problems found when the
+    // values are resolved (platform/cli/run_resolve.h).
+    std::map<std::string, long> lines;
+    long lineOf(const std::string& key) const
+    {
+        const auto it = lines.find(key);
+        return it != lines.end() ? it->second : 0;
+    }
 
     // The resolved configuration as JSON (recorded in each session).
     std::string toJson() const;

@@ -5,6 +5,7 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zstd.h>
@@ -55,6 +56,14 @@ FileWriter::create(const std::filesystem::path& path, const std::string& library
                 ErrorCode::Io,
                 fmt::format("{}: cannot create recording: {}{}", path.string(), std::strerror(err),
                             err == EACCES || err == EROFS ? " (choose a writable directory)" : ""));
+    }
+    // Locked while it is written: the kiosk's recovery and retention leave a locked file alone
+    // (platform/session_files.h), and two writers never share one file.
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        ::close(fd);
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("{}: another process is writing it; name another file", path.string()));
     }
     struct stat st {
     };
