@@ -6,6 +6,7 @@
 #include <iterator>
 #include <numbers>
 #include <span>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -39,7 +40,6 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.specularGrid = config.specularGrid;
     s.diffuseGrid = config.diffuseGrid;
     s.horizonDirections = config.horizonDirections;
-    pipeline::render::applyRenderSwitches(config.switches, s);
     s.areaLights = config.areaLights != 0;
     s.cacheSlices = config.cacheSlices;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
@@ -86,81 +86,118 @@ void applyDisplayGeometry(RunConfig& config, const Output& output, const OutputC
     }
 }
 
-// The site's [booth] dimmer = "auto": the scale that brings the surface's 99th percentile of Y,
-// under the brightest of the booth's lamps at the stand's brightest tilt of 0, 15, 30, 45 and 60
-// degrees (the CPU model on a 32 x 20 probe frame from the default eye, each lamp's own adaptive
-// basis), to the panel's peak. Logs the scale and what it does to the display's error on the
-// probe (over-peak share, dE00 against the dimmed scene), per lamp at its brightest tilt.
+// The views the automatic dimmer probes: the stand's tilts of 0, 15, 30, 45 and 60 degrees, each
+// seen from the default eye and from 0.4 m to either side of it (a visitor walking past: the
+// simulated scenario's walk), on a 32 x 20 probe frame.
+constexpr std::array<double, 5> kDimmerTiltsDeg{0.0, 15.0, 30.0, 45.0, 60.0};
+constexpr std::array<double, 3> kDimmerEyeOffsetsM{-0.4, 0.0, 0.4};
+
+// Each probe view of one lamp (the CPU model, the lamp's own adaptive basis), as the display pass
+// meets it.
+std::vector<DimmerView> dimmerViews(const RunConfig& config,
+                                    const pipeline::render::BoothSceneSetup& setup,
+                                    const pipeline::booth::BoothLight& light)
+{
+    namespace sh = pipeline::shading;
+    pipeline::colour::ChannelBasis basis = setup.basis;
+    if (setup.adaptive) {
+        if (auto b = setup.adaptive->basisFor(light.spd)) {
+            basis = std::move(*b);
+        }
+    }
+    const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
+                                     0.01, basis);
+    const auto pl = sh::prepareLight(light, setup.observer, setup.settings.lights, basis);
+    std::vector<DimmerView> views;
+    for (const double tiltDeg : kDimmerTiltsDeg) {
+        for (const double offsetM : kDimmerEyeOffsetsM) {
+            sh::View view;
+            view.panel = pipeline::scene::panelPose(config.stand,
+                                                    pipeline::scene::degreesToRadians(tiltDeg));
+            view.eye = config.defaultEyeM + glm::dvec3(offsetM, 0.0, 0.0);
+            view.pixelsX = 32;
+            view.pixelsY = 20;
+            DimmerView v;
+            v.frame = sh::renderRealtime(ps, pl, view, setup.observer, setup.settings);
+            for (int py = 0; py < view.pixelsY; ++py) {
+                for (int px = 0; px < view.pixelsX; ++px) {
+                    v.pixelM.push_back(sh::shadingPoint(view, setup.scene, {}, px, py).p);
+                }
+            }
+            v.normal = view.panel.normal;
+            v.eyeM = view.eye;
+            views.push_back(std::move(v));
+        }
+    }
+    return views;
+}
+
+// The site's [booth] dimmer = "auto": the largest scale at which, for every lamp, at most 1 % of
+// the surface over all its probe views together, and at most 5 % in any one view, is above the
+// panel's peak as the display pass meets it (pass 1's Y over the viewing-angle gain at each
+// pixel's angle to the eye: the run summary's "above the panel's peak"). Logs the scale and, per
+// lamp, that share (mean over the views, worst view) and the display's error at the worst view,
+// before and after.
 void chooseBoothDimmer(RunConfig& config,
                        const pipeline::render::BoothSceneSetup& setup,
                        const pipeline::display::DisplayModel& displayModel)
 {
-    namespace sh = pipeline::shading;
     auto log = logger("booth");
-    std::vector<sh::XyzFrame> frames; // per lamp, the frame of its brightest tilt
-    std::vector<std::string> names;
-    for (const auto& light : setup.booth.lights) {
-        pipeline::colour::ChannelBasis basis = setup.basis;
-        if (setup.adaptive) {
-            if (auto b = setup.adaptive->basisFor(light.spd)) {
-                basis = std::move(*b);
-            }
-        }
-        const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
-                                         0.01, basis);
-        const auto pl = sh::prepareLight(light, setup.observer, setup.settings.lights, basis);
-        double brightest = -1.0;
-        sh::XyzFrame keep;
-        for (const double tiltDeg : {0.0, 15.0, 30.0, 45.0, 60.0}) {
-            sh::View view;
-            view.panel = pipeline::scene::panelPose(config.stand,
-                                                    pipeline::scene::degreesToRadians(tiltDeg));
-            view.eye = config.defaultEyeM;
-            view.pixelsX = 32;
-            view.pixelsY = 20;
-            sh::XyzFrame f = sh::renderRealtime(ps, pl, view, setup.observer, setup.settings);
-            const double q = quantileY({f}, 0.99);
-            if (q > brightest) {
-                brightest = q;
-                keep = std::move(f);
-            }
-        }
-        frames.push_back(std::move(keep));
-        names.push_back(light.name);
-    }
     const double peakY = displayModel.whiteXyz().y;
+    std::vector<std::vector<pipeline::shading::XyzFrame>> demand; // per lamp, per view
     double scale = 1.0;
-    for (const auto& f : frames) {
-        scale = std::min(scale, autoBoothDimmer({f}, peakY));
+    for (const auto& light : setup.booth.lights) {
+        auto& lamp = demand.emplace_back();
+        for (const auto& v : dimmerViews(config, setup, light)) {
+            lamp.push_back(panelDemand(v, displayModel, config.viewingCompensation));
+            scale = std::min(scale, autoBoothDimmer({lamp.back()}, peakY, 0.95));
+        }
+        scale = std::min(scale, autoBoothDimmer(lamp, peakY, 0.99));
     }
     config.boothDimmer = scale;
     config.boothDimmerAuto = false;
     config.boothDimmerChosenAuto = true;
     auto inverse = pipeline::display::DisplayInverse::build(displayModel);
-    if (!inverse) {
-        log->info("booth dimmer (auto): {:.4f} for the panel's peak {:.0f} cd/m^2",
-                  config.boothDimmer, peakY);
-        return;
-    }
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-        const DimmerEffect before = boothDimmerEffect(frames[i], 1.0, *inverse);
-        const DimmerEffect after = boothDimmerEffect(frames[i], config.boothDimmer, *inverse);
-        log->info("booth dimmer (auto) {:.4f} for the panel's peak {:.0f} cd/m^2; lamp {} at its "
-                  "brightest tilt: surface above the peak {:.1f}% -> {:.1f}%, display dE00 mean "
-                  "/ p95 / max {:.2f} / {:.2f} / {:.2f} -> {:.2f} / {:.2f} / {:.2f}",
-                  config.boothDimmer, peakY, names[i], 100.0 * before.overPeakFraction,
-                  100.0 * after.overPeakFraction, before.de00Mean, before.de00P95, before.de00Max,
-                  after.de00Mean, after.de00P95, after.de00Max);
+    for (std::size_t i = 0; i < demand.size(); ++i) {
+        const auto share = [&](double s) {
+            double sum = 0.0, worst = 0.0;
+            std::size_t at = 0;
+            for (std::size_t k = 0; k < demand[i].size(); ++k) {
+                const double f = overPeakFraction(demand[i][k], s, peakY);
+                sum += f;
+                at = f > worst ? k : at;
+                worst = std::max(worst, f);
+            }
+            return std::make_tuple(sum / static_cast<double>(demand[i].size()), worst, at);
+        };
+        const auto [before, beforeWorst, at] = share(1.0);
+        const auto [after, afterWorst, unused] = share(scale);
+        std::string effect;
+        if (inverse) {
+            const DimmerEffect b = boothDimmerEffect(demand[i][at], 1.0, *inverse);
+            const DimmerEffect a = boothDimmerEffect(demand[i][at], scale, *inverse);
+            effect =
+                    fmt::format("; display dE00 mean / p95 / max there {:.2f} / {:.2f} / {:.2f} -> "
+                                "{:.2f} / {:.2f} / {:.2f}",
+                                b.de00Mean, b.de00P95, b.de00Max, a.de00Mean, a.de00P95, a.de00Max);
+        }
+        log->info("booth dimmer (auto) {:.4f} for the panel's peak {:.0f} cd/m^2; lamp {}: surface "
+                  "above the panel's peak{} over {} probe views: mean {:.1f}% -> {:.1f}%, worst "
+                  "view {:.1f}% -> {:.1f}%{}",
+                  scale, peakY, setup.booth.lights[i].name,
+                  config.viewingCompensation ? " (viewing gain included)" : "", demand[i].size(),
+                  100.0 * before, 100.0 * after, 100.0 * beforeWorst, 100.0 * afterWorst, effect);
     }
 }
 
-Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
-makeBoothScene(RunConfig& config,
-               const pipeline::booth::Booth& booth,
-               const pipeline::colour::ChannelBasis& basis,
-               const pipeline::colour::Observer& observer,
-               std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
-               const pipeline::display::DisplayModel& displayModel)
+// The booth pass's setup: the scene folder (its digest checked against a recording's), the
+// booth, the bases, and the counts chosen for the scene (recorded in 'config').
+Expected<pipeline::render::BoothSceneSetup>
+boothSceneSetup(RunConfig& config,
+                const pipeline::booth::Booth& booth,
+                const pipeline::colour::ChannelBasis& basis,
+                const pipeline::colour::Observer& observer,
+                std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive)
 {
     const auto dir = resolveSceneDir(config.sceneDir);
     auto digest = sceneDigest(dir);
@@ -180,7 +217,6 @@ makeBoothScene(RunConfig& config,
     }
     config.scene = scene->name;
     pipeline::render::BoothSceneSetup setup;
-    setup.stand = config.stand;
     setup.booth = booth;
     setup.scene = std::move(*scene);
     setup.basis = basis;
@@ -201,13 +237,19 @@ makeBoothScene(RunConfig& config,
         config.areaLights = pipeline::shading::defaultAreaLights(setup.scene) ? 1 : 0;
     }
     setup.settings = boothRenderSettings(config);
-    // The planner in the loop: the scene's cached plan (computed once when missing), recorded.
+    return setup;
+}
+
+// The planner in the loop: the scene's cached plan (computed once when missing), recorded in
+// config.plannedLamps, and each planned lamp's counts in the setup.
+Expected<void> applyRenderPlan(RunConfig& config, pipeline::render::BoothSceneSetup& setup)
+{
     if (config.planner && config.plannedLamps.empty()) {
-        auto plan = loadOrComputeRenderPlan(dir, dataDir() / "booth", config.basis,
-                                            config.plannerCache.empty()
-                                                    ? defaultPlanCacheDir()
-                                                    : std::filesystem::path(config.plannerCache),
-                                            config.planIfMissing);
+        auto plan = loadOrComputeRenderPlan(
+                resolveSceneDir(config.sceneDir), dataDir() / "booth", config.basis,
+                config.plannerCache.empty() ? defaultPlanCacheDir()
+                                            : std::filesystem::path(config.plannerCache),
+                config.planIfMissing);
         if (!plan && !config.planIfMissing && plan.error().code == ErrorCode::NotFound) {
             // 'replica run''s default on a scene nobody planned: the fixed rules, said once.
             logger("planner")->info("{}; the fixed rules until then", plan.error().message);
@@ -231,17 +273,13 @@ makeBoothScene(RunConfig& config,
         logger("planner")->info("lamp {}: {} lights, {} specular samples, {} horizon directions",
                                 name, p.lights, p.specularSamples, p.horizonDirections);
     }
-    if (config.boothDimmerAuto) {
-        chooseBoothDimmer(config, setup, displayModel);
-    }
-    setup.luminanceScale = config.boothDimmer;
-    if (config.boothDimmer != 1.0) {
-        for (auto& light : setup.booth.lights) {
-            for (double& t : light.luminance.cdM2) {
-                t *= config.boothDimmer;
-            }
-        }
-    }
+    return {};
+}
+
+// The booth pass, its shading passes compiled before the first frame unless --no-warm-up.
+Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
+createBoothScene(const RunConfig& config, pipeline::render::BoothSceneSetup setup)
+{
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
     if (!pass) {
         return tl::unexpected(pass.error());
@@ -260,6 +298,35 @@ makeBoothScene(RunConfig& config,
                                (*pass)->variantCount(), *ms);
     }
     return std::shared_ptr<pipeline::render::BoothScenePass>(std::move(*pass));
+}
+
+Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
+makeBoothScene(RunConfig& config,
+               const pipeline::booth::Booth& booth,
+               const pipeline::colour::ChannelBasis& basis,
+               const pipeline::colour::Observer& observer,
+               std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
+               const pipeline::display::DisplayModel& displayModel)
+{
+    auto setup = boothSceneSetup(config, booth, basis, observer, std::move(adaptive));
+    if (!setup) {
+        return tl::unexpected(setup.error());
+    }
+    if (auto ok = applyRenderPlan(config, *setup); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    if (config.boothDimmerAuto) {
+        chooseBoothDimmer(config, *setup, displayModel);
+    }
+    setup->luminanceScale = config.boothDimmer;
+    if (config.boothDimmer != 1.0) {
+        for (auto& light : setup->booth.lights) {
+            for (double& t : light.luminance.cdM2) {
+                t *= config.boothDimmer;
+            }
+        }
+    }
+    return createBoothScene(config, std::move(*setup));
 }
 
 // The display pass's setup from the configuration: the profile (checked against the digest a
@@ -309,7 +376,6 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
                                                 : pipeline::render::InverseMethod::Analytic;
     d.gamut = config.gamutMapping == "clip" ? pd::GamutMode::Clip : pd::GamutMode::HueKeeping;
     d.viewingCompensation = config.viewingCompensation;
-    d.viewingFiltered = config.switches.viewingFiltered;
     d.flareSubtraction = config.flareSubtraction;
     d.falseColour = config.falseColour;
     id = displayProfileId(config, d.model.name);
@@ -318,22 +384,11 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
 
 } // namespace
 
-Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
-                                                    const OutputChoice& outputChoice)
+namespace {
+
+// The booth, scene and basis a configuration names must be ones this build has.
+Expected<void> checkBuildHas(const RunConfig& config)
 {
-    RunConfig config = configIn;
-    std::string displayId;
-    auto display = displaySetup(config, displayId);
-    if (!display) {
-        return tl::unexpected(display.error());
-    }
-    const std::string dir = dataDir().string();
-    auto app = std::make_unique<Appliance>();
-    app->config = config;
-    // Channel bases: adaptive_k6 (re-encoded for each light; the default), box6 (built in; what
-    // the first recordings used) or one fitted by 'replica spectral fit' under data/channels/
-    // (docs/accuracy.md).
-    const bool adaptive = config.basis == kAdaptiveBasis;
     const std::vector<std::string> bases = pipeline::spectral::channelBasisNames();
     const bool knownBasis = std::find(bases.begin(), bases.end(), config.basis) != bases.end();
     const bool knownScene = config.renderer == "booth" || config.scene == "colorchecker";
@@ -344,11 +399,153 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
                                      config.booth, config.scene, config.basis,
                                      fmt::join(bases, ", ")));
     }
-    if (adaptive && config.renderer != "booth") {
+    if (config.basis == kAdaptiveBasis && config.renderer != "booth") {
         return makeError(ErrorCode::InvalidArgument,
                          "basis adaptive_k6 re-encodes the booth renderer's surface scene; the "
                          "flat renderer needs a fixed basis (--basis replica_k6)");
     }
+    return {};
+}
+
+// The channel basis the surface is drawn in, and with adaptive_k6 the encoder that re-encodes it
+// for each light (its general basis then): adaptive_k6 (the default), box6 (built in; what the
+// first recordings used) or one fitted by 'replica spectral fit' under data/channels/
+// (docs/accuracy.md).
+struct Encoding {
+    pipeline::colour::ChannelBasis basis = pipeline::colour::boxBasis();
+    std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive;
+};
+
+Expected<Encoding> loadEncoding(const RunConfig& config, const std::string& dir)
+{
+    Encoding e;
+    if (config.basis == kAdaptiveBasis) {
+        auto made = pipeline::spectral::AdaptiveEncoder::createDefault(dir);
+        if (!made) {
+            return tl::unexpected(made.error());
+        }
+        e.adaptive = std::make_shared<const pipeline::spectral::AdaptiveEncoder>(std::move(*made));
+        e.basis = e.adaptive->generalBasis();
+    } else if (config.basis != "box6") {
+        auto fitted = pipeline::colour::loadChannelBasis(std::filesystem::path(dir) / "channels" /
+                                                         (config.basis + ".csv"));
+        if (!fitted) {
+            return tl::unexpected(fitted.error());
+        }
+        e.basis = std::move(*fitted);
+    }
+    return e;
+}
+
+// The state stage (state/): the light, eye and tilt estimators, from the booth data and the
+// configuration alone (nothing of the renderer): the lamps and their spectra are the booth's.
+Expected<std::unique_ptr<state::SceneEstimator>> makeStateStage(const RunConfig& config,
+                                                                const pipeline::booth::Booth& booth,
+                                                                const Encoding& encoding,
+                                                                const std::string& dir)
+{
+    auto calibration = pipeline::spectral::loadSpectrometerCalibration(
+            std::filesystem::path(dir) / config.spectrometerCalibration);
+    if (!calibration) {
+        return tl::unexpected(calibration.error());
+    }
+    state::SceneEstimatorSetup setup;
+    setup.light.booth = booth;
+    setup.light.calibration = *calibration;
+    setup.light.chain = config.sensing;
+    setup.light.instrument = config.instrument;
+    if (config.renderer == "booth") {
+        // The re-encode decision and the diffuse term's sliced refresh are state.
+        setup.light.adaptive = encoding.adaptive;
+        setup.tilt.cacheSlices = config.cacheSlices;
+    }
+    setup.eye.trackerInBooth = config.trackerInBooth;
+    setup.eye.defaultEyeM = config.defaultEyeM;
+    setup.tilt.defaultTiltRad = config.defaultTiltRad;
+    if (!config.defaultLamp.empty()) {
+        const auto& lamps = booth.lights;
+        const auto it = std::find_if(lamps.begin(), lamps.end(),
+                                     [&](const auto& l) { return l.name == config.defaultLamp; });
+        if (it == lamps.end()) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
+                                         config.defaultLamp, config.booth, booth.names()));
+        }
+        setup.light.defaultLamp = static_cast<int>(it - lamps.begin());
+    }
+    auto estimator = state::SceneEstimator::create(std::move(setup));
+    if (!estimator) {
+        return tl::unexpected(estimator.error());
+    }
+    return std::make_unique<state::SceneEstimator>(std::move(*estimator));
+}
+
+// The renderer, in the output's GL context: the booth pass (booth renderer) and the display pass.
+Expected<void> makeRenderer(Appliance& app,
+                            pipeline::render::DisplayPassSetup display,
+                            const Encoding& encoding,
+                            const pipeline::colour::Observer& observer,
+                            const std::string& dir)
+{
+    const RunConfig& config = app.config;
+    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches. The
+    // booth renderer does not read it (its scene has its own textures).
+    auto surface =
+            config.renderer == "flat"
+                    ? pipeline::render::makeColorCheckerSurface(dir, encoding.basis, 600, 400)
+                    : pipeline::render::makeColorCheckerSurface(dir, encoding.basis, 6, 4);
+    if (!surface) {
+        return tl::unexpected(surface.error());
+    }
+    pipeline::render::GlesRendererSetup setup;
+    setup.width = config.width;
+    setup.height = config.height;
+    setup.stand = config.stand;
+    setup.booth = app.booth;
+    setup.surface = std::move(*surface);
+    setup.basis = encoding.basis;
+    setup.observer = observer;
+    app.displayWhiteXyz = display.model.whiteXyz();
+    app.displayModel = display.model;
+    setup.display = std::move(display);
+    setup.lightsU = config.lightsU;
+    setup.lightsV = config.lightsV;
+    if (config.renderer == "booth") {
+        auto boothScene = makeBoothScene(app.config, app.booth, encoding.basis, observer,
+                                         encoding.adaptive, setup.display.model);
+        if (!boothScene) {
+            return tl::unexpected(boothScene.error());
+        }
+        app.boothScene = *boothScene;
+        setup.boothScene = std::move(*boothScene);
+    }
+    auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
+    if (!renderer) {
+        return tl::unexpected(renderer.error());
+    }
+    app.renderer = std::move(*renderer);
+    return {};
+}
+
+} // namespace
+
+Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
+                                                    const OutputChoice& outputChoice)
+{
+    // In the order the data flows: the booth data, the state stage, then the output (the display
+    // and the GL context the renderer draws in) and the renderer.
+    RunConfig config = configIn;
+    if (auto ok = checkBuildHas(config); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    std::string displayId;
+    auto display = displaySetup(config, displayId);
+    if (!display) {
+        return tl::unexpected(display.error());
+    }
+    const std::string dir = dataDir().string();
+    auto app = std::make_unique<Appliance>();
+    app->displayProfileId = displayId;
     auto booth = pipeline::scene::loadDefaultBooth(dir);
     if (!booth) {
         return tl::unexpected(booth.error());
@@ -358,36 +555,15 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     if (!observer) {
         return tl::unexpected(observer.error());
     }
-    auto calibration = pipeline::spectral::loadSpectrometerCalibration(
-            std::filesystem::path(dir) / config.spectrometerCalibration);
-    if (!calibration) {
-        return tl::unexpected(calibration.error());
+    auto encoding = loadEncoding(config, dir);
+    if (!encoding) {
+        return tl::unexpected(encoding.error());
     }
-    pipeline::colour::ChannelBasis basis = pipeline::colour::boxBasis();
-    std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> encoder;
-    if (adaptive) {
-        auto made = pipeline::spectral::AdaptiveEncoder::createDefault(dir);
-        if (!made) {
-            return tl::unexpected(made.error());
-        }
-        encoder = std::make_shared<const pipeline::spectral::AdaptiveEncoder>(std::move(*made));
-        basis = encoder->generalBasis();
-    } else if (config.basis != "box6") {
-        auto fitted = pipeline::colour::loadChannelBasis(std::filesystem::path(dir) / "channels" /
-                                                         (config.basis + ".csv"));
-        if (!fitted) {
-            return tl::unexpected(fitted.error());
-        }
-        basis = std::move(*fitted);
+    auto estimator = makeStateStage(config, app->booth, *encoding, dir);
+    if (!estimator) {
+        return tl::unexpected(estimator.error());
     }
-    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches. The
-    // booth renderer does not read it (its scene has its own textures).
-    auto surface = config.renderer == "flat"
-                           ? pipeline::render::makeColorCheckerSurface(dir, basis, 600, 400)
-                           : pipeline::render::makeColorCheckerSurface(dir, basis, 6, 4);
-    if (!surface) {
-        return tl::unexpected(surface.error());
-    }
+    app->sceneEstimator = std::move(*estimator);
 
     auto output =
             outputChoice.kind == "kms" ? createKmsOutput(outputChoice.kms) : createHeadlessOutput();
@@ -397,67 +573,9 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     app->output = std::move(*output);
     applyDisplayGeometry(config, *app->output, outputChoice);
     app->config = config;
-
-    pipeline::render::GlesRendererSetup setup;
-    setup.stand = config.stand;
-    setup.width = config.width;
-    setup.height = config.height;
-    setup.stand = config.stand;
-    setup.booth = app->booth;
-    setup.surface = std::move(*surface);
-    setup.basis = basis;
-    setup.observer = *observer;
-    app->displayWhiteXyz = display->model.whiteXyz();
-    setup.display = std::move(*display);
-    setup.lightsU = config.lightsU;
-    setup.lightsV = config.lightsV;
-    setup.surroundIlluminance = config.switches.surroundIlluminance;
-    if (config.renderer == "booth") {
-        auto boothScene = makeBoothScene(app->config, app->booth, basis, *observer, encoder,
-                                         setup.display.model);
-        if (!boothScene) {
-            return tl::unexpected(boothScene.error());
-        }
-        app->boothScene = *boothScene;
-        setup.boothScene = std::move(*boothScene);
+    if (auto ok = makeRenderer(*app, std::move(*display), *encoding, *observer, dir); !ok) {
+        return tl::unexpected(ok.error());
     }
-    auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
-    if (!renderer) {
-        return tl::unexpected(renderer.error());
-    }
-    app->renderer = std::move(*renderer);
-    app->displayProfileId = displayId;
-
-    // The state stage (state/): the light, eye and tilt estimators.
-    state::SceneEstimatorSetup updaterSetup;
-    updaterSetup.light.booth = app->booth;
-    updaterSetup.light.calibration = *calibration;
-    if (app->boothScene) {
-        // The re-encode decision and the diffuse term's sliced refresh are state: the estimators
-        // take the booth pass's encoder, lamp spectra and slice count.
-        updaterSetup.light.adaptive = encoder;
-        updaterSetup.light.encodeSpectra = app->boothScene->lampSpectra();
-        updaterSetup.tilt.cacheSlices = config.cacheSlices;
-    }
-    updaterSetup.eye.trackerInBooth = config.trackerInBooth;
-    updaterSetup.eye.defaultEyeM = config.defaultEyeM;
-    updaterSetup.tilt.defaultTiltRad = config.defaultTiltRad;
-    if (!config.defaultLamp.empty()) {
-        const auto& lamps = app->booth.lights;
-        const auto it = std::find_if(lamps.begin(), lamps.end(),
-                                     [&](const auto& l) { return l.name == config.defaultLamp; });
-        if (it == lamps.end()) {
-            return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
-                                         config.defaultLamp, config.booth, app->booth.names()));
-        }
-        updaterSetup.light.defaultLamp = static_cast<int>(it - lamps.begin());
-    }
-    auto updater = state::SceneEstimator::create(std::move(updaterSetup));
-    if (!updater) {
-        return tl::unexpected(updater.error());
-    }
-    app->updater = std::make_unique<state::SceneEstimator>(std::move(*updater));
     return app;
 }
 
@@ -467,7 +585,7 @@ Expected<void> restoreStateAtStart(Appliance& appliance, const std::string& conf
     if (config.is_discarded() || !config.is_object() || !config.contains(kStateAtStartKey)) {
         return {};
     }
-    if (auto ok = appliance.updater->restore(config[kStateAtStartKey]); !ok) {
+    if (auto ok = appliance.sceneEstimator->restore(config[kStateAtStartKey]); !ok) {
         return makeError(ok.error().code, fmt::format("the run configuration's {}: {}",
                                                       kStateAtStartKey, ok.error().message));
     }

@@ -1,5 +1,5 @@
 // Builds the appliance's parts from a run configuration: output (GL context), renderer, scene
-// updater, and the HAL sources (simulated or replayed).
+// estimator (the state stage), and the HAL sources (simulated or replayed).
 #pragma once
 
 #include <filesystem>
@@ -16,11 +16,13 @@
 #include <hal/sources.h>
 #include <pipeline/base/expected.h>
 #include <pipeline/base/rigid_transform.h>
+#include <pipeline/display/display_model.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/render_profile.h>
 #include <pipeline/render/renderer.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/scene/stand.h>
+#include <pipeline/spectral/live_chain.h>
 #include <platform/output/output.h>
 #include <platform/render_plan.h>
 #include <recordings/recording.h>
@@ -56,8 +58,7 @@ struct RunConfig {
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
     // "booth": the surface scene in sceneDir lit by the booth model (pass 1 from
-    // render/booth_scene_pass.h); "flat": the flat patch image under a uniform grid of lights, what
-    // recordings made before the booth renderer hold (a configuration without "renderer").
+    // render/booth_scene_pass.h); "flat": the flat patch image under a uniform grid of lights.
     std::string renderer = "booth";
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
@@ -77,13 +78,11 @@ struct RunConfig {
     // have none: they replay per pixel.
     int diffuseGrid = kAutoDiffuseGrid;
     int horizonDirections = 8;
-    // How the renderer evaluates the equations (pipeline/render/render_profile.h): a new run
-    // the current profile's switches. Recorded as the profile's number ("render_profile"), or,
-    // where the switches match no profile, one key each; recordings made before profiles hold the
-    // keys, absent keys replaying as before each switch existed (profile 1 when all are absent).
-    pipeline::render::RenderSwitches switches = pipeline::render::currentRenderSwitches();
-    // The profile these switches are (kExplicitRenderProfile: none).
-    int renderProfile() const { return pipeline::render::matchRenderProfile(switches); }
+    // The render path that drew the frames (pipeline/render/render_profile.h): a new run's is
+    // kRenderProfile; a recording's is the number it holds (0 without the key). Only
+    // kRenderProfile is rendered; an older number marks a recording whose frames this build
+    // reproduces approximately (replay compares them with what the recording showed).
+    int renderProfile = pipeline::render::kRenderProfile;
     // shading::RenderSettings::areaLights: 1 eq. (1) from the median-cut regions' areas, 0 from
     // point lights; kAutoAreaLights: shading::defaultAreaLights for the scene (areas on a flat
     // surface, points on relief), chosen when the appliance is built and recorded as chosen.
@@ -123,6 +122,12 @@ struct RunConfig {
     int lightsU = 8;
     int lightsV = 4;
     std::string spectrometerCalibration = "spectrometer/sim_usb2000_responsivity.csv";
+    // The live spectrometer chain (pipeline/spectral/live_chain.h): its corrections and averaging,
+    // and the instrument's calibration (stray light, wavelength shift) they use, recorded as
+    // "sensing". Recordings made before it have none and replay with LiveChainOptions::none()
+    // (countsToSpectrum with default options, one spectrum at a time), spectrum for spectrum.
+    pipeline::spectral::LiveChainOptions sensing;
+    pipeline::spectral::InstrumentCalibration instrument;
     // The display profile: a path under data/ (or absolute), or kUncalibratedDisplay for the
     // nominal sRGB-like model of displayPeakCdM2/displayBlackCdM2 ('replica run --uncalibrated';
     // also what recordings made before profiles existed replay with).
@@ -181,9 +186,10 @@ struct Appliance {
     // The booth renderer's pass 1 (shared with the renderer), null with the flat renderer: what
     // tests ask about the adaptive encoding (its basis, how often it re-encoded).
     std::shared_ptr<pipeline::render::BoothScenePass> boothScene;
-    std::unique_ptr<state::SceneEstimator> updater; // the state stage (state/)
-    std::string displayProfileId;                   // as recorded in the session
+    std::unique_ptr<state::SceneEstimator> sceneEstimator; // the state stage (state/)
+    std::string displayProfileId;                          // as recorded in the session
     glm::dvec3 displayWhiteXyz{0.0}; // the panel's full white (cd/m^2): Lab white of frame reports
+    pipeline::display::DisplayModel displayModel; // the panel: drive values to XYZ (replay)
     ~Appliance()
     {
         boothScene.reset();

@@ -1,8 +1,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/common.hpp>
+
 #include <pipeline/colour/ciede2000.h>
 #include <pipeline/colour/cielab.h>
+#include <pipeline/display/viewing_angle.h>
 #include <platform/booth_dimmer.h>
 
 namespace replica::platform {
@@ -46,6 +49,38 @@ double autoBoothDimmer(const std::vector<pipeline::shading::XyzFrame>& frames,
         return 1.0;
     }
     return peakY / yq;
+}
+
+pipeline::shading::XyzFrame panelDemand(const DimmerView& view,
+                                        const pipeline::display::DisplayModel& model,
+                                        bool viewingCompensation)
+{
+    namespace pd = pipeline::display;
+    pipeline::shading::XyzFrame out = view.frame;
+    if (!viewingCompensation || model.viewing.empty()) {
+        return out;
+    }
+    const glm::dvec3 white = model.whiteXyz();
+    for (std::size_t i = 0; i < out.xyz.size() && i < view.pixelM.size(); ++i) {
+        const double angle = pd::viewingAngleDeg(view.pixelM[i], view.normal, view.eyeM);
+        // The shader's floor on the gain (display_main.glsl).
+        const glm::dvec3 gain =
+                glm::max(pd::viewingGain(model.viewing, white, angle), glm::dvec3(1e-3));
+        out.xyz[i] /= gain;
+    }
+    return out;
+}
+
+double overPeakFraction(const pipeline::shading::XyzFrame& frame, double scale, double peakY)
+{
+    if (frame.xyz.empty()) {
+        return 0.0;
+    }
+    long over = 0;
+    for (const auto& p : frame.xyz) {
+        over += scale * p.y > peakY ? 1 : 0;
+    }
+    return static_cast<double>(over) / static_cast<double>(frame.xyz.size());
 }
 
 DimmerEffect boothDimmerEffect(const pipeline::shading::XyzFrame& frame,

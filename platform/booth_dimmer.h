@@ -7,6 +7,8 @@
 
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/shading/frame.h>
 
@@ -23,6 +25,29 @@ double quantileY(const std::vector<pipeline::shading::XyzFrame>& frames, double 
 double autoBoothDimmer(const std::vector<pipeline::shading::XyzFrame>& frames,
                        double peakY,
                        double quantile = 0.99);
+
+// One view of pass 1's frame as the display pass meets it: where each pixel lies on the panel
+// (metres, booth frame; row-major like the frame), the panel's normal and the eye.
+struct DimmerView {
+    pipeline::shading::XyzFrame frame;
+    std::vector<glm::dvec3> pixelM;
+    glm::dvec3 normal{0.0, 0.0, 1.0};
+    glm::dvec3 eyeM{0.0};
+};
+
+// What the display pass asks the panel to emit for each pixel of the view (display_main.glsl):
+// pass 1's XYZ divided by the viewing-angle gain at the pixel's angle to the eye (none when
+// 'viewingCompensation' is off or the profile has no table). The pass also subtracts the screen's
+// flare (rho_d E / pi: about 1 cd/m^2 at 2000 lux, against a peak of 900); it is left in, so the
+// demand errs high by that. A pixel is above the panel's peak as the run summary counts it
+// (GamutClass::OverPeak: the demand's Y over the white's) exactly when its demand's Y is.
+pipeline::shading::XyzFrame panelDemand(const DimmerView& view,
+                                        const pipeline::display::DisplayModel& model,
+                                        bool viewingCompensation);
+
+// The share of the frame's pixels whose Y, times 'scale', is above peakY (the run summary's
+// "above the panel's peak" for a demand frame).
+double overPeakFraction(const pipeline::shading::XyzFrame& frame, double scale, double peakY);
 
 // What a dimmer does to what the panel can show of pass 1's frame: every pixel's XYZ scaled by
 // 'scale', through the display's inverse (hue-keeping gamut mapping) and back through its model

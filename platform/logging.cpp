@@ -2,17 +2,20 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
+#include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <sys/stat.h>
 #include <sys/uio.h>
 
+#include <pipeline/base/printable.h>
 #include <platform/logging.h>
 
 #ifdef REPLICA_HAVE_LIBSYSTEMD
@@ -25,6 +28,25 @@ namespace {
 const char* const kAreas[] = {
         "hal.spectrometer", "hal.tracker", "hal.accel", "hal.lamp", "pipeline", "render",
         "output",           "rec",         "loop",      "replica",  "planner",  "booth"};
+
+// The message of a log line with its control characters escaped (pipeline/base/printable.h):
+// a log line may carry text from a recording or a device, and a terminal must not obey it.
+class PrintableMessage final : public spdlog::custom_flag_formatter
+{
+public:
+    void format(const spdlog::details::log_msg& msg,
+                const std::tm& /*time*/,
+                spdlog::memory_buf_t& dest) override
+    {
+        const auto text = printable(std::string_view(msg.payload.data(), msg.payload.size()),
+                                    std::string_view::npos, true);
+        dest.append(text.data(), text.data() + text.size());
+    }
+    std::unique_ptr<custom_flag_formatter> clone() const override
+    {
+        return std::make_unique<PrintableMessage>();
+    }
+};
 
 std::mutex& registryMutex()
 {
@@ -70,21 +92,6 @@ std::vector<SpecItem> specItems(const std::string& spec)
     return items;
 }
 
-// 'spec' has passed checkLogSpec.
-void applySpec(const std::string& spec)
-{
-    for (const auto& item : specItems(spec)) {
-        const auto level = *parseLevel(item.level);
-        if (!item.name) {
-            for (const char* area : kAreas) {
-                logger(area)->set_level(level);
-            }
-        } else {
-            logger(*item.name)->set_level(level);
-        }
-    }
-}
-
 class TapSink final : public spdlog::sinks::base_sink<std::mutex>
 {
 public:
@@ -114,7 +121,9 @@ protected:
     void sink_it_(const spdlog::details::log_msg& msg) override
     {
         const std::string area(msg.logger_name.begin(), msg.logger_name.end());
-        const std::string text(msg.payload.begin(), msg.payload.end());
+        // Control characters escaped, as on the console (pipeline/base/printable.h).
+        const auto text = printable(std::string_view(msg.payload.data(), msg.payload.size()),
+                                    std::string_view::npos, false);
 #ifdef REPLICA_HAVE_LIBSYSTEMD
         static const bool native = [] {
             struct stat st {
@@ -154,6 +163,101 @@ std::vector<spdlog::sink_ptr>& taps()
     return t;
 }
 
+bool isTap(const spdlog::sink_ptr& s)
+{
+    const auto& t = taps();
+    return std::find(t.begin(), t.end(), s) != t.end();
+}
+
+// The level a logger's console shows: its own, or its console sink's when that is higher (a
+// logger held open for a tap).
+spdlog::level::level_enum consoleLevel(const spdlog::logger& l)
+{
+    for (const auto& s : l.sinks()) {
+        if (!isTap(s)) {
+            return std::max(s->level(), l.level());
+        }
+    }
+    return l.level();
+}
+
+// Shows 'level' on the logger's console while the logger lets every tap's level through (a
+// quieter console must not hide warnings from a recording). Under registryMutex().
+void setLevelLocked(spdlog::logger& l, spdlog::level::level_enum level)
+{
+    auto open = level;
+    for (const auto& t : taps()) {
+        open = std::min(open, t->level());
+    }
+    for (const auto& s : l.sinks()) {
+        if (!isTap(s)) {
+            s->set_level(level);
+        }
+    }
+    l.set_level(open);
+}
+
+// 'spec' has passed checkLogSpec.
+void applySpec(const std::string& spec)
+{
+    for (const auto& item : specItems(spec)) {
+        const auto level = *parseLevel(item.level);
+        std::vector<std::shared_ptr<spdlog::logger>> loggers;
+        if (!item.name) {
+            for (const char* area : kAreas) {
+                loggers.push_back(logger(area));
+            }
+        } else {
+            loggers.push_back(logger(*item.name));
+        }
+        std::lock_guard lock(registryMutex());
+        for (const auto& l : loggers) {
+            setLevelLocked(*l, level);
+        }
+    }
+}
+
+// The process's warnings and errors (followLogs).
+struct LogHistory {
+    std::mutex mutex;
+    std::deque<LoggedMessage> kept;
+    std::vector<std::shared_ptr<LogFollower>> followers;
+    std::shared_ptr<void> tap;
+};
+
+LogHistory& history()
+{
+    static LogHistory h;
+    return h;
+}
+
+void startLogHistory()
+{
+    auto& h = history();
+    {
+        std::lock_guard lock(h.mutex);
+        if (h.tap) {
+            return;
+        }
+    }
+    auto tap =
+            tapLogs(spdlog::level::warn, [](spdlog::level::level_enum level,
+                                            const std::string& area, const std::string& message) {
+                auto& hist = history();
+                const LoggedMessage m{std::chrono::steady_clock::now(), level, area, message};
+                std::lock_guard lock(hist.mutex);
+                hist.kept.push_back(m);
+                if (hist.kept.size() > kLogHistoryLimit) {
+                    hist.kept.pop_front();
+                }
+                for (const auto& f : hist.followers) {
+                    (*f)(m);
+                }
+            });
+    std::lock_guard lock(h.mutex);
+    h.tap = std::move(tap);
+}
+
 } // namespace
 
 std::shared_ptr<spdlog::logger> logger(const std::string& area)
@@ -169,16 +273,20 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
         spdlog::initialize_logger(created);
     } else {
         created = spdlog::stderr_color_mt(area);
-        created->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
+        auto formatter = std::make_unique<spdlog::pattern_formatter>();
+        formatter->add_flag<PrintableMessage>('*').set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %*");
+        created->set_formatter(std::move(formatter));
     }
     // An area first used after --log-level was applied follows the general level, not spdlog's
     // default (info): 'replay --log-level warn' must not print a late area's info lines.
+    auto console = consoleLevel(*created);
     if (auto general = spdlog::get("replica"); general && general != created) {
-        created->set_level(general->level());
+        console = consoleLevel(*general);
     }
     for (const auto& t : taps()) {
         created->sinks().push_back(t);
     }
+    setLevelLocked(*created, console);
     return created;
 }
 
@@ -207,15 +315,10 @@ std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap)
         std::lock_guard lock(registryMutex());
         taps().push_back(sink);
         spdlog::apply_all([&](const std::shared_ptr<spdlog::logger>& l) {
-            // A quieter console (--log-level error) must not hide warnings from the tap: the
-            // console sinks take the logger's level, the logger lets the tap's level through.
-            if (l->level() > minLevel) {
-                for (auto& existing : l->sinks()) {
-                    existing->set_level(std::max(existing->level(), l->level()));
-                }
-                l->set_level(minLevel);
-            }
+            // A quieter console (--log-level error) must not hide warnings from the tap.
+            const auto console = consoleLevel(*l);
             l->sinks().push_back(sink);
+            setLevelLocked(*l, console);
         });
     }
     spdlog::sink_ptr held = sink;
@@ -227,6 +330,25 @@ std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap)
             auto& s = l->sinks();
             s.erase(std::remove(s.begin(), s.end(), held), s.end());
         });
+    });
+}
+
+std::shared_ptr<void> followLogs(LogFollower follower)
+{
+    auto& h = history();
+    auto f = std::make_shared<LogFollower>(std::move(follower));
+    {
+        std::lock_guard lock(h.mutex);
+        for (const auto& m : h.kept) {
+            (*f)(m);
+        }
+        h.followers.push_back(f);
+    }
+    return std::shared_ptr<void>(nullptr, [f](void*) {
+        auto& hist = history();
+        std::lock_guard lock(hist.mutex);
+        auto& v = hist.followers;
+        v.erase(std::remove(v.begin(), v.end(), f), v.end());
     });
 }
 
@@ -279,6 +401,7 @@ void setupLogging(const std::string& spec, bool fromCommandLine)
     for (const char* area : kAreas) {
         logger(area);
     }
+    startLogHistory();
     // The default, then the environment, then the command line: the command line wins.
     applySpec("info");
     if (const char* env = std::getenv("REPLICA_LOG"); env != nullptr && checkLogSpec(env).empty()) {

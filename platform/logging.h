@@ -5,6 +5,7 @@
 // docs/appliance.md, "Logs").
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -31,6 +32,25 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area);
 using LogTap = std::function<void(
         spdlog::level::level_enum level, const std::string& area, const std::string& message)>;
 std::shared_ptr<void> tapLogs(spdlog::level::level_enum minLevel, LogTap tap);
+
+// One warning or error of this process, as every recording holds it (/replica/log).
+struct LoggedMessage {
+    std::chrono::steady_clock::time_point time;
+    spdlog::level::level_enum level = spdlog::level::warn;
+    std::string area;
+    std::string message;
+};
+
+// The process keeps its warnings and errors from the first setupLogging on (the newest
+// kLogHistoryLimit of them), so that a recording opened later still holds those logged before it
+// (--uncalibrated's, a site file's, start-up recovery's).
+constexpr std::size_t kLogHistoryLimit = 1000;
+
+// Calls `follower` with each warning and error kept so far, oldest first, then with each new one
+// as it is logged, until the returned handle is destroyed; none is missed or repeated. It runs
+// under the history's lock, on the thread that logs: it must not log.
+using LogFollower = std::function<void(const LoggedMessage&)>;
+std::shared_ptr<void> followLogs(LogFollower follower);
 
 // True when $JOURNAL_STREAM's value ("DEVICE:INODE", which systemd sets for a service whose
 // stderr it connected to the journal) names the file open on fd; false for an empty, malformed or

@@ -9,6 +9,7 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/reference/reference_integrator.h>
@@ -55,6 +56,12 @@ Expected<RenderPlan> parseRenderPlan(const std::string& text, const std::string&
                 fmt::format("{}: {}; delete the file and run with --planner again to plan anew",
                             source, what));
     };
+    if (auto ok = checkJsonLimits(text, source); !ok) {
+        return makeError(ok.error().code,
+                         fmt::format("{}; delete the file and run with --planner again to plan "
+                                     "anew",
+                                     ok.error().message));
+    }
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(text);

@@ -1,5 +1,6 @@
 // Re-deriving samples from their recorded raw inputs.
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 
@@ -19,6 +20,11 @@ bool sameBits(const glm::dvec3& a, const glm::dvec3& b)
     return std::bit_cast<std::uint64_t>(a.x) == std::bit_cast<std::uint64_t>(b.x) &&
            std::bit_cast<std::uint64_t>(a.y) == std::bit_cast<std::uint64_t>(b.y) &&
            std::bit_cast<std::uint64_t>(a.z) == std::bit_cast<std::uint64_t>(b.z);
+}
+
+bool finite(const glm::dvec3& v)
+{
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 Expected<hal::accel::AxisMapping> reprocessAxes(const std::optional<std::string>& chosen,
@@ -108,6 +114,7 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         if (!sameBits(eye, s.eyeTrackerM) || tracked != s.tracked) {
             ++report.posesChanged;
         }
+        report.posesNonFinite += finite(eye) ? 0 : 1;
         s.eyeTrackerM = eye;
         s.tracked = tracked;
     }
@@ -123,6 +130,7 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         const glm::dvec3 g = hal::accel::gravityFromRaw(*s.raw, *m);
         ++report.accelReprocessed;
         report.accelChanged += sameBits(g, s.gravity) ? 0 : 1;
+        report.accelNonFinite += finite(g) ? 0 : 1;
         s.gravity = g;
     }
     for (auto& s : rec.samples(recordings::lampSelectorKind())) {

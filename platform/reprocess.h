@@ -30,6 +30,10 @@ struct ReprocessReport {
     // sample keeps its recorded time (when the loop received it, so the frames that used it
     // still find it); only its values are re-derived.
     std::size_t poseTimesDiffer = 0;
+    // Samples whose re-derived values are not finite (an accelerometer scale of 1e308 overflows):
+    // kept as they came out, which the loop ignores as it does a live device's NaN; counted so that
+    // replay warns and its summary says how many.
+    std::size_t posesNonFinite = 0, accelNonFinite = 0;
 };
 
 // Replaces the values of every sample that has a raw input with what today's code makes of it;

@@ -1,5 +1,5 @@
 // The run configuration: everything that decides what a frame looks like, as JSON (recorded in
-// every session) and back, old recordings' keys included.
+// every session) and back.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -62,7 +62,7 @@ std::string RunConfig::toJson() const
                      {"booth_dimmer", boothDimmer},
                      {"booth_dimmer_auto", boothDimmerAuto || boothDimmerChosenAuto},
                      {"cache_slices", cacheSlices},
-                     {"render_profile", renderProfile()},
+                     {"render_profile", renderProfile},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
                      {"display_inverse", displayInverse},
@@ -77,21 +77,6 @@ std::string RunConfig::toJson() const
                      {"default_lamp", defaultLamp},
                      {"default_eye_m", {defaultEyeM.x, defaultEyeM.y, defaultEyeM.z}},
                      {"default_tilt_rad", defaultTiltRad}};
-    if (renderProfile() == pipeline::render::kExplicitRenderProfile) {
-        // Switches no profile names: one key each, as recordings made before profiles hold them.
-        j["hardware_filter"] = switches.hardwareFilter;
-        j["specular_lod_bias"] = switches.specularLodBias;
-        j["specular_nearest_level"] = switches.specularNearestLevel;
-        j["horizon_spread"] = switches.horizonSpread;
-        j["horizon_half"] = switches.horizonHalf;
-        j["horizon_bilinear"] = switches.horizonBilinear;
-        j["specular_branch_free"] = switches.specularBranchFree;
-        j["specular_exact_level"] = switches.specularExactLevel;
-        j["texel_exact_ties"] = switches.texelExactTies;
-        j["horizon_pick"] = switches.horizonPick;
-        j["surround_illuminance"] = switches.surroundIlluminance;
-        j["viewing_filtered"] = switches.viewingFiltered;
-    }
     {
         std::vector<double> rotation;
         for (int i = 0; i < 3; ++i) {
@@ -102,6 +87,12 @@ std::string RunConfig::toJson() const
         const glm::dvec3& t = trackerInBooth.translation;
         j["t_booth_tracker"] = {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}};
     }
+    j["sensing"] = {{"stray_light", sensing.strayLight},
+                    {"wavelength_lines", sensing.wavelengthLines},
+                    {"average_spectra", sensing.averageSpectra},
+                    {"steady_distance", sensing.steadyDistance},
+                    {"stray_light_fraction", instrument.strayLightFraction},
+                    {"wavelength_offset_nm", instrument.wavelengthOffsetNm}};
     if (!plannedLamps.empty()) {
         nlohmann::json lamps = nlohmann::json::object();
         for (const auto& [name, p] : plannedLamps) {
@@ -116,168 +107,137 @@ std::string RunConfig::toJson() const
 
 namespace {
 
-// The render switches a run configuration records: "render_profile" N >= 1 names them; without
-// it (recordings made before profiles) or with 0, one key each, an absent key being the switch
-// as it was before it existed (render profile 1's).
-Expected<pipeline::render::RenderSwitches> readSwitches(const nlohmann::json& j)
+// The keys every version records (required by the schema).
+void readRequired(const nlohmann::json& j, RunConfig& c)
 {
-    using pipeline::render::kExplicitRenderProfile;
-    const int profile = j.value("render_profile", kExplicitRenderProfile);
-    static constexpr const char* kKeys[] = {
-            "hardware_filter",      "specular_lod_bias",    "specular_nearest_level",
-            "horizon_spread",       "horizon_half",         "horizon_bilinear",
-            "specular_branch_free", "specular_exact_level", "texel_exact_ties",
-            "horizon_pick",         "surround_illuminance", "viewing_filtered"};
-    if (profile != kExplicitRenderProfile) {
-        for (const char* key : kKeys) {
-            if (j.contains(key)) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("run configuration: render_profile {} and the "
-                                             "explicit switch '{}' both given; a profile fixes "
-                                             "every switch",
-                                             profile, key));
-            }
-        }
-        auto p = pipeline::render::findRenderProfile(profile);
-        if (!p) {
-            return makeError(ErrorCode::Unsupported,
-                             fmt::format("run configuration: {}", p.error().message));
-        }
-        return (*p)->switches;
-    }
-    // Profile 1 is every switch as it was before it existed: what an absent key means. (A switch
-    // added after profiles has no key: recordings that name no profile replay it as then.)
-    pipeline::render::RenderSwitches s = (*pipeline::render::findRenderProfile(1))->switches;
-    s.hardwareFilter = j.value("hardware_filter", s.hardwareFilter);
-    s.specularNearestLevel = j.value("specular_nearest_level", s.specularNearestLevel);
-    s.horizonSpread = j.value("horizon_spread", s.horizonSpread);
-    s.horizonHalf = j.value("horizon_half", s.horizonHalf);
-    s.horizonBilinear = j.value("horizon_bilinear", s.horizonBilinear);
-    s.specularBranchFree = j.value("specular_branch_free", s.specularBranchFree);
-    s.specularExactLevel = j.value("specular_exact_level", s.specularExactLevel);
-    s.texelExactTies = j.value("texel_exact_ties", s.texelExactTies);
-    s.horizonPick = j.value("horizon_pick", s.horizonPick);
-    s.specularLodBias = j.value("specular_lod_bias", s.specularLodBias);
-    s.surroundIlluminance = j.value("surround_illuminance", s.surroundIlluminance);
-    s.viewingFiltered = j.value("viewing_filtered", s.viewingFiltered);
-    return s;
+    c.width = j.at("width").get<int>();
+    c.height = j.at("height").get<int>();
+    c.rateHz = j.at("rate_hz").get<double>();
+    c.booth = j.at("booth").get<std::string>();
+    c.scene = j.at("scene").get<std::string>();
+    c.basis = j.at("basis").get<std::string>();
+    c.lightsU = j.at("lights_u").get<int>();
+    c.lightsV = j.at("lights_v").get<int>();
+    c.spectrometerCalibration = j.at("spectrometer_calibration").get<std::string>();
+    c.display = j.at("display").get<std::string>();
+    c.displayPeakCdM2 = j.at("display_peak_cd_m2").get<double>();
+    c.displayBlackCdM2 = j.at("display_black_cd_m2").get<double>();
 }
 
-} // namespace
-
-Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std::string>* warnings)
+// What the renderers draw with. An absent key is today's default: this build has one render
+// path, and a recording of an older render profile replays on it approximately.
+void readRendering(const nlohmann::json& j, RunConfig& c)
 {
-    RunConfig c;
-    try {
-        const auto j = nlohmann::json::parse(json);
-        if (auto ok = validateJson(j, runConfigSchema(), "run configuration", warnings); !ok) {
-            return tl::unexpected(ok.error());
-        }
-        c.width = j.at("width").get<int>();
-        c.height = j.at("height").get<int>();
-        c.rateHz = j.at("rate_hz").get<double>();
-        c.booth = j.at("booth").get<std::string>();
-        c.scene = j.at("scene").get<std::string>();
-        c.basis = j.at("basis").get<std::string>();
-        c.lightsU = j.at("lights_u").get<int>();
-        c.lightsV = j.at("lights_v").get<int>();
-        c.spectrometerCalibration = j.at("spectrometer_calibration").get<std::string>();
-        c.display = j.at("display").get<std::string>();
-        c.displayPeakCdM2 = j.at("display_peak_cd_m2").get<double>();
-        c.displayBlackCdM2 = j.at("display_black_cd_m2").get<double>();
-        // Absent in recordings made before the booth renderer: those replay with the flat one.
-        c.renderer = j.value("renderer", std::string("flat"));
-        c.sceneDir = j.value("scene_dir", c.sceneDir);
-        c.sceneDigest = j.value("scene_digest", std::string());
-        c.boothLights = j.value("booth_lights", c.boothLights);
-        c.specularSamples = j.value("specular_samples", c.specularSamples);
-        // Absent before the specular grid: those recordings were shaded per pixel.
-        c.specularGrid = j.value("specular_grid", 0);
-        c.diffuseGrid = j.value("diffuse_grid", 0);
-        c.areaLights = j.value("area_lights", 0);
-        // Absent before the booth dimmer: those recordings replay undimmed. A recorded "auto"
-        // is the number it chose; a replay never chooses again.
-        c.boothDimmer = j.value("booth_dimmer", 1.0);
-        c.boothDimmerChosenAuto = j.value("booth_dimmer_auto", false);
-        c.cacheSlices = j.value("cache_slices", 1);
-        if (auto switches = readSwitches(j); switches) {
-            c.switches = *switches;
-        } else {
-            return tl::unexpected(switches.error());
-        }
-        c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
-        // Recordings made before display profiles had none of these: the plain pass 2 they had
-        // was on-axis, without flare subtraction.
-        c.displayDigest = j.value("display_digest", std::string());
-        c.displayInverse = j.value("display_inverse", std::string("analytic"));
-        c.gamutMapping = j.value("gamut_mapping", std::string("hue"));
-        c.viewingCompensation = j.value("viewing_compensation", false);
-        c.flareSubtraction = j.value("flare_subtraction", false);
-        c.falseColour = j.value("false_colour", false);
-        if (j.contains("t_booth_tracker")) {
-            const auto r = j.at("t_booth_tracker").at("rotation").get<std::vector<double>>();
-            const auto t = j.at("t_booth_tracker").at("translation").get<std::vector<double>>();
-            if (r.size() != 9 || t.size() != 3) {
-                return makeError(ErrorCode::Corrupt,
-                                 "run configuration: t_booth_tracker needs 9 + 3 numbers");
+    // Absent in recordings made before the booth renderer: what they show is the flat patch
+    // image (the scene they hold), not a render path.
+    c.renderer = j.value("renderer", std::string("flat"));
+    c.sceneDir = j.value("scene_dir", c.sceneDir);
+    c.sceneDigest = j.value("scene_digest", c.sceneDigest);
+    c.boothLights = j.value("booth_lights", c.boothLights);
+    c.specularSamples = j.value("specular_samples", c.specularSamples);
+    c.specularGrid = j.value("specular_grid", c.specularGrid);
+    c.diffuseGrid = j.value("diffuse_grid", c.diffuseGrid);
+    c.areaLights = j.value("area_lights", c.areaLights);
+    // A recorded "auto" is the number it chose; a replay never chooses again.
+    c.boothDimmer = j.value("booth_dimmer", c.boothDimmer);
+    c.boothDimmerChosenAuto = j.value("booth_dimmer_auto", false);
+    c.cacheSlices = j.value("cache_slices", c.cacheSlices);
+    c.renderProfile = j.value("render_profile", 0);
+    c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
+    c.displayDigest = j.value("display_digest", c.displayDigest);
+    c.displayInverse = j.value("display_inverse", c.displayInverse);
+    c.gamutMapping = j.value("gamut_mapping", c.gamutMapping);
+    c.viewingCompensation = j.value("viewing_compensation", c.viewingCompensation);
+    c.flareSubtraction = j.value("flare_subtraction", c.flareSubtraction);
+    c.falseColour = j.value("false_colour", c.falseColour);
+    if (j.contains("planned_lamps")) {
+        for (const auto& [name, l] : j.at("planned_lamps").items()) {
+            LampPlan p;
+            p.lights = l.at("lights").get<int>();
+            p.specularSamples = l.at("specular_samples").get<int>();
+            p.horizonDirections = l.at("horizon_directions").get<int>();
+            if (p.lights < 1 || p.lights > 256 || p.specularSamples < 0 ||
+                p.specularSamples > 256 || p.horizonDirections < 0 || p.horizonDirections > 32) {
+                throw std::runtime_error(
+                        fmt::format("planned_lamps.{}: a count out of range", name));
             }
-            pipeline::RigidTransform x;
-            for (std::size_t k = 0; k < 9; ++k) {
-                x.rotation[static_cast<int>(k % 3)][static_cast<int>(k / 3)] = r[k];
-            }
-            x.translation = {t[0], t[1], t[2]};
-            if (!pipeline::isRotation(x.rotation)) {
-                return makeError(ErrorCode::Corrupt,
-                                 "run configuration: t_booth_tracker/rotation is not a rotation "
-                                 "(orthonormal, determinant +1)");
-            }
-            c.trackerInBooth = x;
+            c.plannedLamps[name] = p;
         }
-        // Absent before the site file: the constants the code had then (the defaults).
-        const auto vec3 = [&j](const char* key, glm::dvec3& v) {
-            if (j.contains(key)) {
-                const auto a = j.at(key).get<std::vector<double>>();
-                if (a.size() != 3) {
-                    throw std::runtime_error(fmt::format("{}: expected 3 numbers", key));
-                }
-                v = {a[0], a[1], a[2]};
-            }
-        };
-        vec3("stand_hinge_m", c.stand.hingeM);
-        c.stand.hingeToPanelM = j.value("stand_hinge_to_panel_m", c.stand.hingeToPanelM);
-        c.stand.panelWidthM = j.value("panel_width_m", c.stand.panelWidthM);
-        c.stand.panelHeightM = j.value("panel_height_m", c.stand.panelHeightM);
-        // Recordings made before t_booth_tracker was recorded whole: the angles (degrees) and
-        // translation of the site file, absent = the fixed mounting.
-        if (!j.contains("t_booth_tracker")) {
-            glm::dvec3 rotationDeg{0.0};
-            glm::dvec3 translationM = pipeline::kDefaultTrackerInBoothM;
-            vec3("tracker_rotation_deg", rotationDeg);
-            vec3("tracker_translation_m", translationM);
-            c.trackerInBooth = pipeline::rigidFromDegrees(rotationDeg, translationM);
-        }
-        c.defaultLamp = j.value("default_lamp", std::string());
-        vec3("default_eye_m", c.defaultEyeM);
-        c.defaultTiltRad = j.value("default_tilt_rad", c.defaultTiltRad);
-        // Absent before the planner in the loop: the fixed rules.
-        if (j.contains("planned_lamps")) {
-            for (const auto& [name, l] : j.at("planned_lamps").items()) {
-                LampPlan p;
-                p.lights = l.at("lights").get<int>();
-                p.specularSamples = l.at("specular_samples").get<int>();
-                p.horizonDirections = l.at("horizon_directions").get<int>();
-                if (p.lights < 1 || p.lights > 256 || p.specularSamples < 0 ||
-                    p.specularSamples > 256 || p.horizonDirections < 0 ||
-                    p.horizonDirections > 32) {
-                    throw std::runtime_error(
-                            fmt::format("planned_lamps.{}: a count out of range", name));
-                }
-                c.plannedLamps[name] = p;
-            }
-        }
-    } catch (const std::exception& e) {
-        return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
     }
+}
+
+// "key": [x, y, z] into v when present.
+void readVec3(const nlohmann::json& j, const char* key, glm::dvec3& v)
+{
+    if (j.contains(key)) {
+        const auto a = j.at(key).get<std::vector<double>>();
+        if (a.size() != 3) {
+            throw std::runtime_error(fmt::format("{}: expected 3 numbers", key));
+        }
+        v = {a[0], a[1], a[2]};
+    }
+}
+
+// The stand, the panel, the tracker's mounting and the defaults for absent samples.
+Expected<void> readGeometry(const nlohmann::json& j, RunConfig& c)
+{
+    if (j.contains("t_booth_tracker")) {
+        const auto r = j.at("t_booth_tracker").at("rotation").get<std::vector<double>>();
+        const auto t = j.at("t_booth_tracker").at("translation").get<std::vector<double>>();
+        if (r.size() != 9 || t.size() != 3) {
+            return makeError(ErrorCode::Corrupt,
+                             "run configuration: t_booth_tracker needs 9 + 3 numbers");
+        }
+        pipeline::RigidTransform x;
+        for (std::size_t k = 0; k < 9; ++k) {
+            x.rotation[static_cast<int>(k % 3)][static_cast<int>(k / 3)] = r[k];
+        }
+        x.translation = {t[0], t[1], t[2]};
+        if (!pipeline::isRotation(x.rotation)) {
+            return makeError(ErrorCode::Corrupt,
+                             "run configuration: t_booth_tracker/rotation is not a rotation "
+                             "(orthonormal, determinant +1)");
+        }
+        c.trackerInBooth = x;
+    } else if (j.contains("tracker_rotation_deg") || j.contains("tracker_translation_m")) {
+        // Recordings made before the transform was recorded whole hold the site file's angles
+        // (degrees) and translation.
+        glm::dvec3 rotationDeg{0.0};
+        glm::dvec3 translationM = pipeline::kDefaultTrackerInBoothM;
+        readVec3(j, "tracker_rotation_deg", rotationDeg);
+        readVec3(j, "tracker_translation_m", translationM);
+        c.trackerInBooth = pipeline::rigidFromDegrees(rotationDeg, translationM);
+    }
+    readVec3(j, "stand_hinge_m", c.stand.hingeM);
+    c.stand.hingeToPanelM = j.value("stand_hinge_to_panel_m", c.stand.hingeToPanelM);
+    c.stand.panelWidthM = j.value("panel_width_m", c.stand.panelWidthM);
+    c.stand.panelHeightM = j.value("panel_height_m", c.stand.panelHeightM);
+    c.defaultLamp = j.value("default_lamp", c.defaultLamp);
+    readVec3(j, "default_eye_m", c.defaultEyeM);
+    c.defaultTiltRad = j.value("default_tilt_rad", c.defaultTiltRad);
+    return {};
+}
+
+// The live spectrometer chain's options and the instrument's calibration. Absent before the
+// live chain's corrections: none, one spectrum at a time.
+void readSensing(const nlohmann::json& j, RunConfig& c)
+{
+    c.sensing = pipeline::spectral::LiveChainOptions::none();
+    c.instrument = {};
+    if (j.contains("sensing")) {
+        const auto& s = j.at("sensing");
+        c.sensing.strayLight = s.at("stray_light").get<bool>();
+        c.sensing.wavelengthLines = s.at("wavelength_lines").get<bool>();
+        c.sensing.averageSpectra = s.at("average_spectra").get<int>();
+        c.sensing.steadyDistance = s.at("steady_distance").get<double>();
+        c.instrument.strayLightFraction = s.at("stray_light_fraction").get<double>();
+        c.instrument.wavelengthOffsetNm = s.at("wavelength_offset_nm").get<double>();
+    }
+}
+
+// The checks across fields and ranges the schema cannot state.
+Expected<void> checkRanges(const RunConfig& c)
+{
     if (!frameSizeOk(c.width, c.height) || !(c.rateHz >= 1.0) || c.rateHz > 1000.0 ||
         c.lightsU <= 0 || c.lightsV <= 0 ||
         static_cast<long long>(c.lightsU) * static_cast<long long>(c.lightsV) > 256 ||
@@ -285,20 +245,17 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
         c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < kAutoSpecularSamples ||
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
-        c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 ||
-        !(std::abs(c.switches.specularLodBias) <= pipeline::shading::kMaxSpecularLodBias) ||
-        c.cacheSlices < 1 || c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights ||
-        c.areaLights > 1 || !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0) {
-        return makeError(
-                ErrorCode::InvalidArgument,
-                fmt::format(
-                        "run configuration: size {}x{} (each side 1-{}, at most "
-                        "{}:1), rate {} Hz (1-1000), lights {}x{} (at most 256), "
-                        "display peak/black, specular samples, specular or diffuse "
-                        "grid, specular lod bias, horizon directions, cache slices, area lights "
-                        "or booth dimmer (0 to 1) out of range",
-                        c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz, c.lightsU,
-                        c.lightsV));
+        c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 || c.cacheSlices < 1 ||
+        c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights || c.areaLights > 1 ||
+        !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("run configuration: size {}x{} (each side 1-{}, at most "
+                                     "{}:1), rate {} Hz (1-1000), lights {}x{} (at most 256), "
+                                     "display peak/black, specular samples, specular or diffuse "
+                                     "grid, horizon directions, cache slices, area lights "
+                                     "or booth dimmer (0 to 1) out of range",
+                                     c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz,
+                                     c.lightsU, c.lightsV));
     }
     const auto finite3 = [](const glm::dvec3& v) {
         return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -320,6 +277,12 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
                                      "to 10 m each)",
                                      c.stand.panelWidthM, c.stand.panelHeightM));
     }
+    return {};
+}
+
+// The names fromJson takes for the renderer, the display inverse and the gamut mapping.
+Expected<void> checkNames(const RunConfig& c)
+{
     if (c.renderer != "booth" && c.renderer != "flat") {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("run configuration: renderer '{}' is not 'booth' or 'flat'",
@@ -331,6 +294,38 @@ Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std
                          fmt::format("run configuration: display inverse '{}' (analytic, lut3d) "
                                      "or gamut mapping '{}' (hue, clip) unknown",
                                      c.displayInverse, c.gamutMapping));
+    }
+    if (auto ok = pipeline::render::checkRenderProfile(c.renderProfile); !ok) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("run configuration: {}", ok.error().message));
+    }
+    return {};
+}
+
+} // namespace
+
+Expected<RunConfig> RunConfig::fromJson(const std::string& json, std::vector<std::string>* warnings)
+{
+    RunConfig c;
+    try {
+        const auto j = nlohmann::json::parse(json);
+        if (auto ok = validateJson(j, runConfigSchema(), "run configuration", warnings); !ok) {
+            return tl::unexpected(ok.error());
+        }
+        readRequired(j, c);
+        readRendering(j, c);
+        readSensing(j, c);
+        if (auto ok = readGeometry(j, c); !ok) {
+            return tl::unexpected(ok.error());
+        }
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Corrupt, fmt::format("run configuration: {}", e.what()));
+    }
+    if (auto ok = checkRanges(c); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    if (auto ok = checkNames(c); !ok) {
+        return tl::unexpected(ok.error());
     }
     return c;
 }

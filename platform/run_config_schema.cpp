@@ -15,7 +15,6 @@ const JsonSchema& runConfigSchema()
         const auto metres3 = array(number(-100.0, 100.0), 3, 3);
         const auto flag = boolean().optional();
         const auto name = string(4096);
-        const double lodBias = pipeline::shading::kMaxSpecularLodBias;
         return object({
                 // Read by every version (required).
                 {"width", integer(1, kMaxFrameSide)},
@@ -38,8 +37,18 @@ const JsonSchema& runConfigSchema()
                 {"specular_samples", integer(kAutoSpecularSamples, 256).optional()},
                 {"specular_grid", integer(kAutoSpecularGrid, 256).optional()},
                 {"diffuse_grid", integer(kAutoDiffuseGrid, 256).optional()},
+                {"area_lights", integer(kAutoAreaLights, 1).optional()},
+                {"cache_slices", integer(1, kMaxCacheSlices).optional()},
+                // A luminance scale on the booth's lights (0 excluded by fromJson).
+                {"booth_dimmer", number(0.0, 1.0).optional()},
+                {"booth_dimmer_auto", flag},
+                // The render path (pipeline/render/render_profile.h); RunConfig::fromJson
+                // refuses one newer than this build's.
+                {"render_profile", integer(0, 65535).optional()},
+                // Render profile 0's switches, one key each: older render paths, not read (such
+                // a recording replays on today's path, approximately).
                 {"hardware_filter", flag},
-                {"specular_lod_bias", number(-lodBias, lodBias).optional()},
+                {"specular_lod_bias", number(-8.0, 8.0).optional()},
                 {"specular_nearest_level", flag},
                 {"horizon_spread", flag},
                 {"horizon_half", flag},
@@ -48,20 +57,13 @@ const JsonSchema& runConfigSchema()
                 {"specular_exact_level", flag},
                 {"texel_exact_ties", flag},
                 {"horizon_pick", flag},
-                {"area_lights", integer(kAutoAreaLights, 1).optional()},
-                {"cache_slices", integer(1, kMaxCacheSlices).optional()},
-                // A luminance scale on the booth's lights (0 excluded by fromJson).
-                {"booth_dimmer", number(0.0, 1.0).optional()},
-                {"booth_dimmer_auto", flag},
-                // The render profile that fixes the render switches (0: each switch's own key).
-                {"render_profile", integer(0, 65535).optional()},
                 {"surround_illuminance", flag},
+                {"viewing_filtered", flag},
                 {"horizon_directions", integer(0, 32).optional()},
                 {"display_digest", string(64).optional()},
                 {"display_inverse", string(64).optional()},
                 {"gamut_mapping", string(64).optional()},
                 {"viewing_compensation", flag},
-                {"viewing_filtered", flag},
                 {"flare_subtraction", flag},
                 {"false_colour", flag},
                 {"stand_hinge_m", metres3.optional()},
@@ -78,6 +80,14 @@ const JsonSchema& runConfigSchema()
                 {"t_booth_tracker", object({{"rotation", array(number(-1.000001, 1.000001), 9, 9)},
                                             {"translation", metres3}})
                                             .optional()},
+                // The live spectrometer chain (pipeline/spectral/live_chain.h).
+                {"sensing", object({{"stray_light", boolean()},
+                                    {"wavelength_lines", boolean()},
+                                    {"average_spectra", integer(1, 1000)},
+                                    {"steady_distance", number(0.0, 10.0)},
+                                    {"stray_light_fraction", number(0.0, 0.5)},
+                                    {"wavelength_offset_nm", number(-5.0, 5.0)}})
+                                    .optional()},
                 // The planner's choice per lamp name (platform/render_plan.h).
                 {"planned_lamps", map(object({{"lights", integer(1, 256)},
                                               {"specular_samples", integer(0, 256)},

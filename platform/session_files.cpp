@@ -1,10 +1,19 @@
 // Session files: recovery, retention, rotation.
 #include <algorithm>
 #include <array>
+#include <cerrno>
+#include <cstring>
 #include <ctime>
 #include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
 
 #include <platform/logging.h>
 #include <platform/session_files.h>
@@ -15,19 +24,146 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<fs::path> recordingsIn(const fs::path& dir)
+constexpr const char* kLockName = ".replica-kiosk.lock";
+constexpr const char* kRegisterName = ".replica-sessions";
+constexpr const char* kUnrecoverable = ".unrecoverable";
+
+// The names newSessionPath gives (and their .unrecoverable).
+bool sessionName(const std::string& name)
 {
+    static const std::regex pattern(R"(\d{8}T\d{6}Z(-\d+)?\.mcap(\.unrecoverable)?)");
+    return std::regex_match(name, pattern);
+}
+
+// The file's bytes, never through a symbolic link; empty when it cannot be read.
+std::string readNoFollow(const fs::path& file)
+{
+    const int fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) {
+        return {};
+    }
+    std::string text;
+    std::array<char, 4096> buf{};
+    for (ssize_t n = 0; (n = ::read(fd, buf.data(), buf.size())) > 0;) {
+        text.append(buf.data(), static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    return text;
+}
+
+std::set<std::string> registered(const fs::path& dir)
+{
+    std::set<std::string> names;
+    std::istringstream in(readNoFollow(dir / kRegisterName));
+    for (std::string line; std::getline(in, line);) {
+        names.insert(line);
+    }
+    return names;
+}
+
+// Adds a session file's name to the folder's register, on disk before the file exists.
+void registerName(const fs::path& dir, const std::string& name)
+{
+    const int fd = ::open((dir / kRegisterName).c_str(),
+                          O_WRONLY | O_APPEND | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0640);
+    if (fd < 0) {
+        logger("rec")->warn("{}: cannot register the session file {}: {}; retention and "
+                            "recovery will leave it alone",
+                            (dir / kRegisterName).string(), name, std::strerror(errno));
+        return;
+    }
+    const std::string line = name + "\n";
+    const bool ok = ::write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size());
+    (void)::fsync(fd);
+    ::close(fd);
+    if (!ok) {
+        logger("rec")->warn("{}: could not register {}", (dir / kRegisterName).string(), name);
+    }
+}
+
+} // namespace
+
+std::vector<fs::path> kioskFiles(const fs::path& dir)
+{
+    const auto mine = registered(dir);
     std::vector<fs::path> out;
     std::error_code ec;
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-        if (it->is_regular_file(ec) && it->path().extension() == ".mcap") {
+        std::string name = it->path().filename().string();
+        if (!sessionName(name) || it->symlink_status(ec).type() != fs::file_type::regular) {
+            continue;
+        }
+        if (name.ends_with(kUnrecoverable)) {
+            name.resize(name.size() - std::strlen(kUnrecoverable));
+        }
+        if (mine.contains(name)) {
             out.push_back(it->path());
         }
     }
     return out;
 }
 
-} // namespace
+bool heldOpenElsewhere(const fs::path& file)
+{
+    const int fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) {
+        return false;
+    }
+    const bool held = ::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+    ::close(fd); // releases the probe's own lock
+    return held;
+}
+
+std::uint64_t freeBytes(const fs::path& dir)
+{
+    struct statvfs st {
+    };
+    if (::statvfs(dir.c_str(), &st) != 0) {
+        return 0;
+    }
+    return static_cast<std::uint64_t>(st.f_bavail) * static_cast<std::uint64_t>(st.f_frsize);
+}
+
+Expected<SessionFolderLock> SessionFolderLock::acquire(const fs::path& dir)
+{
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    const fs::path path = dir / kLockName;
+    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0640);
+    if (fd < 0) {
+        return makeError(ErrorCode::Io, fmt::format("{}: cannot open the sessions folder's lock: "
+                                                    "{}",
+                                                    path.string(), std::strerror(errno)));
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        ::close(fd);
+        std::string pid = readNoFollow(path);
+        pid.erase(std::remove_if(pid.begin(), pid.end(), [](char c) { return c < '0' || c > '9'; }),
+                  pid.end());
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: the sessions folder is in use by another kiosk (pid {}); "
+                                     "stop it first ('systemctl stop replica'), or give this one "
+                                     "another recording.directory",
+                                     dir.string(), pid.empty() ? "unknown" : pid));
+    }
+    const std::string pid = fmt::format("{}\n", ::getpid());
+    if (::ftruncate(fd, 0) != 0 || ::write(fd, pid.data(), pid.size()) < 0) {
+        logger("rec")->warn("{}: could not write this kiosk's pid", path.string());
+    }
+    return SessionFolderLock(fd);
+}
+
+SessionFolderLock::SessionFolderLock(SessionFolderLock&& other) noexcept : fd_(other.fd_)
+{
+    other.fd_ = -1;
+}
+
+SessionFolderLock::~SessionFolderLock()
+{
+    if (fd_ >= 0) {
+        ::close(fd_);
+    }
+}
 
 bool recordingFinished(const fs::path& file)
 {
@@ -46,22 +182,40 @@ bool recordingFinished(const fs::path& file)
     return in.gcount() == 8 && tail == kMagic;
 }
 
-std::vector<fs::path> recoverUnfinished(const fs::path& dir)
+std::vector<fs::path> recoverUnfinished(const fs::path& dir, const FreeSpace& free)
 {
     auto log = logger("rec");
     std::vector<fs::path> recovered;
-    for (const auto& f : recordingsIn(dir)) {
-        if (recordingFinished(f)) {
+    for (const auto& f : kioskFiles(dir)) {
+        if (f.extension() != ".mcap" || recordingFinished(f)) {
+            continue;
+        }
+        if (heldOpenElsewhere(f)) {
+            log->warn("{}: unfinished but being written by another process; left alone",
+                      f.string());
+            continue;
+        }
+        std::error_code ec;
+        const auto bytes = fs::file_size(f, ec);
+        if (const auto room = free(dir); !ec && room < bytes) {
+            log->warn("{}: unfinished ({} bytes) and only {} bytes free to recover it into: left "
+                      "as it is; recovered at a start when there is room",
+                      f.string(), bytes, room);
             continue;
         }
         fs::path tmp = f;
         tmp += ".recovering";
         auto r = recordings::recoverRecording(f, tmp, recordings::ExistingOutput::Replace);
-        std::error_code ec;
         if (!r) {
             fs::remove(tmp, ec);
+            if (r.error().code == ErrorCode::Io) { // no room after all, or a write failed
+                log->warn("{}: unfinished; recovering it failed ({}): left as it is, tried again "
+                          "at the next start",
+                          f.string(), r.error().message);
+                continue;
+            }
             fs::path bad = f;
-            bad += ".unrecoverable";
+            bad += kUnrecoverable;
             fs::rename(f, bad, ec);
             log->warn("{}: unfinished and not recoverable ({}); renamed to {}", f.string(),
                       r.error().message, bad.string());
@@ -91,7 +245,7 @@ enforceRetention(const fs::path& dir, std::uint64_t keepBytes, const fs::path& k
     };
     std::vector<Entry> files;
     std::uint64_t total = 0;
-    for (const auto& f : recordingsIn(dir)) {
+    for (const auto& f : kioskFiles(dir)) {
         std::error_code ec;
         const auto bytes = fs::file_size(f, ec);
         const auto time = fs::last_write_time(f, ec);
@@ -108,7 +262,10 @@ enforceRetention(const fs::path& dir, std::uint64_t keepBytes, const fs::path& k
         if (total <= keepBytes) {
             break;
         }
-        if (!keep.empty() && e.path == keep) {
+        // Not the file being written, not a session waiting for its recovery, not one another
+        // process has open.
+        const bool waiting = e.path.extension() == ".mcap" && !recordingFinished(e.path);
+        if ((!keep.empty() && e.path == keep) || waiting || heldOpenElsewhere(e.path)) {
             continue;
         }
         std::error_code ec;
@@ -134,9 +291,10 @@ fs::path newSessionPath(const fs::path& dir)
     std::strftime(stamp.data(), stamp.size(), "%Y%m%dT%H%M%SZ", &utc);
     fs::path p = dir / (std::string(stamp.data()) + ".mcap");
     std::error_code ec;
-    for (int n = 1; fs::exists(p, ec); ++n) {
+    for (int n = 1; fs::exists(fs::symlink_status(p, ec)); ++n) {
         p = dir / fmt::format("{}-{}.mcap", stamp.data(), n);
     }
+    registerName(dir, p.filename().string());
     return p;
 }
 

@@ -1,6 +1,10 @@
 // The kiosk's folder of session recordings: a fresh name per session, a crashed session recovered
 // in place at start, a new file when one grows past its size or age, and the oldest deleted
-// beyond a total size. Works with any file names (std::filesystem, no shell).
+// beyond a total size. The folder is the kiosk's: one kiosk at a time (a lock file), and recovery
+// and retention touch only the files the kiosk wrote (its name pattern, listed in the folder's
+// register before each is created), never through a symbolic link, never one another process
+// holds open (every recording being written holds a lock on its file). Works with any file names
+// (std::filesystem, no shell).
 #pragma once
 
 #include <chrono>
@@ -19,18 +23,54 @@ namespace replica::platform {
 // Whether the file ends with the MCAP magic, i.e. its writer closed it.
 bool recordingFinished(const std::filesystem::path& file);
 
-// Rebuilds every unfinished *.mcap in dir in place ('replica recover' into a temporary file,
-// then renamed over the original); returns the files recovered. Files nothing can be recovered
-// from are renamed to NAME.unrecoverable so that they are not tried again at every start.
-std::vector<std::filesystem::path> recoverUnfinished(const std::filesystem::path& dir);
+// The folder's lock (dir/.replica-kiosk.lock, flock), held for the process's life: a second
+// kiosk on the folder is refused with one line naming the holder's pid.
+class SessionFolderLock
+{
+public:
+    static Expected<SessionFolderLock> acquire(const std::filesystem::path& dir);
+    SessionFolderLock(SessionFolderLock&& other) noexcept;
+    SessionFolderLock& operator=(SessionFolderLock&&) = delete;
+    SessionFolderLock(const SessionFolderLock&) = delete;
+    ~SessionFolderLock();
 
-// Deletes the oldest *.mcap (by modification time, then name) until their total is at most
-// keepBytes; never 'keep'. Returns the files deleted.
+private:
+    explicit SessionFolderLock(int fd) : fd_(fd) {}
+    int fd_ = -1;
+};
+
+// The kiosk's own files in dir: named as newSessionPath names them (YYYYmmddTHHMMSSZ[-N].mcap,
+// or that with .unrecoverable) and listed in the folder's register (dir/.replica-sessions), each
+// a regular file (not a symbolic link).
+std::vector<std::filesystem::path> kioskFiles(const std::filesystem::path& dir);
+
+// Whether another open file description holds a lock on the file (a recording being written:
+// the writer locks its file).
+bool heldOpenElsewhere(const std::filesystem::path& file);
+
+// Free bytes where 'dir' is (statvfs); a test may pass its own.
+using FreeSpace = std::function<std::uint64_t(const std::filesystem::path&)>;
+std::uint64_t freeBytes(const std::filesystem::path& dir);
+
+// Rebuilds every unfinished kiosk file in dir in place ('replica recover' into a temporary file,
+// then renamed over the original); returns the files recovered. One without room for its copy
+// (less free space than its size) is left as it is and tried again at the next start; one
+// nothing can be recovered from is renamed to NAME.unrecoverable so that it is not tried again.
+// A file another process holds open is not touched.
+std::vector<std::filesystem::path> recoverUnfinished(const std::filesystem::path& dir,
+                                                     const FreeSpace& free = freeBytes);
+
+// Deletes the oldest kiosk files (by modification time, then name) until the total of all of
+// them (unfinished and .unrecoverable ones included) is at most keepBytes; never 'keep', never
+// an unfinished one (it waits for its recovery), never one another process holds open. Returns
+// the files deleted.
 std::vector<std::filesystem::path> enforceRetention(const std::filesystem::path& dir,
                                                     std::uint64_t keepBytes,
                                                     const std::filesystem::path& keep = {});
 
-// dir/YYYYmmddTHHMMSSZ.mcap (UTC), with -N appended when that name is taken.
+// dir/YYYYmmddTHHMMSSZ.mcap (UTC), with -N appended when that name is taken, listed in the
+// folder's register before it is returned (so that a crash between the two leaves nothing
+// unlisted).
 std::filesystem::path newSessionPath(const std::filesystem::path& dir);
 
 struct RotationPolicy {

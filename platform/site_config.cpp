@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <toml++/toml.h>
 
+#include <pipeline/base/input_file.h>
 #include <platform/site_config.h>
 
 namespace replica::platform {
@@ -44,8 +45,8 @@ long lineOf(const toml::node& n)
 class Reader
 {
 public:
-    Reader(const toml::table& root, std::vector<SiteProblem>& problems)
-        : root_(root), problems_(problems)
+    Reader(const toml::table& root, std::vector<SiteProblem>& problems, SiteConfig& config)
+        : root_(root), problems_(problems), config_(config)
     {}
 
     void string(const char* section,
@@ -265,7 +266,11 @@ private:
         sections_.insert(section);
         known_.insert(std::string(section) + "." + key);
         const auto* t = root_.get_as<toml::table>(section);
-        return t != nullptr ? t->get(key) : nullptr;
+        const toml::node* n = t != nullptr ? t->get(key) : nullptr;
+        if (n != nullptr) {
+            config_.lines[std::string(section) + "." + key] = lineOf(*n);
+        }
+        return n;
     }
 
     bool toDouble(const char* section, const char* key, const toml::node& n, double& v)
@@ -306,6 +311,7 @@ private:
 
     const toml::table& root_;
     std::vector<SiteProblem>& problems_;
+    SiteConfig& config_;
     std::set<std::string> sections_;
     std::set<std::string> known_;
 };
@@ -334,25 +340,32 @@ std::filesystem::path defaultSiteConfigPath()
 
 Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
 {
+    // Read as any input file (a regular file, at most kMaxTomlBytes, never waiting on a FIFO).
+    auto text = readInputFile(file, kMaxTomlBytes, "site");
+    if (!text) {
+        return makeError(text.error().code,
+                         fmt::format("{}; give a readable site file (a commented example is "
+                                     "installed as /usr/share/replica/replica.toml)",
+                                     text.error().message));
+    }
+    return parseSiteConfig(*text, file);
+}
+
+Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesystem::path& file)
+{
     SiteLoad out;
     out.config.source = file;
     toml::table root;
     try {
-        root = toml::parse_file(file.string());
+        root = toml::parse(text, file.string());
     } catch (const toml::parse_error& e) {
         const auto& where = e.source();
-        if (where.begin.line == 0) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("{}: {}; give a readable site file (a commented example "
-                                         "is installed as /usr/share/replica/replica.toml)",
-                                         file.string(), e.description()));
-        }
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("{}:{}: not valid TOML: {}", file.string(), where.begin.line,
                                      e.description()));
     }
     SiteConfig& c = out.config;
-    Reader r(root, out.problems);
+    Reader r(root, out.problems, c);
     r.string("booth", "id", c.boothId);
     r.numberOrAuto("booth", "dimmer", c.boothDimmer, c.boothDimmerAuto, 0.0, 1.0);
     r.string("scene", "dir", c.sceneDir);
@@ -394,6 +407,13 @@ Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file)
     r.string("devices", "accel_axes", c.accelAxes);
     r.string("devices", "lamp_gpio", c.lampGpio);
     r.string("devices", "spectrometer_serial", c.spectrometerSerial);
+    r.number("spectrometer", "stray_light_fraction", c.spectrometerStrayLight, 0.0, 0.05);
+    r.number("spectrometer", "wavelength_offset_nm", c.spectrometerWavelengthOffsetNm, -5.0, 5.0);
+    {
+        double unused = 0.0; // the calibration's figures, for people
+        r.number("spectrometer", "calibration_spectra", unused, 0.0, 1e9);
+        r.number("spectrometer", "calibration_spread_nm", unused, 0.0, 100.0);
+    }
     r.string("run", "hal", c.hal, {"live", "sim", "replay"});
     r.string("run", "replay_file", c.replayFile);
     r.number("run", "rate_hz", c.rateHz, 1.0, 240.0);
@@ -435,6 +455,9 @@ std::string SiteConfig::toJson() const
             {"booth",
              {{"id", boothId},
               {"dimmer", boothDimmerAuto ? nlohmann::json("auto") : nlohmann::json(boothDimmer)}}},
+            {"spectrometer",
+             {{"stray_light_fraction", spectrometerStrayLight},
+              {"wavelength_offset_nm", spectrometerWavelengthOffsetNm}}},
             {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
             {"render",
              {{"planner",

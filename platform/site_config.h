@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,11 @@ struct SiteConfig {
     // dimmer = <number in (0, 1]> | "auto" (platform/booth_dimmer.h); absent: 1, undimmed.
     double boothDimmer = 1.0;
     bool boothDimmerAuto = false;
+    // [spectrometer]: the instrument's calibration ('replica calibrate spectrometer';
+    // pipeline/spectral/live_chain.h InstrumentCalibration): absent, the data sheet's stray light
+    // and no shift.
+    double spectrometerStrayLight = 5e-4;
+    double spectrometerWavelengthOffsetNm = 0.0;
     // [scene]
     std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
     std::string renderer = "booth"; // or "flat"
@@ -89,6 +95,15 @@ struct SiteConfig {
     glm::dvec3 defaultEyeM{0.0, 0.45, 0.60};
     double defaultTiltDeg = 0.0;
 
+    // The line of each key the file gives ("display.size" -> 12), for problems found when the
+    // values are resolved (platform/cli/run_resolve.h).
+    std::map<std::string, long> lines;
+    long lineOf(const std::string& key) const
+    {
+        const auto it = lines.find(key);
+        return it != lines.end() ? it->second : 0;
+    }
+
     // The resolved configuration as JSON (recorded in each session).
     std::string toJson() const;
 };
@@ -108,6 +123,8 @@ struct SiteLoad {
 // is a problem (the values that are good are kept). Fails only when the file cannot be read or
 // is not TOML at all (the error names the line).
 Expected<SiteLoad> loadSiteConfig(const std::filesystem::path& file);
+// The same for the text of 'file' already read (the fuzz target, tests/fuzz/site_file_fuzz.cpp).
+Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesystem::path& file);
 
 // "FILE:LINE: key: what" (LINE left out when 0).
 std::string formatProblem(const std::filesystem::path& file, const SiteProblem& p);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <pipeline/base/input_file.h>
 #include <platform/site_config.h>
 #include <platform/site_file.h>
 #include <recordings/device_kind.h>
@@ -18,13 +19,7 @@ namespace {
 
 Expected<std::string> readText(const std::filesystem::path& file)
 {
-    std::ifstream in(file);
-    if (!in) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot read it", file.string()));
-    }
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+    return readInputFile(file, kMaxTomlBytes, "site");
 }
 
 Expected<toml::table> parse(const std::string& text, const std::filesystem::path& file)

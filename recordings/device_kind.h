@@ -11,9 +11,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <typeinfo>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
@@ -60,12 +62,17 @@ struct DeviceEmitter {
 
 class DeviceKindBase;
 
+// A sample of one of the sample types the device kinds have, as the recorder's queue carries it.
+// A kind of another type does not compile (DeviceKind's static_assert): its type joins this list.
+using AnySample =
+        std::variant<hal::SpectrumSample, hal::PoseSample, hal::AccelSample, hal::LampSample>;
+
 // What a sample of any kind is written to: the recording writer, and in tests anything else.
 class DeviceSink
 {
 public:
     virtual ~DeviceSink() = default;
-    virtual void writeDevice(const DeviceKindBase& kind, std::any sample) = 0;
+    virtual void writeDevice(const DeviceKindBase& kind, AnySample sample) = 0;
 };
 
 // The loop's per-device slot: polls the source, keeps the latest samples (hal::SampleLatch),
@@ -89,8 +96,8 @@ public:
 };
 
 // The one description of a device kind, its sample type erased: what the recorder, reader,
-// replay and inspect need. Samples travel as std::any holding the kind's Sample; a recording's
-// samples of a kind as std::any holding std::vector<Sample>.
+// replay and inspect need. A sample to write travels as an AnySample holding the kind's Sample;
+// a recording's samples of a kind (the reader's side) as std::any holding std::vector<Sample>.
 class DeviceKindBase
 {
 public:
@@ -107,7 +114,7 @@ public:
     // false when the sample cannot be written (a NaN or infinite value). 'state' is the kind's
     // own, kept by the writer from sample to sample (e.g. the HID descriptor written last).
     virtual bool
-    encode(const std::any& sample, std::any& state, const DeviceEmitter& emit) const = 0;
+    encode(const AnySample& sample, std::any& state, const DeviceEmitter& emit) const = 0;
 
     // Reader. decode throws nlohmann::json exceptions on a missing or mistyped field.
     virtual std::any emptySamples() const = 0;
@@ -167,7 +174,7 @@ public:
         inner_.poll(untilNs, out);
         if (tee_ != nullptr && *tee_ != nullptr) {
             for (std::size_t i = first; i < out.size(); ++i) {
-                (*tee_)->writeDevice(kind_, std::any(out[i]));
+                (*tee_)->writeDevice(kind_, AnySample(out[i]));
             }
         }
     }
@@ -215,7 +222,7 @@ public:
     void writeLatest(DeviceSink& sink) const override
     {
         if (const Sample* s = latch_.latest()) {
-            sink.writeDevice(kind_, std::any(*s));
+            sink.writeDevice(kind_, AnySample(*s));
         }
     }
     const Sample* chosen() const { return chosen_; }
@@ -233,15 +240,18 @@ private:
 template <typename Sample>
 class DeviceKind final : public DeviceKindBase
 {
+    static_assert(std::is_constructible_v<AnySample, Sample>,
+                  "a device kind's sample type must be one of AnySample's");
+
 public:
     DeviceKind(DeviceNames names, SampleCodec<Sample> codec)
         : DeviceKindBase(std::move(names)), codec_(std::move(codec))
     {}
     const std::type_info& sampleType() const override { return typeid(Sample); }
 
-    bool encode(const std::any& sample, std::any& state, const DeviceEmitter& emit) const override
+    bool encode(const AnySample& sample, std::any& state, const DeviceEmitter& emit) const override
     {
-        const auto& s = std::any_cast<const Sample&>(sample);
+        const auto& s = std::get<Sample>(sample);
         auto payload = codec_.encode(s);
         if (!payload) {
             return false;
@@ -313,8 +323,20 @@ private:
     SampleCodec<Sample> codec_;
 };
 
-// The registry: every device kind this build knows, in channel-id order. The order is the
-// order the loop polls and records them in.
+// The registry, typed: the device kinds the state stage consumes, one DeviceKind each, as a
+// tuple in channel-id order. The loop makes a typed slot for each (DeviceSlots) and hands their
+// chosen samples to the estimators as typed pointers, in this order
+// (state::SceneEstimator::update; platform/loop/frame_loop.cpp checks at compile time that it
+// takes exactly these). A kind outside this tuple is data only: polled, recorded, read, listed
+// and replayed, and consumed by nothing.
+template <typename... Samples>
+using KindTuple = std::tuple<const DeviceKind<Samples>*...>;
+using StateKinds =
+        KindTuple<hal::SpectrumSample, hal::PoseSample, hal::AccelSample, hal::LampSample>;
+const StateKinds& stateKinds();
+
+// Every device kind this build knows (the typed ones, as DeviceKindBase), in channel-id order.
+// The order is the order the loop polls and records them in.
 using DeviceKinds = std::vector<const DeviceKindBase*>;
 const DeviceKinds& deviceKinds();
 
@@ -328,14 +350,6 @@ const DeviceKind<hal::LampSample>& lampSelectorKind();
 // Recording::samples<Sample>() use); null when none.
 const DeviceKindBase* kindOfType(const DeviceKinds& kinds, const std::type_info& type);
 const DeviceKindBase* kindNamed(const DeviceKinds& kinds, const std::string& name);
-
-// A DeviceSlot's chosen sample, typed; null when the slot is of another type or has none.
-template <typename Sample>
-const Sample* chosenSample(const DeviceSlot* slot)
-{
-    const auto* typed = dynamic_cast<const TypedDeviceSlot<Sample>*>(slot);
-    return typed != nullptr ? typed->chosen() : nullptr;
-}
 
 // The sources of a run, one per device kind present, kept in channel-id order (the order they
 // are polled and recorded in).
@@ -388,5 +402,75 @@ public:
 private:
     std::vector<Entry> entries_;
 };
+
+// A run's slots, one per source it has, in the sources' (channel-id) order: the loop polls,
+// chooses and records through all(); the slot of each kind of 'kinds' is also held typed, and
+// chosen() gives their chosen samples as typed pointers (null: the run has no such device, or
+// none yet). A source of a kind outside 'kinds' gets a slot of its own type (data only).
+template <typename... Samples>
+class DeviceSlots
+{
+public:
+    DeviceSlots(const KindTuple<Samples...>& kinds, Sources& sources, DeviceSink* const* tee)
+    {
+        for (auto& e : sources.entries()) {
+            if (!e.source) {
+                continue;
+            }
+            bool typed = false;
+            adoptTyped(kinds, e, tee, typed, std::index_sequence_for<Samples...>{});
+            if (!typed) {
+                all_.push_back(e.kind->makeSlot(*e.source, tee));
+            }
+        }
+    }
+    const std::vector<std::unique_ptr<DeviceSlot>>& all() const { return all_; }
+    std::tuple<const Samples*...> chosen() const
+    {
+        return std::apply(
+                [](const auto*... slot) {
+                    return std::tuple<const Samples*...>{
+                            (slot != nullptr ? slot->chosen() : nullptr)...};
+                },
+                typed_);
+    }
+
+private:
+    template <std::size_t... I>
+    void adoptTyped(const KindTuple<Samples...>& kinds,
+                    Sources::Entry& e,
+                    DeviceSink* const* tee,
+                    bool& typed,
+                    std::index_sequence<I...>)
+    {
+        (adopt<I>(*std::get<I>(kinds), e, tee, typed), ...);
+    }
+    template <std::size_t I, typename Sample>
+    void
+    adopt(const DeviceKind<Sample>& kind, Sources::Entry& e, DeviceSink* const* tee, bool& typed)
+    {
+        if (typed || e.kind != &kind) {
+            return;
+        }
+        // Sources::set keeps a kind's source of its own sample type (hal::Source<Sample>).
+        auto slot = std::make_unique<TypedDeviceSlot<Sample>>(
+                kind, static_cast<hal::Source<Sample>&>(*e.source), tee);
+        std::get<I>(typed_) = slot.get();
+        all_.push_back(std::move(slot));
+        typed = true;
+    }
+
+    std::vector<std::unique_ptr<DeviceSlot>> all_;
+    std::tuple<TypedDeviceSlot<Samples>*...> typed_{};
+};
+
+// The slots of the typed registry's kinds (StateKinds): what the loop holds.
+template <typename Kinds>
+struct SlotsFor;
+template <typename... Samples>
+struct SlotsFor<KindTuple<Samples...>> {
+    using type = DeviceSlots<Samples...>;
+};
+using StateSlots = SlotsFor<StateKinds>::type;
 
 } // namespace replica::recordings

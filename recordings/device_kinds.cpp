@@ -91,14 +91,21 @@ const DeviceKind<hal::LampSample>& lampSelectorKind()
     return kind;
 }
 
-const DeviceKinds& deviceKinds()
+const StateKinds& stateKinds()
 {
-    static const DeviceKinds kinds{
+    static const StateKinds kinds{
             &spectrometerKind(),
             &trackerKind(),
             &accelKind(),
             &lampSelectorKind(),
     };
+    return kinds;
+}
+
+const DeviceKinds& deviceKinds()
+{
+    static const DeviceKinds kinds =
+            std::apply([](const auto*... kind) { return DeviceKinds{kind...}; }, stateKinds());
     return kinds;
 }
 

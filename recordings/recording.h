@@ -138,6 +138,9 @@ struct Recording {
     std::vector<FrameRecord> frames;
     std::vector<DisplayDigestRecord> displayDigests; // format 4; empty when none were recorded
     std::vector<LightRecord> lights;                 // format 4: the decided light, on change
+    // Format 4: thumbnails of what the panel showed, tNs the shown frame's tick (session time) and
+    // frameIndex the frame of that tick (0 where no frame has it).
+    std::vector<ThumbnailRecord> thumbnails;
     // Format 5: raw messages that found no use: their sample is not in the recording (dropped by
     // the recorder), or a HID report's descriptor is not (lost with a damaged chunk).
     std::uint64_t unmatchedRaw = 0;
@@ -212,7 +215,7 @@ public:
     template <typename Sample>
     void write(const DeviceKind<Sample>& kind, const Sample& s)
     {
-        writeDevice(kind, std::any(s));
+        writeDevice(kind, AnySample(s));
     }
     // A sample of the first registered kind of its type (deviceKinds()).
     template <typename Sample>
@@ -220,7 +223,7 @@ public:
     {
         const auto* kind = kindOfType(deviceKinds(), typeid(Sample));
         if (kind != nullptr) {
-            writeDevice(*kind, std::any(s));
+            writeDevice(*kind, AnySample(s));
         }
     }
     virtual void write(const FrameRecord& f) = 0;

@@ -1,6 +1,7 @@
 // Reading recordings of every known format version (1: unchunked, 2: chunked, 3: lamp selector,
-// 4: what was shown; of its channels replay needs only the display digests) and
+// 4: what was shown; of its channels replay reads the display digests and the thumbnails) and
 // inspecting files.
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -8,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <recordings/mcap/reader.h>
 #include <recordings/recording.h>
 #include <recordings/sample_codec.h>
@@ -35,6 +37,71 @@ Expected<std::string> slurp(const std::filesystem::path& path)
     return bytes;
 }
 
+// A format this build reads, or one line saying it is newer.
+Expected<void> checkFormatVersion(const std::string& name, int formatVersion)
+{
+    if (formatVersion < 1 || formatVersion > kFormatVersion) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("{}: recording format {} is newer than this replica reads "
+                                     "(up to {}); update replica",
+                                     name, formatVersion, kFormatVersion));
+    }
+    return {};
+}
+
+// One session per recording: a second /replica/session channel or message would change the
+// configuration (the frame size, the scene) part way through the file, whichever came last.
+Expected<void> checkOneSession(const mcap::Scan& s, const std::string& name)
+{
+    std::vector<std::uint16_t> ids;
+    for (const auto& [id, channel] : s.channels) {
+        if (channel.topic == kSessionTopic) {
+            ids.push_back(id);
+        }
+    }
+    if (ids.size() > 1) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: {} channels carry {} (ids {} and {}); a recording has "
+                                     "one session: not a recording Replica wrote",
+                                     name, ids.size(), kSessionTopic, ids[0], ids[1]));
+    }
+    const auto sessions = std::count_if(s.messages.begin(), s.messages.end(), [&](const auto& m) {
+        return !ids.empty() && m.channelId == ids[0];
+    });
+    if (sessions > 1) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: {} {} messages; a recording has one session: not a "
+                                     "recording Replica wrote",
+                                     name, sessions, kSessionTopic));
+    }
+    return {};
+}
+
+// A thumbnail message (foxglove.CompressedImage): its PNG, tNs its Unix time until
+// placeThumbnails.
+ThumbnailRecord decodeThumbnailMessage(const nlohmann::json& j)
+{
+    ThumbnailRecord t;
+    t.tNs = j.at("timestamp").at("sec").get<std::int64_t>() * 1'000'000'000 +
+            j.at("timestamp").at("nsec").get<std::int64_t>();
+    t.png = base64Decode(j.at("data").get<std::string>());
+    return t;
+}
+
+// A thumbnail's time is its frame's tick after the session's wall-clock start.
+void placeThumbnails(Recording& rec)
+{
+    std::map<std::int64_t, std::uint64_t> frameAtTick;
+    for (const FrameRecord& f : rec.frames) {
+        frameAtTick.emplace(f.tickNs, f.frameIndex);
+    }
+    for (ThumbnailRecord& t : rec.thumbnails) {
+        t.tNs -= rec.session.wallClockStartNs;
+        const auto it = frameAtTick.find(t.tNs);
+        t.frameIndex = it != frameAtTick.end() ? it->second : 0;
+    }
+}
+
 } // namespace
 
 Expected<Recording> readRecording(const std::filesystem::path& path, const DeviceKinds& kinds)
@@ -58,6 +125,9 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                                                                      s.damageCount - 1)
                                                        : "",
                                      name));
+    }
+    if (auto ok = checkOneSession(s, name); !ok) {
+        return tl::unexpected(ok.error());
     }
     Recording rec;
     bool haveSession = false;
@@ -83,6 +153,11 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                                          name, topic, m.sequence, m.data.size(),
                                          kMaxMessageBytes >> 10));
         }
+        if (auto ok = checkJsonLimits(
+                    m.data, fmt::format("{}: {} message (sequence {})", name, topic, m.sequence));
+            !ok) {
+            return tl::unexpected(ok.error());
+        }
         try {
             const auto j = nlohmann::json::parse(m.data);
             if (topic == kSessionTopic) {
@@ -92,6 +167,13 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                     return tl::unexpected(ok.error());
                 }
                 rec.session = decodeSession(j, rec.formatVersion, kinds);
+                // The run configuration is JSON inside the session's JSON: held to the same
+                // limits before anything (replay, inspect --json) parses it.
+                if (auto ok = checkJsonLimits(rec.session.configJson,
+                                              fmt::format("{}: run configuration", name));
+                    !ok) {
+                    return tl::unexpected(ok.error());
+                }
                 haveSession = true;
             } else if (auto k = sampleTopics.find(topic); k != sampleTopics.end()) {
                 const auto* kind = kinds[k->second];
@@ -106,6 +188,8 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                 rec.displayDigests.push_back(decodeDisplayDigest(j));
             } else if (topic == kLightTopic) { // format 4
                 rec.lights.push_back(decodeLight(j));
+            } else if (topic == kThumbnailTopic) { // format 4
+                rec.thumbnails.push_back(decodeThumbnailMessage(j));
             } else if (topic == kRecorderTopic) {
                 const auto r = decodeRecorderStatus(j, kinds);
                 rec.droppedMessages = r.droppedTotal();
@@ -123,12 +207,10 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                 fmt::format("{}: MCAP file without a replica session; not a replica recording",
                             name));
     }
-    if (rec.formatVersion < 1 || rec.formatVersion > kFormatVersion) {
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("{}: recording format {} is newer than this replica reads "
-                                     "(up to {}); update replica",
-                                     name, rec.formatVersion, kFormatVersion));
+    if (auto ok = checkFormatVersion(name, rec.formatVersion); !ok) {
+        return tl::unexpected(ok.error());
     }
+    placeThumbnails(rec);
     rec.unmatchedRaw = unusableRaw;
     for (std::size_t i = 0; i < kinds.size(); ++i) {
         if (rawState[i].has_value()) {

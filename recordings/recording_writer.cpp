@@ -23,7 +23,7 @@ namespace {
 // A device's sample: its kind (an index into the writer's kinds) and the sample.
 struct DeviceItem {
     std::size_t kind = 0;
-    std::any sample;
+    AnySample sample;
 };
 using Item = std::variant<DeviceItem, FrameRecord, DisplayDigestRecord, PosesRecord, LightRecord>;
 // The most device kinds a writer takes (each has its own drop counter).
@@ -80,7 +80,7 @@ public:
     }
 
     using RecordingWriter::write;
-    void writeDevice(const DeviceKindBase& kind, std::any sample) override
+    void writeDevice(const DeviceKindBase& kind, AnySample sample) override
     {
         const auto& kinds = options_.kinds;
         const auto it = std::find(kinds.begin(), kinds.end(), &kind);

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <recordings/mcap/reader.h>
 #include <recordings/mcap/writer.h>
 #include <recordings/recover.h>
@@ -174,25 +175,10 @@ Expected<void> writeRecovered(const mcap::Scan& s, const fs::path& path)
     return {};
 }
 
-} // namespace
-
-Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
-                                         const std::filesystem::path& out,
-                                         ExistingOutput existing)
+// How recover scans: resynchronising, chunked records only, and (for a file whose first chunk,
+// with the channel definitions, was lost) the fixed channels of Replica's formats assumed.
+mcap::ScanOptions recoverOptions(std::string_view bytes)
 {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(in, ec)) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: no such recording (or not a regular file)", in.string()));
-    }
-    if (auto ok = checkOutput(in, out, existing); !ok) {
-        return tl::unexpected(ok.error());
-    }
-    auto read = readInputFile(in, kMaxRecordingBytes, "recording");
-    if (!read) {
-        return tl::unexpected(read.error());
-    }
-    const std::string& bytes = *read;
     mcap::ScanOptions options;
     options.resync = true;
     options.maxDamageReports = 50;
@@ -212,44 +198,49 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
             options.fallbackSchemas[d.schema.id] = d.schema;
         }
     }
-    auto s = mcap::scan(bytes, options);
-    // The session message lives in the first chunk; if that chunk was lost, restore it from the
-    // copy in the replica.session Metadata record.
+    return options;
+}
+
+// The session message lives in the first chunk; if that chunk was lost, restores it from the
+// copy in the replica.session Metadata record. Whether it did.
+bool restoreSession(mcap::Scan& s, const mcap::ScanOptions& options)
+{
     const auto sessionId = static_cast<std::uint16_t>(ChannelId::Session);
     const bool haveSession = std::any_of(s.messages.begin(), s.messages.end(),
                                          [&](const auto& m) { return m.channelId == sessionId; });
-    bool sessionRestored = false;
-    if (!haveSession && !s.messages.empty() && options.fallbackChannels.contains(sessionId)) {
-        for (const auto& md : s.metadata) {
-            auto it = md.metadata.find("session");
-            if (md.name != kSessionMetadataName || it == md.metadata.end()) {
-                continue;
-            }
-            std::uint64_t t = 0;
-            try {
-                const auto j = nlohmann::json::parse(it->second);
-                t = static_cast<std::uint64_t>(
-                        std::max<std::int64_t>(0, j.at("wall_clock_start_ns").get<std::int64_t>()));
-            } catch (const std::exception&) {
-                break; // not a usable session description
-            }
-            const auto& def = options.fallbackChannels.at(sessionId);
-            if (!s.channels.contains(sessionId)) {
-                s.channels.emplace(sessionId, def);
-                s.schemas.emplace(def.schemaId, options.fallbackSchemas.at(def.schemaId));
-                s.channelsAssumed.push_back(sessionId);
-            }
-            s.messages.insert(s.messages.begin(), mcap::Message{sessionId, 0, t, t, it->second});
-            sessionRestored = true;
-            break;
+    if (haveSession || s.messages.empty() || !options.fallbackChannels.contains(sessionId)) {
+        return false;
+    }
+    for (const auto& md : s.metadata) {
+        auto it = md.metadata.find("session");
+        if (md.name != kSessionMetadataName || it == md.metadata.end()) {
+            continue;
         }
+        std::uint64_t t = 0;
+        try {
+            if (!checkJsonLimits(it->second, "session metadata")) {
+                return false;
+            }
+            const auto j = nlohmann::json::parse(it->second);
+            t = static_cast<std::uint64_t>(
+                    std::max<std::int64_t>(0, j.at("wall_clock_start_ns").get<std::int64_t>()));
+        } catch (const std::exception&) {
+            return false; // not a usable session description
+        }
+        const auto& def = options.fallbackChannels.at(sessionId);
+        if (!s.channels.contains(sessionId)) {
+            s.channels.emplace(sessionId, def);
+            s.schemas.emplace(def.schemaId, options.fallbackSchemas.at(def.schemaId));
+            s.channelsAssumed.push_back(sessionId);
+        }
+        s.messages.insert(s.messages.begin(), mcap::Message{sessionId, 0, t, t, it->second});
+        return true;
     }
-    if (s.messages.empty()) {
-        return makeError(
-                ErrorCode::Corrupt,
-                fmt::format("{}: nothing recoverable: {}", in.string(),
-                            s.damage.empty() ? "the file holds no messages" : s.damage.front()));
-    }
+    return false;
+}
+
+RecoverReport reportOf(const mcap::Scan& s, bool sessionRestored)
+{
     RecoverReport r;
     r.problems = s.damage;
     if (s.damageCount > s.damage.size()) {
@@ -266,12 +257,17 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
     }
     r.channelsAssumed = s.channelsAssumed;
     r.sessionRestored = sessionRestored;
+    return r;
+}
 
+// Writes the kept messages to a new file beside `out` and puts it in place; whatever goes wrong,
+// the temporary file goes and `out` stays as it was.
+Expected<void> writeInPlace(const mcap::Scan& s, const fs::path& out, ExistingOutput existing)
+{
     auto tmp = createTemporaryBeside(out);
     if (!tmp) {
         return tl::unexpected(tmp.error());
     }
-    // Whatever goes wrong from here, the temporary file goes and `out` stays as it was.
     auto written = writeRecovered(s, *tmp);
     if (!written) {
         written =
@@ -281,10 +277,43 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
         written = moveIntoPlace(*tmp, out, existing);
     }
     if (!written) {
+        std::error_code ec;
         std::filesystem::remove(*tmp, ec);
-        return tl::unexpected(written.error());
     }
-    return r;
+    return written;
+}
+
+} // namespace
+
+Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
+                                         const std::filesystem::path& out,
+                                         ExistingOutput existing)
+{
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(in, ec)) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: no such recording (or not a regular file)", in.string()));
+    }
+    if (auto ok = checkOutput(in, out, existing); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    auto read = readInputFile(in, kMaxRecordingBytes, "recording");
+    if (!read) {
+        return tl::unexpected(read.error());
+    }
+    const auto options = recoverOptions(*read);
+    auto s = mcap::scan(*read, options);
+    const bool sessionRestored = restoreSession(s, options);
+    if (s.messages.empty()) {
+        return makeError(
+                ErrorCode::Corrupt,
+                fmt::format("{}: nothing recoverable: {}", in.string(),
+                            s.damage.empty() ? "the file holds no messages" : s.damage.front()));
+    }
+    if (auto ok = writeInPlace(s, out, existing); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return reportOf(s, sessionRestored);
 }
 
 } // namespace replica::recordings

@@ -24,6 +24,26 @@ double meanLuminance(const pipeline::booth::Booth& booth)
     return booth.lights.empty() ? 0.0 : sum / static_cast<double>(booth.lights.size());
 }
 
+nlohmann::json chainJson(const pipeline::spectral::LiveSpectrometerChain::State& s)
+{
+    return {{"window", s.window},
+            {"offset_nm", s.offsetNm},
+            {"integration_time_us", s.integrationTimeUs},
+            {"wavelength_coeffs", s.wavelengthCoeffs},
+            {"nonlinearity_coeffs", s.nonlinearityCoeffs}};
+}
+
+pipeline::spectral::LiveSpectrometerChain::State chainFromJson(const nlohmann::json& j)
+{
+    pipeline::spectral::LiveSpectrometerChain::State s;
+    s.window = j.at("window").get<std::vector<std::vector<std::uint16_t>>>();
+    s.offsetNm = finiteFromJson(j.at("offset_nm"));
+    s.integrationTimeUs = j.at("integration_time_us").get<std::uint32_t>();
+    s.wavelengthCoeffs = j.at("wavelength_coeffs").get<std::array<double, 4>>();
+    s.nonlinearityCoeffs = j.at("nonlinearity_coeffs").get<std::array<double, 8>>();
+    return s;
+}
+
 } // namespace
 
 Expected<LightEstimator> LightEstimator::create(LightEstimatorSetup setup)
@@ -75,10 +95,11 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
         pipeline::spectral::RawSpectrum raw{spectrum->counts, spectrum->integrationTimeUs,
                                             spectrum->wavelengthCoeffs,
                                             spectrum->nonlinearityCoeffs};
-        auto spd = pipeline::spectral::countsToSpectrum(raw, setup_.calibration);
         // A saturated spectrum has lost its peaks: its shape cannot be trusted, keep the last
-        // light.
-        if (spd && !spectrum->saturated) {
+        // light (and leave it out of the average).
+        auto spd = spectrum->saturated ? makeError(ErrorCode::InvalidArgument, "saturated")
+                                       : chain_.add(raw);
+        if (spd) {
             const int lamp = arbiter_.onClassified(classifier_ ? classifier_->classify(*spd) : -1,
                                                    spectrum->timestampNs);
             haveSpectrum_ = true;
@@ -98,10 +119,10 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
 
 std::vector<pipeline::colour::Spectrum> LightEstimator::encodeSpectra(const LightEstimatorSetup& s)
 {
+    // What the booth pass draws each lamp with: its booth light's spectrum (the booth data).
     std::vector<pipeline::colour::Spectrum> out;
-    for (std::size_t i = 0; i < s.booth.lights.size(); ++i) {
-        out.push_back(i < s.encodeSpectra.size() ? s.encodeSpectra[i]
-                                                 : s.booth.lights[i].referenceSpectrum);
+    for (const auto& lamp : s.booth.lights) {
+        out.push_back(lamp.spd);
     }
     return out;
 }
@@ -163,11 +184,11 @@ Expected<void> EncodingDecision::restore(const nlohmann::json& j)
 
 void LightEstimator::write(pipeline::scene::SceneState& state)
 {
-    // Changed as the renderer sees it: another lamp, or in direct-sensor mode another spectrum or
-    // luminance.
-    const bool changed =
-            !written_ || lamp_ != writtenLamp_ ||
-            (lamp_ < 0 && (spd_.v != writtenSpd_.v || luminance_ != writtenLuminance_));
+    // Changed: another content key (pipeline::scene::lightKey: another lamp, or in direct-sensor
+    // mode another spectrum or luminance), the key the renderer labels the light it holds with.
+    const bool changed = !written_ || pipeline::scene::lightKey(lamp_, spd_, luminance_) !=
+                                              pipeline::scene::lightKey(writtenLamp_, writtenSpd_,
+                                                                        writtenLuminance_);
     written_ = true;
     writtenLamp_ = lamp_;
     writtenSpd_ = spd_;
@@ -205,7 +226,8 @@ nlohmann::json LightEstimator::save() const
               {"disagree_since_ns", optionalJson(a.disagreeSinceNs)},
               {"overruled", a.overruled},
               {"warned", a.warned}}},
-            {"encoding", encoding_.save()}};
+            {"encoding", encoding_.save()},
+            {"chain", chainJson(chain_.state())}};
 }
 
 Expected<void> LightEstimator::restore(const nlohmann::json& j)
@@ -252,6 +274,9 @@ Expected<void> LightEstimator::restore(const nlohmann::json& j)
         s.overruled = a.at("overruled").get<std::uint64_t>();
         s.warned = a.at("warned").get<bool>();
         arbiter_.restore(s);
+        // Absent in states saved before the live chain averaged: an empty average.
+        chain_.restore(j.contains("chain") ? chainFromJson(j.at("chain"))
+                                           : pipeline::spectral::LiveSpectrometerChain::State{});
         if (auto ok = encoding_.restore(j.at("encoding")); !ok) {
             return makeError(ok.error().code, "light: " + ok.error().message);
         }

@@ -19,6 +19,7 @@
 #include <pipeline/scene/scene_state.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/light_classifier.h>
+#include <pipeline/spectral/live_chain.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 
 namespace replica::state {
@@ -31,7 +32,7 @@ class EncodingDecision
 {
 public:
     EncodingDecision() = default;
-    // lampSpectra[i]: what lamp i is encoded for (the renderer's booth light of that lamp).
+    // lampSpectra[i]: what lamp i is encoded for (the spectrum of its booth light).
     EncodingDecision(std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive,
                      std::vector<pipeline::colour::Spectrum> lampSpectra,
                      double reencodeDistance = pipeline::spectral::kAdaptiveReencodeDistance)
@@ -58,16 +59,19 @@ private:
 struct LightEstimatorSetup {
     pipeline::booth::Booth booth;
     pipeline::spectral::SpectrometerCalibration calibration;
+    // The live chain's corrections and averaging, and the instrument's calibration they use
+    // (pipeline/spectral/live_chain.h; the run configuration's "sensing").
+    pipeline::spectral::LiveChainOptions chain = pipeline::spectral::LiveChainOptions::none();
+    pipeline::spectral::InstrumentCalibration instrument;
     pipeline::spectral::LightClassifierParams classifier;
     // Shown until the first usable spectrum: a booth lamp index (-1: no light).
     int defaultLamp = -1;
     // A light-adaptive encoder (basis "adaptive_k6"), none for a fixed basis: each new lamp (or a
-    // sensed shape moved by more than reencodeDistance) gets a basis of its own, made for
-    // encodeSpectra[lamp] (the renderer's booth light of that lamp; the lamp's own spectrum where
-    // it is missing) or for the sensed spectrum (pipeline/spectral/adaptive_encoding.h).
+    // sensed shape moved by more than reencodeDistance) gets a basis of its own, made for the
+    // spectrum of the lamp's booth light (booth.lights[lamp].spd, what the booth pass draws it
+    // with) or for the sensed spectrum (pipeline/spectral/adaptive_encoding.h).
     std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive;
     double reencodeDistance = pipeline::spectral::kAdaptiveReencodeDistance;
-    std::vector<pipeline::colour::Spectrum> encodeSpectra;
 };
 
 class LightEstimator
@@ -100,6 +104,7 @@ private:
                             std::optional<pipeline::spectral::LightClassifier> classifier)
         : setup_(std::move(setup)), classifier_(std::move(classifier)),
           arbiter_(static_cast<int>(setup_.booth.lights.size())),
+          chain_(setup_.calibration, setup_.instrument, setup_.chain),
           encoding_(setup_.adaptive, encodeSpectra(setup_), setup_.reencodeDistance)
     {}
     static std::vector<pipeline::colour::Spectrum> encodeSpectra(const LightEstimatorSetup& s);
@@ -108,6 +113,7 @@ private:
     LightEstimatorSetup setup_;
     std::optional<pipeline::spectral::LightClassifier> classifier_; // none: no lamps
     LampArbiter arbiter_;
+    pipeline::spectral::LiveSpectrometerChain chain_;
     std::optional<std::uint32_t> lastSpectrum_;
     std::optional<std::uint32_t> lastSelector_;
     bool haveSpectrum_ = false;

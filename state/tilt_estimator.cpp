@@ -49,12 +49,17 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
             heldValid_ = true;
         }
     }
-    // The diffuse term's tilt: one frame of the cache's refresh schedule.
+    // The diffuse term's tilt: one frame of the cache's refresh schedule, and what the frame
+    // draws of it (the band of a refresh under way).
+    const auto last = diffuse_;
     diffuse_ =
             pipeline::scene::nextDiffuse(diffuse_, held_, state.lightChanged, setup_.cacheSlices);
-    state.tiltRad = tilt_;
+    // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel); a
+    // non-finite one (set from elsewhere: sense()) shows the held tilt.
+    state.tiltRad = std::isfinite(tilt_) ? tilt_ : held_;
     state.heldTiltRad = held_;
-    state.diffuse = diffuse_;
+    state.diffuse =
+            pipeline::scene::diffuseDraw(last, *diffuse_, state.lightChanged, setup_.cacheSlices);
 }
 
 nlohmann::json TiltEstimator::save() const

@@ -4,20 +4,77 @@
 # state/ (sensor samples -> SceneState) sits between hal and the renderer: it may include hal and the
 # pipeline below render/, and nothing but platform includes it (hal -> state -> render).
 # Inside pipeline/, its folders are in an order (pipeline/CMakeLists.txt): each may include only itself
-# and the folders before it; only render/ includes GL headers; no run-time file includes the header of
-# an offline tool (the list in pipeline/CMakeLists.txt).
+# and the folders before it; only pipeline/render/ and platform/output/ include GL, EGL, GBM or DRM
+# headers; no run-time file of pipeline/ or state/ includes the header of an offline tool (the list in
+# pipeline/CMakeLists.txt); every top-level folder is one this check knows.
+#
+# It reads every include the compiler would: <...> and "..." (a quoted path relative to the including
+# file is resolved against the tree), any spacing (`# include`, `#include  <...>`), in .h, .hpp,
+# .inl, .ipp, .hh, .c, .cc, .cxx and .cpp files. tests/layering_check_test.sh plants one violation of
+# each kind and shows this check failing on it.
 set -uo pipefail
-root="$1"
+root="${1%/}"
 status=0
+fail() {
+    echo "FAIL: $1" >&2
+    [ -z "${2:-}" ] || echo "$2" >&2
+    status=1
+}
+
+# Every top-level folder is a layer or a known support folder: a new layer needs its edges here.
+known_top=(build data deploy docs hal pipeline platform recordings state tests tools)
+for dir in "$root"/*/; do
+    top=$(basename "$dir")
+    if [[ " ${known_top[*]} " != *" $top "* ]]; then
+        fail "$top/ is a top-level folder this check does not know: add it to known_top in \
+tests/layering_check.sh with the layers it may include (and checks for them)"
+    fi
+done
+
+# All includes of the layers as "file:line:target", file relative to the root and target as written
+# between <> or "" (a quoted one resolved relative to its file when it names a file there).
+layers=(hal pipeline platform recordings state)
+sources=()
+for layer in "${layers[@]}"; do [ -d "$root/$layer" ] && sources+=("$root/$layer"); done
+includes=$(grep -rnE '^[[:space:]]*#[[:space:]]*include' "${sources[@]}" \
+               --include='*.h' --include='*.hpp' --include='*.inl' --include='*.ipp' \
+               --include='*.hh' --include='*.c' --include='*.cc' --include='*.cxx' --include='*.cpp' |
+           sed "s#^$root/##")
+resolved=""
+computed=""
+while IFS= read -r hit; do
+    [ -n "$hit" ] || continue
+    file=${hit%%:*}
+    rest=${hit#*:}
+    line=${rest%%:*}
+    text=${rest#*:}
+    if [[ $text =~ ^[[:space:]]*#[[:space:]]*include[[:space:]]*\<([^\>]+)\> ]]; then
+        target=${BASH_REMATCH[1]}
+    elif [[ $text =~ ^[[:space:]]*#[[:space:]]*include[[:space:]]*\"([^\"]+)\" ]]; then
+        target=${BASH_REMATCH[1]}
+        # A quoted include is searched next to its file first.
+        if [ -e "$root/$(dirname "$file")/$target" ]; then
+            target=$(realpath -m --relative-to="$root" "$root/$(dirname "$file")/$target")
+        fi
+    else
+        computed+="$hit"$'\n'
+        continue
+    fi
+    resolved+="$file:$line:$target"$'\n'
+done <<<"$includes"
+if [ -n "$computed" ]; then
+    fail "an include this check cannot read (write it as #include <path> or \"path\"):" "$computed"
+fi
+
+# The includes of the files under $1/ whose target matches the extended regex $2.
+includes_of() {
+    grep -E "^$1/[^:]*:[0-9]+:($2)" <<<"$resolved" || true
+}
 check() {
     local layer="$1" pattern="$2" why="$3"
     local hits
-    hits=$(grep -rnE "#include <($pattern)/" "$root/$layer" --include='*.h' --include='*.cpp' || true)
-    if [ -n "$hits" ]; then
-        echo "FAIL: $layer/ $why:" >&2
-        echo "$hits" >&2
-        status=1
-    fi
+    hits=$(includes_of "$layer" "($pattern)/")
+    [ -z "$hits" ] || fail "$layer/ $why:" "$hits"
 }
 check pipeline 'hal|recordings|platform|state' \
     "must not depend on device, recording, state-stage or platform code"
@@ -25,19 +82,11 @@ check hal 'recordings|platform|state' "must not depend on recordings, state or p
 check recordings 'platform|state' "must not depend on state or platform"
 check state 'recordings|platform|pipeline/render' \
     "must not depend on recordings, platform or the renderer (hal -> state -> render)"
-# hal may include only the header-only vocabulary from pipeline/base.
-hits=$(grep -rnE '#include <pipeline/' "$root/hal" --include='*.h' --include='*.cpp' | grep -v '<pipeline/base/' || true)
-if [ -n "$hits" ]; then
-    echo "FAIL: hal/ may include only pipeline/base/ from pipeline:" >&2
-    echo "$hits" >&2
-    status=1
-fi
-hits=$(grep -rnE '#include <pipeline/' "$root/recordings" --include='*.h' --include='*.cpp' | grep -v '<pipeline/base/' || true)
-if [ -n "$hits" ]; then
-    echo "FAIL: recordings/ may include only pipeline/base/ from pipeline:" >&2
-    echo "$hits" >&2
-    status=1
-fi
+# hal and recordings may include only the header-only vocabulary from pipeline/base.
+for layer in hal recordings; do
+    hits=$(includes_of "$layer" 'pipeline/' | grep -vE ':pipeline/base/' || true)
+    [ -z "$hits" ] || fail "$layer/ may include only pipeline/base/ from pipeline:" "$hits"
+done
 # The order inside pipeline/, lowest first (the same list heads pipeline/CMakeLists.txt).
 order=(base csv colour spectral image brdf booth scene surface shading reference display tuning render)
 declare -A rank
@@ -45,51 +94,41 @@ for i in "${!order[@]}"; do rank[${order[$i]}]=$i; done
 for dir in "$root"/pipeline/*/; do
     folder=$(basename "$dir")
     if [ -z "${rank[$folder]+x}" ]; then
-        echo "FAIL: pipeline/$folder/ is not in the pipeline's order: add it to the list in" \
-             "tests/layering_check.sh and pipeline/CMakeLists.txt" >&2
-        status=1
+        fail "pipeline/$folder/ is not in the pipeline's order: add it to the list in \
+tests/layering_check.sh and pipeline/CMakeLists.txt"
         continue
     fi
     while IFS= read -r hit; do
         [ -n "$hit" ] || continue
-        target=$(sed -E 's#.*<pipeline/([a-z_]+)/.*#\1#' <<<"$hit")
+        target=${hit#*:*:pipeline/}
+        target=${target%%/*}
         if [ -z "${rank[$target]+x}" ] || [ "${rank[$target]}" -gt "${rank[$folder]}" ]; then
-            echo "FAIL: pipeline/$folder/ may include only ${order[*]:0:${rank[$folder]}+1}" \
-                 "(pipeline's order), not $target/: ${hit#"$root"/}" >&2
-            status=1
+            fail "pipeline/$folder/ may include only ${order[*]:0:${rank[$folder]}+1} (pipeline's order), not $target/: $hit"
         fi
-    done < <(grep -rnE '#include <pipeline/' "$dir" --include='*.h' --include='*.cpp' || true)
+    done < <(includes_of "pipeline/$folder" 'pipeline/')
 done
-# Only render/ may use GL: the CPU model and the reference build without GLES.
-hits=$(grep -rnE '#include <(GLES[0-9]*|EGL|GL)/' "$root/pipeline" --include='*.h' --include='*.cpp' |
-       grep -v "^$root/pipeline/render/" || true)
-if [ -n "$hits" ]; then
-    echo "FAIL: only pipeline/render/ may include GL headers:" >&2
-    echo "$hits" >&2
-    status=1
-fi
+# Only the renderer and the output may use GL, EGL, GBM or DRM: the CPU model, the reference, state
+# and the devices build without them.
+gl='(GLES[0-9]*|EGL|GL|KHR|drm|libdrm)/|(gbm|drm|drm_fourcc|drm_mode|xf86drm|xf86drmMode)\.h$'
+hits=$(grep -E "^[^:]*:[0-9]+:($gl)" <<<"$resolved" | grep -vE '^(pipeline/render|platform/output)/' || true)
+[ -z "$hits" ] || fail "only pipeline/render/ and platform/output/ may include GL, EGL, GBM or DRM headers:" "$hits"
 # Offline tools (fits, studies, generators) are for the CLI, benchmarks and tests: no run-time file
-# of the pipeline includes their headers.
-offline=$(sed -n '/# offline-sources-begin/,/# offline-sources-end/p' "$root/pipeline/CMakeLists.txt" |
-          grep -oE '[a-z_]+/[a-z_0-9]+\.cpp' | sed 's/\.cpp$//')
-if [ -z "$offline" ]; then
-    echo "FAIL: no offline-sources list found in pipeline/CMakeLists.txt" >&2
-    status=1
-fi
+# of the pipeline, and nothing in state/, includes their headers.
+offline=$(sed -n '/# offline-sources-begin/,/# offline-sources-end/p' "$root/pipeline/CMakeLists.txt" 2>/dev/null |
+          grep -oE '[a-z_0-9/]+\.cpp' | sed 's/\.cpp$//')
+[ -n "$offline" ] || fail "no offline-sources list found in pipeline/CMakeLists.txt"
 for tool in $offline; do
     while IFS= read -r hit; do
         [ -n "$hit" ] || continue
-        file=$(cut -d: -f1 <<<"$hit")
-        rel=${file#"$root"/pipeline/}
+        rel=${hit%%:*}
+        rel=${rel#pipeline/}
         rel=${rel%.*}
         # The tool's own files and the other offline tools may include it.
         if ! grep -qxF "$rel" <<<"$offline"; then
-            echo "FAIL: run-time pipeline file includes an offline tool's header (move the file to" \
-                 "the offline list in pipeline/CMakeLists.txt, or the code out of the tool):" \
-                 "${hit#"$root"/}" >&2
-            status=1
+            fail "a run-time file includes an offline tool's header (move the file to the offline \
+list in pipeline/CMakeLists.txt, or the code out of the tool): $hit"
         fi
-    done < <(grep -rnF "#include <pipeline/$tool.h>" "$root/pipeline" --include='*.h' --include='*.cpp' || true)
+    done < <(grep -E "^(pipeline|state)/[^:]*:[0-9]+:pipeline/$tool\.(h|hpp|inl)$" <<<"$resolved" || true)
 done
 [ $status -eq 0 ] && echo "PASS: layer dependencies follow the allowed edges"
 exit $status

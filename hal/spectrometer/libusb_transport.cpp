@@ -194,6 +194,47 @@ Expected<std::vector<UsbDeviceId>> listUsbDevices(std::uint16_t vendor, std::uin
     return found;
 }
 
+namespace {
+
+// Interface 0 of an opened device claimed, configuration 1 selected; closes the handle where that
+// fails.
+Expected<void>
+claimInterface(libusb_device_handle* handle, std::uint16_t vendor, std::uint16_t product)
+{
+    int rc = LIBUSB_SUCCESS;
+    // Detach a kernel driver only if one is bound (the USB2000+ normally has none). Not libusb's
+    // auto-detach: that claims with USBDEVFS_DISCONNECT_CLAIM, which umockdev (the emulated device
+    // of tests/umockdev) does not implement, where a plain claim works on both.
+    if (libusb_kernel_driver_active(handle, 0) == 1) {
+        libusb_detach_kernel_driver(handle, 0);
+    }
+    // Select configuration 1 only when it is not already active: setting the active configuration
+    // again is a lightweight device reset (libusb's documentation), and the kernel has usually
+    // chosen configuration 1 at enumeration.
+    int active = 0;
+    if (libusb_get_configuration(handle, &active) == LIBUSB_SUCCESS && active == 1) {
+        rc = LIBUSB_SUCCESS;
+    } else {
+        rc = libusb_set_configuration(handle, 1);
+    }
+    if (rc != LIBUSB_SUCCESS && rc != LIBUSB_ERROR_BUSY) {
+        libusb_close(handle);
+        return makeError(ErrorCode::DeviceFailure,
+                         fmt::format("USB device {:04x}:{:04x}: cannot select configuration 1: {}",
+                                     vendor, product, libusb_strerror(rc)));
+    }
+    if (rc = libusb_claim_interface(handle, 0); rc != LIBUSB_SUCCESS) {
+        libusb_close(handle);
+        return makeError(ErrorCode::Io,
+                         fmt::format("USB device {:04x}:{:04x}: cannot claim interface 0 ({}); "
+                                     "is another program (OceanView, seabreeze) using it?",
+                                     vendor, product, libusb_strerror(rc)));
+    }
+    return {};
+}
+
+} // namespace
+
 Expected<std::unique_ptr<UsbTransport>> openLibusbTransport(std::uint16_t vendor,
                                                             std::uint16_t product,
                                                             int bus,
@@ -271,33 +312,8 @@ Expected<std::unique_ptr<UsbTransport>> openLibusbTransport(std::uint16_t vendor
         return makeError(ErrorCode::Io, fmt::format("could not open USB device {:04x}:{:04x}: {}",
                                                     vendor, product, libusb_strerror(rc)));
     }
-    // Detach a kernel driver only if one is bound (the USB2000+ normally has none). Not libusb's
-    // auto-detach: that claims with USBDEVFS_DISCONNECT_CLAIM, which umockdev (the emulated device
-    // of tests/umockdev) does not implement, where a plain claim works on both.
-    if (libusb_kernel_driver_active(handle, 0) == 1) {
-        libusb_detach_kernel_driver(handle, 0);
-    }
-    // Select configuration 1 only when it is not already active: setting the active configuration
-    // again is a lightweight device reset (libusb's documentation), and the kernel has usually
-    // chosen configuration 1 at enumeration.
-    int active = 0;
-    if (libusb_get_configuration(handle, &active) == LIBUSB_SUCCESS && active == 1) {
-        rc = LIBUSB_SUCCESS;
-    } else {
-        rc = libusb_set_configuration(handle, 1);
-    }
-    if (rc != LIBUSB_SUCCESS && rc != LIBUSB_ERROR_BUSY) {
-        libusb_close(handle);
-        return makeError(ErrorCode::DeviceFailure,
-                         fmt::format("USB device {:04x}:{:04x}: cannot select configuration 1: {}",
-                                     vendor, product, libusb_strerror(rc)));
-    }
-    if (rc = libusb_claim_interface(handle, 0); rc != LIBUSB_SUCCESS) {
-        libusb_close(handle);
-        return makeError(ErrorCode::Io,
-                         fmt::format("USB device {:04x}:{:04x}: cannot claim interface 0 ({}); "
-                                     "is another program (OceanView, seabreeze) using it?",
-                                     vendor, product, libusb_strerror(rc)));
+    if (auto ok = claimInterface(handle, vendor, product); !ok) {
+        return tl::unexpected(ok.error());
     }
     return std::unique_ptr<UsbTransport>(
             std::make_unique<LibusbTransport>(std::move(*ctx), handle, id));

@@ -76,11 +76,6 @@ std::vector<std::uint8_t> setTriggerMode(std::uint16_t mode)
     return out;
 }
 
-std::vector<std::uint8_t> queryStatus()
-{
-    return {kQueryStatus};
-}
-
 Expected<Status> parseStatus(std::span<const std::uint8_t> reply)
 {
     if (reply.size() != kStatusReplyBytes) {

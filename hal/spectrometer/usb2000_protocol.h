@@ -60,7 +60,6 @@ std::vector<std::uint8_t> setIntegrationTime(std::uint32_t us);
 std::vector<std::uint8_t> querySlot(std::uint8_t slot);
 std::vector<std::uint8_t> requestSpectrum();
 std::vector<std::uint8_t> setTriggerMode(std::uint16_t mode);
-std::vector<std::uint8_t> queryStatus();
 
 struct Status {
     std::uint16_t pixels = 0;

@@ -9,9 +9,7 @@
 namespace replica::hal::hid {
 namespace {
 
-constexpr std::uint32_t kMaxReportBits = 8192 * 8; // hidraw's HID_MAX_BUFFER_SIZE is 16 KiB
-constexpr std::uint32_t kMaxReportCount = 4096;
-constexpr std::size_t kMaxPushDepth = 16;
+constexpr std::uint32_t kMaxReportBits = kMaxReportBytes * 8;
 constexpr std::size_t kMaxUsageRange = 65536;
 
 // Item types and tags (HID 1.11, 6.2.2.4 - 6.2.2.8).
@@ -185,255 +183,382 @@ ReportDescriptor::find(ReportType type, std::uint32_t u, std::uint32_t withinCol
     return nullptr;
 }
 
-Expected<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> bytes)
+namespace {
+
+// One short item as read from the descriptor (long items are skipped by readItem).
+struct Item {
+    std::size_t at = 0; // byte offset of the prefix
+    std::uint8_t prefix = 0;
+    std::uint8_t type = 0;
+    std::uint8_t tag = 0;
+    ItemValue value;
+    bool skip = false; // a long item: nothing to act on
+};
+
+// Reads the item at 'pos' and moves 'pos' past it.
+Expected<Item> readItem(std::span<const std::uint8_t> bytes, std::size_t& pos)
+{
+    Item item;
+    item.at = pos;
+    item.prefix = bytes[pos++];
+    if (item.prefix == 0xFE) { // long item: size, tag, data; no long items are defined, skip
+        if (pos + 2 > bytes.size()) {
+            return tl::unexpected(errorAt(item.at, "long item cut short"));
+        }
+        const std::size_t n = bytes[pos];
+        pos += 2;
+        if (pos + n > bytes.size()) {
+            return tl::unexpected(
+                    errorAt(item.at, fmt::format("long item needs {} data bytes, only {} left", n,
+                                                 bytes.size() - pos)));
+        }
+        pos += n;
+        item.skip = true;
+        return item;
+    }
+    const int size = (item.prefix & 3) == 3 ? 4 : (item.prefix & 3);
+    item.type = (item.prefix >> 2) & 3;
+    item.tag = item.prefix >> 4;
+    if (pos + static_cast<std::size_t>(size) > bytes.size()) {
+        return tl::unexpected(
+                errorAt(item.at, fmt::format("item 0x{:02x} needs {} data bytes, only {} left",
+                                             item.prefix, size, bytes.size() - pos)));
+    }
+    item.value.size = size;
+    for (int i = 0; i < size; ++i) {
+        item.value.raw |= static_cast<std::uint32_t>(bytes[pos + static_cast<std::size_t>(i)])
+                          << (8 * i);
+    }
+    pos += static_cast<std::size_t>(size);
+    if (item.type == kReserved) {
+        return tl::unexpected(
+                errorAt(item.at, fmt::format("reserved item type (0x{:02x})", item.prefix)));
+    }
+    return item;
+}
+
+// The usages a main item gives its values: the Usage items in order, then a Usage Minimum..Maximum
+// range, the last one repeated for any further value. The range is not spelled out (a 4 KiB
+// descriptor could otherwise ask for millions of them).
+struct MainUsages {
+    std::vector<std::uint32_t> list;
+    std::uint32_t rangeLo = 0;
+    std::uint32_t rangeCount = 0;
+
+    bool empty() const { return list.empty() && rangeCount == 0; }
+    std::uint32_t at(std::uint32_t i) const
+    {
+        if (i < list.size()) {
+            return list[i];
+        }
+        if (rangeCount == 0) {
+            return list.back();
+        }
+        const auto k = static_cast<std::uint32_t>(i - list.size());
+        return rangeLo + std::min(k, rangeCount - 1);
+    }
+};
+
+class DescriptorParser
+{
+public:
+    Expected<ReportDescriptor> run(std::span<const std::uint8_t> bytes);
+
+private:
+    Expected<void> global(const Item& item);
+    void local(const Item& item);
+    Expected<MainUsages> takeUsages(const Item& item);
+    Expected<void> main(const Item& item);
+    Expected<void> collection(const Item& item, const MainUsages& usages);
+    Expected<void> data(const Item& item, const MainUsages& usages);
+    Expected<void> finish(std::size_t end);
+
+    ReportDescriptor d_;
+    GlobalState g_;
+    std::vector<GlobalState> stack_;
+    std::vector<LocalUsage> usages_;
+    LocalUsage usageMin_;
+    LocalUsage usageMax_;
+    bool haveMin_ = false;
+    bool haveMax_ = false;
+    std::vector<HidCollection> open_;
+};
+
+Expected<ReportDescriptor> DescriptorParser::run(std::span<const std::uint8_t> bytes)
 {
     if (bytes.empty()) {
         return makeError(ErrorCode::Corrupt, "HID report descriptor is empty");
     }
-    ReportDescriptor d;
-    GlobalState g;
-    std::vector<GlobalState> stack;
-    std::vector<LocalUsage> usages;
-    LocalUsage usageMin;
-    LocalUsage usageMax;
-    bool haveMin = false;
-    bool haveMax = false;
-    std::vector<HidCollection> open;
-
+    if (bytes.size() > kMaxDescriptorBytes) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("HID report descriptor of {} bytes, more than the {} a device "
+                                     "may have (the kernel's HID_MAX_DESCRIPTOR_SIZE)",
+                                     bytes.size(), kMaxDescriptorBytes));
+    }
     std::size_t pos = 0;
     while (pos < bytes.size()) {
-        const std::size_t at = pos;
-        const std::uint8_t prefix = bytes[pos++];
-        if (prefix == 0xFE) { // long item: size, tag, data; no long items are defined, skip
-            if (pos + 2 > bytes.size()) {
-                return tl::unexpected(errorAt(at, "long item cut short"));
-            }
-            const std::size_t n = bytes[pos];
-            pos += 2;
-            if (pos + n > bytes.size()) {
-                return tl::unexpected(
-                        errorAt(at, fmt::format("long item needs {} data bytes, only {} left", n,
-                                                bytes.size() - pos)));
-            }
-            pos += n;
+        auto item = readItem(bytes, pos);
+        if (!item) {
+            return tl::unexpected(item.error());
+        }
+        Expected<void> ok;
+        if (item->skip) {
             continue;
         }
-        const int size = (prefix & 3) == 3 ? 4 : (prefix & 3);
-        const std::uint8_t type = (prefix >> 2) & 3;
-        const std::uint8_t tag = prefix >> 4;
-        if (pos + static_cast<std::size_t>(size) > bytes.size()) {
-            return tl::unexpected(
-                    errorAt(at, fmt::format("item 0x{:02x} needs {} data bytes, only {} left",
-                                            prefix, size, bytes.size() - pos)));
+        if (item->type == kGlobal) {
+            ok = global(*item);
+        } else if (item->type == kLocal) {
+            local(*item);
+        } else {
+            ok = main(*item);
         }
-        ItemValue v;
-        v.size = size;
-        for (int i = 0; i < size; ++i) {
-            v.raw |= static_cast<std::uint32_t>(bytes[pos + static_cast<std::size_t>(i)])
-                     << (8 * i);
-        }
-        pos += static_cast<std::size_t>(size);
-
-        if (type == kReserved) {
-            return tl::unexpected(
-                    errorAt(at, fmt::format("reserved item type (0x{:02x})", prefix)));
-        }
-        if (type == kGlobal) {
-            switch (tag) {
-            case kUsagePage:
-                g.usagePage = static_cast<std::uint16_t>(v.raw);
-                break;
-            case kLogicalMin:
-                g.logicalMin = v;
-                break;
-            case kLogicalMax:
-                g.logicalMax = v;
-                break;
-            case kPhysicalMin:
-            case kPhysicalMax:
-                break; // physical ranges only rescale; the trackers' units come with logical values
-            case kUnitExponent:
-                // HID 1.11 codes it as a signed nibble; some descriptors write a signed byte.
-                g.unit.exponent = (size == 1 && v.raw <= 0xF) ? signedNibble(v.raw)
-                                                              : static_cast<int>(v.asSigned());
-                break;
-            case kUnit:
-                g.unit.raw = v.raw;
-                break;
-            case kReportSize:
-                g.reportSize = v.raw;
-                break;
-            case kReportId:
-                if (v.raw == 0 || v.raw > 255) {
-                    return tl::unexpected(
-                            errorAt(at, fmt::format("report ID {} (must be 1..255)", v.raw)));
-                }
-                g.reportId = static_cast<std::uint8_t>(v.raw);
-                d.numberedReports = true;
-                break;
-            case kReportCount:
-                g.reportCount = v.raw;
-                break;
-            case kPush:
-                if (stack.size() >= kMaxPushDepth) {
-                    return tl::unexpected(errorAt(at, "Push nested too deep"));
-                }
-                stack.push_back(g);
-                break;
-            case kPop:
-                if (stack.empty()) {
-                    return tl::unexpected(errorAt(at, "Pop without a Push"));
-                }
-                g = stack.back();
-                stack.pop_back();
-                break;
-            default:
-                return tl::unexpected(
-                        errorAt(at, fmt::format("reserved global item tag 0x{:x}", tag)));
-            }
-            continue;
-        }
-        if (type == kLocal) {
-            switch (tag) {
-            case kUsage:
-                usages.push_back({v.raw, size});
-                break;
-            case kUsageMin:
-                usageMin = LocalUsage{v.raw, size};
-                haveMin = true;
-                break;
-            case kUsageMax:
-                usageMax = LocalUsage{v.raw, size};
-                haveMax = true;
-                break;
-            default:
-                break; // designators, strings, delimiters: not needed here
-            }
-            continue;
-        }
-        // Main items.
-        std::vector<std::uint32_t> resolved;
-        for (const auto& u : usages) {
-            resolved.push_back(resolve(u, g.usagePage));
-        }
-        if (haveMin || haveMax) {
-            if (!haveMin || !haveMax) {
-                return tl::unexpected(errorAt(at, "Usage Minimum without Usage Maximum (or the "
-                                                  "other way round)"));
-            }
-            const std::uint32_t lo = resolve(usageMin, g.usagePage);
-            const std::uint32_t hi = resolve(usageMax, g.usagePage);
-            if (hi < lo || hi - lo >= kMaxUsageRange) {
-                return tl::unexpected(
-                        errorAt(at, fmt::format("usage range 0x{:x}..0x{:x} is empty or too large",
-                                                lo, hi)));
-            }
-            for (std::uint32_t u = lo; u <= hi; ++u) {
-                resolved.push_back(u);
-            }
-        }
-        usages.clear();
-        haveMin = false;
-        haveMax = false;
-
-        switch (tag) {
-        case kCollection: {
-            HidCollection c;
-            c.usage = resolved.empty() ? 0 : resolved.front();
-            c.type = static_cast<std::uint8_t>(v.raw);
-            c.depth = static_cast<int>(open.size());
-            open.push_back(c);
-            d.collections.push_back(c);
-            break;
-        }
-        case kEndCollection:
-            if (open.empty()) {
-                return tl::unexpected(errorAt(at, "End Collection without a Collection"));
-            }
-            open.pop_back();
-            break;
-        case kInput:
-        case kOutput:
-        case kFeature: {
-            const ReportType rt = tag == kInput    ? ReportType::Input
-                                  : tag == kOutput ? ReportType::Output
-                                                   : ReportType::Feature;
-            if (g.reportSize == 0 || g.reportSize > 64) {
-                return tl::unexpected(
-                        errorAt(at, fmt::format("{} item with Report Size {} (must be 1..64)",
-                                                toString(rt), g.reportSize)));
-            }
-            if (g.reportCount > kMaxReportCount) {
-                return tl::unexpected(
-                        errorAt(at, fmt::format("Report Count {} is implausible", g.reportCount)));
-            }
-            auto& bits = d.reportBits[{rt, g.reportId}];
-            const bool constant = (v.raw & 0x01) != 0;
-            const bool variable = (v.raw & 0x02) != 0;
-            // Not a structured binding: clang before 16 cannot capture one in the lambda below
-            // (the libFuzzer build, tests/fuzz/run_fuzz.sh).
-            const auto logical = logicalRange(g);
-            std::vector<std::uint32_t> path;
-            for (const auto& c : open) {
-                path.push_back(c.usage);
-            }
-            auto make = [&](std::uint32_t u, std::uint32_t bitSize) {
-                HidField f;
-                f.type = rt;
-                f.reportId = g.reportId;
-                f.bitOffset = bits;
-                f.bitSize = bitSize;
-                f.usage = u;
-                f.constant = constant || !variable || u == 0;
-                f.relative = (v.raw & 0x04) != 0;
-                f.nullState = (v.raw & 0x40) != 0;
-                f.logicalMin = logical.first;
-                f.logicalMax = logical.second;
-                f.unit = g.unit;
-                f.collections = path;
-                return f;
-            };
-            if (constant || !variable) {
-                // Padding or an array of selectors: space in the report, no values for us.
-                if (g.reportCount > 0) {
-                    d.fields.push_back(make(0, g.reportSize * g.reportCount));
-                }
-            } else {
-                for (std::uint32_t i = 0; i < g.reportCount; ++i) {
-                    const std::uint32_t u =
-                            resolved.empty()
-                                    ? 0
-                                    : resolved[std::min<std::size_t>(i, resolved.size() - 1)];
-                    d.fields.push_back(make(u, g.reportSize));
-                    d.fields.back().bitOffset = bits + i * g.reportSize;
-                }
-            }
-            bits += g.reportSize * g.reportCount;
-            if (bits > kMaxReportBits) {
-                return tl::unexpected(
-                        errorAt(at, fmt::format("{} report {} grows beyond {} bytes", toString(rt),
-                                                g.reportId, kMaxReportBits / 8)));
-            }
-            break;
-        }
-        default:
-            return tl::unexpected(errorAt(at, fmt::format("reserved main item tag 0x{:x}", tag)));
+        if (!ok) {
+            return tl::unexpected(ok.error());
         }
     }
-    if (!open.empty()) {
+    if (auto ok = finish(bytes.size()); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return std::move(d_);
+}
+
+Expected<void> DescriptorParser::global(const Item& item)
+{
+    const ItemValue& v = item.value;
+    switch (item.tag) {
+    case kUsagePage:
+        g_.usagePage = static_cast<std::uint16_t>(v.raw);
+        break;
+    case kLogicalMin:
+        g_.logicalMin = v;
+        break;
+    case kLogicalMax:
+        g_.logicalMax = v;
+        break;
+    case kPhysicalMin:
+    case kPhysicalMax:
+        break; // physical ranges only rescale; the trackers' units come with logical values
+    case kUnitExponent:
+        // HID 1.11 codes it as a signed nibble; some descriptors write a signed byte.
+        g_.unit.exponent = (v.size == 1 && v.raw <= 0xF) ? signedNibble(v.raw)
+                                                         : static_cast<int>(v.asSigned());
+        break;
+    case kUnit:
+        g_.unit.raw = v.raw;
+        break;
+    case kReportSize:
+        g_.reportSize = v.raw;
+        break;
+    case kReportId:
+        if (v.raw == 0 || v.raw > 255) {
+            return tl::unexpected(
+                    errorAt(item.at, fmt::format("report ID {} (must be 1..255)", v.raw)));
+        }
+        g_.reportId = static_cast<std::uint8_t>(v.raw);
+        d_.numberedReports = true;
+        break;
+    case kReportCount:
+        g_.reportCount = v.raw;
+        break;
+    case kPush:
+        if (stack_.size() >= kMaxPushDepth) {
+            return tl::unexpected(errorAt(
+                    item.at, fmt::format("Push nested deeper than {} levels", kMaxPushDepth)));
+        }
+        stack_.push_back(g_);
+        break;
+    case kPop:
+        if (stack_.empty()) {
+            return tl::unexpected(errorAt(item.at, "Pop without a Push"));
+        }
+        g_ = stack_.back();
+        stack_.pop_back();
+        break;
+    default:
         return tl::unexpected(
-                errorAt(bytes.size(), fmt::format("{} collection(s) never closed", open.size())));
+                errorAt(item.at, fmt::format("reserved global item tag 0x{:x}", item.tag)));
     }
-    if (d.numberedReports) {
-        for (const auto& f : d.fields) {
+    return {};
+}
+
+void DescriptorParser::local(const Item& item)
+{
+    const LocalUsage u{item.value.raw, item.value.size};
+    switch (item.tag) {
+    case kUsage:
+        usages_.push_back(u); // at most one per descriptor byte: bounded by its length
+        break;
+    case kUsageMin:
+        usageMin_ = u;
+        haveMin_ = true;
+        break;
+    case kUsageMax:
+        usageMax_ = u;
+        haveMax_ = true;
+        break;
+    default:
+        break; // designators, strings, delimiters: not needed here
+    }
+}
+
+// The local usages resolved against the current page, cleared for the next main item.
+Expected<MainUsages> DescriptorParser::takeUsages(const Item& item)
+{
+    MainUsages m;
+    for (const auto& u : usages_) {
+        m.list.push_back(resolve(u, g_.usagePage));
+    }
+    const bool range = haveMin_ || haveMax_;
+    const bool bothEnds = haveMin_ && haveMax_;
+    usages_.clear();
+    haveMin_ = false;
+    haveMax_ = false;
+    if (!range) {
+        return m;
+    }
+    if (!bothEnds) {
+        return tl::unexpected(errorAt(item.at, "Usage Minimum without Usage Maximum (or the "
+                                               "other way round)"));
+    }
+    const std::uint32_t lo = resolve(usageMin_, g_.usagePage);
+    const std::uint32_t hi = resolve(usageMax_, g_.usagePage);
+    if (hi < lo || hi - lo >= kMaxUsageRange) {
+        return tl::unexpected(errorAt(
+                item.at, fmt::format("usage range 0x{:x}..0x{:x} is empty or too large", lo, hi)));
+    }
+    m.rangeLo = lo;
+    m.rangeCount = hi - lo + 1;
+    return m;
+}
+
+Expected<void> DescriptorParser::main(const Item& item)
+{
+    auto usages = takeUsages(item);
+    if (!usages) {
+        return tl::unexpected(usages.error());
+    }
+    switch (item.tag) {
+    case kCollection:
+        return collection(item, *usages);
+    case kEndCollection:
+        if (open_.empty()) {
+            return tl::unexpected(errorAt(item.at, "End Collection without a Collection"));
+        }
+        open_.pop_back();
+        return {};
+    case kInput:
+    case kOutput:
+    case kFeature:
+        return data(item, *usages);
+    default:
+        return tl::unexpected(
+                errorAt(item.at, fmt::format("reserved main item tag 0x{:x}", item.tag)));
+    }
+}
+
+Expected<void> DescriptorParser::collection(const Item& item, const MainUsages& usages)
+{
+    if (open_.size() >= kMaxCollectionDepth) {
+        return tl::unexpected(
+                errorAt(item.at, fmt::format("collections nested deeper than {} levels (the limit)",
+                                             kMaxCollectionDepth)));
+    }
+    if (d_.collections.size() >= kMaxCollections) {
+        return tl::unexpected(errorAt(
+                item.at, fmt::format("more than {} collections (the limit)", kMaxCollections)));
+    }
+    HidCollection c;
+    c.usage = usages.empty() ? 0 : usages.at(0);
+    c.type = static_cast<std::uint8_t>(item.value.raw);
+    c.depth = static_cast<int>(open_.size());
+    open_.push_back(c);
+    d_.collections.push_back(c);
+    return {};
+}
+
+// An Input, Output or Feature item: its values as fields at their bit positions in the report.
+Expected<void> DescriptorParser::data(const Item& item, const MainUsages& usages)
+{
+    const ItemValue& v = item.value;
+    const ReportType rt = item.tag == kInput    ? ReportType::Input
+                          : item.tag == kOutput ? ReportType::Output
+                                                : ReportType::Feature;
+    if (g_.reportSize == 0 || g_.reportSize > 64) {
+        return tl::unexpected(errorAt(item.at, fmt::format("{} item with Report Size {} (must be "
+                                                           "1..64)",
+                                                           toString(rt), g_.reportSize)));
+    }
+    if (g_.reportCount > kMaxReportCount) {
+        return tl::unexpected(errorAt(item.at, fmt::format("Report Count {} is more than the {} "
+                                                           "an item may have",
+                                                           g_.reportCount, kMaxReportCount)));
+    }
+    auto& bits = d_.reportBits[{rt, g_.reportId}];
+    // Checked before any field is made: the report's size bounds the fields of one report, and
+    // kMaxFields all of them together (61 reports of 4,096 one-bit values would be 4 million).
+    if (bits + g_.reportSize * g_.reportCount > kMaxReportBits) {
+        return tl::unexpected(
+                errorAt(item.at, fmt::format("{} report {} grows beyond {} bytes", toString(rt),
+                                             g_.reportId, kMaxReportBits / 8)));
+    }
+    const bool constant = (v.raw & 0x01) != 0;
+    const bool variable = (v.raw & 0x02) != 0;
+    const std::uint32_t count =
+            constant || !variable ? (g_.reportCount > 0 ? 1 : 0) : g_.reportCount;
+    if (d_.fields.size() + count > kMaxFields) {
+        return tl::unexpected(errorAt(
+                item.at, fmt::format("more than {} fields in all (the limit)", kMaxFields)));
+    }
+    const auto logical = logicalRange(g_);
+    std::vector<std::uint32_t> path;
+    for (const auto& c : open_) {
+        path.push_back(c.usage);
+    }
+    for (std::uint32_t i = 0; i < count; ++i) {
+        HidField f;
+        f.type = rt;
+        f.reportId = g_.reportId;
+        f.bitOffset = bits + i * g_.reportSize;
+        // Padding or an array of selectors: space in the report, no values for us.
+        const bool padding = constant || !variable;
+        f.bitSize = padding ? g_.reportSize * g_.reportCount : g_.reportSize;
+        f.usage = padding || usages.empty() ? 0 : usages.at(i);
+        f.constant = padding || f.usage == 0;
+        f.relative = (v.raw & 0x04) != 0;
+        f.nullState = (v.raw & 0x40) != 0;
+        f.logicalMin = logical.first;
+        f.logicalMax = logical.second;
+        f.unit = g_.unit;
+        f.collections = path;
+        d_.fields.push_back(std::move(f));
+    }
+    bits += g_.reportSize * g_.reportCount;
+    return {};
+}
+
+Expected<void> DescriptorParser::finish(std::size_t end)
+{
+    if (!open_.empty()) {
+        return tl::unexpected(
+                errorAt(end, fmt::format("{} collection(s) never closed", open_.size())));
+    }
+    if (d_.numberedReports) {
+        for (const auto& f : d_.fields) {
             if (f.reportId == 0) {
                 return makeError(ErrorCode::Corrupt,
-                                 "HID report descriptor: some reports have IDs and some have none; "
-                                 "a device must number all its reports or none");
+                                 "HID report descriptor: some reports have IDs and some have "
+                                 "none; a device must number all its reports or none");
             }
         }
     }
-    return d;
+    return {};
+}
+
+} // namespace
+
+Expected<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> bytes)
+{
+    return DescriptorParser().run(bytes);
 }
 
 std::optional<std::int64_t> extractField(const HidField& f, std::span<const std::uint8_t> data)

@@ -17,6 +17,17 @@
 
 namespace replica::hal::hid {
 
+// What a descriptor may ask for (docs/limits.md). Past one, parsing fails with the limit and the
+// value, and the device is not used. Together they cap a parsed descriptor at a few MiB:
+// kMaxFields fields, each with at most kMaxCollectionDepth enclosing usages.
+constexpr std::size_t kMaxDescriptorBytes = 4096; // the kernel's HID_MAX_DESCRIPTOR_SIZE
+constexpr std::size_t kMaxCollectionDepth = 32;
+constexpr std::size_t kMaxCollections = 1024;
+constexpr std::size_t kMaxFields = 12288;       // the kernel's HID_MAX_USAGES
+constexpr std::uint32_t kMaxReportCount = 4096; // values in one main item
+constexpr std::uint32_t kMaxReportBytes = 8192; // data bytes of one report (hidraw buffers 16 KiB)
+constexpr std::size_t kMaxPushDepth = 16;
+
 enum class ReportType { Input, Output, Feature };
 
 const char* toString(ReportType t);

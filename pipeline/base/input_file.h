@@ -4,6 +4,7 @@
 // taken from an input file before it becomes part of a path.
 #pragma once
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -25,6 +26,13 @@ namespace replica {
 // mistake near memory.
 constexpr std::uintmax_t kMaxJsonBytes = 64u << 20;
 constexpr std::uintmax_t kMaxCsvBytes = 64u << 20;
+// Rows and fields of one CSV or CGATS table: a 64 MiB file of one-character rows would otherwise
+// hold tens of millions of rows, each its own allocation. The largest shipped table has 733 rows
+// and 100 fields.
+constexpr std::size_t kMaxTableRows = 1u << 20;
+constexpr std::size_t kMaxTableFields = 4096;
+// The site file: a few kilobytes of TOML.
+constexpr std::uintmax_t kMaxTomlBytes = 1u << 20;
 // Images (EXR, PNG): file size, and pixels per side checked from the header before allocating.
 constexpr std::uintmax_t kMaxImageBytes = 1024u << 20;
 constexpr int kMaxImageSide = 16384;
@@ -145,6 +153,50 @@ readInputFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::s
         }
     }
     return text;
+}
+
+// Refuses a table (CSV: 'separator' ','; CGATS: ' ', fields separated by spaces or tabs) with more
+// than kMaxTableRows lines or a line of more than kMaxTableFields fields, before it is split: one
+// line naming 'source' (and the line), the limit and the value.
+inline Expected<void>
+checkTableLimits(std::string_view text, std::string_view source, char separator)
+{
+    std::size_t rows = 0;
+    std::size_t fields = 0;
+    std::size_t widest = 0;
+    std::size_t widestRow = 0;
+    bool inField = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (c == '\n') {
+            ++rows;
+            fields = 0;
+            inField = false;
+        } else if (separator == ' ') {
+            const bool blank = c == ' ' || c == '\t' || c == '\r';
+            fields += !blank && !inField ? 1 : 0; // a field starts
+            inField = !blank;
+        } else {
+            fields = std::max<std::size_t>(fields, 1) + (c == separator ? 1 : 0);
+        }
+        if (fields > widest) {
+            widest = fields;
+            widestRow = rows + 1;
+        }
+    }
+    rows += !text.empty() && text.back() != '\n' ? 1 : 0;
+    if (rows > kMaxTableRows) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: {} lines, more than the limit of {} for a table", source,
+                                     rows, kMaxTableRows));
+    }
+    if (widest > kMaxTableFields) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}:{}: {} fields on one line, more than the limit of {} for "
+                                     "a table",
+                                     source, widestRow, widest, kMaxTableFields));
+    }
+    return {};
 }
 
 // A name read from an input file (a booth light's name, a luminance map's file name) that will

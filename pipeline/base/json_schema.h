@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/base/json_limits.h>
 
 namespace replica {
 
@@ -39,7 +40,6 @@ struct JsonSchema {
     std::shared_ptr<const JsonSchema> items; // arrays: every element
 
     JsonSchema optional() const;
-    JsonSchema orNull() const;
 };
 
 struct JsonSchemaField {
@@ -51,13 +51,6 @@ inline JsonSchema JsonSchema::optional() const
 {
     JsonSchema s = *this;
     s.required = false;
-    return s;
-}
-
-inline JsonSchema JsonSchema::orNull() const
-{
-    JsonSchema s = *this;
-    s.nullable = true;
     return s;
 }
 
@@ -308,6 +301,9 @@ inline Expected<nlohmann::json> parseJsonChecked(const std::string& text,
                                                  const std::string& file,
                                                  std::vector<std::string>* warnings = nullptr)
 {
+    if (auto ok = checkJsonLimits(text, file); !ok) {
+        return tl::unexpected(ok.error());
+    }
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(text);

@@ -42,11 +42,6 @@ Frame Frame::fromNormal(const Vec3& n)
     return f;
 }
 
-Vec3 Frame::toLocal(const Vec3& w) const
-{
-    return Vec3(glm::dot(w, t), glm::dot(w, b), glm::dot(w, n));
-}
-
 double wardEval(WardModel model, double alpha, const Vec3& n, const Vec3& i, const Vec3& o)
 {
     const double ci = glm::dot(n, i);

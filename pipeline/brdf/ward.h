@@ -35,7 +35,6 @@ struct Frame {
     Vec3 t, b, n;
     static Frame fromNormal(const Vec3& n);
     Vec3 toWorld(const Vec3& local) const { return t * local.x + b * local.y + n * local.z; }
-    Vec3 toLocal(const Vec3& w) const;
 };
 
 // Walter's sampling of the half vector (local frame, z = normal): tan^2 theta_h = -alpha^2 ln u1,

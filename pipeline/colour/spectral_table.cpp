@@ -15,6 +15,9 @@ namespace {} // namespace
 
 Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::string& source)
 {
+    if (auto ok = checkTableLimits(text, source, ','); !ok) {
+        return tl::unexpected(ok.error());
+    }
     SpectralTable table;
     table.source = source;
     std::istringstream in(text);

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <pipeline/base/input_file.h>
 #include <pipeline/csv/csv_cells.h>
 #include <pipeline/display/cgats.h>
 
@@ -122,21 +123,197 @@ int CgatsTable::field(const std::string& name) const
     return it == fields.end() ? -1 : static_cast<int>(it - fields.begin());
 }
 
+namespace {
+
+// The CGATS reader, one line at a time: the identifier, the header's keywords, the field list
+// (BEGIN_DATA_FORMAT ... END_DATA_FORMAT) and the rows (BEGIN_DATA ... END_DATA).
+class CgatsParser
+{
+public:
+    enum class State { Identifier, Header, Format, Data, Done };
+
+    explicit CgatsParser(const std::string& source) : source_(source) {}
+
+    State state() const { return state_; }
+
+    // One line's tokens (not empty).
+    Expected<void> read(const std::vector<std::string>& tok, const std::string& text, int lineNo)
+    {
+        switch (state_) {
+        case State::Identifier:
+            return identifier(tok, text, lineNo);
+        case State::Header:
+            return header(tok, lineNo);
+        case State::Format:
+            return format(tok);
+        case State::Data:
+            return data(tok, lineNo);
+        case State::Done:
+            break;
+        }
+        return {};
+    }
+
+    // The table, or what the file lacks where it ends early.
+    Expected<CgatsTable> finish()
+    {
+        const std::string& source = source_;
+        if (state_ == State::Identifier) {
+            return makeError(ErrorCode::Corrupt, fmt::format("{}: empty file", source));
+        }
+        if (state_ == State::Header) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: no BEGIN_DATA: no readings", source));
+        }
+        if (state_ == State::Format) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}:{}: BEGIN_DATA_FORMAT without END_DATA_FORMAT", source,
+                                         formatLine_));
+        }
+        if (state_ == State::Data) {
+            return makeError(
+                    ErrorCode::Corrupt,
+                    fmt::format("{}:{}: BEGIN_DATA without END_DATA (the file is cut short)",
+                                source, dataLine_));
+        }
+        return std::move(table_);
+    }
+
+private:
+    Expected<void>
+    identifier(const std::vector<std::string>& tok, const std::string& line, int lineNo)
+    {
+        const std::string& source = source_;
+        if (tok.size() != 1 || tok[0].size() < 3 ||
+            !std::all_of(tok[0].begin(), tok[0].end(), [](unsigned char ch) {
+                return std::isupper(ch) != 0 || std::isdigit(ch) != 0;
+            })) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}:{}: not a CGATS file: the first line must be "
+                                         "its type (CTI1, CTI3), found '{}'",
+                                         source, lineNo, csv::trimCell(line)));
+        }
+        table_.identifier = tok[0];
+        state_ = State::Header;
+        return {};
+    }
+
+    Expected<void> header(const std::vector<std::string>& tok, int lineNo)
+    {
+        const std::string& source = source_;
+        if (tok[0] == "BEGIN_DATA_FORMAT") {
+            state_ = State::Format;
+            formatLine_ = lineNo;
+        } else if (tok[0] == "BEGIN_DATA") {
+            if (table_.fields.empty()) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}:{}: BEGIN_DATA before the field list "
+                                             "(BEGIN_DATA_FORMAT ... END_DATA_FORMAT)",
+                                             source, lineNo));
+            }
+            state_ = State::Data;
+            dataLine_ = lineNo;
+        } else if (tok[0] == "NUMBER_OF_FIELDS" || tok[0] == "NUMBER_OF_SETS") {
+            double v = 0.0;
+            if (tok.size() != 2 || !parseNumber(tok[1], v) || v < 0 || v != std::floor(v)) {
+                return makeError(ErrorCode::Corrupt, fmt::format("{}:{}: {} needs a whole number",
+                                                                 source, lineNo, tok[0]));
+            }
+            (tok[0] == "NUMBER_OF_FIELDS" ? declaredFields_ : declaredSets_) = static_cast<long>(v);
+        } else if (tok[0] == "KEYWORD") {
+            // Declares a private keyword; its value follows on its own line.
+        } else if (tok.size() >= 2) {
+            std::string value = tok[1];
+            for (std::size_t i = 2; i < tok.size(); ++i) {
+                value += " " + tok[i];
+            }
+            table_.keywords.emplace_back(tok[0], value);
+        } else {
+            table_.keywords.emplace_back(tok[0], "");
+        }
+        return {};
+    }
+
+    Expected<void> format(const std::vector<std::string>& tok)
+    {
+        const std::string& source = source_;
+        if (tok[0] == "END_DATA_FORMAT") {
+            if (declaredFields_ >= 0 &&
+                static_cast<long>(table_.fields.size()) != declaredFields_) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}:{}: NUMBER_OF_FIELDS is {} but the format "
+                                             "lists {} fields",
+                                             source, formatLine_, declaredFields_,
+                                             table_.fields.size()));
+            }
+            state_ = State::Header;
+        } else {
+            table_.fields.insert(table_.fields.end(), tok.begin(), tok.end());
+        }
+        return {};
+    }
+
+    Expected<void> data(const std::vector<std::string>& tok, int lineNo)
+    {
+        const std::string& source = source_;
+        if (tok[0] == "END_DATA") {
+            if (!pending_.empty()) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}:{}: the last row has {} values, expected {}",
+                                             source, pendingLine_, pending_.size(),
+                                             table_.fields.size()));
+            }
+            if (declaredSets_ >= 0 && static_cast<long>(table_.rows.size()) != declaredSets_) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}:{}: NUMBER_OF_SETS is {} but the data has "
+                                             "{} rows",
+                                             source, lineNo, declaredSets_, table_.rows.size()));
+            }
+            state_ = State::Done;
+            return {};
+        }
+        // Argyll writes a row a line; a row that does not fill its line is an error there.
+        if (pending_.empty()) {
+            pendingLine_ = lineNo;
+        }
+        pending_.insert(pending_.end(), tok.begin(), tok.end());
+        if (pending_.size() == table_.fields.size()) {
+            table_.rows.push_back(pending_);
+            table_.rowLines.push_back(pendingLine_);
+            pending_.clear();
+        } else {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}:{}: {} values, expected {} ({})", source, pendingLine_,
+                                         pending_.size(), table_.fields.size(),
+                                         fmt::join(table_.fields, " ")));
+        }
+        return {};
+    }
+
+    const std::string& source_;
+    CgatsTable table_;
+    State state_ = State::Identifier;
+    long declaredFields_ = -1;
+    long declaredSets_ = -1;
+    int formatLine_ = 0;
+    int dataLine_ = 0;
+    std::vector<std::string> pending_; // data tokens of the row being read
+    int pendingLine_ = 0;
+};
+
+} // namespace
+
 Expected<CgatsTable> parseCgats(const std::string& text, const std::string& source)
 {
-    CgatsTable t;
+    if (auto ok = checkTableLimits(text, source, ' '); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    CgatsParser parser(source);
     std::istringstream in(text);
     std::string line;
     int lineNo = 0;
-    enum class State { Identifier, Header, Format, Data, Done } state = State::Identifier;
-    long declaredFields = -1;
-    long declaredSets = -1;
-    int formatLine = 0;
-    int dataLine = 0;
     std::vector<std::string> tok;
-    std::vector<std::string> pending; // data tokens of the row being read
-    int pendingLine = 0;
-    while (state != State::Done && std::getline(in, line)) {
+    while (parser.state() != CgatsParser::State::Done && std::getline(in, line)) {
         ++lineNo;
         if (!tokenize(line, tok)) {
             return makeError(ErrorCode::Corrupt,
@@ -145,122 +322,11 @@ Expected<CgatsTable> parseCgats(const std::string& text, const std::string& sour
         if (tok.empty()) {
             continue;
         }
-        switch (state) {
-        case State::Identifier:
-            if (tok.size() != 1 || tok[0].size() < 3 ||
-                !std::all_of(tok[0].begin(), tok[0].end(), [](unsigned char ch) {
-                    return std::isupper(ch) != 0 || std::isdigit(ch) != 0;
-                })) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("{}:{}: not a CGATS file: the first line must be "
-                                             "its type (CTI1, CTI3), found '{}'",
-                                             source, lineNo, csv::trimCell(line)));
-            }
-            t.identifier = tok[0];
-            state = State::Header;
-            break;
-        case State::Header:
-            if (tok[0] == "BEGIN_DATA_FORMAT") {
-                state = State::Format;
-                formatLine = lineNo;
-            } else if (tok[0] == "BEGIN_DATA") {
-                if (t.fields.empty()) {
-                    return makeError(ErrorCode::Corrupt,
-                                     fmt::format("{}:{}: BEGIN_DATA before the field list "
-                                                 "(BEGIN_DATA_FORMAT ... END_DATA_FORMAT)",
-                                                 source, lineNo));
-                }
-                state = State::Data;
-                dataLine = lineNo;
-            } else if (tok[0] == "NUMBER_OF_FIELDS" || tok[0] == "NUMBER_OF_SETS") {
-                double v = 0.0;
-                if (tok.size() != 2 || !parseNumber(tok[1], v) || v < 0 || v != std::floor(v)) {
-                    return makeError(
-                            ErrorCode::Corrupt,
-                            fmt::format("{}:{}: {} needs a whole number", source, lineNo, tok[0]));
-                }
-                (tok[0] == "NUMBER_OF_FIELDS" ? declaredFields : declaredSets) =
-                        static_cast<long>(v);
-            } else if (tok[0] == "KEYWORD") {
-                // Declares a private keyword; its value follows on its own line.
-            } else if (tok.size() >= 2) {
-                std::string value = tok[1];
-                for (std::size_t i = 2; i < tok.size(); ++i) {
-                    value += " " + tok[i];
-                }
-                t.keywords.emplace_back(tok[0], value);
-            } else {
-                t.keywords.emplace_back(tok[0], "");
-            }
-            break;
-        case State::Format:
-            if (tok[0] == "END_DATA_FORMAT") {
-                if (declaredFields >= 0 && static_cast<long>(t.fields.size()) != declaredFields) {
-                    return makeError(ErrorCode::Corrupt,
-                                     fmt::format("{}:{}: NUMBER_OF_FIELDS is {} but the format "
-                                                 "lists {} fields",
-                                                 source, formatLine, declaredFields,
-                                                 t.fields.size()));
-                }
-                state = State::Header;
-            } else {
-                t.fields.insert(t.fields.end(), tok.begin(), tok.end());
-            }
-            break;
-        case State::Data:
-            if (tok[0] == "END_DATA") {
-                if (!pending.empty()) {
-                    return makeError(ErrorCode::Corrupt,
-                                     fmt::format("{}:{}: the last row has {} values, expected {}",
-                                                 source, pendingLine, pending.size(),
-                                                 t.fields.size()));
-                }
-                if (declaredSets >= 0 && static_cast<long>(t.rows.size()) != declaredSets) {
-                    return makeError(ErrorCode::Corrupt,
-                                     fmt::format("{}:{}: NUMBER_OF_SETS is {} but the data has "
-                                                 "{} rows",
-                                                 source, lineNo, declaredSets, t.rows.size()));
-                }
-                state = State::Done;
-                break;
-            }
-            // Argyll writes a row a line; a row that does not fill its line is an error there.
-            if (pending.empty()) {
-                pendingLine = lineNo;
-            }
-            pending.insert(pending.end(), tok.begin(), tok.end());
-            if (pending.size() == t.fields.size()) {
-                t.rows.push_back(pending);
-                t.rowLines.push_back(pendingLine);
-                pending.clear();
-            } else {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("{}:{}: {} values, expected {} ({})", source,
-                                             pendingLine, pending.size(), t.fields.size(),
-                                             fmt::join(t.fields, " ")));
-            }
-            break;
-        case State::Done:
-            break;
+        if (auto ok = parser.read(tok, line, lineNo); !ok) {
+            return tl::unexpected(ok.error());
         }
     }
-    if (state == State::Identifier) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: empty file", source));
-    }
-    if (state == State::Header) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: no BEGIN_DATA: no readings", source));
-    }
-    if (state == State::Format) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}:{}: BEGIN_DATA_FORMAT without END_DATA_FORMAT", source,
-                                     formatLine));
-    }
-    if (state == State::Data) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}:{}: BEGIN_DATA without END_DATA (the file is cut short)",
-                                     source, dataLine));
-    }
-    return t;
+    return parser.finish();
 }
 
 std::string cgatsText(const CgatsTable& t)
@@ -434,14 +500,15 @@ Expected<MeasurementSet> loadMeasurements(const std::filesystem::path& path, int
     if (ext != ".ti3") {
         return loadMeasurementCsv(path, bitDepth);
     }
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open the measurement file", path.string()));
+    auto text = readInputFile(path, kMaxCsvBytes, "measurement");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open the measurement file", path.string()));
+        }
+        return tl::unexpected(text.error());
     }
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return parseTi3(ss.str(), path.string(), bitDepth == 0 ? 8 : bitDepth);
+    return parseTi3(*text, path.string(), bitDepth == 0 ? 8 : bitDepth);
 }
 
 } // namespace replica::pipeline::display

@@ -118,6 +118,9 @@ struct SensedStudyOptions {
     std::uint64_t seed = 1;
     double illuminanceLux = 2000.0;
     FlareHandling flare = FlareHandling::InBoothSubtract;
+    // The lights the site calibrates the instrument's wavelength shift under (the booth's
+    // fluorescent lamps); empty: the study's own lights.
+    std::vector<spectral::FineLight> calibrationLights;
 };
 
 struct SensedLightStats {

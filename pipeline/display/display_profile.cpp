@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <pipeline/base/json_schema.h>
 #include <pipeline/display/display_profile.h>
 
@@ -133,9 +134,51 @@ std::string profileToJson(const DisplayModel& m)
     return j.dump(2) + "\n";
 }
 
+namespace {
+
+// The fit report a profile carries (fields absent from older profiles keep their defaults).
+FitReport fitReportFromJson(const nlohmann::json& f)
+{
+    FitReport r;
+    r.trainingColours = f.value("training_colours", 0);
+    r.heldOutColours = f.value("held_out_colours", 0);
+    r.heldOutMeanDe00 = f.value("held_out_mean_de00", 0.0);
+    r.heldOutP90De00 = f.value("held_out_p90_de00", 0.0);
+    r.heldOutMaxDe00 = f.value("held_out_max_de00", 0.0);
+    r.trainingMeanDe00 = f.value("training_mean_de00", 0.0);
+    r.directPrimariesHeldOutMeanDe00 = f.value("direct_primaries_held_out_mean_de00", 0.0);
+    r.additivityDe00 = f.value("additivity_de00", -1.0);
+    r.additivityLuminancePercent = f.value("additivity_luminance_percent", 0.0);
+    if (f.contains("chromaticity_drift")) {
+        r.chromaticityDrift = f.at("chromaticity_drift").get<std::array<double, 3>>();
+    }
+    r.monotonicCorrections = f.value("monotonic_corrections", 0);
+    r.optimiserEvaluations = f.value("optimiser_evaluations", 0);
+    if (f.contains("noise_percent")) {
+        r.noisePercent = f.at("noise_percent").get<double>();
+        r.toneShape = f.at("tone_shape").get<std::array<std::string, 3>>();
+        r.toneSmoothing = f.at("tone_smoothing").get<std::array<double, 3>>();
+        r.inverseCountsRms = f.at("inverse_counts_rms").get<std::array<double, 3>>();
+        r.inverseCountsMax = f.at("inverse_counts_max").get<std::array<double, 3>>();
+        r.heldOutNoiseMeanDe00 = f.value("held_out_noise_mean_de00", -1.0);
+        r.additivityLuminanceSigmaPercent = f.value("additivity_luminance_sigma_percent", -1.0);
+        r.additivityNoiseDe00 = f.value("additivity_noise_de00", -1.0);
+        r.additiveWithinNoise = f.value("additive_within_noise", false);
+        r.gamutEdgeSigma = f.value("gamut_edge_sigma", -1.0);
+        r.crosstalkModel = f.value("crosstalk_model", std::string());
+        r.crosstalkGainDe00 = f.value("crosstalk_gain_de00", 0.0);
+    }
+    return r;
+}
+
+} // namespace
+
 Expected<DisplayModel> profileFromJson(const std::string& text, const std::string& source)
 {
     DisplayModel m;
+    if (auto ok = checkJsonLimits(text, source); !ok) {
+        return tl::unexpected(ok.error());
+    }
     try {
         const auto j = nlohmann::json::parse(text);
         if (!j.is_object() || j.value("format", "") != "replica-display-profile") {
@@ -199,37 +242,7 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
             m.viewing.dy = v.at("dy").get<std::vector<double>>();
         }
         if (j.contains("fit")) {
-            const auto& f = j.at("fit");
-            m.fit.trainingColours = f.value("training_colours", 0);
-            m.fit.heldOutColours = f.value("held_out_colours", 0);
-            m.fit.heldOutMeanDe00 = f.value("held_out_mean_de00", 0.0);
-            m.fit.heldOutP90De00 = f.value("held_out_p90_de00", 0.0);
-            m.fit.heldOutMaxDe00 = f.value("held_out_max_de00", 0.0);
-            m.fit.trainingMeanDe00 = f.value("training_mean_de00", 0.0);
-            m.fit.directPrimariesHeldOutMeanDe00 =
-                    f.value("direct_primaries_held_out_mean_de00", 0.0);
-            m.fit.additivityDe00 = f.value("additivity_de00", -1.0);
-            m.fit.additivityLuminancePercent = f.value("additivity_luminance_percent", 0.0);
-            if (f.contains("chromaticity_drift")) {
-                m.fit.chromaticityDrift = f.at("chromaticity_drift").get<std::array<double, 3>>();
-            }
-            m.fit.monotonicCorrections = f.value("monotonic_corrections", 0);
-            m.fit.optimiserEvaluations = f.value("optimiser_evaluations", 0);
-            if (f.contains("noise_percent")) {
-                m.fit.noisePercent = f.at("noise_percent").get<double>();
-                m.fit.toneShape = f.at("tone_shape").get<std::array<std::string, 3>>();
-                m.fit.toneSmoothing = f.at("tone_smoothing").get<std::array<double, 3>>();
-                m.fit.inverseCountsRms = f.at("inverse_counts_rms").get<std::array<double, 3>>();
-                m.fit.inverseCountsMax = f.at("inverse_counts_max").get<std::array<double, 3>>();
-                m.fit.heldOutNoiseMeanDe00 = f.value("held_out_noise_mean_de00", -1.0);
-                m.fit.additivityLuminanceSigmaPercent =
-                        f.value("additivity_luminance_sigma_percent", -1.0);
-                m.fit.additivityNoiseDe00 = f.value("additivity_noise_de00", -1.0);
-                m.fit.additiveWithinNoise = f.value("additive_within_noise", false);
-                m.fit.gamutEdgeSigma = f.value("gamut_edge_sigma", -1.0);
-                m.fit.crosstalkModel = f.value("crosstalk_model", std::string());
-                m.fit.crosstalkGainDe00 = f.value("crosstalk_gain_de00", 0.0);
-            }
+            m.fit = fitReportFromJson(j.at("fit"));
         }
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("{}: {}", source, e.what()));

@@ -15,6 +15,9 @@ namespace replica::pipeline::display {
 Expected<MeasurementSet>
 parseMeasurementCsv(const std::string& text, const std::string& source, int bitDepth)
 {
+    if (auto ok = checkTableLimits(text, source, ','); !ok) {
+        return tl::unexpected(ok.error());
+    }
     MeasurementSet set;
     set.source = source;
     bool header = false;

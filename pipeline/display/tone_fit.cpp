@@ -8,292 +8,12 @@
 
 #include <pipeline/base/assert.h>
 #include <pipeline/base/linear_solve.h>
+#include <pipeline/display/gogo_model.h>
+#include <pipeline/display/smoothing_spline.h>
 #include <pipeline/display/tone_fit.h>
 
 namespace replica::pipeline::display {
 namespace {
-
-double gogoEval(const std::array<double, 4>& p, double x, ToneShape shape)
-{
-    const double u = p[1] * x + (1.0 - p[1]);
-    const double base = u > 0.0 ? p[0] * std::pow(u, p[2]) : 0.0;
-    return shape == ToneShape::Gog ? base : base + p[3];
-}
-
-double weightedCost(const std::array<double, 4>& p,
-                    ToneShape shape,
-                    const std::vector<double>& x,
-                    const std::vector<double>& v,
-                    const std::vector<double>& w)
-{
-    double c = 0.0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        const double r = v[i] - gogoEval(p, x[i], shape);
-        c += w[i] * r * r;
-    }
-    return c;
-}
-
-void clampParams(std::array<double, 4>& p)
-{
-    p[0] = std::max(p[0], 1e-12);
-    p[1] = std::clamp(p[1], 0.05, 20.0);
-    p[2] = std::clamp(p[2], 0.1, 10.0);
-}
-
-// Starting point: scale from the top reading, gamma from a log-log line through the mid-tones.
-std::array<double, 4> gogoStart(const std::vector<double>& x, const std::vector<double>& v)
-{
-    std::size_t top = 0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        if (x[i] > x[top]) {
-            top = i;
-        }
-    }
-    const double s = v[top] > 0.0 ? v[top] : 1.0;
-    double sxx = 0.0;
-    double sxy = 0.0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        const double q = v[i] / s;
-        if (x[i] > 0.0 && q > 0.02 && q < 0.9) {
-            sxx += std::log(x[i]) * std::log(x[i]);
-            sxy += std::log(x[i]) * std::log(q);
-        }
-    }
-    const double gamma = sxx > 0.0 ? std::clamp(sxy / sxx, 0.3, 6.0) : 2.2;
-    return {s, 1.0, gamma, 0.0};
-}
-
-// Levenberg-Marquardt on the weighted squared residuals of GOG (3 parameters) or GOGO (4).
-std::array<double, 4> fitGogo(const std::vector<double>& x,
-                              const std::vector<double>& v,
-                              const std::vector<double>& w,
-                              ToneShape shape,
-                              std::array<double, 4> p)
-{
-    const std::size_t np = shape == ToneShape::Gog ? 3 : 4;
-    if (shape == ToneShape::Gog) {
-        p[3] = 0.0;
-    }
-    clampParams(p);
-    double cost = weightedCost(p, shape, x, v, w);
-    double mu = 1e-3;
-    for (int it = 0; it < 200; ++it) {
-        std::vector<double> jtj(np * np, 0.0);
-        std::vector<double> jtr(np, 0.0);
-        for (std::size_t i = 0; i < x.size(); ++i) {
-            if (w[i] == 0.0) {
-                continue;
-            }
-            const double u = p[1] * x[i] + (1.0 - p[1]);
-            std::array<double, 4> g{0.0, 0.0, 0.0, 1.0};
-            if (u > 0.0) {
-                const double up = std::pow(u, p[2]);
-                g[0] = up;
-                g[1] = p[0] * p[2] * std::pow(u, p[2] - 1.0) * (x[i] - 1.0);
-                g[2] = p[0] * up * std::log(u);
-            }
-            const double r = v[i] - gogoEval(p, x[i], shape);
-            for (std::size_t a = 0; a < np; ++a) {
-                jtr[a] += w[i] * g[a] * r;
-                for (std::size_t b = 0; b < np; ++b) {
-                    jtj[a * np + b] += w[i] * g[a] * g[b];
-                }
-            }
-        }
-        bool improved = false;
-        for (int tries = 0; tries < 12 && !improved; ++tries) {
-            std::vector<double> a = jtj;
-            for (std::size_t d = 0; d < np; ++d) {
-                a[d * np + d] += mu * std::max(jtj[d * np + d], 1e-300);
-            }
-            std::vector<double> step = jtr;
-            if (std::vector<double> lhs = a; !solveLinear(lhs, step, np)) {
-                mu *= 10.0;
-                continue;
-            }
-            std::array<double, 4> q = p;
-            for (std::size_t d = 0; d < np; ++d) {
-                q[d] += step[d];
-            }
-            clampParams(q);
-            const double c = weightedCost(q, shape, x, v, w);
-            if (c <= cost) {
-                const double gain = cost - c;
-                p = q;
-                improved = true;
-                mu = std::max(mu / 3.0, 1e-12);
-                if (gain <= 1e-14 * cost || cost == 0.0) {
-                    cost = c;
-                    return p;
-                }
-                cost = c;
-            } else {
-                mu *= 4.0;
-            }
-        }
-        if (!improved) {
-            break;
-        }
-    }
-    return p;
-}
-
-// The k-th derivative at each run of k + 1 knots as coefficients of the values there
-// (k! times the divided difference), and the run's length as its weight in the integral.
-struct Penalty {
-    std::vector<std::vector<double>> rows; // rows[j]: coefficients of knots j .. j + k
-    std::vector<double> length;
-};
-
-Penalty penaltyRows(const std::vector<double>& x, int order)
-{
-    Penalty p;
-    const std::size_t k = static_cast<std::size_t>(order);
-    double factorial = 1.0;
-    for (int i = 2; i <= order; ++i) {
-        factorial *= i;
-    }
-    for (std::size_t j = 0; j + k < x.size(); ++j) {
-        // Divided differences built up as coefficient vectors over knots j .. j + k.
-        std::vector<std::vector<double>> dd(k + 1);
-        for (std::size_t i = 0; i <= k; ++i) {
-            dd[i].assign(k + 1, 0.0);
-            dd[i][i] = 1.0;
-        }
-        for (std::size_t level = 1; level <= k; ++level) {
-            for (std::size_t i = 0; i + level <= k; ++i) {
-                const double span = x[j + i + level] - x[j + i];
-                for (std::size_t c = 0; c <= k; ++c) {
-                    dd[i][c] = (dd[i + 1][c] - dd[i][c]) / span;
-                }
-            }
-        }
-        std::vector<double> row(k + 1);
-        for (std::size_t c = 0; c <= k; ++c) {
-            row[c] = factorial * dd[0][c];
-        }
-        p.rows.push_back(std::move(row));
-        p.length.push_back((x[j + k] - x[j]) / static_cast<double>(k));
-    }
-    return p;
-}
-
-// Solves (diag(w) + lambda P) c = diag(w) e, P the integrated squared 'order'-th derivative of
-// the values at the knots x (strictly increasing), by a banded Cholesky factorisation.
-std::vector<double> smoothSpline(const std::vector<double>& x,
-                                 const std::vector<double>& e,
-                                 const std::vector<double>& w,
-                                 double lambda,
-                                 int order,
-                                 const Penalty& pen)
-{
-    const std::size_t n = x.size();
-    const std::size_t k = static_cast<std::size_t>(order);
-    const std::size_t bw = k + 1;
-    // a[i * bw + d] = A(i, i - d).
-    std::vector<double> a(n * bw, 0.0);
-    for (std::size_t i = 0; i < n; ++i) {
-        a[i * bw] = w[i];
-    }
-    for (std::size_t j = 0; j < pen.rows.size(); ++j) {
-        const double s = lambda * pen.length[j];
-        for (std::size_t r = 0; r <= k; ++r) {
-            for (std::size_t c = 0; c <= r; ++c) {
-                a[(j + r) * bw + (r - c)] += s * pen.rows[j][r] * pen.rows[j][c];
-            }
-        }
-    }
-    std::vector<double> l(n * bw, 0.0);
-    for (std::size_t i = 0; i < n; ++i) {
-        for (std::size_t d = std::min(k, i); d >= 1; --d) {
-            const std::size_t j = i - d;
-            double s = a[i * bw + d];
-            for (std::size_t m = d + 1; m <= k && m <= i; ++m) {
-                s -= l[i * bw + m] * l[j * bw + (m - d)];
-            }
-            l[i * bw + d] = s / l[j * bw];
-        }
-        double s = a[i * bw];
-        for (std::size_t m = 1; m <= k && m <= i; ++m) {
-            s -= l[i * bw + m] * l[i * bw + m];
-        }
-        l[i * bw] = std::sqrt(std::max(s, 1e-300));
-    }
-    std::vector<double> y(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        double s = w[i] * e[i];
-        for (std::size_t d = 1; d <= k && d <= i; ++d) {
-            s -= l[i * bw + d] * y[i - d];
-        }
-        y[i] = s / l[i * bw];
-    }
-    std::vector<double> c(n);
-    for (std::size_t i = n; i-- > 0;) {
-        double s = y[i];
-        for (std::size_t d = 1; d <= k && i + d < n; ++d) {
-            s -= l[(i + d) * bw + d] * c[i + d];
-        }
-        c[i] = s / l[i * bw];
-    }
-    return c;
-}
-
-// The penalty's scale, so that the lambda grid is dimensionless: trace(W) / trace(P).
-double lambdaScale(const std::vector<double>& w, const Penalty& pen)
-{
-    double trP = 0.0;
-    for (std::size_t j = 0; j < pen.rows.size(); ++j) {
-        for (double q : pen.rows[j]) {
-            trP += pen.length[j] * q * q;
-        }
-    }
-    const double trW = std::accumulate(w.begin(), w.end(), 0.0);
-    return trP > 0.0 && trW > 0.0 ? trW / trP : 1.0;
-}
-
-std::vector<double> lambdaGrid()
-{
-    std::vector<double> g;
-    for (int k = -24; k <= 16; ++k) {
-        g.push_back(std::pow(10.0, 0.5 * k));
-    }
-    return g;
-}
-
-// Cubic Hermite through (knots, values) with three-point slopes; constant beyond the ends.
-double hermite(const std::vector<double>& k, const std::vector<double>& v, double t)
-{
-    const std::size_t n = k.size();
-    if (n == 0) {
-        return 0.0;
-    }
-    if (n == 1 || !(t > k.front())) {
-        return v.front();
-    }
-    if (t >= k.back()) {
-        return v.back();
-    }
-    auto slope = [&](std::size_t i) {
-        if (i == 0) {
-            return (v[1] - v[0]) / (k[1] - k[0]);
-        }
-        if (i + 1 == n) {
-            return (v[n - 1] - v[n - 2]) / (k[n - 1] - k[n - 2]);
-        }
-        const double h0 = k[i] - k[i - 1];
-        const double h1 = k[i + 1] - k[i];
-        return ((v[i + 1] - v[i]) / h1 * h0 + (v[i] - v[i - 1]) / h0 * h1) / (h0 + h1);
-    };
-    const auto it = std::upper_bound(k.begin(), k.end(), t);
-    const std::size_t i = static_cast<std::size_t>(it - k.begin()) - 1;
-    const double h = k[i + 1] - k[i];
-    const double s = (t - k[i]) / h;
-    const double s2 = s * s;
-    const double s3 = s2 * s;
-    return (2 * s3 - 3 * s2 + 1) * v[i] + (s3 - 2 * s2 + s) * h * slope(i) +
-           (-2 * s3 + 3 * s2) * v[i + 1] + (s3 - s2) * h * slope(i + 1);
-}
 
 struct Sorted {
     std::vector<std::size_t> order; // sorted index -> sample index
@@ -302,50 +22,6 @@ struct Sorted {
     std::vector<double> v;
     std::vector<double> w;
 };
-
-// The GOGO's linearised domain: y = g^-1((v - offset) / scale) with g(y) = sign(y) |y|^gamma, in
-// which the GOG part is the straight line max(gain x + 1 - gain, 0).
-double linearise(const std::array<double, 4>& p, double v)
-{
-    const double q = (v - p[3]) / p[0];
-    return q >= 0.0 ? std::pow(q, 1.0 / p[2]) : -std::pow(-q, 1.0 / p[2]);
-}
-
-double delinearise(const std::array<double, 4>& p, double y)
-{
-    return p[3] + p[0] * (y >= 0.0 ? std::pow(y, p[2]) : -std::pow(-y, p[2]));
-}
-
-double linearBase(const std::array<double, 4>& p, double x)
-{
-    return std::max(p[1] * x + (1.0 - p[1]), 0.0);
-}
-
-// dy/dv, with |v - offset| held above 1e-4 of the scale so that a reading at black keeps a finite
-// (tiny) weight instead of an infinite slope.
-double lineariseSlope(const std::array<double, 4>& p, double v)
-{
-    const double q = std::max(std::abs((v - p[3]) / p[0]), 1e-4);
-    return std::pow(q, 1.0 / p[2] - 1.0) / (p[2] * p[0]);
-}
-
-// The residual of v from the GOGO in the linearised domain, and its weights (the value domain's
-// weights through the slope).
-void linearisedResidual(const std::array<double, 4>& p,
-                        const std::vector<double>& x,
-                        const std::vector<double>& v,
-                        const std::vector<double>& w,
-                        std::vector<double>& e,
-                        std::vector<double>& wl)
-{
-    e.resize(x.size());
-    wl.resize(x.size());
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        e[i] = linearise(p, v[i]) - linearBase(p, x[i]);
-        const double d = lineariseSlope(p, v[i]);
-        wl[i] = w[i] / (d * d);
-    }
-}
 
 // The splines cross-validated: the domain of the residual and the penalised derivative.
 struct SplineKind {
@@ -398,6 +74,232 @@ void fitFixed(const Sorted& s,
         const Penalty pen = penaltyRows(s.x, order);
         correction = smoothSpline(s.x, e, wl, lambda * lambdaScale(wl, pen), order, pen);
     }
+}
+
+// Which spline kinds take part: forcing the value-domain or the linearised spline keeps to its
+// domain; 'order' keeps to one penalty.
+bool kindUsed(const SplineKind& k, const ToneFitOptions& o, std::size_t n)
+{
+    if (o.order != 0 && o.order != k.order) {
+        return false;
+    }
+    if (o.forceShape && o.shape == ToneShape::Spline && k.linearised) {
+        return false;
+    }
+    if (o.forceShape && o.shape == ToneShape::LinearisedSpline && !k.linearised) {
+        return false;
+    }
+    return static_cast<std::size_t>(k.order) + 1 < n;
+}
+
+// The cross-validated errors of every candidate at every sample: row 0 GOG, row 1 GOGO, then
+// each spline kind at each smoothing of the grid (2 + kind * grid size + lambda index). A sample
+// never left out keeps error 0.
+class CvErrors
+{
+public:
+    CvErrors(const Sorted& s, std::size_t gridSize)
+        : s_(s), gridSize_(gridSize),
+          err_(2 + kSplineKinds.size() * gridSize, std::vector<double>(s.x.size(), 0.0))
+    {}
+
+    std::vector<double>& row(std::size_t r) { return err_[r]; }
+    double at(std::size_t r, std::size_t i) const { return err_[r][i]; }
+    static std::size_t splineRow(std::size_t kind, std::size_t lambda, std::size_t gridSize)
+    {
+        return 2 + kind * gridSize + lambda;
+    }
+    SplineKind kind(std::size_t r) const { return kSplineKinds[(r - 2) / gridSize_]; }
+    std::size_t lambdaIndex(std::size_t r) const { return (r - 2) % gridSize_; }
+
+    // The weighted sum of squared errors of a row.
+    double score(std::size_t r) const
+    {
+        double acc = 0.0;
+        for (std::size_t i = 0; i < s_.x.size(); ++i) {
+            acc += s_.w[i] * err_[r][i] * err_[r][i];
+        }
+        return acc;
+    }
+
+    // The standard error of the difference between two rows' scores (paired over the samples):
+    // a row within 'oneSe' of them of the best is not told apart from it by these readings.
+    double scoreSe(std::size_t a, std::size_t b) const
+    {
+        const std::size_t n = s_.x.size();
+        double sum = 0.0;
+        double sum2 = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double d = s_.w[i] * (err_[a][i] * err_[a][i] - err_[b][i] * err_[b][i]);
+            sum += d;
+            sum2 += d * d;
+        }
+        const double nn = static_cast<double>(n);
+        return std::sqrt(std::max(0.0, sum2 - sum * sum / nn) * nn / std::max(nn - 1.0, 1.0));
+    }
+
+private:
+    const Sorted& s_;
+    std::size_t gridSize_;
+    std::vector<std::vector<double>> err_;
+};
+
+// A refit of nearby data with everything fixed but the values: one least-squares fit from the
+// previous parameters.
+ToneFit refitFixed(const Sorted& s, double maxCount, const ToneFitOptions& o)
+{
+    const std::size_t n = s.x.size();
+    ToneFit fit;
+    fit.maxCount = maxCount;
+    fit.knots = s.count;
+    fit.shape = o.shape;
+    const bool spline = o.shape == ToneShape::Spline || o.shape == ToneShape::LinearisedSpline;
+    fit.lambda = spline ? o.lambda : 0.0;
+    fit.order = o.order != 0 ? o.order : 2;
+    fitFixed(s, s.w, o.shape, fit.lambda, fit.order, o.start, fit.gogo, fit.correction);
+    if (o.shape == ToneShape::Gog) {
+        fit.gogo[3] = 0.0;
+    }
+    fit.residual.assign(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        fit.residual[s.order[i]] = s.v[i] - fit(s.count[i]);
+    }
+    fit.cvResidual = fit.residual;
+    return fit;
+}
+
+// The parametric fits on all samples, the start of each fold's.
+struct ParametricFits {
+    std::array<double, 4> gog;
+    std::array<double, 4> gogo;
+};
+
+// Interleaved folds over the levels between the end points (black and full drive stay in every
+// training set: leaving them out would test extrapolation): each left-out sample's error under
+// every candidate fitted without it.
+void crossValidate(const Sorted& s,
+                   const ToneFitOptions& o,
+                   const ParametricFits& all,
+                   const std::vector<double>& grid,
+                   const std::vector<Penalty>& penalties,
+                   CvErrors& cvErr)
+{
+    const std::size_t n = s.x.size();
+    const int folds = std::max(2, o.folds);
+    for (int f = 0; f < folds; ++f) {
+        std::vector<double> w = s.w;
+        std::vector<std::size_t> out;
+        for (std::size_t i = 1; i < n; ++i) {
+            if (static_cast<int>((i - 1) % static_cast<std::size_t>(folds)) == f) {
+                w[i] = 0.0;
+                out.push_back(i);
+            }
+        }
+        if (out.empty()) {
+            continue;
+        }
+        const auto pg = fitGogo(s.x, s.v, w, ToneShape::Gog, all.gog);
+        const auto po = fitGogo(s.x, s.v, w, ToneShape::Gogo, all.gogo);
+        std::vector<double> e(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            e[i] = s.v[i] - gogoEval(po, s.x[i], ToneShape::Gogo);
+        }
+        std::vector<double> el;
+        std::vector<double> wl;
+        linearisedResidual(po, s.x, s.v, w, el, wl);
+        for (std::size_t i : out) {
+            cvErr.row(0)[i] = s.v[i] - gogoEval(pg, s.x[i], ToneShape::Gog);
+            cvErr.row(1)[i] = e[i];
+        }
+        for (std::size_t ki = 0; ki < kSplineKinds.size(); ++ki) {
+            const SplineKind& kind = kSplineKinds[ki];
+            if (!kindUsed(kind, o, n)) {
+                continue;
+            }
+            const auto& ee = kind.linearised ? el : e;
+            const auto& ww = kind.linearised ? wl : w;
+            const Penalty& pen = penalties[ki];
+            const double scale = lambdaScale(ww, pen);
+            for (std::size_t k = 0; k < grid.size(); ++k) {
+                const auto c = smoothSpline(s.x, ee, ww, grid[k] * scale, kind.order, pen);
+                auto& row = cvErr.row(CvErrors::splineRow(ki, k, grid.size()));
+                for (std::size_t i : out) {
+                    row[i] = kind.linearised
+                                     ? s.v[i] - delinearise(po, linearBase(po, s.x[i]) + c[i])
+                                     : e[i] - c[i];
+                }
+            }
+        }
+    }
+}
+
+// The best smoothing and order of each domain (0: value, 1: linearised): its row and score.
+struct DomainBest {
+    std::array<std::size_t, 2> row{0, 0};
+    std::array<double, 2> score{std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::infinity()};
+};
+
+DomainBest
+bestPerDomain(const CvErrors& cvErr, const ToneFitOptions& o, std::size_t n, std::size_t gridSize)
+{
+    DomainBest best;
+    for (std::size_t ki = 0; ki < kSplineKinds.size(); ++ki) {
+        if (!kindUsed(kSplineKinds[ki], o, n)) {
+            continue;
+        }
+        const std::size_t d = kSplineKinds[ki].linearised ? 1 : 0;
+        for (std::size_t k = 0; k < gridSize; ++k) {
+            const std::size_t r = CvErrors::splineRow(ki, k, gridSize);
+            const double sc = cvErr.score(r);
+            if (sc < best.score[d]) {
+                best.score[d] = sc;
+                best.row[d] = r;
+            }
+        }
+    }
+    return best;
+}
+
+// The shape kept and its row: the forced one, else the simplest shape within 2 % (and within the
+// one-standard-error rule) of the best cross-validated error.
+std::pair<ToneShape, std::size_t>
+chooseShape(const Sorted& s, const CvErrors& cvErr, const DomainBest& best, const ToneFitOptions& o)
+{
+    const std::size_t bestDomain = best.score[1] < best.score[0] ? 1 : 0;
+    ToneShape shape = bestDomain == 1 ? ToneShape::LinearisedSpline : ToneShape::Spline;
+    std::size_t row = best.row[bestDomain];
+    if (o.forceShape) {
+        shape = o.shape;
+        if (shape == ToneShape::Gog || shape == ToneShape::Gogo) {
+            row = shape == ToneShape::Gog ? 0 : 1;
+        } else {
+            row = best.row[shape == ToneShape::LinearisedSpline ? 1 : 0];
+        }
+        return {shape, row};
+    }
+    double scale = 0.0;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+        scale += s.w[i] * s.v[i] * s.v[i];
+    }
+    std::size_t bestAll = row;
+    for (std::size_t r : {std::size_t{1}, std::size_t{0}}) {
+        if (cvErr.score(r) < cvErr.score(bestAll)) {
+            bestAll = r;
+        }
+    }
+    const double bestScore = cvErr.score(bestAll);
+    auto within = [&](std::size_t r) {
+        return cvErr.score(r) <= bestScore * 1.02 + 1e-24 * scale ||
+               cvErr.score(r) <= bestScore + o.oneSe * cvErr.scoreSe(r, bestAll);
+    };
+    if (within(0)) {
+        return {ToneShape::Gog, 0};
+    }
+    if (within(1)) {
+        return {ToneShape::Gogo, 1};
+    }
+    return {shape, row};
 }
 
 } // namespace
@@ -459,189 +361,39 @@ ToneFit fitTone(const std::vector<ToneSample>& samples, double maxCount, const T
 {
     REPLICA_ASSERT(samples.size() >= 4, "a tone fit needs at least four samples");
     const Sorted s = sortSamples(samples, maxCount);
+    if (o.forceShape && o.lambda >= 0.0 && o.warmStart) {
+        return refitFixed(s, maxCount, o);
+    }
+    const std::size_t n = s.x.size();
     ToneFit fit;
     fit.maxCount = maxCount;
     fit.knots = s.count;
-    const std::size_t n = s.x.size();
-    if (o.forceShape && o.lambda >= 0.0 && o.warmStart) {
-        // A refit of nearby data with everything fixed but the values: one least-squares fit from
-        // the previous parameters.
-        fit.shape = o.shape;
-        const bool spline = o.shape == ToneShape::Spline || o.shape == ToneShape::LinearisedSpline;
-        fit.lambda = spline ? o.lambda : 0.0;
-        fit.order = o.order != 0 ? o.order : 2;
-        fitFixed(s, s.w, o.shape, fit.lambda, fit.order, o.start, fit.gogo, fit.correction);
-        if (o.shape == ToneShape::Gog) {
-            fit.gogo[3] = 0.0;
-        }
-        fit.residual.assign(n, 0.0);
-        for (std::size_t i = 0; i < n; ++i) {
-            fit.residual[s.order[i]] = s.v[i] - fit(s.count[i]);
-        }
-        fit.cvResidual = fit.residual;
-        return fit;
-    }
     const std::array<double, 4> start = gogoStart(s.x, s.v);
-    const std::array<double, 4> gog = fitGogo(s.x, s.v, s.w, ToneShape::Gog, start);
-    const std::array<double, 4> gogoAll = fitGogo(s.x, s.v, s.w, ToneShape::Gogo, gog);
+    ParametricFits all;
+    all.gog = fitGogo(s.x, s.v, s.w, ToneShape::Gog, start);
+    all.gogo = fitGogo(s.x, s.v, s.w, ToneShape::Gogo, all.gog);
 
     const auto grid = lambdaGrid();
-    // Which spline kinds take part: forcing the value-domain or the linearised spline keeps to
-    // its domain; 'order' keeps to one penalty.
-    auto kindUsed = [&](const SplineKind& k) {
-        if (o.order != 0 && o.order != k.order) {
-            return false;
-        }
-        if (o.forceShape && o.shape == ToneShape::Spline && k.linearised) {
-            return false;
-        }
-        if (o.forceShape && o.shape == ToneShape::LinearisedSpline && !k.linearised) {
-            return false;
-        }
-        return static_cast<std::size_t>(k.order) + 1 < n;
-    };
-    std::vector<std::vector<double>> cvErr(2 + kSplineKinds.size() * grid.size(),
-                                           std::vector<double>(n, 0.0));
+    CvErrors cvErr(s, grid.size());
     const bool cv = !(o.forceShape &&
                       ((o.shape != ToneShape::Spline && o.shape != ToneShape::LinearisedSpline) ||
                        o.lambda >= 0.0));
     std::vector<Penalty> penalties;
     for (const SplineKind& kind : kSplineKinds) {
-        penalties.push_back(kindUsed(kind) ? penaltyRows(s.x, kind.order) : Penalty{});
+        penalties.push_back(kindUsed(kind, o, n) ? penaltyRows(s.x, kind.order) : Penalty{});
     }
     if (cv) {
-        // Interleaved folds over the levels between the end points (black and full drive stay
-        // in every training set: leaving them out would test extrapolation).
-        const int folds = std::max(2, o.folds);
-        for (int f = 0; f < folds; ++f) {
-            std::vector<double> w = s.w;
-            std::vector<std::size_t> out;
-            for (std::size_t i = 1; i < n; ++i) {
-                if (static_cast<int>((i - 1) % static_cast<std::size_t>(folds)) == f) {
-                    w[i] = 0.0;
-                    out.push_back(i);
-                }
-            }
-            if (out.empty()) {
-                continue;
-            }
-            const auto pg = fitGogo(s.x, s.v, w, ToneShape::Gog, gog);
-            const auto po = fitGogo(s.x, s.v, w, ToneShape::Gogo, gogoAll);
-            std::vector<double> e(n);
-            for (std::size_t i = 0; i < n; ++i) {
-                e[i] = s.v[i] - gogoEval(po, s.x[i], ToneShape::Gogo);
-            }
-            std::vector<double> el;
-            std::vector<double> wl;
-            linearisedResidual(po, s.x, s.v, w, el, wl);
-            for (std::size_t i : out) {
-                cvErr[0][i] = s.v[i] - gogoEval(pg, s.x[i], ToneShape::Gog);
-                cvErr[1][i] = e[i];
-            }
-            for (std::size_t ki = 0; ki < kSplineKinds.size(); ++ki) {
-                const SplineKind& kind = kSplineKinds[ki];
-                if (!kindUsed(kind)) {
-                    continue;
-                }
-                const auto& ee = kind.linearised ? el : e;
-                const auto& ww = kind.linearised ? wl : w;
-                const Penalty& pen = penalties[ki];
-                const double scale = lambdaScale(ww, pen);
-                for (std::size_t k = 0; k < grid.size(); ++k) {
-                    const auto c = smoothSpline(s.x, ee, ww, grid[k] * scale, kind.order, pen);
-                    for (std::size_t i : out) {
-                        cvErr[2 + ki * grid.size() + k][i] =
-                                kind.linearised
-                                        ? s.v[i] - delinearise(po, linearBase(po, s.x[i]) + c[i])
-                                        : e[i] - c[i];
-                    }
-                }
-            }
-        }
+        crossValidate(s, o, all, grid, penalties, cvErr);
     }
-    auto score = [&](std::size_t row) {
-        double acc = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            acc += s.w[i] * cvErr[row][i] * cvErr[row][i];
-        }
-        return acc;
-    };
-    // The best smoothing and order of each domain.
-    std::array<std::size_t, 2> bestRow{0, 0};
-    std::array<double, 2> bestScore{std::numeric_limits<double>::infinity(),
-                                    std::numeric_limits<double>::infinity()};
-    for (std::size_t ki = 0; ki < kSplineKinds.size(); ++ki) {
-        if (!kindUsed(kSplineKinds[ki])) {
-            continue;
-        }
-        const std::size_t d = kSplineKinds[ki].linearised ? 1 : 0;
-        for (std::size_t k = 0; k < grid.size(); ++k) {
-            const std::size_t r = 2 + ki * grid.size() + k;
-            const double sc = score(r);
-            if (sc < bestScore[d]) {
-                bestScore[d] = sc;
-                bestRow[d] = r;
-            }
-        }
-    }
-    // The standard error of the difference between two rows' scores (paired over the samples):
-    // a row within 'oneSe' of them of the best is not told apart from it by these readings.
-    auto scoreSe = [&](std::size_t a, std::size_t b) {
-        double sum = 0.0;
-        double sum2 = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const double d = s.w[i] * (cvErr[a][i] * cvErr[a][i] - cvErr[b][i] * cvErr[b][i]);
-            sum += d;
-            sum2 += d * d;
-        }
-        const double nn = static_cast<double>(n);
-        return std::sqrt(std::max(0.0, sum2 - sum * sum / nn) * nn / std::max(nn - 1.0, 1.0));
-    };
-    fit.cvScore = {score(0), score(1), bestScore[0], bestScore[1]};
-    const std::size_t bestDomain = bestScore[1] < bestScore[0] ? 1 : 0;
-    ToneShape shape = bestDomain == 1 ? ToneShape::LinearisedSpline : ToneShape::Spline;
-    std::size_t row = bestRow[bestDomain];
-    auto rowKind = [&](std::size_t r) { return kSplineKinds[(r - 2) / grid.size()]; };
-    auto rowLambda = [&](std::size_t r) { return grid[(r - 2) % grid.size()]; };
-    if (o.forceShape) {
-        shape = o.shape;
-        if (shape == ToneShape::Gog || shape == ToneShape::Gogo) {
-            row = shape == ToneShape::Gog ? 0 : 1;
-        } else {
-            row = bestRow[shape == ToneShape::LinearisedSpline ? 1 : 0];
-        }
-    } else {
-        // The simplest shape within 2 % (and within the one-standard-error rule) of the best
-        // cross-validated error.
-        double scale = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            scale += s.w[i] * s.v[i] * s.v[i];
-        }
-        std::size_t bestAll = row;
-        for (std::size_t r : {std::size_t{1}, std::size_t{0}}) {
-            if (score(r) < score(bestAll)) {
-                bestAll = r;
-            }
-        }
-        const double best = score(bestAll);
-        auto within = [&](std::size_t r) {
-            return score(r) <= best * 1.02 + 1e-24 * scale ||
-                   score(r) <= best + o.oneSe * scoreSe(r, bestAll);
-        };
-        if (within(0)) {
-            shape = ToneShape::Gog;
-            row = 0;
-        } else if (within(1)) {
-            shape = ToneShape::Gogo;
-            row = 1;
-        }
-    }
+    const DomainBest best = bestPerDomain(cvErr, o, n, grid.size());
+    fit.cvScore = {cvErr.score(0), cvErr.score(1), best.score[0], best.score[1]};
+    const auto [shape, row] = chooseShape(s, cvErr, best, o);
     const bool spline = shape == ToneShape::Spline || shape == ToneShape::LinearisedSpline;
     double lambda = 0.0;
     int order = o.order != 0 ? o.order : 2;
     if (spline && row >= 2) {
-        lambda = rowLambda(row);
-        order = rowKind(row).order;
+        lambda = grid[cvErr.lambdaIndex(row)];
+        order = cvErr.kind(row).order;
     }
     if (o.forceShape && o.lambda >= 0.0) {
         lambda = o.lambda;
@@ -650,7 +402,8 @@ ToneFit fitTone(const std::vector<ToneSample>& samples, double maxCount, const T
     fit.lambda = spline ? lambda : 0.0;
     fit.order = order;
     std::vector<double> corr;
-    fitFixed(s, s.w, shape, lambda, order, shape == ToneShape::Gog ? gog : gogoAll, fit.gogo, corr);
+    fitFixed(s, s.w, shape, lambda, order, shape == ToneShape::Gog ? all.gog : all.gogo, fit.gogo,
+             corr);
     if (shape == ToneShape::Gog) {
         fit.gogo[3] = 0.0;
     }
@@ -660,7 +413,7 @@ ToneFit fitTone(const std::vector<ToneSample>& samples, double maxCount, const T
     for (std::size_t i = 0; i < n; ++i) {
         const double r = s.v[i] - fit(s.count[i]);
         fit.residual[s.order[i]] = r;
-        fit.cvResidual[s.order[i]] = cv && i > 0 ? cvErr[row][i] : r;
+        fit.cvResidual[s.order[i]] = cv && i > 0 ? cvErr.at(row, i) : r;
     }
     return fit;
 }

@@ -14,6 +14,9 @@ namespace replica::pipeline::display {
 
 Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const std::string& source)
 {
+    if (auto ok = checkTableLimits(text, source, ','); !ok) {
+        return tl::unexpected(ok.error());
+    }
     ViewingAngleTable t;
     bool header = false;
     double x0 = 0.0;

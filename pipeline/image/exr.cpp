@@ -27,28 +27,6 @@ const std::vector<float>* ChannelImage::plane(const std::string& name) const
     return nullptr;
 }
 
-Expected<std::vector<std::string>> exrChannelNames(const std::filesystem::path& path)
-{
-    if (auto ok = checkInputFile(path, kMaxImageBytes, "OpenEXR"); !ok) {
-        if (ok.error().code == ErrorCode::NotFound) {
-            return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
-        }
-        return tl::unexpected(ok.error());
-    }
-    try {
-        Imf::InputFile file(path.c_str());
-        std::vector<std::string> out;
-        for (auto it = file.header().channels().begin(); it != file.header().channels().end();
-             ++it) {
-            out.emplace_back(it.name());
-        }
-        return out;
-    } catch (const std::exception& e) {
-        return makeError(ErrorCode::Corrupt, fmt::format("{}: not a readable OpenEXR file ({})",
-                                                         path.string(), e.what()));
-    }
-}
-
 Expected<ChannelImage> readExr(const std::filesystem::path& path,
                                const std::vector<std::string>& names)
 {

@@ -26,9 +26,6 @@ struct ChannelImage {
 Expected<ChannelImage> readExr(const std::filesystem::path& path,
                                const std::vector<std::string>& names);
 
-// Names of every channel in the file, for messages and for reading all of them.
-Expected<std::vector<std::string>> exrChannelNames(const std::filesystem::path& path);
-
 // Writes 32-bit float channels (or, with halfFloat, 16-bit half channels: OpenEXR rounds each
 // value to the nearest half) with ZIP compression; string attributes are stored as header
 // comments.

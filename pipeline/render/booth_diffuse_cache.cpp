@@ -29,7 +29,7 @@ void BoothDiffuseCache::setSurroundIlluminance(bool on)
 {
     if (on != surroundIlluminance_) {
         surroundIlluminance_ = on;
-        valid_ = false;
+        invalidate();
     }
 }
 
@@ -42,8 +42,8 @@ Expected<void> BoothDiffuseCache::ensureTarget(int width, int height)
         c = Buffer{}; // a new texture holds nothing yet
     }
     facetTexture_.reset();
-    front_ = 0;
-    pending_.reset();
+    shown_ = 0;
+    invalidate();
     glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
     if (facetCache_) {
         facetTexture_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
@@ -71,7 +71,6 @@ Expected<void> BoothDiffuseCache::ensureTarget(int width, int height)
     }
     width_ = width;
     height_ = height;
-    valid_ = false;
     if (!complete) {
         return makeError(ErrorCode::Unsupported,
                          "render: the booth pass's RGBA32F cache is not renderable on this GL");
@@ -80,43 +79,69 @@ Expected<void> BoothDiffuseCache::ensureTarget(int width, int height)
 }
 
 void BoothDiffuseCache::update(const BoothPrograms& programs,
-                               const shading::PanelPose& pose,
+                               const CacheWant& want,
                                const SurfaceLayout& layout,
                                const PixelRect& rect,
                                int width,
                                int height)
 {
-    const Key key{pose.centre, pose.right, pose.up,       pose.normal,
-                  width,       height,     layout.offset, layout.scale};
-    // Only a new pose is drawn in bands: the compose places the surface by this draw's layout,
-    // and the facet normals (one texture behind both buffers) follow the layout too, so a cache
-    // of another layout or size is no frame to show meanwhile.
-    const bool samePlacement = key.width == key_.width && key.height == key_.height &&
-                               key.offset == key_.offset && key.scale == key_.scale;
-    if (!valid_ || (!(key == key_) && (slices_ == 1 || !samePlacement))) {
-        // Drawn whole: the first cache, a new light, size, layout, channels or surround (nothing
-        // of the old cache would do), or any change with unsliced refreshes.
-        pending_.reset();
-        drawSlice(programs, front_, pose, {0, 1, rect, width, height});
-        key_ = key;
-        valid_ = true;
-        ++refreshes_;
+    const Key shown = keyOf(want.shown, layout, width, height);
+    if (!want.band) {
+        if (front_ != shown) {
+            drawWhole(programs, shown, want.shown, rect);
+        }
         return;
     }
-    if (!pending_ && !(key == key_)) {
-        pending_ = PendingRefresh{key, pose, 0};
+    const CacheBand& band = *want.band;
+    const Key toward = keyOf(band.toward, layout, width, height);
+    const bool last = band.band + 1 >= band.bands;
+    // The one draw, where the buffers hold what the frame before it drew: the band asked for.
+    const bool earlierBands =
+            band.band == 0 || (back_ && back_->key == toward && back_->bands == band.band);
+    if (earlierBands && (last || front_ == shown) && slices_ > 1) {
+        drawBand(programs, toward, band, rect);
+        return;
     }
-    if (pending_) {
-        // One band of the refresh into the back buffer; the last one makes it the front.
-        const int back = 1 - front_;
-        drawSlice(programs, back, pending_->pose,
-                  {pending_->nextSlice, slices_, rect, width, height});
-        if (++pending_->nextSlice == slices_) {
-            front_ = back;
-            key_ = pending_->key;
-            pending_.reset();
-            ++refreshes_;
-        }
+    // Otherwise the term shown whole (the last band's frame shows the refresh's tilt: whole, it is
+    // the same pixels), then the refresh's bands so far.
+    if (front_ != shown) {
+        drawWhole(programs, shown, want.shown, rect);
+    }
+    if (last || slices_ == 1) {
+        return;
+    }
+    for (int b = 0; b <= band.band; ++b) {
+        drawBand(programs, toward, {band.toward, b, band.bands}, rect);
+    }
+}
+
+void BoothDiffuseCache::drawWhole(const BoothPrograms& programs,
+                                  const Key& key,
+                                  const shading::PanelPose& pose,
+                                  const PixelRect& rect)
+{
+    // A refresh's bands in the other buffer were drawn with the diffuse grid of its tilt, which
+    // this draw replaces: they are of no use any more.
+    back_.reset();
+    drawSlice(programs, shown_, pose, {0, 1, rect, key.width, key.height});
+    front_ = key;
+    ++refreshes_;
+}
+
+void BoothDiffuseCache::drawBand(const BoothPrograms& programs,
+                                 const Key& key,
+                                 const CacheBand& band,
+                                 const PixelRect& rect)
+{
+    const int back = 1 - shown_;
+    drawSlice(programs, back, band.toward, {band.band, band.bands, rect, key.width, key.height});
+    back_ = Partial{key, band.band + 1};
+    if (band.band + 1 == band.bands) {
+        // The last band: that buffer is the one composed from now on.
+        shown_ = back;
+        front_ = key;
+        back_.reset();
+        ++refreshes_;
     }
 }
 

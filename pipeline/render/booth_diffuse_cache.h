@@ -1,8 +1,9 @@
 // The booth shading pass's cache of the eye-independent part of a frame: the diffuse term (paper
 // eq. 1 and 2) in XYZ and E_geo, the illuminance on the panel plane, in alpha; with relief and a
 // per-pixel specular term also each pixel's facet normal; on a flat surface the diffuse grid it
-// interpolates E_geo from. Recomputed only when what it was drawn for changes
-// (BoothShadingPass::draw says when, and how a sliced refresh proceeds).
+// interpolates E_geo from. Two buffers, each labelled with what it holds; it draws what it is
+// asked (a term whole, or band b of K of one) and keeps no schedule: the state stage decides
+// which band a frame draws (pipeline/scene/diffuse_schedule.h).
 #pragma once
 
 #include <array>
@@ -20,6 +21,19 @@
 
 namespace replica::pipeline::render {
 
+// What a frame asks of the cache: the term composed at 'shown', and (a sliced refresh under way)
+// band 'band' of 'bands' of the term at 'toward', drawn into the second buffer; the last band
+// makes that buffer the one composed ('shown' is then 'toward').
+struct CacheBand {
+    shading::PanelPose toward;
+    int band = 0;
+    int bands = 1;
+};
+struct CacheWant {
+    shading::PanelPose shown;
+    std::optional<CacheBand> band;
+};
+
 class BoothDiffuseCache
 {
 public:
@@ -32,27 +46,36 @@ public:
 
     // Makes the cache's targets width x height (new ones, holding nothing, on a size change).
     Expected<void> ensureTarget(int width, int height);
-    // Brings the cache up to date for 'pose' and 'layout' (BoothShadingPass::draw's rule): drawn
-    // whole, or the next band of a sliced refresh. 'rect': surfaceRect of the layout.
+    // Makes the buffers hold what 'want' names, for 'layout' ('rect': its surfaceRect): where
+    // they already hold the term shown and the refresh's earlier bands, the one band asked for;
+    // otherwise (a fresh cache, a new light, size, layout, channels or surround, frame N drawn
+    // alone) the term shown whole, then the refresh's bands so far. A band at the same pose,
+    // size and layout as the whole term is the same pixels, so either way the frame is the same.
     void update(const BoothPrograms& programs,
-                const shading::PanelPose& pose,
+                const CacheWant& want,
                 const SurfaceLayout& layout,
                 const PixelRect& rect,
                 int width,
                 int height);
 
-    // Forces the next update to draw the cache whole.
-    void invalidate() { valid_ = false; }
+    // Forgets what both buffers hold: the next update draws the term whole.
+    void invalidate()
+    {
+        front_.reset();
+        back_.reset();
+    }
     // BoothShadingPass::setSurroundIlluminance.
     void setSurroundIlluminance(bool on);
     bool surroundIlluminance() const { return surroundIlluminance_; }
     long refreshes() const { return refreshes_; }
-    bool refreshPending() const { return pending_.has_value(); }
+    // Whether a sliced refresh is under way (some of its bands drawn, the frame composed from the
+    // other buffer).
+    bool refreshPending() const { return back_.has_value(); }
 
     // The complete cache the frame composes from: its framebuffer and texture, and the facet
     // normals (0 without).
-    GLuint frontFramebuffer() const { return buffers_[static_cast<std::size_t>(front_)].fbo.get(); }
-    GLuint frontTexture() const { return buffers_[static_cast<std::size_t>(front_)].texture.get(); }
+    GLuint frontFramebuffer() const { return buffers_[static_cast<std::size_t>(shown_)].fbo.get(); }
+    GLuint frontTexture() const { return buffers_[static_cast<std::size_t>(shown_)].texture.get(); }
     GLuint facetTexture() const { return facetTexture_.get(); }
 
 private:
@@ -71,12 +94,16 @@ private:
         // illuminance.
         std::optional<PixelRect> zeroAround;
     };
-    // A sliced refresh under way: the key and pose it draws, and its next band.
-    struct PendingRefresh {
+    // What the second buffer holds of a sliced refresh: the key it is drawn for and how many
+    // bands of it.
+    struct Partial {
         Key key;
-        shading::PanelPose pose;
-        int nextSlice = 0;
+        int bands = 0;
     };
+    Key keyOf(const shading::PanelPose& pose, const SurfaceLayout& layout, int w, int h) const
+    {
+        return {pose.centre, pose.right, pose.up, pose.normal, w, h, layout.offset, layout.scale};
+    }
     // Band 'slice' of 'slices' of a refresh (slice 0 also draws the diffuse grid and clears what
     // needs clearing), for a frame of width x height whose surface is 'rect'.
     struct Band {
@@ -86,6 +113,15 @@ private:
         int width = 0;
         int height = 0;
     };
+    // The term whole into the buffer composed; band 'band' into the other one.
+    void drawWhole(const BoothPrograms& programs,
+                   const Key& key,
+                   const shading::PanelPose& pose,
+                   const PixelRect& rect);
+    void drawBand(const BoothPrograms& programs,
+                  const Key& key,
+                  const CacheBand& band,
+                  const PixelRect& rect);
     // Draws the eye-independent part at 'pose' into buffers_[buffer], band 'band'.
     void drawSlice(const BoothPrograms& programs,
                    int buffer,
@@ -94,16 +130,14 @@ private:
 
     int slices_ = 1;
     bool facetCache_ = false;
-    // key_: what the front buffer holds when valid_.
-    Key key_;
-    bool valid_ = false;
     bool surroundIlluminance_ = true;
     long refreshes_ = 0;
-    // The front buffer the frames compose from, and (slices_ > 1 only) the back one a sliced
-    // refresh draws into.
+    // The buffer the frames compose from and what it holds (none: nothing known), and (slices_ >
+    // 1 only) what the other one holds of a sliced refresh.
     std::array<Buffer, 2> buffers_{};
-    int front_ = 0;
-    std::optional<PendingRefresh> pending_;
+    int shown_ = 0;
+    std::optional<Key> front_;
+    std::optional<Partial> back_;
     // One texture behind both buffers: a facet normal depends on the layout and size alone, and a
     // change of either redraws the cache whole, so a band drawn into the back buffer writes there
     // what it already holds.

@@ -15,7 +15,6 @@ using namespace booth_upload;
 void BoothInputs::uploadScene(const shading::PreparedScene& ps,
                               bool relief,
                               int horizonDirs,
-                              bool horizonHalf,
                               const BoothPrograms& programs)
 {
     const surface::SurfaceScene& s = *ps.scene;
@@ -38,7 +37,7 @@ void BoothInputs::uploadScene(const shading::PreparedScene& ps,
     normals_ = relief ? texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, s.width, s.height, n.data())
                       : texture2d(GL_RGB32F, GL_RGB, GL_FLOAT, 1, 1, n.data());
 
-    horizon_ = horizonTexture(ps.horizon, horizonDirs, horizonHalf);
+    horizon_ = horizonTexture(ps.horizon, horizonDirs);
 
     lightsUbo_ = GlBuffer::make();
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_.get());
@@ -62,41 +61,34 @@ void BoothInputs::replaceChannels(const shading::PreparedScene& ps)
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, s.width, s.height, GL_RGB, GL_FLOAT, b.data());
 }
 
-Expected<void> BoothInputs::uploadLight(const shading::PreparedLight& pl,
-                                        const surface::SurfaceScene& s,
-                                        const colour::Observer& observer,
-                                        const shading::RenderSettings& settings,
-                                        bool hwFilter,
-                                        const BoothPrograms& programs)
+namespace {
+
+// A region's corner in the ceiling's unit coordinates (s, t in [0, 1]).
+glm::dvec2 ceilingUnit(const booth::BoothLight& bl, const shading::Vec3& q)
+{
+    const double u2 = glm::dot(bl.edgeU, bl.edgeU);
+    const double v2 = glm::dot(bl.edgeV, bl.edgeV);
+    const shading::Vec3 d = q - (bl.centre - 0.5 * (bl.edgeU + bl.edgeV));
+    return {u2 > 0.0 ? glm::dot(d, bl.edgeU) / u2 : 0.0,
+            v2 > 0.0 ? glm::dot(d, bl.edgeV) / v2 : 0.0};
+}
+
+} // namespace
+
+void BoothInputs::uploadLightBlock(const shading::PreparedLight& pl)
 {
     const booth::BoothLight& bl = *pl.light;
     const double a = bl.texelAreaM2();
-    if (pl.points.size() > static_cast<std::size_t>(kBoothMaxLights)) {
-        return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("render: {} lights; the GL pass holds at most {}: prepare the "
-                                     "light with {} or fewer",
-                                     pl.points.size(), kBoothMaxLights, kBoothMaxLights));
-    }
-    const int lightCount = static_cast<int>(pl.points.size());
     // The block's four arrays one after another: uLight, uLightSpreadU (w: the region's mean
     // luminance), uLightSpreadV, uLightRect.
     const std::size_t block = static_cast<std::size_t>(kBoothMaxLights) * 4;
     std::vector<float> packed(block * 4, 0.0f);
-    const double u2 = glm::dot(bl.edgeU, bl.edgeU);
-    const double v2 = glm::dot(bl.edgeV, bl.edgeV);
-    // A region's corner in the ceiling's unit coordinates (s, t in [0, 1]).
-    const auto unit = [&](const shading::Vec3& q) {
-        const shading::Vec3 d = q - (bl.centre - 0.5 * (bl.edgeU + bl.edgeV));
-        return glm::dvec2(u2 > 0.0 ? glm::dot(d, bl.edgeU) / u2 : 0.0,
-                          v2 > 0.0 ? glm::dot(d, bl.edgeV) / v2 : 0.0);
-    };
-    for (int i = 0; i < lightCount; ++i) {
-        const booth::PointLight& p = pl.points[static_cast<std::size_t>(i)];
-        const std::size_t k = static_cast<std::size_t>(i) * 4;
+    for (std::size_t i = 0; i < pl.points.size(); ++i) {
+        const booth::PointLight& p = pl.points[i];
+        const std::size_t k = i * 4;
         const glm::vec3 pos = f3(p.position);
-        // Zero spreads leave every light's softness at uSoftness: the frames before the spread.
-        const glm::vec3 su = settings.horizonSpread ? f3(p.spreadU) : glm::vec3(0.0f);
-        const glm::vec3 sv = settings.horizonSpread ? f3(p.spreadV) : glm::vec3(0.0f);
+        const glm::vec3 su = f3(p.spreadU);
+        const glm::vec3 sv = f3(p.spreadV);
         for (int c = 0; c < 3; ++c) {
             packed[k + static_cast<std::size_t>(c)] = pos[c];
             packed[block + k + static_cast<std::size_t>(c)] = su[c];
@@ -104,8 +96,8 @@ Expected<void> BoothInputs::uploadLight(const shading::PreparedLight& pl,
         }
         packed[k + 3] = static_cast<float>(p.sumCdM2 * a);
         packed[block + k + 3] = static_cast<float>(p.meanCdM2);
-        const glm::dvec2 lo = unit(p.regionOrigin);
-        const glm::dvec2 hi = unit(p.regionOrigin + p.regionU + p.regionV);
+        const glm::dvec2 lo = ceilingUnit(bl, p.regionOrigin);
+        const glm::dvec2 hi = ceilingUnit(bl, p.regionOrigin + p.regionU + p.regionV);
         const std::array<double, 4> rect{lo.x, lo.y, hi.x, hi.y};
         for (std::size_t c = 0; c < 4; ++c) {
             packed[3 * block + k + c] = static_cast<float>(rect[c]);
@@ -114,8 +106,11 @@ Expected<void> BoothInputs::uploadLight(const shading::PreparedLight& pl,
     glBindBuffer(GL_UNIFORM_BUFFER, lightsUbo_.get());
     glBufferSubData(GL_UNIFORM_BUFFER, 0, static_cast<GLsizeiptr>(packed.size() * sizeof(float)),
                     packed.data());
+}
 
-    // Mip chain exactly as booth::buildMipChain made it (each level uploaded, not regenerated).
+void BoothInputs::uploadMipChain(const shading::PreparedLight& pl, bool hwFilter)
+{
+    // Exactly as booth::buildMipChain made it (each level uploaded, not regenerated).
     lum_.reset();
     lum_ = GlTexture::make();
     glBindTexture(GL_TEXTURE_2D, lum_.get());
@@ -134,20 +129,38 @@ Expected<void> BoothInputs::uploadLight(const shading::PreparedLight& pl,
     nearest(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
     if (hwFilter) {
-        // booth::MipChain::sample's rule (glsl/mip_chain.glsl lumSample); border colour 0.
+        // booth::MipChain::sampleNearestLevel's rule (glsl/mip_chain.glsl lumSample); border
+        // colour 0.
         constexpr GLenum kClampToBorder = 0x812D; // GL_CLAMP_TO_BORDER_EXT / _OES
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
-                        settings.specularNearestLevel ? GL_LINEAR_MIPMAP_NEAREST
-                                                      : GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, kClampToBorder);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, kClampToBorder);
     }
+}
 
+Expected<void> BoothInputs::uploadLight(const shading::PreparedLight& pl,
+                                        const surface::SurfaceScene& s,
+                                        const colour::Observer& observer,
+                                        bool hwFilter,
+                                        const BoothPrograms& programs)
+{
+    const booth::BoothLight& bl = *pl.light;
+    if (pl.points.size() > static_cast<std::size_t>(kBoothMaxLights)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: {} lights; the GL pass holds at most {}: prepare the "
+                                     "light with {} or fewer",
+                                     pl.points.size(), kBoothMaxLights, kBoothMaxLights));
+    }
+    uploadLightBlock(pl);
+    uploadMipChain(pl, hwFilter);
+    const double u2 = glm::dot(bl.edgeU, bl.edgeU);
+    const double v2 = glm::dot(bl.edgeV, bl.edgeV);
+    const auto& levels = pl.mips.levels;
     const colour::Xyz specXyz = colour::spectrumToXyz(observer, s.rhoS * pl.unitSpd);
-    programs.uniformAll(glProgramUniform1i, "uLightCount", lightCount);
+    programs.uniformAll(glProgramUniform1i, "uLightCount", static_cast<int>(pl.points.size()));
     programs.set3All("uLightNormal", bl.normal());
-    programs.uniformAll(glProgramUniform1f, "uTexelArea", static_cast<float>(a));
+    programs.uniformAll(glProgramUniform1f, "uTexelArea", static_cast<float>(bl.texelAreaM2()));
     std::array<float, colour::kChannels * 3> m{};
     for (std::size_t k = 0; k < colour::kChannels; ++k) {
         for (int c = 0; c < 3; ++c) {
@@ -164,7 +177,7 @@ Expected<void> BoothInputs::uploadLight(const shading::PreparedLight& pl,
     programs.uniformAll(glProgramUniform2f, "uInvEdge2",
                         static_cast<float>(u2 > 0.0 ? 1.0 / u2 : 0.0),
                         static_cast<float>(v2 > 0.0 ? 1.0 / v2 : 0.0));
-    programs.uniformAll(glProgramUniform1i, "uLumMaxLevel", lumMaxLevel);
+    programs.uniformAll(glProgramUniform1i, "uLumMaxLevel", static_cast<int>(levels.size()) - 1);
     programs.uniformAll(glProgramUniform2i, "uLumSize", levels[0].width, levels[0].height);
     programs.uniformAll(glProgramUniform2f, "uLumUsed", static_cast<float>(pl.mips.usedU),
                         static_cast<float>(pl.mips.usedV));

@@ -22,7 +22,6 @@ public:
     void uploadScene(const shading::PreparedScene& ps,
                      bool relief,
                      int horizonDirs,
-                     bool horizonHalf,
                      const BoothPrograms& programs);
     // Replaces the channel coefficients with those of 'ps' (the same size: checked by the caller).
     void replaceChannels(const shading::PreparedScene& ps);
@@ -32,13 +31,17 @@ public:
     Expected<void> uploadLight(const shading::PreparedLight& pl,
                                const surface::SurfaceScene& scene,
                                const colour::Observer& observer,
-                               const shading::RenderSettings& settings,
                                bool hwFilter,
                                const BoothPrograms& programs);
     // Binds the textures to their units (booth_programs.h) and the lights' block to binding 0.
     void bind() const;
 
 private:
+    // The lights' block: each light's position and intensity, spreads and region rectangle.
+    void uploadLightBlock(const shading::PreparedLight& pl);
+    // The luminance mip chain, filtered by the sampler with 'hwFilter'.
+    void uploadMipChain(const shading::PreparedLight& pl, bool hwFilter);
+
     GlBuffer lightsUbo_;
     GlTexture coeffA_, coeffB_, normals_, horizon_, lum_;
 };

@@ -1,12 +1,10 @@
 // Scene state to booth pass: the state's light, encoding and tilts uploaded where the GPU holds
 // others, then drawn.
 #include <algorithm>
-#include <cmath>
 
 #include <fmt/format.h>
 
 #include <pipeline/render/booth_scene_pass.h>
-#include <pipeline/scene/diffuse_schedule.h>
 
 namespace replica::pipeline::render {
 
@@ -93,12 +91,10 @@ Expected<void> BoothScenePass::useVariant(std::size_t v)
             return ok;
         }
         var.encodings = encodings_;
-        var.holds.valid = false;
     }
     if (v != active_) {
         // Each pass holds its own light and cache: they must follow the variant drawn.
         var.pass->setSurroundIlluminance(pass_->surroundIlluminance());
-        var.holds.valid = false;
         active_ = v;
         prepared_ = var.prepared.get();
         pass_ = var.pass.get();
@@ -119,7 +115,6 @@ void BoothScenePass::invalidateCache()
 {
     for (auto& v : variants_) {
         v.pass->invalidateCache();
-        v.holds.valid = false;
     }
 }
 
@@ -127,7 +122,6 @@ void BoothScenePass::setSurroundIlluminance(bool on)
 {
     for (auto& v : variants_) {
         v.pass->setSurroundIlluminance(on);
-        v.holds.valid = false;
     }
 }
 
@@ -150,47 +144,33 @@ std::string BoothScenePass::description() const
                        setup_.adaptive ? ", re-encoded for each new light" : "");
 }
 
-std::vector<colour::Spectrum> BoothScenePass::lampSpectra() const
-{
-    std::vector<colour::Spectrum> out;
-    for (const auto& lamp : setup_.booth.lights) {
-        out.push_back(lamp.spd);
-    }
-    return out;
-}
-
 Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
 {
-    const int lamp = state.lampIndex;
-    const bool isLamp = lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.booth.lights.size();
-    const booth::BoothLight* l =
-            isLamp ? &setup_.booth.lights[static_cast<std::size_t>(lamp)] : nullptr;
-    const int index = isLamp ? lamp : -1;
-    const bool onGpu = index == lightIndex_ && state.encoding == encodings_ &&
-                       (isLamp || (state.illuminant.v == directSpd_.v &&
-                                   state.emitterLuminanceCdM2 == directLuminance_));
-    if (onGpu && !state.lightChanged) {
+    // The light the GPU holds is labelled with its content key (the state stage's, the same key
+    // by which it says a light changed) and its encoding.
+    const std::uint64_t key = scene::lightKey(state);
+    if (heldLight_ == key && state.encoding == encodings_) {
         return {};
     }
     if (auto ok = applyEncoding(state); !ok) {
         return ok;
     }
+    const int lamp = state.lampIndex;
+    const bool isLamp = lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.booth.lights.size();
     if (auto ok = useVariant(isLamp ? lampVariant_[static_cast<std::size_t>(lamp)] : 0); !ok) {
         return ok;
     }
     if (isLamp) {
-        light_ = shading::prepareLight(*l, setup_.observer, pass_->settings().lights, basis_);
+        light_ = shading::prepareLight(setup_.booth.lights[static_cast<std::size_t>(lamp)],
+                                       setup_.observer, pass_->settings().lights, basis_);
     } else {
         // Direct-sensor mode: a uniform emitter with the sensed spectrum.
         direct_ = uniformEmitter(setup_.booth.lights.front(),
                                  state.emitterLuminanceCdM2 * setup_.luminanceScale,
                                  state.illuminant);
         light_ = shading::prepareLight(direct_, setup_.observer, pass_->settings().lights, basis_);
-        directSpd_ = state.illuminant;
-        directLuminance_ = state.emitterLuminanceCdM2;
     }
-    lightIndex_ = index;
-    variants_[active_].holds.valid = false; // a new light draws the cache whole
+    heldLight_ = key;
     return pass_->setLight(light_);
 }
 
@@ -212,45 +192,7 @@ Expected<void> BoothScenePass::applyEncoding(const scene::SceneState& state)
     }
     encodings_ = state.encoding;
     variants_[active_].encodings = encodings_;
-    variants_[active_].holds.valid = false;
     return pass_->setChannels(*prepared_);
-}
-
-Expected<void> BoothScenePass::drawCached(const scene::SceneState& state,
-                                          const shading::View& view,
-                                          int width,
-                                          int height)
-{
-    Variant& var = variants_[active_];
-    const int k = std::max(var.settings.cacheSlices, 1);
-    const auto pose = [&](double tiltRad) { return scene::panelPose(setup_.stand, tiltRad); };
-    const SurfaceLayout layout = layoutOnPanel(setup_.scene, setup_.stand);
-    const double sensed = std::isfinite(state.tiltRad) ? state.tiltRad : state.heldTiltRad;
-    const scene::DiffuseTilt want =
-            state.diffuse ? *state.diffuse : scene::DiffuseTilt{sensed, std::nullopt, 0};
-    // The one draw that takes the cache from what it holds to what the state says, where the
-    // state is the schedule's next frame after it (the same diffuse term, the next band of a
-    // refresh, or its last band): the cache at diffuseTarget(want) draws that band.
-    const bool oneDraw = var.holds.valid && scene::diffuseFollows(var.holds.diffuse, want, k);
-    var.holds = {true, want};
-    if (oneDraw) {
-        const scene::PanelPose p = pose(scene::diffuseTarget(want));
-        return pass_->draw(view, width, height, layout, &p);
-    }
-    // Otherwise (a fresh pass, a new light, frame N drawn alone): the shown diffuse term whole,
-    // then a refresh's bands so far; the last draw is the frame.
-    pass_->invalidateCache();
-    const scene::PanelPose shown = pose(want.shownRad);
-    if (auto ok = pass_->draw(view, width, height, layout, &shown); !ok || !want.refreshRad) {
-        return ok;
-    }
-    const scene::PanelPose target = pose(*want.refreshRad);
-    for (int band = 0; band < want.refreshBands; ++band) {
-        if (auto ok = pass_->draw(view, width, height, layout, &target); !ok) {
-            return ok;
-        }
-    }
-    return {};
 }
 
 Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, int height)
@@ -258,15 +200,22 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
     if (auto ok = selectLight(state); !ok) {
         return ok;
     }
+    // The tilts are the state stage's (a finite specular tilt, the diffuse term and its band);
+    // the stand turns each into the panel's pose.
+    const auto pose = [&](double tiltRad) { return scene::panelPose(setup_.stand, tiltRad); };
     shading::View view;
-    // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel);
-    // a non-finite one falls back to the held tilt.
-    view.panel = scene::panelPose(setup_.stand,
-                                  std::isfinite(state.tiltRad) ? state.tiltRad : state.heldTiltRad);
+    view.panel = pose(state.tiltRad);
     view.eye = state.eyeBoothM;
     view.pixelsX = width;
     view.pixelsY = height;
-    return drawCached(state, view, width, height);
+    CacheWant want{view.panel, std::nullopt};
+    if (state.diffuse) {
+        want.shown = pose(state.diffuse->shownRad);
+        if (const auto& b = state.diffuse->band) {
+            want.band = CacheBand{pose(b->towardRad), b->band, b->bands};
+        }
+    }
+    return pass_->draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand), &want);
 }
 
 PixelRect BoothScenePass::surfaceRect(int width, int height) const

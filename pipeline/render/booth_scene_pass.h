@@ -2,16 +2,18 @@
 // booth light (its measured luminance image), an unknown light becomes a uniform emitter with the
 // sensed spectrum (the paper's direct-sensor mode); the eye comes from the tracker, the panel pose
 // from the tilt through the stand's hinge model, the cached diffuse term's from the state's
-// diffuse tilt; with a light-adaptive encoder the surface is in the state's encoding. It keeps no
-// history: what it holds on the GPU (light, encoding, caches) is a cache of earlier states, and
-// a fresh pass given any frame's state draws that frame bit for bit (the state stage, state/,
-// decides everything that used to carry from frame to frame here).
+// diffuse term and its refresh band; with a light-adaptive encoder the surface is in the state's
+// encoding. It keeps no history and no schedule: what it holds on the GPU (light, encoding,
+// caches) is labelled with what it holds, and a fresh pass given any frame's state draws that
+// frame bit for bit (the state stage, state/, decides what carries from frame to frame).
 // Needs a current GLES 3.1 context for every call.
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,16 +60,14 @@ public:
 
     // Draws the state's frame into the bound RGBA32F framebuffer (viewport width x height, the
     // whole panel; the surface at its physical size in the middle, black around it; alpha: the
-    // illuminance on the panel, lux). The cached diffuse term shows state.diffuse.shownRad (the
-    // tilt estimator's hold filter and sliced refresh: state/tilt_estimator.h); a refresh under
-    // way draws its next band (BoothShadingPass::draw); the specular term is drawn at the state's
-    // tilt and eye. Where the caches do not hold what the state says (a fresh pass, frame N of a
-    // recording drawn alone) they are drawn first: the frame is the same.
+    // illuminance on the panel, lux). Everything it draws is what the state names: the light (by
+    // its content key, scene::lightKey), the encoding, the specular term at the state's tilt and
+    // eye, and the cached diffuse term at state.diffuse's tilt with the band of a sliced refresh
+    // it names (the state stage decides the schedule: pipeline/scene/diffuse_schedule.h; this
+    // pass holds the buffers, BoothDiffuseCache). Where the buffers do not hold what the state
+    // says (a fresh pass, frame N of a recording drawn alone) they are drawn first: the frame is
+    // the same.
     Expected<void> draw(const scene::SceneState& state, int width, int height);
-
-    // The spectrum of each lamp's booth light (by lampIndex): what a light-adaptive encoder
-    // encodes a lamp for (state::LightEstimatorSetup::encodeSpectra).
-    std::vector<colour::Spectrum> lampSpectra() const;
 
     // The pixels of a width x height frame that can show the surface; draw() writes XYZ (0, 0, 0)
     // everywhere else (render::surfaceRect).
@@ -108,12 +108,6 @@ private:
     // re-projected onto the state's basis, the coefficient textures replaced).
     Expected<void> applyEncoding(const scene::SceneState& state);
 
-    // What a shading pass's diffuse cache holds, as far as this pass drew it: the tilt of its
-    // front cache and a sliced refresh's progress (none: unknown, e.g. after a new light).
-    struct CacheHolds {
-        bool valid = false;
-        scene::DiffuseTilt diffuse;
-    };
     // One shading pass per distinct setting (variants_[0]: setup_.settings), each with the scene
     // prepared for its horizon directions; 'encodings' is the encoding its channels hold.
     struct Variant {
@@ -121,24 +115,18 @@ private:
         std::unique_ptr<shading::PreparedScene> prepared;
         std::unique_ptr<BoothShadingPass> pass;
         int encodings = 0;
-        CacheHolds holds;
     };
     // Makes variant v the one drawn, its channels brought up to date.
     Expected<void> useVariant(std::size_t v);
-    // Draws the frame with the active pass, its cache brought to what the state says.
-    Expected<void>
-    drawCached(const scene::SceneState& state, const shading::View& view, int width, int height);
-
     BoothSceneSetup setup_;
     std::vector<Variant> variants_;
     std::vector<std::size_t> lampVariant_; // by lamp index
     std::size_t active_ = 0;
     shading::PreparedScene* prepared_ = nullptr; // variants_[active_]'s
     BoothShadingPass* pass_ = nullptr;
-    // The light on the GPU now: a booth light (by index) or the direct-mode emitter.
-    int lightIndex_ = -2;
-    colour::Spectrum directSpd_{};
-    double directLuminance_ = -1.0;
+    // The light on the GPU now, by its content key (scene::lightKey; none: none yet), and the
+    // direct-mode emitter it was made from.
+    std::optional<std::uint64_t> heldLight_;
     booth::BoothLight direct_;
     shading::PreparedLight light_;
     // The encoding on the GPU (SceneState::encoding) and its basis.

@@ -45,10 +45,20 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                          fmt::format("render: {} horizon directions; the GL pass holds at most {}",
                                      horizonDirs, kBoothMaxHorizonDirections));
     }
+    if (!exactLevelTwiceBias(settings_)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: the GL pass reads the nearest specular mip level at "
+                                     "a bias of whole half levels (within {}); {} with a bias of "
+                                     "{} is the CPU model's alone",
+                                     shading::kMaxSpecularLodBias,
+                                     settings_.specularNearestLevel ? "the nearest level"
+                                                                    : "trilinear levels",
+                                     settings_.specularLodBias));
+    }
     // The luminance chain is filtered by the sampler where the GL can filter float textures and
     // clamp to a border (GLES 3.2 has both's core equivalents only for the border); otherwise the
     // shader filters by hand with texelFetch, the same rule.
-    hwFilter_ = settings_.hardwareFilter && hasExtension("GL_OES_texture_float_linear") &&
+    hwFilter_ = hasExtension("GL_OES_texture_float_linear") &&
                 (hasExtension("GL_EXT_texture_border_clamp") ||
                  hasExtension("GL_OES_texture_border_clamp"));
     // Which passes run is fixed for the pass's life: compiled into each program, so that none
@@ -65,8 +75,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                          fmt::format("render: {} specular samples; the GL pass takes at most {}",
                                      samples, kBoothMaxSpecularSamples));
     }
-    // Horizon sines a layer of the horizon texture (horizonTexture) and layers.
-    const int perLayer = settings_.horizonHalf ? 8 : 4;
+    // Horizon sines a layer of the horizon texture (horizonTexture, half floats) and layers.
+    const int perLayer = 8;
     const int layers = std::max((horizonDirs + perLayer - 1) / perLayer, 1);
     BoothShaderConfig config;
     config.relief = relief;
@@ -91,7 +101,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
         return ok;
     }
     vao_ = GlVertexArray::make();
-    inputs_.uploadScene(ps, relief, horizonDirs, settings_.horizonHalf, programs_);
+    inputs_.uploadScene(ps, relief, horizonDirs, programs_);
     // The grids' targets: the specular one shaded every frame (mode 2), the diffuse one drawn
     // whenever the cache is (mode 3).
     if (auto ok = specularTerm_.init(s, samples, specularNodes, programs_); !ok) {
@@ -106,10 +116,8 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
                          static_cast<float>(s.heightM));
     programs_.uniformAll(glProgramUniform1f, "uSoftness",
                          static_cast<float>(settings_.horizonSoftness));
-    programs_.uniformAll(glProgramUniform1f, "uLodBias",
-                         static_cast<float>(settings_.specularLodBias));
     programs_.uniformAll(glProgramUniform1f, "uLodScale",
-                         std::ldexp(1.0f, exactLevelTwiceBias(settings_).value_or(0)));
+                         std::ldexp(1.0f, *exactLevelTwiceBias(settings_)));
     programs_.uniformAll(glProgramUniform1i, "uDiffuse", settings_.diffusePass ? 1 : 0);
     programs_.uniformAll(
             glProgramUniform1f, "uFlareRho",
@@ -142,14 +150,14 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
     }
     light_ = &pl;
     cache_.invalidate();
-    return inputs_.uploadLight(pl, *scene_->scene, *observer_, settings_, hwFilter_, programs_);
+    return inputs_.uploadLight(pl, *scene_->scene, *observer_, hwFilter_, programs_);
 }
 
 Expected<void> BoothShadingPass::draw(const shading::View& view,
                                       int width,
                                       int height,
                                       const SurfaceLayout& layout,
-                                      const shading::PanelPose* cachePose)
+                                      const CacheWant* cache)
 {
     if (light_ == nullptr) {
         return makeError(ErrorCode::InvalidArgument, "render: booth pass drawn before setLight");
@@ -188,8 +196,8 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     // What the surface can light (the whole viewport for a layout that does not scale): what the
     // compose draws, and all the cache holds without the surround's illuminance.
     const PixelRect rect = surfaceRect(layout, width, height);
-    cache_.update(programs_, cachePose != nullptr ? *cachePose : view.panel, layout, rect, width,
-                  height);
+    cache_.update(programs_, cache != nullptr ? *cache : CacheWant{view.panel, std::nullopt},
+                  layout, rect, width, height);
     specularTerm_.drawGrid(programs_, view.panel, width, height);
     // Without a specular term or flare to add the frame is the cache as it is.
     composeBoothFrame(programs_, cache_, specularTerm_,

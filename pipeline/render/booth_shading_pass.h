@@ -51,24 +51,19 @@ public:
 
     // Draws into the bound framebuffer (viewport width x height, an RGBA32F colour target): XYZ
     // (cd/m^2) and, in alpha, E_geo (lux on the panel plane, every pixel: pass 2's flare term).
-    // The eye-independent part (eq. 1 and 2, E_geo) is kept in a cache of the viewport's size and
-    // recomputed only when the light, the size, the layout or its pose differs from the cached
-    // one (exactly), or after invalidateCache(); its pose is cachePose when given (a pose held
-    // against sensor noise: booth_scene_pass.h), else view.panel. Every draw then adds the
-    // specular term for view.eye and view.panel. A frame drawn from the cache is bit-identical
-    // to one that recomputes it.
-    // With settings.cacheSlices = K > 1 a pose change (the panel tilted) recomputes the cache in
-    // K bands of rows over K draws into a second cache, while the draws compose from the complete
-    // cache they have; the K-th draw swaps the two and composes from the new one. A pose change
-    // during those K draws waits for them (the bands all belong to one pose), so the diffuse term
-    // shown is always one whole cache, at most 2K - 2 draws behind the pose asked for. A first
-    // cache, and any change of light, size, layout, channels or surround, is drawn whole at once as
-    // with K = 1. Once the pose holds still the frames are those of K = 1, bit for bit.
+    // The eye-independent part (eq. 1 and 2, E_geo) is kept in a cache of the viewport's size
+    // (booth_diffuse_cache.h) and drawn again only where it does not hold what 'cache' names
+    // (the term shown and, a sliced refresh under way, band b of K of the term at another pose,
+    // drawn into a second buffer that the last band makes the one shown: what the state stage
+    // decided, booth_scene_pass.h); without 'cache', the term whole at view.panel. A change of
+    // light, size, layout, channels or surround draws it whole. Every draw then adds the specular
+    // term for view.eye and view.panel. A frame drawn from the cache is bit-identical to one that
+    // recomputes it, and a band is the same pixels as that band of the whole term.
     Expected<void> draw(const shading::View& view,
                         int width,
                         int height,
                         const SurfaceLayout& layout = {},
-                        const shading::PanelPose* cachePose = nullptr);
+                        const CacheWant* cache = nullptr);
 
     // Forces the next draw to recompute the cached part (e.g. after the channel encoding of the
     // scene's textures changed under the pass).
@@ -88,8 +83,8 @@ public:
 
     const shading::RenderSettings& settings() const { return settings_; }
     const shading::PreparedScene& scene() const { return *scene_; }
-    // Whether the luminance chain is filtered by the sampler (settings.hardwareFilter and the
-    // GL's float-filtering and border-clamp extensions) or by hand in the shader.
+    // Whether the luminance chain is filtered by the sampler (where the GL has the
+    // float-filtering and border-clamp extensions) or by hand in the shader.
     bool hardwareFilter() const { return hwFilter_; }
 
 private:

@@ -48,43 +48,31 @@ Expected<void> nodeTarget(shading::GridNodes nodes,
     return {};
 }
 
-// The horizon map as a 2-D array texture: directions [4j, 4j + 4) in layer j of an RGBA32F array,
-// or with 'half' [8j, 8j + 8) as half floats in layer j of an RGBA32UI array (packHalf2x16's
-// layout: direction 2i in the low 16 bits of word i). 'dirs' 0: one empty texel.
-GlTexture horizonTexture(const surface::HorizonMap& map, int dirs, bool half)
+// The horizon map as a 2-D array texture: directions [8j, 8j + 8) as half floats in layer j of an
+// RGBA32UI array (packHalf2x16's layout: direction 2i in the low 16 bits of word i). 'dirs' 0: one
+// empty texel.
+GlTexture horizonTexture(const surface::HorizonMap& map, int dirs)
 {
-    const int perLayer = half ? 8 : 4;
-    const int layers = std::max((dirs + perLayer - 1) / perLayer, 1);
+    constexpr int kPerLayer = 8;
+    const int layers = std::max((dirs + kPerLayer - 1) / kPerLayer, 1);
     const int w = dirs > 0 ? map.width : 1;
     const int h = dirs > 0 ? map.height : 1;
     const auto texels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
     const auto k = static_cast<std::size_t>(dirs);
-    const std::size_t components = texels * 4 * static_cast<std::size_t>(layers);
-    std::vector<float> sines(half ? 0 : components, 0.0f);
-    std::vector<std::uint32_t> words(half ? components : 0, 0u);
+    std::vector<std::uint32_t> words(texels * 4 * static_cast<std::size_t>(layers), 0u);
     for (std::size_t i = 0; i < texels && k > 0; ++i) {
         for (std::size_t d = 0; d < k; ++d) {
-            const float sinB = map.sinBeta[i * k + d];
-            if (half) {
-                const std::size_t word = ((d / 8) * texels + i) * 4 + (d % 8) / 2;
-                words[word] |= static_cast<std::uint32_t>(glm::packHalf1x16(sinB))
-                               << (d % 2 == 0 ? 0 : 16);
-            } else {
-                sines[((d / 4) * texels + i) * 4 + d % 4] = sinB;
-            }
+            const std::size_t word = ((d / 8) * texels + i) * 4 + (d % 8) / 2;
+            words[word] |= static_cast<std::uint32_t>(glm::packHalf1x16(map.sinBeta[i * k + d]))
+                           << (d % 2 == 0 ? 0 : 16);
         }
     }
     GlTexture tex = GlTexture::make();
     glBindTexture(GL_TEXTURE_2D_ARRAY, tex.get());
-    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, half ? GL_RGBA32UI : GL_RGBA32F, w, h, layers);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32UI, w, h, layers);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    if (half) {
-        glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, layers, GL_RGBA_INTEGER,
-                        GL_UNSIGNED_INT, words.data());
-    } else {
-        glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, layers, GL_RGBA, GL_FLOAT,
-                        sines.data());
-    }
+    glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, w, h, layers, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+                    words.data());
     nearest(GL_TEXTURE_2D_ARRAY);
     return tex;
 }
@@ -94,14 +82,14 @@ glm::vec3 f3(const glm::dvec3& v)
     return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
 }
 
-// 2 x the specular mip level bias when RenderSettings::specularExactLevel applies (the nearest
-// level and a bias of whole half levels; within kMaxSpecularLodBias, 4^bias keeps the shader's
-// clamped ratio, 1e-20 to 1e30, a normal float), else nothing: the shader then takes log2.
+// 2 x the specular mip level bias for the GL pass's exact level (the nearest level and a bias of
+// whole half levels; within kMaxSpecularLodBias, 4^bias keeps the shader's clamped ratio, 1e-20
+// to 1e30, a normal float), else nothing: the GL pass renders no other setting.
 std::optional<int> exactLevelTwiceBias(const shading::RenderSettings& s)
 {
     const double twice = 2.0 * s.specularLodBias;
-    if (!s.specularExactLevel || !s.specularNearestLevel ||
-        !(std::abs(twice) <= 2.0 * shading::kMaxSpecularLodBias) || twice != std::round(twice)) {
+    if (!s.specularNearestLevel || !(std::abs(twice) <= 2.0 * shading::kMaxSpecularLodBias) ||
+        twice != std::round(twice)) {
         return std::nullopt;
     }
     return static_cast<int>(twice);
@@ -166,21 +154,14 @@ std::string boothShaderSource(const BoothShaderConfig& c, const shading::RenderS
                        "#define BOOTH_HW_FILTER {}\n"
                        "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
                        "#define BOOTH_SPEC_SAMPLES {}\n#define BOOTH_WARD_MODEL {}\n"
-                       "#define BOOTH_NEAREST_LEVEL {}\n#define BOOTH_FACET_CACHE {}\n"
-                       "#define BOOTH_LIGHT_CALLS{}\n"
-                       "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_HORIZON_HALF {}\n"
-                       "#define BOOTH_HORIZON_BILINEAR {}\n#define BOOTH_SPEC_CALLS{}\n"
-                       "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_SPEC_BRANCH_FREE {}\n"
-                       "#define BOOTH_EXACT_LEVEL {}\n#define BOOTH_EXACT_TIES {}\n"
-                       "#define BOOTH_HORIZON_PICK {}\n#define BOOTH_AREA_LIGHTS {}\n",
+                       "#define BOOTH_FACET_CACHE {}\n#define BOOTH_LIGHT_CALLS{}\n"
+                       "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_SPEC_CALLS{}\n"
+                       "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_AREA_LIGHTS {}\n",
                        c.mode, c.relief ? 1 : 0, c.specularGrid ? 1 : 0, c.diffuseGrid ? 1 : 0,
                        c.hardwareFilter ? 1 : 0, c.horizonDirections, c.horizonSlots,
-                       c.specularSamples, wardModelIndex(c.wardModel),
-                       s.specularNearestLevel ? 1 : 0, c.facetCache ? 1 : 0, lightCalls,
-                       c.unrolledLights, s.horizonHalf ? 1 : 0, s.horizonBilinear ? 1 : 0,
-                       specCalls, c.unrolledSpecularSamples, s.specularBranchFree ? 1 : 0,
-                       exactLevelTwiceBias(s) ? 1 : 0, s.texelExactTies ? 1 : 0,
-                       s.horizonPick ? 1 : 0, s.areaLights ? 1 : 0) +
+                       c.specularSamples, wardModelIndex(c.wardModel), c.facetCache ? 1 : 0,
+                       lightCalls, c.unrolledLights, specCalls, c.unrolledSpecularSamples,
+                       s.areaLights ? 1 : 0) +
            kBoothXyzShader;
 }
 

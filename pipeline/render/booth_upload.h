@@ -27,14 +27,14 @@ Expected<void> nodeTarget(shading::GridNodes nodes,
                           GlTexture& texture,
                           GlFramebuffer& fbo);
 
-// The horizon map as a 2-D array texture: directions [4j, 4j + 4) in layer j of an RGBA32F array,
-// or with 'half' [8j, 8j + 8) as half floats in layer j of an RGBA32UI array (packHalf2x16's
-// layout). 'dirs' 0: one empty texel.
-GlTexture horizonTexture(const surface::HorizonMap& map, int dirs, bool half);
+// The horizon map as a 2-D array texture: directions [8j, 8j + 8) as half floats in layer j of
+// an RGBA32UI array (packHalf2x16's layout). 'dirs' 0: one empty texel.
+GlTexture horizonTexture(const surface::HorizonMap& map, int dirs);
 
 glm::vec3 f3(const glm::dvec3& v);
 
-// 2 x the specular mip level bias when RenderSettings::specularExactLevel applies, else nothing.
+// 2 x the specular mip level bias where the GL pass renders it (the nearest level, a bias of
+// whole half levels), else nothing.
 std::optional<int> exactLevelTwiceBias(const shading::RenderSettings& s);
 
 // BOOTH_WARD_MODEL's number for a Ward model.

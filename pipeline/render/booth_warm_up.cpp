@@ -49,7 +49,7 @@ Expected<double> BoothScenePass::warmUp(int width, int height)
         // on the pass it draws with) before any frame, so the loop never draws this one.
         light_ = shading::prepareLight(*light, setup_.observer, pass.settings().lights,
                                        setup_.basis);
-        lightIndex_ = -2; // the next draw selects its light afresh
+        heldLight_.reset(); // the next draw selects its light afresh
         if (auto ok = pass.setLight(light_); !ok) {
             restore();
             return tl::unexpected(ok.error());

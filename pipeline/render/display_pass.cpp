@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/display/display_inverse.h>
-#include <pipeline/display/display_shader.h>
+#include <pipeline/display/display_pass_params.h>
 #include <pipeline/render/display_pass.h>
 #include <pipeline/render/display_shaders.h>
 #include <pipeline/render/gl_program.h>
@@ -44,22 +44,49 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     if (!inverse) {
         return tl::unexpected(inverse.error());
     }
-    const display::DisplayShaderParams params = display::makeDisplayShaderParams(*inverse);
+    const display::DisplayPassParams params = display::makeDisplayPassParams(*inverse);
     white_ = setup.model.whiteXyz();
     flarePerLux_ = setup.flareSubtraction ? params.flarePerLux : 0.0f;
-
-    const bool filtered = setup.viewingCompensation && setup.viewingFiltered &&
-                          !params.viewingGrid.empty() &&
+    // The viewing gain filtered by the sampler where the GL filters float textures.
+    const bool filtered = setup.viewingCompensation && !params.viewingGrid.empty() &&
                           hasExtension("GL_OES_texture_float_linear");
+    if (auto ok = compilePrograms(params, filtered); !ok) {
+        return ok;
+    }
+    rgbaTarget_ = texture2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height, nullptr);
+    classTarget_ = texture2d(GL_R8, GL_RED, GL_UNSIGNED_BYTE, width, height, nullptr);
+    toneLut_ = texture2d(GL_RG32F, GL_RG, GL_FLOAT, params.lutSize - 1, 3, params.lut.data());
+    if (filtered) {
+        viewingGrid_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, display::kViewingGridNodes, 1,
+                                 params.viewingGrid.data());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    }
+    glm::dvec3 latticeScale(0.0);
+    const std::vector<float> lattice = uploadLut3d(*inverse, latticeScale);
+    findSurround(params, lattice);
+    if (auto ok = makeTargets(); !ok) {
+        return ok;
+    }
+    setConstantUniforms(params, latticeScale);
+    if (GLenum err = glGetError(); err != GL_NO_ERROR) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("display pass: GL error 0x{:04x} while setting up", err));
+    }
+    return {};
+}
+
+Expected<void> DisplayPass::compilePrograms(const display::DisplayPassParams& params, bool filtered)
+{
     const std::string fragment =
             fmt::format("#version 310 es\n#define DISP_METHOD {}\n#define DISP_GAMUT_MODE {}\n"
                         "#define DISP_VIEWING {}\n#define DISP_FALSE_COLOUR {}\n"
                         "#define DISP_VIEWING_ROWS {}\n#define DISP_VIEWING_FILTERED {}\n"
                         "#define DISP_VIEWING_GRID_PER_DEG {:.17g}\n"
                         "#define DISP_VIEWING_GRID_NODES {}\n",
-                        setup.method == InverseMethod::Lut3d ? 1 : 0,
-                        setup.gamut == display::GamutMode::Clip ? 1 : 0,
-                        setup.viewingCompensation ? 1 : 0, setup.falseColour ? 1 : 0,
+                        setup_.method == InverseMethod::Lut3d ? 1 : 0,
+                        setup_.gamut == display::GamutMode::Clip ? 1 : 0,
+                        setup_.viewingCompensation ? 1 : 0, setup_.falseColour ? 1 : 0,
                         params.viewingRows, filtered ? 1 : 0, 1.0 / display::kViewingGridStepDeg,
                         display::kViewingGridNodes) +
             kDisplayFragmentShader;
@@ -79,22 +106,18 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
         return tl::unexpected(count.error());
     }
     countProgram_ = std::move(*count);
+    return {};
+}
 
-    rgbaTarget_ = texture2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height, nullptr);
-    classTarget_ = texture2d(GL_R8, GL_RED, GL_UNSIGNED_BYTE, width, height, nullptr);
-    toneLut_ = texture2d(GL_RG32F, GL_RG, GL_FLOAT, params.lutSize - 1, 3, params.lut.data());
-    if (filtered) {
-        viewingGrid_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, display::kViewingGridNodes, 1,
-                                 params.viewingGrid.data());
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    }
+std::vector<float> DisplayPass::uploadLut3d(const display::DisplayInverse& inverse,
+                                            glm::dvec3& latticeScale)
+{
     // A 3-D texture always exists (a 2^3 dummy on the analytic path) so that the sampler is valid.
-    const int n = setup.method == InverseMethod::Lut3d ? std::max(setup.lut3dSize, 2) : 2;
+    const int n = lut3dSize();
     std::vector<float> lattice(static_cast<std::size_t>(n * n * n) * 4, 0.0f);
-    glm::dvec3 latticeScale(0.0);
-    if (setup.method == InverseMethod::Lut3d) {
-        const auto lut = display::DisplayLut3d::build(*inverse, n);
+    latticeScale = glm::dvec3(0.0);
+    if (setup_.method == InverseMethod::Lut3d) {
+        const auto lut = display::DisplayLut3d::build(inverse, n);
         for (std::size_t i = 0; i < lut.nodes().size(); ++i) {
             for (int c = 0; c < 3; ++c) {
                 lattice[i * 4 + static_cast<std::size_t>(c)] =
@@ -110,17 +133,27 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, n, n, n, GL_RGBA, GL_FLOAT, lattice.data());
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return lattice;
+}
 
+int DisplayPass::lut3dSize() const
+{
+    return setup_.method == InverseMethod::Lut3d ? std::max(setup_.lut3dSize, 2) : 2;
+}
+
+void DisplayPass::findSurround(const display::DisplayPassParams& params,
+                               const std::vector<float>& lattice)
+{
     // The black surround's output, in float as the shader forms it: a pixel below black gets the
     // counts at r = 0 (the tone LUT's first entry; on the 3-D LUT path the lattice's first node),
     // then floor(counts + dither). Constant only if no dither entry moves it.
-    surroundConstant_ = params.blackY > 0.0f && !setup.falseColour &&
-                        (setup.method == InverseMethod::Lut3d ||
-                         setup.gamut == display::GamutMode::HueKeeping) &&
+    surroundConstant_ = params.blackY > 0.0f && !setup_.falseColour &&
+                        (setup_.method == InverseMethod::Lut3d ||
+                         setup_.gamut == display::GamutMode::HueKeeping) &&
                         params.lutSize >= 2;
     for (int c = 0; c < 3 && surroundConstant_; ++c) {
         const float counts =
-                setup.method == InverseMethod::Lut3d
+                setup_.method == InverseMethod::Lut3d
                         ? lattice[static_cast<std::size_t>(c)]
                         : params.lut[static_cast<std::size_t>(c * 2 * (params.lutSize - 1))] *
                                   params.maxCount;
@@ -134,7 +167,10 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
         surroundRgba_[static_cast<std::size_t>(c)] = q / params.maxCount;
     }
     surroundRgba_[3] = 1.0f;
+}
 
+Expected<void> DisplayPass::makeTargets()
+{
     counts_ = GlBuffer::make();
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, counts_.get());
     glBufferData(GL_SHADER_STORAGE_BUFFER, 4 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
@@ -154,7 +190,12 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     // The read buffer stays attachment 0: what glReadPixels on this framebuffer returns.
     glReadBuffer(GL_COLOR_ATTACHMENT0);
 
-    // Uniforms that never change.
+    return {};
+}
+
+void DisplayPass::setConstantUniforms(const display::DisplayPassParams& params,
+                                      const glm::dvec3& latticeScale)
+{
     glUseProgram(program_.get());
     glUniformMatrix3fv(glGetUniformLocation(program_.get(), "uDispXyzToLinear"), 1, GL_FALSE,
                        params.xyzToLinear.data());
@@ -173,7 +214,7 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
         glUniform4fv(glGetUniformLocation(program_.get(), "uDispViewing"), params.viewingRows,
                      params.viewing.data());
     }
-    setInt(program_.get(), "uDispLut3dSize", n);
+    setInt(program_.get(), "uDispLut3dSize", lut3dSize());
     setUniform3(program_.get(), "uDispLut3dScale", latticeScale);
     setInt(program_.get(), "uXyz", 0);
     setInt(program_.get(), "uDispToneLut", 1);
@@ -182,11 +223,6 @@ Expected<void> DisplayPass::init(const DisplayPassSetup& setup, int width, int h
     glUseProgram(countProgram_.get());
     setInt(countProgram_.get(), "uClass", 0);
     glUseProgram(0);
-    if (GLenum err = glGetError(); err != GL_NO_ERROR) {
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("display pass: GL error 0x{:04x} while setting up", err));
-    }
-    return {};
 }
 
 Expected<std::array<GLuint, 4>> DisplayPass::countClasses(const PixelRect& rect) const

@@ -2,7 +2,7 @@
 // profile's inverse model, with front-surface flare subtraction and viewing-angle compensation per
 // pixel, hue-keeping gamut mapping, ordered dither to the panel's bit depth, an optional
 // false-colour overlay of out-of-gamut pixels, and a GPU count of those pixels per frame. Needs a
-// current GLES 3.1 context; the maths is pipeline/display's (display_shader.h mirrors
+// current GLES 3.1 context; the maths is pipeline/display's (display_pass_params.h mirrors
 // display_inverse.h).
 #pragma once
 
@@ -15,7 +15,9 @@
 #include <glm/vec3.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_model.h>
+#include <pipeline/display/display_pass_params.h>
 #include <pipeline/display/gamut_map.h>
 #include <pipeline/render/gl_handles.h>
 #include <pipeline/render/pixel_rect.h>
@@ -34,13 +36,11 @@ struct DisplayPassSetup {
     InverseMethod method = InverseMethod::Analytic;
     int lut3dSize = 33;
     bool viewingCompensation = true; // from the profile's table and the tracked eye; off: on-axis
-    // The gain read from the table resampled every half degree (display::kViewingGridStepDeg) with
-    // the sampler's linear filter, where the GL filters float textures (GL_OES_texture_float_
+    // The gain is read from the table resampled every half degree (display::kViewingGridStepDeg)
+    // with the sampler's linear filter where the GL filters float textures (GL_OES_texture_float_
     // linear): the same function as the rows to float rounding when the rows lie on the half
-    // degrees, 4 % fewer instructions in the painting's frame on llvmpipe. Off, or without the
-    // extension: the rows themselves, as before 2026-12-02 (recordings made before replay so, bit
-    // for bit).
-    bool viewingFiltered = true;
+    // degrees, 4 % fewer instructions in the painting's frame on llvmpipe; without the extension
+    // from the rows themselves.
     bool flareSubtraction = true; // rho_d E / pi per pixel; never for a lit-booth profile
     bool falseColour = false;     // field-staff overlay: out-of-gamut pixels striped in colour
 };
@@ -75,8 +75,7 @@ public:
     // Fails when the profile does not validate, is not 8-bit (the output target in this build), or
     // the GL lacks what the pass needs.
     Expected<void> init(const DisplayPassSetup& setup, int width, int height);
-    // Whether init found the viewing gain filtered (DisplayPassSetup::viewingFiltered and the
-    // extension it needs).
+    // Whether init found the viewing gain filtered (compensation on and the extension it needs).
     bool viewingFiltered() const { return static_cast<bool>(viewingGrid_); }
     // Reads xyzTexture (RGBA32F, texelFetch), draws into framebuffer(), counts the gamut classes.
     Expected<display::GamutCounters> draw(GLuint xyzTexture, const DisplayPassFrame& frame);
@@ -89,6 +88,19 @@ public:
     bool surroundConstant() const { return surroundConstant_; }
 
 private:
+    // The display program for the profile's parameters ('filtered': the viewing gain through the
+    // sampler) and the gamut count's compute program.
+    Expected<void> compilePrograms(const display::DisplayPassParams& params, bool filtered);
+    // The 3-D LUT texture (a 2^3 dummy on the analytic path); its lattice and scale.
+    std::vector<float> uploadLut3d(const display::DisplayInverse& inverse,
+                                   glm::dvec3& latticeScale);
+    int lut3dSize() const;
+    // surroundConstant_ and surroundRgba_: what a pixel below black is driven to.
+    void findSurround(const display::DisplayPassParams& params, const std::vector<float>& lattice);
+    // The gamut counts' buffer and the RGBA8 + R8 framebuffer.
+    Expected<void> makeTargets();
+    void setConstantUniforms(const display::DisplayPassParams& params,
+                             const glm::dvec3& latticeScale);
     // The class image's counts (in gamut, chroma, over peak, below black) over 'rect', on the GPU.
     Expected<std::array<GLuint, 4>> countClasses(const PixelRect& rect) const;
 
@@ -101,7 +113,8 @@ private:
     GlTexture rgbaTarget_;
     GlTexture classTarget_;
     GlTexture toneLut_;
-    GlTexture viewingGrid_; // none unless the gain is filtered (DisplayPassSetup::viewingFiltered)
+    GlTexture viewingGrid_; // none unless the gain is filtered (compensation on and the GL filters
+                            // floats)
     GlTexture lut3d_;
     GlBuffer counts_; // SSBO of 4 uints, one per gamut class
     float flarePerLux_ = 0.0f;

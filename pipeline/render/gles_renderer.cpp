@@ -37,8 +37,8 @@ public:
         }
         vao_ = GlVertexArray::make();
         if (setup_.boothScene) {
-            setup_.boothScene->setSurroundIlluminance(setup_.surroundIlluminance ||
-                                                      !displayPass_.surroundConstant());
+            // E_geo around the surface only where the display pass reads it.
+            setup_.boothScene->setSurroundIlluminance(!displayPass_.surroundConstant());
         }
         xyzTarget_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
         fbo_ = GlFramebuffer::make();

@@ -30,11 +30,6 @@ struct GlesRendererSetup {
     // When set, pass 1 is the booth-lit surface scene (booth_scene_pass.h) instead of the flat
     // patch image under the uniform grid of lights above.
     std::shared_ptr<BoothScenePass> boothScene;
-    // Keep E_geo around the booth surface in the XYZ frame's alpha even when the display pass
-    // clears the surround and never reads it (what recordings made before
-    // BoothShadingPass::setSurroundIlluminance hold in their XYZ digests). Off: the booth pass
-    // shades only the surface's rectangle whenever the display pass clears the rest.
-    bool surroundIlluminance = true;
 };
 
 Expected<std::unique_ptr<Renderer>> createGlesRenderer(GlesRendererSetup setup);

@@ -29,11 +29,20 @@ nextDiffuse(const std::optional<DiffuseTilt>& last, double heldRad, bool lightCh
     return d;
 }
 
-bool diffuseFollows(const DiffuseTilt& had, const DiffuseTilt& want, int slices)
+DiffuseDraw diffuseDraw(const std::optional<DiffuseTilt>& last,
+                        const DiffuseTilt& now,
+                        bool lightChanged,
+                        int slices)
 {
-    // The held tilt that could have led there: a refresh's target, else the tilt shown (while a
-    // refresh is under way the held tilt does not matter).
-    return nextDiffuse(had, diffuseTarget(want), false, slices) == want;
+    const int k = std::max(slices, 1);
+    DiffuseDraw d{now.shownRad, std::nullopt};
+    if (now.refreshRad) {
+        d.band = DiffuseBand{*now.refreshRad, now.refreshBands - 1, k};
+    } else if (!lightChanged && last && last->refreshRad && k > 1) {
+        // The refresh's last band, drawn this frame: it shows its tilt from this frame on.
+        d.band = DiffuseBand{*last->refreshRad, k - 1, k};
+    }
+    return d;
 }
 
 } // namespace replica::pipeline::scene

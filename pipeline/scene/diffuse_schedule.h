@@ -1,7 +1,7 @@
 // The refresh schedule of the booth pass's cached diffuse term, in one place: the tilt estimator
-// steps it once a frame to say what each frame's diffuse term shows (state/tilt_estimator.h), and
-// the booth pass asks it whether the cache it holds is one frame of it behind what a state wants
-// (render::BoothScenePass::draw), so that it draws one band instead of the whole cache.
+// steps it once a frame (state/tilt_estimator.h) and writes what the frame draws (DiffuseDraw:
+// the term shown, and "band b of K toward tilt T"); the booth pass draws what that names into the
+// buffers it holds (render::BoothDiffuseCache) and keeps no schedule of its own.
 #pragma once
 
 #include <optional>
@@ -20,14 +20,13 @@ namespace replica::pipeline::scene {
 DiffuseTilt
 nextDiffuse(const std::optional<DiffuseTilt>& last, double heldRad, bool lightChanged, int slices);
 
-// Whether 'want' is one frame of the schedule after 'had' under the same light: the frame's one
-// draw is then the diffuse term at diffuseTarget(want) (the same term, or a refresh's next band).
-bool diffuseFollows(const DiffuseTilt& had, const DiffuseTilt& want, int slices);
-
-// The tilt a frame's draw of the cache is for: the refresh under way, else the tilt shown.
-inline double diffuseTarget(const DiffuseTilt& d)
-{
-    return d.refreshRad.value_or(d.shownRad);
-}
+// What the frame whose diffuse term is 'now' draws, 'last' being the previous frame's (none: the
+// first): the term shown, and the band of a refresh this frame draws (its bands are drawn one a
+// frame; the frame that draws the last one shows its tilt). A new light or a first frame draws
+// the term whole; so does any frame with K = 1.
+DiffuseDraw diffuseDraw(const std::optional<DiffuseTilt>& last,
+                        const DiffuseTilt& now,
+                        bool lightChanged,
+                        int slices);
 
 } // namespace replica::pipeline::scene

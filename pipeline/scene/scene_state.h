@@ -17,13 +17,32 @@
 namespace replica::pipeline::scene {
 
 // The tilt the booth pass's cached diffuse term shows (the tilt estimator: the hold filter and the
-// sliced refresh, state/tilt_estimator.h). A new held tilt is drawn into a second cache in K bands
-// over K frames (RenderSettings::cacheSlices); the frame that draws the last band shows it.
+// sliced refresh, state/tilt_estimator.h), as the estimator carries it from frame to frame. A new
+// held tilt is drawn into a second cache in K bands over K frames (RenderSettings::cacheSlices);
+// the frame that draws the last band shows it.
 struct DiffuseTilt {
     double shownRad = 0.0;            // the tilt of the diffuse term shown in this frame
     std::optional<double> refreshRad; // a sliced refresh under way toward this tilt...
     int refreshBands = 0;             // ...with this many of its K bands drawn (this frame's too)
     bool operator==(const DiffuseTilt&) const = default;
+};
+
+// This frame's band of a sliced refresh: band 'band' (0-based) of 'bands', toward 'towardRad'.
+// The last band (band == bands - 1) completes it: the frame then shows towardRad.
+struct DiffuseBand {
+    double towardRad = 0.0;
+    int band = 0;
+    int bands = 1;
+    bool operator==(const DiffuseBand&) const = default;
+};
+
+// What the frame's cached diffuse term is, as the state stage decided it
+// (pipeline/scene/diffuse_schedule.h): the term composed, and the band of a refresh drawn this
+// frame. The renderer holds buffers and draws what this names; it keeps no schedule.
+struct DiffuseDraw {
+    double shownRad = 0.0;
+    std::optional<DiffuseBand> band;
+    bool operator==(const DiffuseDraw&) const = default;
 };
 
 struct SceneState {
@@ -34,9 +53,9 @@ struct SceneState {
     colour::Spectrum illuminant{};
     int lampIndex = -1;                // classified lamp, -1 when unknown (direct-sensor mode)
     double emitterLuminanceCdM2 = 0.0; // luminance of the booth emitter for this lamp
-    // The light differs from the previous frame's (another lamp, or a sensed spectrum or
-    // luminance that moved; the first frame's too): the renderer uploads it and draws its cached
-    // diffuse term whole.
+    // The light's content key differs from the previous frame's (lightKey: another lamp, or a
+    // sensed spectrum or luminance that moved; the first frame's too): the state stage re-takes
+    // the held tilt, draws the diffuse term whole and decides the encoding on it.
     bool lightChanged = true;
     // The channel encoding (a light-adaptive encoder only): 0 is the renderer's own basis; n > 0
     // the n-th re-encode, 'basis' its basis (made for 'encodedFor').
@@ -44,11 +63,19 @@ struct SceneState {
     std::shared_ptr<const colour::ChannelBasis> basis;
     colour::Spectrum encodedFor{};
     glm::dvec3 eyeBoothM{0.0, 0.45, 0.60};
-    double tiltRad = 0.0;     // the sensed tilt: the specular term's
+    // The specular term's tilt: the sensed one, finite (a non-finite one is replaced by the held
+    // tilt in the tilt estimator, the one place that decides the panel's pose).
+    double tiltRad = 0.0;
     double heldTiltRad = 0.0; // the hold filter's tilt (the diffuse term's once refreshed)
-    // The diffuse term's tilt, which the tilt estimator always sets; none in a state made by
-    // hand (a test, a benchmark): the diffuse term at tiltRad.
-    std::optional<DiffuseTilt> diffuse;
+    // The diffuse term, which the tilt estimator always sets; none in a state made by hand (a
+    // test, a benchmark): the diffuse term whole at tiltRad.
+    std::optional<DiffuseDraw> diffuse;
 };
+
+// The content key of a state's light: the lamp, or in direct-sensor mode (lampIndex < 0) the
+// sensed spectrum and the emitter's luminance (FNV-1a 64 of their bytes). The light estimator
+// says a light changed when this key does; the renderer labels the light it holds with it.
+std::uint64_t lightKey(const SceneState& state);
+std::uint64_t lightKey(int lampIndex, const colour::Spectrum& illuminant, double luminanceCdM2);
 
 } // namespace replica::pipeline::scene

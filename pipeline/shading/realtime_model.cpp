@@ -4,7 +4,6 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
-#include <thread>
 
 #include <glm/geometric.hpp>
 
@@ -66,13 +65,6 @@ double horizonVisibility(const surface::HorizonMap* horizon,
 // light's direction in the macro tangent frame (right, up, nGeo), its horizon softness
 // (lightSoftness) and the horizon test at the texel or, with 'at', bilinear at that fractional
 // texel position. 1 without a horizon map (what horizonVisibility returns there).
-// sp with its facet normal set to the macro normal: eq. (1) without the relief.
-ShadingPoint withMacroNormal(ShadingPoint sp)
-{
-    sp.nShade = sp.nGeo;
-    return sp;
-}
-
 struct ReliefLightVisibility {
     // The horizon at sp: its texel's, or with 'bilinear' the bilinear one at (texX, texY)
     // (RenderSettings::horizonBilinear).
@@ -416,174 +408,6 @@ double gridValue(const std::vector<double>& values, GridNodes nodes, double u, d
     const int iy = static_cast<int>(y0);
     return (1.0 - ay) * ((1.0 - ax) * at(ix, iy) + ax * at(ix + 1, iy)) +
            ay * ((1.0 - ax) * at(ix, iy + 1) + ax * at(ix + 1, iy + 1));
-}
-
-XyzFrame renderRealtime(const PreparedScene& ps,
-                        const PreparedLight& light,
-                        const View& view,
-                        const colour::Observer& obs,
-                        const RenderSettings& settings)
-{
-    const surface::SurfaceScene& scene = *ps.scene;
-    XyzFrame frame;
-    frame.width = view.pixelsX;
-    frame.height = view.pixelsY;
-    frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height),
-                     colour::Xyz(0.0));
-    const bool relief = settings.reliefPass && !ps.normals.empty();
-    const bool specular = settings.specularPass && scene.glossy();
-    const std::vector<Vec3> none;
-    const std::vector<Vec3>& normals = relief ? ps.normals : none;
-    // The GL pass's half-float horizons (RenderSettings::horizonHalf): the same rounded sines here.
-    const surface::HorizonMap* horizon = nullptr;
-    if (relief && settings.horizonDirections > 0) {
-        horizon = settings.horizonHalf ? &ps.horizonHalf : &ps.horizon;
-    }
-    const booth::BoothLight& bl = *light.light;
-    const Vec3 nl = bl.normal();
-    const double a = bl.texelAreaM2();
-    // Without the horizon spread every light's spread is zero: its softness is horizonSoftness.
-    std::vector<booth::PointLight> sharp;
-    if (!settings.horizonSpread) {
-        sharp = light.points;
-        for (booth::PointLight& p : sharp) {
-            p.spreadU = Vec3(0.0);
-            p.spreadV = Vec3(0.0);
-        }
-    }
-    const std::vector<booth::PointLight>& points = settings.horizonSpread ? light.points : sharp;
-    // Eq. (1) from the regions' areas or from their centroids (RenderSettings::areaLights).
-    const auto diffuse = settings.areaLights ? areaLightIrradiance : pointLightIrradiance;
-    const colour::Xyz specXyz = colour::spectrumToXyz(obs, scene.rhoS * light.unitSpd);
-    const int threads = std::clamp(settings.threads, 1, std::max(frame.height, 1));
-    // Rows [0, rows) split over the threads: f(thread, first row, end row).
-    const auto inParallel = [threads](int rows, const auto& f) {
-        std::vector<std::thread> pool;
-        for (int t = 0; t < threads; ++t) {
-            pool.emplace_back(f, t, rows * t / threads, rows * (t + 1) / threads);
-        }
-        for (auto& th : pool) {
-            th.join();
-        }
-    };
-    // The unit vector from a shading point to the eye (the macro normal with the eye on it), and
-    // the specular term (rho_s = 1) seen along it: what a pixel and a grid node both shade.
-    const auto towardEye = [&](const ShadingPoint& sp) {
-        const Vec3 toEye = view.eye - sp.p;
-        const double eyeDist = glm::length(toEye);
-        return eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
-    };
-    const auto specularAt = [&](const ShadingPoint& sp, const Vec3& toEye) {
-        return filteredSpecular(light, sp, toEye, scene.model, scene.alpha,
-                                settings.specularSamples, horizon, settings.horizonSoftness,
-                                settings.specularLodBias, settings.specularNearestLevel);
-    };
-
-    // The specular grid, when used: every node first (as the GL pass's mode 2 does).
-    const GridNodes nodes = specular ? gridNodes(scene, settings.specularGrid) : GridNodes{};
-    std::vector<double> grid(static_cast<std::size_t>(nodes.x) * static_cast<std::size_t>(nodes.y));
-    if (nodes.x > 0) {
-        inParallel(nodes.y, [&](int, int j0, int j1) {
-            for (int j = j0; j < j1; ++j) {
-                for (int i = 0; i < nodes.x; ++i) {
-                    const ShadingPoint sp = shadingPointAt(view, scene, normals,
-                                                           static_cast<double>(i) / (nodes.x - 1),
-                                                           static_cast<double>(j) / (nodes.y - 1));
-                    const Vec3 toEye = towardEye(sp);
-                    const double s = glm::dot(toEye, sp.nGeo) > 0.0 ? specularAt(sp, toEye) : 0.0;
-                    grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(nodes.x) +
-                         static_cast<std::size_t>(i)] = std::isfinite(s) ? s : 0.0;
-                }
-            }
-        });
-    }
-
-    // The diffuse grid, when used (flat surfaces only): eq. (1) with the macro normal at every
-    // node first, as the GL pass's mode 3 does when it recomputes its cache.
-    const GridNodes diffuseNodes = relief ? GridNodes{} : gridNodes(scene, settings.diffuseGrid);
-    std::vector<double> diffuseGrid(static_cast<std::size_t>(diffuseNodes.x) *
-                                    static_cast<std::size_t>(diffuseNodes.y));
-    if (diffuseNodes.x > 0) {
-        inParallel(diffuseNodes.y, [&](int, int j0, int j1) {
-            for (int j = j0; j < j1; ++j) {
-                for (int i = 0; i < diffuseNodes.x; ++i) {
-                    const ShadingPoint sp = shadingPointAt(
-                            view, scene, normals, static_cast<double>(i) / (diffuseNodes.x - 1),
-                            static_cast<double>(j) / (diffuseNodes.y - 1));
-                    const double e =
-                            diffuse(points, nl, a, withMacroNormal(sp), nullptr, 0.0, false);
-                    diffuseGrid[static_cast<std::size_t>(j) *
-                                        static_cast<std::size_t>(diffuseNodes.x) +
-                                static_cast<std::size_t>(i)] = std::isfinite(e) ? e : 0.0;
-                }
-            }
-        });
-    }
-
-    struct Counts {
-        long flare = 0, behind = 0, bad = 0;
-    };
-    const auto renderRows = [&](int y0, int y1, Counts& c) {
-        for (int py = y0; py < y1; ++py) {
-            for (int px = 0; px < frame.width; ++px) {
-                const ShadingPoint sp = shadingPoint(view, scene, normals, px, py);
-                const Vec3 toEye = towardEye(sp);
-                const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
-                c.behind += behind ? 1 : 0;
-                const double eGeo =
-                        diffuseNodes.x > 0
-                                ? gridValue(diffuseGrid, diffuseNodes, (px + 0.5) / view.pixelsX,
-                                            (py + 0.5) / view.pixelsY)
-                                : diffuse(points, nl, a, withMacroNormal(sp), nullptr, 0.0, false);
-                double e = eGeo;
-                if (relief) {
-                    e = diffuse(points, nl, a, sp, horizon, settings.horizonSoftness,
-                                settings.horizonBilinear);
-                }
-                if (!settings.diffusePass) {
-                    e = 0.0;
-                }
-                colour::Xyz xyz(0.0);
-                if (settings.channels == ChannelRep::Basis6) {
-                    const colour::ChannelCoeffs cc = scene.channels(ps.paletteCoeffs, sp.tx, sp.ty);
-                    for (std::size_t k = 0; k < colour::kChannels; ++k) {
-                        xyz += light.channelXyz[k] * cc[k];
-                    }
-                    xyz *= e / std::numbers::pi;
-                } else {
-                    xyz = colour::spectrumToXyz(obs,
-                                                scene.reflectance(sp.tx, sp.ty) * light.unitSpd) *
-                          (e / std::numbers::pi);
-                }
-                if (specular && nodes.x > 0) {
-                    const double u = (px + 0.5) / view.pixelsX;
-                    const double v = (py + 0.5) / view.pixelsY;
-                    xyz += specXyz * gridValue(grid, nodes, u, v);
-                } else if (specular && !behind) {
-                    xyz += specXyz * specularAt(sp, toEye);
-                }
-                const colour::Xyz flare = light.white * (kScreenFlareRho * eGeo / std::numbers::pi);
-                colour::Xyz out = subtractFlare(xyz, flare, c.flare);
-                if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z)) {
-                    ++c.bad;
-                    out = colour::Xyz(0.0);
-                }
-                frame.xyz[static_cast<std::size_t>(py) * frame.width + px] = out;
-            }
-        }
-    };
-    std::vector<Counts> counts(static_cast<std::size_t>(threads));
-    inParallel(frame.height, [&](int t, int y0, int y1) {
-        renderRows(y0, y1, counts[static_cast<std::size_t>(t)]);
-    });
-    for (const auto& c : counts) {
-        frame.flareClamped += c.flare;
-        frame.eyeBehindPixels += c.behind;
-        frame.nonFinite += c.bad;
-    }
-    frame.whiteY = panelWhiteY(light, view.panel, settings.areaLights);
-    frame.whiteXyz = light.white * frame.whiteY;
-    return frame;
 }
 
 } // namespace replica::pipeline::shading

@@ -27,8 +27,6 @@ enum class ChannelRep {
 
 // The specular mip level bias the renderer uses unless told otherwise (RenderSettings).
 inline constexpr double kDefaultSpecularLodBias = 0.0;
-// What renderers used before the bias was a setting: recordings without it replay with this.
-inline constexpr double kLegacySpecularLodBias = 1.0;
 // The largest |bias| a command line or a recorded configuration may ask for (8 levels: a 256x
 // sharper or blurrier footprint, far past any useful setting).
 inline constexpr double kMaxSpecularLodBias = 8.0;
@@ -56,60 +54,14 @@ struct RenderSettings {
     bool specularPass = true;      // ignored (skipped) for a matte scene
     bool reliefPass = true;        // normal map + horizon; ignored for a flat scene
     double horizonSoftness = 0.02; // half-width of the smoothstep in sin(elevation)
-    // Widen each point light's horizon smoothstep to the spread of its ceiling region
-    // (booth::PointLight::spreadU/V; pointLightIrradiance). Off: every light uses
-    // horizonSoftness alone, as before 2026-12-02 (recordings made before replay so).
-    bool horizonSpread = true;
     // The diffuse term (eq. 1) from areas, not points: each median-cut region is the uniform
     // rectangle it covers on the ceiling (its mean luminance), its irradiance Lambert's contour
     // integral over the region clipped to the surface's horizon (areaLightIrradiance). Point
     // lights are wrong in the near field: the shipped 1.0 x 0.5 m ceiling cut into 32 regions of
     // 12.5 cm half a metre away lit a flat matte surface 2-3 % too bright at small tilts. Relief
-    // keeps one horizon test per region, at its centroid's direction. Off: point lights, as
-    // before 2026-12-03 (recordings made before replay so, bit for bit).
+    // keeps one horizon test per region, at its centroid's direction. Off: point lights (the
+    // appliance's choice on relief, defaultAreaLights).
     bool areaLights = true;
-    // Store the horizon sines as half floats (surface::halfPrecision, within 2^-12): the GL pass
-    // packs eight directions into one RGBA32UI texel instead of two RGBA32F texels, one texture
-    // read a pixel fewer (2-3 ms of the painting's 960x600 frame on llvmpipe). Off: float sines,
-    // as before 2026-12-02 (recordings made before replay so).
-    bool horizonHalf = true;
-    // Read the horizons for eq. (1) bilinearly at the pixel's point on the surface
-    // (HorizonMap::sinHorizonBilinear) instead of at the texel holding it. At a 10-degree tilt the
-    // ceiling grazes the panel and a light's visibility turns within a texel: the nearest texel's
-    // horizon took the painting's max ΔE00 to 3.07, the bilinear one to 1.5 (docs/rendering.md).
-    // It costs four horizon reads a pixel where one was, only when the cache is recomputed; the
-    // specular lobe keeps the nearest texel's. Off: as before 2026-12-02 (recordings made before).
-    bool horizonBilinear = true;
-    // The GL pass only (the CPU model has no such choice): each specular sample computed on every
-    // pixel and kept or zeroed at the end, instead of returning early at each test. The same
-    // tests and arithmetic, 7.5 % fewer instructions in the painting's frame on llvmpipe, but LLVM
-    // fuses some multiply-adds differently, so frames differ in the last bits. Off: early
-    // returns, as before 2026-12-02 (recordings made before replay so, bit for bit).
-    bool specularBranchFree = true;
-    // The GL pass only: each specular sample's nearest mip level taken from the footprint
-    // ratio's float exponent, ceil(log2 r) / 2 rounded down (exactly the level
-    // booth::MipChain::sampleNearestLevel picks from 0.5 log2 r), instead of through log2, which
-    // llvmpipe computes with a polynomial: 2 % of the painting's instructions. It applies with
-    // specularNearestLevel and a specularLodBias that is a multiple of 0.5 (the default 0; the
-    // ratio is then scaled by 4^bias exactly); otherwise log2 as before. Frames differ where the
-    // polynomial's rounding put a sample on the other side of a level boundary. Off: log2, as
-    // before 2026-12-02 (recordings made before replay so, bit for bit).
-    bool specularExactLevel = true;
-    // The GL pass only (the CPU model and the reference always do this, shading::shadingPoint):
-    // a pixel's texel position is its offset into the surface's pixels times the texels,
-    // divided last (exact on a texel edge with a correctly rounded division, as llvmpipe's), so
-    // that a pixel centre exactly on a texel edge takes the texel after it in float as in
-    // double. u * texels, as before, rounds such a centre either way: at 48x30 and 96x60 one
-    // pixel row in thirty read the texel row before the CPU model's (ΔE00 up to 56 at a pigment
-    // edge). Off: u * texels, as before 2026-12-02 (recordings made before replay so, bit for
-    // bit).
-    bool texelExactTies = true;
-    // The GL pass only: the two horizon directions around a light's azimuth picked by
-    // comparisons (HorizonMap::sinHorizon's (1 - t) lo + t hi), instead of a tent weight on
-    // every direction: about half the operations per light and direction on relief, and the
-    // CPU model's sum rather than another, so other float rounding. Off: the tent weights, as
-    // before 2026-12-02 (recordings made before replay so, bit for bit).
-    bool horizonPick = true;
     // The GL pass only, and only across frames (one frame is the same either way): when the
     // panel's pose changes, the cached eye-independent part (eq. 1 and 2, the frame's costly part
     // on relief) is recomputed in this many bands of rows over as many frames, into a second
@@ -134,9 +86,6 @@ struct RenderSettings {
     // (gridNodes' layout) and interpolated, it costs a frame that recomputes the cache
     // (the panel being tilted) a few hundred sums instead of one per pixel.
     int diffuseGrid = 0;
-    // The GL pass only: let the sampler filter the luminance mip chain where the GL can (same
-    // rule as booth::MipChain::sample); off, or without the extensions, the shader filters by hand.
-    bool hardwareFilter = true;
     // Added to each specular sample's mip level (Colbert & Krivanek's level, 1/2 log2 of the
     // sample's footprint over a texel's): more blurs the luminance image under each sample, less
     // aliases it. Colbert & Krivanek add 1; docs/rendering.md measures 0 as the better choice
@@ -145,7 +94,9 @@ struct RenderSettings {
     // Read each specular sample from the one mip level nearest its own (MipChain::
     // sampleNearestLevel) instead of between the two around it: half the texel fetches, about
     // 15% of the painting's frame on llvmpipe, for p95 0.57 / max 1.64 at worst against 0.52 /
-    // 1.13 (docs/rendering.md). Recordings made before it replay trilinear.
+    // 1.13 (docs/rendering.md). The CPU model takes either (the studies compare them); the GL
+    // pass renders the nearest level only, at a bias of whole half levels (BoothShadingPass
+    // refuses other settings).
     bool specularNearestLevel = true;
     int threads = 2;
 };
@@ -214,7 +165,8 @@ struct PreparedScene {
     const surface::SurfaceScene* scene = nullptr;
     std::vector<Vec3> normals; // empty when flat
     surface::HorizonMap horizon;
-    // surface::halfPrecision(horizon), rounded once here for RenderSettings::horizonHalf (the
+    // surface::halfPrecision(horizon), rounded once here: what eq. (1) and the lobe read, as the
+    // GL pass packs its horizons as half floats (the
     // planner renders one prepared scene dozens of times). Whoever replaces 'horizon' rounds it
     // again.
     surface::HorizonMap horizonHalf;
@@ -232,7 +184,7 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
 // horizon whose half-width is 'softness' or sqrt(3) times the spread of the light's elevation sine
 // over its ceiling region (booth::PointLight::spreadU/V), whichever is wider. The horizon (none
 // when null) is the texel (sp.tx, sp.ty)'s, or with 'bilinear' the bilinear one at (sp.texX,
-// sp.texY) (RenderSettings::horizonBilinear), its azimuths in sp's frame (right, up).
+// sp.texY) (what renderRealtime asks on relief), its azimuths in sp's frame (right, up).
 double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             const Vec3& lightNormal,
                             double texelAreaM2,

@@ -28,8 +28,8 @@ ShadingPoint shadingPoint(const View& view,
                           int py)
 {
     // The texel position with the division last: exact wherever the pixel centre lies on a
-    // texel edge, which then takes the texel after it (the GL pass's rule with
-    // RenderSettings::texelExactTies). u * texels rounded such a centre either way.
+    // texel edge, which then takes the texel after it (the GL pass's rule too). u * texels
+    // rounds such a centre either way.
     const glm::dvec2 texel((px + 0.5) * scene.width / view.pixelsX,
                            (py + 0.5) * scene.height / view.pixelsY);
     return shadingPointAt(view, scene, normals, (px + 0.5) / view.pixelsX,

@@ -56,6 +56,13 @@ ShadingPoint shadingPointAt(const View& view,
                             double v,
                             const std::optional<glm::dvec2>& texel = std::nullopt);
 
+// sp with its facet normal set to the macro normal: eq. (1) without the relief.
+inline ShadingPoint withMacroNormal(ShadingPoint sp)
+{
+    sp.nShade = sp.nGeo;
+    return sp;
+}
+
 // Whether the eye is at or behind the surface's plane at sp, as renderRealtime decides it (its
 // specular term is then 0 and the pixel counted in XyzFrame::eyeBehindPixels).
 bool eyeBehind(const View& view, const ShadingPoint& sp);

@@ -1,5 +1,5 @@
 // Colour accuracy of a representation against the full-spectral calculation, with the normalisation
-// of issue 3 (our reading of the paper's section "Color accuracy"):
+// of docs/accuracy.md (our reading of the paper's section "Color accuracy"):
 //   1. each workflow's XYZ is scaled so that its own white sample has Y = 1/1.13;
 //   2. the source white is the light's own XYZ (full spectral, 36 bands) scaled to Y = 1;
 //   3. both are adapted with CAT02 (D = 1) to D65 (summed on the same grid, Y = 1);

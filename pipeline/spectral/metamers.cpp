@@ -51,14 +51,14 @@ double reflectancePairDifference(const Observer& obs,
     return colour::ciede2000(labUnder(obs, light, a), labUnder(obs, light, b));
 }
 
-std::vector<MetamerPair> findMetamerPairs(const Observer& obs,
-                                          const colour::ChannelBasis& basis,
-                                          const Spectrum& matchLight,
-                                          const Spectrum& mismatchLight,
-                                          const NamedSpectra& seeds,
-                                          std::size_t count,
-                                          double minMismatch,
-                                          double targetMismatch)
+namespace {
+
+// The channel-weight directions that leave the colour under the matching light unchanged: 600
+// directions on the unit sphere of the null space of the 3 x 6 matrix M (XYZ of each
+// reconstruction spectrum under that light).
+std::vector<std::array<double, kChannels>> nullSpaceDirections(const Observer& obs,
+                                                               const colour::ChannelBasis& basis,
+                                                               const Spectrum& matchLight)
 {
     // Null space of the 3 x 6 matrix M (XYZ of each reconstruction spectrum under the matching
     // light): the eigenvectors of M^T M with the three smallest eigenvalues (which are ~0).
@@ -92,7 +92,53 @@ std::vector<MetamerPair> findMetamerPairs(const Observer& obs,
         }
         directions.push_back(d);
     }
+    return directions;
+}
 
+// Greedily the largest mismatches whose hue (of a, under the mismatch light) is at least 30
+// degrees from every pair taken so far, at most 'count', named pair01, pair02, ...
+std::vector<MetamerPair> spreadHues(std::vector<MetamerPair> candidates,
+                                    const Observer& obs,
+                                    const Spectrum& mismatchLight,
+                                    std::size_t count)
+{
+    std::sort(candidates.begin(), candidates.end(), [](const MetamerPair& x, const MetamerPair& y) {
+        return x.de00Mismatch > y.de00Mismatch;
+    });
+    std::vector<MetamerPair> chosen;
+    std::vector<double> hues;
+    for (const auto& c : candidates) {
+        if (chosen.size() >= count) {
+            break;
+        }
+        const colour::Lab lab = labUnder(obs, mismatchLight, c.a);
+        const double hue = std::atan2(lab.b, lab.a) * 180.0 / std::numbers::pi;
+        const bool spread = std::all_of(hues.begin(), hues.end(), [hue](double h) {
+            const double diff = std::abs(std::remainder(hue - h, 360.0));
+            return diff >= 30.0;
+        });
+        if (!spread) {
+            continue;
+        }
+        hues.push_back(hue);
+        chosen.push_back(c);
+        chosen.back().name = fmt::format("pair{:02}", chosen.size());
+    }
+    return chosen;
+}
+
+} // namespace
+
+std::vector<MetamerPair> findMetamerPairs(const Observer& obs,
+                                          const colour::ChannelBasis& basis,
+                                          const Spectrum& matchLight,
+                                          const Spectrum& mismatchLight,
+                                          const NamedSpectra& seeds,
+                                          std::size_t count,
+                                          double minMismatch,
+                                          double targetMismatch)
+{
+    const auto directions = nullSpaceDirections(obs, basis, matchLight);
     std::vector<MetamerPair> candidates;
     for (std::size_t s = 0; s < seeds.size(); ++s) {
         const auto c0 = colour::projectReflectance(basis, seeds.spectra[s]);
@@ -147,31 +193,7 @@ std::vector<MetamerPair> findMetamerPairs(const Observer& obs,
             candidates.push_back(best);
         }
     }
-    // Spread the hues: greedily take the largest mismatch whose hue (of a, under the mismatch
-    // light) is at least 30 degrees from every pair taken so far.
-    std::sort(candidates.begin(), candidates.end(), [](const MetamerPair& x, const MetamerPair& y) {
-        return x.de00Mismatch > y.de00Mismatch;
-    });
-    std::vector<MetamerPair> chosen;
-    std::vector<double> hues;
-    for (const auto& c : candidates) {
-        if (chosen.size() >= count) {
-            break;
-        }
-        const colour::Lab lab = labUnder(obs, mismatchLight, c.a);
-        const double hue = std::atan2(lab.b, lab.a) * 180.0 / std::numbers::pi;
-        const bool spread = std::all_of(hues.begin(), hues.end(), [hue](double h) {
-            const double diff = std::abs(std::remainder(hue - h, 360.0));
-            return diff >= 30.0;
-        });
-        if (!spread) {
-            continue;
-        }
-        hues.push_back(hue);
-        chosen.push_back(c);
-        chosen.back().name = fmt::format("pair{:02}", chosen.size());
-    }
-    return chosen;
+    return spreadHues(std::move(candidates), obs, mismatchLight, count);
 }
 
 Expected<void> saveMetamerPairs(const std::vector<MetamerPair>& pairs,

@@ -38,8 +38,8 @@ Expected<Spectrum> loadCieIlluminant(const std::filesystem::path& dataDir, const
 // All of them, in that order.
 Expected<NamedSpectra> loadAllCieIlluminants(const std::filesystem::path& dataDir);
 
-// The lights of the accuracy table (issue 3): A, D50, D65, F2, F7, F8, F11 and LED-B4 (5000 K
-// phosphor-converted white LED).
+// The lights of the accuracy table (docs/accuracy.md): A, D50, D65, F2, F7, F8, F11 and LED-B4
+// (5000 K phosphor-converted white LED).
 std::vector<std::string> evaluationLightNames();
 
 } // namespace replica::pipeline::spectral

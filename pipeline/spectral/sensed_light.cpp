@@ -2,12 +2,14 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 
 #include <fmt/format.h>
 
 #include <pipeline/base/interpolate.h>
 #include <pipeline/colour/xyz.h>
 #include <pipeline/spectral/band_noise.h>
+#include <pipeline/spectral/live_chain.h>
 #include <pipeline/spectral/sensed_light.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 
@@ -138,25 +140,12 @@ InstrumentImpairments idealInstrument()
     return i;
 }
 
-Expected<SensedLight> senseLight(const FineLight& light,
-                                 const colour::Observer& observer,
-                                 const InstrumentImpairments& imp,
-                                 const SensingCorrections& corr,
-                                 std::uint64_t seed)
-{
-    if (light.wavelengthNm.size() < 2 || light.continuum.size() != light.wavelengthNm.size()) {
-        return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("{}: a fine light needs two samples or more", light.name));
-    }
-    if (!(imp.fwhmNm >= 0.0) || !(imp.strayFraction >= 0.0) || !(imp.strayFraction < 1.0) ||
-        !(std::abs(imp.wavelengthErrorNm) <= 5.0) || corr.scansAveraged < 1) {
-        return makeError(ErrorCode::InvalidArgument,
-                         "sensed light: FWHM and stray light must be >= 0, the wavelength error "
-                         "within 5 nm and at least one scan averaged");
-    }
-    NoiseSource noise(seed);
-    SensedLight out;
+namespace {
 
+// Each pixel's photo-electron rate (counts per second, the brightest pixel at
+// kPeakRateCountsPerS) for the light through the instrument's optics.
+Expected<std::vector<double>> pixelRates(const FineLight& light, const InstrumentImpairments& imp)
+{
     // Each pixel's true centre and edges (midway to its neighbours).
     std::vector<double> centre(kPixels);
     for (int p = 0; p < kPixels; ++p) {
@@ -207,68 +196,76 @@ Expected<SensedLight> senseLight(const FineLight& light,
     for (double& r : rate) {
         r *= kPeakRateCountsPerS / peakRate;
     }
-    const double strayRate = imp.strayFraction * kPeakRateCountsPerS;
+    return rate;
+}
 
-    const double noiseScale = imp.noise ? 1.0 : 0.0;
-    std::vector<double> sum(kPixels, 0.0);
-    std::vector<std::uint16_t> counts(kPixels, 0);
-    auto scan = [&](std::uint32_t us) {
+// The detector reading the light: one scan at a time, as counts.
+class Detector
+{
+public:
+    Detector(std::vector<double> rate, const InstrumentImpairments& imp, std::uint64_t seed)
+        : rate_(std::move(rate)), imp_(imp), noise_(seed), counts_(kPixels, 0)
+    {}
+    // One scan of 'us' microseconds into counts(); returns its brightest raw pixel.
+    double scan(std::uint32_t us)
+    {
         const double t = us * 1e-6;
+        const double strayRate = imp_.strayFraction * kPeakRateCountsPerS;
+        const double noiseScale = imp_.noise ? 1.0 : 0.0;
         double peak = 0.0;
         for (int p = 0; p < kPixels; ++p) {
             const auto i = static_cast<std::size_t>(p);
-            const double photo = p > kDarkLast ? (rate[i] + strayRate) * t : 0.0;
+            const double photo = p > kDarkLast ? (rate_[i] + strayRate) * t : 0.0;
             const double charge = photo + kDarkCurrentCountsPerS * t;
-            const double g1 = noise.gaussian();
-            const double g2 = noise.gaussian();
+            const double g1 = noise_.gaussian();
+            const double g2 = noise_.gaussian();
             const double x = charge + noiseScale * std::sqrt(kShotVariancePerCount * charge) * g1;
             const double compressed = x / (1.0 - kNonlinearityK * x);
             const double u = std::clamp(x / kBowFullScale, 0.0, 1.0);
             const double measured =
-                    compressed * (1.0 + imp.residualNonlinearity * 4.0 * u * (1.0 - u));
+                    compressed * (1.0 + imp_.residualNonlinearity * 4.0 * u * (1.0 - u));
             const double value = std::clamp(
                     std::round(kDarkOffsetCounts + measured + noiseScale * kReadNoiseCounts * g2),
                     0.0, 65535.0);
-            counts[i] = static_cast<std::uint16_t>(value);
+            counts_[i] = static_cast<std::uint16_t>(value);
             peak = std::max(peak, value);
         }
         return peak;
-    };
-    auto darkMean = [&] {
+    }
+    const std::vector<std::uint16_t>& counts() const { return counts_; }
+    double darkMean() const
+    {
         double d = 0.0;
         for (int p = kDarkFirst; p <= kDarkLast; ++p) {
-            d += counts[static_cast<std::size_t>(p)];
+            d += counts_[static_cast<std::size_t>(p)];
         }
         return d / (kDarkLast - kDarkFirst + 1);
-    };
+    }
     // Auto-integration, as the appliance runs it: read, adjust, until the time stays.
-    std::uint32_t us = kStartIntegrationUs;
-    for (int round = 0; round < 12; ++round) {
-        scan(us);
-        const AutoIntegrationDecision d = nextIntegrationTime(counts, darkMean(), us);
-        if (!d.changed) {
-            break;
+    std::uint32_t settle()
+    {
+        std::uint32_t us = kStartIntegrationUs;
+        for (int round = 0; round < 12; ++round) {
+            scan(us);
+            const AutoIntegrationDecision d = nextIntegrationTime(counts_, darkMean(), us);
+            if (!d.changed) {
+                break;
+            }
+            us = d.integrationTimeUs;
         }
-        us = d.integrationTimeUs;
+        return us;
     }
-    for (int s = 0; s < corr.scansAveraged; ++s) {
-        out.peakCounts = scan(us);
-        for (int p = 0; p < kPixels; ++p) {
-            sum[static_cast<std::size_t>(p)] += counts[static_cast<std::size_t>(p)];
-        }
-    }
-    for (int p = 0; p < kPixels; ++p) {
-        const double mean = sum[static_cast<std::size_t>(p)] / corr.scansAveraged;
-        counts[static_cast<std::size_t>(p)] =
-                static_cast<std::uint16_t>(std::clamp(std::round(mean), 0.0, 65535.0));
-    }
-    out.integrationTimeUs = us;
 
-    RawSpectrum raw;
-    raw.counts = counts;
-    raw.integrationTimeUs = us;
-    raw.wavelengthCoeffs = kCoeffs;
-    raw.nonlinearityCoeffs = {1.0, kNonlinearityK, 0, 0, 0, 0, 0, 0};
+private:
+    std::vector<double> rate_;
+    InstrumentImpairments imp_;
+    NoiseSource noise_;
+    std::vector<std::uint16_t> counts_;
+};
+
+// The simulated instrument's EEPROM and responsivity calibration, as the appliance reads them.
+SpectrometerCalibration simulatedCalibration()
+{
     SpectrometerCalibration cal;
     for (double nm = 330.0; nm <= 1120.0; nm += 1.0) {
         cal.wavelengthNm.push_back(nm);
@@ -276,6 +273,43 @@ Expected<SensedLight> senseLight(const FineLight& light,
     }
     cal.darkPixelFirst = kDarkFirst;
     cal.darkPixelLast = kDarkLast;
+    return cal;
+}
+
+RawSpectrum rawSpectrum(std::span<const std::uint16_t> counts, std::uint32_t us)
+{
+    RawSpectrum raw;
+    raw.counts = counts;
+    raw.integrationTimeUs = us;
+    raw.wavelengthCoeffs = kCoeffs;
+    raw.nonlinearityCoeffs = {1.0, kNonlinearityK, 0, 0, 0, 0, 0, 0};
+    return raw;
+}
+
+// The study's own chain: the scans' counts averaged, then countsToSpectrum with the corrections
+// asked for.
+Expected<colour::Spectrum> studyChain(Detector& detector,
+                                      std::uint32_t us,
+                                      const InstrumentImpairments& imp,
+                                      const SensingCorrections& corr,
+                                      SensedLight& out)
+{
+    std::vector<double> sum(kPixels, 0.0);
+    for (int s = 0; s < corr.scansAveraged; ++s) {
+        out.peakCounts = detector.scan(us);
+        for (int p = 0; p < kPixels; ++p) {
+            sum[static_cast<std::size_t>(p)] += detector.counts()[static_cast<std::size_t>(p)];
+        }
+    }
+    std::vector<std::uint16_t> counts(kPixels, 0);
+    for (int p = 0; p < kPixels; ++p) {
+        const double mean = sum[static_cast<std::size_t>(p)] / corr.scansAveraged;
+        counts[static_cast<std::size_t>(p)] =
+                static_cast<std::uint16_t>(std::clamp(std::round(mean), 0.0, 65535.0));
+    }
+    out.scansAveraged = corr.scansAveraged;
+    const RawSpectrum raw = rawSpectrum(counts, us);
+    const SpectrometerCalibration cal = simulatedCalibration();
     ChainOptions options;
     if (corr.strayLight) {
         options.strayLightFraction = imp.strayFraction;
@@ -290,7 +324,63 @@ Expected<SensedLight> senseLight(const FineLight& light,
             out.wavelengthFoundNm = corr.rememberedOffsetNm;
         }
     }
-    auto spd = countsToSpectrum(raw, cal, options);
+    return countsToSpectrum(raw, cal, options);
+}
+
+// The appliance's own chain (LiveSpectrometerChain with its defaults), fed one scan at a time
+// for scansAveraged scans of the steady light, calibrated with the instrument's characterised
+// stray light and the shift remembered from the site's calibration.
+Expected<colour::Spectrum> applianceChain(Detector& detector,
+                                          std::uint32_t us,
+                                          const InstrumentImpairments& imp,
+                                          const SensingCorrections& corr,
+                                          SensedLight& out)
+{
+    InstrumentCalibration instrument;
+    instrument.strayLightFraction = imp.strayFraction;
+    instrument.wavelengthOffsetNm =
+            std::isfinite(corr.rememberedOffsetNm) ? corr.rememberedOffsetNm : 0.0;
+    LiveSpectrometerChain chain(simulatedCalibration(), instrument, corr.chain);
+    Expected<colour::Spectrum> spd = makeError(ErrorCode::InvalidArgument, "no scan");
+    for (int s = 0; s < corr.scansAveraged; ++s) {
+        out.peakCounts = detector.scan(us);
+        spd = chain.add(rawSpectrum(detector.counts(), us));
+        if (!spd) {
+            return spd;
+        }
+    }
+    out.wavelengthFoundNm = chain.wavelengthOffsetNm();
+    out.scansAveraged = chain.averaged();
+    return spd;
+}
+
+} // namespace
+
+Expected<SensedLight> senseLight(const FineLight& light,
+                                 const colour::Observer& observer,
+                                 const InstrumentImpairments& imp,
+                                 const SensingCorrections& corr,
+                                 std::uint64_t seed)
+{
+    if (light.wavelengthNm.size() < 2 || light.continuum.size() != light.wavelengthNm.size()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: a fine light needs two samples or more", light.name));
+    }
+    if (!(imp.fwhmNm >= 0.0) || !(imp.strayFraction >= 0.0) || !(imp.strayFraction < 1.0) ||
+        !(std::abs(imp.wavelengthErrorNm) <= 5.0) || corr.scansAveraged < 1) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "sensed light: FWHM and stray light must be >= 0, the wavelength error "
+                         "within 5 nm and at least one scan averaged");
+    }
+    auto rate = pixelRates(light, imp);
+    if (!rate) {
+        return tl::unexpected(rate.error());
+    }
+    Detector detector(std::move(*rate), imp, seed);
+    SensedLight out;
+    out.integrationTimeUs = detector.settle();
+    auto spd = corr.applianceChain ? applianceChain(detector, out.integrationTimeUs, imp, corr, out)
+                                   : studyChain(detector, out.integrationTimeUs, imp, corr, out);
     if (!spd) {
         return tl::unexpected(spd.error());
     }

@@ -16,6 +16,7 @@
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/colour/spectrum.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/spectral/live_chain.h>
 
 namespace replica::pipeline::spectral {
 
@@ -67,6 +68,12 @@ struct SensingCorrections {
     // has none (an incandescent lamp): the calibration error belongs to the instrument, not the
     // light. NaN = none known.
     double rememberedOffsetNm = std::numeric_limits<double>::quiet_NaN();
+    // The appliance's own chain instead (LiveSpectrometerChain with 'chain', fed each of the
+    // scansAveraged scans in turn; the instrument's calibration: its stray light, and
+    // rememberedOffsetNm as the site's calibrated shift); strayLight and wavelengthLines are then
+    // the chain's.
+    bool applianceChain = false;
+    LiveChainOptions chain;
 };
 
 struct SensedLight {
@@ -75,6 +82,7 @@ struct SensedLight {
     bool linesFound = false;
     std::uint32_t integrationTimeUs = 0; // chosen by auto-integration
     double peakCounts = 0.0;             // brightest raw pixel of the last scan
+    int scansAveraged = 1;               // in the spectrum returned
 };
 
 // Senses 'light' (scansAveraged spectra after auto-integration settles). Deterministic for a seed.

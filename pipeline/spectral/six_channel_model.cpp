@@ -81,6 +81,218 @@ std::unique_ptr<Representation> makeSixChannelRepresentation(const Observer& obs
     return std::make_unique<SixChannelRepresentation>(obs, std::move(model));
 }
 
+namespace {
+
+// The alternating least squares of the six-channel fit: with two of the toXyz matrix T, the
+// reflectance projection P_r and the light projection P_l fixed, the third minimises the weighted
+// squared XYZ error over the training lights and reflectances in closed form (a ridge-regularised
+// linear solve).
+class SixChannelAls
+{
+public:
+    SixChannelAls(std::vector<FitLight> fitLights,
+                  DenseMatrix c,
+                  const colour::ChannelBasis& initial)
+        : fitLights_(std::move(fitLights)), c_(std::move(c)), nl_(fitLights_.size()), g_(nl_),
+          u_(nl_), hg_(nl_), hgc_(nl_), pl_(kK, kBands), pr_(kK, kBands), t_(kK, 3)
+    {
+        for (std::size_t j = 0; j < nl_; ++j) {
+            g_[j] = fitLights_[j].h * fitLights_[j].a;
+            u_[j] = fitLights_[j].h.transposed() * fitLights_[j].h;
+            hg_[j] = fitLights_[j].h.transposed() * g_[j];
+            hgc_[j] = hg_[j] * c_;
+        }
+        for (std::size_t k = 0; k < kK; ++k) {
+            for (std::size_t l = 0; l < kBands; ++l) {
+                pr_(k, l) = initial.project[k][l];
+                pl_(k, l) = initial.project[k][l];
+            }
+        }
+    }
+
+    // Step 1: toXyz.
+    Expected<void> solveToXyz()
+    {
+        const DenseMatrix x = c_ * pr_.transposed(); // 36 x K: sum_i w^2 r_i c_i^T / N
+        const DenseMatrix cc = pr_ * x;              // K x K
+        DenseMatrix n(3 * kK, 3 * kK), rhs(3 * kK, 1);
+        for (std::size_t j = 0; j < nl_; ++j) {
+            const auto s = lightCoeffs(j);
+            const DenseMatrix hgx = hg_[j] * x; // 3 x K
+            for (std::size_t k = 0; k < kK; ++k) {
+                for (std::size_t a = 0; a < 3; ++a) {
+                    rhs(3 * k + a, 0) += s[k] * hgx(a, k);
+                    for (std::size_t k2 = 0; k2 < kK; ++k2) {
+                        for (std::size_t b = 0; b < 3; ++b) {
+                            n(3 * k + a, 3 * k2 + b) += s[k] * s[k2] * u_[j](a, b) * cc(k, k2);
+                        }
+                    }
+                }
+            }
+        }
+        auto sol = solveRidge(n, rhs, kRidge);
+        if (!sol) {
+            return tl::unexpected(sol.error());
+        }
+        for (std::size_t k = 0; k < kK; ++k) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                t_(k, a) = (*sol)(3 * k + a, 0);
+            }
+        }
+        return {};
+    }
+
+    // Step 2: reflectProject.
+    Expected<void> solveReflectProject()
+    {
+        DenseMatrix sum(kK, kK);
+        DenseMatrix rhs(kK * kBands, 1);
+        for (std::size_t j = 0; j < nl_; ++j) {
+            const auto s = lightCoeffs(j);
+            const DenseMatrix q = tut(j);
+            const DenseMatrix thgc = t_ * hgc_[j]; // K x 36
+            for (std::size_t k = 0; k < kK; ++k) {
+                for (std::size_t k2 = 0; k2 < kK; ++k2) {
+                    sum(k, k2) += s[k] * s[k2] * q(k, k2);
+                }
+                for (std::size_t l = 0; l < kBands; ++l) {
+                    rhs(k * kBands + l, 0) += s[k] * thgc(k, l);
+                }
+            }
+        }
+        DenseMatrix n(kK * kBands, kK * kBands);
+        for (std::size_t k = 0; k < kK; ++k) {
+            for (std::size_t k2 = 0; k2 < kK; ++k2) {
+                for (std::size_t l = 0; l < kBands; ++l) {
+                    for (std::size_t l2 = 0; l2 < kBands; ++l2) {
+                        n(k * kBands + l, k2 * kBands + l2) = sum(k, k2) * c_(l, l2);
+                    }
+                }
+            }
+        }
+        auto sol = solveRidge(n, rhs, kRidge);
+        if (!sol) {
+            return tl::unexpected(sol.error());
+        }
+        for (std::size_t k = 0; k < kK; ++k) {
+            for (std::size_t l = 0; l < kBands; ++l) {
+                pr_(k, l) = (*sol)(k * kBands + l, 0);
+            }
+        }
+        return {};
+    }
+
+    // Step 3: lightProject.
+    Expected<void> solveLightProject()
+    {
+        const DenseMatrix x2 = c_ * pr_.transposed();
+        const DenseMatrix cc2 = pr_ * x2;
+        DenseMatrix n(kK * kBands, kK * kBands), rhs(kK * kBands, 1);
+        for (std::size_t j = 0; j < nl_; ++j) {
+            const DenseMatrix q = tut(j);
+            const DenseMatrix thgx = t_ * (hg_[j] * x2); // K x K; diagonal (k, k) is what we need
+            const Spectrum& e = fitLights_[j].spectrum;
+            for (std::size_t k = 0; k < kK; ++k) {
+                for (std::size_t l = 0; l < kBands; ++l) {
+                    rhs(k * kBands + l, 0) += e[l] * thgx(k, k);
+                }
+                for (std::size_t k2 = 0; k2 < kK; ++k2) {
+                    const double f = q(k, k2) * cc2(k, k2);
+                    for (std::size_t l = 0; l < kBands; ++l) {
+                        for (std::size_t l2 = 0; l2 < kBands; ++l2) {
+                            n(k * kBands + l, k2 * kBands + l2) += f * e[l] * e[l2];
+                        }
+                    }
+                }
+            }
+        }
+        auto sol = solveRidge(n, rhs, kRidge);
+        if (!sol) {
+            return tl::unexpected(sol.error());
+        }
+        for (std::size_t k = 0; k < kK; ++k) {
+            for (std::size_t l = 0; l < kBands; ++l) {
+                pl_(k, l) = (*sol)(k * kBands + l, 0);
+            }
+        }
+        return {};
+    }
+
+    // The weighted squared XYZ error the steps minimise.
+    double objective() const
+    {
+        const DenseMatrix x3 = c_ * pr_.transposed();
+        const DenseMatrix cc3 = pr_ * x3;
+        double obj = 0.0;
+        for (std::size_t j = 0; j < nl_; ++j) {
+            const auto s = lightCoeffs(j);
+            const DenseMatrix gcg = g_[j] * c_ * g_[j].transposed();
+            obj += gcg(0, 0) + gcg(1, 1) + gcg(2, 2);
+            const DenseMatrix thgx = t_ * (hg_[j] * x3);
+            const DenseMatrix q = tut(j);
+            for (std::size_t k = 0; k < kK; ++k) {
+                obj -= 2.0 * s[k] * thgx(k, k);
+                for (std::size_t k2 = 0; k2 < kK; ++k2) {
+                    obj += s[k] * s[k2] * q(k, k2) * cc3(k, k2);
+                }
+            }
+        }
+        return obj;
+    }
+
+    // Gauge: the product s_k c_k T_k is unchanged by scaling lightProject[k] by a and toXyz[k] by
+    // 1/a; choose a so that an equal-energy light has s_k = 1, which keeps the light channels
+    // readable.
+    SixChannelModel gaugedModel(const Observer& obs, const std::string& name) const
+    {
+        SixChannelModel model;
+        model.name = name;
+        const Spectrum equal =
+                Spectrum::constant(1.0 / colour::spectrumToXyz(obs, Spectrum::constant(1.0)).y);
+        for (std::size_t k = 0; k < kK; ++k) {
+            double s = 0.0;
+            for (std::size_t l = 0; l < kBands; ++l) {
+                s += pl_(k, l) * equal[l];
+            }
+            const double a = std::abs(s) > 1e-12 ? 1.0 / s : 1.0;
+            for (std::size_t l = 0; l < kBands; ++l) {
+                model.lightProject[k][l] = pl_(k, l) * a;
+                model.reflectProject[k][l] = pr_(k, l);
+            }
+            model.toXyz[k] = Xyz{t_(k, 0), t_(k, 1), t_(k, 2)} * (1.0 / a);
+        }
+        return model;
+    }
+
+private:
+    std::array<double, kK> lightCoeffs(std::size_t j) const
+    {
+        std::array<double, kK> s{};
+        for (std::size_t k = 0; k < kK; ++k) {
+            for (std::size_t l = 0; l < kBands; ++l) {
+                s[k] += pl_(k, l) * fitLights_[j].spectrum[l];
+            }
+        }
+        return s;
+    }
+
+    // T_k^T U_j T_k' for all k, k'.
+    DenseMatrix tut(std::size_t j) const
+    {
+        const DenseMatrix ut = u_[j] * t_.transposed(); // 3 x K
+        return t_ * ut;                                 // K x K
+    }
+
+    static constexpr double kRidge = 1e-9;
+    std::vector<FitLight> fitLights_;
+    DenseMatrix c_;
+    std::size_t nl_;
+    std::vector<DenseMatrix> g_, u_, hg_, hgc_; // G_j = H_j A_j, U_j = H^T H, H^T G, H^T G C
+    DenseMatrix pl_, pr_, t_;
+};
+
+} // namespace
+
 Expected<SixChannelModel> fitSixChannelModel(const Observer& obs,
                                              const Spectrum& d65,
                                              const NamedSpectra& reflectances,
@@ -90,184 +302,26 @@ Expected<SixChannelModel> fitSixChannelModel(const Observer& obs,
                                              const std::string& name,
                                              SixChannelFitReport* report)
 {
-    constexpr double kRidge = 1e-9;
     const auto fitLights = makeFitLights(obs, d65, lights, true);
     if (fitLights.empty() || reflectances.size() < kK) {
         return makeError(ErrorCode::InvalidArgument, "six-channel fit: needs training lights with "
                                                      "luminance and at least six reflectances");
     }
-    const DenseMatrix c =
-            weightedSecondMoment(reflectances, sampleWeights(obs, reflectances, true));
-    const std::size_t nl = fitLights.size();
-    std::vector<DenseMatrix> g(nl), u(nl), hg(nl),
-            hgc(nl); // G_j = H_j A_j, U_j = H^T H, H^T G, H^T G C
-    for (std::size_t j = 0; j < nl; ++j) {
-        g[j] = fitLights[j].h * fitLights[j].a;
-        u[j] = fitLights[j].h.transposed() * fitLights[j].h;
-        hg[j] = fitLights[j].h.transposed() * g[j];
-        hgc[j] = hg[j] * c;
-    }
-    DenseMatrix pl(kK, kBands), pr(kK, kBands), t(kK, 3);
-    for (std::size_t k = 0; k < kK; ++k) {
-        for (std::size_t l = 0; l < kBands; ++l) {
-            pr(k, l) = initial.project[k][l];
-            pl(k, l) = initial.project[k][l];
-        }
-    }
-    auto lightCoeffs = [&](std::size_t j) {
-        std::array<double, kK> s{};
-        for (std::size_t k = 0; k < kK; ++k) {
-            for (std::size_t l = 0; l < kBands; ++l) {
-                s[k] += pl(k, l) * fitLights[j].spectrum[l];
-            }
-        }
-        return s;
-    };
-    // T_k^T U_j T_k' for all k, k'.
-    auto tut = [&](std::size_t j) {
-        const DenseMatrix ut = u[j] * t.transposed(); // 3 x K
-        return t * ut;                                // K x K
-    };
+    SixChannelAls als(fitLights,
+                      weightedSecondMoment(reflectances, sampleWeights(obs, reflectances, true)),
+                      initial);
     for (int round = 0; round < rounds; ++round) {
-        const DenseMatrix x = c * pr.transposed(); // 36 x K: sum_i w^2 r_i c_i^T / N
-        const DenseMatrix cc = pr * x;             // K x K
-        // Step 1: toXyz.
-        {
-            DenseMatrix n(3 * kK, 3 * kK), rhs(3 * kK, 1);
-            for (std::size_t j = 0; j < nl; ++j) {
-                const auto s = lightCoeffs(j);
-                const DenseMatrix hgx = hg[j] * x; // 3 x K
-                for (std::size_t k = 0; k < kK; ++k) {
-                    for (std::size_t a = 0; a < 3; ++a) {
-                        rhs(3 * k + a, 0) += s[k] * hgx(a, k);
-                        for (std::size_t k2 = 0; k2 < kK; ++k2) {
-                            for (std::size_t b = 0; b < 3; ++b) {
-                                n(3 * k + a, 3 * k2 + b) += s[k] * s[k2] * u[j](a, b) * cc(k, k2);
-                            }
-                        }
-                    }
-                }
-            }
-            auto sol = solveRidge(n, rhs, kRidge);
-            if (!sol) {
-                return tl::unexpected(sol.error());
-            }
-            for (std::size_t k = 0; k < kK; ++k) {
-                for (std::size_t a = 0; a < 3; ++a) {
-                    t(k, a) = (*sol)(3 * k + a, 0);
-                }
-            }
-        }
-        // Step 2: reflectProject.
-        {
-            DenseMatrix sum(kK, kK);
-            DenseMatrix rhs(kK * kBands, 1);
-            for (std::size_t j = 0; j < nl; ++j) {
-                const auto s = lightCoeffs(j);
-                const DenseMatrix q = tut(j);
-                const DenseMatrix thgc = t * hgc[j]; // K x 36
-                for (std::size_t k = 0; k < kK; ++k) {
-                    for (std::size_t k2 = 0; k2 < kK; ++k2) {
-                        sum(k, k2) += s[k] * s[k2] * q(k, k2);
-                    }
-                    for (std::size_t l = 0; l < kBands; ++l) {
-                        rhs(k * kBands + l, 0) += s[k] * thgc(k, l);
-                    }
-                }
-            }
-            DenseMatrix n(kK * kBands, kK * kBands);
-            for (std::size_t k = 0; k < kK; ++k) {
-                for (std::size_t k2 = 0; k2 < kK; ++k2) {
-                    for (std::size_t l = 0; l < kBands; ++l) {
-                        for (std::size_t l2 = 0; l2 < kBands; ++l2) {
-                            n(k * kBands + l, k2 * kBands + l2) = sum(k, k2) * c(l, l2);
-                        }
-                    }
-                }
-            }
-            auto sol = solveRidge(n, rhs, kRidge);
-            if (!sol) {
-                return tl::unexpected(sol.error());
-            }
-            for (std::size_t k = 0; k < kK; ++k) {
-                for (std::size_t l = 0; l < kBands; ++l) {
-                    pr(k, l) = (*sol)(k * kBands + l, 0);
-                }
-            }
-        }
-        // Step 3: lightProject.
-        {
-            const DenseMatrix x2 = c * pr.transposed();
-            const DenseMatrix cc2 = pr * x2;
-            DenseMatrix n(kK * kBands, kK * kBands), rhs(kK * kBands, 1);
-            for (std::size_t j = 0; j < nl; ++j) {
-                const DenseMatrix q = tut(j);
-                const DenseMatrix thgx = t * (hg[j] * x2); // K x K; diagonal (k, k) is what we need
-                const Spectrum& e = fitLights[j].spectrum;
-                for (std::size_t k = 0; k < kK; ++k) {
-                    for (std::size_t l = 0; l < kBands; ++l) {
-                        rhs(k * kBands + l, 0) += e[l] * thgx(k, k);
-                    }
-                    for (std::size_t k2 = 0; k2 < kK; ++k2) {
-                        const double f = q(k, k2) * cc2(k, k2);
-                        for (std::size_t l = 0; l < kBands; ++l) {
-                            for (std::size_t l2 = 0; l2 < kBands; ++l2) {
-                                n(k * kBands + l, k2 * kBands + l2) += f * e[l] * e[l2];
-                            }
-                        }
-                    }
-                }
-            }
-            auto sol = solveRidge(n, rhs, kRidge);
-            if (!sol) {
-                return tl::unexpected(sol.error());
-            }
-            for (std::size_t k = 0; k < kK; ++k) {
-                for (std::size_t l = 0; l < kBands; ++l) {
-                    pl(k, l) = (*sol)(k * kBands + l, 0);
-                }
+        for (auto step : {&SixChannelAls::solveToXyz, &SixChannelAls::solveReflectProject,
+                          &SixChannelAls::solveLightProject}) {
+            if (auto ok = (als.*step)(); !ok) {
+                return tl::unexpected(ok.error());
             }
         }
         if (report != nullptr) {
-            const DenseMatrix x3 = c * pr.transposed();
-            const DenseMatrix cc3 = pr * x3;
-            double obj = 0.0;
-            for (std::size_t j = 0; j < nl; ++j) {
-                const auto s = lightCoeffs(j);
-                const DenseMatrix gcg = g[j] * c * g[j].transposed();
-                obj += gcg(0, 0) + gcg(1, 1) + gcg(2, 2);
-                const DenseMatrix thgx = t * (hg[j] * x3);
-                const DenseMatrix q = tut(j);
-                for (std::size_t k = 0; k < kK; ++k) {
-                    obj -= 2.0 * s[k] * thgx(k, k);
-                    for (std::size_t k2 = 0; k2 < kK; ++k2) {
-                        obj += s[k] * s[k2] * q(k, k2) * cc3(k, k2);
-                    }
-                }
-            }
-            report->objective.push_back(obj);
+            report->objective.push_back(als.objective());
         }
     }
-    // Gauge: the product s_k c_k T_k is unchanged by scaling lightProject[k] by a and toXyz[k] by
-    // 1/a; choose a so that an equal-energy light has s_k = 1, which keeps the light channels
-    // readable.
-    SixChannelModel model;
-    model.name = name;
-    const Spectrum equal =
-            Spectrum::constant(1.0 / colour::spectrumToXyz(obs, Spectrum::constant(1.0)).y);
-    for (std::size_t k = 0; k < kK; ++k) {
-        double s = 0.0;
-        for (std::size_t l = 0; l < kBands; ++l) {
-            s += pl(k, l) * equal[l];
-        }
-        const double a = std::abs(s) > 1e-12 ? 1.0 / s : 1.0;
-        for (std::size_t l = 0; l < kBands; ++l) {
-            model.lightProject[k][l] = pl(k, l) * a;
-            model.reflectProject[k][l] = pr(k, l);
-        }
-        model.toXyz[k] = Xyz{t(k, 0), t(k, 1), t(k, 2)} * (1.0 / a);
-    }
-    return model;
+    return als.gaugedModel(obs, name);
 }
 
 } // namespace replica::pipeline::spectral

@@ -48,7 +48,7 @@ HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM)
 
 // The map with every sine rounded to the nearest half float (IEEE binary16, ties away from zero):
 // within 2^-12 of the float, and exactly what the GL pass stores when it packs eight directions
-// into one texel (shading::RenderSettings::horizonHalf), so that the CPU model reads the same.
+// into one texel (shading::PreparedScene::horizonHalf), so that the CPU model reads the same.
 HorizonMap halfPrecision(const HorizonMap& map);
 
 // The exact horizon at a fractional texel position and azimuth, by marching the bilinear height

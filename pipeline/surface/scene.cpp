@@ -83,42 +83,11 @@ SurfaceScene::channels(const std::vector<colour::ChannelCoeffs>& pc, int x, int 
     return c;
 }
 
-Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
+namespace {
+
+// The Ward BRDF's parameters (the "ward" object; defaults where absent).
+Expected<void> readWard(const nlohmann::json& w, const std::string& f, SurfaceScene& s)
 {
-    const auto file = dir / "scene.json";
-    auto parsed = readJsonManifest(file, sceneSchema(), "scene manifest",
-                                   "--scene must name a folder with scene.json", kFormat);
-    if (!parsed) {
-        return tl::unexpected(parsed.error());
-    }
-    nlohmann::json& j = *parsed;
-    const std::string f = file.string();
-    SurfaceScene s;
-    s.name = j.value("name", dir.filename().string());
-    if (!j.contains("size_m") || !j["size_m"].is_array() || j["size_m"].size() != 2 ||
-        !j["size_m"][0].is_number() || !j["size_m"][1].is_number() ||
-        !(j["size_m"][0].get<double>() > 0.0) || !(j["size_m"][1].get<double>() > 0.0)) {
-        return makeError(
-                ErrorCode::Corrupt,
-                fmt::format("{}: 'size_m' must be [width, height] in metres, both > 0", f));
-    }
-    s.widthM = j["size_m"][0].get<double>();
-    s.heightM = j["size_m"][1].get<double>();
-    if (!j.contains("palette") || !j["palette"].is_array() || j["palette"].empty()) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: 'palette' must be a non-empty array", f));
-    }
-    for (std::size_t k = 0; k < j["palette"].size(); ++k) {
-        const auto& p = j["palette"][k];
-        auto r = spectrumField(p.value("reflectance", nlohmann::json()),
-                               fmt::format("{}: palette[{}].reflectance", f, k), 1.5);
-        if (!r) {
-            return tl::unexpected(r.error());
-        }
-        s.paletteNames.push_back(p.value("name", fmt::format("p{}", k)));
-        s.palette.push_back(*r);
-    }
-    const auto& w = j.value("ward", nlohmann::json::object());
     s.alpha = w.value("alpha", 0.1);
     if (!(s.alpha >= 0.0 && s.alpha <= 5.0)) {
         return makeError(ErrorCode::Corrupt, fmt::format("{}: ward.alpha must be in [0, 5]", f));
@@ -144,6 +113,13 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
                                                          "ward-duer, ward-duer-guarded, ward-gmd)",
                                                          f, model));
     }
+    return {};
+}
+
+// The texels: material.exr (pigments A and B, their mix, the shade) and height.exr, the same size
+// and square over the scene's size.
+Expected<void> readTexels(const std::filesystem::path& dir, const std::string& f, SurfaceScene& s)
+{
     auto mat = image::readExr(dir / "material.exr", {"A", "B", "mix", "shade"});
     if (!mat) {
         return tl::unexpected(mat.error());
@@ -192,6 +168,52 @@ Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: texels must be square: size_m {}x{} over {}x{} texels", f,
                                      s.widthM, s.heightM, s.width, s.height));
+    }
+    return {};
+}
+
+} // namespace
+
+Expected<SurfaceScene> loadScene(const std::filesystem::path& dir)
+{
+    const auto file = dir / "scene.json";
+    auto parsed = readJsonManifest(file, sceneSchema(), "scene manifest",
+                                   "--scene must name a folder with scene.json", kFormat);
+    if (!parsed) {
+        return tl::unexpected(parsed.error());
+    }
+    nlohmann::json& j = *parsed;
+    const std::string f = file.string();
+    SurfaceScene s;
+    s.name = j.value("name", dir.filename().string());
+    if (!j.contains("size_m") || !j["size_m"].is_array() || j["size_m"].size() != 2 ||
+        !j["size_m"][0].is_number() || !j["size_m"][1].is_number() ||
+        !(j["size_m"][0].get<double>() > 0.0) || !(j["size_m"][1].get<double>() > 0.0)) {
+        return makeError(
+                ErrorCode::Corrupt,
+                fmt::format("{}: 'size_m' must be [width, height] in metres, both > 0", f));
+    }
+    s.widthM = j["size_m"][0].get<double>();
+    s.heightM = j["size_m"][1].get<double>();
+    if (!j.contains("palette") || !j["palette"].is_array() || j["palette"].empty()) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: 'palette' must be a non-empty array", f));
+    }
+    for (std::size_t k = 0; k < j["palette"].size(); ++k) {
+        const auto& p = j["palette"][k];
+        auto r = spectrumField(p.value("reflectance", nlohmann::json()),
+                               fmt::format("{}: palette[{}].reflectance", f, k), 1.5);
+        if (!r) {
+            return tl::unexpected(r.error());
+        }
+        s.paletteNames.push_back(p.value("name", fmt::format("p{}", k)));
+        s.palette.push_back(*r);
+    }
+    if (auto ok = readWard(j.value("ward", nlohmann::json::object()), f, s); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    if (auto ok = readTexels(dir, f, s); !ok) {
+        return tl::unexpected(ok.error());
     }
     return s;
 }

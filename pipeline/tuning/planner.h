@@ -48,7 +48,7 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
                      const RenderSettings& base,
                      const colour::ChannelBasis& basis);
 
-// One view (the old probe; 'replica render --plan'): planRenderViews on 'view' at probeX x probeY.
+// One view ('replica render --plan'): planRenderViews on 'view' at probeX x probeY.
 Plan planRender(const surface::SurfaceScene& scene,
                 const booth::BoothLight& light,
                 const View& view,

@@ -113,6 +113,120 @@ const JsonSchema& captureSchema()
 // "edge_u", "edge_v", "texels": [w, h], "corners": [[x, y] x 4] (image pixels of ceiling uv
 // (0,0),(1,0),(1,1),(0,1)), "exposures": [{"file", "seconds"}], "calibration": {"cdm2_per_unit": k}
 // | {"spot": {"x", "y", "radius", "cdm2"}}}]}. Paths are relative to capture.json.
+// The calibration's scale from the HDR image's units to cd/m^2: given, or from a spot of known
+// luminance.
+Expected<double> calibrationScale(const nlohmann::json& cal,
+                                  const pipeline::booth::LuminanceImage& hdr,
+                                  const std::string& where)
+{
+    double scale = 0.0;
+    if (cal.contains("cdm2_per_unit")) {
+        scale = cal["cdm2_per_unit"].get<double>();
+    } else {
+        const auto& spot = cal.at("spot");
+        const double sx = spot.at("x").get<double>(), sy = spot.at("y").get<double>();
+        const double r = spot.at("radius").get<double>();
+        double sum = 0.0;
+        int count = 0;
+        for (int y = 0; y < hdr.height; ++y) {
+            for (int x = 0; x < hdr.width; ++x) {
+                if ((x + 0.5 - sx) * (x + 0.5 - sx) + (y + 0.5 - sy) * (y + 0.5 - sy) <= r * r) {
+                    sum += hdr.at(x, y);
+                    ++count;
+                }
+            }
+        }
+        if (count == 0 || !(sum > 0.0)) {
+            return makeError(ErrorCode::InvalidArgument,
+                             where + ": calibration spot covers no lit pixel");
+        }
+        scale = spot.at("cdm2").get<double>() / (sum / count);
+    }
+    if (!(scale > 0.0) || !std::isfinite(scale)) {
+        return makeError(ErrorCode::InvalidArgument, where + ": calibration scale must be > 0");
+    }
+    return scale;
+}
+
+// One light of the capture description: its rectangle, spectrum, and luminance from its
+// exposure series (HDR merge, calibration, warp to the ceiling's texels).
+Expected<pipeline::booth::BoothLight> buildLight(const nlohmann::json& lj,
+                                                 const std::string& where,
+                                                 const pipeline::colour::SpectralTable& table,
+                                                 const std::filesystem::path& base)
+{
+    using namespace pipeline;
+    booth::BoothLight l;
+    l.name = lj.at("name").get<std::string>();
+    // The name becomes OUT/NAME.exr: never a path out of --out.
+    if (auto ok = checkPlainName(l.name, where + ".name"); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    const auto v3 = [&](const char* k) {
+        const auto& a = lj.at(k);
+        return glm::dvec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>());
+    };
+    l.centre = v3("centre");
+    l.edgeU = v3("edge_u");
+    l.edgeV = v3("edge_v");
+    if (lj.contains("spd_column")) {
+        auto s = table.spectrum(lj["spd_column"].get<std::string>());
+        if (!s) {
+            return makeError(ErrorCode::InvalidArgument, where + ": " + s.error().message);
+        }
+        l.spd = *s;
+    } else {
+        const auto& s = lj.at("spd");
+        if (s.size() != colour::kBands) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: spd must hold {} values", where, colour::kBands));
+        }
+        for (std::size_t b = 0; b < colour::kBands; ++b) {
+            l.spd[b] = std::max(s[b].get<double>(), 0.0);
+        }
+    }
+    std::vector<booth::Exposure> series;
+    for (const auto& ej : lj.at("exposures")) {
+        auto e = readPngGrey(base / ej.at("file").get<std::string>());
+        if (!e) {
+            return tl::unexpected(e.error());
+        }
+        e->seconds = ej.at("seconds").get<double>();
+        series.push_back(std::move(*e));
+    }
+    auto curve = booth::recoverResponse(series);
+    if (!curve) {
+        return makeError(ErrorCode::InvalidArgument, where + ": " + curve.error().message);
+    }
+    auto hdr = booth::mergeHdr(series, *curve);
+    if (!hdr) {
+        return makeError(ErrorCode::InvalidArgument, where + ": " + hdr.error().message);
+    }
+    auto scale = calibrationScale(lj.at("calibration"), *hdr, where);
+    if (!scale) {
+        return tl::unexpected(scale.error());
+    }
+    for (double& v : hdr->cdM2) {
+        v *= *scale;
+    }
+    std::array<glm::dvec2, 4> corners;
+    for (std::size_t k = 0; k < 4; ++k) {
+        corners[k] = {lj.at("corners").at(k).at(0).get<double>(),
+                      lj.at("corners").at(k).at(1).get<double>()};
+    }
+    auto hm = booth::homographyFromCorners(corners);
+    if (!hm) {
+        return makeError(ErrorCode::InvalidArgument, where + ": " + hm.error().message);
+    }
+    auto warped = booth::warpToCeiling(*hdr, *hm, lj.at("texels").at(0).get<int>(),
+                                       lj.at("texels").at(1).get<int>());
+    if (!warped) {
+        return makeError(ErrorCode::InvalidArgument, where + ": " + warped.error().message);
+    }
+    l.luminance = std::move(*warped);
+    return l;
+}
+
 int runBuild(const std::string& input, const std::string& out)
 {
     using namespace pipeline;
@@ -141,100 +255,11 @@ int runBuild(const std::string& input, const std::string& out)
         for (std::size_t li = 0; li < j.at("lights").size(); ++li) {
             const auto& lj = j["lights"][li];
             const std::string where = fmt::format("{}: lights[{}]", input, li);
-            booth::BoothLight l;
-            l.name = lj.at("name").get<std::string>();
-            // The name becomes OUT/NAME.exr: never a path out of --out.
-            if (auto ok = checkPlainName(l.name, where + ".name"); !ok) {
-                return fail(cmd, kExitFailure, ok.error().message);
+            auto l = buildLight(lj, where, *table, base);
+            if (!l) {
+                return fail(cmd, kExitFailure, l.error().message);
             }
-            const auto v3 = [&](const char* k) {
-                const auto& a = lj.at(k);
-                return glm::dvec3(a.at(0).get<double>(), a.at(1).get<double>(),
-                                  a.at(2).get<double>());
-            };
-            l.centre = v3("centre");
-            l.edgeU = v3("edge_u");
-            l.edgeV = v3("edge_v");
-            if (lj.contains("spd_column")) {
-                auto s = table->spectrum(lj["spd_column"].get<std::string>());
-                if (!s) {
-                    return fail(cmd, kExitFailure, where + ": " + s.error().message);
-                }
-                l.spd = *s;
-            } else {
-                const auto& s = lj.at("spd");
-                if (s.size() != colour::kBands) {
-                    return fail(cmd, kExitFailure,
-                                fmt::format("{}: spd must hold {} values", where, colour::kBands));
-                }
-                for (std::size_t b = 0; b < colour::kBands; ++b) {
-                    l.spd[b] = std::max(s[b].get<double>(), 0.0);
-                }
-            }
-            std::vector<booth::Exposure> series;
-            for (const auto& ej : lj.at("exposures")) {
-                auto e = readPngGrey(base / ej.at("file").get<std::string>());
-                if (!e) {
-                    return fail(cmd, kExitFailure, e.error().message);
-                }
-                e->seconds = ej.at("seconds").get<double>();
-                series.push_back(std::move(*e));
-            }
-            auto curve = booth::recoverResponse(series);
-            if (!curve) {
-                return fail(cmd, kExitFailure, where + ": " + curve.error().message);
-            }
-            auto hdr = booth::mergeHdr(series, *curve);
-            if (!hdr) {
-                return fail(cmd, kExitFailure, where + ": " + hdr.error().message);
-            }
-            double scale = 0.0;
-            const auto& cal = lj.at("calibration");
-            if (cal.contains("cdm2_per_unit")) {
-                scale = cal["cdm2_per_unit"].get<double>();
-            } else {
-                const auto& spot = cal.at("spot");
-                const double sx = spot.at("x").get<double>(), sy = spot.at("y").get<double>();
-                const double r = spot.at("radius").get<double>();
-                double sum = 0.0;
-                int count = 0;
-                for (int y = 0; y < hdr->height; ++y) {
-                    for (int x = 0; x < hdr->width; ++x) {
-                        if ((x + 0.5 - sx) * (x + 0.5 - sx) + (y + 0.5 - sy) * (y + 0.5 - sy) <=
-                            r * r) {
-                            sum += hdr->at(x, y);
-                            ++count;
-                        }
-                    }
-                }
-                if (count == 0 || !(sum > 0.0)) {
-                    return fail(cmd, kExitFailure,
-                                where + ": calibration spot covers no lit pixel");
-                }
-                scale = spot.at("cdm2").get<double>() / (sum / count);
-            }
-            if (!(scale > 0.0) || !std::isfinite(scale)) {
-                return fail(cmd, kExitFailure, where + ": calibration scale must be > 0");
-            }
-            for (double& v : hdr->cdM2) {
-                v *= scale;
-            }
-            std::array<glm::dvec2, 4> corners;
-            for (std::size_t k = 0; k < 4; ++k) {
-                corners[k] = {lj.at("corners").at(k).at(0).get<double>(),
-                              lj.at("corners").at(k).at(1).get<double>()};
-            }
-            auto hm = booth::homographyFromCorners(corners);
-            if (!hm) {
-                return fail(cmd, kExitFailure, where + ": " + hm.error().message);
-            }
-            auto warped = booth::warpToCeiling(*hdr, *hm, lj.at("texels").at(0).get<int>(),
-                                               lj.at("texels").at(1).get<int>());
-            if (!warped) {
-                return fail(cmd, kExitFailure, where + ": " + warped.error().message);
-            }
-            l.luminance = std::move(*warped);
-            model.lights.push_back(std::move(l));
+            model.lights.push_back(std::move(*l));
         }
     } catch (const nlohmann::json::exception& e) {
         return fail(cmd, kExitFailure,

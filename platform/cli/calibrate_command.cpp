@@ -13,9 +13,12 @@
 
 #include <hal/accel/iio_accel.h>
 #include <pipeline/scene/calibration.h>
+#include <pipeline/spectral/live_chain.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
 #include <platform/site_file.h>
+#include <recordings/device_kind.h>
+#include <recordings/recording.h>
 
 namespace replica::platform {
 namespace {
@@ -28,6 +31,11 @@ struct CalibrateOptions {
     double panelHeightM = 0.0;
     std::string accelAxes = "x,y,z";
     bool dryRun = false;
+    // calibrate spectrometer
+    std::string recording;
+    std::string longPass;
+    double cutOnNm = 0.0;
+    double strayLight = -1.0;
 };
 
 // Rows of 'columns' numbers, comma- or space-separated; '#' starts a comment; a first row that is
@@ -212,12 +220,90 @@ int calibrateStand(const CalibrateOptions& o)
     return finish(o, "stand", standSection(*fit));
 }
 
+// The spectrometer samples of a recording as the chain reads them (the samples must outlive the
+// result's spans).
+Expected<std::vector<hal::SpectrumSample>> recordedSpectra(const std::string& file)
+{
+    auto rec = recordings::readRecording(file);
+    if (!rec) {
+        return tl::unexpected(rec.error());
+    }
+    auto samples = rec->samples(recordings::spectrometerKind());
+    if (samples.empty()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: no spectrometer samples; record the booth's fluorescent "
+                                     "lamp with 'replica run --record FILE' first",
+                                     file));
+    }
+    return samples;
+}
+
+std::vector<pipeline::spectral::RawSpectrum>
+rawSpectra(const std::vector<hal::SpectrumSample>& samples)
+{
+    std::vector<pipeline::spectral::RawSpectrum> raw;
+    for (const auto& s : samples) {
+        raw.push_back({s.counts, s.integrationTimeUs, s.wavelengthCoeffs, s.nonlinearityCoeffs});
+    }
+    return raw;
+}
+
+// The instrument's calibration for the live chain (pipeline/spectral/live_chain.h): the
+// wavelength shift from the mercury lines of a fluorescent lamp, recorded; the stray light from a
+// recording through a long-pass filter, or the instrument's data (a number), or the data sheet's.
+int calibrateSpectrometer(const CalibrateOptions& o)
+{
+    auto log = logger("replica");
+    const pipeline::spectral::SpectrometerCalibration cal; // the dark pixels
+    auto lamp = recordedSpectra(o.recording);
+    if (!lamp) {
+        log->error("{}", lamp.error().message);
+        return kExitFailure;
+    }
+    const auto shift = pipeline::spectral::calibrateWavelengthShift(rawSpectra(*lamp), cal);
+    if (!shift) {
+        log->error("{}: no run of 10 steady spectra shows two mercury lines (404.66, 435.83, "
+                   "546.07 nm); record a fluorescent booth lamp, not tungsten or an LED",
+                   o.recording);
+        return kExitFailure;
+    }
+    double stray = o.strayLight >= 0.0
+                           ? o.strayLight
+                           : pipeline::spectral::InstrumentCalibration{}.strayLightFraction;
+    std::string strayFrom = o.strayLight >= 0.0 ? "the instrument's data" : "the data sheet";
+    if (!o.longPass.empty()) {
+        auto filtered = recordedSpectra(o.longPass);
+        if (!filtered) {
+            log->error("{}", filtered.error().message);
+            return kExitFailure;
+        }
+        const auto f =
+                pipeline::spectral::strayLightFromLongPass(rawSpectra(*filtered), cal, o.cutOnNm);
+        if (!f) {
+            log->error("{}: no usable spectrum below the {:.0f} nm cut-on", o.longPass, o.cutOnNm);
+            return kExitFailure;
+        }
+        stray = *f;
+        strayFrom = fmt::format("{} through a {:.0f} nm long-pass filter", o.longPass, o.cutOnNm);
+    }
+    fmt::print("wavelength shift {:+.3f} nm (median of {} runs of 10 spectra, spread {:.3f} nm); "
+               "stray light {:.3g} of the peak ({})\n",
+               shift->offsetNm, shift->runs, shift->spreadNm, stray, strayFrom);
+    const std::string body = fmt::format(
+            "# 'replica calibrate spectrometer' from {}; stray light from {}\n"
+            "stray_light_fraction = {:.6g}\nwavelength_offset_nm = {:.4f}\n"
+            "calibration_spectra = {}\ncalibration_spread_nm = {:.4f}\n",
+            o.recording, strayFrom, stray, shift->offsetNm, lamp->size(), shift->spreadNm);
+    return finish(o, "spectrometer", body);
+}
+
 } // namespace
 
 void registerCalibrateCommand(CLI::App& app, int& exitCode)
 {
     auto* cmd = app.add_subcommand(
-            "calibrate", "site calibration: the tracker's pose in the booth, the stand's hinge");
+            "calibrate", "site calibration: the tracker's pose in the booth, the stand's hinge, "
+                         "the spectrometer");
     cmd->require_subcommand(1);
     auto o = std::make_shared<CalibrateOptions>();
     auto common = [o](CLI::App* sub, const char* what) {
@@ -248,6 +334,35 @@ void registerCalibrateCommand(CLI::App& app, int& exitCode)
                       "sensor axis for each panel axis, as for 'replica run'")
             ->capture_default_str();
     stand->callback([o, &exitCode] { exitCode = calibrateStand(*o); });
+    auto* spectrometer = cmd->add_subcommand(
+            "spectrometer", "the spectrometer's wavelength shift from the mercury lines of a "
+                            "fluorescent booth lamp, and its stray light, for the live chain");
+    spectrometer
+            ->add_option("--recording", o->recording,
+                         "a recording ('replica run --record') of a fluorescent booth lamp, "
+                         "steady for some seconds")
+            ->required();
+    spectrometer->add_option("--long-pass", o->longPass,
+                             "a recording of the lamp through a long-pass filter: the stray light "
+                             "is what reaches the pixels below its cut-on");
+    spectrometer->add_option("--cut-on-nm", o->cutOnNm, "the long-pass filter's cut-on (nm)")
+            ->check(CLI::Range(400.0, 900.0));
+    spectrometer
+            ->add_option("--stray-light", o->strayLight,
+                         "the stray light from the instrument's data, as a fraction of the peak "
+                         "(without it and --long-pass: the data sheet's 0.0005)")
+            ->check(CLI::Range(0.0, 0.05));
+    spectrometer->add_option("--site", o->site, "site configuration file to write the result into")
+            ->capture_default_str();
+    spectrometer->add_flag("--dry-run", o->dryRun, "print the section instead of writing the file");
+    spectrometer->callback([o, &exitCode] {
+        if (!o->longPass.empty() && !(o->cutOnNm > 0.0)) {
+            logger("replica")->error("--long-pass needs --cut-on-nm (the filter's cut-on)");
+            exitCode = kExitUsage;
+            return;
+        }
+        exitCode = calibrateSpectrometer(*o);
+    });
 }
 
 } // namespace replica::platform

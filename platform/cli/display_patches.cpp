@@ -159,74 +159,101 @@ private:
     std::FILE* fromMeter_ = nullptr;
 };
 
-} // namespace
+// 'display patches --make-set': the default set written as a .ti1.
+int makeSetMain(const PatchesOptions& o)
+{
+    const auto set = defaultSet(o.bits, o.step, o.fullDriveRepeats, o.colours, o.seed);
+    if (!writeAtomically(o.makeSet, pd::ti1Text(set, o.bits, "Replica display patches"))) {
+        logger("replica")->error("{}: cannot write the patch set", o.makeSet);
+        return kExitFailure;
+    }
+    fmt::print("patch set: {} ({} patches)\n", o.makeSet, set.size());
+    return kExitOk;
+}
 
-int patchesMain(const PatchesOptions& o)
+// Whether the options fit together; the usage error logged where not.
+bool usageOk(const PatchesOptions& o)
 {
     auto log = logger("replica");
-    if (!o.makeSet.empty()) {
-        const auto set = defaultSet(o.bits, o.step, o.fullDriveRepeats, o.colours, o.seed);
-        if (!writeAtomically(o.makeSet, pd::ti1Text(set, o.bits, "Replica display patches"))) {
-            log->error("{}: cannot write the patch set", o.makeSet);
-            return kExitFailure;
-        }
-        fmt::print("patch set: {} ({} patches)\n", o.makeSet, set.size());
-        return kExitOk;
-    }
     const bool kms = o.output == "kms";
     if (o.output != "headless" && !kms) {
         log->error("display patches: --output is 'headless' (with --show-dir DIR) or 'kms', not "
                    "'{}'",
                    o.output);
-        return kExitUsage;
+        return false;
     }
     if (kms && !o.showDir.empty()) {
         log->error("display patches: --show-dir is the headless display's; with --output kms the "
                    "patch is shown on the panel");
-        return kExitUsage;
+        return false;
     }
     if (o.set.empty() || o.out.empty() || (!kms && o.showDir.empty())) {
         log->error("display patches: give SET.ti1, --out READINGS.ti3 and --show-dir DIR or "
                    "--output kms (or --make-set SET.ti1)");
-        return kExitUsage;
+        return false;
     }
+    return true;
+}
+
+// The patch set, and the readings already taken: they must be of the set's first patches, in
+// order (resume).
+struct PatchSession {
+    std::vector<glm::dvec3> set;
+    std::vector<pd::Measurement> readings;
+};
+
+std::optional<PatchSession> loadSession(const PatchesOptions& o)
+{
+    auto log = logger("replica");
     std::ifstream sf(o.set, std::ios::binary);
     if (!sf) {
         log->error("{}: cannot open the patch set", o.set);
-        return kExitFailure;
+        return std::nullopt;
     }
     std::ostringstream ss;
     ss << sf.rdbuf();
     auto set = pd::parseTi1(ss.str(), o.set, o.bits);
     if (!set) {
         log->error("{}", set.error().message);
-        return kExitFailure;
+        return std::nullopt;
     }
-    // Resume: the readings already taken must be of the set's first patches, in order.
-    std::vector<pd::Measurement> readings;
-    if (std::filesystem::exists(o.out)) {
-        auto done = pd::loadMeasurements(o.out, o.bits);
-        if (!done) {
-            log->error("{} (delete it to start again)", done.error().message);
-            return kExitFailure;
-        }
-        for (std::size_t i = 0; i < done->rows.size(); ++i) {
-            if (i >= set->size() || done->rows[i].counts != (*set)[i]) {
-                log->error("{}:{}: reading {} is not of patch {} of {}: a different set? (delete "
-                           "it to start again)",
-                           o.out, done->rows[i].line, i + 1, i + 1, o.set);
-                return kExitFailure;
-            }
-        }
-        readings = done->rows;
-        fmt::print("resuming at patch {} of {} ({} readings in {})\n", readings.size() + 1,
-                   set->size(), readings.size(), o.out);
+    PatchSession session{std::move(*set), {}};
+    if (!std::filesystem::exists(o.out)) {
+        return session;
     }
-    // The panel, through the appliance's KMS output (CPU copies into dumb buffers: a patch is
-    // one flat colour, drawn here, with no renderer behind it).
-    std::unique_ptr<Output> panel;
-    DisplayInfo mode;
-    if (kms) {
+    auto done = pd::loadMeasurements(o.out, o.bits);
+    if (!done) {
+        log->error("{} (delete it to start again)", done.error().message);
+        return std::nullopt;
+    }
+    for (std::size_t i = 0; i < done->rows.size(); ++i) {
+        if (i >= session.set.size() || done->rows[i].counts != session.set[i]) {
+            log->error("{}:{}: reading {} is not of patch {} of {}: a different set? (delete "
+                       "it to start again)",
+                       o.out, done->rows[i].line, i + 1, i + 1, o.set);
+            return std::nullopt;
+        }
+    }
+    session.readings = done->rows;
+    fmt::print("resuming at patch {} of {} ({} readings in {})\n", session.readings.size() + 1,
+               session.set.size(), session.readings.size(), o.out);
+    return session;
+}
+
+// Where the patches are shown: the panel, through the appliance's KMS output (CPU copies into
+// dumb buffers: a patch is one flat colour, drawn here, with no renderer behind it), or a
+// full-frame PNG of the patch (8-bit) and its counts in --show-dir for the headless display.
+class PatchScreen
+{
+public:
+    bool open(const PatchesOptions& o)
+    {
+        o_ = &o;
+        if (o.output != "kms") {
+            std::filesystem::create_directories(o.showDir);
+            return true;
+        }
+        auto log = logger("replica");
         KmsOptions ko;
         ko.device = o.kmsDevice;
         ko.connector = o.kmsConnector;
@@ -236,33 +263,25 @@ int patchesMain(const PatchesOptions& o)
             log->error("{}: cannot show patches on the panel: {}; without the panel: --output "
                        "headless --show-dir DIR",
                        o.kmsDevice, out.error().message);
-            return kExitFailure;
+            return false;
         }
-        panel = std::move(*out);
-        mode = panel->display().value_or(DisplayInfo{});
-        if (mode.width <= 0 || mode.height <= 0) {
+        panel_ = std::move(*out);
+        mode_ = panel_->display().value_or(DisplayInfo{});
+        if (mode_.width <= 0 || mode_.height <= 0) {
             log->error("{}: the KMS output reports no mode", o.kmsDevice);
-            return kExitFailure;
+            return false;
         }
-        fmt::print("showing patches on {} {}x{}\n", mode.connector, mode.width, mode.height);
-    } else {
-        std::filesystem::create_directories(o.showDir);
+        fmt::print("showing patches on {} {}x{}\n", mode_.connector, mode_.width, mode_.height);
+        return true;
     }
-    std::optional<Meter> meter;
-    if (!o.spotread.empty()) {
-        meter = Meter::start(o.spotread);
-        if (!meter) {
-            log->error("cannot start the meter '{}'", o.spotread);
-            return kExitFailure;
-        }
-    }
-    const double maxCount = std::ldexp(1.0, o.bits) - 1.0;
-    for (std::size_t i = readings.size(); i < set->size(); ++i) {
-        const glm::dvec3 c = (*set)[i];
-        // Show: fullscreen on the panel, or a full-frame PNG of the patch (8-bit) and its counts
-        // for the headless display.
-        const int width = kms ? mode.width : 64;
-        const int height = kms ? mode.height : 64;
+
+    // Shows patch i (counts c) of 'total'; 'kept' readings are in --out so far.
+    bool show(const glm::dvec3& c, std::size_t i, std::size_t total, std::size_t kept) const
+    {
+        const PatchesOptions& o = *o_;
+        const double maxCount = std::ldexp(1.0, o.bits) - 1.0;
+        const int width = panel_ ? mode_.width : 64;
+        const int height = panel_ ? mode_.height : 64;
         std::array<std::uint8_t, 4> px{0, 0, 0, 255};
         for (int k = 0; k < 3; ++k) {
             px[static_cast<std::size_t>(k)] =
@@ -273,21 +292,94 @@ int patchesMain(const PatchesOptions& o)
         for (std::size_t p = 0; p < rgba.size(); p += 4) {
             std::copy(px.begin(), px.end(), rgba.begin() + static_cast<std::ptrdiff_t>(p));
         }
-        if (kms) {
-            if (auto ok = panel->present(DisplayFrame{width, height, rgba, 0}); !ok) {
+        auto log = logger("replica");
+        if (panel_) {
+            if (auto ok = panel_->present(DisplayFrame{width, height, rgba, 0}); !ok) {
                 log->error("{}: cannot show patch {} of {}: {}; {} readings kept in {}",
-                           o.kmsDevice, i + 1, set->size(), ok.error().message, readings.size(),
-                           o.out);
-                return kExitFailure;
+                           o.kmsDevice, i + 1, total, ok.error().message, kept, o.out);
+                return false;
             }
-        } else {
-            const auto dir = std::filesystem::path(o.showDir);
-            if (auto ok = writePng(dir / "patch.png", width, height, rgba);
-                !ok ||
-                !writeAtomically(dir / "patch.txt", fmt::format("{} {} {}\n", c.x, c.y, c.z))) {
-                log->error("{}: cannot show the patch", o.showDir);
-                return kExitFailure;
-            }
+            return true;
+        }
+        const auto dir = std::filesystem::path(o.showDir);
+        if (auto ok = writePng(dir / "patch.png", width, height, rgba);
+            !ok || !writeAtomically(dir / "patch.txt", fmt::format("{} {} {}\n", c.x, c.y, c.z))) {
+            log->error("{}: cannot show the patch", o.showDir);
+            return false;
+        }
+        return true;
+    }
+
+private:
+    const PatchesOptions* o_ = nullptr;
+    std::unique_ptr<Output> panel_;
+    DisplayInfo mode_;
+};
+
+// One reading typed as X Y Z: the reading, std::nullopt at the end of input ('stopped' set), or
+// std::nullopt after logging what is wrong with the line.
+std::optional<glm::dvec3> readTyped(const glm::dvec3& c,
+                                    std::size_t i,
+                                    std::size_t total,
+                                    std::size_t kept,
+                                    const std::string& out,
+                                    bool& stopped)
+{
+    fmt::print("patch {}/{} {},{},{}: X Y Z (cd/m^2)? ", i + 1, total, c.x, c.y, c.z);
+    std::fflush(stdout);
+    std::string line;
+    if (!std::getline(std::cin, line)) {
+        fmt::print("\nstopped: {} of {} readings in {}; run again to resume\n", kept, total, out);
+        stopped = true;
+        return std::nullopt;
+    }
+    double x = 0.0;
+    double y = 0.0;
+    double z = 0.0;
+    char extra = 0;
+    if (std::sscanf(line.c_str(), " %lf %lf %lf %c", &x, &y, &z, &extra) != 3 ||
+        !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+        logger("replica")->error("patch {}: '{}' is not three numbers X Y Z; {} readings kept in "
+                                 "{}",
+                                 i + 1, line, kept, out);
+        return std::nullopt;
+    }
+    return glm::dvec3(x, y, z);
+}
+
+} // namespace
+
+int patchesMain(const PatchesOptions& o)
+{
+    auto log = logger("replica");
+    if (!o.makeSet.empty()) {
+        return makeSetMain(o);
+    }
+    if (!usageOk(o)) {
+        return kExitUsage;
+    }
+    auto session = loadSession(o);
+    if (!session) {
+        return kExitFailure;
+    }
+    const auto& set = session->set;
+    auto& readings = session->readings;
+    PatchScreen screen;
+    if (!screen.open(o)) {
+        return kExitFailure;
+    }
+    std::optional<Meter> meter;
+    if (!o.spotread.empty()) {
+        meter = Meter::start(o.spotread);
+        if (!meter) {
+            log->error("cannot start the meter '{}'", o.spotread);
+            return kExitFailure;
+        }
+    }
+    for (std::size_t i = readings.size(); i < set.size(); ++i) {
+        const glm::dvec3 c = set[i];
+        if (!screen.show(c, i, set.size(), readings.size())) {
+            return kExitFailure;
         }
         if (o.settleMs > 0) {
             std::this_thread::sleep_for(std::chrono::milliseconds(o.settleMs));
@@ -300,30 +392,16 @@ int patchesMain(const PatchesOptions& o)
                 meter->stop();
                 log->error("the meter ended before reading patch {} of {} ({}): {} readings kept "
                            "in {}; run again to resume",
-                           i + 1, set->size(), last.empty() ? "no output" : last, readings.size(),
+                           i + 1, set.size(), last.empty() ? "no output" : last, readings.size(),
                            o.out);
                 return kExitFailure;
             }
         } else {
-            fmt::print("patch {}/{} {},{},{}: X Y Z (cd/m^2)? ", i + 1, set->size(), c.x, c.y, c.z);
-            std::fflush(stdout);
-            std::string line;
-            if (!std::getline(std::cin, line)) {
-                fmt::print("\nstopped: {} of {} readings in {}; run again to resume\n",
-                           readings.size(), set->size(), o.out);
-                return kExitOk;
+            bool stopped = false;
+            xyz = readTyped(c, i, set.size(), readings.size(), o.out, stopped);
+            if (!xyz) {
+                return stopped ? kExitOk : kExitFailure;
             }
-            double x = 0.0;
-            double y = 0.0;
-            double z = 0.0;
-            char extra = 0;
-            if (std::sscanf(line.c_str(), " %lf %lf %lf %c", &x, &y, &z, &extra) != 3 ||
-                !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-                log->error("patch {}: '{}' is not three numbers X Y Z; {} readings kept in {}",
-                           i + 1, line, readings.size(), o.out);
-                return kExitFailure;
-            }
-            xyz = glm::dvec3(x, y, z);
         }
         pd::Measurement m;
         m.counts = c;
@@ -333,7 +411,7 @@ int patchesMain(const PatchesOptions& o)
             log->error("{}: cannot write the readings", o.out);
             return kExitFailure;
         }
-        fmt::print("[{}/{}] {},{},{} -> XYZ {:.4f} {:.4f} {:.4f}\n", i + 1, set->size(), c.x, c.y,
+        fmt::print("[{}/{}] {},{},{} -> XYZ {:.4f} {:.4f} {:.4f}\n", i + 1, set.size(), c.x, c.y,
                    c.z, xyz->x, xyz->y, xyz->z);
     }
     if (meter) {

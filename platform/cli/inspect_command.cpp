@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <pipeline/base/printable.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
 #include <recordings/recording.h>
@@ -16,16 +17,10 @@
 namespace replica::platform {
 namespace {
 
-// Text from a recording is untrusted: control characters (a terminal escape sequence) are shown
-// as \xNN, and a field is cut at 'max' characters.
+// Text from a recording is untrusted: shown escaped, a field cut at 'max' characters.
 std::string shown(std::string_view s, std::size_t max = 200)
 {
-    std::string out;
-    for (const char c : s.substr(0, max)) {
-        const auto u = static_cast<unsigned char>(c);
-        out += u < 0x20 || u == 0x7f ? fmt::format("\\x{:02x}", u) : std::string(1, c);
-    }
-    return s.size() > max ? out + "..." : out;
+    return printable(s, max);
 }
 
 struct InspectOptions {

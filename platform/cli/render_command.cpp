@@ -92,6 +92,111 @@ int fail(int code, const std::string& msg)
     return code;
 }
 
+// The real-time model's settings from the options (the scene's defaults where not given).
+pipeline::shading::RenderSettings settingsFromArgs(const RenderArgs& a,
+                                                   const pipeline::surface::SurfaceScene& scene)
+{
+    using namespace pipeline;
+    shading::RenderSettings settings;
+    settings.lights = a.lights;
+    settings.specularSamples = a.samples > 0 ? a.samples : shading::defaultSpecularSamples(scene);
+    settings.horizonDirections = a.horizonDirections;
+    settings.specularGrid =
+            a.specularGrid >= 0 ? a.specularGrid : shading::defaultSpecularGrid(scene);
+    settings.diffuseGrid = a.diffuseGrid >= 0 ? a.diffuseGrid : shading::defaultDiffuseGrid(scene);
+    settings.specularLodBias = a.lodBias;
+    settings.specularNearestLevel = !a.trilinear;
+    settings.areaLights = !a.pointLights;
+    return settings;
+}
+
+// The frame as an absolute-XYZ OpenEXR file, with what made it in its header.
+Expected<void> writeXyzExr(const pipeline::shading::XyzFrame& frame,
+                           const RenderArgs& a,
+                           const std::string& mode,
+                           const std::string& sceneName)
+{
+    using namespace pipeline;
+    image::ChannelImage img;
+    img.width = frame.width;
+    img.height = frame.height;
+    img.names = {"X", "Y", "Z"};
+    img.planes.assign(3, std::vector<float>(frame.xyz.size()));
+    for (std::size_t k = 0; k < frame.xyz.size(); ++k) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            img.planes[c][k] = static_cast<float>(frame.xyz[k][static_cast<int>(c)]);
+        }
+    }
+    if (auto ok = image::writeExr(
+                a.out, img,
+                {{"units",
+                  "absolute CIE 1931 XYZ, cd/m^2 (panel emission after screen-flare subtraction)"},
+                 {"renderer", mode},
+                 {"light", a.light},
+                 {"scene", sceneName}});
+        !ok) {
+        return ok;
+    }
+    return {};
+}
+
+// What the render did, for --json and the summary line.
+nlohmann::json renderSummary(const RenderArgs& a,
+                             const std::string& mode,
+                             double ms,
+                             const pipeline::shading::XyzFrame& frame,
+                             const pipeline::shading::RenderSettings& settings,
+                             const pipeline::surface::SurfaceScene& scene,
+                             const std::string& basisName,
+                             const pipeline::shading::Plan& plan)
+{
+    nlohmann::json j{{"out", a.out},
+                     {"mode", mode},
+                     {"ms", ms},
+                     {"width", frame.width},
+                     {"height", frame.height},
+                     {"white_y_cdm2", frame.whiteY},
+                     {"flare_clamped", frame.flareClamped},
+                     {"eye_behind_pixels", frame.eyeBehindPixels}};
+    if (!a.reference) {
+        j["lights"] = settings.lights;
+        j["basis"] = basisName;
+        j["specular_samples"] =
+                scene.glossy() && settings.specularPass ? settings.specularSamples : 0;
+        j["specular_grid"] = scene.glossy() && settings.specularPass ? settings.specularGrid : 0;
+        j["diffuse_grid"] = scene.flat() || !settings.reliefPass ? settings.diffuseGrid : 0;
+        j["specular_lod_bias"] = settings.specularLodBias;
+        j["specular_nearest_level"] = settings.specularNearestLevel;
+        j["area_lights"] = settings.areaLights;
+        j["horizon_directions"] =
+                !scene.flat() && settings.reliefPass ? settings.horizonDirections : 0;
+        if (a.plan) {
+            j["plan_met_budget"] = plan.met;
+            j["plan_probe_de00_p95"] = plan.probeError.p95;
+            j["plan_skipped"] = plan.skipped;
+        }
+    }
+    return j;
+}
+
+// One frame of the GL pass (in the current context).
+Expected<pipeline::shading::XyzFrame> renderGl(const pipeline::shading::PreparedScene& ps,
+                                               const pipeline::shading::PreparedLight& pl,
+                                               const pipeline::shading::View& view,
+                                               const pipeline::colour::Observer& obs,
+                                               const pipeline::shading::RenderSettings& settings)
+{
+    using namespace pipeline;
+    auto pass = render::BoothShadingPass::create(ps, settings, obs);
+    if (!pass) {
+        return tl::unexpected(pass.error());
+    }
+    if (auto ok = (*pass)->setLight(pl); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    return render::renderBoothFrame(**pass, pl, view);
+}
+
 int runRender(const RenderArgs& a)
 {
     using namespace pipeline;
@@ -144,16 +249,7 @@ int runRender(const RenderArgs& a)
 
     const auto t0 = std::chrono::steady_clock::now();
     shading::XyzFrame frame;
-    shading::RenderSettings settings;
-    settings.lights = a.lights;
-    settings.specularSamples = a.samples > 0 ? a.samples : shading::defaultSpecularSamples(*scene);
-    settings.horizonDirections = a.horizonDirections;
-    settings.specularGrid =
-            a.specularGrid >= 0 ? a.specularGrid : shading::defaultSpecularGrid(*scene);
-    settings.diffuseGrid = a.diffuseGrid >= 0 ? a.diffuseGrid : shading::defaultDiffuseGrid(*scene);
-    settings.specularLodBias = a.lodBias;
-    settings.specularNearestLevel = !a.trilinear;
-    settings.areaLights = !a.pointLights;
+    shading::RenderSettings settings = settingsFromArgs(a, *scene);
     std::string mode = "realtime-cpu";
     shading::Plan plan;
     if (a.reference) {
@@ -170,14 +266,7 @@ int runRender(const RenderArgs& a)
                                               *basis);
         if (a.gl) {
             mode = "realtime-gles";
-            auto pass = render::BoothShadingPass::create(ps, settings, *obs);
-            if (!pass) {
-                return fail(kExitFailure, pass.error().message);
-            }
-            if (auto ok = (*pass)->setLight(pl); !ok) {
-                return fail(kExitFailure, ok.error().message);
-            }
-            auto f = render::renderBoothFrame(**pass, pl, view);
+            auto f = renderGl(ps, pl, view, *obs, settings);
             if (!f) {
                 return fail(kExitFailure, f.error().message);
             }
@@ -197,52 +286,10 @@ int runRender(const RenderArgs& a)
                     fmt::format("{} pixels were not finite; this is a bug, please report it",
                                 frame.nonFinite));
     }
-    image::ChannelImage img;
-    img.width = frame.width;
-    img.height = frame.height;
-    img.names = {"X", "Y", "Z"};
-    img.planes.assign(3, std::vector<float>(frame.xyz.size()));
-    for (std::size_t k = 0; k < frame.xyz.size(); ++k) {
-        for (std::size_t c = 0; c < 3; ++c) {
-            img.planes[c][k] = static_cast<float>(frame.xyz[k][static_cast<int>(c)]);
-        }
-    }
-    if (auto ok = image::writeExr(
-                a.out, img,
-                {{"units",
-                  "absolute CIE 1931 XYZ, cd/m^2 (panel emission after screen-flare subtraction)"},
-                 {"renderer", mode},
-                 {"light", a.light},
-                 {"scene", scene->name}});
-        !ok) {
+    if (auto ok = writeXyzExr(frame, a, mode, scene->name); !ok) {
         return fail(kExitFailure, ok.error().message);
     }
-    nlohmann::json j{{"out", a.out},
-                     {"mode", mode},
-                     {"ms", ms},
-                     {"width", frame.width},
-                     {"height", frame.height},
-                     {"white_y_cdm2", frame.whiteY},
-                     {"flare_clamped", frame.flareClamped},
-                     {"eye_behind_pixels", frame.eyeBehindPixels}};
-    if (!a.reference) {
-        j["lights"] = settings.lights;
-        j["basis"] = basis->name;
-        j["specular_samples"] =
-                scene->glossy() && settings.specularPass ? settings.specularSamples : 0;
-        j["specular_grid"] = scene->glossy() && settings.specularPass ? settings.specularGrid : 0;
-        j["diffuse_grid"] = scene->flat() || !settings.reliefPass ? settings.diffuseGrid : 0;
-        j["specular_lod_bias"] = settings.specularLodBias;
-        j["specular_nearest_level"] = settings.specularNearestLevel;
-        j["area_lights"] = settings.areaLights;
-        j["horizon_directions"] =
-                !scene->flat() && settings.reliefPass ? settings.horizonDirections : 0;
-        if (a.plan) {
-            j["plan_met_budget"] = plan.met;
-            j["plan_probe_de00_p95"] = plan.probeError.p95;
-            j["plan_skipped"] = plan.skipped;
-        }
-    }
+    const nlohmann::json j = renderSummary(a, mode, ms, frame, settings, *scene, basis->name, plan);
     if (a.json) {
         std::printf("%s\n", j.dump().c_str());
     } else {

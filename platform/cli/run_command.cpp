@@ -1,6 +1,7 @@
 // 'replica run': the appliance's main job, the fixed-rate loop on the chosen sensors and output.
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -8,8 +9,10 @@
 #include <initializer_list>
 #include <iterator>
 #include <map>
+#include <mutex>
 #include <numbers>
 #include <optional>
+#include <thread>
 #include <utility>
 
 #include <fmt/format.h>
@@ -23,12 +26,15 @@
 #include <platform/cli/frame_outputs.h>
 #include <platform/cli/loop_summary.h>
 #include <platform/cli/run_options.h>
+#include <platform/cli/run_resolve.h>
 #include <platform/cli/run_sources.h>
 #include <platform/fault_injection.h>
+#include <platform/image/png_writer.h>
 #include <platform/live_sources.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 #include <platform/loop/shown_recorder.h>
+#include <platform/output/service_screen.h>
 #include <platform/session_files.h>
 #include <platform/site_config.h>
 #include <platform/site_file.h>
@@ -39,113 +45,12 @@
 namespace replica::platform {
 namespace {
 
-int runMain(const run_cli::RunOptions& given)
+void logStart(const Appliance& appliance, const Sources& sources)
 {
     auto log = logger("replica");
-    // --frames 0 runs until SIGINT/SIGTERM (the kiosk), closing the recording properly. Routed to
-    // the loop's stop flag before anything is opened: a signal during start-up (the recording is
-    // created before the shading passes are built and warmed up) then ends the run cleanly at its
-    // first frame instead of killing it (SIGTERM) or being lost (SIGINT is ignored in a
-    // background job of a non-interactive shell until a handler is installed).
-    installStopSignals();
-    run_cli::RunOptions o = given;
-    if (!o.sitePath.empty()) {
-        // The site file's [sources] fill in what the command line leaves open.
-        auto site = readSiteSources(o.sitePath);
-        if (!site) {
-            log->error("{}", site.error().message);
-            return kExitUsage;
-        }
-        for (const auto& [kind, from] : *site) {
-            if (o.sources[kind].empty()) {
-                o.sources[kind] = from;
-            }
-        }
-    }
-    if (o.hal == "replay" && o.replayFile.empty()) {
-        log->error("--hal replay needs --replay-file RECORDING (or run.replay_file in the site "
-                   "file)");
-        return kExitUsage;
-    }
-    if (o.hal == "replay" && o.replayFrom.empty()) {
-        o.replayFrom = o.replayFile; // every device replays it unless told otherwise
-    }
-    if (o.hal == "live" && o.fast) {
-        log->error("--fast needs the simulated sensors: live sensors run on the wall clock");
-        return kExitUsage;
-    }
-    if (auto choice = run_cli::chooseDevices(o); !choice) { // usage errors before anything is built
-        log->error("{}", choice.error().message);
-        return kExitUsage;
-    }
-    if (o.output != "headless" && o.output != "kms") {
-        log->error("--output {}: expected 'headless' (no display) or 'kms' (fullscreen on the "
-                   "console, no display server)",
-                   o.output);
-        return kExitUsage;
-    }
-    if (!o.record.empty() && !o.force) {
-        // Refused before the run starts (the writer refuses it again, race-free): an existing
-        // recording is evidence, and a link must not redirect the write.
-        struct stat st {
-        };
-        if (::lstat(o.record.c_str(), &st) == 0 &&
-            (S_ISLNK(st.st_mode) || (S_ISREG(st.st_mode) && st.st_size > 0))) {
-            log->error("--record {}: {}", o.record,
-                       S_ISLNK(st.st_mode) ? "is a symbolic link; name the file itself"
-                                           : "already exists; pass --force to overwrite it, or "
-                                             "name a new file");
-            return kExitUsage;
-        }
-    }
-    if (o.output == "kms" && !o.size.empty()) {
-        log->error("--size {}: on KMS the frame is the display mode's size; choose the mode with "
-                   "--kms-mode WIDTHxHEIGHT",
-                   o.size);
-        return kExitUsage;
-    }
-    const auto size = run_cli::parseSize(o.size.empty() ? std::string("960x600") : o.size);
-    if (!size) {
-        log->error("--size {}: expected WIDTHxHEIGHT, e.g. 960x600, each side 1-{} and at most "
-                   "{}:1",
-                   o.size, kMaxFrameSide, kMaxFrameAspect);
-        return kExitUsage;
-    }
-    RunConfig config;
-    if (const int code = run_cli::runConfigFromOptions(o, *size, config); code != kExitOk) {
-        return code;
-    }
-
-    OutputChoice outputChoice = o.outputChoice;
-    outputChoice.kind = o.output;
-    outputChoice.frameFromMode = true;
-    // The EDID's physical size only when neither the command line nor a site file gives one.
-    outputChoice.panelFromDisplay = o.panelSizeMm.empty() && !o.site;
-    auto appliance = buildAppliance(config, outputChoice);
-    if (!appliance) {
-        log->error("{}", appliance.error().message);
-        return kExitFailure;
-    }
-    // Live devices stamp samples on this clock; the loop's ticks start with it (within the few
-    // milliseconds between here and the first tick, which only delays samples by that much).
-    hal::SteadyClock liveClock;
-    auto sources = run_cli::makeRunSources(o, **appliance, liveClock);
-    if (!sources) {
-        log->error("{}", sources.error().message);
-        return kExitFailure; // usage errors were caught before anything was built
-    }
-    if (!o.faults.empty()) {
-        auto plan = parseFaultPlan(o.faults);
-        if (!plan) {
-            log->error("{}", plan.error().message);
-            return kExitUsage;
-        }
-        injectFaults(*sources, *plan);
-        log->warn("injecting faults into the sensor samples: {}", o.faults);
-    }
     log->info("{}; data {}", versionString(), dataDir().string());
     std::string devices;
-    for (const auto& e : sources->entries()) {
+    for (const auto& e : sources.entries()) {
         if (e.source) {
             const auto& info = e.source->info();
             devices += fmt::format("{}{}={} [{} {}]", devices.empty() ? "" : ", ", e.kind->name(),
@@ -153,167 +58,156 @@ int runMain(const run_cli::RunOptions& given)
         }
     }
     log->info("hal: {}; output={}; renderer={} on {}; {}x{} at {} Hz; display {}", devices,
-              (*appliance)->output->name(), (*appliance)->renderer->description(),
-              (*appliance)->output->glRenderer(), (*appliance)->config.width,
-              (*appliance)->config.height, config.rateHz, (*appliance)->displayProfileId);
+              appliance.output->name(), appliance.renderer->description(),
+              appliance.output->glRenderer(), appliance.config.width, appliance.config.height,
+              appliance.config.rateHz, appliance.displayProfileId);
+}
 
-    std::unique_ptr<recordings::RecordingWriter> recorder;
-    std::unique_ptr<SessionRecorder> sessions;
-    bool recordFailed = false;
-    const bool kioskRecording = o.kiosk && o.site && o.site->recordingEnabled && o.record.empty();
-    if (!o.record.empty() || kioskRecording) {
-        recordings::SessionInfo session;
-        session.softwareVersion = versionString();
-        // The configuration as built: the scene folder and digest, the display profile's digest.
-        const RunConfig& built = (*appliance)->config;
-        // The resolved configuration: the run configuration as built, the options the run
-        // resolved from the command line and the site file, and the site file itself.
-        auto resolved = nlohmann::json::parse(built.toJson());
-        resolved["run_options"] = {{"hal", o.hal},
-                                   {"replay_file", o.replayFile},
-                                   {"output", o.output},
-                                   {"kms_device", outputChoice.kms.device},
-                                   {"kms_connector", outputChoice.kms.connector},
-                                   {"kiosk", o.kiosk},
-                                   {"tracker_port", o.live.trackerPort},
-                                   {"tracker_bind", o.live.trackerBind},
-                                   {"iio_root", o.live.iioRoot.string()},
-                                   {"accel_name", o.live.accelName},
-                                   {"accel_axes", o.live.accelAxes},
-                                   {"lamp_gpio", o.live.lampGpio},
-                                   {"spectrometer_serial", o.live.spectrometerSerial}};
-        if (o.site) {
-            resolved["site"] = nlohmann::json::parse(o.site->toJson());
-        }
-        session.configJson = resolved.dump();
-        session.boothModel = built.booth;
-        session.scene = built.scene;
-        session.displayProfile = (*appliance)->displayProfileId;
-        session.wallClockStartNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                           std::chrono::system_clock::now().time_since_epoch())
-                                           .count();
-        for (const auto& e : sources->entries()) {
-            if (e.source) {
-                session.devices[e.kind->name()] = e.source->info();
-            }
-        }
-        recordings::WriterOptions options;
-        options.flushInterval = std::chrono::milliseconds(o.recordFlushMs);
-        options.overwrite = o.force;
-        // Called once from the writer thread; the loop keeps displaying without the recording.
-        options.onError = [log](const Error& e) {
-            log->error("{}; recording stopped, display continues", e.message);
-        };
-        if (kioskRecording) {
-            const SiteConfig& site = *o.site;
-            const std::filesystem::path dir = site.recordingDirectory;
-            std::error_code ec;
-            std::filesystem::create_directories(dir, ec);
-            recoverUnfinished(dir);
-            RotationPolicy policy;
-            policy.rotateBytes = site.rotateBytes;
-            policy.rotateAge = std::chrono::seconds(site.rotateSeconds);
-            policy.keepBytes = site.keepBytes;
-            // Each rotated file starts with the estimators' state ("state_at_start": the
-            // classifier's hysteresis, the lamp selector's arbitration, the encoding, the held
-            // eye and tilts), so that it replays alone, bit for bit, as the panel showed it.
-            const state::SceneEstimator* estimator = (*appliance)->updater.get();
-            sessions = std::make_unique<SessionRecorder>(
-                    dir, policy, [session, options, estimator](const std::filesystem::path& path) {
-                        if (!estimator->started()) {
-                            return recordings::RecordingWriter::create(path, session, options);
-                        }
-                        recordings::SessionInfo withState = session;
-                        auto resolvedJson = nlohmann::json::parse(session.configJson);
-                        resolvedJson[kStateAtStartKey] = estimator->save();
-                        withState.configJson = resolvedJson.dump();
-                        return recordings::RecordingWriter::create(path, withState, options);
-                    });
-            if (auto ok = sessions->open(); !ok) {
-                log->error("{}; running without recording", ok.error().message);
-                sessions.reset();
-            }
-        } else {
-            auto w = recordings::RecordingWriter::create(o.record, session, options);
-            if (!w) {
-                // The appliance still displays; the run reports failure at the end.
-                log->error("{}; running without recording", w.error().message);
-                recordFailed = true;
-            } else {
-                recorder = std::move(*w);
-            }
+// The session as recorded in each file: the configuration as built (the scene folder and digest,
+// the display profile's digest), the options the run resolved from the command line and the site
+// file, the site file itself, and the devices.
+recordings::SessionInfo sessionInfo(const run_cli::RunOptions& o,
+                                    const Appliance& appliance,
+                                    const OutputChoice& outputChoice,
+                                    const Sources& sources)
+{
+    recordings::SessionInfo session;
+    session.softwareVersion = versionString();
+    const RunConfig& built = appliance.config;
+    auto resolved = nlohmann::json::parse(built.toJson());
+    resolved["run_options"] = {{"hal", o.hal},
+                               {"replay_file", o.replayFile},
+                               {"output", o.output},
+                               {"kms_device", outputChoice.kms.device},
+                               {"kms_connector", outputChoice.kms.connector},
+                               {"kiosk", o.kiosk},
+                               {"tracker_port", o.live.trackerPort},
+                               {"tracker_bind", o.live.trackerBind},
+                               {"iio_root", o.live.iioRoot.string()},
+                               {"accel_name", o.live.accelName},
+                               {"accel_axes", o.live.accelAxes},
+                               {"lamp_gpio", o.live.lampGpio},
+                               {"spectrometer_serial", o.live.spectrometerSerial}};
+    if (o.site) {
+        resolved["site"] = nlohmann::json::parse(o.site->toJson());
+    }
+    session.configJson = resolved.dump();
+    session.boothModel = built.booth;
+    session.scene = built.scene;
+    session.displayProfile = appliance.displayProfileId;
+    session.wallClockStartNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                       std::chrono::system_clock::now().time_since_epoch())
+                                       .count();
+    for (const auto& e : sources.entries()) {
+        if (e.source) {
+            session.devices[e.kind->name()] = e.source->info();
         }
     }
+    return session;
+}
 
-    // What the panel showed, into the recording (format 4 channels).
+// Where the run records: one --record file, or the kiosk's session files (rotated, each starting
+// with the estimators' state). Either way ShownRecorder adds what the panel showed, so that every
+// file, each rotated one included, holds the same channels.
+struct RunRecording {
+    std::unique_ptr<recordings::RecordingWriter> file;
+    std::unique_ptr<SessionRecorder> sessions;
     std::unique_ptr<ShownRecorder> shown;
-    if (recorder) {
+    bool failed = false; // --record could not be opened: the run reports failure at the end
+
+    recordings::RecordingWriter* writer() const
+    {
+        return sessions ? sessions->current() : file.get();
+    }
+};
+
+std::unique_ptr<SessionRecorder> openSessions(const SiteConfig& site,
+                                              const recordings::SessionInfo& session,
+                                              const recordings::WriterOptions& options,
+                                              const state::SceneEstimator* estimator)
+{
+    const std::filesystem::path dir = site.recordingDirectory;
+    RotationPolicy policy;
+    policy.rotateBytes = site.rotateBytes;
+    policy.rotateAge = std::chrono::seconds(site.rotateSeconds);
+    policy.keepBytes = site.keepBytes;
+    // Each rotated file starts with the estimators' state ("state_at_start": the classifier's
+    // hysteresis, the lamp selector's arbitration, the encoding, the held eye and tilts), so
+    // that it replays alone, bit for bit, as the panel showed it.
+    auto sessions = std::make_unique<SessionRecorder>(
+            dir, policy, [session, options, estimator](const std::filesystem::path& path) {
+                if (!estimator->started()) {
+                    return recordings::RecordingWriter::create(path, session, options);
+                }
+                recordings::SessionInfo withState = session;
+                auto resolvedJson = nlohmann::json::parse(session.configJson);
+                resolvedJson[kStateAtStartKey] = estimator->save();
+                withState.configJson = resolvedJson.dump();
+                return recordings::RecordingWriter::create(path, withState, options);
+            });
+    if (auto ok = sessions->open(); !ok) {
+        logger("replica")->error("{}; running without recording", ok.error().message);
+        return nullptr;
+    }
+    return sessions;
+}
+
+RunRecording openRecording(const run_cli::RunOptions& o,
+                           const Appliance& appliance,
+                           const OutputChoice& outputChoice,
+                           const Sources& sources)
+{
+    auto log = logger("replica");
+    RunRecording rec;
+    const bool kioskRecording = o.kiosk && o.site && o.site->recordingEnabled && o.record.empty();
+    if (o.record.empty() && !kioskRecording) {
+        return rec;
+    }
+    const auto session = sessionInfo(o, appliance, outputChoice, sources);
+    recordings::WriterOptions options;
+    options.flushInterval = std::chrono::milliseconds(o.recordFlushMs);
+    options.overwrite = o.force;
+    // Called once from the writer thread; the loop keeps displaying without the recording.
+    options.onError = [log](const Error& e) {
+        log->error("{}; recording stopped, display continues", e.message);
+    };
+    if (kioskRecording) {
+        rec.sessions = openSessions(*o.site, session, options, appliance.sceneEstimator.get());
+    } else if (auto w = recordings::RecordingWriter::create(o.record, session, options); !w) {
+        // The appliance still displays; the run reports failure at the end.
+        log->error("{}; running without recording", w.error().message);
+        rec.failed = true;
+    } else {
+        rec.file = std::move(*w);
+    }
+    if (rec.writer() != nullptr) {
         ShownOptions so;
         so.displayDigests = o.recordDigests;
         so.thumbnailHz = o.thumbnailHz;
         so.thumbnailWidth = o.thumbnailWidth;
-        shown = std::make_unique<ShownRecorder>(*recorder, **appliance, so);
+        rec.shown = std::make_unique<ShownRecorder>(rec.writer(), appliance, so);
     }
-    FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
-    const TickSource ticks = o.frames == 0 ? endlessTicks(config.periodNs())
-                                           : fixedRateTicks(config.periodNs(), o.frames);
-    // Scan-out needs the display pixels of every frame, digests or not.
-    auto readback = outputs.readback();
-    if ((*appliance)->output->needsPixels() && readback == pipeline::render::Readback::None) {
-        readback = pipeline::render::Readback::Display;
-    }
-    if (shown) {
-        readback = std::max(readback, shown->readback());
-    }
-    auto keep = outputs.callback();
-    const FrameCallback onFrame = [&](const recordings::FrameRecord& f,
-                                      const pipeline::scene::SceneState& state,
-                                      const pipeline::render::RenderedFrame& image) {
-        keep(f, state, image);
-        if (shown) {
-            shown->onFrame(f, state, image);
-        }
-    };
-    SystemdNotifier notifier;
-    LoopOptions loopOptions;
-    loopOptions.skipLateTicks = true;
-    loopOptions.periodNs = config.periodNs();
-    loopOptions.afterFrame = [&notifier](const LoopStats& s) {
-        notifier.frameShown(s.frames, s.skippedTicks);
-    };
-    if (sessions) {
-        loopOptions.nextRecorder = [&sessions](recordings::RecordingWriter*) {
-            return sessions->afterFrame();
-        };
-    }
-    const auto wallStart = std::chrono::steady_clock::now();
-    auto stats = runFrames(**appliance, *sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
-                           sessions ? sessions->current() : recorder.get(), readback, onFrame,
-                           loopOptions);
-    const double wallS =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
-    notifier.stopping();
-    if (shown) {
-        shown->finish(); // the last thumbnail and the log tap, before the writer closes
-    }
-    if (!stats) {
-        log->error("{}", stats.error().message);
-        return kExitFailure;
-    }
-    int code = recordFailed ? kExitFailure : kExitOk;
-    if (sessions) {
-        if (auto closed = sessions->close(); !closed) {
+    return rec;
+}
+
+// Closes the recording; returns the run's exit code given the loop's ('code') and adds the
+// recording's figures to the summary.
+int closeRecording(RunRecording& rec, const run_cli::RunOptions& o, nlohmann::json& summary)
+{
+    auto log = logger("replica");
+    int code = rec.failed ? kExitFailure : kExitOk;
+    if (rec.sessions) {
+        if (auto closed = rec.sessions->close(); !closed) {
             log->warn("session {} is incomplete; the next start recovers it",
-                      sessions->currentPath().string());
+                      rec.sessions->currentPath().string());
             code = kExitFailure;
         } else {
-            fmt::print("recording: {} ({} rotations)\n", sessions->currentPath().string(),
-                       sessions->rotations());
+            fmt::print("recording: {} ({} rotations)\n", rec.sessions->currentPath().string(),
+                       rec.sessions->rotations());
         }
     }
-    nlohmann::json summary{{"command", "run"}, {"wall_s", wallS}};
-    if (recorder) {
-        if (auto closed = recorder->close(); !closed) {
+    if (rec.file) {
+        if (auto closed = rec.file->close(); !closed) {
             // Already logged by onError when it happened; say where the run stands.
             log->warn("recording {} is incomplete; 'replica recover' rebuilds what was written",
                       o.record);
@@ -321,14 +215,14 @@ int runMain(const run_cli::RunOptions& given)
         } else if (!o.json) {
             fmt::print("recording: {}\n", o.record);
         }
-        const auto ws = recorder->stats();
+        const auto ws = rec.file->stats();
         summary["recording"] = {{"file", o.record},      {"complete", code == kExitOk},
                                 {"bytes", ws.bytes},     {"messages", ws.messages},
                                 {"dropped", ws.dropped}, {"rejected_nonfinite", ws.rejected},
                                 {"chunks", ws.chunks}};
     }
-    if (shown) {
-        const auto ss = shown->stats();
+    if (rec.shown) {
+        const auto ss = rec.shown->stats();
         const auto n = static_cast<double>(std::max<std::uint64_t>(ss.thumbnails, 1));
         const auto d = static_cast<double>(std::max<std::uint64_t>(ss.digests, 1));
         summary["shown"] = {{"display_digests", ss.digests},
@@ -346,6 +240,74 @@ int runMain(const run_cli::RunOptions& given)
                   ss.digests, ss.digestMsTotal / d, ss.thumbnails, ss.thumbnailBytes,
                   ss.copyMsTotal / n, ss.encodeMsTotal / n, ss.lightChanges, ss.poses);
     }
+    return code;
+}
+
+// The loop, from the first tick to the stop (or the last frame), into the recording.
+Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
+                            Appliance& appliance,
+                            Sources& sources,
+                            RunRecording& rec,
+                            FrameOutputs& outputs,
+                            double& wallS)
+{
+    const auto periodNs = appliance.config.periodNs();
+    const TickSource ticks =
+            o.frames == 0 ? endlessTicks(periodNs) : fixedRateTicks(periodNs, o.frames);
+    // Scan-out needs the display pixels of every frame, digests or not.
+    auto readback = outputs.readback();
+    if (appliance.output->needsPixels() && readback == pipeline::render::Readback::None) {
+        readback = pipeline::render::Readback::Display;
+    }
+    if (rec.shown) {
+        readback = std::max(readback, rec.shown->readback());
+    }
+    auto keep = outputs.callback();
+    const FrameCallback onFrame = [&](const recordings::FrameRecord& f,
+                                      const pipeline::scene::SceneState& state,
+                                      const pipeline::render::RenderedFrame& image) {
+        keep(f, state, image);
+        if (rec.shown) {
+            rec.shown->onFrame(f, state, image);
+        }
+    };
+    SystemdNotifier notifier;
+    LoopOptions loopOptions;
+    loopOptions.skipLateTicks = true;
+    loopOptions.periodNs = periodNs;
+    loopOptions.afterFrame = [&notifier](const LoopStats& s) {
+        notifier.frameShown(s.frames, s.skippedTicks);
+    };
+    if (rec.sessions) {
+        loopOptions.nextRecorder = [&rec](recordings::RecordingWriter*) {
+            auto* next = rec.sessions->afterFrame();
+            if (rec.shown) {
+                rec.shown->setWriter(next); // the next file holds what was shown too
+            }
+            return next;
+        };
+    }
+    const auto wallStart = std::chrono::steady_clock::now();
+    auto stats = runFrames(appliance, sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
+                           rec.writer(), readback, onFrame, loopOptions);
+    wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    notifier.stopping();
+    if (rec.shown) {
+        rec.shown->finish(); // the last thumbnail and the log tap, before the writer closes
+    }
+    return stats;
+}
+
+// The frame outputs (--digests, --snapshot) written, the summary's last lines printed.
+int finishRun(const run_cli::RunOptions& o,
+              const Appliance& appliance,
+              const Sources& sources,
+              FrameOutputs& outputs,
+              const LoopStats& stats,
+              nlohmann::json& summary,
+              int code)
+{
+    auto log = logger("replica");
     if (auto ok = outputs.finish(o.digests, o.snapshot); !ok) {
         log->error("{}", ok.error().message);
         return kExitFailure;
@@ -362,19 +324,187 @@ int runMain(const run_cli::RunOptions& given)
             fmt::print("snapshot: {}\n", o.snapshot);
         }
     }
-    if (const auto* selector = sources->get(recordings::lampSelectorKind())) {
+    if (const auto* selector = sources.get(recordings::lampSelectorKind())) {
         log->info("lamp selector {} [{} {}]: overruled by the spectrometer {} times",
                   hal::toString(selector->info().kind), selector->info().model,
-                  selector->info().serial, (*appliance)->updater->lampArbiter().overruled());
+                  selector->info().serial, appliance.sceneEstimator->lampArbiter().overruled());
     }
     const double periodMs = 1000.0 / o.rateHz;
-    logLoopSummary(*stats, periodMs, !o.digests.empty());
-    summary.update(loopSummaryJson(*stats, periodMs));
+    logLoopSummary(stats, periodMs, !o.digests.empty());
+    summary.update(loopSummaryJson(stats, periodMs));
     summary["exit_code"] = code;
     if (o.json) {
         fmt::print("{}\n", summary.dump(2));
     }
     return code;
+}
+
+// Start-up (planning a scene that has no plan, the warm-up, recovering the sessions a crash left)
+// runs before any recording is open: a stop signal then ends the process within 50 ms instead of
+// waiting for it (systemd would kill it after TimeoutStopSec). Nothing is lost: a session being
+// recovered is renamed over only once complete, and the plan cache and the folder's lock are
+// written atomically or released by the kernel. From the loop on, stops end at a frame boundary.
+class StartupStop
+{
+public:
+    StartupStop() : thread_([this] { watch(); }) {}
+    ~StartupStop()
+    {
+        {
+            std::lock_guard lock(mutex_);
+            done_ = true;
+        }
+        wake_.notify_one();
+        thread_.join();
+    }
+    StartupStop(const StartupStop&) = delete;
+    StartupStop& operator=(const StartupStop&) = delete;
+
+private:
+    void watch()
+    {
+        std::unique_lock lock(mutex_);
+        while (!done_) {
+            if (stopRequested()) {
+                logger("replica")->info("stop requested during start-up: exiting before the first "
+                                        "frame (no recording was open yet)");
+                std::fflush(stdout);
+                std::_Exit(kExitOk);
+            }
+            wake_.wait_for(lock, std::chrono::milliseconds(50));
+        }
+    }
+
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    bool done_ = false;
+    std::thread thread_;
+};
+
+// The kiosk's answer to a configuration error: a service screen on the panel instead of black,
+// through the output the options name (headless too: --snapshot writes it), saying what failed,
+// where, and the command that checks it. An endless run holds it until stopped (a process that
+// exits leaves a KMS panel black), telling systemd it is up so that the unit neither restarts it
+// nor times it out; then, like a counted run at once, it exits 78, which the unit does not
+// restart on.
+int showServiceScreen(const run_cli::Refusal& r, const run_cli::RunOptions& given)
+{
+    auto log = logger("replica");
+    auto output = r.output.kind == "kms" ? createKmsOutput(r.output.kms) : createHeadlessOutput();
+    if (!output) {
+        log->error("service screen: {}", output.error().message);
+        return r.code;
+    }
+    auto size = run_cli::parseSize(r.size);
+    if (const auto display = (*output)->display(); display) {
+        size = std::make_pair(display->width, display->height);
+    }
+    const auto [width, height] = size.value_or(std::make_pair(960, 600));
+    std::vector<std::string> lines = r.lines;
+    lines.push_back("");
+    lines.push_back("Check it:  replica config check " + r.siteFile);
+    lines.push_back("Then:      systemctl restart replica");
+    const auto image = renderServiceScreen(
+            width, height, "Replica cannot start: the site file has a problem", lines);
+    if (auto shown = presentServiceScreen(**output, image); !shown) {
+        log->error("service screen: {}", shown.error().message);
+    }
+    if (!given.snapshot.empty()) {
+        if (auto ok = writePng(given.snapshot, image.width, image.height, image.rgba); !ok) {
+            log->error("{}", ok.error().message);
+        }
+    }
+    log->error("the service screen shows the problem; 'replica config check {}' lists it",
+               r.siteFile);
+    if (r.endless) {
+        SystemdNotifier notifier; // READY=1 (the screen is up), then the watchdog's pings
+        for (std::uint64_t n = 0; !stopRequested(); ++n) {
+            notifier.frameShown(n, 0);
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        notifier.stopping();
+    }
+    return r.code;
+}
+
+int runMain(const run_cli::RunOptions& given)
+{
+    auto log = logger("replica");
+    // --frames 0 runs until SIGINT/SIGTERM (the kiosk), closing the recording properly. Routed to
+    // the stop flag before anything is opened (SIGINT is ignored in a background job of a
+    // non-interactive shell until a handler is installed): during start-up StartupStop ends the
+    // process at once, from the first frame on the loop ends at a frame boundary.
+    installStopSignals();
+    // What 'replica config check' resolves too: a site file it accepts starts here.
+    auto plan = run_cli::resolveRun(given);
+    if (!plan) {
+        for (const auto& line : plan.error().lines) {
+            log->error("{}", line);
+        }
+        if (given.kiosk && plan.error().code == run_cli::kExitConfig) {
+            return showServiceScreen(plan.error(), given);
+        }
+        return plan.error().code;
+    }
+    const run_cli::RunOptions& o = plan->options;
+    if (o.site && !o.logLevelGiven) {
+        setupLogging(o.site->logLevel, true); // the site's log levels (checked by resolveRun)
+    }
+    // The sessions folder is this kiosk's alone: a second kiosk on it is refused here, in one
+    // line naming the first one's pid, before it builds anything.
+    std::optional<SessionFolderLock> folderLock;
+    const bool kioskRecording = o.kiosk && o.site && o.site->recordingEnabled && o.record.empty();
+    if (kioskRecording) {
+        auto lock = SessionFolderLock::acquire(o.site->recordingDirectory);
+        if (!lock && lock.error().code == ErrorCode::InvalidArgument) {
+            log->error("{}", lock.error().message);
+            return kExitFailure;
+        }
+        if (!lock) {
+            log->warn("{}", lock.error().message); // recording then says why it cannot start
+        } else {
+            folderLock.emplace(std::move(*lock));
+        }
+    }
+    auto startup = std::make_unique<StartupStop>();
+    if (folderLock) {
+        recoverUnfinished(o.site->recordingDirectory);
+    }
+    auto appliance = buildAppliance(plan->config, plan->output);
+    if (!appliance) {
+        log->error("{}", appliance.error().message);
+        return kExitFailure;
+    }
+    // Live devices stamp samples on this clock; the loop's ticks start with it (within the few
+    // milliseconds between here and the first tick, which only delays samples by that much).
+    hal::SteadyClock liveClock;
+    auto sources = run_cli::makeRunSources(o, **appliance, liveClock);
+    if (!sources) {
+        log->error("{}", sources.error().message);
+        return kExitFailure; // usage errors were caught before anything was built
+    }
+    if (!o.faults.empty()) {
+        auto faults = parseFaultPlan(o.faults);
+        if (!faults) {
+            log->error("{}", faults.error().message);
+            return kExitUsage;
+        }
+        injectFaults(*sources, *faults);
+        log->warn("injecting faults into the sensor samples: {}", o.faults);
+    }
+    startup.reset(); // from here a stop ends the loop at a frame, the recording closed
+    logStart(**appliance, *sources);
+    RunRecording rec = openRecording(o, **appliance, plan->output, *sources);
+    FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
+    double wallS = 0.0;
+    auto stats = runLoop(o, **appliance, *sources, rec, outputs, wallS);
+    if (!stats) {
+        log->error("{}", stats.error().message);
+        return kExitFailure;
+    }
+    nlohmann::json summary{{"command", "run"}, {"wall_s", wallS}};
+    const int code = closeRecording(rec, o, summary);
+    return finishRun(o, **appliance, *sources, outputs, *stats, summary, code);
 }
 
 } // namespace
@@ -388,46 +518,10 @@ void registerRunCommand(CLI::App& app, int& exitCode)
     run_cli::addRunOptions(*cmd, *opts);
     cmd->callback([opts, cmd, &exitCode] {
         run_cli::RunOptions o = *opts;
-        std::string file = o.config;
-        if (file.empty() && o.kiosk) {
-            file = defaultSiteConfigPath().string();
-            std::error_code ec;
-            if (!std::filesystem::exists(file, ec)) {
-                logger("replica")->error("--kiosk: no site file at {}; install the package (it "
-                                         "ships one) or pass --config FILE",
-                                         file);
-                exitCode = run_cli::kExitConfig;
-                return;
-            }
-        }
-        if (!file.empty()) {
-            auto site = loadSiteConfig(file);
-            if (!site) {
-                logger("replica")->error("{}", site.error().message);
-                exitCode = run_cli::kExitConfig;
-                return;
-            }
-            if (!site->problems.empty()) {
-                for (const auto& p : site->problems) {
-                    logger("replica")->error("{}", formatProblem(file, p));
-                }
-                logger("replica")->error("{}: {} problems; 'replica config check {}' lists them",
-                                         file, site->problems.size(), file);
-                exitCode = run_cli::kExitConfig;
-                return;
-            }
-            o.site = site->config;
-            run_cli::applySite(*o.site, o, *cmd);
-            // The site's log levels, unless the command line or $REPLICA_LOG set them.
-            const auto* parent = cmd->get_parent();
-            if (parent != nullptr && parent->get_option("--log-level")->count() == 0 &&
-                std::getenv("REPLICA_LOG") == nullptr) {
-                setupLogging(o.site->logLevel, true);
-            }
-        }
-        if (o.kiosk && cmd->get_option("--frames")->count() == 0) {
-            o.frames = 0;
-        }
+        o.given = run_cli::givenOptions(*cmd);
+        const auto* parent = cmd->get_parent();
+        o.logLevelGiven = (parent != nullptr && parent->get_option("--log-level")->count() > 0) ||
+                          std::getenv("REPLICA_LOG") != nullptr;
         exitCode = runMain(o);
     });
 }

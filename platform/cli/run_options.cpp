@@ -22,24 +22,6 @@
 namespace replica::platform::run_cli {
 namespace {
 
-// Whether the display profile is not a characterised panel: the nominal model, or a profile fitted
-// from synthetic measurements (its description says so, as 'replica display fit --synthetic'
-// writes it).
-bool syntheticDisplay(const RunConfig& config)
-{
-    if (config.display == kUncalibratedDisplay) {
-        return true;
-    }
-    std::ifstream in(dataPath(config.display));
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    try {
-        const auto j = nlohmann::json::parse(text);
-        return j.value("description", std::string()).find("SYNTHETIC") != std::string::npos;
-    } catch (const std::exception&) {
-        return false; // buildAppliance reports an unreadable profile
-    }
-}
-
 // Copies the site file's value into the run's option: Site a SiteConfig member, Path the
 // RunOptions member (or a path of members into it).
 template <auto Site, auto... Path>
@@ -82,9 +64,8 @@ constexpr std::array kSiteDefaults = {
         SiteDefault{"--no-warm-up", [](const S& s, O& o) { o.noWarmUp = !s.warmUp; }},
 };
 
-} // namespace
-
-void addRunOptions(CLI::App& cmd, RunOptions& o)
+// The site file, the sensor sources and the live devices' settings.
+void addSourceOptions(CLI::App& cmd, RunOptions& o)
 {
     cmd.add_option("--config", o.config,
                    "site file (TOML, docs/appliance.md); the command line overrides it. "
@@ -146,6 +127,11 @@ void addRunOptions(CLI::App& cmd, RunOptions& o)
                    "--tracker hid: the device axis for x right, y up, z towards the viewer, e.g. "
                    "x,-y,z for a tracker whose y points down the screen")
             ->capture_default_str();
+}
+
+// The output, the frames, the recording and what it records.
+void addOutputOptions(CLI::App& cmd, RunOptions& o)
+{
     cmd.add_option("--output", o.output,
                    "frame output: headless (surfaceless EGL) or kms (fullscreen scan-out)")
             ->capture_default_str();
@@ -188,6 +174,11 @@ void addRunOptions(CLI::App& cmd, RunOptions& o)
                  "standard output instead of the text lines");
     cmd.add_option("--digests", o.digests, "write one digest per frame to FILE (JSON)");
     cmd.add_option("--snapshot", o.snapshot, "write the last frame to FILE (PNG)");
+}
+
+// The scene, the renderer and the display model.
+void addRenderOptions(CLI::App& cmd, RunOptions& o)
+{
     cmd.add_option("--scene", o.scene,
                    "surface scene folder (scene.json + EXRs); default: the shipped ColorChecker, "
                    "data/scenes/colorchecker");
@@ -242,6 +233,15 @@ void addRunOptions(CLI::App& cmd, RunOptions& o)
                  "peak, blue: below black)");
 }
 
+} // namespace
+
+void addRunOptions(CLI::App& cmd, RunOptions& o)
+{
+    addSourceOptions(cmd, o);
+    addOutputOptions(cmd, o);
+    addRenderOptions(cmd, o);
+}
+
 std::string deviceOption(const recordings::DeviceKindBase& kind)
 {
     std::string s = kind.name();
@@ -255,9 +255,22 @@ std::string dataPath(const std::string& p)
     return path.is_relative() ? (dataDir() / path).string() : path.string();
 }
 
-void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd)
+std::set<std::string> givenOptions(const CLI::App& cmd)
 {
-    const auto unset = [&cmd](const char* name) { return cmd.get_option(name)->count() == 0; };
+    std::set<std::string> given;
+    for (const auto* opt : cmd.get_options()) {
+        if (opt->count() > 0) {
+            for (const auto& name : opt->get_lnames()) {
+                given.insert("--" + name);
+            }
+        }
+    }
+    return given;
+}
+
+void applySite(const SiteConfig& s, RunOptions& o)
+{
+    const auto unset = [&o](const char* name) { return !o.given.contains(name); };
     for (const auto& row : kSiteDefaults) {
         if (unset(row.option)) {
             row.fill(s, o);
@@ -286,128 +299,6 @@ std::optional<std::pair<int, int>> parseSize(const std::string& s)
         return std::nullopt;
     }
     return std::make_pair(w, h);
-}
-
-int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfig& config)
-{
-    auto log = logger("replica");
-    config.width = size.first;
-    config.height = size.second;
-    if (!o.panelSizeMm.empty()) {
-        auto panel = parseSizeMm(o.panelSizeMm);
-        if (!panel) {
-            log->error("--panel-size-mm: {}", panel.error().message);
-            return kExitUsage;
-        }
-        config.stand.panelWidthM = panel->width / 1000.0;
-        config.stand.panelHeightM = panel->height / 1000.0;
-    }
-    config.rateHz = o.rateHz;
-    config.renderer = o.renderer;
-    // The flat renderer has no 36-band scene to re-encode: it keeps the best fixed basis.
-    config.basis = !o.basis.empty() ? o.basis
-                                    : (o.renderer == "flat" ? std::string("replica_k6")
-                                                            : std::string(kAdaptiveBasis));
-    if (!o.scene.empty()) {
-        // Stored relative to the data folder when it is inside it, so that a recording replays on
-        // another installation.
-        std::error_code ec;
-        const auto abs = std::filesystem::weakly_canonical(o.scene, ec);
-        const auto data = std::filesystem::weakly_canonical(dataDir(), ec);
-        const auto rel = abs.lexically_relative(data);
-        config.sceneDir = !rel.empty() && *rel.begin() != ".." ? rel.string() : abs.string();
-        if (!std::filesystem::is_regular_file(abs / "scene.json", ec)) {
-            log->error("--scene {}: no scene.json there; name a scene folder such as {}", o.scene,
-                       (dataDir() / "scenes" / "painting").string());
-            return kExitUsage;
-        }
-    }
-    if (o.uncalibrated && !o.displayProfile.empty()) {
-        log->error("--uncalibrated and --display-profile {} contradict each other: give one",
-                   o.displayProfile);
-        return kExitUsage;
-    }
-    if (o.uncalibrated) {
-        config.display = kUncalibratedDisplay;
-        log->warn("--uncalibrated: driving a nominal sRGB-like {} cd/m^2 model, not a "
-                  "characterised panel; colours on screen are not the surface's",
-                  config.displayPeakCdM2);
-    } else if (!o.displayProfile.empty()) {
-        // Like the scene: relative to the data folder when inside it, so that replay (which
-        // opens only files inside the data folders) finds it on another installation.
-        std::error_code ec;
-        const auto abs = std::filesystem::weakly_canonical(
-                std::filesystem::absolute(o.displayProfile, ec), ec);
-        const auto data = std::filesystem::weakly_canonical(dataDir(), ec);
-        const auto rel = abs.lexically_relative(data);
-        config.display = !rel.empty() && *rel.begin() != ".."
-                                 ? rel.string()
-                                 : std::filesystem::absolute(o.displayProfile, ec).string();
-    }
-    config.displayInverse = o.displayInverse;
-    config.gamutMapping = o.gamut;
-    config.viewingCompensation = !o.noViewing;
-    config.flareSubtraction = !o.noFlare;
-    config.falseColour = o.falseColour;
-    // The planner in the loop: by default each lamp draws with the plan cached or shipped with
-    // the scene (the fixed rules where there is none); --planner (or the site's planner = true)
-    // also plans a scene that has none, --no-planner (planner = false) keeps the fixed rules.
-    config.planner = !o.noPlanner;
-    config.planIfMissing = o.planner;
-    if (!o.planner && !o.noPlanner && o.site && o.site->renderPlannerSet) {
-        config.planner = o.site->renderPlanner;
-        config.planIfMissing = o.site->renderPlanner;
-    }
-    config.plannerCache = o.planCache;
-    config.warmUp = !o.noWarmUp;
-    if (o.site) {
-        const SiteConfig& site = *o.site;
-        config.booth = site.boothId;
-        config.boothDimmer = site.boothDimmer;
-        config.boothDimmerAuto = site.boothDimmerAuto;
-        const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
-        config.stand = site.stand;
-        if (!o.panelSizeMm.empty()) { // the command line wins over the site file
-            config.stand.panelWidthM = panelW;
-            config.stand.panelHeightM = panelH;
-        }
-        config.trackerInBooth = site.trackerInBooth();
-        config.defaultLamp = site.defaultLamp;
-        config.defaultEyeM = site.defaultEyeM;
-        config.defaultTiltRad = site.defaultTiltDeg * std::numbers::pi / 180.0;
-    }
-    if (!o.sitePath.empty()) {
-        auto t = readTrackerTransform(o.sitePath);
-        if (!t && t.error().code != ErrorCode::NotFound) {
-            log->error("{}", t.error().message);
-            return kExitFailure;
-        }
-        if (t) {
-            config.trackerInBooth = *t; // the calibration wins over the site's angles
-            log->info("tracker pose in the booth from {} (T_booth_tracker)", o.sitePath);
-        } else {
-            log->warn("{}; using [tracker] rotation_deg and translation_m (absent: the fixed "
-                      "mounting)",
-                      t.error().message);
-        }
-    }
-    if (o.hal == "live" && syntheticDisplay(config)) {
-        const bool allowed = o.site && o.site->allowSynthetic;
-        for (int i = 0; i < 3; ++i) {
-            log->warn("!!! LIVE RUN ON A SYNTHETIC DISPLAY PROFILE ({}): the colours on this "
-                      "screen are not the surface's. Characterise the panel ('replica display "
-                      "fit') and set display.profile in the site file. !!!",
-                      config.display);
-        }
-        if (o.kiosk && !allowed) {
-            log->error("{}: the kiosk refuses a live run on a synthetic display profile; set "
-                       "display.profile to the panel's profile, or display.allow_synthetic = "
-                       "true to accept wrong colours",
-                       o.site ? o.site->source.string() : std::string("(no site file)"));
-            return kExitConfig;
-        }
-    }
-    return kExitOk;
 }
 
 } // namespace replica::platform::run_cli

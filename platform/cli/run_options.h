@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -61,6 +62,9 @@ struct RunOptions {
     std::string faults; // --inject-faults
     // From the site file only (no command-line option).
     std::optional<SiteConfig> site;
+    // The options the command line gave ("--size"): the site file fills in the others.
+    std::set<std::string> given;
+    bool logLevelGiven = false; // --log-level or $REPLICA_LOG: the site's [log] level is not used
 };
 
 constexpr int kExitConfig = 78; // EX_CONFIG: the unit's RestartPreventExitStatus
@@ -68,12 +72,11 @@ constexpr int kExitConfig = 78; // EX_CONFIG: the unit's RestartPreventExitStatu
 // Declares every option of 'replica run' on 'cmd', each into its field of 'o'.
 void addRunOptions(CLI::App& cmd, RunOptions& o);
 
-// The site file's values for every option the command line did not give.
-void applySite(const SiteConfig& s, RunOptions& o, const CLI::App& cmd);
+// The options 'cmd' was given on the command line, for RunOptions::given.
+std::set<std::string> givenOptions(const CLI::App& cmd);
 
-// The run configuration the options ask for, at frame size 'size': logs what is wrong in one line
-// and returns the exit code (kExitOk when 'config' is built).
-int runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfig& config);
+// The site file's values for every option the command line did not give (o.given).
+void applySite(const SiteConfig& s, RunOptions& o);
 
 // The run's option that chooses a device kind's source, without its dashes: "spectrometer",
 // "lamp-selector".

@@ -50,6 +50,12 @@ std::vector<SensedConfig> sensedConfigs()
     avg.name = "corrected + 5 spectra averaged";
     avg.corrections.scansAveraged = 5;
     c.push_back(avg);
+    // The kiosk's own chain (state/light_estimator.cpp runs the same LiveSpectrometerChain), with
+    // its defaults, on a light steady for as many spectra as it averages.
+    SensedConfig live{std::string(kApplianceRow), sheet, 0.5, {}};
+    live.corrections.applianceChain = true;
+    live.corrections.scansAveraged = live.corrections.chain.averageSpectra;
+    c.push_back(live);
     return c;
 }
 
@@ -100,6 +106,13 @@ int sensedReport(const pd::DisplayInverse& inverse,
         return kExitFailure;
     }
     const auto basis = encoder->generalBasis();
+    // The site calibrates the instrument's wavelength shift under its booth's fluorescent lamps,
+    // whatever light is then sensed.
+    auto booth = pd::fineBoothLights(data);
+    if (!booth) {
+        log->error("{}", booth.error().message);
+        return kExitFailure;
+    }
     nlohmann::json rows = nlohmann::json::array();
     if (!o.json) {
         fmt::print("End to end from the sensed light ({} mode, adaptive_k6, {} draws per light, "
@@ -121,6 +134,7 @@ int sensedReport(const pd::DisplayInverse& inverse,
         so.seed = o.seed;
         so.illuminanceLux = lux;
         so.flare = flare;
+        so.calibrationLights = *booth;
         auto res =
                 pd::sensedStudy(inverse, panel, *observer, lights, samples, &*encoder, basis, so);
         if (!res) {
@@ -131,6 +145,7 @@ int sensedReport(const pd::DisplayInverse& inverse,
             if (o.json) {
                 rows.push_back({{"instrument", cfg.name.substr(cfg.name.find_first_not_of(' '))},
                                 {"light", r.light},
+                                {"appliance", cfg.name == kApplianceRow},
                                 {"render", sensedStatsJson(r.render)},
                                 {"panel_in_gamut", sensedStatsJson(r.panelInGamut)},
                                 {"panel_out_of_gamut", sensedStatsJson(r.panelOutOfGamut)},

@@ -14,6 +14,9 @@
 
 namespace replica::platform {
 
+// The table's row that is the appliance's own chain (pipeline/spectral/live_chain.h, its defaults).
+inline constexpr const char* kApplianceRow = "appliance: live chain (the kiosk's)";
+
 struct SensedReportOptions {
     bool sensed = false;
     std::string mode = "direct";

@@ -50,6 +50,91 @@ nlohmann::json labJson(const colour::Lab& lab)
     return nlohmann::json::array({lab.L, lab.a, lab.b});
 }
 
+// --sensed: the light through the simulated spectrometer, adaptive_k6 (the appliance's), the
+// display.
+int runSensedEval(const EvalOptions& o,
+                  const colour::SpectralTable& lightTable,
+                  const spectral::NamedSpectra& set)
+{
+    auto fail = [](const std::string& msg) {
+        std::fprintf(stderr, "replica spectral eval: %s\n", msg.c_str());
+        return kExitFailure;
+    };
+    const auto data = dataDir();
+    if (o.representation != spectral::kApplianceRepresentation || !o.encodedFor.empty()) {
+        return fail(fmt::format("--sensed renders as the appliance does ({}, encoded for the "
+                                "sensed light); drop --representation and --encoded-for",
+                                spectral::kApplianceRepresentation));
+    }
+    auto fine = spectral::restoreLines(lightTable, "value");
+    if (!fine) {
+        return fail(fine.error().message);
+    }
+    fine->name = std::filesystem::path(o.illuminant).stem().string();
+    const std::string profile = o.profile.empty()
+                                        ? (data / "displays" / "wide-ips-synthetic.json").string()
+                                        : o.profile;
+    auto model = pipeline::display::loadProfile(profile);
+    if (!model) {
+        return fail(model.error().message);
+    }
+    auto inverse = pipeline::display::DisplayInverse::build(*model);
+    if (!inverse) {
+        return fail(fmt::format("{}: {}", profile, inverse.error().message));
+    }
+    const pipeline::display::DisplayModel panelModel = *model;
+    SensedReportOptions so = o.sensed;
+    so.json = o.json;
+    return sensedReport(
+            *inverse, [panelModel](const glm::dvec3& c) { return panelModel.forward(c); }, {*fine},
+            pipeline::display::SensedSamples{set.names, set.spectra}, 2000.0,
+            pipeline::display::FlareHandling::InBoothSubtract, so);
+}
+
+// The representation's report, as a table or JSON.
+int printEvalReport(const EvalOptions& o,
+                    const spectral::AccuracyReport& report,
+                    const spectral::NamedSpectra& set)
+{
+    if (o.json) {
+        nlohmann::json out;
+        out["representation"] = report.representation;
+        out["illuminant"] = o.illuminant;
+        if (!o.encodedFor.empty()) {
+            out["encoded_for"] = o.encodedFor;
+        }
+        out["reflectances"] = o.reflectances;
+        out["white"] = set.names[report.whiteIndex];
+        out["grid"] = "380-730 nm, 10 nm (36 bands)";
+        out["samples"] = nlohmann::json::array();
+        for (const auto& s : report.samples) {
+            out["samples"].push_back({{"name", s.name},
+                                      {"lab_reference", labJson(s.labReference)},
+                                      {"lab_approx", labJson(s.labApprox)},
+                                      {"de00", s.de00}});
+        }
+        out["stats"] = {{"mean", report.stats.mean},
+                        {"std", report.stats.std},
+                        {"p90", report.stats.p90},
+                        {"max", report.stats.max}};
+        std::cout << out.dump(2) << "\n";
+        return kExitOk;
+    }
+    std::cout << fmt::format("representation {}, white sample '{}', CIEDE2000 against spectral36 "
+                             "(CAT02 to D65, white Y = 1/1.13)\n",
+                             report.representation, set.names[report.whiteIndex]);
+    std::cout << fmt::format("{:<24} {:>26} {:>26} {:>8}\n", "sample", "Lab reference",
+                             "Lab approx", "de00");
+    for (const auto& s : report.samples) {
+        std::cout << fmt::format("{:<24} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.4f}\n",
+                                 s.name, s.labReference.L, s.labReference.a, s.labReference.b,
+                                 s.labApprox.L, s.labApprox.a, s.labApprox.b, s.de00);
+    }
+    std::cout << fmt::format("mean {:.4f}  std {:.4f}  p90 {:.4f}  max {:.4f}\n", report.stats.mean,
+                             report.stats.std, report.stats.p90, report.stats.max);
+    return kExitOk;
+}
+
 int runEval(const EvalOptions& o)
 {
     auto fail = [](const std::string& msg) {
@@ -82,35 +167,7 @@ int runEval(const EvalOptions& o)
         return fail(set.error().message);
     }
     if (o.sensed.sensed) {
-        // The light through the simulated spectrometer, adaptive_k6 (the appliance's), the display.
-        if (o.representation != spectral::kApplianceRepresentation || !o.encodedFor.empty()) {
-            return fail(fmt::format("--sensed renders as the appliance does ({}, encoded for the "
-                                    "sensed light); drop --representation and --encoded-for",
-                                    spectral::kApplianceRepresentation));
-        }
-        auto fine = spectral::restoreLines(*lightTable, "value");
-        if (!fine) {
-            return fail(fine.error().message);
-        }
-        fine->name = std::filesystem::path(o.illuminant).stem().string();
-        const std::string profile =
-                o.profile.empty() ? (data / "displays" / "wide-ips-synthetic.json").string()
-                                  : o.profile;
-        auto model = pipeline::display::loadProfile(profile);
-        if (!model) {
-            return fail(model.error().message);
-        }
-        auto inverse = pipeline::display::DisplayInverse::build(*model);
-        if (!inverse) {
-            return fail(fmt::format("{}: {}", profile, inverse.error().message));
-        }
-        const pipeline::display::DisplayModel panelModel = *model;
-        SensedReportOptions so = o.sensed;
-        so.json = o.json;
-        return sensedReport(
-                *inverse, [panelModel](const glm::dvec3& c) { return panelModel.forward(c); },
-                {*fine}, pipeline::display::SensedSamples{set->names, set->spectra}, 2000.0,
-                pipeline::display::FlareHandling::InBoothSubtract, so);
+        return runSensedEval(o, *lightTable, *set);
     }
     auto rep = spectral::makeRepresentation(data, *obs, *d65, o.representation);
     if (!rep) {
@@ -144,44 +201,7 @@ int runEval(const EvalOptions& o)
     if (!report) {
         return fail(fmt::format("{}: {}", o.reflectances, report.error().message));
     }
-    if (o.json) {
-        nlohmann::json out;
-        out["representation"] = report->representation;
-        out["illuminant"] = o.illuminant;
-        if (!o.encodedFor.empty()) {
-            out["encoded_for"] = o.encodedFor;
-        }
-        out["reflectances"] = o.reflectances;
-        out["white"] = set->names[report->whiteIndex];
-        out["grid"] = "380-730 nm, 10 nm (36 bands)";
-        out["samples"] = nlohmann::json::array();
-        for (const auto& s : report->samples) {
-            out["samples"].push_back({{"name", s.name},
-                                      {"lab_reference", labJson(s.labReference)},
-                                      {"lab_approx", labJson(s.labApprox)},
-                                      {"de00", s.de00}});
-        }
-        out["stats"] = {{"mean", report->stats.mean},
-                        {"std", report->stats.std},
-                        {"p90", report->stats.p90},
-                        {"max", report->stats.max}};
-        std::cout << out.dump(2) << "\n";
-        return kExitOk;
-    }
-    std::cout << fmt::format("representation {}, white sample '{}', CIEDE2000 against spectral36 "
-                             "(CAT02 to D65, white Y = 1/1.13)\n",
-                             report->representation, set->names[report->whiteIndex]);
-    std::cout << fmt::format("{:<24} {:>26} {:>26} {:>8}\n", "sample", "Lab reference",
-                             "Lab approx", "de00");
-    for (const auto& s : report->samples) {
-        std::cout << fmt::format("{:<24} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.3f} {:8.4f}\n",
-                                 s.name, s.labReference.L, s.labReference.a, s.labReference.b,
-                                 s.labApprox.L, s.labApprox.a, s.labApprox.b, s.de00);
-    }
-    std::cout << fmt::format("mean {:.4f}  std {:.4f}  p90 {:.4f}  max {:.4f}\n",
-                             report->stats.mean, report->stats.std, report->stats.p90,
-                             report->stats.max);
-    return kExitOk;
+    return printEvalReport(o, *report, *set);
 }
 
 struct FitOptions {
@@ -234,6 +254,114 @@ Expected<std::vector<std::pair<std::string, double>>> parseWeights(const std::st
     return weights;
 }
 
+// The training reflectances: named sets or CSV files, never the ColorChecker (the evaluation set).
+Expected<spectral::NamedSpectra> loadTraining(const std::filesystem::path& data,
+                                              const std::string& names)
+{
+    spectral::NamedSpectra training;
+    for (const auto& name : splitList(names)) {
+        if (name.rfind("colorchecker", 0) == 0) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("'{}' is the evaluation set; train on sets that exclude "
+                                         "it (ces99, or a CSV of your own)",
+                                         name));
+        }
+        auto set = name.find(".csv") != std::string::npos
+                           ? spectral::loadNamedSpectra(name)
+                           : spectral::loadReflectanceSet(data, name);
+        if (!set) {
+            return tl::unexpected(set.error());
+        }
+        training.append(*set);
+    }
+    return training;
+}
+
+// The training lights (--lights, else the evaluation lights) and any light --weights names
+// besides, with each one's weight in replica_k6 (others 1).
+Expected<spectral::NamedSpectra>
+loadFitLights(const std::filesystem::path& data,
+              const std::vector<std::string>& lightNames,
+              const std::vector<std::pair<std::string, double>>& weights,
+              std::vector<double>& lightWeights)
+{
+    spectral::NamedSpectra lights;
+    for (const auto& name : lightNames) {
+        auto l = spectral::loadCieIlluminant(data, name);
+        if (!l) {
+            return tl::unexpected(l.error());
+        }
+        lights.names.push_back(name);
+        lights.spectra.push_back(*l);
+    }
+    for (const auto& [name, w] : weights) {
+        if (std::find(lights.names.begin(), lights.names.end(), name) == lights.names.end()) {
+            auto l = spectral::loadCieIlluminant(data, name);
+            if (!l) {
+                return makeError(l.error().code, fmt::format("--weights: {}", l.error().message));
+            }
+            lights.names.push_back(name);
+            lights.spectra.push_back(*l);
+        }
+    }
+    for (const auto& name : lights.names) {
+        double w = 1.0;
+        for (const auto& [n, v] : weights) {
+            if (n == name) {
+                w = v;
+            }
+        }
+        lightWeights.push_back(w);
+    }
+    return lights;
+}
+
+// The output folder, checked before the fits (minutes), not after them.
+Expected<void> checkOutDir(const std::filesystem::path& outDir)
+{
+    std::error_code ec;
+    std::filesystem::create_directories(outDir, ec);
+    if (ec || !std::filesystem::is_directory(outDir)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("--out {}: cannot use it as the output folder ({}); give a "
+                                     "writable folder",
+                                     outDir.string(), ec ? ec.message() : "not a folder"));
+    }
+    const std::filesystem::path probe = outDir / ".replica-spectral-fit-write-test";
+    const bool writable = static_cast<bool>(std::ofstream(probe));
+    std::filesystem::remove(probe, ec);
+    if (!writable) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("--out {}: the folder is not writable; give a writable "
+                                     "folder",
+                                     outDir.string()));
+    }
+    return {};
+}
+
+// paper6's alternating fit is not convex, so its start matters. It starts from the light-aware
+// basis with the three booth lamps weighted 10 : 1, which generalised best to the ColorChecker of
+// the starts tried (that one, general_k6, replica_k6 as weighted now; docs/accuracy.md).
+Expected<spectral::SixChannelModel> fitPaperSix(const colour::Observer& obs,
+                                                const colour::Spectrum& d65,
+                                                const spectral::NamedSpectra& training,
+                                                const spectral::NamedSpectra& lights,
+                                                int rounds,
+                                                spectral::SixChannelFitReport& report)
+{
+    spectral::BasisFitOptions paperStart;
+    for (const auto& name : lights.names) {
+        const bool booth = name == "A" || name == "F8" || name == "F7";
+        paperStart.lightWeights.push_back(booth ? 10.0 : 1.0);
+    }
+    auto start = spectral::fitChannelBasis(obs, d65, training, lights, paperStart, "start");
+    if (!start) {
+        return tl::unexpected(start.error());
+    }
+    return spectral::fitSixChannelModel(obs, d65, training, lights, *start, rounds, "paper6",
+                                        &report);
+}
+
 int runFit(const FitOptions& o)
 {
     auto fail = [](const std::string& msg) {
@@ -253,110 +381,45 @@ int runFit(const FitOptions& o)
     if (!d65) {
         return fail(d65.error().message);
     }
-    spectral::NamedSpectra training;
-    for (const auto& name : splitList(o.reflectances)) {
-        if (name.rfind("colorchecker", 0) == 0) {
-            return fail(
-                    fmt::format("'{}' is the evaluation set; train on sets that exclude it (ces99, "
-                                "or a CSV of your own)",
-                                name));
-        }
-        auto set = name.find(".csv") != std::string::npos
-                           ? spectral::loadNamedSpectra(name)
-                           : spectral::loadReflectanceSet(data, name);
-        if (!set) {
-            return fail(set.error().message);
-        }
-        training.append(*set);
+    auto training = loadTraining(data, o.reflectances);
+    if (!training) {
+        return fail(training.error().message);
     }
-    spectral::NamedSpectra lights;
     const auto lightNames =
             o.lights.empty() ? spectral::evaluationLightNames() : splitList(o.lights);
-    for (const auto& name : lightNames) {
-        auto l = spectral::loadCieIlluminant(data, name);
-        if (!l) {
-            return fail(l.error().message);
-        }
-        lights.names.push_back(name);
-        lights.spectra.push_back(*l);
+    // replica_k6: every training light, weighted as --weights says; general_k6: all equal.
+    spectral::BasisFitOptions boothOptions;
+    auto lights = loadFitLights(data, lightNames, *weights, boothOptions.lightWeights);
+    if (!lights) {
+        return fail(lights.error().message);
     }
     const std::filesystem::path outDir =
             o.out.empty() ? data / "channels" : std::filesystem::path(o.out);
-    // The output folder is checked before the fits (minutes), not after them.
-    std::error_code ec;
-    std::filesystem::create_directories(outDir, ec);
-    if (ec || !std::filesystem::is_directory(outDir)) {
-        return fail(fmt::format("--out {}: cannot use it as the output folder ({}); give a "
-                                "writable folder",
-                                outDir.string(), ec ? ec.message() : "not a folder"));
+    if (auto ok = checkOutDir(outDir); !ok) {
+        return fail(ok.error().message);
     }
-    {
-        const std::filesystem::path probe = outDir / ".replica-spectral-fit-write-test";
-        const bool writable = static_cast<bool>(std::ofstream(probe));
-        std::filesystem::remove(probe, ec);
-        if (!writable) {
-            return fail(fmt::format("--out {}: the folder is not writable; give a writable "
-                                    "folder",
-                                    outDir.string()));
-        }
-    }
-    const std::string provenance =
-            fmt::format("fitted by 'replica spectral fit' on {} reflectances ({}) and {} lights "
-                        "({}); working grid "
-                        "380-730 nm at 10 nm; see docs/accuracy.md",
-                        training.size(), o.reflectances, lights.size(), fmt::join(lightNames, " "));
-
-    // replica_k6: every training light, weighted as --weights says; general_k6: all equal.
-    spectral::BasisFitOptions boothOptions;
-    for (const auto& [name, w] : *weights) {
-        if (std::find(lights.names.begin(), lights.names.end(), name) == lights.names.end()) {
-            auto l = spectral::loadCieIlluminant(data, name);
-            if (!l) {
-                return fail(fmt::format("--weights: {}", l.error().message));
-            }
-            lights.names.push_back(name);
-            lights.spectra.push_back(*l);
-        }
-    }
-    for (const auto& name : lights.names) {
-        double w = 1.0;
-        for (const auto& [n, v] : *weights) {
-            if (n == name) {
-                w = v;
-            }
-        }
-        boothOptions.lightWeights.push_back(w);
-    }
-    auto k6 = spectral::fitChannelBasis(*obs, *d65, training, lights, boothOptions, "replica_k6");
+    const std::string provenance = fmt::format(
+            "fitted by 'replica spectral fit' on {} reflectances ({}) and {} lights "
+            "({}); working grid "
+            "380-730 nm at 10 nm; see docs/accuracy.md",
+            training->size(), o.reflectances, lightNames.size(), fmt::join(lightNames, " "));
+    auto k6 = spectral::fitChannelBasis(*obs, *d65, *training, *lights, boothOptions, "replica_k6");
     if (!k6) {
         return fail(k6.error().message);
     }
-    auto general = spectral::fitChannelBasis(*obs, *d65, training, lights,
+    auto general = spectral::fitChannelBasis(*obs, *d65, *training, *lights,
                                              spectral::BasisFitOptions{}, "general_k6");
     if (!general) {
         return fail(general.error().message);
     }
     spectral::BasisFitOptions pca;
     pca.lightAware = false;
-    auto pca6 = spectral::fitChannelBasis(*obs, *d65, training, lights, pca, "pca6");
+    auto pca6 = spectral::fitChannelBasis(*obs, *d65, *training, *lights, pca, "pca6");
     if (!pca6) {
         return fail(pca6.error().message);
     }
-    // paper6's alternating fit is not convex, so its start matters. It starts from the light-aware
-    // basis with the three booth lamps weighted 10 : 1, which generalised best to the ColorChecker
-    // of the starts tried (that one, general_k6, replica_k6 as weighted now; docs/accuracy.md).
-    spectral::BasisFitOptions paperStart;
-    for (const auto& name : lights.names) {
-        const bool booth = name == "A" || name == "F8" || name == "F7";
-        paperStart.lightWeights.push_back(booth ? 10.0 : 1.0);
-    }
-    auto start = spectral::fitChannelBasis(*obs, *d65, training, lights, paperStart, "start");
-    if (!start) {
-        return fail(start.error().message);
-    }
     spectral::SixChannelFitReport report;
-    auto paper6 = spectral::fitSixChannelModel(*obs, *d65, training, lights, *start, o.rounds,
-                                               "paper6", &report);
+    auto paper6 = fitPaperSix(*obs, *d65, *training, *lights, o.rounds, report);
     if (!paper6) {
         return fail(paper6.error().message);
     }

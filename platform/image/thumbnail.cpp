@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <png.h>
 
 #include <platform/image/thumbnail.h>
@@ -102,6 +103,30 @@ Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image)
     png_write_image(png, rows.data());
     png_write_end(png, nullptr);
     png_destroy_write_struct(&png, &info);
+    return out;
+}
+
+Expected<RgbImage> decodePngRgb(const std::vector<std::uint8_t>& png)
+{
+    png_image image{};
+    image.version = PNG_IMAGE_VERSION;
+    if (png.empty() || png_image_begin_read_from_memory(&image, png.data(), png.size()) == 0) {
+        return makeError(ErrorCode::Corrupt, fmt::format("not a PNG: {}", image.message));
+    }
+    if (static_cast<long long>(image.width) * static_cast<long long>(image.height) >
+        kMaxThumbnailPixels) {
+        png_image_free(&image);
+        return makeError(ErrorCode::Corrupt, fmt::format("a PNG of {}x{} pixels is no thumbnail",
+                                                         image.width, image.height));
+    }
+    image.format = PNG_FORMAT_RGB;
+    RgbImage out;
+    out.width = static_cast<int>(image.width);
+    out.height = static_cast<int>(image.height);
+    out.rgb.resize(PNG_IMAGE_SIZE(image));
+    if (png_image_finish_read(&image, nullptr, out.rgb.data(), 0, nullptr) == 0) {
+        return makeError(ErrorCode::Corrupt, fmt::format("damaged PNG: {}", image.message));
+    }
     return out;
 }
 

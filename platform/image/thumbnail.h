@@ -24,4 +24,9 @@ RgbImage downscaleRgba(int width, int height, const std::vector<std::uint8_t>& r
 // PNG (8-bit RGB, zlib level 6) of the image, in memory.
 Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image);
 
+// The image of a PNG in memory (any colour type, converted to 8-bit RGB by libpng), at most
+// kMaxThumbnailPixels; fails with the reason on anything else.
+inline constexpr long long kMaxThumbnailPixels = 8192LL * 8192LL;
+Expected<RgbImage> decodePngRgb(const std::vector<std::uint8_t>& png);
+
 } // namespace replica::platform

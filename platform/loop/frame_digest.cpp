@@ -7,6 +7,7 @@
 #include <xxhash.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <platform/loop/frame_digest.h>
 
 namespace replica::platform {
@@ -78,6 +79,9 @@ Expected<DigestFile> readDigestFile(const std::filesystem::path& path)
         }
         return tl::unexpected(in.error());
     }
+    if (auto ok = checkJsonLimits(*in, path.string()); !ok) {
+        return tl::unexpected(ok.error());
+    }
     DigestFile file;
     auto& out = file.frames;
     try {
@@ -110,26 +114,6 @@ Expected<DigestFile> readDigestFile(const std::filesystem::path& path)
                          fmt::format("{}: malformed digest file: {}", path.string(), e.what()));
     }
     return file;
-}
-
-Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path)
-{
-    auto file = readDigestFile(path);
-    if (!file) {
-        return tl::unexpected(file.error());
-    }
-    return std::move(file->frames);
-}
-
-long firstDifference(const std::vector<FrameDigest>& a, const std::vector<FrameDigest>& b)
-{
-    const std::size_t n = std::min(a.size(), b.size());
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!(a[i] == b[i])) {
-            return static_cast<long>(i);
-        }
-    }
-    return a.size() == b.size() ? -1 : static_cast<long>(n);
 }
 
 } // namespace replica::platform

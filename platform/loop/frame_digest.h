@@ -42,10 +42,5 @@ Expected<void> writeDigests(const std::filesystem::path& path,
                             const std::vector<FrameDigest>& d,
                             DigestHash hash = kDigestHash);
 Expected<DigestFile> readDigestFile(const std::filesystem::path& path);
-// The frames only (either version).
-Expected<std::vector<FrameDigest>> readDigests(const std::filesystem::path& path);
-
-// The first index where the two lists differ (in any field or in length), or -1 if they are equal.
-long firstDifference(const std::vector<FrameDigest>& a, const std::vector<FrameDigest>& b);
 
 } // namespace replica::platform

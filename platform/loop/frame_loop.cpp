@@ -6,6 +6,10 @@
 #include <iostream>
 #include <string>
 #include <thread>
+#include <tuple>
+#include <type_traits>
+
+#include <state/scene_estimator.h>
 
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
@@ -114,6 +118,165 @@ std::uint64_t ticksToSkip(std::int64_t nowNs, std::int64_t tickNs, std::int64_t 
     return static_cast<std::uint64_t>((nowNs - tickNs) / periodNs);
 }
 
+namespace {
+
+// The estimators take exactly one typed sample of each kind of the typed registry, in its order:
+// a kind without its consumer (or a consumer without its kind) is a compile error here.
+template <typename... Samples>
+constexpr bool consumesEachKind(const recordings::KindTuple<Samples...>*)
+{
+    return std::is_invocable_v<decltype(&state::SceneEstimator::update), state::SceneEstimator&,
+                               pipeline::scene::SceneState&, const Samples*...>;
+}
+static_assert(consumesEachKind(static_cast<const recordings::StateKinds*>(nullptr)),
+              "state::SceneEstimator::update must take one sample of each of "
+              "recordings::StateKinds, in order");
+
+// When each frame starts: a realtime tick waits for its wall-clock time (skipping ticks a slow
+// frame missed, with skipLateTicks), a stepped one for a line on standard input.
+class Pacer
+{
+public:
+    Pacer(Pacing pacing, const LoopOptions& options)
+        : pacing_(pacing), options_(options), stepping_(pacing == Pacing::Step),
+          wallStart_(std::chrono::steady_clock::now())
+    {}
+
+    // The next tick to draw, none at the end.
+    std::optional<TickPlan> next(const TickSource& ticks, LoopStats& stats)
+    {
+        std::optional<TickPlan> tick = ticks();
+        if (!tick || pacing_ != Pacing::Realtime || !options_.skipLateTicks) {
+            return tick;
+        }
+        const std::uint64_t skip = ticksToSkip(elapsedNs(), tick->tickNs, options_.periodNs);
+        // The plan's last tick is rendered even when late: a fixed run ends on its last frame.
+        for (std::uint64_t i = 0; i < skip; ++i) {
+            std::optional<TickPlan> later = ticks();
+            if (!later) {
+                break;
+            }
+            tick = std::move(later);
+            ++stats.skippedTicks;
+        }
+        if (skip > 0) {
+            logger("loop")->debug("late: skipped {} ticks to frame {}", skip, tick->frameIndex);
+        }
+        return tick;
+    }
+
+    void wait(const TickPlan& tick, LoopStats& stats)
+    {
+        if (tick.estimateOnly) {
+            afterWarmup_ = true;
+        } else if (pacing_ == Pacing::Realtime) {
+            if (afterWarmup_) {
+                // Pace from here as if the session had started tickNs ago (a slice's first frame).
+                wallStart_ = std::chrono::steady_clock::now() -
+                             std::chrono::nanoseconds(std::min<std::int64_t>(
+                                     tick.tickNs, std::int64_t{1'000'000'000} * 86'400 * 365));
+                afterWarmup_ = false;
+            }
+            // A recording's tick is untrusted (a tick_ns of 9e18 is 285 years away): computed
+            // without overflow, and no frame waits more than a second. A live run's ticks are a
+            // period apart, at most a second (--rate >= 1), so this never shortens one.
+            const std::int64_t elapsed = elapsedNs();
+            if (tick.tickNs < elapsed - 2'000'000) {
+                ++stats.lateFrames;
+            }
+            if (tick.tickNs > elapsed) {
+                std::this_thread::sleep_for(std::chrono::nanoseconds(
+                        std::min<std::int64_t>(tick.tickNs - elapsed, 1'000'000'000)));
+            }
+        } else if (stepping_) {
+            std::string line;
+            if (!std::getline(std::cin, line)) {
+                stepping_ = false; // input closed: run the rest without waiting
+            }
+        }
+    }
+
+private:
+    std::int64_t elapsedNs() const
+    {
+        return std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::steady_clock::now() - wallStart_)
+                .count();
+    }
+
+    Pacing pacing_;
+    const LoopOptions& options_;
+    bool stepping_;
+    std::chrono::steady_clock::time_point wallStart_;
+    bool afterWarmup_ = false;
+};
+
+using Slots = decltype(recordings::DeviceSlots(
+        recordings::stateKinds(), std::declval<Sources&>(), nullptr));
+
+// Every source polled up to the tick, then each slot's sample for the frame chosen.
+void pollAndChoose(const Slots& slots, const TickPlan& tick, LoopStats& stats)
+{
+    const bool replaying = tick.recorded.has_value();
+    for (const auto& slot : slots.all()) {
+        const auto& kind = slot->kind();
+        if (auto d = slot->poll(tick.tickNs); d > 0) {
+            stats.dropped[kind.name()] += d;
+            logger("loop")->warn("{} {}: {} {} dropped before t={} ns", kind.names().displayName,
+                                 slot->source().info().serial, d, kind.names().samplesNoun,
+                                 tick.tickNs);
+        }
+    }
+    for (const auto& slot : slots.all()) {
+        slot->choose(replaying ? tick.recorded->sequence(slot->kind()) : std::nullopt, replaying,
+                     stats.replayMismatches);
+    }
+}
+
+// The display pass's gamut counters of one frame into the run's figures.
+void countGamut(const pipeline::render::RenderedFrame& image,
+                std::uint64_t frameIndex,
+                LoopStats& stats)
+{
+    // Over the surface's pixels: the black panel around a booth surface is below black by
+    // construction and would count whatever the booth and the display do.
+    const double oog = image.gamut.surfaceOutOfGamutFraction();
+    const auto& g = image.gamut;
+    const bool surface = g.surfacePixels > 0;
+    logger("loop")->debug("frame {}: {:.4f} of the {} pixels out of gamut (chroma {}, above peak "
+                          "{}, below black {})",
+                          frameIndex, oog, surface ? "surface's" : "frame's",
+                          surface ? g.surfaceChroma : g.chroma,
+                          surface ? g.surfaceOverPeak : g.overPeak,
+                          surface ? g.surfaceBelowBlack : g.belowBlack);
+    stats.sumOutOfGamutFraction += oog;
+    stats.maxOutOfGamutFraction = std::max(stats.maxOutOfGamutFraction, oog);
+    stats.sumOverPeakFraction += g.surfaceOverPeakFraction();
+    stats.maxOverPeakFraction = std::max(stats.maxOverPeakFraction, g.surfaceOverPeakFraction());
+}
+
+// After a frame: the recorder for the next ones (a rotation starts its file with the latest
+// sample of each device, so that it replays on its own).
+recordings::RecordingWriter* nextRecorder(const LoopOptions& options,
+                                          recordings::RecordingWriter* recorder,
+                                          const Slots& slots,
+                                          LoopStats& stats)
+{
+    if (!options.nextRecorder) {
+        return recorder;
+    }
+    auto* next = options.nextRecorder(recorder);
+    if (next != recorder && next != nullptr) {
+        for (const auto& slot : slots.all()) {
+            slot->writeLatest(*next);
+        }
+        ++stats.recorderRotations;
+    }
+    return next;
+}
+
+} // namespace
+
 Expected<LoopStats> runFrames(Appliance& appliance,
                               Sources& sources,
                               const TickSource& ticks,
@@ -127,114 +290,31 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     LoopStats stats;
     // One slot per device the run has, in the order they are polled and recorded; each polls its
     // source through the recording decorator (RecordingSource), which writes what it polls to
-    // the current recorder ('recorder' changes when the recording rotates).
+    // the current recorder ('recorder' changes when the recording rotates). The state stage's
+    // kinds are typed: their samples reach the estimators as typed pointers.
     recordings::DeviceSink* tee = recorder;
-    std::vector<std::unique_ptr<recordings::DeviceSlot>> slots;
-    for (auto& e : sources.entries()) {
-        if (e.source) {
-            slots.push_back(e.kind->makeSlot(*e.source, &tee));
-            stats.dropped[e.kind->name()] = 0;
-        }
+    const Slots slots(recordings::stateKinds(), sources, &tee);
+    for (const auto& slot : slots.all()) {
+        stats.dropped[slot->kind().name()] = 0;
     }
-    const auto slotOf = [&slots](const recordings::DeviceKindBase& kind) {
-        for (const auto& s : slots) {
-            if (&s->kind() == &kind) {
-                return static_cast<const recordings::DeviceSlot*>(s.get());
-            }
-        }
-        return static_cast<const recordings::DeviceSlot*>(nullptr);
-    };
-    const auto* spectrometer = slotOf(recordings::spectrometerKind());
-    const auto* tracker = slotOf(recordings::trackerKind());
-    const auto* accel = slotOf(recordings::accelKind());
-    const auto* lampSelector = slotOf(recordings::lampSelectorKind());
     pipeline::scene::SceneState state;
     pipeline::render::RenderedFrame image;
-    bool stepping = pacing == Pacing::Step;
-    auto wallStart = std::chrono::steady_clock::now();
-    bool afterWarmup = false;
-
-    for (;;) {
-        if (stopRequested()) {
-            log->info("stop requested: ending after {} frames", stats.frames);
+    Pacer pacer(pacing, options);
+    while (!stopRequested()) {
+        const std::optional<TickPlan> next = pacer.next(ticks, stats);
+        if (!next) {
             break;
         }
-        std::optional<TickPlan> nextTick = ticks();
-        if (!nextTick) {
-            break;
-        }
-        if (pacing == Pacing::Realtime && options.skipLateTicks) {
-            const std::int64_t nowNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                               std::chrono::steady_clock::now() - wallStart)
-                                               .count();
-            const std::uint64_t skip = ticksToSkip(nowNs, nextTick->tickNs, options.periodNs);
-            // The plan's last tick is rendered even when late: a fixed run ends on its last frame.
-            for (std::uint64_t i = 0; i < skip; ++i) {
-                std::optional<TickPlan> later = ticks();
-                if (!later) {
-                    break;
-                }
-                nextTick = std::move(later);
-                ++stats.skippedTicks;
-            }
-            if (skip > 0) {
-                log->debug("late: skipped {} ticks to frame {}", skip, nextTick->frameIndex);
-            }
-        }
-        const TickPlan& tick = *nextTick;
-        if (tick.warmup) {
-            afterWarmup = true;
-        } else if (pacing == Pacing::Realtime) {
-            if (afterWarmup) {
-                // Pace from here as if the session had started tickNs ago (a slice's first frame).
-                wallStart = std::chrono::steady_clock::now() -
-                            std::chrono::nanoseconds(std::min<std::int64_t>(
-                                    tick.tickNs, std::int64_t{1'000'000'000} * 86'400 * 365));
-                afterWarmup = false;
-            }
-            // A recording's tick is untrusted (a tick_ns of 9e18 is 285 years away): computed
-            // without overflow, and no frame waits more than a second. A live run's ticks are a
-            // period apart, at most a second (--rate >= 1), so this never shortens one.
-            const std::int64_t elapsed = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                                 std::chrono::steady_clock::now() - wallStart)
-                                                 .count();
-            if (tick.tickNs < elapsed - 2'000'000) {
-                ++stats.lateFrames;
-            }
-            if (tick.tickNs > elapsed) {
-                std::this_thread::sleep_for(std::chrono::nanoseconds(
-                        std::min<std::int64_t>(tick.tickNs - elapsed, 1'000'000'000)));
-            }
-        } else if (stepping) {
-            std::string line;
-            if (!std::getline(std::cin, line)) {
-                stepping = false; // input closed: run the rest without waiting
-            }
-        }
-
+        const TickPlan& tick = *next;
+        pacer.wait(tick, stats);
         const auto workStart = std::chrono::steady_clock::now();
-        const bool replaying = tick.recorded.has_value();
-        for (auto& slot : slots) {
-            const auto& kind = slot->kind();
-            if (auto d = slot->poll(tick.tickNs); d > 0) {
-                stats.dropped[kind.name()] += d;
-                log->warn("{} {}: {} {} dropped before t={} ns", kind.names().displayName,
-                          slot->source().info().serial, d, kind.names().samplesNoun, tick.tickNs);
-            }
-        }
-        for (auto& slot : slots) {
-            slot->choose(replaying ? tick.recorded->sequence(slot->kind()) : std::nullopt,
-                         replaying, stats.replayMismatches);
-        }
-
+        pollAndChoose(slots, tick, stats);
         state.frameIndex = tick.frameIndex;
         state.tickNs = tick.tickNs;
-        appliance.updater->update(state,
-                                  recordings::chosenSample<hal::SpectrumSample>(spectrometer),
-                                  recordings::chosenSample<hal::PoseSample>(tracker),
-                                  recordings::chosenSample<hal::AccelSample>(accel),
-                                  recordings::chosenSample<hal::LampSample>(lampSelector));
-        if (tick.warmup) {
+        std::apply(
+                [&](const auto*... sample) { appliance.sceneEstimator->update(state, sample...); },
+                slots.chosen());
+        if (tick.estimateOnly) {
             // Before a replayed slice: the state stage alone. A frame is a function of its
             // SceneState (the renderer keeps no history), so nothing before the slice is drawn.
             ++stats.estimatedOnly;
@@ -243,28 +323,13 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         if (auto ok = appliance.renderer->render(state, image, readback); !ok) {
             return tl::unexpected(ok.error());
         }
-        // Over the surface's pixels: the black panel around a booth surface is below black by
-        // construction and would count whatever the booth and the display do.
-        const double oog = image.gamut.surfaceOutOfGamutFraction();
-        const auto& g = image.gamut;
-        const bool surface = g.surfacePixels > 0;
-        log->debug("frame {}: {:.4f} of the {} pixels out of gamut (chroma {}, above peak {}, "
-                   "below black {})",
-                   tick.frameIndex, oog, surface ? "surface's" : "frame's",
-                   surface ? g.surfaceChroma : g.chroma, surface ? g.surfaceOverPeak : g.overPeak,
-                   surface ? g.surfaceBelowBlack : g.belowBlack);
-        stats.sumOutOfGamutFraction += oog;
-        stats.maxOutOfGamutFraction = std::max(stats.maxOutOfGamutFraction, oog);
-        stats.sumOverPeakFraction += g.surfaceOverPeakFraction();
-        stats.maxOverPeakFraction =
-                std::max(stats.maxOverPeakFraction, g.surfaceOverPeakFraction());
+        countGamut(image, tick.frameIndex, stats);
         DisplayFrame frame{image.width, image.height, image.rgba, image.displayFramebuffer};
         if (auto ok = appliance.output->present(frame); !ok) {
             log->warn("output {}: {}", appliance.output->name(), ok.error().message);
         }
-
         recordings::FrameRecord record{tick.frameIndex, tick.tickNs, {}};
-        for (const auto& slot : slots) {
+        for (const auto& slot : slots.all()) {
             record.setSequence(slot->kind(), slot->chosenSequence());
         }
         if (recorder != nullptr) {
@@ -282,18 +347,11 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         if (options.afterFrame) {
             options.afterFrame(stats);
         }
-        if (options.nextRecorder) {
-            auto* next = options.nextRecorder(recorder);
-            if (next != recorder && next != nullptr) {
-                // The new file starts with what the scene holds now.
-                for (const auto& slot : slots) {
-                    slot->writeLatest(*next);
-                }
-                ++stats.recorderRotations;
-            }
-            recorder = next;
-            tee = recorder;
-        }
+        recorder = nextRecorder(options, recorder, slots, stats);
+        tee = recorder;
+    }
+    if (stopRequested()) {
+        log->info("stop requested: ending after {} frames", stats.frames);
     }
     if (stats.replayMismatches > 0) {
         log->warn("replay: {} recorded samples were missing; the latest sample was used instead",

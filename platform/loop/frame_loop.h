@@ -33,7 +33,7 @@ struct TickPlan {
     // only (state/: classifier, held samples, held tilt, encoding), not rendered, so that the
     // slice's first frame has the recording's state. It never waits for its tick or for a step;
     // the first frame after it anchors the pacing.
-    bool warmup = false;
+    bool estimateOnly = false;
 };
 
 // Ticks k * period for k = 0 .. frames-1.
@@ -46,9 +46,9 @@ struct LoopStats {
     // Device kind name -> samples lost (sequence gaps seen), for every device the run has.
     std::map<std::string, std::uint64_t> dropped;
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
-    std::uint64_t replayMismatches = 0;  // replay: a recorded sample was not found (latest used)
-    std::uint64_t skippedTicks = 0;      // LoopOptions::skipLateTicks: ticks never rendered
-    std::uint64_t estimatedOnly = 0;     // TickPlan::warmup: ticks only estimated, never drawn
+    std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
+    std::uint64_t skippedTicks = 0;     // LoopOptions::skipLateTicks: ticks never rendered
+    std::uint64_t estimatedOnly = 0;    // TickPlan::estimateOnly: ticks only estimated, never drawn
     std::uint64_t recorderRotations = 0; // LoopOptions::nextRecorder returned a new recorder
     // Each frame's work on the wall clock, from polling the sources to handing the frame on
     // (not the wait for its tick): what says whether the machine keeps the rate.
@@ -85,9 +85,8 @@ TickSource fixedRateTicks(std::int64_t periodNs, std::uint64_t frames);
 // int64 nanoseconds, and 0 already means "without end".
 constexpr std::uint64_t kMaxFrames = 1'000'000'000;
 
-// Asks a running loop to stop after the frame in hand (async-signal-safe: SIGINT/SIGTERM handlers
-// call it), so that recordings are closed properly. installStopSignals() routes both signals here.
-void requestStop();
+// Whether SIGINT/SIGTERM asked a running loop to stop after the frame in hand, so that recordings
+// are closed properly; installStopSignals() routes both signals to an async-signal-safe flag.
 bool stopRequested();
 void installStopSignals();
 

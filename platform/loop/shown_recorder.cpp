@@ -38,27 +38,33 @@ int foxgloveLevel(spdlog::level::level_enum l)
 
 } // namespace
 
-ShownRecorder::ShownRecorder(recordings::RecordingWriter& writer,
+ShownRecorder::ShownRecorder(recordings::RecordingWriter* writer,
                              const Appliance& appliance,
                              ShownOptions options)
-    : writer_(writer), appliance_(appliance), options_(options)
+    : writer_(writer), start_(Clock::now()), appliance_(appliance), options_(options)
 {
     if (auto obs = pipeline::colour::loadCie1931(dataDir()); obs) {
         observer_ = std::move(*obs);
     }
     if (options_.log) {
-        // Session time of a message: since the recorder was made, just before the first tick.
-        const auto start = Clock::now();
-        logTap_ = tapLogs(spdlog::level::warn, [this, start](spdlog::level::level_enum level,
-                                                             const std::string& area,
-                                                             const std::string& message) {
+        // Session time of a message: since the recorder was made, just before the first tick;
+        // those logged before it (the process's start-up) at 0.
+        logTap_ = followLogs([this](const LoggedMessage& m) {
             recordings::LogRecord r;
-            r.tNs = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start)
-                            .count();
-            r.level = foxgloveLevel(level);
-            r.name = area;
-            r.message = message;
-            writer_.write(r);
+            r.tNs = std::max<std::int64_t>(
+                    0,
+                    std::chrono::duration_cast<std::chrono::nanoseconds>(m.time - start_).count());
+            r.level = foxgloveLevel(m.level);
+            r.name = m.area;
+            r.message = m.message;
+            std::lock_guard lock(writerMutex_);
+            logs_.push_back(r);
+            if (logs_.size() > kLogHistoryLimit) {
+                logs_.erase(logs_.begin());
+            }
+            if (writer_ != nullptr) {
+                writer_->write(r);
+            }
         });
     }
     if (options_.thumbnailHz > 0.0 && options_.thumbnailWidth > 0) {
@@ -78,14 +84,36 @@ pipeline::render::Readback ShownRecorder::readback() const
                                                  : pipeline::render::Readback::None;
 }
 
+void ShownRecorder::setWriter(recordings::RecordingWriter* writer)
+{
+    {
+        std::lock_guard lock(writerMutex_);
+        if (writer == writer_) {
+            return;
+        }
+        writer_ = writer;
+        ++writerGeneration_;
+        if (writer_ != nullptr) {
+            for (const auto& r : logs_) {
+                writer_->write(r);
+            }
+        }
+    }
+    // The new file's first frame records the eye, the light and a thumbnail afresh.
+    lastPose_.reset();
+    lastLamp_ = -2;
+    lastLightSpectrum_.reset();
+    lastLightNs_ = 0;
+    nextThumbnailNs_ = 0;
+}
+
 void ShownRecorder::onFrame(const recordings::FrameRecord& frame,
                             const pipeline::scene::SceneState& state,
                             const pipeline::render::RenderedFrame& image)
 {
     if (options_.displayDigests && !image.rgba.empty()) {
         const auto t0 = Clock::now();
-        writer_.write(recordings::DisplayDigestRecord{frame.frameIndex, frame.tickNs,
-                                                      xxh3_64(image.rgba)});
+        write(recordings::DisplayDigestRecord{frame.frameIndex, frame.tickNs, xxh3_64(image.rgba)});
         std::lock_guard lock(mutex_);
         stats_.digestMsTotal += msSince(t0);
         ++stats_.digests;
@@ -105,6 +133,10 @@ void ShownRecorder::onFrame(const recordings::FrameRecord& frame,
         Pending p = pending_ ? std::move(*pending_) : Pending{};
         p.tNs = frame.tickNs;
         p.frameIndex = frame.frameIndex;
+        {
+            std::lock_guard writerLock(writerMutex_);
+            p.generation = writerGeneration_;
+        }
         p.width = image.width;
         p.height = image.height;
         p.rgba.assign(image.rgba.begin(), image.rgba.end());
@@ -115,8 +147,8 @@ void ShownRecorder::onFrame(const recordings::FrameRecord& frame,
     const bool moved = !lastPose_ || lastPose_->eyeBoothM != state.eyeBoothM ||
                        lastPose_->tiltRad != state.tiltRad;
     if (moved && (!lastPose_ || state.tickNs - lastPoseNs_ >= options_.posePeriodNs)) {
-        writer_.write(recordings::PosesRecord{frame.tickNs, state.eyeBoothM, state.tiltRad,
-                                              appliance_.updater->trackerInBooth().translation});
+        write(recordings::PosesRecord{frame.tickNs, state.eyeBoothM, state.tiltRad,
+                                      appliance_.sceneEstimator->trackerInBooth().translation});
         lastPose_ = state;
         lastPoseNs_ = state.tickNs;
         std::lock_guard lock(mutex_);
@@ -139,14 +171,14 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
     recordings::LightRecord l;
     l.tNs = frame.tickNs;
     l.frameIndex = frame.frameIndex;
-    const auto c = appliance_.updater->classification();
+    const auto c = appliance_.sceneEstimator->classification();
     l.distance = c.distance;
     const auto& lamps = appliance_.booth.lights;
     if (s.lampIndex >= 0 && static_cast<std::size_t>(s.lampIndex) < lamps.size()) {
         l.mode = "lamp";
         l.lamp = s.lampIndex;
         l.name = lamps[static_cast<std::size_t>(s.lampIndex)].name;
-        const int trusted = appliance_.updater->lampArbiter().trustedLamp();
+        const int trusted = appliance_.sceneEstimator->lampArbiter().trustedLamp();
         l.why = trusted == s.lampIndex
                         ? fmt::format("the booth's lamp selector is set to {} (lamp {})", l.name,
                                       l.lamp)
@@ -170,7 +202,7 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
             l.duv = cct->duv;
         }
     }
-    writer_.write(l);
+    write(l);
     lastLamp_ = s.lampIndex;
     lastLightNs_ = frame.tickNs;
     lastLightSpectrum_ = frame.sequence(recordings::spectrometerKind());
@@ -200,7 +232,14 @@ void ShownRecorder::encoderLoop()
             continue;
         }
         const auto bytes = png->size();
-        writer_.write(recordings::ThumbnailRecord{p.tNs, p.frameIndex, std::move(*png)});
+        {
+            // A frame of the previous file is not the next file's thumbnail.
+            std::lock_guard writerLock(writerMutex_);
+            if (writer_ == nullptr || p.generation != writerGeneration_) {
+                continue;
+            }
+            writer_->write(recordings::ThumbnailRecord{p.tNs, p.frameIndex, std::move(*png)});
+        }
         std::lock_guard lock(mutex_);
         ++stats_.thumbnails;
         stats_.thumbnailBytes += bytes;

@@ -1,8 +1,9 @@
 // What the panel showed, into the recording (format 4): a digest of every displayed frame, a PNG
 // thumbnail at a low rate (downscaled and encoded on a thread of its own, never in the frame's
 // time), the eye, panel and tracker frames, the decided light when it changes, and the
-// appliance's warnings and errors. None of it changes a frame: it reads the frame after it was
-// rendered and handed to the output.
+// appliance's warnings and errors (those logged before the recorder was made included). None of
+// it changes a frame: it reads the frame after it was rendered and handed to the output. One
+// recorder serves a single --record file and a kiosk session's rotated files alike (setWriter).
 #pragma once
 
 #include <atomic>
@@ -47,7 +48,7 @@ struct ShownStats {
 class ShownRecorder
 {
 public:
-    ShownRecorder(recordings::RecordingWriter& writer,
+    ShownRecorder(recordings::RecordingWriter* writer,
                   const Appliance& appliance,
                   ShownOptions options);
     ~ShownRecorder();
@@ -56,6 +57,11 @@ public:
 
     // The read-back the loop must do for this (the display frame, or nothing).
     pipeline::render::Readback readback() const;
+    // The file to record into from the next frame on (a kiosk session's next file; null: none).
+    // A new file starts as a file of its own: every warning and error so far, the eye and
+    // transforms, the light in force and a thumbnail at its first frame. Call from the frame
+    // thread, between frames.
+    void setWriter(recordings::RecordingWriter* writer);
     // Call after each frame was presented (the loop's frame callback).
     void onFrame(const recordings::FrameRecord& frame,
                  const pipeline::scene::SceneState& state,
@@ -68,8 +74,22 @@ public:
 private:
     void encoderLoop();
     void recordLight(const recordings::FrameRecord& frame, const pipeline::scene::SceneState& s);
+    template <typename Record>
+    void write(const Record& r)
+    {
+        std::lock_guard lock(writerMutex_);
+        if (writer_ != nullptr) {
+            writer_->write(r);
+        }
+    }
 
-    recordings::RecordingWriter& writer_;
+    // The writer in use, and how many writers came before it; the messages logged so far (the
+    // newest kLogHistoryLimit), each new file's first records.
+    mutable std::mutex writerMutex_;
+    recordings::RecordingWriter* writer_ = nullptr;
+    std::uint64_t writerGeneration_ = 0;
+    std::vector<recordings::LogRecord> logs_;
+    std::chrono::steady_clock::time_point start_;
     const Appliance& appliance_;
     ShownOptions options_;
     std::optional<pipeline::colour::Observer> observer_;
@@ -85,6 +105,7 @@ private:
     struct Pending {
         std::int64_t tNs = 0;
         std::uint64_t frameIndex = 0;
+        std::uint64_t generation = 0; // the writer it belongs in
         int width = 0, height = 0;
         std::vector<std::uint8_t> rgba;
     };

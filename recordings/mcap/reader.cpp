@@ -38,11 +38,26 @@ std::optional<ChunkFields> chunkFields(std::string_view content)
     return c;
 }
 
+// What unpacking chunks may cost: the uncompressed bytes they may produce (and so copy and
+// checksum), and what they did (Scan::bytesExamined).
+struct Work {
+    std::uint64_t budget = 0;
+    bool overBudget = false;
+    std::uint64_t examined = 0;
+};
+
 // Decompresses and checks a chunk; returns the reason it is unusable, or the records. Every
-// chunk's uncompressed size is taken from 'budget' before anything is allocated; 'overBudget' is
-// set when it runs out (the scan then stops).
-std::string unpack(const ChunkFields& c, std::string& out, std::uint64_t& budget, bool& overBudget)
+// chunk's uncompressed size is taken from the budget before anything is allocated, copied or
+// checksummed, so that the work of every attempt (recover tries each plausible chunk header after
+// damage) is bounded by the budget; 'overBudget' is set when it runs out (the scan then stops).
+std::string unpack(const ChunkFields& c, std::string& out, Work& work)
 {
+    if (c.compression.empty() && c.records.size() != c.uncompressedSize) {
+        // Checked before the copy: a chunk claiming 0 bytes must not make each attempt copy
+        // megabytes for free (nested chunks made recover quadratic in the file's size).
+        return fmt::format("holds {} bytes uncompressed, not the {} it claims", c.records.size(),
+                           c.uncompressedSize);
+    }
     if (c.uncompressedSize > kMaxChunkBytes) {
         return fmt::format("claims {} uncompressed bytes (at most {} MiB)", c.uncompressedSize,
                            kMaxChunkBytes >> 20);
@@ -62,12 +77,16 @@ std::string unpack(const ChunkFields& c, std::string& out, std::uint64_t& budget
     } else if (!c.compression.empty()) {
         return fmt::format("uses unsupported compression '{}'", c.compression);
     }
-    if (c.uncompressedSize > budget) {
-        overBudget = true;
+    // What this attempt reads and writes: the uncompressed records, and a zstd frame's input too
+    // (a frame of many empty blocks produces nothing but takes time to read).
+    const std::uint64_t cost = c.uncompressedSize + (c.compression.empty() ? 0 : c.records.size());
+    if (cost > work.budget) {
+        work.overBudget = true;
         return fmt::format("would take the recording past its decompression budget ({})",
                            "see docs/recordings.md, 'Limits'");
     }
-    budget -= c.uncompressedSize;
+    work.budget -= cost;
+    work.examined += cost;
     if (c.compression.empty()) {
         out.assign(c.records);
     } else if (c.compression == "zstd") {
@@ -94,12 +113,21 @@ std::string unpack(const ChunkFields& c, std::string& out, std::uint64_t& budget
 class Scanner
 {
 public:
-    Scanner(std::string_view file, const ScanOptions& o)
-        : f_(file), o_(o), budget_(o.maxDecompressedBytes != 0 ? o.maxDecompressedBytes
-                                                               : decompressionBudget(file.size()))
-    {}
+    Scanner(std::string_view file, const ScanOptions& o) : f_(file), o_(o)
+    {
+        work_.budget = o.maxDecompressedBytes != 0 ? o.maxDecompressedBytes
+                                                   : decompressionBudget(file.size());
+    }
 
     Scan run()
+    {
+        Scan s = records();
+        s.bytesExamined = work_.examined;
+        return s;
+    }
+
+private:
+    Scan records()
     {
         if (f_.size() < kMagic.size() || f_.substr(0, kMagic.size()) != kMagic) {
             problem("not an MCAP file (bad magic bytes at byte 0)");
@@ -180,7 +208,7 @@ public:
             default:
                 break; // indexes, attachments, metadata and private records carry no samples
             }
-            if (overBudget_) {
+            if (work_.overBudget) {
                 return overBudget();
             }
             if (!ok) {
@@ -197,7 +225,7 @@ public:
             s_.dataSectionEnd = next;
             at = next;
         }
-        if (overBudget_) {
+        if (work_.overBudget) {
             return overBudget();
         }
         problem(fmt::format("no Data End record: the recording was cut short at byte {} (power "
@@ -206,7 +234,6 @@ public:
         return std::move(s_);
     }
 
-private:
     Scan overBudget()
     {
         // What is not read is lost: counted, so that recover says so (exit 3).
@@ -250,8 +277,8 @@ private:
                 continue;
             }
             std::string records;
-            if (!unpack(*c, records, budget_, overBudget_).empty()) {
-                if (overBudget_) {
+            if (!unpack(*c, records, work_).empty()) {
+                if (work_.overBudget) {
                     break;
                 }
                 continue;
@@ -328,8 +355,8 @@ private:
             return false;
         }
         std::string records;
-        if (auto why = unpack(*c, records, budget_, overBudget_); !why.empty()) {
-            if (overBudget_) {
+        if (auto why = unpack(*c, records, work_); !why.empty()) {
+            if (work_.overBudget) {
                 return false; // reported once, by run()
             }
             problem(fmt::format("chunk at byte {} {}", at, why));
@@ -440,6 +467,9 @@ private:
             const auto body = f_.substr(p + kRecordPrefix, rlen);
             if (rop == Op::ChunkIndex) {
                 ++chunkIndexes;
+                chunkIndex(body, p);
+            } else if (rop == Op::MetadataIndex) {
+                metadataIndex(body, p);
             } else if (rop == Op::Statistics) {
                 statistics(body);
             } else if (rop == Op::Channel) {
@@ -455,6 +485,90 @@ private:
         if (chunkIndexes != s_.chunks.size()) {
             problem(fmt::format("the summary indexes {} chunks but the data section holds {}",
                                 chunkIndexes, s_.chunks.size()));
+        }
+        if (offsetsStart != 0) {
+            summaryOffsets(offsetsStart, footerAt, summaryStart, summaryEnd);
+        }
+    }
+
+    // A Chunk Index must point at a chunk the scan found intact, exactly, and its message index
+    // offsets into the data section after that chunk: an index is how other readers seek.
+    void chunkIndex(std::string_view body, std::size_t at)
+    {
+        ByteReader r(body);
+        r.u64();
+        r.u64();
+        const auto offset = r.u64();
+        const auto length = r.u64();
+        ByteReader map(r.str());
+        if (r.failed()) {
+            problem(fmt::format("malformed Chunk Index record at byte {} in the summary", at));
+            return;
+        }
+        const auto it =
+                std::lower_bound(s_.chunks.begin(), s_.chunks.end(), offset,
+                                 [](const ChunkSpan& c, std::uint64_t o) { return c.offset < o; });
+        if (it == s_.chunks.end() || it->offset != offset || it->length != length) {
+            problem(fmt::format("the Chunk Index at byte {} points at bytes {}..+{}, where the "
+                                "data section holds no intact chunk of that length",
+                                at, offset, length));
+            return;
+        }
+        while (map.remaining() > 0 && !map.failed()) {
+            map.u16();
+            const auto indexAt = map.u64();
+            if (!map.failed() && (indexAt < offset + length || indexAt >= s_.dataSectionEnd)) {
+                problem(fmt::format("the Chunk Index at byte {} puts a message index at byte {}, "
+                                    "outside the data section after its chunk",
+                                    at, indexAt));
+                return;
+            }
+        }
+    }
+
+    void metadataIndex(std::string_view body, std::size_t at)
+    {
+        ByteReader r(body);
+        const auto offset = r.u64();
+        const auto length = r.u64();
+        if (r.failed() || offset < kMagic.size() || offset > s_.dataSectionEnd ||
+            length > s_.dataSectionEnd - offset) {
+            problem(fmt::format("the Metadata Index at byte {} points outside the data section "
+                                "(byte {}, {} bytes)",
+                                at, offset, length));
+        }
+    }
+
+    // Summary Offset records, between their start and the footer: each group within the summary.
+    void summaryOffsets(std::size_t from,
+                        std::size_t to,
+                        std::size_t summaryStart,
+                        std::size_t summaryEnd)
+    {
+        std::size_t p = from;
+        while (p + kRecordPrefix <= to) {
+            ByteReader r(f_.substr(p, kRecordPrefix));
+            const auto op = static_cast<Op>(r.u8());
+            const auto len = r.u64();
+            if (len > to - p - kRecordPrefix) {
+                problem(fmt::format("summary offset record at byte {} overruns the footer", p));
+                return;
+            }
+            ByteReader g(f_.substr(p + kRecordPrefix, len));
+            g.u8();
+            const auto start = g.u64();
+            const auto length = g.u64();
+            if (op == Op::SummaryOffset && (g.failed() || start < summaryStart ||
+                                            start > summaryEnd || length > summaryEnd - start)) {
+                problem(fmt::format("the Summary Offset at byte {} points outside the summary "
+                                    "(byte {}, {} bytes)",
+                                    p, start, length));
+                return;
+            }
+            p += kRecordPrefix + static_cast<std::size_t>(len);
+        }
+        if (p != to) {
+            problem(fmt::format("the summary offsets end in a partial record at byte {}", p));
         }
     }
 
@@ -497,8 +611,7 @@ private:
     ScanOptions o_;
     Scan s_;
     std::size_t resyncAt_ = 0;
-    std::uint64_t budget_ = 0;
-    bool overBudget_ = false;
+    Work work_;
 };
 
 } // namespace

@@ -69,6 +69,10 @@ struct Scan {
     bool footer = false;              // footer and trailing magic present and consistent
     bool summary = false;             // a summary with statistics was present and checked
     std::uint64_t dataSectionEnd = 0; // offset just past the last intact data-section record
+    // Chunk bytes copied, decompressed and checksummed, every attempt counted (recover's resync
+    // tries each plausible chunk header after damage), zstd input included: at most the
+    // decompression budget, so the work is linear in the file's size.
+    std::uint64_t bytesExamined = 0;
 };
 
 // Scans a whole file held in memory. Never throws on malformed input; reports it in damage.

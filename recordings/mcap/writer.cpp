@@ -5,6 +5,7 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zstd.h>
@@ -55,6 +56,14 @@ FileWriter::create(const std::filesystem::path& path, const std::string& library
                 ErrorCode::Io,
                 fmt::format("{}: cannot create recording: {}{}", path.string(), std::strerror(err),
                             err == EACCES || err == EROFS ? " (choose a writable directory)" : ""));
+    }
+    // Locked while it is written: the kiosk's recovery and retention leave a locked file alone
+    // (platform/session_files.h), and two writers never share one file.
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        ::close(fd);
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("{}: another process is writing it; name another file", path.string()));
     }
     struct stat st {
     };
@@ -239,27 +248,58 @@ Expected<void> FileWriter::checkNotDeleted()
     return {};
 }
 
-Expected<void> FileWriter::finish()
+// The chunk index records, one per chunk written.
+std::string FileWriter::chunkIndexRecords() const
 {
-    if (finished_) {
-        return failure_ ? Expected<void>(tl::unexpected(*failure_)) : Expected<void>{};
+    std::string g;
+    for (const auto& ci : chunkIndexes_) {
+        ByteWriter map;
+        for (const auto& [channel, at] : ci.indexOffsets) {
+            map.u16(channel);
+            map.u64(at);
+        }
+        ByteWriter w;
+        w.u64(ci.startTime);
+        w.u64(ci.endTime);
+        w.u64(ci.offset);
+        w.u64(ci.length);
+        w.str(map.bytes());
+        w.u64(ci.indexLength);
+        w.str("zstd");
+        w.u64(ci.compressedSize);
+        w.u64(ci.uncompressedSize);
+        g += record(Op::ChunkIndex, w.bytes());
     }
-    if (auto ok = closeChunk(false); !ok) {
-        finished_ = true;
-        return ok;
+    return g;
+}
+
+// The statistics record: message, schema, channel, metadata and chunk counts, the time span, and
+// the messages per channel.
+std::string FileWriter::statisticsRecord() const
+{
+    ByteWriter counts;
+    for (const auto& [channel, n] : channelCounts_) {
+        counts.u16(channel);
+        counts.u64(n);
     }
-    if (auto ok = checkNotDeleted(); !ok) {
-        finished_ = true;
-        return ok;
-    }
-    ByteWriter dataEnd;
-    dataEnd.u32(dataCrc_);
-    if (auto ok = put(record(Op::DataEnd, dataEnd.bytes())); !ok) {
-        finished_ = true;
-        return ok;
-    }
-    finished_ = true;
-    const std::uint64_t summaryStart = offset_;
+    ByteWriter w;
+    w.u64(messageCount_);
+    w.u16(static_cast<std::uint16_t>(schemas_.size()));
+    w.u32(static_cast<std::uint32_t>(channels_.size()));
+    w.u32(0);
+    w.u32(static_cast<std::uint32_t>(metadataIndexes_.size()));
+    w.u32(static_cast<std::uint32_t>(chunkIndexes_.size()));
+    w.u64(messageCount_ ? firstTime_ : 0);
+    w.u64(messageCount_ ? lastTime_ : 0);
+    w.str(counts.bytes());
+    return record(Op::Statistics, w.bytes());
+}
+
+// The summary section from 'summaryStart' to the end of the file: schemas, channels, chunk and
+// metadata indexes and statistics, each group's offset, the footer, the summary's CRC and the
+// closing magic.
+std::string FileWriter::summarySection(std::uint64_t summaryStart) const
+{
     std::string summary;
     struct Group {
         Op op;
@@ -282,26 +322,7 @@ Expected<void> FileWriter::finish()
         g += encodeChannel(c);
     }
     group(Op::Channel, g);
-    g.clear();
-    for (const auto& ci : chunkIndexes_) {
-        ByteWriter map;
-        for (const auto& [channel, at] : ci.indexOffsets) {
-            map.u16(channel);
-            map.u64(at);
-        }
-        ByteWriter w;
-        w.u64(ci.startTime);
-        w.u64(ci.endTime);
-        w.u64(ci.offset);
-        w.u64(ci.length);
-        w.str(map.bytes());
-        w.u64(ci.indexLength);
-        w.str("zstd");
-        w.u64(ci.compressedSize);
-        w.u64(ci.uncompressedSize);
-        g += record(Op::ChunkIndex, w.bytes());
-    }
-    group(Op::ChunkIndex, g);
+    group(Op::ChunkIndex, chunkIndexRecords());
     g.clear();
     for (const auto& mi : metadataIndexes_) {
         ByteWriter w;
@@ -311,24 +332,7 @@ Expected<void> FileWriter::finish()
         g += record(Op::MetadataIndex, w.bytes());
     }
     group(Op::MetadataIndex, g);
-    {
-        ByteWriter counts;
-        for (const auto& [channel, n] : channelCounts_) {
-            counts.u16(channel);
-            counts.u64(n);
-        }
-        ByteWriter w;
-        w.u64(messageCount_);
-        w.u16(static_cast<std::uint16_t>(schemas_.size()));
-        w.u32(static_cast<std::uint32_t>(channels_.size()));
-        w.u32(0);
-        w.u32(static_cast<std::uint32_t>(metadataIndexes_.size()));
-        w.u32(static_cast<std::uint32_t>(chunkIndexes_.size()));
-        w.u64(messageCount_ ? firstTime_ : 0);
-        w.u64(messageCount_ ? lastTime_ : 0);
-        w.str(counts.bytes());
-        group(Op::Statistics, record(Op::Statistics, w.bytes()));
-    }
+    group(Op::Statistics, statisticsRecord());
     const std::uint64_t offsetsStart = summaryStart + summary.size();
     for (const auto& gr : groups) {
         ByteWriter w;
@@ -348,6 +352,30 @@ Expected<void> FileWriter::finish()
     tail.u32(summaryCrc);
     tail.raw(kMagic);
     summary += tail.bytes();
+    return summary;
+}
+
+Expected<void> FileWriter::finish()
+{
+    if (finished_) {
+        return failure_ ? Expected<void>(tl::unexpected(*failure_)) : Expected<void>{};
+    }
+    if (auto ok = closeChunk(false); !ok) {
+        finished_ = true;
+        return ok;
+    }
+    if (auto ok = checkNotDeleted(); !ok) {
+        finished_ = true;
+        return ok;
+    }
+    ByteWriter dataEnd;
+    dataEnd.u32(dataCrc_);
+    if (auto ok = put(record(Op::DataEnd, dataEnd.bytes())); !ok) {
+        finished_ = true;
+        return ok;
+    }
+    finished_ = true;
+    const std::string summary = summarySection(offset_);
     if (auto ok = put(summary); !ok) {
         return ok;
     }

@@ -54,6 +54,9 @@ private:
     Expected<void> put(std::string_view bytes);
     Expected<void> fail(std::string what, int err);
     Expected<void> checkNotDeleted();
+    std::string summarySection(std::uint64_t summaryStart) const;
+    std::string chunkIndexRecords() const;
+    std::string statisticsRecord() const;
 
     struct ChunkIndex {
         std::uint64_t startTime = 0, endTime = 0, offset = 0, length = 0;

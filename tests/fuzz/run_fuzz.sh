@@ -14,7 +14,9 @@ seconds="${4:-40}"
 case "$target" in
 mcap_reader) corpus="$src/tests/fuzz/corpus" dict="" max_len=32768 ;;
 json_input) corpus="$src/tests/fuzz/json_corpus" dict="$src/tests/fuzz/json_input.dict" max_len=16384 ;;
-*) echo "run_fuzz.sh: unknown target '$target' (mcap_reader, json_input)" >&2; exit 2 ;;
+hid_descriptor) corpus="$src/tests/fuzz/hid_corpus" dict="" max_len=4200 ;;
+site_file) corpus="$src/tests/fuzz/site_corpus" dict="" max_len=8192 ;;
+*) echo "run_fuzz.sh: unknown target '$target' (mcap_reader, json_input, hid_descriptor, site_file)" >&2; exit 2 ;;
 esac
 mkdir -p "$work/crashes/$target"
 rm -rf "$work/scratch/$target" && mkdir -p "$work/scratch/$target"

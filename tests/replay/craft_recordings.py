@@ -119,6 +119,45 @@ def recording(config_changes=None, frames=((0, 0), (1, 16666667)), software="rep
     return finish([chunk(records)])
 
 
+def nested_chunks(size, claimed_zero):
+    """Chunks nested in chunks to 'size' bytes, each holding the next: claiming 0 uncompressed
+    bytes, or their true size with a wrong CRC. Recover tries each as a place to resynchronise.
+    Written outermost first (each level's header is 49 bytes), so that writing it is linear."""
+    header = 9 + 28 + 4 + 8
+    levels = size // header
+    out = [MAGIC]
+    for k in range(levels, 0, -1):
+        inner = (k - 1) * header
+        body = struct.pack("<QQQI", 0, 0, 0 if claimed_zero else inner, 0xDEADBEEF)
+        out.append(bytes([0x06]) + struct.pack("<Q", header - 9 + inner) + body + s("") +
+                   struct.pack("<Q", inner))
+    return b"".join(out)
+
+
+def indexed(records, chunk_offset):
+    """A recording whose summary holds one Chunk Index claiming the chunk at 'chunk_offset'."""
+    head = MAGIC + rec(0x01, s("") + s("replica 0.1.0 (format 3)"))
+    the_chunk = chunk(records)
+    data = head + the_chunk + rec(0x0F, struct.pack("<I", 0))
+    index = rec(0x08, struct.pack("<QQQQ", 0, 0, chunk_offset, len(the_chunk)) + s(b"") +
+                struct.pack("<Q", 0) + s("") + struct.pack("<QQ", 0, 0))
+    summary_start = len(data)
+    return data + index + rec(0x02, struct.pack("<QQI", summary_start, 0, 0)) + MAGIC
+
+
+def session_records(config, second_session=None):
+    """The records of a sound recording; with 'second_session', a second /replica/session
+    channel (id 8) whose message holds that configuration."""
+    records = b"".join(schema(i, n) for i, n, _ in TOPICS)
+    records += b"".join(channel(i, i, t) for i, _, t in TOPICS)
+    records += message(1, 0, 0, json.dumps(session(config)).encode())
+    records += message(5, 0, 0, json.dumps({"frame": 0, "tick_ns": 0}).encode())
+    if second_session is not None:
+        records += channel(8, 1, "/replica/session")
+        records += message(8, 0, 0, json.dumps(session(second_session)).encode())
+    return records
+
+
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -164,6 +203,21 @@ def main():
     write("spectrum-20000-counts.mcap", recording(extra=[(2, json.dumps(spectrum).encode())]))
     big = json.dumps({"frame": 0, "tick_ns": 0, "pad": "x" * (2 << 20)}).encode()
     write("message-2mib.mcap", recording(extra=[(5, big)]))
+    # Issue 32: JSON nested 100,000 deep in the run configuration and in the session message.
+    deep = "[" * 100000 + "]" * 100000
+    write("config-deep.mcap", recording(config_text='{"width": ' + deep + "}"))
+    write("session-deep.mcap",
+          recording(session_changes={"owner": json.loads("[" * 200 + "]" * 200)}))
+    # A second /replica/session channel with another frame size.
+    write("session-twice.mcap", finish([chunk(session_records(
+        CONFIG, dict(CONFIG, width=640, height=480)))]))
+    # A chunk index claiming offset 2^63; and one off by a byte.
+    write("index-2pow63.mcap", indexed(session_records(CONFIG), 1 << 63))
+    write("index-off-by-one.mcap", indexed(session_records(CONFIG), 8 + 9 + 32 + 1))
+    write("index-sound.mcap", indexed(session_records(CONFIG), 8 + 9 + 32))
+    # 16 MiB of nested chunks for recover (quadratic before: 143 s).
+    write("nested-zero-16mib.mcap", nested_chunks(16 << 20, True))
+    write("nested-crc-16mib.mcap", nested_chunks(16 << 20, False))
     # Chunks that claim 256 MiB each (4, and 200) but hold a few bytes.
     tiny = rle_zstd(16)
     write("claims-4x256mib.mcap",

@@ -259,6 +259,68 @@ else
     pass=$((pass + 1))
     echo "ok: replay --clock recorded of a tick 285 years away ends"
 fi
+# --- Issue 32: limits at every parser, each case under ulimit -v with its time and peak memory
+# printed (bounded: exits by the 60 s hang guard; peak resident memory asserted).
+# bounded MAX_RSS_MB CODE PATTERN -- replica ARGS...: as expect, plus peak RSS (from /usr/bin/time).
+bounded() {
+    local max_mb="$1" code="$2" pattern="$3"
+    shift 4
+    local err got lines stats
+    err=$( (ulimit -v "$limit_kb"; /usr/bin/time -f "time %e s, peak %M KB" -o "$work/time.txt" \
+        timeout 60 "$replica" "$@") 2>&1 >/dev/null)
+    got=$?
+    stats=$(cat "$work/time.txt" 2>/dev/null | tail -1)
+    lines=$(printf '%s\n' "$err" | grep -c .)
+    local kb
+    kb=$(printf '%s' "$stats" | sed -E 's/.*peak ([0-9]+) KB.*/\1/')
+    if [ "$got" -eq 124 ]; then
+        fail "replica $* hung (killed after 60 s)"
+    elif [ "$got" -ne "$code" ]; then
+        fail "replica $* exited $got, expected $code: $err"
+    elif [ "$lines" -ne 1 ]; then
+        fail "replica $* printed $lines lines, expected one: $err"
+    elif ! printf '%s' "$err" | grep -qE -- "$pattern"; then
+        fail "replica $* did not say /$pattern/: $err"
+    elif [ "$limit_kb" != unlimited ] && [ -n "$kb" ] && [ "$kb" -gt $((max_mb * 1024)) ]; then
+        fail "replica $* peaked at $kb KB, more than $max_mb MB"
+    else
+        pass=$((pass + 1))
+        echo "ok: exit $got ($stats): $err"
+    fi
+}
+if [ -x /usr/bin/time ]; then
+    for cmd in inspect replay; do
+        bounded 200 1 "run configuration: JSON nested 100001 levels deep, more than the limit of 32" -- "${R[@]}" $cmd "$rec/config-deep.mcap"
+        bounded 200 1 "/replica/session message \(sequence 0\): JSON nested 201 levels deep" -- "${R[@]}" $cmd "$rec/session-deep.mcap"
+        bounded 200 1 "2 channels carry /replica/session \(ids 1 and 8\)" -- "${R[@]}" $cmd "$rec/session-twice.mcap"
+    done
+    bounded 200 1 "config-deep.mcap: run configuration: JSON nested 100001" -- "${R[@]}" inspect --json "$rec/config-deep.mcap"
+    bounded 200 1 "Chunk Index at byte [0-9]+ points at bytes 9223372036854775808" -- "${R[@]}" inspect "$rec/index-2pow63.mcap"
+    bounded 200 1 "Chunk Index at byte [0-9]+ points at bytes 50\.\." -- "${R[@]}" inspect "$rec/index-off-by-one.mcap"
+    # Recover on 16 MiB of nested chunks: linear (143 s before), nothing recoverable.
+    bounded 400 1 "nested-zero-16mib.mcap: nothing recoverable" -- "${R[@]}" recover "$rec/nested-zero-16mib.mcap" "$work/nested-out.mcap"
+    bounded 400 1 "nested-crc-16mib.mcap: nothing recoverable" -- "${R[@]}" recover "$rec/nested-crc-16mib.mcap" "$work/nested-out.mcap"
+    # A site file of 2 MiB, and tables past their row and field limits.
+    { printf '[booth]\n'; head -c $((2 << 20)) /dev/zero | tr '\0' '#'; } > "$work/huge.toml"
+    bounded 100 1 "huge.toml: [0-9]+ bytes, more than the 1 MiB a site file may hold" -- "${R[@]}" config check "$work/huge.toml"
+    { echo "R,G,B,X,Y,Z"; yes "1,2,3,4,5,6" | head -n 1100000; } > "$work/rows.csv"
+    bounded 300 1 "rows.csv: 1100001 lines, more than the limit of 1048576 for a table" -- "${R[@]}" display fit "$work/rows.csv" --out "$work/p.json"
+    { printf 'R'; head -c 10000 /dev/zero | tr '\0' ','; echo; } > "$work/wide.csv"
+    bounded 100 1 "wide.csv:1: 10001 fields on one line, more than the limit of 4096" -- "${R[@]}" display fit "$work/wide.csv" --out "$work/p.json"
+else
+    fail "/usr/bin/time is missing: the bounded cases did not run"
+fi
+# replay shows a recording's text with its control characters escaped, as inspect does.
+out=$("$replica" --log-level info replay "$rec/escapes.mcap" 2>&1)
+if printf '%s' "$out" | grep -q $'\x1b'; then
+    fail "replay printed a raw escape sequence from a recording"
+elif ! printf '%s' "$out" | grep -qF 'recorded by \x1b]0;owned\x07'; then
+    fail "replay did not show the escaped software string: $out"
+else
+    pass=$((pass + 1))
+    echo "ok: replay escapes control characters"
+fi
+
 # inspect shows a recording's text with its control characters escaped.
 out=$("$replica" inspect "$rec/escapes.mcap" 2>&1)
 if printf '%s' "$out" | grep -q $'\x1b'; then

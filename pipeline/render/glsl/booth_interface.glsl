@@ -12,8 +12,9 @@ out vec4 outXyz;
 uniform vec2 uViewport;
 uniform vec2 uSurfOffset;
 uniform vec2 uSurfScale;
-// The surface's pixel rectangle in window coordinates (BOOTH_EXACT_TIES): left edge x, top edge y
-// (window y runs up), width and height in pixels; from uSurfOffset, uSurfScale and uViewport.
+// The surface's pixel rectangle in window coordinates (for view.cpp shadingPoint's texel rule):
+// left edge x, top edge y (window y runs up), width and height in pixels; from uSurfOffset,
+// uSurfScale and uViewport.
 uniform vec4 uSurfPixels;
 // The surface in the booth frame (metres): centre, unit axes, physical size; texels.
 uniform vec3 uCentre;
@@ -27,13 +28,9 @@ uniform vec3 uEye;
 uniform sampler2D uCoeffA;      // channels 0..2 per texel (row 0 = top row of the scene)
 uniform sampler2D uCoeffB;      // channels 3..5
 uniform sampler2D uNormals;     // tangent-space normal per texel
-// sin(horizon elevation): 4 directions a layer, or with BOOTH_HORIZON_HALF 8 a layer as half
-// floats, two a word (booth_shading_pass.cpp horizonTexture; RenderSettings::horizonHalf).
-#if BOOTH_HORIZON_HALF
+// sin(horizon elevation): 8 directions a layer as half floats, two a word (booth_upload.cpp
+// horizonTexture; the CPU model reads the same rounded sines, PreparedScene::horizonHalf).
 uniform highp usampler2DArray uHorizon;
-#else
-uniform sampler2DArray uHorizon;
-#endif
 const bool uRelief = BOOTH_RELIEF != 0; // normal map and horizons (fixed for the pass's life)
 // Horizon directions (0: no horizon shadowing), specular samples (0: no specular pass) and the
 // Ward model (0 Ward 1992, 1 Ward-Duer, 2 Ward-Duer guarded, 3 GMD) are fixed for the pass's life
@@ -101,8 +98,7 @@ uniform sampler2D uLum;         // luminance mip chain (cd/m^2), padded to power
 uniform int uLumMaxLevel;
 uniform ivec2 uLumSize;         // level 0
 uniform vec2 uLumUsed;          // the light's share of the padded texture
-uniform float uLodBias;         // RenderSettings::specularLodBias
-uniform float uLodScale;        // 4^uLodBias, exact (BOOTH_EXACT_LEVEL only)
+uniform float uLodScale;        // 4^RenderSettings::specularLodBias, exact (a whole half level)
 
 const float kPi = 3.14159265358979;
 const float kMinCosView = 1e-3;

@@ -23,8 +23,7 @@ void main() {
     vec3 p = uCentre + uRight * ((u - 0.5) * uSizeM.x) + uUp * ((0.5 - v) * uSizeM.y);
     float texX = u * float(uTexels.x);
     float texY = v * float(uTexels.y);
-#if BOOTH_EXACT_TIES
-    // RenderSettings::texelExactTies (view.cpp shadingPoint's rule): the pixel's texel position
+    // view.cpp shadingPoint's rule: the pixel's texel position
     // from its offset into the surface's pixels times the texels, divided last. For the
     // whole-pixel rectangles the CPU model renders the product is exact, and a correctly rounded
     // division (llvmpipe's) of it lands exactly on a texel edge where the pixel centre does, so
@@ -37,9 +36,6 @@ void main() {
         texY = along.y / uSurfPixels.w;
     }
     ivec2 tc = clamp(ivec2(floor(vec2(texX, texY))), ivec2(0), uTexels - 1);
-#else
-    ivec2 tc = clamp(ivec2(int(texX), int(texY)), ivec2(0), uTexels - 1);
-#endif
     vec3 nShade = uNormal;
     // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
     bool facets = uMode == 0 || (uSpecSamples > 0 && (uMode == 2 || !kGrid));
@@ -53,11 +49,11 @@ void main() {
         outFacet = vec4(nl, 0.0);
 #endif
         nShade = normalize(uRight * nl.x + uUp * nl.y + uNormal * nl.z);
-#if BOOTH_HORIZON_BILINEAR && BOOTH_MODE == 0
-        // Eq. (1)'s horizons at this point (RenderSettings::horizonBilinear); the compose's lobe
+#if BOOTH_MODE == 0
+        // Eq. (1)'s horizons at this point; the compose's lobe
         // reads the texel's below.
         bilinearHorizons(texX, texY);
-#elif BOOTH_HORIZON_HALF
+#else
         for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {
             uvec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
             for (int w = 0; w < 4; ++w) {
@@ -65,14 +61,6 @@ void main() {
                 hz[8 * j + 2 * w] = pair.x;
                 hz[8 * j + 2 * w + 1] = pair.y;
             }
-        }
-#else
-        for (int j = 0; j < (uHorizonDirs + 3) / 4; ++j) {
-            vec4 b = texelFetch(uHorizon, ivec3(tc, j), 0);
-            hz[4 * j] = b.x;
-            hz[4 * j + 1] = b.y;
-            hz[4 * j + 2] = b.z;
-            hz[4 * j + 3] = b.w;
         }
 #endif
     }

@@ -2,29 +2,17 @@
 // shading/realtime_model.cpp filteredSpecular with brdf::sampleWard (brdf/ward.cpp) inlined.
 
 // Sample k of filteredSpecular's loop (brdf::sampleWard inlined, rho_s = 1): its weighted
-// luminance, 0 where the sample leaves the lobe, the surface or the ceiling. With
-// BOOTH_SPEC_BRANCH_FREE (RenderSettings::specularBranchFree) every pixel computes the sample
-// and keeps it or 0 at the end: llvmpipe runs each early return as a masked branch with masked
-// stores after it, and a lane that fails a test only ever yields 0. Without it, the early returns
-// of the frames recorded before.
+// luminance, 0 where the sample leaves the lobe, the surface or the ceiling. Every pixel computes
+// the sample and keeps it or 0 at the end, without early returns: llvmpipe runs each early return
+// as a masked branch with masked stores after it, and a lane that fails a test only ever yields 0.
 float specSample(int k, vec3 n, vec3 o, float co, vec3 ft, vec3 fbt, vec3 nGeo, float planeDist,
                  vec3 eu, vec3 ev, float lu0, float lv0, float visFrom, float visScale) {
     vec4 sk = uSpecSample[k];
     vec3 hl = sk.xyz;
     vec3 h = ft * hl.x + fbt * hl.y + n * hl.z;
     float oh = dot(o, h);
-#if !BOOTH_SPEC_BRANCH_FREE
-    if (!(oh > 0.0)) {
-        return 0.0;
-    }
-#endif
     vec3 i = 2.0 * oh * h - o;
     float ci = dot(n, i);
-#if !BOOTH_SPEC_BRANCH_FREE
-    if (!(ci > 0.0)) {
-        return 0.0;
-    }
-#endif
     float hz3 = hl.z * hl.z * hl.z;
     float w;
     if (uWardModel == 0) {
@@ -39,49 +27,26 @@ float specSample(int k, vec3 n, vec3 o, float co, vec3 ft, vec3 fbt, vec3 nGeo, 
     float solidAngle = sk.w * oh;
     float cosG = dot(nGeo, i);
     float denom = dot(i, uLightNormal);
-#if !BOOTH_SPEC_BRANCH_FREE
-    if (!(cosG > 0.0) || !(denom < 0.0)) {
-        return 0.0;
-    }
-#endif
     float t = planeDist / denom;
-#if !BOOTH_SPEC_BRANCH_FREE
-    if (!(t > 0.0) || isinf(t)) {
-        return 0.0;
-    }
-#endif
     float lu = lu0 + t * dot(i, eu);
     float lv = lv0 + t * dot(i, ev);
     bool onCeiling = lu >= 0.0 && lu <= 1.0 && lv >= 0.0 && lv <= 1.0;
-#if !BOOTH_SPEC_BRANCH_FREE
-    if (!onCeiling) {
-        return 0.0;
-    }
-#endif
     float ratio = solidAngle * t * t / (uTexelArea * -denom);
-#if BOOTH_EXACT_LEVEL
-    // RenderSettings::specularExactLevel: sampleNearestLevel's level d = ceil(l + 0.5) - 1 for
+    // sampleNearestLevel's level d = ceil(l + 0.5) - 1 for
     // l = 0.5 log2(r) + bias > 0.5, else 0, is ceil(log2(r 4^bias)) halved and rounded down, and
     // for a normal float r ceil(log2 r) is its exponent plus one unless the mantissa is zero:
     // adding the largest mantissa carries into the exponent exactly then. (llvmpipe's log2 is a
     // polynomial.) The ratio is kept within normal floats; d < 0 clamps to level 0 below.
     float r = clamp(ratio, 1e-20, 1e30) * uLodScale;
     float lod = float((((floatBitsToInt(r) + 0x7fffff) >> 23) - 127) >> 1);
-#else
-    float lod = 0.5 * log2(max(ratio, 1e-20)) + uLodBias;
-#endif
     float vis = clamp((cosG - visFrom) * visScale, 0.0, 1.0);
     float value = lumSample(lu, lv, lod) * w * (vis * vis * (3.0 - 2.0 * vis));
-#if BOOTH_SPEC_BRANCH_FREE
     // The early returns' tests: a half vector facing the eye and a mirror direction above the
     // facet; above the macro surface and towards the ceiling's plane; ahead of the point and
     // finite; inside the ceiling.
     bool inLobe = oh > 0.0 && ci > 0.0;
     bool towardsCeiling = cosG > 0.0 && denom < 0.0 && t > 0.0 && !isinf(t);
     return inLobe && towardsCeiling && onCeiling ? value : 0.0;
-#else
-    return value;
-#endif
 }
 
 // realtime_model.cpp filteredSpecular with brdf::sampleWard inlined (rho_s = 1).

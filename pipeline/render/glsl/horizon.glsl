@@ -15,10 +15,9 @@ vec2 bilinearTexel(float x, float y, out ivec2 c) {
     return vec2(fx - x0, fy - y0);
 }
 
-#if BOOTH_HORIZON_BILINEAR && BOOTH_MODE == 0
+#if BOOTH_MODE == 0
 // Adds w times texel t's horizon sines to hz (horizonTexture's layout).
 void addHorizons(ivec2 t, float w) {
-#if BOOTH_HORIZON_HALF
     for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {
         uvec4 b = texelFetch(uHorizon, ivec3(t, j), 0);
         for (int q = 0; q < 4; ++q) {
@@ -27,15 +26,6 @@ void addHorizons(ivec2 t, float w) {
             hz[8 * j + 2 * q + 1] += w * pair.y;
         }
     }
-#else
-    for (int j = 0; j < (uHorizonDirs + 3) / 4; ++j) {
-        vec4 b = texelFetch(uHorizon, ivec3(t, j), 0);
-        hz[4 * j] += w * b.x;
-        hz[4 * j + 1] += w * b.y;
-        hz[4 * j + 2] += w * b.z;
-        hz[4 * j + 3] += w * b.w;
-    }
-#endif
 }
 
 // surface::HorizonMap::sinHorizonBilinear's four texels and weights at texel position (x, y),
@@ -63,8 +53,7 @@ float sinHorizon(vec3 l) {
         phi += 2.0 * kPi;
     }
     float f = phi / (2.0 * kPi) * float(uHorizonDirs);
-#if BOOTH_HORIZON_PICK
-    // RenderSettings::horizonPick: the two directions around phi picked by comparisons, each
+    // The two directions around phi picked by comparisons, each
     // direction past the first replacing the pair when f has reached it (every index a
     // constant: a compare and two selects a direction, where the tent weights below take seven
     // operations), then sinHorizon's (1 - t) lo + t hi. f = K (phi rounded up to 2 pi) is
@@ -79,16 +68,6 @@ float sinHorizon(vec3 l) {
     }
     float t = f - floor(f);
     float sinB = (1.0 - t) * lo + t * hi;
-#else
-    // Linear between the two directions around phi (wrapping): written as a tent weight over
-    // all k so that every index is a constant (the same sum as indexing hz[k0] and hz[k1]).
-    float sinB = 0.0;
-    for (int k = 0; k < uHorizonDirs; ++k) {
-        float d = abs(f - float(k));
-        d = min(d, float(uHorizonDirs) - d);
-        sinB += max(1.0 - d, 0.0) * hz[k];
-    }
-#endif
     return sinB;
 }
 

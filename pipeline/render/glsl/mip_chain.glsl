@@ -34,25 +34,10 @@ float lumBilinear(float u, float v, int level) {
     return (1.0 - ay) * ((1.0 - ax) * lumTexel(c, level, size) + ax * lumTexel(c + ivec2(1, 0), level, size))
          + ay * ((1.0 - ax) * lumTexel(c + ivec2(0, 1), level, size) + ax * lumTexel(c + ivec2(1, 1), level, size));
 }
-#if BOOTH_NEAREST_LEVEL
 // booth::MipChain::sampleNearestLevel.
 float lumSample(float u, float v, float level) {
     float l = clamp(level, 0.0, float(uLumMaxLevel));
     int d = l <= 0.5 ? 0 : min(int(ceil(l + 0.5)) - 1, uLumMaxLevel);
     return lumBilinear(u * uLumUsed.x, v * uLumUsed.y, d);
 }
-#else
-// booth::MipChain::sample.
-float lumSample(float u, float v, float level) {
-    float l = clamp(level, 0.0, float(uLumMaxLevel));
-    int l0 = int(floor(l));
-    int l1 = min(l0 + 1, uLumMaxLevel);
-    float t = l - float(l0);
-    float a = lumBilinear(u * uLumUsed.x, v * uLumUsed.y, l0);
-    if (t <= 0.0 || l1 == l0) {
-        return a;
-    }
-    return (1.0 - t) * a + t * lumBilinear(u * uLumUsed.x, v * uLumUsed.y, l1);
-}
-#endif
 #endif

@@ -13,7 +13,7 @@ vec3 viewingGain(float angleDeg) {
 #elif DISP_VIEWING_ROWS == 1
     return uDispViewing[0].yzw;
 #elif DISP_VIEWING_FILTERED
-    // DisplayPassSetup::viewingFiltered: the gain every half degree, interpolated by the sampler.
+    // Where the GL filters float textures: the gain every half degree, interpolated by the sampler.
     // One filtered read where the row count, two indexed uniform reads (a gather per component
     // on llvmpipe) and a division were: 6 % of the painting's frame. NaN and 90 degrees or more
     // take the last node, the last row's gain.
@@ -22,6 +22,7 @@ vec3 viewingGain(float angleDeg) {
                    vec2((a * float(DISP_VIEWING_GRID_PER_DEG) + 0.5) / float(DISP_VIEWING_GRID_NODES),
                         0.5)).rgb;
 #else
+    // Without GL_OES_texture_float_linear: the rows themselves.
     float a = clamp(angleDeg, 0.0, 90.0);
     if (!(a < uDispViewing[DISP_VIEWING_ROWS - 1].x)) {
         return uDispViewing[DISP_VIEWING_ROWS - 1].yzw;

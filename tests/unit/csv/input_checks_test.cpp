@@ -8,7 +8,9 @@
 #include <sys/stat.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <pipeline/base/json_schema.h>
+#include <pipeline/base/printable.h>
 
 #include <gtest/gtest.h>
 
@@ -105,6 +107,62 @@ TEST(JsonSchema, NamesThePathOfTheFirstViolation)
                              s, "f.json", &warnings));
     EXPECT_EQ(warnings, (std::vector<std::string>{"f.json: /ward/beta: unknown key, ignored",
                                                   "f.json: /colour: unknown key, ignored"}));
+}
+
+// Depth counted by hand for each text: brackets in strings and escaped quotes do not count.
+TEST(JsonLimits, DepthIsCountedOutsideStringsAndRefusedPastTheLimit)
+{
+    EXPECT_EQ(jsonDepth("1"), 0u);
+    EXPECT_EQ(jsonDepth("{\"a\": [1, {\"b\": []}]}"), 4u);
+    EXPECT_EQ(jsonDepth("[\"[[[\\\"[[\", []]"), 2u); // ["[[[\"[[", []]
+    const std::string at = std::string(kMaxJsonDepth, '[') + std::string(kMaxJsonDepth, ']');
+    EXPECT_TRUE(checkJsonLimits(at, "f.json"));
+    const std::string past = "[" + at + "]";
+    auto e = checkJsonLimits(past, "f.json");
+    ASSERT_FALSE(e);
+    EXPECT_EQ(e.error().message, "f.json: JSON nested 33 levels deep, more than the limit of 32");
+    // The schema-checked reader refuses it before parsing, naming the file.
+    auto parsed = parseJsonChecked(std::string(100000, '[') + std::string(100000, ']'),
+                                   json_schema::any(), "deep.json");
+    ASSERT_FALSE(parsed);
+    EXPECT_EQ(parsed.error().message,
+              "deep.json: JSON nested 100000 levels deep, more than the limit of 32");
+    auto big = checkJsonLimits("[1, 2]", "f.json", 5);
+    ASSERT_FALSE(big);
+    EXPECT_EQ(big.error().message, "f.json: JSON of 6 bytes, more than the limit of 5");
+}
+
+// Lines and fields counted by hand; CGATS fields are separated by runs of spaces or tabs.
+TEST(TableLimits, RowsAndFieldsAreCountedBeforeSplitting)
+{
+    EXPECT_TRUE(checkTableLimits("a,b\n1,2\n", "t.csv", ','));
+    std::string wide = "x" + std::string(kMaxTableFields, ',') + "\n";
+    auto w = checkTableLimits("a,b\n" + wide, "t.csv", ',');
+    ASSERT_FALSE(w);
+    EXPECT_EQ(w.error().message, "t.csv:2: 4097 fields on one line, more than the limit of 4096 "
+                                 "for a table");
+    std::string cgats;
+    for (std::size_t i = 0; i <= kMaxTableFields; ++i) {
+        cgats += " \t 1";
+    }
+    auto c = checkTableLimits(cgats, "t.ti3", ' ');
+    ASSERT_FALSE(c);
+    EXPECT_EQ(c.error().message, "t.ti3:1: 4097 fields on one line, more than the limit of 4096 "
+                                 "for a table");
+    EXPECT_TRUE(checkTableLimits(std::string(kMaxTableRows, '\n'), "t.csv", ','));
+    auto r = checkTableLimits(std::string(kMaxTableRows, '\n') + "1", "t.csv", ',');
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().message,
+              "t.csv: 1048577 lines, more than the limit of 1048576 for a table");
+}
+
+TEST(Printable, ControlCharactersAreEscapedAndLongTextCut)
+{
+    EXPECT_EQ(printable("\x1b]0;owned\x07ok\x7f"), "\\x1b]0;owned\\x07ok\\x7f");
+    EXPECT_EQ(printable("a\nb"), "a\\x0ab");
+    EXPECT_EQ(printable("a\nb", std::string_view::npos, true), "a\nb");
+    EXPECT_EQ(printable("abcdef", 3), "abc...");
+    EXPECT_EQ(printable("caf\xc3\xa9"), "caf\xc3\xa9"); // UTF-8 passes
 }
 
 } // namespace

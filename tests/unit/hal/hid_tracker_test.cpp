@@ -307,6 +307,69 @@ TEST(HidDescriptor, MalformedDescriptorsAreRefusedNamingTheByte)
     }
 }
 
+// The descriptors of issue 32, each within 4 KiB, that asked for gigabytes before the parser had
+// limits: every limit is named with its value, and a descriptor just inside each one parses.
+TEST(HidDescriptor, LimitsAreEnforcedBeforeAnythingGrows)
+{
+    auto expectError = [](const std::vector<std::uint8_t>& bytes, const std::string& what) {
+        auto d = parseReportDescriptor(bytes);
+        ASSERT_FALSE(d) << what;
+        EXPECT_NE(d.error().message.find(what), std::string::npos) << d.error().message;
+    };
+    // Nested collections: Usage Page, Usage, then N x Collection (Physical), N x End Collection.
+    auto nested = [](std::size_t n) {
+        std::vector<std::uint8_t> b{0x05, 0x01, 0x09, 0x01};
+        for (std::size_t i = 0; i < n; ++i) {
+            b.insert(b.end(), {0xA1, 0x00});
+        }
+        b.insert(b.end(), {0x75, 0x01, 0x95, 0x01, 0x81, 0x02});
+        b.insert(b.end(), n, 0xC0);
+        return b;
+    };
+    ASSERT_TRUE(parseReportDescriptor(nested(kMaxCollectionDepth)));
+    EXPECT_EQ(parseReportDescriptor(nested(kMaxCollectionDepth))->fields.at(0).collections.size(),
+              kMaxCollectionDepth);
+    expectError(nested(kMaxCollectionDepth + 1), "collections nested deeper than 32 levels");
+    expectError(nested(1000), "byte 68: collections nested deeper than 32");
+
+    // 61 report IDs x 16 Input items of 4,096 one-bit values: 4 million fields in 1 KiB.
+    std::vector<std::uint8_t> many{0x05, 0x01, 0x19, 0x01, 0x29, 0x10, 0x75, 0x01,
+                                   0x96, 0x00, 0x10, 0x15, 0x00, 0x25, 0x01};
+    for (int id = 1; id <= 61; ++id) {
+        many.insert(many.end(), {0x85, static_cast<std::uint8_t>(id)});
+        for (int k = 0; k < 16; ++k) {
+            many.insert(many.end(), {0x81, 0x02});
+        }
+    }
+    ASSERT_LE(many.size(), kMaxDescriptorBytes);
+    // 12288 fields is three items of 4096: the fourth item (report 1's) crosses the limit.
+    expectError(many, "more than 12288 fields in all (the limit)");
+    expectError(std::vector<std::uint8_t>(kMaxDescriptorBytes + 1, 0x00),
+                "HID report descriptor of 4097 bytes, more than the 4096");
+    expectError({0x75, 0x01, 0x96, 0x01, 0x10, 0x81, 0x02},
+                "Report Count 4097 is more than the 4096");
+    // 4,096 values of 64 bits: 32 KiB, more than a report may hold.
+    expectError({0x75, 0x40, 0x96, 0x00, 0x10, 0x81, 0x02},
+                "input report 0 grows beyond 8192 bytes");
+    std::vector<std::uint8_t> pushes(kMaxPushDepth + 1, 0xA4);
+    expectError(pushes, "Push nested deeper than 16 levels");
+    // Collections side by side: 1,025 of them in under 4 KiB.
+    std::vector<std::uint8_t> wide;
+    for (std::size_t i = 0; i <= kMaxCollections; ++i) {
+        wide.insert(wide.end(), {0xA1, 0x00, 0xC0});
+    }
+    expectError(wide, "more than 1024 collections (the limit)");
+    // A usage range is not spelled out: 4,096 values over a 65,536-usage range take their usages
+    // from it in order.
+    std::vector<std::uint8_t> range{0x05, 0x01, 0x1A, 0x00, 0x00, 0x2A, 0xFF, 0xFF,
+                                    0x75, 0x01, 0x96, 0x00, 0x10, 0x81, 0x02};
+    auto r = parseReportDescriptor(range);
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ(r->fields.size(), 4096u);
+    EXPECT_EQ(r->fields[4095].usage, usage(0x01, 4095));
+    EXPECT_EQ(r->fields[4095].bitOffset, 4095u);
+}
+
 TEST(HidEyeHead, LayoutsAreFoundAndNonTrackersRefused)
 {
     auto a = eht::findLayout(*parseReportDescriptor(kDescriptorA));

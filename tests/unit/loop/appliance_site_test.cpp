@@ -382,48 +382,79 @@ void writeRecording(const fs::path& path, int samples)
     ASSERT_TRUE((*w)->close());
 }
 
-TEST(SessionFolder, RetentionDeletesTheOldestUntilTheTotalFits)
+TEST(SessionFolder, RetentionDeletesTheKiosksOldestUntilTheTotalFits)
 {
     const fs::path dir = scratch("retention");
-    // Names a shell loop would trip on; sizes 100..400 bytes, oldest first.
-    const std::vector<std::string> names{"a b.mcap", "-rf.mcap", "new\nline.mcap", "d*.mcap"};
+    // Four kiosk sessions (named and registered by newSessionPath), 100..400 bytes, oldest first.
     const auto now = fs::file_time_type::clock::now();
-    for (std::size_t i = 0; i < names.size(); ++i) {
-        tests::spit(dir / names[i], std::string(100 * (i + 1), 'x'));
-        fs::last_write_time(dir / names[i], now - std::chrono::hours(10 - static_cast<int>(i)));
+    std::vector<fs::path> mine;
+    for (int i = 0; i < 4; ++i) {
+        mine.push_back(newSessionPath(dir));
+        // Ending with the MCAP magic, as a closed recording does (an unfinished one waits for its
+        // recovery and is not deleted).
+        tests::spit(mine.back(), std::string(static_cast<std::size_t>(100 * (i + 1)) - 8, 'x') +
+                                         std::string("\x89MCAP0\r\n", 8));
+        fs::last_write_time(mine.back(), now - std::chrono::hours(10 - i));
     }
-    tests::spit(dir / "notes.txt", std::string(5000, 'x')); // not a recording: never counted
-    // 1000 bytes in all; at most 650: the three oldest go (900, 700, 400 left after each).
+    // Files the kiosk did not write: never counted, never deleted, however old. One with the
+    // kiosk's name pattern but not in its register (an operator's --record), names a shell loop
+    // trips on, and a symbolic link to a big file outside.
+    tests::spit(dir / "20200101T000000Z.mcap", std::string(5000, 'x'));
+    tests::spit(dir / "a b.mcap", std::string(5000, 'x'));
+    tests::spit(dir / "-rf.mcap", std::string(5000, 'x'));
+    const fs::path outside = scratch("retention-outside") / "big.mcap";
+    tests::spit(outside, std::string(100000, 'x'));
+    fs::create_symlink(outside, dir / "20200101T000001Z.mcap");
+    for (const auto& f : {dir / "20200101T000000Z.mcap", dir / "a b.mcap", dir / "-rf.mcap"}) {
+        fs::last_write_time(f, now - std::chrono::hours(100));
+    }
+    // 1000 bytes of the kiosk's; at most 650: the three oldest go (900, 700, 400 left after each).
     const auto deleted = enforceRetention(dir, 650);
     EXPECT_EQ(deleted.size(), 3u);
-    EXPECT_TRUE(fs::exists(dir / "d*.mcap"));
-    EXPECT_FALSE(fs::exists(dir / "a b.mcap"));
-    EXPECT_FALSE(fs::exists(dir / "new\nline.mcap"));
-    EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+    EXPECT_FALSE(fs::exists(mine[0]));
+    EXPECT_FALSE(fs::exists(mine[2]));
+    EXPECT_TRUE(fs::exists(mine[3]));
+    EXPECT_TRUE(fs::exists(dir / "20200101T000000Z.mcap"));
+    EXPECT_TRUE(fs::exists(dir / "a b.mcap"));
+    EXPECT_TRUE(fs::exists(dir / "-rf.mcap"));
+    EXPECT_TRUE(fs::is_symlink(dir / "20200101T000001Z.mcap"));
+    EXPECT_EQ(fs::file_size(outside), 100000u);
     // The file being written is never deleted, even when it alone is over.
-    EXPECT_TRUE(enforceRetention(dir, 1, dir / "d*.mcap").empty());
-    EXPECT_TRUE(fs::exists(dir / "d*.mcap"));
+    EXPECT_TRUE(enforceRetention(dir, 1, mine[3]).empty());
+    EXPECT_TRUE(fs::exists(mine[3]));
     fs::remove_all(dir);
+    fs::remove_all(outside.parent_path());
 }
 
 TEST(SessionFolder, ACrashedSessionIsRecoveredInPlace)
 {
     const fs::path dir = scratch("recover");
-    writeRecording(dir / "closed.mcap", 50);
-    writeRecording(dir / "crashed.mcap", 3000);
-    EXPECT_TRUE(recordingFinished(dir / "closed.mcap"));
+    const fs::path closed = newSessionPath(dir);
+    writeRecording(closed, 50);
+    const fs::path crashed = newSessionPath(dir);
+    writeRecording(crashed, 3000);
+    EXPECT_TRUE(recordingFinished(closed));
     // A power cut: the file ends mid-chunk, without summary and footer.
-    const auto size = fs::file_size(dir / "crashed.mcap");
-    fs::resize_file(dir / "crashed.mcap", size - 200);
-    EXPECT_FALSE(recordingFinished(dir / "crashed.mcap"));
-    EXPECT_FALSE(recordings::readRecording(dir / "crashed.mcap").has_value() &&
-                 recordingFinished(dir / "crashed.mcap"));
+    const auto size = fs::file_size(crashed);
+    fs::resize_file(crashed, size - 200);
+    EXPECT_FALSE(recordingFinished(crashed));
 
+    // Without room for the recovered copy it is left as it is, and counted by retention (which
+    // does not delete it: it waits for its recovery).
+    const auto bytes = fs::file_size(crashed);
+    EXPECT_TRUE(recoverUnfinished(dir, [&](const fs::path&) { return bytes / 2; }).empty());
+    EXPECT_EQ(fs::file_size(crashed), bytes);
+    EXPECT_FALSE(fs::exists(fs::path(crashed.string() + ".unrecoverable")));
+    EXPECT_TRUE(enforceRetention(dir, fs::file_size(closed)).size() == 1u);
+    EXPECT_FALSE(fs::exists(closed)); // the finished one went; the unfinished one is counted
+    EXPECT_TRUE(fs::exists(crashed));
+
+    // Room again: recovered at the next start.
     const auto recovered = recoverUnfinished(dir);
     ASSERT_EQ(recovered.size(), 1u);
-    EXPECT_EQ(recovered[0], dir / "crashed.mcap");
-    EXPECT_TRUE(recordingFinished(dir / "crashed.mcap"));
-    auto rec = recordings::readRecording(dir / "crashed.mcap");
+    EXPECT_EQ(recovered[0], crashed);
+    EXPECT_TRUE(recordingFinished(crashed));
+    auto rec = recordings::readRecording(crashed);
     ASSERT_TRUE(rec) << rec.error().message;
     EXPECT_GT(rec->samples(recordings::trackerKind()).size(), 0u);
     EXPECT_LE(rec->samples(recordings::trackerKind()).size(), 3000u);
@@ -435,9 +466,50 @@ TEST(SessionFolder, ACrashedSessionIsRecoveredInPlace)
     EXPECT_TRUE(recoverUnfinished(dir).empty());
 
     // Garbage that nothing can be recovered from is set aside, not retried at every start.
-    tests::spit(dir / "junk.mcap", "not a recording at all");
+    const fs::path junk = newSessionPath(dir);
+    tests::spit(junk, "not a recording at all");
     EXPECT_TRUE(recoverUnfinished(dir).empty());
-    EXPECT_TRUE(fs::exists(dir / "junk.mcap.unrecoverable"));
+    EXPECT_TRUE(fs::exists(fs::path(junk.string() + ".unrecoverable")));
+    // ... and counted and deleted by retention like the kiosk's other files.
+    const auto gone = enforceRetention(dir, 0, crashed);
+    EXPECT_EQ(gone, std::vector<fs::path>{fs::path(junk.string() + ".unrecoverable")});
+    fs::remove_all(dir);
+}
+
+TEST(SessionFolder, AFileAnotherWriterHoldsOpenIsLeftAlone)
+{
+    const fs::path dir = scratch("held");
+    // A recording being written (its writer locks it), unfinished, under a kiosk name: not
+    // recovered in place (which would cut the writer off), not deleted.
+    const fs::path open = newSessionPath(dir);
+    auto w = recordings::RecordingWriter::create(open, recordings::SessionInfo{});
+    ASSERT_TRUE(w) << w.error().message;
+    hal::PoseSample p;
+    (*w)->write(p);
+    EXPECT_TRUE(heldOpenElsewhere(open));
+    EXPECT_FALSE(recordingFinished(open));
+    EXPECT_TRUE(recoverUnfinished(dir).empty());
+    EXPECT_TRUE(enforceRetention(dir, 0).empty());
+    ASSERT_TRUE((*w)->close());
+    EXPECT_FALSE(heldOpenElsewhere(open));
+    EXPECT_TRUE(recordingFinished(open));
+    fs::remove_all(dir);
+}
+
+TEST(SessionFolder, ASecondKioskIsRefusedNamingTheFirstOnesPid)
+{
+    const fs::path dir = scratch("lock");
+    auto first = SessionFolderLock::acquire(dir);
+    ASSERT_TRUE(first) << first.error().message;
+    auto second = SessionFolderLock::acquire(dir);
+    ASSERT_FALSE(second);
+    EXPECT_NE(second.error().message.find("(pid " + std::to_string(::getpid()) + ")"),
+              std::string::npos)
+            << second.error().message;
+    {
+        auto released = std::move(*first);
+    } // the first kiosk ends
+    EXPECT_TRUE(SessionFolderLock::acquire(dir));
     fs::remove_all(dir);
 }
 

@@ -65,6 +65,33 @@ TEST(BoothDimmer, EffectCountsWhatTheDisplayCannotShow)
     EXPECT_LT(dimmed.de00Max, 0.05);
 }
 
+TEST(BoothDimmer, DemandDividesByTheViewingGainAtEachPixel)
+{
+    // A panel whose white keeps 0.5 of its luminance at 60 degrees (no colour shift): a pixel
+    // seen from 60 degrees off the normal asks for twice its Y, one seen on the normal for its Y.
+    auto model = pipeline::display::nominalDisplayModel("test-900", 900.0, 0.0);
+    model.viewing.angleDeg = {0.0, 60.0};
+    model.viewing.luminanceRatio = {1.0, 0.5};
+    model.viewing.dx = {0.0, 0.0};
+    model.viewing.dy = {0.0, 0.0};
+    DimmerView v;
+    v.frame = greyRamp(2, 600.0); // Y = 300, 600
+    v.pixelM = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};
+    v.normal = {0.0, 0.0, 1.0};
+    // The eye on the first pixel's normal, and 60 degrees off the second's: tan 60 = 1 / z.
+    v.eyeM = {0.0, 0.0, 1.0 / std::sqrt(3.0)};
+    const auto d = panelDemand(v, model, true);
+    ASSERT_EQ(d.xyz.size(), 2u);
+    EXPECT_NEAR(d.xyz[0].y, 300.0, 1e-9);
+    EXPECT_NEAR(d.xyz[1].y, 1200.0, 1e-6);
+    // Compensation off: the frame as it is. Above the 900 peak: the second pixel only, until a
+    // scale brings 1200 under it.
+    EXPECT_NEAR(panelDemand(v, model, false).xyz[1].y, 600.0, 1e-12);
+    EXPECT_EQ(overPeakFraction(d, 1.0, 900.0), 0.5);
+    EXPECT_EQ(overPeakFraction(d, 0.74, 900.0), 0.0);
+    EXPECT_EQ(overPeakFraction(d, 0.76, 900.0), 0.5);
+}
+
 TEST(BoothDimmer, SiteKeyTakesANumberOrAuto)
 {
     const fs::path dir = fs::temp_directory_path() / ("dimmer-" + std::to_string(::getpid()));

@@ -1,6 +1,7 @@
 // Devices as data: the registry writes exactly the channels format 5 always had, and a device kind
 // that is nothing but data (a second accelerometer: new names and channel, the accelerometer's
-// sample type and codec) is polled by the loop, recorded, read back, listed and replayed.
+// sample type and codec) is polled by the loop, recorded, read back, listed and replayed; the
+// state stage's kinds reach the estimators typed, a data-only kind does not reach them.
 #include <filesystem>
 
 #include <pipeline/base/data_dir.h>
@@ -192,6 +193,62 @@ TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAnd
         EXPECT_EQ(again[i].sequences, live[i].sequences) << i;
     }
     std::filesystem::remove_all(dir);
+}
+
+// The state stage's kinds are typed: the loop's slots hand the estimators one typed sample per
+// kind of recordings::StateKinds (frame_loop.cpp checks at compile time that
+// state::SceneEstimator::update takes exactly those). A kind outside them is data only: it has a
+// slot (polled, recorded) but no estimator gets its samples, even of the same sample type.
+TEST(DeviceKinds, TheEstimatorsGetTypedSamplesOfTheStateKindsAndADataKindIsPolledOnly)
+{
+    const auto schema = recordings::accelSchema();
+    const DeviceKind<hal::AccelSample> secondAccel(
+            {"accel2",
+             "second accelerometer",
+             "samples",
+             {16, "/hal/accel2", schema.first, schema.second},
+             std::nullopt,
+             "accel2_seq",
+             "dropped_accel2",
+             true},
+            recordings::accelCodec());
+    hal::AccelSample first;
+    first.sequence = 7;
+    first.timestampNs = 10;
+    first.gravity = {0.0, -9.81, 0.0};
+    hal::AccelSample second = first;
+    second.sequence = 9;
+    second.gravity = {1.0, -9.0, 0.5};
+    recordings::Sources sources;
+    sources.set(secondAccel, std::make_unique<hal::ReplaySource<hal::AccelSample>>(
+                                     hal::DeviceInfo{"accel2", "A2", "", {}},
+                                     std::vector<hal::AccelSample>{second}));
+    sources.set(recordings::accelKind(), std::make_unique<hal::ReplaySource<hal::AccelSample>>(
+                                                 hal::DeviceInfo{"accel", "A1", "", {}},
+                                                 std::vector<hal::AccelSample>{first}));
+    recordings::DeviceSink* tee = nullptr;
+    const recordings::StateSlots slots(recordings::stateKinds(), sources, &tee);
+    ASSERT_EQ(slots.all().size(), 2u);
+    EXPECT_EQ(&slots.all()[0]->kind(), &recordings::accelKind()); // channel order: 4, then 16
+    EXPECT_EQ(&slots.all()[1]->kind(), &secondAccel);
+    std::uint64_t mismatches = 0;
+    for (const auto& slot : slots.all()) {
+        slot->poll(100);
+        slot->choose(std::nullopt, false, mismatches);
+    }
+    EXPECT_EQ(slots.all()[1]->chosenSequence(), 9u); // the data kind's slot did choose its sample
+    const auto [spectrum, pose, accel, lamp] = slots.chosen();
+    EXPECT_EQ(spectrum, nullptr);
+    EXPECT_EQ(pose, nullptr);
+    EXPECT_EQ(lamp, nullptr);
+    ASSERT_NE(accel, nullptr);
+    EXPECT_EQ(accel->sequence, 7u); // the registered accelerometer's, never the second one's
+    EXPECT_EQ(accel->gravity, first.gravity);
+    // The type-erased registry is the typed one, in its order.
+    const auto& kinds = recordings::deviceKinds();
+    ASSERT_EQ(kinds.size(), std::tuple_size_v<recordings::StateKinds>);
+    EXPECT_EQ(kinds[0], std::get<0>(recordings::stateKinds()));
+    EXPECT_EQ(kinds[2], std::get<2>(recordings::stateKinds()));
 }
 
 } // namespace

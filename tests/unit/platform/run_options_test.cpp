@@ -1,15 +1,18 @@
 // 'replica run''s options: the site file fills in what the command line leaves open (one row per
 // setting), the warm-up is one option fed by either, and every device kind has its source option,
 // defaulted from --hal as its description says.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <platform/cli/commands.h>
 #include <platform/cli/run_options.h>
+#include <platform/cli/run_resolve.h>
 #include <platform/cli/run_sources.h>
 #include <platform/site_config.h>
 #include <recordings/device_kind.h>
@@ -34,6 +37,7 @@ RunOptions parseRun(std::vector<std::string> args, const std::string& toml)
         argv.push_back(a.c_str());
     }
     app.parse(static_cast<int>(argv.size()), argv.data());
+    o.given = givenOptions(app);
     if (!toml.empty()) {
         const auto file = std::filesystem::temp_directory_path() /
                           ("replica-run-options-" + std::to_string(::getpid()) + ".toml");
@@ -42,7 +46,7 @@ RunOptions parseRun(std::vector<std::string> args, const std::string& toml)
         std::filesystem::remove(file);
         EXPECT_TRUE(site && site->problems.empty());
         if (site) {
-            applySite(site->config, o, app);
+            applySite(site->config, o);
         }
     }
     return o;
@@ -62,16 +66,17 @@ TEST(RunOptions, TheSiteFileFillsOnlyWhatTheCommandLineLeavesOpen)
     EXPECT_EQ(o.outputChoice.kms.connector, "HDMI-A-1");
     EXPECT_EQ(o.recordFlushMs, 250);
     EXPECT_TRUE(o.noWarmUp);
-    RunConfig config;
-    ASSERT_EQ(runConfigFromOptions(o, {64, 40}, config), kExitOk);
-    EXPECT_FALSE(config.warmUp);
+    auto plan = resolveRun(o);
+    ASSERT_TRUE(plan) << plan.error().lines.front();
+    EXPECT_FALSE(plan->config.warmUp);
 
     // Without the key the warm-up stays on; --no-warm-up alone turns it off.
     const RunOptions plain = parseRun({}, "[run]\nhal = \"sim\"\n");
     EXPECT_FALSE(plain.noWarmUp);
     EXPECT_EQ(plain.rateHz, 60.0); // the site file's default, as the command line's
-    ASSERT_EQ(runConfigFromOptions(plain, {64, 40}, config), kExitOk);
-    EXPECT_TRUE(config.warmUp);
+    plan = resolveRun(plain);
+    ASSERT_TRUE(plan) << plan.error().lines.front();
+    EXPECT_TRUE(plan->config.warmUp);
     EXPECT_TRUE(parseRun({"--no-warm-up"}, "").noWarmUp);
 }
 
@@ -107,6 +112,57 @@ TEST(RunOptions, EveryDeviceKindHasItsSourceOptionDefaultedFromHal)
             << refused.error().message;
     EXPECT_NE(refused.error().message.find("accel live|sim|replay"), std::string::npos)
             << refused.error().message;
+}
+
+// Writes 'toml' as a site file and resolves 'replica run --kiosk --config FILE ARGS' as the kiosk
+// and 'replica config check' both do.
+Resolved<RunPlan> resolveKiosk(const std::string& toml, std::vector<std::string> args = {})
+{
+    const auto file = std::filesystem::temp_directory_path() /
+                      ("replica-resolve-" + std::to_string(::getpid()) + ".toml");
+    std::ofstream(file) << toml;
+    args.insert(args.begin(), {"--kiosk", "--config", file.string()});
+    auto plan = resolveRun(parseRun(args, ""));
+    std::filesystem::remove(file);
+    return plan;
+}
+
+TEST(RunResolve, WhatTheKioskWouldRefuseIsTheSiteFilesProblemWithItsLineAndKey)
+{
+    const std::string good = "[run]\nhal = \"sim\"\n";
+    ASSERT_TRUE(resolveKiosk(good + "[display]\noutput = \"headless\"\n"));
+    // Each value the reader accepts but the kiosk could not use: exit 78, the key and its line
+    // (the file's last).
+    const std::vector<std::pair<std::string, std::string>> cases{
+            {"[defaults]\nlamp = \"sodium\"\n", "defaults.lamp"},
+            {"[devices]\naccel_axes = \"x,x,q\"\n", "devices.accel_axes"},
+            {"[devices]\nlamp_gpio = \"gpiochip0:17\"\n", "devices.lamp_gpio"},
+            {"[tracker]\nbind = \"localhost:80\"\n", "tracker.bind"},
+            {"[display]\noutput = \"headless\"\nsize = \"16384x16\"\n", "display.size"},
+            {"[scene]\ndir = \"/nonexistent-replica-scene\"\n", "scene.dir"},
+            {"[display]\nprofile = \"/nonexistent-replica-profile.json\"\n", "display.profile"},
+            {"[log]\nlevel = \"loud\"\n", "log.level"},
+            {"[booth]\nid = \"booth-9\"\n", "booth.id"},
+    };
+    for (const auto& [extra, key] : cases) {
+        const std::string text = good + extra;
+        const long line = static_cast<long>(std::count(text.begin(), text.end(), '\n'));
+        auto plan = resolveKiosk(text);
+        ASSERT_FALSE(plan) << key;
+        EXPECT_EQ(plan.error().code, kExitConfig) << key;
+        EXPECT_EQ(plan.error().problem.key, key);
+        EXPECT_EQ(plan.error().problem.line, line) << key;
+        EXPECT_NE(plan.error().lines.front().find(fmt::format(":{}: {}: ", line, key)),
+                  std::string::npos)
+                << plan.error().lines.front();
+    }
+    // The same value on the command line is the command line's error, naming the option (exit 1,
+    // as when the device refused it).
+    auto cli = resolveKiosk(good, {"--accel-axes", "x,x,q"});
+    ASSERT_FALSE(cli);
+    EXPECT_EQ(cli.error().code, kExitFailure);
+    EXPECT_EQ(cli.error().lines.front().rfind("--accel-axes x,x,q: ", 0), 0u)
+            << cli.error().lines.front();
 }
 
 } // namespace

@@ -270,5 +270,45 @@ TEST(RecordingDamage, FlippedChunkLosesOnlyThatChunk)
     EXPECT_EQ(scan.messages.size(), mcap::scan(s.bytes).messages.size() - lost);
 }
 
+// Chunks nested in chunks, each an uncompressed chunk record holding the next (the hostile
+// recordings of issue 32): 'claimZero' makes each claim 0 uncompressed bytes, otherwise each
+// claims its true size and fails its CRC. Built here from the MCAP specification's layout.
+std::string nestedChunks(std::size_t bytes, bool claimZero)
+{
+    auto u64 = [](std::uint64_t v) { return std::string(reinterpret_cast<const char*>(&v), 8); };
+    auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    std::string inner;
+    while (inner.size() < bytes) {
+        const std::string body = u64(0) + u64(0) + u64(claimZero ? 0 : inner.size()) +
+                                 u32(0xDEADBEEF) + u32(0) + u64(inner.size()) + inner;
+        inner = std::string(1, '\x06') + u64(body.size()) + body;
+    }
+    return std::string(mcap::kMagic) + inner;
+}
+
+// Recover tries every plausible chunk header after damage; each attempt's copying and checksumming
+// is counted against the decompression budget, so nested chunks cost at most the budget, not the
+// square of the file's size (3.9 s for 4 MB before, 16 MB in minutes).
+TEST(RecordingDamage, ResyncWorkOnNestedChunksIsBoundedByTheBudget)
+{
+    mcap::ScanOptions options;
+    options.resync = true;
+    options.chunkedOnly = true;
+    for (const std::size_t n : {std::size_t{64} << 10, std::size_t{1} << 20}) {
+        // Claiming 0 bytes: refused before anything is copied. Each of the ~n/45 levels used to
+        // copy what it holds: n^2/90 bytes, 12 GB for 1 MiB.
+        const auto zero = nestedChunks(n, true);
+        const auto s0 = mcap::scan(zero, options);
+        EXPECT_EQ(s0.bytesExamined, 0u) << n;
+        EXPECT_TRUE(s0.messages.empty());
+        // Claiming their true sizes: each attempt is paid for; the scan stops at the budget.
+        const auto wrong = nestedChunks(n, false);
+        const auto s1 = mcap::scan(wrong, options);
+        EXPECT_LE(s1.bytesExamined, mcap::decompressionBudget(wrong.size())) << n;
+        EXPECT_GT(s1.bytesExamined, wrong.size()) << "more than one level was tried";
+        EXPECT_TRUE(s1.messages.empty());
+    }
+}
+
 } // namespace
 } // namespace replica::recordings

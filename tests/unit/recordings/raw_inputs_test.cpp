@@ -193,6 +193,20 @@ TEST(RawInputs, DatagramsAndSysfsReadingsComeBackAndReprocessBitExactly)
     EXPECT_EQ(straight.samples(recordings::accelKind())[2].gravity,
               accel[2].gravity); // no raw input: as recorded
 
+    // An accelerometer scale of 1e308 (issue 32): 1000 counts of it overflow a double, so that
+    // sample's gravity is not finite. Counted (and replay warns), not hidden.
+    auto huge = *rec;
+    auto scaled =
+            std::make_shared<hal::RawAccelInput>(*huge.samples(recordings::accelKind())[0].raw);
+    scaled->scale = {1e308, 1e308, 1e308};
+    huge.samples(recordings::accelKind())[0].raw = scaled;
+    r = platform::reprocess(huge, {});
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->accelNonFinite, 1u);
+    EXPECT_EQ(r->posesNonFinite, 0u);
+    EXPECT_FALSE(std::isfinite(huge.samples(recordings::accelKind())[0].gravity.y));
+    EXPECT_EQ(platform::reprocess(same, {})->accelNonFinite, 0u);
+
     // A datagram that is not a pose: one line naming the pose.
     auto bad = *rec;
     auto cut =

@@ -47,10 +47,15 @@ protected:
         setup_.settings.specularSamples = 4;
     }
 
-    // The state stage for hand-made states, with the light estimator's re-encode decision.
-    static tests::StateSequence sequence(const BoothScenePass& pass)
+    // The state stage for hand-made states, with the light estimator's re-encode decision made
+    // for each lamp's booth light (the booth data, as the appliance's state stage reads it).
+    tests::StateSequence sequence() const
     {
-        return tests::StateSequence(1, state::EncodingDecision(encoder_, pass.lampSpectra()));
+        std::vector<colour::Spectrum> spectra;
+        for (const auto& lamp : setup_.booth.lights) {
+            spectra.push_back(lamp.spd);
+        }
+        return tests::StateSequence(1, state::EncodingDecision(encoder_, spectra));
     }
 
     static colour::Spectrum cie(const char* name)
@@ -176,7 +181,7 @@ TEST_F(AdaptiveBooth, LampChangeReencodesAtThatFrameAndMatchesTheNewLight)
     auto pass = BoothScenePass::create(setup_);
     ASSERT_TRUE(pass) << pass.error().message;
     EXPECT_EQ((*pass)->encodings(), 0);
-    auto seq = sequence(**pass);
+    auto seq = sequence();
     scene::SceneState st, cur;
     st.tiltRad = 0.4;
     st.lampIndex = 0;
@@ -209,7 +214,7 @@ TEST_F(AdaptiveBooth, DirectSensorModeReencodesPastTheShapeThreshold)
 {
     auto pass = BoothScenePass::create(setup_);
     ASSERT_TRUE(pass);
-    auto seq = sequence(**pass);
+    auto seq = sequence();
     scene::SceneState st, cur;
     st.lampIndex = -1;
     st.emitterLuminanceCdM2 = 1500.0;

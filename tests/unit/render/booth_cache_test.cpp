@@ -74,6 +74,34 @@ TEST_F(BoothCacheTest, AFrameFromTheCacheEqualsOneThatRecomputesIt)
     EXPECT_GT(differ, kCacheW * kCacheH / 10);
 }
 
+// Light changes are the state stage's decision (SceneState::lightChanged, by the light's content
+// key): the pass does not decide it again. It labels the light it holds with that key, so a state
+// that says "changed" about the light it already holds redraws nothing, and one of another lamp
+// is drawn with that lamp whatever lightChanged says.
+TEST_F(BoothCacheTest, ThePassHoldsTheLightByItsContentKeyAndDoesNotDecideAChange)
+{
+    auto pass = BoothScenePass::create(setup_);
+    auto fresh = BoothScenePass::create(setup_);
+    ASSERT_TRUE(pass && fresh);
+    const glm::dvec3 eye{0.05, 0.45, 0.60};
+    tests::StateSequence seq;
+    const scene::SceneState st = seq.next(0.35, eye, 2);
+    const auto f0 = draw(**pass, st);
+    EXPECT_EQ((*pass)->cacheRefreshes(), 1);
+    scene::SceneState again = st;
+    again.lightChanged = true;
+    EXPECT_TRUE(tests::sameFloats(draw(**pass, again), f0));
+    EXPECT_EQ((*pass)->cacheRefreshes(), 1); // the same key: nothing uploaded, nothing redrawn
+    scene::SceneState other = st;
+    other.lampIndex = 0;
+    other.lightChanged = false;
+    EXPECT_NE(scene::lightKey(other), scene::lightKey(st));
+    const auto f1 = draw(**pass, other);
+    EXPECT_EQ((*pass)->cacheRefreshes(), 2);
+    EXPECT_TRUE(tests::sameFloats(draw(**fresh, other), f1));
+    EXPECT_FALSE(tests::sameFloats(f1, f0));
+}
+
 TEST_F(BoothCacheTest, TiltNoiseIsHeldAndLightPoseAndInvalidationRefresh)
 {
     auto pass = BoothScenePass::create(setup_);
@@ -145,11 +173,11 @@ TEST_F(BoothCacheTest, AFreshPassDrawsAnyFrameFromItsStateAlone)
             x = x * 1664525u + 1013904223u; // a fixed pseudo-random walk of tilt and eye
             const double jitter = (static_cast<double>(x >> 8) / 16777216.0 - 0.5) * 0.02;
             const scene::SceneState st = seq.next(0.3 + 0.004 * i + jitter, {0.01 * i, 0.45, 0.6});
-            refreshing += st.diffuse->refreshRad ? 1 : 0;
+            refreshing += st.diffuse->band ? 1 : 0;
             const auto fa = draw(**a, st);
             const auto fb = draw(**b, st);
             ASSERT_TRUE(tests::sameFloats(fa, fb)) << "frame " << i << ", " << slices << " slices";
-            if (i % 4 == 1 || (st.diffuse->refreshRad && alone < 4)) {
+            if (i % 4 == 1 || (st.diffuse->band && alone < 4)) {
                 auto fresh = BoothScenePass::create(setup_);
                 ASSERT_TRUE(fresh);
                 ASSERT_TRUE(tests::sameFloats(draw(**fresh, st), fa))
@@ -270,13 +298,14 @@ TEST(TiltHold, ALaggingDiffuseTermCostsMoreTheFurtherItLags)
     }
 }
 
-// A tilt's recompute in K = 3 bands over three draws (RenderSettings::cacheSlices): each frame
-// composes from one whole cache, the one a pass that recomputes at once draws for some pose asked
-// for earlier; a pose asked for while the bands are drawn waits for them; a new light is drawn
-// whole at once; once the pose holds, the frames are the unsliced pass's, bit for bit. On the
-// ColorChecker with a diffuse grid (mode 3 drawn with the first band) and the surround's
+// A tilt's recompute in K = 3 bands over three draws, each band the one the frame names (the
+// state stage decides them: pipeline/scene/diffuse_schedule.h): each frame composes from one whole
+// cache, the one a pass that recomputes at once draws for the tilt shown; the last band's frame
+// is the unsliced pass's at the new tilt, bit for bit; a band asked for without the earlier ones
+// (frame N drawn alone) draws them first; a new light or layout draws the term shown whole. On
+// the ColorChecker with a diffuse grid (mode 3 drawn with the first band) and the surround's
 // illuminance, and on the painting (relief, the facet cache) without it, as the appliance runs.
-TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnslicedFrames)
+TEST_F(BoothCacheTest, TheBandTheFrameNamesIsDrawnAndTheLastShowsTheUnslicedFrame)
 {
     struct Case {
         const char* scene;
@@ -308,11 +337,18 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         view.eye = {0.05, 0.45, 0.6};
         view.pixelsX = kCacheW;
         view.pixelsY = kCacheH;
-        const auto frame = [&](BoothShadingPass& pass, double cacheTiltDeg) {
-            const shading::PanelPose cachePose =
-                    scene::panelPose(setup_.stand, scene::degreesToRadians(cacheTiltDeg));
+        const auto pose = [&](double deg) {
+            return scene::panelPose(setup_.stand, scene::degreesToRadians(deg));
+        };
+        // The frame showing the term at shownDeg and, given, drawing band b of 3 toward towardDeg.
+        const auto frame = [&](BoothShadingPass& pass, double shownDeg, double towardDeg = 0.0,
+                               int b = -1) {
+            CacheWant want{pose(shownDeg), std::nullopt};
+            if (b >= 0) {
+                want.band = CacheBand{pose(towardDeg), b, 3};
+            }
             target_->bind();
-            auto ok = pass.draw(view, kCacheW, kCacheH, layout, &cachePose);
+            auto ok = pass.draw(view, kCacheW, kCacheH, layout, &want);
             EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
             return tests::readFloats(*target_);
         };
@@ -329,21 +365,30 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         EXPECT_TRUE(tests::sameFloats(frame(s, 20.0), w20)); // the first cache is drawn whole
         EXPECT_EQ(s.cacheRefreshes(), 1);
         EXPECT_FALSE(s.cacheRefreshPending());
-        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0), w20)); // band 1 of 3 drawn behind the frame
+        EXPECT_TRUE(tests::sameFloats(frame(s, 20.0, 23.0, 0), w20)); // band 1 of 3 behind it
         EXPECT_TRUE(s.cacheRefreshPending());
-        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0), w20)); // band 2
-        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w23)); // band 3 completes 23; 27 waits for it
+        EXPECT_TRUE(tests::sameFloats(frame(s, 20.0, 23.0, 1), w20)); // band 2
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0, 23.0, 2), w23)); // band 3 shows 23
         EXPECT_EQ(s.cacheRefreshes(), 2);
         EXPECT_FALSE(s.cacheRefreshPending());
-        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w23));
-        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w23));
-        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0),
-                                      w27)); // held still: the unsliced frame, bit for bit
-        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w27));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0, 27.0, 0), w23));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0, 27.0, 1), w23));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0, 27.0, 2), w27)); // the unsliced frame
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), w27));          // held: nothing drawn
         EXPECT_EQ(s.cacheRefreshes(), 3);
         EXPECT_FALSE(s.cacheRefreshPending());
-        // A new light in the middle of a refresh: drawn whole at once, at the pose asked for.
-        EXPECT_TRUE(tests::sameFloats(frame(s, 20.0), w27));
+        // Band 2 asked for by a fresh pass (frame N drawn alone): the term shown whole and bands
+        // 1 and 2 drawn first; the next frame's last band then completes the refresh.
+        auto alone = BoothShadingPass::create(ps, settings, setup_.observer);
+        ASSERT_TRUE(alone);
+        (*alone)->setSurroundIlluminance(c.surround);
+        ASSERT_TRUE((*alone)->setLight(d65));
+        EXPECT_TRUE(tests::sameFloats(frame(**alone, 20.0, 23.0, 1), w20));
+        EXPECT_TRUE((*alone)->cacheRefreshPending());
+        EXPECT_TRUE(tests::sameFloats(frame(**alone, 23.0, 23.0, 2), w23));
+        EXPECT_EQ((*alone)->cacheRefreshes(), 2);
+        // A new light in the middle of a refresh: the term shown drawn whole at once.
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0, 20.0, 0), w27));
         EXPECT_TRUE(s.cacheRefreshPending());
         ASSERT_TRUE((*whole)->setLight(tungsten));
         ASSERT_TRUE(s.setLight(tungsten));
@@ -351,15 +396,18 @@ TEST_F(BoothCacheTest, ASlicedRefreshComposesFromWholeCachesAndEndsOnTheUnsliced
         EXPECT_TRUE(tests::sameFloats(frame(s, 23.0), t23));
         EXPECT_FALSE(s.cacheRefreshPending());
         EXPECT_FALSE(tests::sameFloats(t23, w23));
-        // A new layout in the middle of a refresh: drawn whole at once too (the compose places
-        // the surface by the new one, and the facet normals follow it).
-        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), t23));
+        // A new layout in the middle of a refresh: the term shown drawn whole again (the compose
+        // places the surface by the new one, and the facet normals follow it), the bands so far
+        // after it; the last band completes the refresh at the new layout.
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0, 27.0, 0), t23));
         EXPECT_TRUE(s.cacheRefreshPending());
         layout.offset.x += 0.125;
+        const auto moved23 = frame(**whole, 23.0);
         const auto moved27 = frame(**whole, 27.0);
-        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0), moved27));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 23.0, 27.0, 1), moved23));
+        EXPECT_TRUE(tests::sameFloats(frame(s, 27.0, 27.0, 2), moved27));
         EXPECT_FALSE(s.cacheRefreshPending());
-        EXPECT_FALSE(tests::sameFloats(moved27, frame(**whole, 23.0)));
+        EXPECT_FALSE(tests::sameFloats(moved27, moved23));
     }
 }
 

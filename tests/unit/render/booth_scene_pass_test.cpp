@@ -6,8 +6,12 @@
 #include <optional>
 #include <utility>
 
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
 #include <pipeline/base/data_dir.h>
 #include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/render/render_profile.h>
 #include <platform/appliance.h>
 
 #include <gtest/gtest.h>
@@ -120,17 +124,41 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
             R"("display_black_cd_m2":0.4})";
     auto o = platform::RunConfig::fromJson(old);
     ASSERT_TRUE(o) << o.error().message;
-    EXPECT_EQ(o->renderer, "flat");
-    // Made before the specular grid and the sampler's filter: per pixel, the shader's filter.
-    EXPECT_EQ(o->specularGrid, 0);
-    EXPECT_EQ(o->diffuseGrid, 0); // and before the diffuse grid: eq. (1) per pixel
-    EXPECT_FALSE(o->switches.hardwareFilter);
-    EXPECT_TRUE(o->switches.surroundIlluminance);
-    // And before the specular mip level bias was a setting: the renderer's bias of then.
-    EXPECT_EQ(o->switches.specularLodBias, shading::kLegacySpecularLodBias);
-    // And before area lights: point lights; a new run chooses for its scene, recorded as chosen.
-    EXPECT_EQ(o->areaLights, 0);
-    EXPECT_EQ(c.areaLights, platform::kAutoAreaLights);
+    EXPECT_EQ(o->renderer, "flat"); // what it shows: the flat patch image
+    // Every other absent key is today's default: this build has one render path, and the
+    // recording's render profile (0: none recorded) says its frames are approximate here.
+    const platform::RunConfig today;
+    EXPECT_EQ(o->specularGrid, today.specularGrid);
+    EXPECT_EQ(o->diffuseGrid, today.diffuseGrid);
+    EXPECT_EQ(o->areaLights, today.areaLights);
+    EXPECT_EQ(o->cacheSlices, today.cacheSlices);
+    EXPECT_EQ(o->viewingCompensation, today.viewingCompensation);
+    EXPECT_EQ(o->flareSubtraction, today.flareSubtraction);
+    EXPECT_EQ(o->renderProfile, 0);
+    EXPECT_FALSE(pipeline::render::rendersExactly(o->renderProfile));
+    EXPECT_EQ(c.renderProfile, pipeline::render::kRenderProfile);
+    EXPECT_TRUE(pipeline::render::rendersExactly(c.renderProfile));
+    // Profile 0's switch keys are known (an older recording holds them) and not read.
+    auto withSwitches = nlohmann::json::parse(old);
+    withSwitches["hardware_filter"] = false;
+    withSwitches["specular_lod_bias"] = 1.0;
+    withSwitches["render_profile"] = 1;
+    std::vector<std::string> warnings;
+    auto o1 = platform::RunConfig::fromJson(withSwitches.dump(), &warnings);
+    ASSERT_TRUE(o1) << o1.error().message;
+    EXPECT_TRUE(warnings.empty()) << warnings.front();
+    EXPECT_EQ(o1->renderProfile, 1);
+    // A profile newer than this build's is refused in one line naming both.
+    platform::RunConfig newer = c;
+    newer.renderProfile = pipeline::render::kRenderProfile + 1;
+    const auto refused = platform::RunConfig::fromJson(newer.toJson());
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find(fmt::format(
+                      "render profile {} is newer than this build's ({})",
+                      pipeline::render::kRenderProfile + 1, pipeline::render::kRenderProfile)),
+              std::string::npos)
+            << refused.error().message;
+    EXPECT_EQ(refused.error().message.find('\n'), std::string::npos);
     for (const int area : {0, 1}) {
         platform::RunConfig chosen = c;
         chosen.areaLights = area;
@@ -141,42 +169,7 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     platform::RunConfig badArea = c;
     badArea.areaLights = 2;
     EXPECT_FALSE(platform::RunConfig::fromJson(badArea.toJson()));
-    // And before each of these was a recorded setting: off (the rule of then), and on for a new
-    // run; each is recorded both ways.
-    const std::pair<const char*, bool pipeline::render::RenderSwitches::*> recordedSwitches[] = {
-            {"the nearest mip level (else trilinear)",
-             &pipeline::render::RenderSwitches::specularNearestLevel},
-            {"each light's horizon spread over its region (else one fixed softness)",
-             &pipeline::render::RenderSwitches::horizonSpread},
-            {"horizon sines as half floats (else floats)",
-             &pipeline::render::RenderSwitches::horizonHalf},
-            {"eq. (1)'s horizon read bilinearly (else each texel's own)",
-             &pipeline::render::RenderSwitches::horizonBilinear},
-            {"branch-free specular samples (else the early returns)",
-             &pipeline::render::RenderSwitches::specularBranchFree},
-            {"the nearest mip level from the ratio's exponent (else log2)",
-             &pipeline::render::RenderSwitches::specularExactLevel},
-            {"the exact texel tie rule (else u * texels)",
-             &pipeline::render::RenderSwitches::texelExactTies},
-            {"the horizon directions picked (else tent-weighted)",
-             &pipeline::render::RenderSwitches::horizonPick},
-            {"the viewing gain filtered from a half-degree grid (else the table's rows)",
-             &pipeline::render::RenderSwitches::viewingFiltered},
-    };
-    for (const auto& [what, key] : recordedSwitches) {
-        EXPECT_FALSE((*o).switches.*key) << what;
-        EXPECT_TRUE(c.switches.*key) << what;
-        platform::RunConfig flipped = c;
-        flipped.switches.*key = false;
-        const auto off = platform::RunConfig::fromJson(flipped.toJson());
-        const auto on = platform::RunConfig::fromJson(c.toJson());
-        ASSERT_TRUE(off && on) << what;
-        EXPECT_FALSE((*off).switches.*key) << what;
-        EXPECT_TRUE((*on).switches.*key) << what;
-    }
-    EXPECT_NE(c.switches.specularLodBias, shading::kLegacySpecularLodBias);
-    // Made before sliced cache refreshes: recomputed whole at once, as then; a new run slices.
-    EXPECT_EQ(o->cacheSlices, 1);
+    // A new run slices the cache's refresh.
     EXPECT_EQ(c.cacheSlices, platform::kDefaultCacheSlices);
     EXPECT_GT(c.cacheSlices, 1);
     for (const int slices : {1, 4, platform::kMaxCacheSlices}) {
@@ -198,23 +191,12 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     // A new run chooses (the grid per scene when the appliance is built) and records both.
     EXPECT_EQ(c.specularGrid, platform::kAutoSpecularGrid);
     EXPECT_EQ(c.diffuseGrid, platform::kAutoDiffuseGrid);
-    EXPECT_TRUE(c.switches.hardwareFilter);
     c.specularGrid = 8;
     c.diffuseGrid = 5;
-    c.switches.specularLodBias = 0.25;
     auto round = platform::RunConfig::fromJson(c.toJson());
     ASSERT_TRUE(round);
     EXPECT_EQ(round->specularGrid, 8);
     EXPECT_EQ(round->diffuseGrid, 5);
-    EXPECT_TRUE(round->switches.hardwareFilter);
-    EXPECT_EQ(round->switches.specularLodBias, 0.25);
-    c.switches.specularLodBias = 1e9; // a corrupt value is refused, not rendered
-    const auto corrupt = platform::RunConfig::fromJson(c.toJson());
-    ASSERT_FALSE(corrupt);
-    EXPECT_NE(corrupt.error().message.find("/specular_lod_bias: expected a number in [-8, 8]"),
-              std::string::npos)
-            << corrupt.error().message;
-    c.switches.specularLodBias = 0.0;
     c.specularGrid = -2;
     EXPECT_FALSE(platform::RunConfig::fromJson(c.toJson()));
     c.specularGrid = 8;
@@ -273,51 +255,21 @@ std::optional<SurroundFrame> surroundFrame(RunConfig c)
     return f;
 }
 
-TEST(ApplianceBoothScene, TheClearedSurroundIsNotShadedAndNoPixelChanges)
+TEST(ApplianceBoothScene, TheSurroundIsShadedOnlyWhereTheDisplayPassReadsIt)
 {
     RunConfig c;
     c.width = 96;
     c.height = 60;
-    ASSERT_FALSE(c.switches.surroundIlluminance); // new runs leave it out
     const auto without = surroundFrame(c);
     if (!without) {
         GTEST_SKIP() << "no EGL/GLES context";
     }
-    c.switches.surroundIlluminance = true; // as recordings made before it replay
-    const auto with = surroundFrame(c);
-    ASSERT_TRUE(with);
+    // The display pass clears the surround: the booth pass shades only the surface
+    // (booth_cache_test shows the frame is the same either way).
     EXPECT_FALSE(without->surround);
-    EXPECT_TRUE(with->surround);
-    // What the panel shows, and the gamut counts, are the same.
-    EXPECT_EQ(without->frame.rgba, with->frame.rgba);
-    EXPECT_EQ(without->frame.gamut.belowBlack, with->frame.gamut.belowBlack);
-    EXPECT_EQ(without->frame.gamut.chroma, with->frame.gamut.chroma);
-    EXPECT_EQ(without->frame.gamut.overPeak, with->frame.gamut.overPeak);
-    // The XYZ frame differs only in the surround's alpha, which nothing reads.
-    const auto& a = without->frame.xyz;
-    const auto& b = with->frame.xyz;
-    ASSERT_EQ(a.size(), b.size());
-    long alphaDiffers = 0;
-    for (int y = 0; y < c.height; ++y) {
-        for (int x = 0; x < c.width; ++x) {
-            const std::size_t i = (static_cast<std::size_t>(y) * c.width + x) * 4;
-            const auto& r = with->rect;
-            const bool in = x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height;
-            for (int k = 0; k < 3; ++k) {
-                ASSERT_EQ(a[i + k], b[i + k]) << x << ", " << y;
-            }
-            if (in) {
-                ASSERT_EQ(a[i + 3], b[i + 3]) << x << ", " << y;
-            } else {
-                alphaDiffers += a[i + 3] != b[i + 3] ? 1 : 0;
-            }
-        }
-    }
-    EXPECT_GT(alphaDiffers, 0);
 
     // A display pass that shades the surround (per-channel clipping) gets its illuminance
-    // whatever the configuration says.
-    c.switches.surroundIlluminance = false;
+    // too.
     c.gamutMapping = "clip";
     const auto clip = surroundFrame(c);
     ASSERT_TRUE(clip);
@@ -335,17 +287,7 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
     c.specularGrid = 3;
     c.diffuseGrid = 2;
     c.horizonDirections = 12;
-    c.switches.specularLodBias = 0.75;
     for (const bool on : {false, true}) {
-        c.switches.hardwareFilter = on;
-        c.switches.specularNearestLevel = !on;
-        c.switches.horizonSpread = on;
-        c.switches.horizonHalf = !on;
-        c.switches.horizonBilinear = on;
-        c.switches.specularBranchFree = !on;
-        c.switches.specularExactLevel = on;
-        c.switches.texelExactTies = !on;
-        c.switches.horizonPick = on;
         c.areaLights = on ? 0 : 1;
         c.cacheSlices = on ? 3 : 1;
         c.flareSubtraction = !on;
@@ -355,16 +297,6 @@ TEST(ApplianceConfig, EveryRecordedRenderSettingReachesTheRenderer)
         EXPECT_EQ(s.specularGrid, 3);
         EXPECT_EQ(s.diffuseGrid, 2);
         EXPECT_EQ(s.horizonDirections, 12);
-        EXPECT_EQ(s.specularLodBias, 0.75);
-        EXPECT_EQ(s.hardwareFilter, on);
-        EXPECT_EQ(s.specularNearestLevel, !on);
-        EXPECT_EQ(s.horizonSpread, on);
-        EXPECT_EQ(s.horizonHalf, !on);
-        EXPECT_EQ(s.horizonBilinear, on);
-        EXPECT_EQ(s.specularBranchFree, !on);
-        EXPECT_EQ(s.specularExactLevel, on);
-        EXPECT_EQ(s.texelExactTies, !on);
-        EXPECT_EQ(s.horizonPick, on);
         EXPECT_EQ(s.areaLights, !on);
         EXPECT_EQ(s.cacheSlices, on ? 3 : 1);
         // Flare subtracted by the display pass: never a second time in pass 1.

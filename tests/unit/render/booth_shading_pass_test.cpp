@@ -200,21 +200,14 @@ std::map<std::string, surface::SurfaceScene> BoothPassTest::scenes_;
 TEST_F(BoothPassTest, MatchesTheCpuModelOnEveryShippedSceneAndLight)
 {
     // The default setting (32 lights, 48 samples, 8 horizons), with the luminance chain filtered
-    // by the sampler (where the GL can: llvmpipe can) and by hand in the shader. Measured: 1e-5
+    // by the sampler where the GL can (llvmpipe can), else by hand in the shader. Measured: 1e-5
     // relative in Y and 2e-4 dE00 at most on the shipped scenes.
-    for (const bool hardware : {true, false}) {
-        shading::RenderSettings settings;
-        settings.hardwareFilter = hardware;
-        const shading::View v = view(64, 40);
-        for (const auto& [name, scene] : scenes_) {
-            bool sampler = !hardware;
-            expectMatchesTheCpuModel(scene, settings, v, name, true, &sampler);
-            if (!hardware) {
-                EXPECT_FALSE(sampler);
-            }
-            RecordProperty(name + (hardware ? "_hardware_filter" : "_shader_filter"),
-                           sampler ? "sampler" : "shader");
-        }
+    shading::RenderSettings settings;
+    const shading::View v = view(64, 40);
+    for (const auto& [name, scene] : scenes_) {
+        bool sampler = false;
+        expectMatchesTheCpuModel(scene, settings, v, name, true, &sampler);
+        RecordProperty(name + "_mip_filter", sampler ? "sampler" : "shader");
     }
 }
 
@@ -258,37 +251,14 @@ TEST_F(BoothPassTest, DiffuseGridMatchesTheCpuModel)
     }
 }
 
-TEST_F(BoothPassTest, HorizonSpreadOnAndOffMatchesTheCpuModel)
+TEST_F(BoothPassTest, HorizonSpreadAndHalfFloatHorizonsMatchTheCpuModel)
 {
-    // Each light's horizon spread over its region (on: the appliance; off: what recordings made
-    // before it replay with) in the GL pass against the CPU model, on the painting at a
-    // 10-degree tilt, where the ceiling grazes the panel and the spread matters most.
+    // Each light's horizon softness from its region's spread, the horizon sines as half floats
+    // (eight a texel) and eq. (1)'s horizon read bilinearly at the pixel's point: the GL pass
+    // against the CPU model on the painting at a 10-degree tilt, where the ceiling grazes the
+    // panel and the horizons shadow most.
     const shading::View v = view(64, 40, 10.0);
-    for (const bool spread : {true, false}) {
-        shading::RenderSettings settings = paintingSettings();
-        settings.horizonSpread = spread;
-        expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
-                                 spread ? "spread" : "no spread");
-    }
-}
-
-TEST_F(BoothPassTest, HorizonEncodingsAndLookupsMatchTheCpuModel)
-{
-    // The horizon sines as half floats, eight a texel, or floats, four a texel; eq. (1)'s horizon
-    // read bilinearly at the pixel's point or at its texel (the appliance: half and bilinear;
-    // recordings made before either replay without it). The GL pass against the CPU model with
-    // the same settings, on the painting at a 10-degree tilt, where the horizons shadow most.
-    const shading::View v = view(64, 40, 10.0);
-    for (const bool half : {true, false}) {
-        for (const bool bilinear : {true, false}) {
-            shading::RenderSettings settings = paintingSettings();
-            settings.horizonHalf = half;
-            settings.horizonBilinear = bilinear;
-            expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
-                                     std::string(half ? "half" : "float") + " horizons, " +
-                                             (bilinear ? "bilinear" : "nearest texel"));
-        }
-    }
+    expectMatchesTheCpuModel(scenes_.at("painting"), paintingSettings(), v, "default horizons");
     // Direction counts that fill a layer partly (4 and 12 of 8 a layer) or span several (20).
     for (const int dirs : {4, 12, 20}) {
         shading::RenderSettings settings = paintingSettings();
@@ -298,77 +268,26 @@ TEST_F(BoothPassTest, HorizonEncodingsAndLookupsMatchTheCpuModel)
     }
 }
 
-TEST_F(BoothPassTest, HorizonPickAndTentWeightsBothMatchTheCpuModel)
+TEST_F(BoothPassTest, HorizonPickMatchesTheCpuModel)
 {
-    // The two directions around a light's azimuth picked by comparisons (the appliance) or every
-    // direction tent-weighted (recordings made before it): each against the CPU model on the
-    // painting at a 10-degree tilt, and the pick where a direction count leaves it one direction
-    // or an odd number.
-    const shading::View v = view(64, 40, 10.0);
-    for (const bool pick : {true, false}) {
-        shading::RenderSettings settings = paintingSettings();
-        settings.horizonPick = pick;
-        expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
-                                 pick ? "picked directions" : "tent weights");
-    }
+    // The two directions around a light's azimuth picked by comparisons, against the CPU model
+    // on the painting at a 10-degree tilt, and where a direction count leaves one direction or
+    // an odd number.
     for (const int dirs : {1, 3}) {
         shading::RenderSettings settings = paintingSettings();
         settings.horizonDirections = dirs;
-        expectMatchesTheCpuModel(scenes_.at("painting"), settings, v,
+        expectMatchesTheCpuModel(scenes_.at("painting"), settings, view(64, 40, 10.0),
                                  "picked from " + std::to_string(dirs) + " directions");
     }
-    // The pick against the tent weights frame for frame: the same two products (the tent's other
-    // weights are exact zeros), so the same value but for the order the compiler fuses them in.
-    // Measured: bit-identical on every pixel at 480x300 from 10 to 110 degrees (2026-12-02,
-    // llvmpipe 15); recorded as a setting all the same, so that a compiler that fuses otherwise
-    // cannot change an old recording's frames. Tilts that put lights on every side of a facet's
-    // azimuth, direction 0 (the wrap) included.
-    const auto ps = shading::prepareScene(scenes_.at("painting"),
-                                          paintingSettings().horizonDirections, 0.01, *basis_);
-    const auto pl =
-            shading::prepareLight(booth_->lights[0], *obs_, paintingSettings().lights, *basis_);
-    std::vector<std::unique_ptr<BoothShadingPass>> passes; // the pick, then the tent weights
-    for (const bool pick : {true, false}) {
-        shading::RenderSettings settings = paintingSettings();
-        settings.horizonPick = pick;
-        auto pass = BoothShadingPass::create(ps, settings, *obs_);
-        ASSERT_TRUE(pass) << pass.error().message;
-        ASSERT_TRUE((*pass)->setLight(pl));
-        passes.push_back(std::move(*pass));
-    }
-    long pixels = 0, exact = 0;
-    for (const double tilt : {10.0, 40.0, 110.0}) {
-        std::vector<shading::XyzFrame> frames;
-        for (const auto& pass : passes) {
-            auto gl = renderBoothFrame(*pass, pl, view(160, 100, tilt));
-            ASSERT_TRUE(gl) << gl.error().message;
-            frames.push_back(std::move(*gl));
-        }
-        for (std::size_t i = 0; i < frames[0].xyz.size(); ++i) {
-            const colour::Xyz a = frames[0].xyz[i];
-            const colour::Xyz b = frames[1].xyz[i];
-            ++pixels;
-            exact += a == b ? 1 : 0;
-            for (int c = 0; c < 3; ++c) {
-                ASSERT_LE(std::abs(a[c] - b[c]), 1e-6 * std::max(std::abs(b[c]), 1e-3))
-                        << "tilt " << tilt << ", pixel " << i << ", channel " << c;
-            }
-        }
-    }
-    std::printf("horizon pick against tent weights: %ld of %ld pixels bit-identical\n", exact,
-                pixels);
-    EXPECT_EQ(pixels, 3L * 160 * 100);
 }
 
-TEST_F(BoothPassTest, BranchFreeSpecularSamplesMatchTheEarlyReturns)
+TEST_F(BoothPassTest, BranchFreeSpecularSamplesMatchTheCpuModel)
 {
-    // RenderSettings::specularBranchFree (the appliance's default; recordings made before it
-    // replay with the early returns): the same samples, zeroed at the end instead of returned
-    // from. Both against the CPU model, and against each other to float rounding, pixel by
-    // pixel, on the glossy flat ColorChecker and the painting. From the default eye the specular
-    // term lifts nearly every pixel (the kept samples must agree); from a grazing eye and from
-    // above at a 10-degree tilt most samples fail a test (the zeros must agree: dropping the
-    // "towards the ceiling" test fails the view from above).
+    // The specular samples computed on every pixel and zeroed at the end where a test fails,
+    // against the CPU model's early returns, on the glossy flat ColorChecker and the painting. From
+    // the default eye the specular term lifts nearly every pixel (the kept samples must agree);
+    // from a grazing eye and from above at a 10-degree tilt most samples fail a test (the zeros
+    // must agree: dropping the "towards the ceiling" test fails the view from above).
     struct Case {
         shading::View view;
         bool specularShows;
@@ -399,113 +318,71 @@ TEST_F(BoothPassTest, BranchFreeSpecularSamplesMatchTheEarlyReturns)
                 }
                 EXPECT_GT(lifted, with.xyz.size() * 9 / 10) << name;
             }
-            std::array<std::vector<shading::XyzFrame>, 2> frames; // tungsten, d65 each
-            for (const bool branchFree : {false, true}) {
-                shading::RenderSettings settings = base;
-                settings.specularBranchFree = branchFree;
-                expectMatchesTheCpuModel(scene, settings, v,
-                                         std::string(name) +
-                                                 (branchFree ? ", branch-free" : ", early returns"),
-                                         false, nullptr, &frames[branchFree ? 1 : 0]);
-            }
-            ASSERT_EQ(frames[0].size(), 2u);
-            ASSERT_EQ(frames[1].size(), 2u);
-            for (std::size_t f = 0; f < 2; ++f) {
-                const auto& early = frames[0][f].xyz;
-                const auto& free = frames[1][f].xyz;
-                ASSERT_EQ(early.size(), free.size());
-                double worst = 0.0;
-                for (std::size_t i = 0; i < early.size(); ++i) {
-                    for (int k = 0; k < 3; ++k) {
-                        worst = std::max(worst, std::abs(early[i][k] - free[i][k]) /
-                                                        std::max(std::abs(early[i][k]), 1e-3));
-                    }
-                }
-                EXPECT_LE(worst, 1e-5) << name << ", light " << f;
-            }
+            expectMatchesTheCpuModel(scene, base, v, std::string(name) + ", branch-free");
         }
     }
 }
 
 TEST_F(BoothPassTest, ExactMipLevelMatchesTheCpuModel)
 {
-    // RenderSettings::specularExactLevel (the appliance's default; recordings made before it
-    // replay with log2): each sample's nearest mip level from the footprint ratio's float
-    // exponent. Against the CPU model, whose level comes from log2 in double, at biases of whole
-    // half levels, where it applies (the ratio scaled by 4^bias); at a quarter-level bias it does
-    // not apply, and the frames are log2's, bit for bit.
+    // Each sample's nearest mip level from the footprint ratio's float exponent, against the CPU
+    // model, whose level comes from log2 in double, at biases of whole half levels (the ratio
+    // scaled by 4^bias). A quarter-level bias or trilinear levels the GL pass refuses (the CPU
+    // model's alone, for the studies).
     const shading::View v = view(64, 40, 30.0);
     for (const char* name : {"colorchecker", "painting"}) {
         const auto& scene = scenes_.at(name);
         shading::RenderSettings settings;
         settings.specularSamples = shading::defaultSpecularSamples(scene);
-        ASSERT_TRUE(settings.specularExactLevel);
         ASSERT_TRUE(settings.specularNearestLevel);
         for (const double bias : {0.0, 0.5, -1.0}) {
             settings.specularLodBias = bias;
             expectMatchesTheCpuModel(scene, settings, v,
                                      fmt::format("{}, exact level, bias {}", name, bias));
         }
+        const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, *basis_);
         settings.specularLodBias = 0.25;
-        std::array<std::vector<shading::XyzFrame>, 2> frames; // log2, exact asked for
-        for (const bool exact : {false, true}) {
-            settings.specularExactLevel = exact;
-            expectMatchesTheCpuModel(scene, settings, v,
-                                     fmt::format("{}, bias 0.25, exact level {}", name, exact),
-                                     false, nullptr, &frames[exact ? 1 : 0]);
-        }
-        ASSERT_EQ(frames[0].size(), 2u);
-        ASSERT_EQ(frames[1].size(), 2u);
-        for (std::size_t f = 0; f < 2; ++f) {
-            ASSERT_EQ(frames[0][f].xyz.size(), frames[1][f].xyz.size());
-            std::size_t differ = 0;
-            for (std::size_t i = 0; i < frames[0][f].xyz.size(); ++i) {
-                differ += frames[0][f].xyz[i] != frames[1][f].xyz[i] ? 1 : 0;
-            }
-            EXPECT_EQ(differ, 0u) << name << ", light " << f;
-        }
+        auto quarter = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_FALSE(quarter);
+        EXPECT_NE(quarter.error().message.find("bias of 0.25"), std::string::npos)
+                << quarter.error().message;
+        settings.specularLodBias = 0.0;
+        settings.specularNearestLevel = false;
+        auto trilinear = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_FALSE(trilinear);
+        EXPECT_NE(trilinear.error().message.find("trilinear"), std::string::npos)
+                << trilinear.error().message;
     }
 }
 
-// The tie tests' verdict on a GL frame against the CPU model's: with the tie rule, the agreement
-// expectMatchesTheCpuModel states; without it, a tie taken on the other side shows (a texel
-// away, more than 0.5 ΔE00), which is how the test knows its frame holds ties.
-void expectTieVerdict(const Agreement& a, bool exact, const std::string& label)
+// The tie tests' verdict on a GL frame against the CPU model's: the agreement
+// expectMatchesTheCpuModel states.
+void expectTieVerdict(const Agreement& a, const std::string& label)
 {
-    if (exact) {
-        EXPECT_LE(a.fracOverTol, 0.002) << label << " max rel " << a.maxRelY;
-        EXPECT_LE(a.de.max, 0.01) << label;
-    } else {
-        EXPECT_GT(a.de.max, 0.5) << label << ": no tie showed";
-    }
+    EXPECT_LE(a.fracOverTol, 0.002) << label << " max rel " << a.maxRelY;
+    EXPECT_LE(a.de.max, 0.01) << label;
 }
 
 TEST_F(BoothPassTest, PixelCentresOnTexelEdgesTakeTheCpuModelsTexel)
 {
-    // RenderSettings::texelExactTies (the appliance's default; recordings made before it replay
-    // with u * texels). At 48x30 and 96x60 a pixel row in about thirty has its centres exactly on
-    // a texel edge of the painting. With the tie rule the GL pass picks the CPU model's texel
-    // there; without it, float rounding picked the texel before on some of those rows, a whole
-    // pigment away at an edge (this is what the comparison catches, so the sizes do hold ties).
+    // At 48x30 and 96x60 a pixel row in about thirty has its centres exactly on a texel edge of
+    // the painting. The GL pass's tie rule (the offset into the surface's pixels times the
+    // texels, divided last) picks the CPU model's texel there; u * texels in float picked the
+    // texel before on some of those rows, a whole pigment away at an edge.
     const auto& scene = scenes_.at("painting");
     shading::RenderSettings settings;
     settings.specularSamples = shading::defaultSpecularSamples(scene);
-    ASSERT_TRUE(settings.texelExactTies);
     const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, *basis_);
     const auto pl = shading::prepareLight(booth_->lights[2], *obs_, settings.lights, *basis_);
     for (const auto& [w, h] : {std::pair{48, 30}, std::pair{96, 60}}) {
         const shading::View v = view(w, h, 30.0);
         const auto cpu = shading::renderRealtime(ps, pl, v, *obs_, settings);
-        for (const bool exact : {true, false}) {
-            shading::RenderSettings s = settings;
-            s.texelExactTies = exact;
-            auto pass = BoothShadingPass::create(ps, s, *obs_);
-            ASSERT_TRUE(pass) << pass.error().message;
-            ASSERT_TRUE((*pass)->setLight(pl));
-            const auto gl = renderBoothFrame(**pass, pl, v);
-            ASSERT_TRUE(gl) << gl.error().message;
-            expectTieVerdict(agree(cpu, *gl), exact, fmt::format("{}x{}", w, h));
-        }
+        auto pass = BoothShadingPass::create(ps, settings, *obs_);
+        ASSERT_TRUE(pass) << pass.error().message;
+        ASSERT_TRUE((*pass)->setLight(pl));
+        const auto gl = renderBoothFrame(**pass, pl, v);
+        ASSERT_TRUE(gl) << gl.error().message;
+        expectTieVerdict(agree(cpu, *gl), fmt::format("{}x{}", w, h));
     }
 }
 
@@ -514,7 +391,7 @@ TEST_F(BoothPassTest, AnOffsetLayoutTakesTheCpuModelsTexelsToo)
     // The appliance draws the surface into part of its frame (SurfaceLayout), and the tie rule
     // reads the surface's pixel rectangle from the layout. Here the surface fills pixels 12 to 108
     // across and 8 to 68 down of a 120x76 viewport: those pixels are the CPU model's 96x60 frame,
-    // ties included (without the rule they differ, so the layout does hold ties).
+    // ties included.
     const auto& scene = scenes_.at("painting");
     shading::RenderSettings settings;
     settings.specularSamples = shading::defaultSpecularSamples(scene);
@@ -526,27 +403,23 @@ TEST_F(BoothPassTest, AnOffsetLayoutTakesTheCpuModelsTexelsToo)
     layout.offset = glm::dvec2(-layout.scale.x * x0 / w, -layout.scale.y * y0 / h);
     const shading::View cpuView = view(pw, ph, 30.0);
     const auto cpu = shading::renderRealtime(ps, pl, cpuView, *obs_, settings);
-    for (const bool exact : {true, false}) {
-        shading::RenderSettings s = settings;
-        s.texelExactTies = exact;
-        auto pass = BoothShadingPass::create(ps, s, *obs_);
-        ASSERT_TRUE(pass) << pass.error().message;
-        ASSERT_TRUE((*pass)->setLight(pl));
-        auto target = XyzTarget::create(w, h);
-        ASSERT_TRUE(target);
-        (*target)->bind();
-        const shading::View glView = view(w, h, 30.0);
-        ASSERT_TRUE((*pass)->draw(glView, w, h, layout));
-        const auto full = (*target)->read(pl, glView);
-        shading::XyzFrame inner = cpu;
-        for (int y = 0; y < ph; ++y) {
-            for (int x = 0; x < pw; ++x) {
-                inner.xyz[static_cast<std::size_t>(y * pw + x)] =
-                        full.xyz[static_cast<std::size_t>((y0 + y) * w + x0 + x)];
-            }
+    auto pass = BoothShadingPass::create(ps, settings, *obs_);
+    ASSERT_TRUE(pass) << pass.error().message;
+    ASSERT_TRUE((*pass)->setLight(pl));
+    auto target = XyzTarget::create(w, h);
+    ASSERT_TRUE(target);
+    (*target)->bind();
+    const shading::View glView = view(w, h, 30.0);
+    ASSERT_TRUE((*pass)->draw(glView, w, h, layout));
+    const auto full = (*target)->read(pl, glView);
+    shading::XyzFrame inner = cpu;
+    for (int y = 0; y < ph; ++y) {
+        for (int x = 0; x < pw; ++x) {
+            inner.xyz[static_cast<std::size_t>(y * pw + x)] =
+                    full.xyz[static_cast<std::size_t>((y0 + y) * w + x0 + x)];
         }
-        expectTieVerdict(agree(cpu, inner), exact, "96x60 at (12, 8) in 120x76");
     }
+    expectTieVerdict(agree(cpu, inner), "96x60 at (12, 8) in 120x76");
 }
 
 TEST_F(BoothPassTest, FlatSpecularGridMeetsTheErrorBudgetAgainstTheReference)

@@ -25,21 +25,21 @@ TEST(DiffuseSchedule, ANewHeldTiltIsDrawnInKBandsAndAMoveMeanwhileWaits)
             {0.1, 0.2, 1},          // then 0.2's refresh starts
             {0.1, 0.2, 2},          {0.2, std::nullopt, 0},
     };
+    // What each frame draws, by hand: the term shown and "band b of K toward T".
+    const std::vector<DiffuseDraw> draws{
+            {0.0, std::nullopt},           {0.0, std::nullopt},
+            {0.0, DiffuseBand{0.1, 0, 3}}, {0.0, DiffuseBand{0.1, 1, 3}},
+            {0.1, DiffuseBand{0.1, 2, 3}}, // the last band: 0.1 shown from this frame
+            {0.1, DiffuseBand{0.2, 0, 3}}, {0.1, DiffuseBand{0.2, 1, 3}},
+            {0.2, DiffuseBand{0.2, 2, 3}},
+    };
     std::optional<DiffuseTilt> last;
     for (std::size_t f = 0; f < held.size(); ++f) {
         const DiffuseTilt d = nextDiffuse(last, held[f], false, k);
         EXPECT_EQ(d, expect[f]) << "frame " << f;
-        if (last) {
-            EXPECT_TRUE(diffuseFollows(*last, d, k)) << "frame " << f;
-        }
+        EXPECT_EQ(diffuseDraw(last, d, false, k), draws[f]) << "frame " << f;
         last = d;
     }
-    // Two frames on is no single draw, nor is a refresh toward another tilt or a band skipped.
-    EXPECT_FALSE(diffuseFollows(expect[2], expect[4], k));
-    EXPECT_FALSE(diffuseFollows(expect[2], {0.0, 0.2, 2}, k));
-    EXPECT_FALSE(diffuseFollows(expect[1], {0.0, 0.1, 2}, k));
-    EXPECT_DOUBLE_EQ(diffuseTarget(expect[3]), 0.1);
-    EXPECT_DOUBLE_EQ(diffuseTarget(expect[4]), 0.1);
 }
 
 TEST(DiffuseSchedule, ANewLightOrOneBandIsDrawnWhole)
@@ -51,8 +51,11 @@ TEST(DiffuseSchedule, ANewLightOrOneBandIsDrawnWhole)
               (DiffuseTilt{0.2, std::nullopt, 0}));
     EXPECT_EQ(nextDiffuse(DiffuseTilt{0.0, std::nullopt, 0}, 0.2, false, 0),
               (DiffuseTilt{0.2, std::nullopt, 0}));
-    EXPECT_TRUE(diffuseFollows({0.0, std::nullopt, 0}, {0.2, std::nullopt, 0}, 1));
-    EXPECT_FALSE(diffuseFollows({0.0, std::nullopt, 0}, {0.2, std::nullopt, 0}, 3));
+    // Drawn whole: no band, neither for a new light in the middle of a refresh nor with K = 1.
+    EXPECT_EQ(diffuseDraw(underWay, {0.3, std::nullopt, 0}, true, 3),
+              (DiffuseDraw{0.3, std::nullopt}));
+    EXPECT_EQ(diffuseDraw(DiffuseTilt{0.0, std::nullopt, 0}, {0.2, std::nullopt, 0}, false, 1),
+              (DiffuseDraw{0.2, std::nullopt}));
 }
 
 } // namespace

@@ -200,5 +200,32 @@ TEST(SpectrometerChain, WavelengthOffsetNeedsLines)
     EXPECT_FALSE(countsToSpectrum(raw, cal, bad).has_value());
 }
 
+TEST(SensedLight, ApplianceChainAveragesASteadyLightWholly)
+{
+    // The data-sheet instrument on lights the project never names (a narrow tri-band fluorescent,
+    // an RGB LED, a phosphor LED): a steady light stays within the chain's steadiness, so every
+    // one of the five spectra is averaged, and the shape comes closer to the real light than one
+    // spectrum's.
+    const auto obs = observer();
+    for (const auto& light : {lamp("cie_illuminants_F1_F12_5nm_380_780.csv", "F12"),
+                              lamp("cie_illuminants_LED_5nm_380_780.csv", "LED-RGB1"),
+                              lamp("cie_illuminants_LED_5nm_380_780.csv", "LED-B3")}) {
+        auto real = fineLightToWorkingGrid(light);
+        ASSERT_TRUE(real);
+        SensingCorrections one;
+        one.applianceChain = true;
+        one.rememberedOffsetNm = 0.0;
+        SensingCorrections five = one;
+        five.scansAveraged = five.chain.averageSpectra;
+        auto a = senseLight(light, obs, InstrumentImpairments{}, one, 7);
+        auto b = senseLight(light, obs, InstrumentImpairments{}, five, 7);
+        ASSERT_TRUE(a && b);
+        EXPECT_EQ(a->scansAveraged, 1) << light.name;
+        EXPECT_EQ(b->scansAveraged, 5) << light.name;
+        EXPECT_LT(spectralShapeDistance(b->spd, *real), spectralShapeDistance(a->spd, *real))
+                << light.name;
+    }
+}
+
 } // namespace
 } // namespace replica::pipeline::spectral

@@ -122,8 +122,13 @@ TEST_F(CliFiles, EvalSensedAblatesEachImpairmentAndIsReproducible)
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto doc = nlohmann::json::parse(r.out);
     const auto& rows = doc.at("rows");
-    ASSERT_EQ(rows.size(), 9u); // unimpaired, all, five ablations, two corrected
+    // Unimpaired, all, five ablations, two corrected, and the appliance's own chain, named.
+    ASSERT_EQ(rows.size(), 10u);
     EXPECT_EQ(rows[0].at("light"), "f7");
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        EXPECT_EQ(rows[i].at("appliance").get<bool>(), i == 9) << i;
+    }
+    EXPECT_EQ(rows[9].at("instrument"), "appliance: live chain (the kiosk's)");
     // The unimpaired instrument renders the real colours; the data-sheet one does not.
     EXPECT_LT(rows[0].at("render").at("max").get<double>(), 0.02);
     EXPECT_GT(rows[1].at("render").at("mean").get<double>(),

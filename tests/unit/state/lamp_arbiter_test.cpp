@@ -84,7 +84,8 @@ TEST(LampArbiter, OffInvalidLostAndOutOfRangeHandTheLightBackToTheClassifier)
     }
 }
 
-// The scene updater with the booth's real lamps and simulated spectra of the scenario.
+// The state stage (SceneEstimator) with the booth's real lamps and simulated spectra of the
+// scenario.
 class SelectorSceneTest : public ::testing::Test
 {
 protected:
@@ -101,7 +102,7 @@ protected:
         hal::sim::makeSimSpectrometer({}, p)->poll(6 * kS, spectra_);
     }
 
-    // Runs the updater over the spectra with the given selector samples, at 20 frames a second;
+    // Runs the state stage over the spectra with the given selector samples, at 20 frames a second;
     // returns the lamp shown at each frame.
     std::vector<int> run(SceneEstimator& u, const std::vector<hal::LampSample>& selector) const
     {

@@ -294,7 +294,7 @@ TEST_F(SceneEstimatorTest, ARestoredEstimatorContinuesBitForBit)
         EXPECT_EQ(sb.tiltRad, sa.tiltRad) << i;
         EXPECT_EQ(sb.heldTiltRad, sa.heldTiltRad) << i;
         EXPECT_EQ(sb.diffuse, sa.diffuse) << i;
-        refreshSeen = refreshSeen || sa.diffuse->refreshRad.has_value();
+        refreshSeen = refreshSeen || sa.diffuse->band.has_value();
         lampChangeSeen = lampChangeSeen || (sa.lightChanged && sa.lampIndex == 0);
         freshDiffers += sf.lampIndex != sa.lampIndex || sf.diffuse != sa.diffuse ? 1 : 0;
     }

@@ -42,7 +42,7 @@ TEST(TiltEstimator, AStepIsHeldThenShownKFramesAfterEachReTake)
         }
         EXPECT_EQ(st.heldTiltRad, a);
         EXPECT_EQ(st.diffuse->shownRad, a);
-        EXPECT_FALSE(st.diffuse->refreshRad);
+        EXPECT_FALSE(st.diffuse->band);
         // j: frames since the step (the step's own frame is j = 1).
         double shownWant = a;
         int refreshSince = -1; // the frame the refresh under way was taken (-1: none)
@@ -56,16 +56,19 @@ TEST(TiltEstimator, AStepIsHeldThenShownKFramesAfterEachReTake)
                 refreshSince = j;
             }
             EXPECT_NEAR(st.heldTiltRad, heldWant, 1e-12) << "frame " << j << ", K " << k;
-            // Shown K - 1 frames after it was taken, in the frame that draws its last band.
+            // Band j - refreshSince of K drawn this frame (with K > 1); shown K - 1 frames after
+            // it was taken, in the frame that draws its last band.
+            const int bandWant = refreshSince >= 0 && k > 1 ? j - refreshSince : -1;
             if (refreshSince >= 0 && j - refreshSince == k - 1) {
                 shownWant = heldWant;
                 refreshSince = -1;
             }
             EXPECT_NEAR(st.diffuse->shownRad, shownWant, 1e-12) << "frame " << j << ", K " << k;
-            EXPECT_EQ(st.diffuse->refreshRad.has_value(), refreshSince >= 0)
-                    << "frame " << j << ", K " << k;
-            if (refreshSince >= 0) {
-                EXPECT_EQ(st.diffuse->refreshBands, j - refreshSince + 1) << j;
+            EXPECT_EQ(st.diffuse->band.has_value(), bandWant >= 0) << "frame " << j << ", K " << k;
+            if (bandWant >= 0 && st.diffuse->band) {
+                EXPECT_NEAR(st.diffuse->band->towardRad, heldWant, 1e-12) << j;
+                EXPECT_EQ(st.diffuse->band->band, bandWant) << j;
+                EXPECT_EQ(st.diffuse->band->bands, k) << j;
             }
         }
         EXPECT_NEAR(st.diffuse->shownRad, a + 15.0 / 16.0 * kDeg, 1e-12);
@@ -73,7 +76,7 @@ TEST(TiltEstimator, AStepIsHeldThenShownKFramesAfterEachReTake)
         st = frame(t, b, true);
         EXPECT_NEAR(st.heldTiltRad, b, 1e-12);
         EXPECT_EQ(st.diffuse->shownRad, st.heldTiltRad);
-        EXPECT_FALSE(st.diffuse->refreshRad);
+        EXPECT_FALSE(st.diffuse->band);
     }
 }
 
@@ -82,7 +85,8 @@ TEST(TiltEstimator, NonFiniteTiltsStayOutOfTheMean)
     TiltEstimator t({0.0, 1});
     frame(t, 0.4, true);
     const auto st = frame(t, std::nan(""));
-    EXPECT_TRUE(std::isnan(st.tiltRad)); // the renderer falls back to the held tilt
+    // The specular term's tilt is decided here, once: the held tilt stands in for it.
+    EXPECT_EQ(st.tiltRad, 0.4);
     EXPECT_EQ(st.heldTiltRad, 0.4);
     EXPECT_EQ(st.diffuse->shownRad, 0.4);
 }

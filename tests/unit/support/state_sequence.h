@@ -4,6 +4,7 @@
 // estimator; the encoding from the re-encode decision (a light-adaptive encoder only).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -25,12 +26,11 @@ public:
     // The next frame: 'st' with its lamp (or illuminant and luminance), eye and sensed tilt set.
     pipeline::scene::SceneState next(pipeline::scene::SceneState st)
     {
-        st.lightChanged =
-                first_ || st.lampIndex != last_.lampIndex ||
-                (st.lampIndex < 0 && (st.illuminant.v != last_.illuminant.v ||
-                                      st.emitterLuminanceCdM2 != last_.emitterLuminanceCdM2));
+        // Changed as the light estimator says it: by the light's content key.
+        const std::uint64_t key = pipeline::scene::lightKey(st);
+        st.lightChanged = first_ || key != lastKey_;
         first_ = false;
-        last_ = st;
+        lastKey_ = key;
         encoding_.write(st);
         tilt_.sense(st.tiltRad);
         tilt_.write(st);
@@ -49,7 +49,7 @@ private:
     state::TiltEstimator tilt_;
     state::EncodingDecision encoding_;
     bool first_ = true;
-    pipeline::scene::SceneState last_;
+    std::uint64_t lastKey_ = 0;
 };
 
 } // namespace replica::tests

@@ -3,16 +3,16 @@
 
 #include <glm/matrix.hpp>
 
-#include <pipeline/display/display_shader.h>
+#include <pipeline/display/display_pass_params.h>
 #include <pipeline/display/viewing_angle.h>
 
 namespace replica::pipeline::display {
 
-DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse)
+DisplayPassParams makeDisplayPassParams(const DisplayInverse& inverse)
 {
     const DisplayModel& m = inverse.model();
     const GamutGeometry& g = inverse.geometry();
-    DisplayShaderParams p;
+    DisplayPassParams p;
     for (int col = 0; col < 3; ++col) {
         for (int row = 0; row < 3; ++row) {
             p.xyzToLinear[static_cast<std::size_t>(col * 3 + row)] =

@@ -13,13 +13,13 @@
 namespace replica::pipeline::display {
 
 constexpr int kMaxViewingRows = 16;
-// The viewing-angle gain sampled every half degree from 0 to 90 (DisplayPassSetup::
-// viewingFiltered): the same piecewise-linear function as the rows wherever every row's angle is
-// a multiple of the step (the shipped table's are multiples of 5 degrees).
+// The viewing-angle gain sampled every half degree from 0 to 90 (the display pass filters it
+// where the GL filters float textures): the same piecewise-linear function as the rows wherever
+// every row's angle is a multiple of the step (the shipped table's are multiples of 5 degrees).
 constexpr double kViewingGridStepDeg = 0.5;
 constexpr int kViewingGridNodes = 181;
 
-struct DisplayShaderParams {
+struct DisplayPassParams {
     std::array<float, 9> xyzToLinear{}; // M^-1, column-major (glUniformMatrix3fv, transpose false)
     std::array<float, 3> blackXyz{};
     float blackY = 0.0f;
@@ -54,6 +54,6 @@ struct DisplayShaderParams {
     float flarePerLux = 0.0f;
 };
 
-DisplayShaderParams makeDisplayShaderParams(const DisplayInverse& inverse);
+DisplayPassParams makeDisplayPassParams(const DisplayInverse& inverse);
 
 } // namespace replica::pipeline::display
