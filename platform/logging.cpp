@@ -1,5 +1,6 @@
 // Area loggers and level parsing.
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <mutex>
@@ -11,9 +12,15 @@
 #include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
+#include <sys/stat.h>
+#include <sys/uio.h>
 
 #include <pipeline/base/printable.h>
 #include <platform/logging.h>
+
+#ifdef REPLICA_HAVE_LIBSYSTEMD
+#include <systemd/sd-journal.h>
+#endif
 
 namespace replica::platform {
 namespace {
@@ -101,6 +108,53 @@ protected:
 private:
     LogTap tap_;
 };
+
+// An area's lines to the journal: the native protocol (sd_journal_sendv: MESSAGE "[area] text",
+// PRIORITY, SYSLOG_IDENTIFIER=replica, REPLICA_LOGGER=area) where journald's socket is there, or
+// else (or in a build without libsystemd, or should a send fail) "<PRIORITY>[area] text" on
+// stderr, which journald files under that priority. sd_journal_sendv reports success when the
+// socket is missing, hence the look at the socket first. One sink per logger: tapLogs sets a
+// logger's sinks' levels one by one.
+class JournalSink final : public spdlog::sinks::base_sink<std::mutex>
+{
+protected:
+    void sink_it_(const spdlog::details::log_msg& msg) override
+    {
+        const std::string area(msg.logger_name.begin(), msg.logger_name.end());
+        // Control characters escaped, as on the console (pipeline/base/printable.h).
+        const auto text = printable(std::string_view(msg.payload.data(), msg.payload.size()),
+                                    std::string_view::npos, false);
+#ifdef REPLICA_HAVE_LIBSYSTEMD
+        static const bool native = [] {
+            struct stat st {
+            };
+            return stat("/run/systemd/journal/socket", &st) == 0 && S_ISSOCK(st.st_mode);
+        }();
+        std::string fields[] = {"MESSAGE=[" + area + "] " + text,
+                                fmt::format("PRIORITY={}", journalPriority(msg.level)),
+                                "SYSLOG_IDENTIFIER=replica", "REPLICA_LOGGER=" + area};
+        iovec iov[std::size(fields)];
+        for (std::size_t i = 0; i < std::size(fields); ++i) {
+            iov[i] = {fields[i].data(), fields[i].size()};
+        }
+        if (native && sd_journal_sendv(iov, static_cast<int>(std::size(fields))) >= 0) {
+            return;
+        }
+#endif
+        const auto line = journalStreamLine(msg.level, area, text);
+        std::fwrite(line.data(), 1, line.size(), stderr);
+    }
+    void flush_() override
+    {
+        std::fflush(stderr);
+    }
+};
+
+bool stderrIsJournal()
+{
+    static const bool is = journalStreamIs(std::getenv("JOURNAL_STREAM"), 2);
+    return is;
+}
 
 // Taps added to every logger, including those created later.
 std::vector<spdlog::sink_ptr>& taps()
@@ -212,10 +266,17 @@ std::shared_ptr<spdlog::logger> logger(const std::string& area)
     if (auto existing = spdlog::get(area)) {
         return existing;
     }
-    auto created = spdlog::stderr_color_mt(area);
-    auto formatter = std::make_unique<spdlog::pattern_formatter>();
-    formatter->add_flag<PrintableMessage>('*').set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %*");
-    created->set_formatter(std::move(formatter));
+    std::shared_ptr<spdlog::logger> created;
+    if (stderrIsJournal()) {
+        // The journal stamps each line itself and files its priority: no time or level text.
+        created = std::make_shared<spdlog::logger>(area, std::make_shared<JournalSink>());
+        spdlog::initialize_logger(created);
+    } else {
+        created = spdlog::stderr_color_mt(area);
+        auto formatter = std::make_unique<spdlog::pattern_formatter>();
+        formatter->add_flag<PrintableMessage>('*').set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %*");
+        created->set_formatter(std::move(formatter));
+    }
     // An area first used after --log-level was applied follows the general level, not spdlog's
     // default (info): 'replay --log-level warn' must not print a late area's info lines.
     auto console = consoleLevel(*created);
@@ -289,6 +350,50 @@ std::shared_ptr<void> followLogs(LogFollower follower)
         auto& v = hist.followers;
         v.erase(std::remove(v.begin(), v.end(), f), v.end());
     });
+}
+
+bool journalStreamIs(const char* journalStream, int fd)
+{
+    if (journalStream == nullptr) {
+        return false;
+    }
+    unsigned long long device = 0;
+    unsigned long long inode = 0;
+    char end = 0;
+    // Exactly "DEVICE:INODE", both decimal (systemd.exec(5)).
+    if (std::sscanf(journalStream, "%llu:%llu%c", &device, &inode, &end) != 2) {
+        return false;
+    }
+    struct stat st {
+    };
+    if (fstat(fd, &st) != 0) {
+        return false;
+    }
+    return static_cast<unsigned long long>(st.st_dev) == device &&
+           static_cast<unsigned long long>(st.st_ino) == inode;
+}
+
+int journalPriority(spdlog::level::level_enum level)
+{
+    switch (level) {
+    case spdlog::level::critical:
+        return 2;
+    case spdlog::level::err:
+        return 3;
+    case spdlog::level::warn:
+        return 4;
+    case spdlog::level::info:
+        return 6;
+    default:
+        return 7;
+    }
+}
+
+std::string journalStreamLine(spdlog::level::level_enum level,
+                              const std::string& area,
+                              const std::string& message)
+{
+    return fmt::format("<{}>[{}] {}\n", journalPriority(level), area, message);
 }
 
 void setupLogging(const std::string& spec, bool fromCommandLine)

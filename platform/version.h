@@ -5,11 +5,12 @@
 
 namespace replica::platform {
 
-// "0.1.0"
+// The package version: "0.1.0+git1234.g5237685c1a2b" (CMakeLists.txt says how it is made).
 const char* versionNumber();
 // 'git describe --always --dirty' of the source tree, or "unknown-commit" outside a git checkout.
 const char* gitCommit();
-// "replica 0.1.0 (git 5237685c1a2b)": what --version prints and recordings store.
+// "replica 0.1.0+git1234.g5237685c1a2b (git 5237685c1a2b)": what --version prints and recordings
+// store.
 std::string versionString();
 
 } // namespace replica::platform

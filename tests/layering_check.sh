@@ -21,8 +21,9 @@ fail() {
     status=1
 }
 
-# Every top-level folder is a layer or a known support folder: a new layer needs its edges here.
-known_top=(build data deploy docs hal pipeline platform recordings state tests tools)
+# Every top-level folder is a layer or a known support folder (cmake/: CMake modules, no sources):
+# a new layer needs its edges here.
+known_top=(build cmake data deploy docs hal pipeline platform recordings state tests tools)
 for dir in "$root"/*/; do
     top=$(basename "$dir")
     if [[ " ${known_top[*]} " != *" $top "* ]]; then

@@ -1,12 +1,15 @@
 // 'replica probe': what live sensors this machine can see (and its GPIO chips, for the lamp
 // selector), for field staff setting up or checking an appliance. Opens each device the way
 // 'replica run --hal live' would, takes one reading, and says what to do about anything missing.
+// With --config FILE: the devices that site file names, as the service's user (platform/cli/
+// probe_site.h), and what the kiosk would do with each.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,6 +29,7 @@
 #include <hal/tracker/opentrack_source.h>
 #include <pipeline/scene/stand.h>
 #include <platform/cli/commands.h>
+#include <platform/cli/probe_site.h>
 #include <platform/logging.h>
 #include <recordings/device_kind.h>
 
@@ -43,6 +47,8 @@ struct ProbeOptions {
     std::string gpioDev = "/dev";
     std::string hidrawSysfs = "/sys/class/hidraw";
     bool json = false;
+    std::string config; // a site file: its devices, as the service user, and the kiosk's plan
+    std::optional<SiteConfig> site;
 };
 
 nlohmann::json probeSpectrometer()
@@ -369,9 +375,46 @@ const std::map<std::string, std::vector<ProbeEntry>>& deviceProbes()
     return probes;
 }
 
+// --config: the site file's device settings, except those given on the command line; its
+// problems are printed (the good values are used). Empty when it cannot be read.
+std::string applySite(ProbeOptions& o, const CLI::App& cmd)
+{
+    auto loaded = loadSiteConfig(o.config);
+    if (!loaded) {
+        return loaded.error().message;
+    }
+    for (const auto& p : loaded->problems) {
+        logger("replica")->warn("{}", formatProblem(o.config, p));
+    }
+    const SiteConfig& s = loaded->config;
+    const auto unless = [&cmd](const char* option, auto& field, const auto& value) {
+        if (cmd.get_option(option)->count() == 0) {
+            field = value;
+        }
+    };
+    unless("--tracker-port", o.trackerPort, s.trackerPort);
+    unless("--tracker-bind", o.trackerBind, s.trackerBind);
+    unless("--iio-root", o.iioRoot, s.iioRoot);
+    unless("--accel-name", o.accelName, s.accelName);
+    unless("--accel-axes", o.accelAxes, s.accelAxes);
+    unless("--lamp-gpio", o.lampGpio, s.lampGpio);
+    o.site = s;
+    return {};
+}
+
 int runProbe(const ProbeOptions& o)
 {
     nlohmann::json report = nlohmann::json::object();
+    std::optional<ProbeIdentity> identity;
+    if (o.site) {
+        identity = becomeServiceUser();
+        report["probed_as"] = {{"user", identity->user},
+                               {"groups", identity->groups},
+                               {"service_user", identity->asServiceUser}};
+        if (!o.json) {
+            fmt::print("{:<15}{} (groups {})\n", "probed as", identity->note, identity->groups);
+        }
+    }
     std::vector<const ProbeEntry*> entries; // in the registry's order
     bool all = true;
     std::vector<std::string> missing;
@@ -393,6 +436,11 @@ int runProbe(const ProbeOptions& o)
         }
     }
     report["all_found"] = all;
+    std::vector<std::string> plan;
+    if (o.site) {
+        plan = kioskPlan(*o.site, report);
+        report["kiosk"] = plan;
+    }
     // The report goes to standard output; a failing probe also says so in one line on standard
     // error, as every other failing command does.
     const auto summary = [&missing] {
@@ -416,6 +464,9 @@ int runProbe(const ProbeOptions& o)
         for (const auto& item : j) {
             fmt::print("{:<15}{}\n", e->name, e->text(item, o));
         }
+    }
+    for (const auto& line : plan) {
+        fmt::print("{:<15}{}\n", "kiosk", line);
     }
     if (!all) {
         std::fflush(stdout);
@@ -452,7 +503,21 @@ void registerProbeCommand(CLI::App& app, int& exitCode)
                     "where hidraw devices are listed (HID eye/head trackers are found there)")
             ->capture_default_str();
     cmd->add_flag("--json", o->json, "print the report as JSON");
-    cmd->callback([o, &exitCode] { exitCode = runProbe(*o); });
+    cmd->add_option("--config", o->config,
+                    "a site file (/etc/replica/replica.toml): probe the devices it names (options "
+                    "given here win), as the service's user 'replica' when run as root, and say "
+                    "what the kiosk would do with each")
+            ->check(CLI::ExistingFile);
+    cmd->callback([o, cmd, &exitCode] {
+        if (!o->config.empty()) {
+            if (const auto error = applySite(*o, *cmd); !error.empty()) {
+                logger("replica")->error("probe: {}", error);
+                exitCode = kExitFailure;
+                return;
+            }
+        }
+        exitCode = runProbe(*o);
+    });
 }
 
 } // namespace replica::platform

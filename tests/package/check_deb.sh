@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
-# Builds replica_<version>_amd64.deb with cpack and checks it without installing it.
+# Builds replica_<version>_amd64.deb with cpack and checks it without installing it: control
+# fields, conffiles, maintainer scripts, contents (documentation and a manual page per command,
+# each rendered by man), the unpacked binary running on its own data, the hardening of the binary
+# (read with readelf), the unit's exposure, and lintian without errors or warnings.
 #   check_deb.sh BUILD_DIR VERSION WORK_DIR
 set -uo pipefail
 build="$1"
@@ -25,6 +28,7 @@ field() { dpkg-deb -f "$deb" "$1"; }
 [ "$(field Package)" = replica ] || fail "Package: $(field Package)"
 [ "$(field Version)" = "$version" ] || fail "Version: $(field Version), expected $version"
 [ "$(field Architecture)" = amd64 ] || fail "Architecture: $(field Architecture)"
+[ "$(field Suggests)" = argyll ] || fail "Suggests: '$(field Suggests)', expected argyll"
 depends=$(field Depends)
 for dep in libc6 libstdc++6 libegl1 libusb-1.0-0 libsystemd0 adduser udev libegl-mesa0; do
     case ", $depends," in
@@ -47,7 +51,10 @@ dpkg-deb -c "$deb" | awk '{print $1, $2, $NF}' >"$work/contents"
 for path in ./usr/bin/replica ./usr/bin/replica-kiosk ./etc/replica/replica.toml \
     ./lib/systemd/system/replica.service ./lib/udev/rules.d/60-replica.rules \
     ./usr/share/replica/booth/booth.json ./usr/share/replica/displays/wide-ips-synthetic.json \
-    ./usr/share/replica/scenes/colorchecker/scene.json ./usr/share/doc/replica/appliance.md; do
+    ./usr/share/replica/scenes/colorchecker/scene.json ./usr/share/doc/replica/appliance.md \
+    ./usr/share/doc/replica/display.md ./usr/share/doc/replica/recordings.md \
+    ./usr/share/doc/replica/foxglove-layout.json ./usr/share/doc/replica/copyright \
+    ./usr/share/man/man1/replica.1.gz ./usr/share/metainfo/org.example.replica.metainfo.xml; do
     grep -q " $path\$" "$work/contents" || fail "$path is not in the package"
 done
 grep -q '^-rwxr-xr-x root/root ./usr/bin/replica$' "$work/contents" ||
@@ -78,6 +85,49 @@ log=$(env -u REPLICA_DATA_DIR "$root/usr/bin/replica" run --frames 2 --fast 2>&1
 echo "$log" | grep -q "data $root/usr/share/replica\$" ||
     fail "the unpacked binary did not use its own data: $(echo "$log" | grep data)"
 
+# The copyright file names the licence of the top-level LICENSE (Apache-2.0).
+grep -q '^License: Apache-2.0$' "$root/usr/share/doc/replica/copyright" ||
+    fail "debian/copyright does not name the Apache-2.0 licence"
+
+# A manual page for the program and for each command its --help lists, each rendered by man
+# without a warning.
+mapfile -t commands < <(env -u REPLICA_DATA_DIR "$root/usr/bin/replica" --help |
+    sed -n '/^Subcommands:/,$p' | sed -n 's/^  \([a-z][a-z-]*\)  .*/\1/p')
+[ ${#commands[@]} -ge 10 ] || fail "--help lists only ${#commands[@]} commands: ${commands[*]}"
+pages=0
+for page in replica replica-kiosk "${commands[@]/#/replica-}"; do
+    file="$root/usr/share/man/man1/$page.1.gz"
+    [ -f "$file" ] || fail "no manual page $page(1) in the package"
+    if command -v man >/dev/null; then
+        text=$(MANWIDTH=80 man --warnings -l "$file" 2>"$work/man.err") || fail "man -l $page.1.gz failed"
+        [ ! -s "$work/man.err" ] || fail "man warns on $page(1): $(head -3 "$work/man.err")"
+        echo "$text" | grep -q "^NAME" || fail "$page(1) has no NAME section"
+        echo "$text" | grep -A1 "^NAME" | grep -Eq "^ +$page +- " || fail "$page(1)'s NAME is not '$page - ...'"
+        echo "$text" | grep -Eq -- "^ +-" || fail "$page(1) lists no options"
+    fi
+    pages=$((pages + 1))
+done
+echo "manual pages: $pages (replica, replica-kiosk and ${#commands[@]} commands)"
+
+# Hardening, read from the binary itself: PIE (ELF type DYN with the PIE flag), full RELRO (a
+# GNU_RELRO segment and BIND_NOW), fortified libc calls (*_chk) and the stack protector.
+if command -v readelf >/dev/null; then
+    bin="$root/usr/bin/replica"
+    # Read once into variables: 'readelf | grep -q' fails under pipefail when grep stops early.
+    header=$(readelf -h "$bin")
+    dynamic=$(readelf -d "$bin")
+    segments=$(readelf -l "$bin")
+    symbols=$(readelf --dyn-syms -W "$bin")
+    grep -q 'Type: *DYN' <<<"$header" || fail "replica is not position independent (PIE)"
+    grep -q 'FLAGS_1.*PIE' <<<"$dynamic" || fail "replica lacks the PIE flag"
+    grep -q GNU_RELRO <<<"$segments" || fail "replica has no RELRO segment (-z relro)"
+    grep -Eq 'BIND_NOW|FLAGS.*NOW' <<<"$dynamic" || fail "replica is not bound now (-z now)"
+    fortified=$(grep -Ec ' __[a-z]+_chk@' <<<"$symbols")
+    [ "$fortified" -gt 0 ] || fail "replica calls no fortified functions (_FORTIFY_SOURCE)"
+    grep -q '__stack_chk_fail' <<<"$symbols" || fail "replica has no stack protector"
+    echo "hardening: PIE, RELRO, BIND_NOW, $fortified fortified functions, stack protector"
+fi
+
 if command -v systemd-analyze >/dev/null; then
     unit="$root/lib/systemd/system/replica.service"
     score=$(systemd-analyze security --offline=true "$unit" 2>/dev/null |
@@ -89,9 +139,9 @@ if command -v systemd-analyze >/dev/null; then
 fi
 if command -v lintian >/dev/null; then
     lintian --no-tag-display-limit "$deb" >"$work/lintian.log" 2>&1 || true
-    if grep '^E:' "$work/lintian.log"; then
-        fail "lintian errors (log: $work/lintian.log)"
+    if grep -E '^(E|W):' "$work/lintian.log"; then
+        fail "lintian errors or warnings (log: $work/lintian.log)"
     fi
-    echo "lintian: $(grep -c '^W:' "$work/lintian.log") warnings, no errors"
+    echo "lintian: no errors or warnings ($(grep -c '^[IPX]:' "$work/lintian.log") notes: $work/lintian.log)"
 fi
 echo "ok"
