@@ -348,11 +348,7 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
             if (read.error().code != ErrorCode::NotFound) {
                 return tl::unexpected(read.error());
             }
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("no display profile at {}: characterise the panel "
-                                         "('replica display fit MEAS.csv --out PROFILE') and pass "
-                                         "--display-profile PROFILE, or run --uncalibrated",
-                                         path.string()));
+            return makeError(ErrorCode::NotFound, missingDisplayProfileMessage(path.string()));
         }
         const std::string& bytes = *read;
         const std::string digest = fmt::format(

@@ -173,6 +173,10 @@ constexpr const char* kUncalibratedDisplay = "srgb-like-800";
 // nominal model's name marked uncalibrated.
 std::string displayProfileId(const RunConfig& config, const std::string& profileName);
 
+// What to say when the display profile a run names is not there: how to make one, or how to run
+// without. The appliance and the configuration check give the same advice.
+std::string missingDisplayProfileMessage(const std::string& path);
+
 // The run's sources, one per device kind present (recordings/device_kind.h); a booth without a
 // lamp selector has none.
 using recordings::Sources;

@@ -179,4 +179,12 @@ std::string displayProfileId(const RunConfig& config, const std::string& profile
     return fmt::format("{} ({}, fnv1a64 {})", profileName, config.display, config.displayDigest);
 }
 
+std::string missingDisplayProfileMessage(const std::string& path)
+{
+    return fmt::format("no display profile at {}: characterise the panel ('replica display fit "
+                       "MEAS.csv --out PROFILE') and pass --display-profile PROFILE, or run "
+                       "--uncalibrated",
+                       path);
+}
+
 } // namespace replica::platform

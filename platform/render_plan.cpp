@@ -84,7 +84,11 @@ Expected<RenderPlan> parseRenderPlan(const std::string& text, const std::string&
     if (!j.contains("lamps") || !j["lamps"].is_object() || j["lamps"].empty()) {
         return bad("\"lamps\" must be an object with one entry per lamp");
     }
-    for (const auto& [name, l] : j["lamps"].items()) {
+    for (const auto& item : j["lamps"].items()) {
+        // Named, not a structured binding: the lambda below captures it, which clang's C++20
+        // (the libFuzzer build) refuses for a binding.
+        const std::string name = item.key();
+        const nlohmann::json& l = item.value();
         const auto count = [&](const char* key, int lo, int hi, int& out) -> bool {
             if (!l.is_object() || !l.contains(key) || !l[key].is_number_integer()) {
                 return false;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/printable.h>
 #include <pipeline/render/render_profile.h>
 #include <platform/cli/replay_shown.h>
 
@@ -98,7 +99,8 @@ olderRecordingLine(const std::string& file, const std::string& madeBy, int recor
 {
     return fmt::format("{}: made by {} (render profile {}; this build renders profile {}); "
                        "bit-exact replay needs that build: comparing with what was shown instead",
-                       file, madeBy, recordedProfile, pipeline::render::kRenderProfile);
+                       printable(file, 512), printable(madeBy, 200), recordedProfile,
+                       pipeline::render::kRenderProfile);
 }
 
 } // namespace replica::platform

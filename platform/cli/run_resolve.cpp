@@ -375,8 +375,11 @@ Resolved<void> checkLoadable(const RunOptions& o, const RunConfig& config)
         auto model = read ? pipeline::display::profileFromJson(*read, path)
                           : Expected<pipeline::display::DisplayModel>(tl::unexpected(read.error()));
         if (!model) {
+            const std::string what = !read && read.error().code == ErrorCode::NotFound
+                                             ? missingDisplayProfileMessage(path)
+                                             : model.error().message;
             return tl::unexpected(refuse(o, "--display-profile", "display.profile", config.display,
-                                         model.error().message, kExitFailure));
+                                         what, kExitFailure));
         }
     }
     if (config.renderer == "booth") {
