@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -42,82 +44,110 @@ Expected<hal::accel::AxisMapping> reprocessAxes(const std::optional<std::string>
     return m;
 }
 
-} // namespace
+// A tracked eye and whether it was tracked, as the live reader decoded them from one raw input.
+struct EyeReading {
+    glm::dvec3 eye{0.0};
+    bool tracked = false;
+    std::int64_t timestampNs = 0;
+};
 
-Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessOptions& options)
+Expected<EyeReading> decodeOpentrackInput(const hal::RawTrackerInput& raw, std::uint32_t sequence)
 {
-    ReprocessReport report;
-    // HID: one processor per opening of the device (a descriptor object each), in order, so the
-    // device-clock anchoring runs over the reports exactly as the live reader ran over them.
-    std::shared_ptr<const std::vector<std::uint8_t>> descriptor;
-    std::optional<hal::tracker::HidReportProcessor> hid;
+    const auto pose = hal::tracker::decodeOpentrack(raw.bytes);
+    if (!pose) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("raw input of pose {}: a {}-byte datagram that is not an "
+                                     "opentrack pose (48 bytes, six finite doubles)",
+                                     sequence, raw.bytes.size()));
+    }
+    hal::tracker::TrackerMounting mounting;
+    mounting.zSign = raw.zSign;
+    mounting.eyeOffsetHeadM = raw.eyeOffsetHeadM;
+    return EyeReading{hal::tracker::eyeFromHeadPose(*pose, mounting), true, 0};
+}
+
+// HID: one processor per opening of the device (a descriptor object each), in order, so the
+// device-clock anchoring runs over the reports exactly as the live reader ran over them.
+class HidReplay
+{
+public:
+    explicit HidReplay(const std::optional<std::string>& trackerAxes) : trackerAxes_(trackerAxes) {}
+
+    Expected<EyeReading> decode(const hal::RawTrackerInput& raw, std::uint32_t sequence)
+    {
+        if (!raw.hidDescriptor) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("raw input of pose {}: a HID report without its report "
+                                         "descriptor",
+                                         sequence));
+        }
+        if (raw.hidDescriptor != descriptor_) {
+            auto layout = hal::tracker::trackerLayout(*raw.hidDescriptor);
+            if (!layout) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("raw input of pose {}: the recorded HID report "
+                                             "descriptor: {}",
+                                             sequence, layout.error().message));
+            }
+            auto m = reprocessAxes(trackerAxes_, raw.axes, "pose", sequence);
+            if (!m) {
+                return tl::unexpected(m.error());
+            }
+            hid_.emplace(std::move(*layout), *m, raw.reanchorNs);
+            descriptor_ = raw.hidDescriptor;
+        }
+        hal::PoseSample p;
+        const auto result = hid_->process(raw.bytes, raw.arrivalNs, p);
+        if (result != hal::hid::eht::DecodeResult::Ok) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("raw input of pose {}: a {}-byte HID report that is {} "
+                                         "for its descriptor",
+                                         sequence, raw.bytes.size(),
+                                         result == hal::hid::eht::DecodeResult::Short
+                                                 ? "too short"
+                                                 : "not the tracking report"));
+        }
+        return EyeReading{p.eyeTrackerM, p.tracked, p.timestampNs};
+    }
+
+private:
+    std::optional<std::string> trackerAxes_;
+    std::shared_ptr<const std::vector<std::uint8_t>> descriptor_;
+    std::optional<hal::tracker::HidReportProcessor> hid_;
+};
+
+Expected<void>
+reprocessPoses(recordings::Recording& rec, const ReprocessOptions& options, ReprocessReport& report)
+{
+    HidReplay hid(options.trackerAxes);
     for (auto& s : rec.samples(recordings::trackerKind())) {
         ++report.poses;
         if (!s.raw) {
             continue;
         }
-        const hal::RawTrackerInput& raw = *s.raw;
-        glm::dvec3 eye{0.0};
-        bool tracked = false;
-        if (raw.kind == hal::RawTrackerInput::Kind::OpentrackDatagram) {
-            const auto pose = hal::tracker::decodeOpentrack(raw.bytes);
-            if (!pose) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("raw input of pose {}: a {}-byte datagram that is "
-                                             "not an opentrack pose (48 bytes, six finite "
-                                             "doubles)",
-                                             s.sequence, raw.bytes.size()));
-            }
-            hal::tracker::TrackerMounting mounting;
-            mounting.zSign = raw.zSign;
-            mounting.eyeOffsetHeadM = raw.eyeOffsetHeadM;
-            eye = hal::tracker::eyeFromHeadPose(*pose, mounting);
-            tracked = true;
-        } else {
-            if (!raw.hidDescriptor) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("raw input of pose {}: a HID report without its "
-                                             "report descriptor",
-                                             s.sequence));
-            }
-            if (raw.hidDescriptor != descriptor) {
-                auto layout = hal::tracker::trackerLayout(*raw.hidDescriptor);
-                if (!layout) {
-                    return makeError(ErrorCode::Corrupt,
-                                     fmt::format("raw input of pose {}: the recorded HID report "
-                                                 "descriptor: {}",
-                                                 s.sequence, layout.error().message));
-                }
-                auto m = reprocessAxes(options.trackerAxes, raw.axes, "pose", s.sequence);
-                if (!m) {
-                    return tl::unexpected(m.error());
-                }
-                hid.emplace(std::move(*layout), *m, raw.reanchorNs);
-                descriptor = raw.hidDescriptor;
-            }
-            hal::PoseSample p;
-            const auto result = hid->process(raw.bytes, raw.arrivalNs, p);
-            if (result != hal::hid::eht::DecodeResult::Ok) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("raw input of pose {}: a {}-byte HID report that "
-                                             "is {} for its descriptor",
-                                             s.sequence, raw.bytes.size(),
-                                             result == hal::hid::eht::DecodeResult::Short
-                                                     ? "too short"
-                                                     : "not the tracking report"));
-            }
-            eye = p.eyeTrackerM;
-            tracked = p.tracked;
-            report.poseTimesDiffer += p.timestampNs != s.timestampNs ? 1 : 0;
+        const bool opentrack = s.raw->kind == hal::RawTrackerInput::Kind::OpentrackDatagram;
+        auto reading = opentrack ? decodeOpentrackInput(*s.raw, s.sequence)
+                                 : hid.decode(*s.raw, s.sequence);
+        if (!reading) {
+            return tl::unexpected(reading.error());
+        }
+        if (!opentrack) {
+            report.poseTimesDiffer += reading->timestampNs != s.timestampNs ? 1 : 0;
         }
         ++report.posesReprocessed;
-        if (!sameBits(eye, s.eyeTrackerM) || tracked != s.tracked) {
+        if (!sameBits(reading->eye, s.eyeTrackerM) || reading->tracked != s.tracked) {
             ++report.posesChanged;
         }
-        report.posesNonFinite += finite(eye) ? 0 : 1;
-        s.eyeTrackerM = eye;
-        s.tracked = tracked;
+        report.posesNonFinite += finite(reading->eye) ? 0 : 1;
+        s.eyeTrackerM = reading->eye;
+        s.tracked = reading->tracked;
     }
+    return {};
+}
+
+Expected<void>
+reprocessAccel(recordings::Recording& rec, const ReprocessOptions& options, ReprocessReport& report)
+{
     for (auto& s : rec.samples(recordings::accelKind())) {
         ++report.accel;
         if (!s.raw) {
@@ -133,6 +163,11 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         report.accelNonFinite += finite(g) ? 0 : 1;
         s.gravity = g;
     }
+    return {};
+}
+
+void reprocessLamps(recordings::Recording& rec, ReprocessReport& report)
+{
     for (auto& s : rec.samples(recordings::lampSelectorKind())) {
         ++report.lamp;
         if (s.lamp == hal::kLampLost || s.lineCount == 0) {
@@ -143,6 +178,20 @@ Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessO
         report.lampChanged += lamp != s.lamp ? 1 : 0;
         s.lamp = lamp;
     }
+}
+
+} // namespace
+
+Expected<ReprocessReport> reprocess(recordings::Recording& rec, const ReprocessOptions& options)
+{
+    ReprocessReport report;
+    if (auto ok = reprocessPoses(rec, options, report); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    if (auto ok = reprocessAccel(rec, options, report); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    reprocessLamps(rec, report);
     return report;
 }
 

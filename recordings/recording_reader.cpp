@@ -102,16 +102,9 @@ void placeThumbnails(Recording& rec)
     }
 }
 
-} // namespace
-
-Expected<Recording> readRecording(const std::filesystem::path& path, const DeviceKinds& kinds)
+// A scan with damage, or of a file that is not one session, is refused before decoding.
+Expected<void> checkScan(const mcap::Scan& s, const std::string& name)
 {
-    const std::string name = path.string();
-    auto bytes = slurp(path);
-    if (!bytes) {
-        return tl::unexpected(bytes.error());
-    }
-    const auto s = mcap::scan(*bytes);
     if (!s.damage.empty()) {
         if (s.damage.front().starts_with("not an MCAP file")) {
             return makeError(ErrorCode::Corrupt,
@@ -126,82 +119,142 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
                                                        : "",
                                      name));
     }
-    if (auto ok = checkOneSession(s, name); !ok) {
-        return tl::unexpected(ok.error());
-    }
-    Recording rec;
-    bool haveSession = false;
-    // Each device kind's samples, by its topic; format 5: its raw inputs, by its raw topic,
-    // attached to their samples by sequence number once all are read.
-    std::map<std::string, std::size_t> sampleTopics, rawTopics;
-    std::vector<std::any> rawState(kinds.size());
-    for (std::size_t i = 0; i < kinds.size(); ++i) {
-        const auto& n = kinds[i]->names();
-        rec.devices[n.name] = kinds[i]->emptySamples();
-        sampleTopics[n.channel.topic] = i;
-        if (n.rawChannel) {
-            rawTopics[n.rawChannel->topic] = i;
+    return checkOneSession(s, name);
+}
+
+// Decodes a recording's messages into 'rec' by topic: the session, each device kind's samples by
+// its topic and (format 5) its raw inputs by its raw topic, attached to their samples by sequence
+// number once all are read.
+class MessageDecoder
+{
+public:
+    MessageDecoder(Recording& rec, const DeviceKinds& kinds, std::string name)
+        : rec_(rec), kinds_(kinds), name_(std::move(name)), rawState_(kinds.size())
+    {
+        for (std::size_t i = 0; i < kinds.size(); ++i) {
+            const auto& n = kinds[i]->names();
+            rec.devices[n.name] = kinds[i]->emptySamples();
+            sampleTopics_[n.channel.topic] = i;
+            if (n.rawChannel) {
+                rawTopics_[n.rawChannel->topic] = i;
+            }
         }
     }
-    std::uint64_t unusableRaw = 0;
-    for (const auto& m : s.messages) {
-        const std::string& topic = s.channels.at(m.channelId).topic;
+
+    Expected<void> decode(const std::string& topic, const mcap::Message& m)
+    {
         if (m.data.size() > kMaxMessageBytes) {
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: {} message (sequence {}) of {} bytes; Replica's are "
                                          "at most {} KiB: not a recording Replica wrote",
-                                         name, topic, m.sequence, m.data.size(),
+                                         name_, topic, m.sequence, m.data.size(),
                                          kMaxMessageBytes >> 10));
         }
         if (auto ok = checkJsonLimits(
-                    m.data, fmt::format("{}: {} message (sequence {})", name, topic, m.sequence));
+                    m.data, fmt::format("{}: {} message (sequence {})", name_, topic, m.sequence));
             !ok) {
-            return tl::unexpected(ok.error());
+            return ok;
         }
         try {
-            const auto j = nlohmann::json::parse(m.data);
-            if (topic == kSessionTopic) {
-                if (auto ok = validateJson(j, sessionSchema(),
-                                           fmt::format("{}: {} message", name, topic));
-                    !ok) {
-                    return tl::unexpected(ok.error());
-                }
-                rec.session = decodeSession(j, rec.formatVersion, kinds);
-                // The run configuration is JSON inside the session's JSON: held to the same
-                // limits before anything (replay, inspect --json) parses it.
-                if (auto ok = checkJsonLimits(rec.session.configJson,
-                                              fmt::format("{}: run configuration", name));
-                    !ok) {
-                    return tl::unexpected(ok.error());
-                }
-                haveSession = true;
-            } else if (auto k = sampleTopics.find(topic); k != sampleTopics.end()) {
-                const auto* kind = kinds[k->second];
-                kind->decode(j, rec.devices[kind->name()]);
-            } else if (auto rk = rawTopics.find(topic); rk != rawTopics.end()) { // format 5
-                if (!kinds[rk->second]->decodeRaw(j, rawState[rk->second])) {
-                    ++unusableRaw;
-                }
-            } else if (topic == kFrameTopic) {
-                rec.frames.push_back(decodeFrame(j, kinds));
-            } else if (topic == kDisplayDigestTopic) { // format 4
-                rec.displayDigests.push_back(decodeDisplayDigest(j));
-            } else if (topic == kLightTopic) { // format 4
-                rec.lights.push_back(decodeLight(j));
-            } else if (topic == kThumbnailTopic) { // format 4
-                rec.thumbnails.push_back(decodeThumbnailMessage(j));
-            } else if (topic == kRecorderTopic) {
-                const auto r = decodeRecorderStatus(j, kinds);
-                rec.droppedMessages = r.droppedTotal();
-                rec.rejectedNonFinite = r.rejectedNonFinite;
-            }
+            return decodeJson(topic, nlohmann::json::parse(m.data));
         } catch (const std::exception& e) {
             return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: damaged {} message (sequence {}): {}", name, topic,
+                             fmt::format("{}: damaged {} message (sequence {}): {}", name_, topic,
                                          m.sequence, e.what()));
         }
     }
-    if (!haveSession) {
+
+    bool haveSession() const { return haveSession_; }
+
+    // The raw inputs attached to their samples; those that matched none are counted.
+    void attachRaw()
+    {
+        rec_.unmatchedRaw = unusableRaw_;
+        for (std::size_t i = 0; i < kinds_.size(); ++i) {
+            if (rawState_[i].has_value()) {
+                rec_.unmatchedRaw +=
+                        kinds_[i]->attachRaw(rec_.devices[kinds_[i]->name()], rawState_[i]);
+            }
+        }
+    }
+
+private:
+    Expected<void> decodeSessionMessage(const std::string& topic, const nlohmann::json& j)
+    {
+        if (auto ok = validateJson(j, sessionSchema(), fmt::format("{}: {} message", name_, topic));
+            !ok) {
+            return ok;
+        }
+        rec_.session = decodeSession(j, rec_.formatVersion, kinds_);
+        // The run configuration is JSON inside the session's JSON: held to the same limits
+        // before anything (replay, inspect --json) parses it.
+        if (auto ok = checkJsonLimits(rec_.session.configJson,
+                                      fmt::format("{}: run configuration", name_));
+            !ok) {
+            return ok;
+        }
+        haveSession_ = true;
+        return {};
+    }
+
+    Expected<void> decodeJson(const std::string& topic, const nlohmann::json& j)
+    {
+        if (topic == kSessionTopic) {
+            return decodeSessionMessage(topic, j);
+        }
+        if (auto k = sampleTopics_.find(topic); k != sampleTopics_.end()) {
+            const auto* kind = kinds_[k->second];
+            kind->decode(j, rec_.devices[kind->name()]);
+        } else if (auto rk = rawTopics_.find(topic); rk != rawTopics_.end()) { // format 5
+            if (!kinds_[rk->second]->decodeRaw(j, rawState_[rk->second])) {
+                ++unusableRaw_;
+            }
+        } else if (topic == kFrameTopic) {
+            rec_.frames.push_back(decodeFrame(j, kinds_));
+        } else if (topic == kDisplayDigestTopic) { // format 4
+            rec_.displayDigests.push_back(decodeDisplayDigest(j));
+        } else if (topic == kLightTopic) { // format 4
+            rec_.lights.push_back(decodeLight(j));
+        } else if (topic == kThumbnailTopic) { // format 4
+            rec_.thumbnails.push_back(decodeThumbnailMessage(j));
+        } else if (topic == kRecorderTopic) {
+            const auto r = decodeRecorderStatus(j, kinds_);
+            rec_.droppedMessages = r.droppedTotal();
+            rec_.rejectedNonFinite = r.rejectedNonFinite;
+        }
+        return {};
+    }
+
+    Recording& rec_;
+    const DeviceKinds& kinds_;
+    std::string name_;
+    std::map<std::string, std::size_t> sampleTopics_, rawTopics_;
+    std::vector<std::any> rawState_;
+    std::uint64_t unusableRaw_ = 0;
+    bool haveSession_ = false;
+};
+
+} // namespace
+
+Expected<Recording> readRecording(const std::filesystem::path& path, const DeviceKinds& kinds)
+{
+    const std::string name = path.string();
+    auto bytes = slurp(path);
+    if (!bytes) {
+        return tl::unexpected(bytes.error());
+    }
+    const auto s = mcap::scan(*bytes);
+    if (auto ok = checkScan(s, name); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    Recording rec;
+    MessageDecoder decoder(rec, kinds, name);
+    for (const auto& m : s.messages) {
+        if (auto ok = decoder.decode(s.channels.at(m.channelId).topic, m); !ok) {
+            return tl::unexpected(ok.error());
+        }
+    }
+    if (!decoder.haveSession()) {
         return makeError(
                 ErrorCode::Corrupt,
                 fmt::format("{}: MCAP file without a replica session; not a replica recording",
@@ -211,12 +264,7 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
         return tl::unexpected(ok.error());
     }
     placeThumbnails(rec);
-    rec.unmatchedRaw = unusableRaw;
-    for (std::size_t i = 0; i < kinds.size(); ++i) {
-        if (rawState[i].has_value()) {
-            rec.unmatchedRaw += kinds[i]->attachRaw(rec.devices[kinds[i]->name()], rawState[i]);
-        }
-    }
+    decoder.attachRaw();
     return rec;
 }
 

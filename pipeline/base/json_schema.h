@@ -158,14 +158,115 @@ inline std::string escapeKey(const std::string& key)
 inline Expected<void> check(const nlohmann::json& j,
                             const JsonSchema& s,
                             const std::string& path,
+                            std::vector<std::string>& warnings);
+
+inline Expected<void>
+mismatch(const std::string& path, const std::string& expected, const nlohmann::json& j)
+{
+    return makeError(ErrorCode::Corrupt,
+                     fmt::format("{}: expected {}, found {}", path.empty() ? "/" : path, expected,
+                                 kindOf(j)));
+}
+
+inline Expected<void>
+checkNumber(const nlohmann::json& j, const JsonSchema& s, const std::string& path)
+{
+    const bool integral = s.type == JsonSchema::Type::Integer;
+    const std::string expected =
+            fmt::format("{} in [{}, {}]", integral ? "an integer" : "a number", s.min, s.max);
+    if (!j.is_number() || (integral && !j.is_number_integer())) {
+        return mismatch(path, expected, j);
+    }
+    const double v = j.get<double>();
+    if (!std::isfinite(v) || v < s.min || v > s.max) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: expected {}, found {}", path.empty() ? "/" : path,
+                                     expected, j.dump()));
+    }
+    return {};
+}
+
+inline Expected<void> checkArray(const nlohmann::json& j,
+                                 const JsonSchema& s,
+                                 const std::string& path,
+                                 std::vector<std::string>& warnings)
+{
+    const std::string expected =
+            s.minItems == s.maxItems
+                    ? fmt::format("an array of {} items", s.minItems)
+                    : fmt::format("an array of {} to {} items", s.minItems, s.maxItems);
+    if (!j.is_array()) {
+        return mismatch(path, expected, j);
+    }
+    if (j.size() < s.minItems || j.size() > s.maxItems) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: expected {}, found {}", path.empty() ? "/" : path,
+                                     expected, j.size()));
+    }
+    for (std::size_t k = 0; k < j.size(); ++k) {
+        if (auto ok = check(j[k], *s.items, fmt::format("{}/{}", path, k), warnings); !ok) {
+            return ok;
+        }
+    }
+    return {};
+}
+
+// An object used as a map: every value against the one item schema.
+inline Expected<void> checkMap(const nlohmann::json& j,
+                               const JsonSchema& s,
+                               const std::string& path,
+                               std::vector<std::string>& warnings)
+{
+    if (j.size() > s.maxItems) {
+        return makeError(ErrorCode::Corrupt, fmt::format("{}: more than {} keys",
+                                                         path.empty() ? "/" : path, s.maxItems));
+    }
+    for (const auto& [key, value] : j.items()) {
+        if (auto ok = check(value, *s.items, path + "/" + escapeKey(key), warnings); !ok) {
+            return ok;
+        }
+    }
+    return {};
+}
+
+// An object with named fields: each required one present, each present one checked, and a
+// warning for each key the schema does not name.
+inline Expected<void> checkFields(const nlohmann::json& j,
+                                  const JsonSchema& s,
+                                  const std::string& path,
+                                  std::vector<std::string>& warnings)
+{
+    for (const auto& [key, field] : s.fields) {
+        const auto it = j.find(key);
+        if (it == j.end()) {
+            if (field.required) {
+                return makeError(ErrorCode::Corrupt,
+                                 fmt::format("{}/{}: required but missing", path, key));
+            }
+            continue;
+        }
+        if (auto ok = check(*it, field, path + "/" + escapeKey(key), warnings); !ok) {
+            return ok;
+        }
+    }
+    for (const auto& [key, value] : j.items()) {
+        bool known = false;
+        for (const auto& f : s.fields) {
+            known = known || f.first == key;
+        }
+        if (!known) {
+            warnings.push_back(fmt::format("{}/{}: unknown key, ignored", path, escapeKey(key)));
+        }
+    }
+    return {};
+}
+
+inline Expected<void> check(const nlohmann::json& j,
+                            const JsonSchema& s,
+                            const std::string& path,
                             std::vector<std::string>& warnings)
 {
     using T = JsonSchema::Type;
-    const std::string at = path.empty() ? "/" : path;
-    const auto bad = [&](const std::string& expected) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: expected {}, found {}", at, expected, kindOf(j)));
-    };
     if (j.is_null() && s.nullable) {
         return {};
     }
@@ -173,91 +274,27 @@ inline Expected<void> check(const nlohmann::json& j,
     case T::Any:
         return {};
     case T::Bool:
-        return j.is_boolean() ? Expected<void>{} : bad("true or false");
+        return j.is_boolean() ? Expected<void>{} : mismatch(path, "true or false", j);
     case T::String:
         if (!j.is_string()) {
-            return bad("a string");
+            return mismatch(path, "a string", j);
         }
         if (j.get_ref<const std::string&>().size() > s.maxItems) {
             return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: string longer than {} characters", at, s.maxItems));
+                             fmt::format("{}: string longer than {} characters",
+                                         path.empty() ? "/" : path, s.maxItems));
         }
         return {};
     case T::Number:
-    case T::Integer: {
-        const bool integral = s.type == T::Integer;
-        const std::string expected =
-                fmt::format("{} in [{}, {}]", integral ? "an integer" : "a number", s.min, s.max);
-        if (!j.is_number() || (integral && !j.is_number_integer())) {
-            return bad(expected);
-        }
-        const double v = j.get<double>();
-        if (!std::isfinite(v) || v < s.min || v > s.max) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: expected {}, found {}", at, expected, j.dump()));
-        }
-        return {};
-    }
-    case T::Array: {
-        const std::string expected =
-                s.minItems == s.maxItems
-                        ? fmt::format("an array of {} items", s.minItems)
-                        : fmt::format("an array of {} to {} items", s.minItems, s.maxItems);
-        if (!j.is_array()) {
-            return bad(expected);
-        }
-        if (j.size() < s.minItems || j.size() > s.maxItems) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: expected {}, found {}", at, expected, j.size()));
-        }
-        for (std::size_t k = 0; k < j.size(); ++k) {
-            if (auto ok = check(j[k], *s.items, fmt::format("{}/{}", path, k), warnings); !ok) {
-                return ok;
-            }
-        }
-        return {};
-    }
-    case T::Object: {
+    case T::Integer:
+        return checkNumber(j, s, path);
+    case T::Array:
+        return checkArray(j, s, path, warnings);
+    case T::Object:
         if (!j.is_object()) {
-            return bad("an object");
+            return mismatch(path, "an object", j);
         }
-        if (s.openObject) {
-            if (j.size() > s.maxItems) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("{}: more than {} keys", at, s.maxItems));
-            }
-            for (const auto& [key, value] : j.items()) {
-                if (auto ok = check(value, *s.items, path + "/" + escapeKey(key), warnings); !ok) {
-                    return ok;
-                }
-            }
-            return {};
-        }
-        for (const auto& [key, field] : s.fields) {
-            const auto it = j.find(key);
-            if (it == j.end()) {
-                if (field.required) {
-                    return makeError(ErrorCode::Corrupt,
-                                     fmt::format("{}/{}: required but missing", path, key));
-                }
-                continue;
-            }
-            if (auto ok = check(*it, field, path + "/" + escapeKey(key), warnings); !ok) {
-                return ok;
-            }
-        }
-        for (const auto& [key, value] : j.items()) {
-            bool known = false;
-            for (const auto& f : s.fields) {
-                known = known || f.first == key;
-            }
-            if (!known) {
-                warnings.push_back(
-                        fmt::format("{}/{}: unknown key, ignored", path, escapeKey(key)));
-            }
-        }
-        return {};
-    }
+        return s.openObject ? checkMap(j, s, path, warnings) : checkFields(j, s, path, warnings);
     }
     return {};
 }

@@ -160,23 +160,21 @@ int reportDamage(const InspectOptions& o,
     return kExitFailure;
 }
 
-int inspectMain(const InspectOptions& o)
-{
-    auto report = recordings::inspectRecording(o.file);
-    if (!report) {
-        return reportDamage(o, report.error().message, nullptr);
-    }
-    auto rec = recordings::readRecording(o.file);
-    if (!rec) {
-        return reportDamage(o, rec.error().message, &*report);
-    }
+// The session time the recording spans: its first and last sample or frame (0, 0 when empty).
+struct TimeSpan {
     std::int64_t first = INT64_MAX;
     std::int64_t last = INT64_MIN;
+    double seconds() const { return static_cast<double>(last - first) * 1e-9; }
+};
+
+TimeSpan timeSpan(const recordings::Recording& rec)
+{
+    TimeSpan s;
     auto span = [&](std::int64_t t) {
-        first = std::min(first, t);
-        last = std::max(last, t);
+        s.first = std::min(s.first, t);
+        s.last = std::max(s.last, t);
     };
-    for (const auto& [name, samples] : rec->devices) {
+    for (const auto& [name, samples] : rec.devices) {
         if (const auto* kind = recordings::kindNamed(recordings::deviceKinds(), name);
             kind != nullptr && samples.has_value()) {
             for (const auto t : kind->times(samples)) {
@@ -184,85 +182,91 @@ int inspectMain(const InspectOptions& o)
             }
         }
     }
-    for (const auto& f : rec->frames) {
+    for (const auto& f : rec.frames) {
         span(f.tickNs);
     }
-    if (first > last) {
-        first = last = 0;
+    if (s.first > s.last) {
+        s.first = s.last = 0;
     }
+    return s;
+}
+
+nlohmann::json inspectJson(const InspectOptions& o,
+                           const recordings::Recording& rec,
+                           const recordings::FileReport& report,
+                           const TimeSpan& span)
+{
     nlohmann::json j{{"file", o.file},
-                     {"format_version", rec->formatVersion},
-                     {"software", rec->session.softwareVersion},
-                     {"config", nlohmann::json::parse(rec->session.configJson, nullptr, false)},
-                     {"booth", rec->session.boothModel},
-                     {"scene", rec->session.scene},
-                     {"display_profile", rec->session.displayProfile},
-                     {"wall_clock_start_ns", rec->session.wallClockStartNs},
-                     {"wall_clock_start", isoUtc(rec->session.wallClockStartNs)},
-                     {"lamp_timeline", lampTimeline(*rec)},
-                     {"display_digests", rec->displayDigests.size()},
-                     {"raw_inputs", rawInputsJson(*rec)},
-                     {"frames", rec->frames.size()},
-                     {"dropped_messages", rec->droppedMessages},
-                     {"rejected_nonfinite", rec->rejectedNonFinite},
-                     {"file_bytes", report->fileBytes},
-                     {"library", report->library},
-                     {"messages", report->messages},
-                     {"chunks", report->chunks},
-                     {"indexed", report->indexed},
-                     {"damage", report->damage},
-                     {"channels", channelsJson(*report)},
-                     {"first_ns", first},
-                     {"last_ns", last},
-                     {"duration_s", static_cast<double>(last - first) * 1e-9}};
+                     {"format_version", rec.formatVersion},
+                     {"software", rec.session.softwareVersion},
+                     {"config", nlohmann::json::parse(rec.session.configJson, nullptr, false)},
+                     {"booth", rec.session.boothModel},
+                     {"scene", rec.session.scene},
+                     {"display_profile", rec.session.displayProfile},
+                     {"wall_clock_start_ns", rec.session.wallClockStartNs},
+                     {"wall_clock_start", isoUtc(rec.session.wallClockStartNs)},
+                     {"lamp_timeline", lampTimeline(rec)},
+                     {"display_digests", rec.displayDigests.size()},
+                     {"raw_inputs", rawInputsJson(rec)},
+                     {"frames", rec.frames.size()},
+                     {"dropped_messages", rec.droppedMessages},
+                     {"rejected_nonfinite", rec.rejectedNonFinite},
+                     {"file_bytes", report.fileBytes},
+                     {"library", report.library},
+                     {"messages", report.messages},
+                     {"chunks", report.chunks},
+                     {"indexed", report.indexed},
+                     {"damage", report.damage},
+                     {"channels", channelsJson(report)},
+                     {"first_ns", span.first},
+                     {"last_ns", span.last},
+                     {"duration_s", span.seconds()}};
     for (const auto* kind : recordings::deviceKinds()) {
-        j[kind->name()] = streamJson(*rec, *kind);
+        j[kind->name()] = streamJson(rec, *kind);
     }
-    if (!rec->frames.empty()) {
-        j["last_frame"] = {{"frame", rec->frames.back().frameIndex},
-                           {"tick_ns", rec->frames.back().tickNs}};
+    if (!rec.frames.empty()) {
+        j["last_frame"] = {{"frame", rec.frames.back().frameIndex},
+                           {"tick_ns", rec.frames.back().tickNs}};
     }
-    if (o.json) {
-        fmt::print("{}\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
-        return kExitOk;
-    }
-    fmt::print("{}: replica recording, format {}, written by {}\n", o.file, rec->formatVersion,
-               shown(rec->session.softwareVersion));
-    fmt::print("  started {} (UTC), {:.3f} s of session time\n",
-               isoUtc(rec->session.wallClockStartNs), static_cast<double>(last - first) * 1e-9);
-    fmt::print("  booth {}, scene {}, display profile {}\n", shown(rec->session.boothModel),
-               shown(rec->session.scene), shown(rec->session.displayProfile));
-    const auto timeline = lampTimeline(*rec);
+    return j;
+}
+
+void printLampTimeline(const recordings::Recording& rec)
+{
+    const auto timeline = lampTimeline(rec);
     if (timeline.empty()) {
         fmt::print("  lamp timeline: none recorded (no selector{})\n",
-                   rec->formatVersion < 4 ? "; format < 4 records no decided light" : "");
-    } else {
-        fmt::print("  lamp timeline:\n");
-        for (const auto& e : timeline) {
-            const double t = e.at("t_s").get<double>();
-            if (e.at("source") == "decided") {
-                fmt::print("    {:9.3f} s  shown: {}{} ({})\n", t,
-                           shown(e.at("name").get<std::string>()),
-                           e.contains("cct_k")
-                                   ? fmt::format(", {:.0f} K", e.at("cct_k").get<double>())
-                                   : std::string(),
-                           shown(e.at("why").get<std::string>()));
-            } else {
-                fmt::print("    {:9.3f} s  selector: {} ({})\n", t, e.at("lamp").get<int>(),
-                           shown(e.at("state").get<std::string>()));
-            }
+                   rec.formatVersion < 4 ? "; format < 4 records no decided light" : "");
+        return;
+    }
+    fmt::print("  lamp timeline:\n");
+    for (const auto& e : timeline) {
+        const double t = e.at("t_s").get<double>();
+        if (e.at("source") == "decided") {
+            fmt::print("    {:9.3f} s  shown: {}{} ({})\n", t,
+                       shown(e.at("name").get<std::string>()),
+                       e.contains("cct_k") ? fmt::format(", {:.0f} K", e.at("cct_k").get<double>())
+                                           : std::string(),
+                       shown(e.at("why").get<std::string>()));
+        } else {
+            fmt::print("    {:9.3f} s  selector: {} ({})\n", t, e.at("lamp").get<int>(),
+                       shown(e.at("state").get<std::string>()));
         }
     }
+}
+
+// Every device kind (an optional one only when the session had it), and the raw inputs kept.
+void printDevices(const recordings::Recording& rec)
+{
     auto line = [](const char* name, const hal::DeviceInfo& info, std::size_t count) {
         fmt::print("  {:<13} {:>7} samples  {} {} ({})\n", name, count, shown(info.model),
                    shown(info.serial), hal::toString(info.kind));
     };
-    // Every device kind; an optional one only when the session had it.
-    const auto raw = rawInputsJson(*rec);
+    const auto raw = rawInputsJson(rec);
     std::string rawCounts;
     for (const auto* kind : recordings::deviceKinds()) {
-        const auto& info = rec->session.device(*kind);
-        const std::size_t count = rec->count(*kind);
+        const auto& info = rec.session.device(*kind);
+        const std::size_t count = rec.count(*kind);
         if (!kind->names().optional || !info.model.empty() || count > 0) {
             line(kind->names().displayName.c_str(), info, count);
         }
@@ -275,19 +279,52 @@ int inspectMain(const InspectOptions& o)
         }
     }
     fmt::print("  raw inputs    {}{} ('replay --reprocess' re-derives them)\n", rawCounts,
-               rec->unmatchedRaw > 0
-                       ? fmt::format("; {} without their sample (dropped)", rec->unmatchedRaw)
+               rec.unmatchedRaw > 0
+                       ? fmt::format("; {} without their sample (dropped)", rec.unmatchedRaw)
                        : std::string());
-    fmt::print("  {:<13} {:>7} frames\n", "frames", rec->frames.size());
+}
+
+void printInspection(const InspectOptions& o,
+                     const recordings::Recording& rec,
+                     const recordings::FileReport& report,
+                     const TimeSpan& span)
+{
+    fmt::print("{}: replica recording, format {}, written by {}\n", o.file, rec.formatVersion,
+               shown(rec.session.softwareVersion));
+    fmt::print("  started {} (UTC), {:.3f} s of session time\n",
+               isoUtc(rec.session.wallClockStartNs), span.seconds());
+    fmt::print("  booth {}, scene {}, display profile {}\n", shown(rec.session.boothModel),
+               shown(rec.session.scene), shown(rec.session.displayProfile));
+    printLampTimeline(rec);
+    printDevices(rec);
+    fmt::print("  {:<13} {:>7} frames\n", "frames", rec.frames.size());
     fmt::print("  time span {:.3f} s ({} .. {} ns); dropped messages {}, rejected (NaN/inf) {}\n",
-               static_cast<double>(last - first) * 1e-9, first, last, rec->droppedMessages,
-               rec->rejectedNonFinite);
-    fmt::print("  {} bytes, {} messages in {} chunks, {}; no damage found\n", report->fileBytes,
-               report->messages, report->chunks, report->indexed ? "indexed" : "not indexed");
-    for (const auto& c : report->channels) {
+               span.seconds(), span.first, span.last, rec.droppedMessages, rec.rejectedNonFinite);
+    fmt::print("  {} bytes, {} messages in {} chunks, {}; no damage found\n", report.fileBytes,
+               report.messages, report.chunks, report.indexed ? "indexed" : "not indexed");
+    for (const auto& c : report.channels) {
         fmt::print("  channel {:>2} {:<20} {:>7} messages  {} ({})\n", c.id, shown(c.topic),
                    c.messages, shown(c.schemaName), shown(c.messageEncoding));
     }
+}
+
+int inspectMain(const InspectOptions& o)
+{
+    auto report = recordings::inspectRecording(o.file);
+    if (!report) {
+        return reportDamage(o, report.error().message, nullptr);
+    }
+    auto rec = recordings::readRecording(o.file);
+    if (!rec) {
+        return reportDamage(o, rec.error().message, &*report);
+    }
+    const TimeSpan span = timeSpan(*rec);
+    if (o.json) {
+        const auto j = inspectJson(o, *rec, *report, span);
+        fmt::print("{}\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace));
+        return kExitOk;
+    }
+    printInspection(o, *rec, *report, span);
     return kExitOk;
 }
 

@@ -197,6 +197,56 @@ Expected<pipeline::shading::XyzFrame> renderGl(const pipeline::shading::Prepared
     return render::renderBoothFrame(**pass, pl, view);
 }
 
+// The frame 'a' asks for: the exact reference, or the real-time model on the CPU or the GL pass,
+// planned or not, and how long it took.
+struct RenderedFrame {
+    pipeline::shading::XyzFrame frame;
+    pipeline::shading::RenderSettings settings;
+    std::string mode;
+    pipeline::shading::Plan plan;
+    double ms = 0.0;
+};
+
+Expected<RenderedFrame> renderFrame(const RenderArgs& a,
+                                    const pipeline::surface::SurfaceScene& scene,
+                                    const pipeline::booth::BoothLight& light,
+                                    const pipeline::shading::View& view,
+                                    const pipeline::colour::Observer& obs,
+                                    const pipeline::colour::ChannelBasis& basis)
+{
+    using namespace pipeline;
+    const auto t0 = std::chrono::steady_clock::now();
+    RenderedFrame r{{}, settingsFromArgs(a, scene), "realtime-cpu", {}, 0.0};
+    if (a.reference) {
+        r.mode = "reference";
+        r.frame = reference::renderReference(scene, light, view, obs);
+    } else {
+        if (a.plan) {
+            r.plan = shading::planRender(scene, light, view, obs, {}, 32, 20, basis);
+            r.settings = r.plan.settings;
+            r.settings.areaLights = !a.pointLights;
+        }
+        const auto pl = shading::prepareLight(light, obs, r.settings.lights, basis);
+        const auto ps = shading::prepareScene(scene, std::max(r.settings.horizonDirections, 1),
+                                              0.01, basis);
+        if (a.gl) {
+            r.mode = "realtime-gles";
+            auto f = renderGl(ps, pl, view, obs, r.settings);
+            if (!f) {
+                return tl::unexpected(f.error());
+            }
+            r.frame = std::move(*f);
+        } else {
+            r.frame = shading::renderRealtime(ps, pl, view, obs, r.settings);
+        }
+        if (a.plan) {
+            r.mode += ", planned";
+        }
+    }
+    r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+}
+
 int runRender(const RenderArgs& a)
 {
     using namespace pipeline;
@@ -247,40 +297,11 @@ int runRender(const RenderArgs& a)
         output = std::move(*out);
     }
 
-    const auto t0 = std::chrono::steady_clock::now();
-    shading::XyzFrame frame;
-    shading::RenderSettings settings = settingsFromArgs(a, *scene);
-    std::string mode = "realtime-cpu";
-    shading::Plan plan;
-    if (a.reference) {
-        mode = "reference";
-        frame = reference::renderReference(*scene, *light, view, *obs);
-    } else {
-        if (a.plan) {
-            plan = shading::planRender(*scene, *light, view, *obs, {}, 32, 20, *basis);
-            settings = plan.settings;
-            settings.areaLights = !a.pointLights;
-        }
-        const auto pl = shading::prepareLight(*light, *obs, settings.lights, *basis);
-        const auto ps = shading::prepareScene(*scene, std::max(settings.horizonDirections, 1), 0.01,
-                                              *basis);
-        if (a.gl) {
-            mode = "realtime-gles";
-            auto f = renderGl(ps, pl, view, *obs, settings);
-            if (!f) {
-                return fail(kExitFailure, f.error().message);
-            }
-            frame = std::move(*f);
-        } else {
-            frame = shading::renderRealtime(ps, pl, view, *obs, settings);
-        }
-        if (a.plan) {
-            mode += ", planned";
-        }
+    auto rendered = renderFrame(a, *scene, *light, view, *obs, *basis);
+    if (!rendered) {
+        return fail(kExitFailure, rendered.error().message);
     }
-    const double ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count();
+    const auto& [frame, settings, mode, plan, ms] = *rendered;
     if (frame.nonFinite != 0) {
         return fail(kExitFailure,
                     fmt::format("{} pixels were not finite; this is a bug, please report it",

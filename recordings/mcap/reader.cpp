@@ -4,111 +4,13 @@
 #include <optional>
 
 #include <fmt/format.h>
-#include <zstd.h>
 
+#include <recordings/mcap/chunk_unpack.h>
 #include <recordings/mcap/crc.h>
 #include <recordings/mcap/reader.h>
 
 namespace replica::recordings::mcap {
 namespace {
-
-// Refuse chunks claiming more than this uncompressed: Replica's writer closes a chunk at 256 KiB,
-// and a corrupt or hostile size field must not make the reader allocate gigabytes.
-constexpr std::uint64_t kMaxChunkBytes = kMaxChunkUncompressedBytes;
-
-struct ChunkFields {
-    std::uint64_t startTime = 0, endTime = 0, uncompressedSize = 0;
-    std::uint32_t crc = 0;
-    std::string_view compression, records;
-};
-
-std::optional<ChunkFields> chunkFields(std::string_view content)
-{
-    ByteReader r(content);
-    ChunkFields c;
-    c.startTime = r.u64();
-    c.endTime = r.u64();
-    c.uncompressedSize = r.u64();
-    c.crc = r.u32();
-    c.compression = r.str();
-    c.records = r.bytes(r.u64());
-    if (r.failed() || r.remaining() != 0) {
-        return std::nullopt;
-    }
-    return c;
-}
-
-// What unpacking chunks may cost: the uncompressed bytes they may produce (and so copy and
-// checksum), and what they did (Scan::bytesExamined).
-struct Work {
-    std::uint64_t budget = 0;
-    bool overBudget = false;
-    std::uint64_t examined = 0;
-};
-
-// Decompresses and checks a chunk; returns the reason it is unusable, or the records. Every
-// chunk's uncompressed size is taken from the budget before anything is allocated, copied or
-// checksummed, so that the work of every attempt (recover tries each plausible chunk header after
-// damage) is bounded by the budget; 'overBudget' is set when it runs out (the scan then stops).
-std::string unpack(const ChunkFields& c, std::string& out, Work& work)
-{
-    if (c.compression.empty() && c.records.size() != c.uncompressedSize) {
-        // Checked before the copy: a chunk claiming 0 bytes must not make each attempt copy
-        // megabytes for free (nested chunks made recover quadratic in the file's size).
-        return fmt::format("holds {} bytes uncompressed, not the {} it claims", c.records.size(),
-                           c.uncompressedSize);
-    }
-    if (c.uncompressedSize > kMaxChunkBytes) {
-        return fmt::format("claims {} uncompressed bytes (at most {} MiB)", c.uncompressedSize,
-                           kMaxChunkBytes >> 20);
-    }
-    if (c.compression == "zstd") {
-        // The frame says its own content size: a chunk claiming more than its frame holds is
-        // refused before the claim is allocated.
-        const unsigned long long framed =
-                ZSTD_getFrameContentSize(c.records.data(), c.records.size());
-        if (framed == ZSTD_CONTENTSIZE_ERROR) {
-            return "does not decompress (not a zstd frame)";
-        }
-        if (framed != ZSTD_CONTENTSIZE_UNKNOWN && framed != c.uncompressedSize) {
-            return fmt::format("claims {} uncompressed bytes but its zstd frame holds {}",
-                               c.uncompressedSize, framed);
-        }
-    } else if (!c.compression.empty()) {
-        return fmt::format("uses unsupported compression '{}'", c.compression);
-    }
-    // What this attempt reads and writes: the uncompressed records, and a zstd frame's input too
-    // (a frame of many empty blocks produces nothing but takes time to read).
-    const std::uint64_t cost = c.uncompressedSize + (c.compression.empty() ? 0 : c.records.size());
-    if (cost > work.budget) {
-        work.overBudget = true;
-        return fmt::format("would take the recording past its decompression budget ({})",
-                           "see docs/recordings.md, 'Limits'");
-    }
-    work.budget -= cost;
-    work.examined += cost;
-    if (c.compression.empty()) {
-        out.assign(c.records);
-    } else if (c.compression == "zstd") {
-        out.resize(static_cast<std::size_t>(c.uncompressedSize));
-        const std::size_t n =
-                ZSTD_decompress(out.data(), out.size(), c.records.data(), c.records.size());
-        if (ZSTD_isError(n)) {
-            return fmt::format("does not decompress ({})", ZSTD_getErrorName(n));
-        }
-        out.resize(n);
-    } else {
-        return fmt::format("uses unsupported compression '{}'", c.compression);
-    }
-    if (out.size() != c.uncompressedSize) {
-        return fmt::format("decompresses to {} bytes, not the {} it claims", out.size(),
-                           c.uncompressedSize);
-    }
-    if (c.crc != 0 && crc32(0, out) != c.crc) {
-        return "fails its CRC check (corrupted)";
-    }
-    return {};
-}
 
 class Scanner
 {
@@ -159,55 +61,11 @@ private:
             }
             const std::string_view content = f_.substr(at + kRecordPrefix, len);
             const std::size_t next = at + kRecordPrefix + static_cast<std::size_t>(len);
-            bool ok = true;
-            switch (static_cast<Op>(op)) {
-            case Op::Header:
-                if (at == kMagic.size()) {
-                    ByteReader h(content);
-                    h.str();
-                    s_.library = h.str();
-                }
-                break;
-            case Op::Schema:
-            case Op::Channel:
-            case Op::Message:
-                if (o_.chunkedOnly) {
-                    // Damage, not a sample (so not counted as a dropped message); its bounds
-                    // looked sane: skip it whole and go on.
-                    problem(fmt::format("{} record at byte {} outside every chunk, where no CRC "
-                                        "covers it: skipped",
-                                        op == static_cast<std::uint8_t>(Op::Message)  ? "Message"
-                                        : op == static_cast<std::uint8_t>(Op::Schema) ? "Schema"
-                                                                                      : "Channel",
-                                        at));
-                    s_.bytesSkipped += next - at;
-                    break;
-                }
-                ok = inner(static_cast<Op>(op), content, at);
-                break;
-            case Op::Chunk:
-                ok = chunk(content, at, next - at);
-                break;
-            case Op::Metadata:
-                if (auto m = decodeMetadata(content)) {
-                    s_.metadata.push_back(std::move(*m));
-                } else {
-                    problem(fmt::format("malformed Metadata record at byte {}", at));
-                    ok = false;
-                }
-                break;
-            case Op::DataEnd:
-                s_.dataEnd = true;
-                s_.dataSectionEnd = at;
-                dataEnd(content, at);
-                summary(next);
+            const Step step = dataRecord(op, content, at, next);
+            if (step == Step::Done) {
                 return std::move(s_);
-            case Op::Footer:
-                problem(fmt::format("footer at byte {} without a Data End record before it", at));
-                return std::move(s_);
-            default:
-                break; // indexes, attachments, metadata and private records carry no samples
             }
+            const bool ok = step == Step::Next;
             if (work_.overBudget) {
                 return overBudget();
             }
@@ -232,6 +90,58 @@ private:
                             "cut or crash?); 'replica recover' rebuilds its index",
                             f_.size()));
         return std::move(s_);
+    }
+
+    // What a record of the data section leaves the scan to do.
+    enum class Step { Next, Damaged, Done };
+
+    Step dataRecord(std::uint8_t op, std::string_view content, std::size_t at, std::size_t next)
+    {
+        switch (static_cast<Op>(op)) {
+        case Op::Header:
+            if (at == kMagic.size()) {
+                ByteReader h(content);
+                h.str();
+                s_.library = h.str();
+            }
+            return Step::Next;
+        case Op::Schema:
+        case Op::Channel:
+        case Op::Message:
+            if (o_.chunkedOnly) {
+                // Damage, not a sample (so not counted as a dropped message); its bounds looked
+                // sane: skip it whole and go on.
+                problem(fmt::format("{} record at byte {} outside every chunk, where no CRC "
+                                    "covers it: skipped",
+                                    op == static_cast<std::uint8_t>(Op::Message)  ? "Message"
+                                    : op == static_cast<std::uint8_t>(Op::Schema) ? "Schema"
+                                                                                  : "Channel",
+                                    at));
+                s_.bytesSkipped += next - at;
+                return Step::Next;
+            }
+            return inner(static_cast<Op>(op), content, at) ? Step::Next : Step::Damaged;
+        case Op::Chunk:
+            return chunk(content, at, next - at) ? Step::Next : Step::Damaged;
+        case Op::Metadata:
+            if (auto m = decodeMetadata(content)) {
+                s_.metadata.push_back(std::move(*m));
+                return Step::Next;
+            }
+            problem(fmt::format("malformed Metadata record at byte {}", at));
+            return Step::Damaged;
+        case Op::DataEnd:
+            s_.dataEnd = true;
+            s_.dataSectionEnd = at;
+            dataEnd(content, at);
+            summary(next);
+            return Step::Done;
+        case Op::Footer:
+            problem(fmt::format("footer at byte {} without a Data End record before it", at));
+            return Step::Done;
+        default:
+            return Step::Next; // indexes, attachments and private records carry no samples
+        }
     }
 
     Scan overBudget()
