@@ -387,18 +387,11 @@ Expected<void> checkBuildHas(const RunConfig& config)
 {
     const std::vector<std::string> bases = pipeline::spectral::channelBasisNames();
     const bool knownBasis = std::find(bases.begin(), bases.end(), config.basis) != bases.end();
-    const bool knownScene = config.renderer == "booth" || config.scene == "colorchecker";
-    if (config.booth != "replica-booth-1" || !knownScene || !knownBasis) {
+    if (config.booth != "replica-booth-1" || !knownBasis) {
         return makeError(ErrorCode::NotFound,
-                         fmt::format("unknown booth '{}', scene '{}' or basis '{}' (this build has "
-                                     "replica-booth-1, colorchecker, and bases {})",
-                                     config.booth, config.scene, config.basis,
-                                     fmt::join(bases, ", ")));
-    }
-    if (config.basis == kAdaptiveBasis && config.renderer != "booth") {
-        return makeError(ErrorCode::InvalidArgument,
-                         "basis adaptive_k6 re-encodes the booth renderer's surface scene; the "
-                         "flat renderer needs a fixed basis (--basis replica_k6)");
+                         fmt::format("unknown booth '{}' or basis '{}' (this build has "
+                                     "replica-booth-1, and bases {})",
+                                     config.booth, config.basis, fmt::join(bases, ", ")));
     }
     return {};
 }
@@ -450,11 +443,9 @@ Expected<std::unique_ptr<state::SceneEstimator>> makeStateStage(const RunConfig&
     setup.light.calibration = *calibration;
     setup.light.chain = config.sensing;
     setup.light.instrument = config.instrument;
-    if (config.renderer == "booth") {
-        // The re-encode decision and the diffuse term's sliced refresh are state.
-        setup.light.adaptive = encoding.adaptive;
-        setup.tilt.cacheSlices = config.cacheSlices;
-    }
+    // The re-encode decision and the diffuse term's sliced refresh are state.
+    setup.light.adaptive = encoding.adaptive;
+    setup.tilt.cacheSlices = config.cacheSlices;
     setup.eye.trackerInBooth = config.trackerInBooth;
     setup.eye.defaultEyeM = config.defaultEyeM;
     setup.tilt.defaultTiltRad = config.defaultTiltRad;
@@ -476,45 +467,28 @@ Expected<std::unique_ptr<state::SceneEstimator>> makeStateStage(const RunConfig&
     return std::make_unique<state::SceneEstimator>(std::move(*estimator));
 }
 
-// The renderer, in the output's GL context: the booth pass (booth renderer) and the display pass.
+// The renderer, in the output's GL context: the booth pass and the display pass.
 Expected<void> makeRenderer(Appliance& app,
                             pipeline::render::DisplayPassSetup display,
                             const Encoding& encoding,
-                            const pipeline::colour::Observer& observer,
-                            const std::string& dir)
+                            const pipeline::colour::Observer& observer)
 {
     const RunConfig& config = app.config;
-    // Surface resolution: about one texel per 2 screen pixels is plenty for flat patches. The
-    // booth renderer does not read it (its scene has its own textures).
-    auto surface =
-            config.renderer == "flat"
-                    ? pipeline::render::makeColorCheckerSurface(dir, encoding.basis, 600, 400)
-                    : pipeline::render::makeColorCheckerSurface(dir, encoding.basis, 6, 4);
-    if (!surface) {
-        return tl::unexpected(surface.error());
-    }
     pipeline::render::GlesRendererSetup setup;
     setup.width = config.width;
     setup.height = config.height;
     setup.stand = config.stand;
-    setup.booth = app.booth;
-    setup.surface = std::move(*surface);
-    setup.basis = encoding.basis;
     setup.observer = observer;
     app.displayWhiteXyz = display.model.whiteXyz();
     app.displayModel = display.model;
     setup.display = std::move(display);
-    setup.lightsU = config.lightsU;
-    setup.lightsV = config.lightsV;
-    if (config.renderer == "booth") {
-        auto boothScene = makeBoothScene(app.config, app.booth, encoding.basis, observer,
-                                         encoding.adaptive, setup.display.model);
-        if (!boothScene) {
-            return tl::unexpected(boothScene.error());
-        }
-        app.boothScene = *boothScene;
-        setup.boothScene = std::move(*boothScene);
+    auto boothScene = makeBoothScene(app.config, app.booth, encoding.basis, observer,
+                                     encoding.adaptive, setup.display.model);
+    if (!boothScene) {
+        return tl::unexpected(boothScene.error());
     }
+    app.boothScene = *boothScene;
+    setup.boothScene = std::move(*boothScene);
     auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
     if (!renderer) {
         return tl::unexpected(renderer.error());
@@ -569,7 +543,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     app->output = std::move(*output);
     applyDisplayGeometry(config, *app->output, outputChoice);
     app->config = config;
-    if (auto ok = makeRenderer(*app, std::move(*display), *encoding, *observer, dir); !ok) {
+    if (auto ok = makeRenderer(*app, std::move(*display), *encoding, *observer); !ok) {
         return tl::unexpected(ok.error());
     }
     return app;

@@ -57,9 +57,11 @@ struct RunConfig {
     double rateHz = 60.0;
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
-    // "booth": the surface scene in sceneDir lit by the booth model (pass 1 from
-    // render/booth_scene_pass.h); "flat": the flat patch image under a uniform grid of lights.
-    std::string renderer = "booth";
+    // A recording drawn by the flat renderer, which this build no longer has (its "renderer" is
+    // "flat", or it has no such key: it was made before the booth renderer). Replay draws it with
+    // the booth pass like any other and compares the frames with what the recording showed, as
+    // for an older render profile. A new run records "renderer": "booth".
+    bool drawnByFlatRenderer = false;
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
     int boothLights = 32;    // median-cut point lights
@@ -116,11 +118,9 @@ struct RunConfig {
     // (BoothScenePass::warmUp) so that no lamp switch waits for a shader compilation.
     bool warmUp = true;
     std::map<std::string, LampPlan> plannedLamps;
-    // docs/accuracy.md. adaptive_k6 (booth renderer only) re-encodes the surface for each new
-    // light; recordings made with replica_k6 or box6 replay as such.
+    // docs/accuracy.md. adaptive_k6 re-encodes the surface for each new light; recordings made
+    // with replica_k6 or box6 replay as such.
     std::string basis = "adaptive_k6";
-    int lightsU = 8;
-    int lightsV = 4;
     std::string spectrometerCalibration = "spectrometer/sim_usb2000_responsivity.csv";
     // The live spectrometer chain (pipeline/spectral/live_chain.h): its corrections and averaging,
     // and the instrument's calibration (stray light, wavelength shift) they use, recorded as
@@ -187,8 +187,8 @@ struct Appliance {
     std::unique_ptr<Output>
             output; // owns the GL context: created before, destroyed after the renderer
     std::unique_ptr<pipeline::render::Renderer> renderer;
-    // The booth renderer's pass 1 (shared with the renderer), null with the flat renderer: what
-    // tests ask about the adaptive encoding (its basis, how often it re-encoded).
+    // The renderer's pass 1 (shared with the renderer): what tests ask about the adaptive
+    // encoding (its basis, how often it re-encoded).
     std::shared_ptr<pipeline::render::BoothScenePass> boothScene;
     std::unique_ptr<state::SceneEstimator> sceneEstimator; // the state stage (state/)
     std::string displayProfileId;                          // as recorded in the session

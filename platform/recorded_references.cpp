@@ -104,7 +104,9 @@ Expected<void> checkRecordedReferences(const RunConfig& config,
                                        const std::vector<std::filesystem::path>& roots,
                                        bool allowUndigested)
 {
-    if (config.renderer == "booth") {
+    // The flat renderer's recordings draw the shipped ColorChecker (RunConfig::fromJson): no
+    // scene of theirs to check.
+    if (!config.drawnByFlatRenderer) {
         if (auto ok = checkReference("scene_dir", config.sceneDir, roots); !ok) {
             return ok;
         }

@@ -45,13 +45,12 @@ std::string RunConfig::toJson() const
                      {"booth", booth},
                      {"scene", scene},
                      {"basis", basis},
-                     {"lights_u", lightsU},
-                     {"lights_v", lightsV},
                      {"spectrometer_calibration", spectrometerCalibration},
                      {"display", display},
                      {"display_peak_cd_m2", displayPeakCdM2},
                      {"display_black_cd_m2", displayBlackCdM2},
-                     {"renderer", renderer},
+                     // Without it, a recording is the flat renderer's (readRendering).
+                     {"renderer", "booth"},
                      {"scene_dir", sceneDir},
                      {"scene_digest", sceneDigest},
                      {"booth_lights", boothLights},
@@ -116,8 +115,6 @@ void readRequired(const nlohmann::json& j, RunConfig& c)
     c.booth = j.at("booth").get<std::string>();
     c.scene = j.at("scene").get<std::string>();
     c.basis = j.at("basis").get<std::string>();
-    c.lightsU = j.at("lights_u").get<int>();
-    c.lightsV = j.at("lights_v").get<int>();
     c.spectrometerCalibration = j.at("spectrometer_calibration").get<std::string>();
     c.display = j.at("display").get<std::string>();
     c.displayPeakCdM2 = j.at("display_peak_cd_m2").get<double>();
@@ -128,11 +125,20 @@ void readRequired(const nlohmann::json& j, RunConfig& c)
 // path, and a recording of an older render profile replays on it approximately.
 void readRendering(const nlohmann::json& j, RunConfig& c)
 {
-    // Absent in recordings made before the booth renderer: what they show is the flat patch
-    // image (the scene they hold), not a render path.
-    c.renderer = j.value("renderer", std::string("flat"));
+    // Absent in recordings made before the booth renderer: the flat renderer drew them.
+    const auto renderer = j.value("renderer", std::string("flat"));
+    if (renderer != "booth" && renderer != "flat") {
+        throw std::runtime_error(fmt::format("renderer '{}' is not 'booth' or 'flat'", renderer));
+    }
+    c.drawnByFlatRenderer = renderer == "flat";
     c.sceneDir = j.value("scene_dir", c.sceneDir);
     c.sceneDigest = j.value("scene_digest", c.sceneDigest);
+    if (c.drawnByFlatRenderer) {
+        // The flat renderer drew its built-in ColorChecker whatever scene the run named: the
+        // booth pass draws the shipped ColorChecker scene in its place.
+        c.sceneDir = RunConfig{}.sceneDir;
+        c.sceneDigest.clear();
+    }
     c.boothLights = j.value("booth_lights", c.boothLights);
     c.specularSamples = j.value("specular_samples", c.specularSamples);
     c.specularGrid = j.value("specular_grid", c.specularGrid);
@@ -239,8 +245,6 @@ void readSensing(const nlohmann::json& j, RunConfig& c)
 Expected<void> checkRanges(const RunConfig& c)
 {
     if (!frameSizeOk(c.width, c.height) || !(c.rateHz >= 1.0) || c.rateHz > 1000.0 ||
-        c.lightsU <= 0 || c.lightsV <= 0 ||
-        static_cast<long long>(c.lightsU) * static_cast<long long>(c.lightsV) > 256 ||
         !std::isfinite(c.displayPeakCdM2) || !std::isfinite(c.displayBlackCdM2) ||
         c.boothLights < 1 || c.boothLights > 256 || c.specularSamples < kAutoSpecularSamples ||
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
@@ -250,12 +254,11 @@ Expected<void> checkRanges(const RunConfig& c)
         !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0) {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("run configuration: size {}x{} (each side 1-{}, at most "
-                                     "{}:1), rate {} Hz (1-1000), lights {}x{} (at most 256), "
-                                     "display peak/black, specular samples, specular or diffuse "
-                                     "grid, horizon directions, cache slices, area lights "
-                                     "or booth dimmer (0 to 1) out of range",
-                                     c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz,
-                                     c.lightsU, c.lightsV));
+                                     "{}:1), rate {} Hz (1-1000), display peak/black, specular "
+                                     "samples, specular or diffuse grid, horizon directions, "
+                                     "cache slices, area lights or booth dimmer (0 to 1) out of "
+                                     "range",
+                                     c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz));
     }
     const auto finite3 = [](const glm::dvec3& v) {
         return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -280,14 +283,9 @@ Expected<void> checkRanges(const RunConfig& c)
     return {};
 }
 
-// The names fromJson takes for the renderer, the display inverse and the gamut mapping.
+// The names fromJson takes for the display inverse and the gamut mapping.
 Expected<void> checkNames(const RunConfig& c)
 {
-    if (c.renderer != "booth" && c.renderer != "flat") {
-        return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("run configuration: renderer '{}' is not 'booth' or 'flat'",
-                                     c.renderer));
-    }
     if ((c.displayInverse != "analytic" && c.displayInverse != "lut3d") ||
         (c.gamutMapping != "hue" && c.gamutMapping != "clip")) {
         return makeError(ErrorCode::InvalidArgument,

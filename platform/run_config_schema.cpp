@@ -1,6 +1,6 @@
 // See run_config_schema.h. Ranges are the physical and format limits the appliance itself keeps
 // (frame size, rate, light counts, the site file's geometry ranges widened a little); the checks
-// across fields (aspect ratio, lights_u * lights_v, names of renderers and inverses) stay in
+// across fields (aspect ratio, names of renderers and inverses) stay in
 // RunConfig::fromJson. A key added to RunConfig::toJson must be added here too
 // (RunConfigSchema.EveryKeyTheRunWritesIsKnown fails otherwise).
 #include <platform/appliance.h>
@@ -23,14 +23,18 @@ const JsonSchema& runConfigSchema()
                 {"booth", name},
                 {"scene", name},
                 {"basis", name},
-                {"lights_u", integer(1, 256)},
-                {"lights_v", integer(1, 256)},
                 {"spectrometer_calibration", name},
                 {"display", name},
                 {"display_peak_cd_m2", number(0.0, 1e5)},
                 {"display_black_cd_m2", number(0.0, 1e5)},
                 // Added later: absent in older recordings, which replay with the old behaviour.
+                // "renderer": "booth", or "flat" (absent: made before the booth renderer), which
+                // replays on the booth pass, approximately.
                 {"renderer", name.optional()},
+                // The flat renderer's grid of point lights, in the recordings it made (before
+                // that, required); not read.
+                {"lights_u", integer(1, 256).optional()},
+                {"lights_v", integer(1, 256).optional()},
                 {"scene_dir", name.optional()},
                 {"scene_digest", string(64).optional()},
                 {"booth_lights", integer(1, 256).optional()},

@@ -369,7 +369,7 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
     r.string("booth", "id", c.boothId);
     r.numberOrAuto("booth", "dimmer", c.boothDimmer, c.boothDimmerAuto, 0.0, 1.0);
     r.string("scene", "dir", c.sceneDir);
-    r.string("scene", "renderer", c.renderer, {"booth", "flat"});
+    r.string("scene", "renderer", c.renderer); // run_resolve.cpp refuses all but "booth"
     r.boolean("render", "planner", c.renderPlanner);
     c.renderPlannerSet = root.at_path("render.planner").as_boolean() != nullptr;
     r.boolean("render", "warm_up", c.warmUp);

@@ -39,7 +39,7 @@ struct SiteConfig {
     double spectrometerWavelengthOffsetNm = 0.0;
     // [scene]
     std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
-    std::string renderer = "booth"; // or "flat"
+    std::string renderer = "booth"; // the one renderer; "flat" is read to be refused by name
     // [render] planner = true: the planner in the loop (RunConfig::planner), planning a scene
     // that has no plan yet at start; false: the fixed rules; absent (renderPlannerSet false):
     // 'replica run''s default, the plan when the scene has one (cached or shipped).

@@ -35,7 +35,7 @@ struct BoothLight {
     // - referenceFile / referenceColumn: where it comes from (data/spectra/<file>, column), at the
     //   table's own resolution for the simulated spectrometer.
     // - nominalLuminanceCdM2: the emitter's mean luminance with this lamp on, as the state's
-    //   emitter luminance (the flat renderer's uniform grid, the booth renderer's unknown light).
+    //   emitter luminance (the booth renderer's unknown light).
     colour::Spectrum referenceSpectrum{};
     std::string referenceFile;
     std::string referenceColumn;
@@ -55,14 +55,13 @@ struct BoothLight {
 colour::Spectrum unitLuminanceSpd(const colour::Observer& obs, const colour::Spectrum& spd);
 
 // A point light standing for part of an emitter (paper eq. 1): its intensity (cd) normal to the
-// emitter's plane, used with the two cosines and 1/d^2. The one point light: median-cut regions of
-// a booth light's luminance image (pointLights) and the uniform grid of the flat renderer
-// (scene::uniformGridLights) both give these.
+// emitter's plane, used with the two cosines and 1/d^2: one median-cut region of a booth light's
+// luminance image (pointLights).
 struct PointLight {
     Vec3 position{0.0};
     double intensityCd = 0.0; // L * a: the summed luminance of the region times one texel's area
-    // Median-cut regions only (0 for a uniform grid): the summed luminance of the region's
-    // texels, eq. (1)'s L_n, whose intensity is sumCdM2 * texel area.
+    // The summed luminance of the region's texels, eq. (1)'s L_n: the intensity is sumCdM2 times
+    // the texel area.
     double sumCdM2 = 0.0;
     // The region's luminance-weighted standard deviation about 'position' along edgeU and edgeV,
     // as vectors in metres: how far the light the point stands for spreads over the ceiling.

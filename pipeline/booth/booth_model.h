@@ -17,8 +17,8 @@ struct Booth {
     std::string id; // "replica-booth-1" from scene::loadDefaultBooth; empty from loadBooth
     std::vector<BoothLight> lights;
 
-    // The ceiling the flat renderer's uniform grid and pass 2's flare estimate light the surface
-    // from: the first light's rectangle (loadDefaultBooth checks that all lights share it).
+    // The ceiling, the one emitter of every lamp: the first light's rectangle (loadDefaultBooth
+    // checks that all lights share it).
     // Precondition: !lights.empty() (loadBooth refuses a booth without lights).
     const BoothLight& ceiling() const { return lights.front(); }
 

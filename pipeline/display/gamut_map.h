@@ -34,8 +34,8 @@ struct GamutCounters {
 
     // The same classes counted over the surface's pixels only (the rectangle a booth surface
     // covers; the black panel around it is below black by construction and says nothing about the
-    // booth and the display). surfacePixels 0: no surface rectangle (the flat renderer, a bare
-    // display pass): the whole frame is the surface.
+    // booth and the display). surfacePixels 0: no surface rectangle (a bare display pass): the
+    // whole frame is the surface.
     std::uint64_t surfacePixels = 0;
     std::uint64_t surfaceChroma = 0;
     std::uint64_t surfaceOverPeak = 0;

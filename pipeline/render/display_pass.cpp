@@ -266,14 +266,6 @@ Expected<display::GamutCounters> DisplayPass::draw(GLuint xyzTexture, const Disp
     setUniform3(program_.get(), "uDispPanelRight", frame.pose.rightEdgeM());
     setUniform3(program_.get(), "uDispPanelUp", frame.pose.upEdgeM());
     setUniform3(program_.get(), "uDispPanelNormal", frame.pose.normal);
-    setUniform3(program_.get(), "uDispLightNormal", frame.lightNormal);
-    setInt(program_.get(), "uDispIlluminanceInAlpha", frame.illuminanceInAlpha ? 1 : 0);
-    const int lights = frame.lights != nullptr && !frame.illuminanceInAlpha ? frame.lightCount : 0;
-    setInt(program_.get(), "uDispLightCount", lights);
-    if (lights > 0) {
-        glUniform4fv(glGetUniformLocation(program_.get(), "uDispLights"), lights,
-                     frame.lights->data());
-    }
     setUniform3(program_.get(), "uDispFlarePerLux",
                 static_cast<double>(flarePerLux_) * frame.lightXyzUnitY);
     glActiveTexture(GL_TEXTURE0);

@@ -45,17 +45,12 @@ struct DisplayPassSetup {
     bool falseColour = false;     // field-staff overlay: out-of-gamut pixels striped in colour
 };
 
-// What changes per frame. 'lights' is the renderer's packed list (x, y, z in m, intensity in cd).
+// What changes per frame. The flare's illuminance on the panel (lux) is the XYZ texture's alpha,
+// where pass 1 wrote it.
 struct DisplayPassFrame {
     scene::PanelPose pose;
     glm::dvec3 eyeM{0.0};
-    const std::vector<float>* lights = nullptr;
-    int lightCount = 0;
-    glm::dvec3 lightNormal{0.0, -1.0, 0.0};
     glm::dvec3 lightXyzUnitY{0.0}; // the booth light's colour, Y = 1
-    // Take the illuminance on the panel (lux) from the XYZ texture's alpha, where pass 1 wrote
-    // it, instead of summing 'lights' again per pixel.
-    bool illuminanceInAlpha = false;
     // When set, pass 1 wrote XYZ (0, 0, 0) outside this rectangle (the black panel around a booth
     // surface). There, whatever the flare and the eye, every pixel is below black and gets the
     // counts of XYZ 0; when those counts survive the dither unchanged (DisplayPass::

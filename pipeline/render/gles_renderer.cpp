@@ -1,11 +1,10 @@
-// The GLES 3.1 renderer: pass 1 (the booth scene, or the flat patch image) into an RGBA32F XYZ
-// target, pass 2 (the display pass) into panel counts, and the read-back.
+// The GLES 3.1 renderer: pass 1 (the booth scene) into an RGBA32F XYZ target, pass 2 (the display
+// pass) into panel counts, and the read-back.
 #include <string>
 
 #include <GLES3/gl31.h>
 #include <fmt/format.h>
 
-#include <pipeline/render/flat_scene_pass.h>
 #include <pipeline/render/gl_handles.h>
 #include <pipeline/render/gl_program.h>
 #include <pipeline/render/gles_renderer.h>
@@ -23,23 +22,13 @@ public:
 
     Expected<void> init()
     {
-        if (!setup_.boothScene) {
-            auto pass = FlatScenePass::create({setup_.surface, setup_.booth, setup_.basis,
-                                               setup_.observer, setup_.lightsU, setup_.lightsV});
-            if (!pass) {
-                return tl::unexpected(pass.error());
-            }
-            flat_ = std::move(*pass);
-        }
         if (auto display = displayPass_.init(setup_.display, setup_.width, setup_.height);
             !display) {
             return tl::unexpected(display.error());
         }
         vao_ = GlVertexArray::make();
-        if (setup_.boothScene) {
-            // E_geo around the surface only where the display pass reads it.
-            setup_.boothScene->setSurroundIlluminance(!displayPass_.surroundConstant());
-        }
+        // E_geo around the surface only where the display pass reads it.
+        setup_.boothScene->setSurroundIlluminance(!displayPass_.surroundConstant());
         xyzTarget_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, setup_.width, setup_.height, nullptr);
         fbo_ = GlFramebuffer::make();
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
@@ -57,47 +46,29 @@ public:
         return {};
     }
 
-    std::string description() const override
-    {
-        return setup_.boothScene ? setup_.boothScene->description() : flat_->description();
-    }
+    std::string description() const override { return setup_.boothScene->description(); }
 
     Expected<void>
     render(const scene::SceneState& state, RenderedFrame& out, Readback readback) override
     {
         const int w = setup_.width;
         const int h = setup_.height;
-        // The panel pose and, for the flat image, the uniform grid of lights: its pass 1 and
-        // pass 2's flare estimate use them. The booth pass writes the illuminance on the panel
-        // itself (the XYZ target's alpha), from the booth model's lights.
-        const scene::PanelPose pose = scene::panelPose(setup_.stand, state.tiltRad);
-        const std::vector<float> packed = flat_ ? flat_->lights(state) : std::vector<float>{};
-        const int count = static_cast<int>(packed.size() / 4);
         glViewport(0, 0, w, h);
 
-        // Pass 1: absolute XYZ.
+        // Pass 1: absolute XYZ, and the illuminance on the panel (lux) in alpha from the booth
+        // model's lights, what pass 2 takes the flare from.
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
-        if (setup_.boothScene) {
-            if (auto ok = setup_.boothScene->draw(state, w, h); !ok) {
-                return ok;
-            }
-        } else {
-            flat_->draw(state, pose, packed);
+        if (auto ok = setup_.boothScene->draw(state, w, h); !ok) {
+            return ok;
         }
         glViewport(0, 0, w, h);
         glBindVertexArray(vao_.get());
 
         // Pass 2: panel counts (display_pass.cpp).
         DisplayPassFrame df;
-        df.pose = pose;
+        df.pose = scene::panelPose(setup_.stand, state.tiltRad);
         df.eyeM = state.eyeBoothM;
-        df.lights = &packed;
-        df.lightCount = count;
-        df.lightNormal = setup_.booth.ceiling().normal();
-        df.illuminanceInAlpha = setup_.boothScene != nullptr;
-        if (setup_.boothScene) {
-            df.blackOutside = setup_.boothScene->surfaceRect(w, h);
-        }
+        df.blackOutside = setup_.boothScene->surfaceRect(w, h);
         const colour::Xyz lightXyz = colour::spectrumToXyz(setup_.observer, state.illuminant);
         df.lightXyzUnitY = lightXyz.y > 0.0 ? lightXyz / lightXyz.y : glm::dvec3(0.0);
         auto gamut = displayPass_.draw(xyzTarget_.get(), df);
@@ -137,7 +108,6 @@ public:
 
 private:
     GlesRendererSetup setup_;
-    std::unique_ptr<FlatScenePass> flat_; // pass 1 without a booth scene
     GlVertexArray vao_;
     GlTexture xyzTarget_;
     GlFramebuffer fbo_;
@@ -148,9 +118,9 @@ private:
 
 Expected<std::unique_ptr<Renderer>> createGlesRenderer(GlesRendererSetup setup)
 {
-    if (setup.booth.lights.empty()) {
+    if (!setup.boothScene) {
         return makeError(ErrorCode::InvalidArgument,
-                         "the renderer needs a booth with at least one light (its ceiling)");
+                         "the renderer needs its pass 1, the booth scene pass");
     }
     auto r = std::make_unique<GlesRenderer>(std::move(setup));
     if (auto ok = r->init(); !ok) {

@@ -15,8 +15,8 @@ namespace replica::pipeline::render {
 struct RenderedFrame {
     int width = 0;
     int height = 0;
-    std::vector<float> xyz; // 4 floats per pixel: X, Y, Z in cd/m^2, then 1 (flat renderer) or
-                            // the illuminance on the panel in lux (booth renderer: the flare)
+    std::vector<float> xyz; // 4 floats per pixel: X, Y, Z in cd/m^2, then the illuminance on the
+                            // panel in lux (what pass 2 takes the flare from)
     std::vector<std::uint8_t> rgba; // 8-bit display counts, 4 per pixel
     display::GamutCounters gamut;   // pixels out of the display's gamut, by class (every frame)
     // The GL framebuffer that holds the display counts (RGBA8, bottom-up) in the renderer's

@@ -3,7 +3,6 @@
 #include <filesystem>
 
 #include <fmt/format.h>
-#include <glm/geometric.hpp>
 
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/booth/lamp_kinds.h>
@@ -28,8 +27,8 @@ Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir)
     }
     booth::Booth b = std::move(*model);
     b.id = "replica-booth-1";
-    // One geometry for the whole appliance: the flat renderer and pass 2 light the surface from
-    // the first light's ceiling, the booth renderer from every light's own.
+    // One geometry for the whole appliance: the lamps share one emitter (the booth model's
+    // ceiling), each drawn from its own light.
     const booth::BoothLight& first = b.ceiling();
     for (const auto& l : b.lights) {
         if (l.centre != first.centre || l.edgeU != first.edgeU || l.edgeV != first.edgeV) {
@@ -67,31 +66,6 @@ Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir)
         light.referenceSpectrum = *s;
     }
     return b;
-}
-
-std::vector<booth::PointLight>
-uniformGridLights(const booth::BoothLight& ceiling, double luminanceCdM2, int nu, int nv)
-{
-    std::vector<booth::PointLight> lights;
-    if (nu <= 0 || nv <= 0) {
-        return lights;
-    }
-    const double cellArea = glm::length(ceiling.edgeU) * glm::length(ceiling.edgeV) / (nu * nv);
-    for (int j = 0; j < nv; ++j) {
-        for (int i = 0; i < nu; ++i) {
-            const double u = (i + 0.5) / nu - 0.5;
-            const double v = (j + 0.5) / nv - 0.5;
-            booth::PointLight l;
-            l.position = ceiling.centre + u * ceiling.edgeU + v * ceiling.edgeV;
-            l.intensityCd = luminanceCdM2 * cellArea;
-            l.regionU = ceiling.edgeU / static_cast<double>(nu);
-            l.regionV = ceiling.edgeV / static_cast<double>(nv);
-            l.regionOrigin = l.position - 0.5 * l.regionU - 0.5 * l.regionV;
-            l.meanCdM2 = luminanceCdM2;
-            lights.push_back(l);
-        }
-    }
-    return lights;
 }
 
 } // namespace replica::pipeline::scene

@@ -1,5 +1,4 @@
-// The appliance's booth (booth::Booth with its lamps' reference spectra and nominal luminances)
-// and its simplest point-light decomposition.
+// The appliance's booth (booth::Booth with its lamps' reference spectra and nominal luminances).
 #pragma once
 
 #include <string>
@@ -17,14 +16,8 @@ namespace replica::pipeline::scene {
 // simulator CIE F8, D65 fluorescent simulator CIE F7, read from dataDir/spectra) and nominal
 // luminance. Booth frame: right-handed, metres; origin on the booth floor at its centre, x to the
 // right, y up, z out of the booth towards the viewer. Fails, naming booth.json, when a light is
-// not a lamp this build knows or when the lights do not share one ceiling (the flat renderer and
-// pass 2 light the surface from booth::Booth::ceiling()).
+// not a lamp this build knows or when the lights do not share one ceiling (the appliance's booth
+// has one emitter, booth::Booth::ceiling(), whichever lamp it shows).
 Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir);
-
-// Splits a uniform emitter (the rectangle of 'ceiling', its luminance image ignored) into nu x nv
-// equal cells, one point light at each cell centre (its intensity L times the cell's area; the
-// cell is its region rectangle, of luminance L).
-std::vector<booth::PointLight>
-uniformGridLights(const booth::BoothLight& ceiling, double luminanceCdM2, int nu, int nv);
 
 } // namespace replica::pipeline::scene

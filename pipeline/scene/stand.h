@@ -16,7 +16,7 @@ struct StandModel {
 };
 
 // The panel's active area in the booth frame (the one panel pose: the CPU model's View, the booth
-// pass, pass 2 and the flat renderer all take it): its centre, unit axes and size.
+// pass and pass 2 all take it): its centre, unit axes and size.
 struct PanelPose {
     glm::dvec3 centre{0.0};           // centre of the active area
     glm::dvec3 right{1.0, 0.0, 0.0};  // unit, along the panel's x

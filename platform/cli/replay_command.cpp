@@ -288,6 +288,7 @@ nlohmann::json baseSummary(const ReplayOptions& o,
             {"format_version", loaded.recording.formatVersion},
             {"recorded_by", loaded.recording.session.softwareVersion},
             {"render_profile", loaded.config.renderProfile},
+            {"recorded_renderer", loaded.config.drawnByFlatRenderer ? "flat" : "booth"},
             {"clock", o.clock},
             {"renderer", appliance.renderer->description()},
             {"gl_renderer", appliance.output->glRenderer()},
@@ -371,8 +372,9 @@ int runReplay(const ReplayOptions& o,
     };
     nlohmann::json summary = baseSummary(o, loaded, appliance, slice, *stats, outputs, wallS);
     if (!exact) {
-        summary["older_recording"] = olderRecordingLine(
-                o.file, loaded.recording.session.softwareVersion, loaded.config.renderProfile);
+        summary["older_recording"] =
+                olderRecordingLine(o.file, loaded.recording.session.softwareVersion,
+                                   loaded.config.renderProfile, loaded.config.drawnByFlatRenderer);
     }
     if (loaded.reprocessed) {
         reportReprocess(*loaded.reprocessed, summary, say);
@@ -423,11 +425,13 @@ int replayMain(const ReplayOptions& o)
     LoadedReplay& loaded = std::get<LoadedReplay>(loadedOr);
     const recordings::Recording& recording = loaded.recording;
     RunConfig& config = loaded.config;
-    const bool exact = pipeline::render::rendersExactly(config.renderProfile);
+    // This build draws with the booth pass, today's profile: a recording of another profile or
+    // drawn by the flat renderer is bit for bit the build that made it's promise.
+    const bool exact =
+            pipeline::render::rendersExactly(config.renderProfile) && !config.drawnByFlatRenderer;
     if (!exact && !o.json) {
-        // Bit for bit is the build that made it's promise; this build renders today's path.
         fmt::print("{}\n", olderRecordingLine(o.file, recording.session.softwareVersion,
-                                              config.renderProfile));
+                                              config.renderProfile, config.drawnByFlatRenderer));
     }
     auto appliance = buildReplayAppliance(o, config);
     if (!appliance) {

@@ -94,9 +94,19 @@ nlohmann::json ShownComparison::json() const
             {"worst", worstFrames}};
 }
 
-std::string
-olderRecordingLine(const std::string& file, const std::string& madeBy, int recordedProfile)
+std::string olderRecordingLine(const std::string& file,
+                               const std::string& madeBy,
+                               int recordedProfile,
+                               bool drawnByFlatRenderer)
 {
+    if (drawnByFlatRenderer) {
+        return fmt::format("{}: made by {} and drawn by the flat renderer (render profile {}); "
+                           "this build has no flat renderer and draws it with the booth pass "
+                           "(profile {}); bit-exact replay needs that build: comparing with what "
+                           "was shown instead",
+                           printable(file, 512), printable(madeBy, 200), recordedProfile,
+                           pipeline::render::kRenderProfile);
+    }
     return fmt::format("{}: made by {} (render profile {}; this build renders profile {}); "
                        "bit-exact replay needs that build: comparing with what was shown instead",
                        printable(file, 512), printable(madeBy, 200), recordedProfile,

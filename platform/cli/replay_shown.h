@@ -1,7 +1,8 @@
 // An older recording on this build: the replayed frames against what the recording holds of what
 // the panel showed (its thumbnails, and its display digests where they match), colorimetrically.
-// A recording made with an older render profile (pipeline/render/render_profile.h) replays on
-// today's render path; bit-exact replay of it is the build that made it's to promise.
+// A recording made with an older render profile (pipeline/render/render_profile.h), or drawn by
+// the flat renderer this build no longer has, replays on today's render path; bit-exact replay of
+// it is the build that made it's to promise.
 #pragma once
 
 #include <cstdint>
@@ -72,9 +73,12 @@ private:
     std::vector<ShownFrameDeltaE> measured_;
 };
 
-// The one line an older recording's replay starts with: who made it and what bit-exact replay
-// needs.
-std::string
-olderRecordingLine(const std::string& file, const std::string& madeBy, int recordedProfile);
+// The one line an older recording's replay starts with: who made it, with which render profile
+// (and that the flat renderer drew it, when it did: this build draws it with the booth pass), and
+// what bit-exact replay needs.
+std::string olderRecordingLine(const std::string& file,
+                               const std::string& madeBy,
+                               int recordedProfile,
+                               bool drawnByFlatRenderer);
 
 } // namespace replica::platform

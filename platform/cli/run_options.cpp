@@ -183,14 +183,13 @@ void addRenderOptions(CLI::App& cmd, RunOptions& o)
                    "surface scene folder (scene.json + EXRs); default: the shipped ColorChecker, "
                    "data/scenes/colorchecker");
     cmd.add_option("--renderer", o.renderer,
-                   "booth (the scene lit by the booth model) or flat (the first recordings' patch "
-                   "renderer)")
-            ->check(CLI::IsMember({"booth", "flat"}))
+                   "booth (the scene lit by the booth model; the one renderer, so the option can "
+                   "be left out)")
             ->capture_default_str();
     cmd.add_option("--basis", o.basis,
                    "channel basis: adaptive_k6 (re-encoded for each light, exact for the light "
-                   "present; the default, booth renderer only), replica_k6 (fixed; the flat "
-                   "renderer's default), general_k6, pca6, box6 (docs/accuracy.md)")
+                   "present; the default), replica_k6, general_k6, pca6, box6 (fixed; "
+                   "docs/accuracy.md)")
             ->check(CLI::IsMember(pipeline::spectral::channelBasisNames()));
     cmd.add_flag("--fast", o.fast,
                  "do not wait for each tick's wall-clock time (same frames, rendered as fast as "

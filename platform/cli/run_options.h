@@ -38,7 +38,7 @@ struct RunOptions {
     bool fast = false;
     std::string scene;
     std::string renderer = "booth";
-    std::string basis; // empty: adaptive_k6 for the booth renderer, replica_k6 for the flat one
+    std::string basis; // empty: adaptive_k6
     std::string displayProfile;
     bool uncalibrated = false;
     std::string displayInverse = "analytic";

@@ -243,15 +243,11 @@ Resolved<void> siteGeometry(const RunOptions& o, RunConfig& config)
     return {};
 }
 
-// The run's rendering choices: renderer, basis, display inverse, planner, warm-up.
+// The run's rendering choices: basis, display inverse, planner, warm-up.
 void renderChoices(const RunOptions& o, RunConfig& config)
 {
     config.rateHz = o.rateHz;
-    config.renderer = o.renderer;
-    // The flat renderer has no 36-band scene to re-encode: it keeps the best fixed basis.
-    config.basis = !o.basis.empty() ? o.basis
-                                    : (o.renderer == "flat" ? std::string("replica_k6")
-                                                            : std::string(kAdaptiveBasis));
+    config.basis = !o.basis.empty() ? o.basis : std::string(kAdaptiveBasis);
     config.displayInverse = o.displayInverse;
     config.gamutMapping = o.gamut;
     config.viewingCompensation = !o.noViewing;
@@ -311,6 +307,16 @@ runConfigFromOptions(const RunOptions& o, std::pair<int, int> size, RunConfig& c
         }
         config.stand.panelWidthM = panel->width / 1000.0;
         config.stand.panelHeightM = panel->height / 1000.0;
+    }
+    if (o.renderer != "booth") {
+        // One renderer: the flat one's recordings replay on it (replica replay), and no new run
+        // draws with it.
+        return tl::unexpected(
+                refuse(o, "--renderer", "scene.renderer", o.renderer,
+                       o.renderer == "flat" ? "the flat renderer was removed; the booth pass draws "
+                                              "every scene (give booth or leave it out); its "
+                                              "recordings still replay"
+                                            : "expected booth, the one renderer"));
     }
     renderChoices(o, config);
     if (auto ok = sceneAndDisplay(o, config); !ok) {
@@ -382,11 +388,9 @@ Resolved<void> checkLoadable(const RunOptions& o, const RunConfig& config)
                                          what, kExitFailure));
         }
     }
-    if (config.renderer == "booth") {
-        if (auto scene = pipeline::surface::loadScene(resolveSceneDir(config.sceneDir)); !scene) {
-            return tl::unexpected(refuse(o, "--scene", "scene.dir", config.sceneDir,
-                                         scene.error().message, kExitFailure));
-        }
+    if (auto scene = pipeline::surface::loadScene(resolveSceneDir(config.sceneDir)); !scene) {
+        return tl::unexpected(refuse(o, "--scene", "scene.dir", config.sceneDir,
+                                     scene.error().message, kExitFailure));
     }
     if (auto axes = hal::accel::parseAxisMapping(o.live.accelAxes); !axes) {
         return tl::unexpected(refuse(o, "--accel-axes", "devices.accel_axes", o.live.accelAxes,

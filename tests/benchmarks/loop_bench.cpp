@@ -1,8 +1,8 @@
 // Per-frame costs of the appliance loop at 960x600: the booth renderer as 'replica run' builds it
 // (both passes) for each shipped scene, with the eye moving and the tilt still (pass 1 draws from
-// its cache) and with the tilt moving every frame (pass 1 recomputes); the flat renderer of the
-// first recordings with each readback choice; hashing a frame for its digest; a booth lamp change
-// with a fixed and the adaptive basis. Prints figures; never fails on timing.
+// its cache) and with the tilt moving every frame (pass 1 recomputes); hashing a frame for its
+// digest; a booth lamp change with a fixed and the adaptive basis. Prints figures; never fails on
+// timing.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,11 +13,9 @@
 
 #include <benchmark/benchmark.h>
 #include <state/tilt_estimator.h>
-#include <tests/benchmarks/flat_renderer_setup.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/booth/booth_model.h>
-#include <pipeline/display/nominal_display.h>
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/render/gles_renderer.h>
 #include <pipeline/spectral/adaptive_encoding.h>
@@ -170,57 +168,15 @@ void BM_ApplianceLampChange(benchmark::State& st)
 }
 BENCHMARK(BM_ApplianceLampChange)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-struct FlatFixture {
-    std::unique_ptr<platform::Output> output;
-    std::unique_ptr<pipeline::render::Renderer> renderer;
-    pipeline::scene::SceneState state;
-};
-
-FlatFixture* flatFixture()
+// A headless GL context for the benchmarks that draw without an appliance; null without EGL.
+platform::Output* glContext()
 {
-    static FlatFixture* f = [] {
-        auto* fx = new FlatFixture;
-        auto out = platform::createHeadlessOutput();
-        if (!out) {
-            return fx;
-        }
-        fx->output = std::move(*out);
-        pipeline::render::GlesRendererSetup s = bench::flatColorCheckerSetup();
-        s.display.model = pipeline::display::nominalDisplayModel("srgb-like-800", 800.0, 0.4);
-        fx->state = bench::flatState(s);
-        auto r = pipeline::render::createGlesRenderer(std::move(s));
-        if (r) {
-            fx->renderer = std::move(*r);
-        }
-        return fx;
+    static std::unique_ptr<platform::Output> out = [] {
+        auto o = platform::createHeadlessOutput();
+        return o ? std::move(*o) : std::unique_ptr<platform::Output>{};
     }();
-    return f;
+    return out.get();
 }
-
-// The flat patch renderer (recordings made before the booth renderer), by readback choice.
-void BM_FlatRenderFrame(benchmark::State& st)
-{
-    auto* fx = flatFixture();
-    if (!fx->renderer) {
-        st.SkipWithError("no EGL/GLES context");
-        return;
-    }
-    const auto readback = static_cast<pipeline::render::Readback>(st.range(0));
-    pipeline::render::RenderedFrame frame;
-    for (auto _ : st) {
-        fx->state.tiltRad += 1e-4; // a new frame each time
-        auto ok = fx->renderer->render(fx->state, frame, readback);
-        benchmark::DoNotOptimize(ok);
-    }
-    st.counters["fps"] =
-            benchmark::Counter(static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
-}
-BENCHMARK(BM_FlatRenderFrame)
-        ->Arg(static_cast<int>(pipeline::render::Readback::None))
-        ->Arg(static_cast<int>(pipeline::render::Readback::Display))
-        ->Arg(static_cast<int>(pipeline::render::Readback::DisplayAndXyz))
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
 
 // One frame's digests at 960x600: the RGBA32F XYZ frame (9.2 MB) and the 8-bit display frame
 // (2.3 MB), as 'replica run --digests' hashes them. Arg 1: FNV-1a (digest format 1), 2: XXH3-64
@@ -257,8 +213,7 @@ BENCHMARK(BM_DigestFrame)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond)
 void BM_BoothLampChange(benchmark::State& st)
 {
     namespace pr = pipeline::render;
-    auto* fx = flatFixture(); // the GL context
-    if (!fx->output) {
+    if (glContext() == nullptr) {
         st.SkipWithError("no EGL/GLES context");
         return;
     }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # An older recording on this build (docs/recordings.md, "Older recordings"): a recording of an older
-# render profile replays, says in one line who made it and that bit-exact replay needs that build,
+# render profile, or one the flat renderer drew, replays, says in one line who made it (and that the
+# flat renderer drew it) and that bit-exact replay needs that build,
 # and compares its frames with the thumbnails of what was shown within the stated ΔE00 (exit 0);
 # a tampered thumbnail or an altered recording is outside it (exit 1); a newer render profile or
 # recording format is refused in one line.
@@ -49,6 +50,29 @@ assert c["result"] == "within_tolerance" and c["measured"] == 7, c
 assert all(w["max"] == 0.0 for w in c["worst"]), c  # the very frames it showed
 assert s["render_profile"] == 1 and s["exit_code"] == 0, s
 assert "bit-exact replay needs that build" in s["older_recording"], s
+PY
+
+# Relabelled as drawn by the flat renderer (renderer "flat", this build's profile: what a run with
+# --renderer flat recorded before that renderer was removed): this build draws it with the booth
+# pass, says so in one line, and compares with what was shown (here the very frames, ΔE00 0).
+alter "$work/flat.mcap" --config renderer='"flat"' --config render_profile=2 --config area_lights=0
+replay "$work/flat.mcap" "$work/flat.out"
+cat "$work/flat.out"
+[ "$rc" -eq 0 ] || fail "a flat renderer's recording exits $rc"
+[ "$(grep -c 'bit-exact replay needs' "$work/flat.out")" -eq 1 ] || fail "the flat note is not one line"
+grep -q "made by replica .* and drawn by the flat renderer (render profile 2); this build has no flat renderer and draws it with the booth pass (profile 2); bit-exact replay needs that build" "$work/flat.out" ||
+    fail "no line saying the flat renderer drew it and the booth pass draws it now"
+grep -Eq "shown: 7 thumbnails .* p95 within the tolerance 2.00; worst frame" "$work/flat.out" ||
+    fail "the flat renderer's recording is not compared with what was shown"
+"$replica" --log-level warn replay "$work/flat.mcap" --no-progress --json >"$work/flat.json"
+python3 - "$work/flat.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+c = s["shown_check"]
+assert s["recorded_renderer"] == "flat" and s["exit_code"] == 0, s
+assert c["result"] == "within_tolerance" and c["measured"] == 7, c
+assert all(w["max"] == 0.0 for w in c["worst"]), c  # the booth pass drew what it showed
+assert "drawn by the flat renderer" in s["older_recording"], s
 PY
 
 # A tampered thumbnail: that frame is far from what the recording says was shown.

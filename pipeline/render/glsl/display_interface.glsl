@@ -1,6 +1,6 @@
 // The display pass (pass 2): XYZ (cd/m^2) in, panel counts and each pixel's gamut class out.
 // What every piece after this file reads: the pass-1 frame, the DISP_* switches compiled in
-// (DisplayPass::init), the pose, eye and lights of the frame. Compiled after "#version 310 es" and
+// (DisplayPass::init), the pose and eye of the frame. Compiled after "#version 310 es" and
 // the DISP_* defines; the pieces follow in the order pipeline/CMakeLists.txt lists them.
 
 precision highp float;
@@ -22,8 +22,4 @@ uniform vec3 uDispPanelOrigin;
 uniform vec3 uDispPanelRight;
 uniform vec3 uDispPanelUp;
 uniform vec3 uDispPanelNormal;
-uniform int uDispLightCount;
-uniform vec4 uDispLights[256];  // xyz: position (m); w: intensity (cd)
-uniform vec3 uDispLightNormal;
 uniform vec3 uDispFlarePerLux;  // rho_d / pi times the light's XYZ with Y = 1; 0 when off
-uniform int uDispIlluminanceInAlpha; // 1: E (lux) is the XYZ texel's alpha (pass 1 wrote it)

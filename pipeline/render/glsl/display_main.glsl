@@ -1,6 +1,7 @@
 // The display pass's main: flare subtracted (the panel's front-surface reflection of the
-// booth light, display/display_model.cpp: frontSurfaceFlareXyz), the viewing-angle gain divided
-// out, inverted to counts, dithered; false colour marks the out-of-gamut pixels when asked.
+// booth light, display/display_model.cpp: frontSurfaceFlareXyz, from the illuminance on the panel
+// that pass 1 wrote into the texel's alpha), the viewing-angle gain divided out, inverted to
+// counts, dithered; false colour marks the out-of-gamut pixels when asked.
 // Flare first (the reflection reaches the eye whatever the panel emits), then the viewing-angle
 // gain (it scales only what the panel emits): eye = gain * emitted + flare.
 
@@ -11,19 +12,7 @@ void main() {
     vec4 texel = texelFetch(uXyz, px, 0);
     vec3 xyz = texel.xyz;
     vec3 p = uDispPanelOrigin + vUv.x * uDispPanelRight + vUv.y * uDispPanelUp;
-    if (uDispIlluminanceInAlpha != 0) {
-        xyz -= texel.w * uDispFlarePerLux;
-    } else if (any(notEqual(uDispFlarePerLux, vec3(0.0)))) {
-        float e = 0.0;
-        for (int i = 0; i < uDispLightCount; ++i) {
-            vec3 d = uDispLights[i].xyz - p;
-            float d2 = max(dot(d, d), 1e-6);
-            vec3 dir = d * inversesqrt(d2);
-            e += uDispLights[i].w * max(dot(uDispPanelNormal, dir), 0.0)
-                 * max(dot(uDispLightNormal, -dir), 0.0) / d2;
-        }
-        xyz -= e * uDispFlarePerLux;
-    }
+    xyz -= texel.w * uDispFlarePerLux; // E (lux) from pass 1, the texel's alpha
     if (uDispViewingOn != 0) {
         vec3 toEye = uDispEye - p;
         float len = length(toEye);

@@ -165,5 +165,35 @@ TEST(RunResolve, WhatTheKioskWouldRefuseIsTheSiteFilesProblemWithItsLineAndKey)
             << cli.error().lines.front();
 }
 
+// One renderer: "flat" is refused by name with a line that says so, from the site file (exit 78,
+// its line and key) and from the command line (exit 2, usage); "booth" is what a run draws with.
+TEST(RunResolve, TheFlatRendererIsRefusedWithOneLineThatSaysItWasRemoved)
+{
+    const std::string good = "[run]\nhal = \"sim\"\n[display]\noutput = \"headless\"\n";
+    ASSERT_TRUE(resolveKiosk(good + "[scene]\nrenderer = \"booth\"\n"));
+    ASSERT_TRUE(resolveKiosk(good, {"--renderer", "booth"}));
+    const std::string text = good + "[scene]\nrenderer = \"flat\"\n";
+    auto site = resolveKiosk(text);
+    ASSERT_FALSE(site);
+    EXPECT_EQ(site.error().code, kExitConfig);
+    EXPECT_EQ(site.error().problem.key, "scene.renderer");
+    EXPECT_EQ(site.error().problem.line, 6);
+    ASSERT_EQ(site.error().lines.size(), 1u);
+    EXPECT_NE(site.error().lines.front().find(":6: scene.renderer: \"flat\": the flat renderer "
+                                              "was removed"),
+              std::string::npos)
+            << site.error().lines.front();
+    auto cli = resolveKiosk(good, {"--renderer", "flat"});
+    ASSERT_FALSE(cli);
+    EXPECT_EQ(cli.error().code, kExitUsage);
+    ASSERT_EQ(cli.error().lines.size(), 1u);
+    EXPECT_EQ(cli.error().lines.front().rfind("--renderer flat: the flat renderer was removed", 0),
+              0u)
+            << cli.error().lines.front();
+    auto other = resolveKiosk(good, {"--renderer", "ray"});
+    ASSERT_FALSE(other);
+    EXPECT_EQ(other.error().code, kExitUsage);
+}
+
 } // namespace
 } // namespace replica::tests

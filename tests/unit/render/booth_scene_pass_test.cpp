@@ -105,7 +105,7 @@ TEST_F(BoothScenePassTest, UnknownLightIsTheSensedSpectrumOnAUniformEmitter)
     EXPECT_DOUBLE_EQ(e.luminance.max(), 1000.0);
 }
 
-TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested)
+TEST(ApplianceConfig, TheFlatRenderersRecordingsAreMarkedAndScenesAreDigested)
 {
     platform::RunConfig c;
     std::string json = c.toJson();
@@ -116,7 +116,8 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
     }
     auto parsed = platform::RunConfig::fromJson(json);
     ASSERT_TRUE(parsed);
-    EXPECT_EQ(parsed->renderer, "booth");
+    EXPECT_FALSE(parsed->drawnByFlatRenderer);
+    EXPECT_EQ(json.find("lights_u"), std::string::npos); // the flat renderer's grid: gone
     const std::string old =
             R"({"width":160,"height":100,"rate_hz":60.0,"booth":"replica-booth-1",)"
             R"("scene":"colorchecker","basis":"box6","lights_u":8,"lights_v":4,)"
@@ -124,7 +125,25 @@ TEST(ApplianceConfig, OldRecordingsReplayWithTheFlatRendererAndScenesAreDigested
             R"("display_black_cd_m2":0.4})";
     auto o = platform::RunConfig::fromJson(old);
     ASSERT_TRUE(o) << o.error().message;
-    EXPECT_EQ(o->renderer, "flat"); // what it shows: the flat patch image
+    // The flat renderer drew it: replay draws the shipped ColorChecker with the booth pass.
+    EXPECT_TRUE(o->drawnByFlatRenderer);
+    EXPECT_EQ(o->sceneDir, "scenes/colorchecker");
+    // So does a recording that names it, whatever scene it names (the flat renderer drew its own
+    // ColorChecker patches); another renderer's name is refused.
+    auto named = nlohmann::json::parse(json);
+    named["renderer"] = "flat";
+    named["scene_dir"] = "scenes/painting";
+    auto flat = platform::RunConfig::fromJson(named.dump());
+    ASSERT_TRUE(flat) << flat.error().message;
+    EXPECT_TRUE(flat->drawnByFlatRenderer);
+    EXPECT_EQ(flat->sceneDir, "scenes/colorchecker");
+    EXPECT_TRUE(flat->sceneDigest.empty());
+    named["renderer"] = "ray";
+    auto unknown = platform::RunConfig::fromJson(named.dump());
+    ASSERT_FALSE(unknown);
+    EXPECT_NE(unknown.error().message.find("renderer 'ray' is not 'booth' or 'flat'"),
+              std::string::npos)
+            << unknown.error().message;
     // Every other absent key is today's default: this build has one render path, and the
     // recording's render profile (0: none recorded) says its frames are approximate here.
     const platform::RunConfig today;

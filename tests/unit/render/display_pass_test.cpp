@@ -1,5 +1,6 @@
 // The GPU display pass against the CPU display model, with the shipped profile: flare subtraction
 // and viewing-angle compensation per pixel, both inverse methods, and the per-frame gamut counts.
+// Pass 1's frame is made here as the booth pass leaves it: XYZ, the illuminance in alpha.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -9,11 +10,13 @@
 #include <glm/geometric.hpp>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/colour/channel_basis.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/render/display_pass.h>
 #include <pipeline/render/gl_program.h>
-#include <pipeline/render/gles_renderer.h>
+#include <pipeline/render/renderer.h>
+#include <pipeline/scene/booth.h>
 
 #include <gtest/gtest.h>
 
@@ -21,6 +24,9 @@
 
 namespace replica::pipeline::render {
 namespace {
+
+constexpr int kPassW = 64;
+constexpr int kPassH = 40;
 
 class DisplayPassTest : public tests::HeadlessGlTest
 {
@@ -34,57 +40,107 @@ protected:
         auto profile = display::loadProfile(dataDir() / "displays" / "wide-ips-synthetic.json");
         ASSERT_TRUE(profile) << profile.error().message;
         profile_ = *profile;
+        auto booth = scene::loadDefaultBooth(dataDir().string());
+        auto observer = colour::loadCie1931(dataDir());
+        ASSERT_TRUE(booth && observer) << "shipped booth and observer";
+        light_ = booth->lights[0].referenceSpectrum;
+        observer_ = *observer;
     }
 
-    std::unique_ptr<Renderer> make(InverseMethod method, double reflectance)
+    // The illuminance on the panel (lux) at pixel (x, y): rising across the panel, at a level
+    // where the grey below is well inside the profile's gamut.
+    double illuminance(int x, int y) const
     {
-        GlesRendererSetup s = tests::flatRendererSetup();
-        // Left half grey, right half a saturated red (out of gamut at the booth's light level).
-        s.surface.width = 2;
-        s.surface.height = 1;
-        s.surface.coeffs = {static_cast<float>(reflectance),
-                            static_cast<float>(reflectance),
-                            static_cast<float>(reflectance),
-                            static_cast<float>(reflectance),
-                            static_cast<float>(reflectance),
-                            static_cast<float>(reflectance),
-                            0.0f,
-                            0.0f,
-                            0.0f,
-                            0.02f,
-                            0.6f,
-                            0.9f};
-        s.display.model = profile_;
-        s.display.method = method;
-        setup_ = s;
-        auto r = createGlesRenderer(s);
-        EXPECT_TRUE(r) << r.error().message;
-        return r ? std::move(*r) : nullptr;
+        const double u = (x + 0.5) / kPassW;
+        const double v = (y + 0.5) / kPassH;
+        return 0.5 * std::numbers::pi * profile_.whiteXyz().y * (1.0 + 0.5 * u + 0.3 * v);
     }
 
-    scene::SceneState state() const
+    // Pass 1's frame as the booth pass leaves it: XYZ (cd/m^2) with the illuminance on the panel
+    // in alpha. Left half a grey of 'reflectance', right half a saturated red (out of gamut at the
+    // booth's light level), both in the box basis under the booth's first lamp (paper eq. 2).
+    std::vector<float> pass1(double reflectance) const
     {
-        scene::SceneState st;
-        st.illuminant = setup_.booth.lights[0].referenceSpectrum;
-        st.emitterLuminanceCdM2 = 2000.0;
-        st.tiltRad = 0.3;
-        st.eyeBoothM = {0.25, 0.55, 0.35}; // off to one side and close: angles up to ~40 deg
-        return st;
+        const colour::ChannelToXyz m = colour::channelToXyz(colour::boxBasis(), observer_, light_);
+        const std::array<double, colour::kChannels> grey{reflectance, reflectance, reflectance,
+                                                         reflectance, reflectance, reflectance};
+        const std::array<double, colour::kChannels> red{0.0, 0.0, 0.0, 0.02, 0.6, 0.9};
+        std::vector<float> px;
+        for (int y = 0; y < kPassH; ++y) {
+            for (int x = 0; x < kPassW; ++x) {
+                const double e = illuminance(x, y);
+                const auto& c = x < kPassW / 2 ? grey : red;
+                glm::dvec3 xyz(0.0);
+                for (std::size_t k = 0; k < colour::kChannels; ++k) {
+                    xyz += c[k] * m[k];
+                }
+                xyz *= e / std::numbers::pi;
+                px.insert(px.end(), {static_cast<float>(xyz.x), static_cast<float>(xyz.y),
+                                     static_cast<float>(xyz.z), static_cast<float>(e)});
+            }
+        }
+        return px;
     }
 
-    // What the pass should drive, from the CPU model: (XYZ - flare) / viewing gain, inverted.
+    // Pass 2 of pass1(reflectance) with the display set-up 'setup_' (the profile, 'method'):
+    // the XYZ it read and the counts it drove.
+    RenderedFrame draw(InverseMethod method, double reflectance)
+    {
+        RenderedFrame f;
+        f.width = kPassW;
+        f.height = kPassH;
+        f.xyz = pass1(reflectance);
+        GLuint tex = 0;
+        glGenTextures(1, &tex);
+        glBindTexture(GL_TEXTURE_2D, tex);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, kPassW, kPassH);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, kPassW, kPassH, GL_RGBA, GL_FLOAT, f.xyz.data());
+        DisplayPassSetup setup = setup_;
+        setup.model = profile_;
+        setup.method = method;
+        DisplayPass pass;
+        auto ok = pass.init(setup, kPassW, kPassH);
+        EXPECT_TRUE(ok) << (ok ? "" : ok.error().message);
+        if (ok) {
+            auto counts = pass.draw(tex, frame());
+            EXPECT_TRUE(counts);
+            f.gamut = counts ? *counts : display::GamutCounters{};
+            f.rgba.assign(static_cast<std::size_t>(kPassW * kPassH * 4), 0);
+            glBindFramebuffer(GL_FRAMEBUFFER, pass.framebuffer());
+            glReadBuffer(GL_COLOR_ATTACHMENT0);
+            glPixelStorei(GL_PACK_ALIGNMENT, 1);
+            glReadPixels(0, 0, kPassW, kPassH, GL_RGBA, GL_UNSIGNED_BYTE, f.rgba.data());
+        }
+        glDeleteTextures(1, &tex);
+        return f;
+    }
+
+    // The panel tilted 0.3 rad, the eye off to one side and close: angles up to ~40 deg.
+    DisplayPassFrame frame() const
+    {
+        DisplayPassFrame df;
+        df.pose = scene::panelPose(scene::StandModel{}, 0.3);
+        df.eyeM = {0.25, 0.55, 0.35};
+        const colour::Xyz light = colour::spectrumToXyz(observer_, light_);
+        df.lightXyzUnitY = light / light.y;
+        return df;
+    }
+
+    // What the pass should drive, from the CPU model: (XYZ - flare) / viewing gain, inverted; the
+    // flare from the illuminance pass 1 left in alpha.
     display::InverseResult
     expected(const display::DisplayInverse& inv, const RenderedFrame& f, int x, int y) const
     {
-        const auto st = state();
-        const auto pose = scene::panelPose(setup_.stand, st.tiltRad);
+        const DisplayPassFrame df = frame();
+        const auto& pose = df.pose;
         const glm::dvec3 p = pose.cornerM() + (x + 0.5) / f.width * pose.rightEdgeM() +
                              (y + 0.5) / f.height * pose.upEdgeM();
-        const double e = tests::gridIlluminance(setup_.booth, st.emitterLuminanceCdM2,
-                                                setup_.lightsU, setup_.lightsV, pose, p);
-        const colour::Xyz light = colour::spectrumToXyz(setup_.observer, st.illuminant);
-        const glm::dvec3 flare = display::frontSurfaceFlareXyz(profile_, e, light / light.y);
-        const double angle = display::viewingAngleDeg(p, pose.normal, st.eyeBoothM);
+        const double e = f.xyz[(static_cast<std::size_t>(y) * static_cast<std::size_t>(f.width) +
+                                static_cast<std::size_t>(x)) *
+                                       4 +
+                               3];
+        const glm::dvec3 flare = display::frontSurfaceFlareXyz(profile_, e, df.lightXyzUnitY);
+        const double angle = display::viewingAngleDeg(p, pose.normal, df.eyeM);
         const glm::dvec3 gain = display::viewingGain(profile_.viewing, profile_.whiteXyz(), angle);
         const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(f.width) +
                                static_cast<std::size_t>(x)) *
@@ -123,15 +179,14 @@ protected:
     }
 
     display::DisplayModel profile_;
-    GlesRendererSetup setup_;
+    colour::Spectrum light_;
+    colour::Observer observer_;
+    DisplayPassSetup setup_; // what draw() passes on, with the profile and the method
 };
 
 TEST_F(DisplayPassTest, AnalyticPassMatchesTheCpuModelWithFlareAndViewingAngle)
 {
-    auto r = make(InverseMethod::Analytic, 0.35);
-    ASSERT_TRUE(r);
-    RenderedFrame f;
-    ASSERT_TRUE(r->render(state(), f));
+    const RenderedFrame f = draw(InverseMethod::Analytic, 0.35);
     auto inv = display::DisplayInverse::build(profile_);
     ASSERT_TRUE(inv);
     std::uint64_t cpuOut = 0;
@@ -164,10 +219,7 @@ TEST_F(DisplayPassTest, AnalyticPassAppliesTheProfilesGamutEdgeTolerance)
 {
     profile_.gamutEdgeTolerance = 0.4;
     profile_.gamutEdgeFloor = 0.05;
-    auto r = make(InverseMethod::Analytic, 0.35);
-    ASSERT_TRUE(r);
-    RenderedFrame f;
-    ASSERT_TRUE(r->render(state(), f));
+    const RenderedFrame f = draw(InverseMethod::Analytic, 0.35);
     auto inv = display::DisplayInverse::build(profile_);
     ASSERT_TRUE(inv);
     display::DisplayModel strict = profile_;
@@ -187,10 +239,7 @@ TEST_F(DisplayPassTest, AnalyticPassAppliesTheProfilesGamutEdgeTolerance)
 TEST_F(DisplayPassTest, AnalyticPassUndoesTheProfilesCrosstalk)
 {
     profile_.crosstalk = glm::dmat3(glm::dvec3(-0.05), glm::dvec3(-0.05), glm::dvec3(-0.05));
-    auto r = make(InverseMethod::Analytic, 0.35);
-    ASSERT_TRUE(r);
-    RenderedFrame f;
-    ASSERT_TRUE(r->render(state(), f));
+    const RenderedFrame f = draw(InverseMethod::Analytic, 0.35);
     auto inv = display::DisplayInverse::build(profile_);
     ASSERT_TRUE(inv);
     display::DisplayModel additive = profile_;
@@ -204,16 +253,10 @@ TEST_F(DisplayPassTest, AnalyticPassUndoesTheProfilesCrosstalk)
 
 TEST_F(DisplayPassTest, CompensationChangesWhatIsDrivenInTheRightDirection)
 {
-    auto r = make(InverseMethod::Analytic, 0.35);
-    ASSERT_TRUE(r);
-    RenderedFrame on;
-    ASSERT_TRUE(r->render(state(), on));
-    setup_.display.viewingCompensation = false;
-    setup_.display.flareSubtraction = false;
-    auto plain = createGlesRenderer(setup_);
-    ASSERT_TRUE(plain);
-    RenderedFrame off;
-    ASSERT_TRUE((*plain)->render(state(), off));
+    const RenderedFrame on = draw(InverseMethod::Analytic, 0.35);
+    setup_.viewingCompensation = false;
+    setup_.flareSubtraction = false;
+    const RenderedFrame off = draw(InverseMethod::Analytic, 0.35);
     // On the grey half: off axis the panel is dimmer, so compensation drives harder, even after
     // taking the reflection away.
     long sumOn = 0;
@@ -295,14 +338,8 @@ TEST_F(DisplayPassTest, FilteredViewingGainDrivesWhatTheTableRowsDo)
 
 TEST_F(DisplayPassTest, LutPassAgreesWithTheAnalyticPass)
 {
-    auto a = make(InverseMethod::Analytic, 0.2);
-    ASSERT_TRUE(a);
-    RenderedFrame fa;
-    ASSERT_TRUE(a->render(state(), fa));
-    auto l = make(InverseMethod::Lut3d, 0.2);
-    ASSERT_TRUE(l);
-    RenderedFrame fl;
-    ASSERT_TRUE(l->render(state(), fl));
+    const RenderedFrame fa = draw(InverseMethod::Analytic, 0.2);
+    const RenderedFrame fl = draw(InverseMethod::Lut3d, 0.2);
     int worst = 0;
     for (int y = 0; y < 40; ++y) {
         for (int x = 0; x < 30; ++x) { // the in-gamut grey half

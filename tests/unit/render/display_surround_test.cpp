@@ -83,7 +83,6 @@ protected:
         f.pose = scene::panelPose(scene::StandModel{}, 0.3);
         f.eyeM = {0.2, 0.5, 0.4};
         f.lightXyzUnitY = {0.96, 1.0, 0.82};
-        f.illuminanceInAlpha = true;
         if (blackOutside) {
             f.blackOutside = kInside;
         }

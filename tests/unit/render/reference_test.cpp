@@ -115,8 +115,8 @@ TEST(PointLights, HotTexelEqualsThePointSourceFormula)
             shading::pointLightIrradiance(prepared.points, light.normal(), light.texelAreaM2(),
                                           {p, n, n, Vec3(1, 0, 0), Vec3(0, 0, -1)});
     EXPECT_NEAR(e, expected, 1e-9 * expected);
-    // The point light's intensity is L * a of the texel (the flat renderer's uniform grid gives
-    // the same field): the one whose region holds the hot texel carries at least it.
+    // The point light's intensity is L * a of the texel: the one whose region holds the hot texel
+    // carries at least it.
     double hottest = 0.0;
     for (const auto& l : prepared.points) {
         EXPECT_NEAR(l.intensityCd, l.sumCdM2 * light.texelAreaM2(), 1e-12 * l.intensityCd);

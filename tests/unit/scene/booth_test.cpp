@@ -1,5 +1,5 @@
 // The appliance's booth is the booth model (data/booth) with its lamps' reference spectra and
-// nominal luminances: one ceiling for the flat renderer, pass 2's flare and the booth renderer.
+// nominal luminances: one ceiling, the one emitter of every lamp.
 #include <filesystem>
 
 #include <glm/geometric.hpp>
@@ -66,32 +66,6 @@ TEST(DefaultBooth, IsTheBoothModelWithItsLampsInTheModelsOrder)
     EXPECT_DOUBLE_EQ(glm::length(c.edgeU), g.widthM);
     EXPECT_DOUBLE_EQ(glm::length(c.edgeV), g.depthM);
     EXPECT_DOUBLE_EQ(c.normal().y, -1.0);
-}
-
-TEST(DefaultBooth, TheUniformGridTilesTheCeilingWithItsPower)
-{
-    // 4 x 2 cells of a 1 x 0.5 m emitter at 2000 cd/m^2: each light L * a = 2000 * 0.0625 cd at
-    // its cell's centre; the cells' rectangles tile the emitter.
-    booth::BoothLight e;
-    e.centre = {0.0, 0.62, -0.05};
-    e.edgeU = {1.0, 0.0, 0.0};
-    e.edgeV = {0.0, 0.0, 0.5};
-    const auto lights = uniformGridLights(e, 2000.0, 4, 2);
-    ASSERT_EQ(lights.size(), 8u);
-    double power = 0.0;
-    for (const auto& l : lights) {
-        EXPECT_NEAR(l.intensityCd, 2000.0 * 1.0 * 0.5 / 8.0, 1e-12);
-        EXPECT_EQ(l.meanCdM2, 2000.0);
-        EXPECT_NEAR(glm::length(l.regionU), 0.25, 1e-15);
-        EXPECT_NEAR(glm::length(l.regionV), 0.25, 1e-15);
-        EXPECT_NEAR(glm::length(l.regionOrigin + 0.5 * (l.regionU + l.regionV) - l.position), 0.0,
-                    1e-15);
-        power += l.intensityCd;
-    }
-    EXPECT_NEAR(power, 2000.0 * 0.5, 1e-9);
-    // The first cell's centre: the emitter's corner plus half a cell along each edge.
-    EXPECT_NEAR(glm::length(lights[0].position - (e.centre + glm::dvec3(-0.375, 0.0, -0.125))), 0.0,
-                1e-15);
 }
 
 TEST(DefaultBooth, RefusesAModelWhoseLightsHaveTwoCeilings)

@@ -217,8 +217,8 @@ TEST_F(Spectral, ShippedPaperModelLoadsAndIsComparableToThePaper)
 }
 
 // The appliance renders new runs with the light-adaptive basis (docs/accuracy.md), a
-// representation of the catalogue; the fixed default (the flat renderer's, and what the adaptive
-// encoder starts from) is the shipped fitted basis, not the box bands.
+// representation of the catalogue; the fixed default (what the adaptive encoder starts from) is
+// the shipped fitted basis, not the box bands.
 TEST(DefaultBasis, ApplianceConfigNamesTheAdaptiveBasisAndTheFixedOneIsTheFittedFile)
 {
     const platform::RunConfig config;

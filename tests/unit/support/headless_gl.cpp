@@ -1,12 +1,6 @@
 #include "headless_gl.h"
 
-#include <algorithm>
-#include <cmath>
-
-#include <glm/geometric.hpp>
-
 #include <pipeline/base/data_dir.h>
-#include <pipeline/scene/booth.h>
 
 namespace replica::tests {
 
@@ -37,19 +31,19 @@ pipeline::render::BoothSceneSetup boothPassSetup(const std::string& scene)
     return setup;
 }
 
-pipeline::render::GlesRendererSetup flatRendererSetup()
+pipeline::render::GlesRendererSetup rendererSetup(const std::string& scene)
 {
     pipeline::render::GlesRendererSetup s;
     s.width = 64;
     s.height = 40;
-    auto booth = pipeline::scene::loadDefaultBooth(dataDir().string());
-    auto observer = pipeline::colour::loadCie1931(dataDir());
-    EXPECT_TRUE(booth && observer) << "shipped booth and observer";
-    if (booth && observer) {
-        s.booth = *booth;
-        s.observer = *observer;
+    const auto passSetup = boothPassSetup(scene);
+    s.stand = passSetup.stand;
+    s.observer = passSetup.observer;
+    auto pass = pipeline::render::BoothScenePass::create(passSetup);
+    EXPECT_TRUE(pass) << (pass ? "" : pass.error().message);
+    if (pass) {
+        s.boothScene = std::move(*pass);
     }
-    s.basis = pipeline::colour::boxBasis();
     return s;
 }
 
@@ -102,24 +96,6 @@ std::vector<pipeline::colour::Xyz> drawXyz(pipeline::render::BoothScenePass& pas
         }
     }
     return ::testing::AssertionSuccess();
-}
-
-double gridIlluminance(const pipeline::booth::Booth& booth,
-                       double cdM2,
-                       int nu,
-                       int nv,
-                       const pipeline::scene::PanelPose& pose,
-                       const glm::dvec3& p)
-{
-    double e = 0.0;
-    for (const auto& l : pipeline::scene::uniformGridLights(booth.ceiling(), cdM2, nu, nv)) {
-        const glm::dvec3 d = l.position - p;
-        const double d2 = glm::dot(d, d);
-        const glm::dvec3 dir = d / std::sqrt(d2);
-        e += l.intensityCd * std::max(glm::dot(pose.normal, dir), 0.0) *
-             std::max(glm::dot(booth.ceiling().normal(), -dir), 0.0) / d2;
-    }
-    return e;
 }
 
 } // namespace replica::tests

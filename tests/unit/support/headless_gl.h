@@ -33,9 +33,9 @@ protected:
 // observer, 16 lights; every other setting at its default.
 pipeline::render::BoothSceneSetup boothPassSetup(const std::string& scene);
 
-// The flat renderer's set-up at 64 x 40 pixels: the default booth, the box basis, the CIE 1931
-// observer; the surface and the display are the test's.
-pipeline::render::GlesRendererSetup flatRendererSetup();
+// The renderer's set-up at 64 x 40 pixels: pass 1 the booth pass of 'scene' (boothPassSetup,
+// created here: the context must be current), the CIE 1931 observer; the display is the test's.
+pipeline::render::GlesRendererSetup rendererSetup(const std::string& scene);
 
 // A short, small sim run that still draws the booth pass: 32x20 at 10 Hz, 8 lights, 2 specular
 // samples, 4 horizon directions.
@@ -54,15 +54,5 @@ std::vector<pipeline::colour::Xyz> drawXyz(pipeline::render::BoothScenePass& pas
 // message is thousands of numbers).
 ::testing::AssertionResult sameFloats(const std::vector<float>& got,
                                       const std::vector<float>& want);
-
-// Paper eq. (1) in double, for the flat renderer's uniform grid of nu x nv point lights on the
-// booth's ceiling at luminance 'cdM2': the illuminance (lux) at 'p' on the panel 'pose', both
-// cosines clamped at 0. The CPU reference the GLES renderer's tests check the GPU against.
-double gridIlluminance(const pipeline::booth::Booth& booth,
-                       double cdM2,
-                       int nu,
-                       int nv,
-                       const pipeline::scene::PanelPose& pose,
-                       const glm::dvec3& p);
 
 } // namespace replica::tests
