@@ -2,6 +2,7 @@
 // and its simplest point-light decomposition.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,12 @@ namespace replica::pipeline::scene {
 // not a lamp this build knows or when the lights do not share one ceiling (the flat renderer and
 // pass 2 light the surface from booth::Booth::ceiling()).
 Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir);
+
+// The same for the booth model in 'boothDir' (one 'replica booth build' made from a site's
+// captures): its lights must be named after lamps this build knows and share one ceiling, as
+// above; the reference spectra come from dataDir/spectra.
+Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
+                                          const std::string& dataDir);
 
 // Splits a uniform emitter (the rectangle of 'ceiling', its luminance image ignored) into nu x nv
 // equal cells, one point light at each cell centre (its intensity L times the cell's area; the
