@@ -98,7 +98,7 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
 {
     if (selector != nullptr && selector->sequence != lastSelector_) {
         lastSelector_ = selector->sequence;
-        // Forced direct-sensor mode: the switch is recorded, not shown.
+        // Forced direct-sensor mode: a turn of the switch is not shown (the recording keeps it).
         if (const auto lamp = setup_.forceDirect ? std::nullopt : arbiter_.onSelector(*selector)) {
             showLamp(*lamp); // a turn of the switch shows at once
         }
