@@ -246,7 +246,7 @@ Expected<void> applyRenderPlan(RunConfig& config, pipeline::render::BoothSceneSe
 {
     if (config.planner && config.plannedLamps.empty()) {
         auto plan = loadOrComputeRenderPlan(
-                resolveSceneDir(config.sceneDir), dataDir() / "booth", config.basis,
+                resolveSceneDir(config.sceneDir), resolveSceneDir(config.boothDir), config.basis,
                 config.plannerCache.empty() ? defaultPlanCacheDir()
                                             : std::filesystem::path(config.plannerCache),
                 config.planIfMissing);
@@ -428,10 +428,12 @@ Expected<Encoding> loadEncoding(const RunConfig& config, const std::string& dir)
 
 // The state stage (state/): the light, eye and tilt estimators, from the booth data and the
 // configuration alone (nothing of the renderer): the lamps and their spectra are the booth's.
-Expected<std::unique_ptr<state::SceneEstimator>> makeStateStage(const RunConfig& config,
-                                                                const pipeline::booth::Booth& booth,
-                                                                const Encoding& encoding,
-                                                                const std::string& dir)
+Expected<std::unique_ptr<state::SceneEstimator>>
+makeStateStage(const RunConfig& config,
+               const pipeline::booth::Booth& booth,
+               const Encoding& encoding,
+               const pipeline::colour::Observer& observer,
+               const std::string& dir)
 {
     auto calibration = pipeline::spectral::loadSpectrometerCalibration(
             std::filesystem::path(dir) / config.spectrometerCalibration);
@@ -443,6 +445,9 @@ Expected<std::unique_ptr<state::SceneEstimator>> makeStateStage(const RunConfig&
     setup.light.calibration = *calibration;
     setup.light.chain = config.sensing;
     setup.light.instrument = config.instrument;
+    setup.light.forceDirect = config.light == kLightDirect;
+    setup.light.directCdM2PerY = config.directCdM2PerY;
+    setup.light.observer = observer;
     // The re-encode decision and the diffuse term's sliced refresh are state.
     setup.light.adaptive = encoding.adaptive;
     setup.tilt.cacheSlices = config.cacheSlices;
@@ -516,7 +521,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     const std::string dir = dataDir().string();
     auto app = std::make_unique<Appliance>();
     app->displayProfileId = displayId;
-    auto booth = pipeline::scene::loadDefaultBooth(dir);
+    auto booth = loadRunBooth(config);
     if (!booth) {
         return tl::unexpected(booth.error());
     }
@@ -529,7 +534,7 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     if (!encoding) {
         return tl::unexpected(encoding.error());
     }
-    auto estimator = makeStateStage(config, app->booth, *encoding, dir);
+    auto estimator = makeStateStage(config, app->booth, *encoding, *observer, dir);
     if (!estimator) {
         return tl::unexpected(estimator.error());
     }

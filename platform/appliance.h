@@ -49,6 +49,16 @@ inline bool frameSizeOk(long long w, long long h)
            h <= kMaxFrameAspect * w;
 }
 
+// RunConfig::light: the classifier's booth lamp, the sensed spectrum where none matches (the
+// default), or always the sensed spectrum (the paper's mode 1, direct-sensor mode).
+constexpr const char* kLightAuto = "auto";
+constexpr const char* kLightDirect = "direct";
+// RunConfig::directCdM2PerY for new runs: the simulated spectrometer's calibration, so that its
+// reading of the shipped tungsten lamp renders at that lamp's nominal luminance (2200 cd/m^2;
+// checked by tests/unit/state/direct_sensor_test.cpp). A real instrument's is the site file's
+// [spectrometer] direct_cdm2_per_y.
+constexpr double kDefaultDirectCdM2PerY = 7.3451e-5;
+
 // Everything that decides what a frame looks like, apart from the samples. Recorded in the session
 // so that replay rebuilds the identical renderer.
 struct RunConfig {
@@ -64,7 +74,19 @@ struct RunConfig {
     bool drawnByFlatRenderer = false;
     std::string sceneDir = "scenes/colorchecker"; // relative paths are under the data folder
     std::string sceneDigest; // FNV-1a 64 of the scene's files; replay refuses a changed scene
-    int boothLights = 32;    // median-cut point lights
+    // The booth model's folder (booth.json and each light's luminance EXR, as 'replica booth
+    // build' writes it; relative paths are under the data folder) and the digest of its files
+    // (platform::boothDigest). Replay refuses a booth whose files have changed. Recordings made
+    // before have neither: the shipped booth, unchecked.
+    std::string boothDir = "booth";
+    std::string boothDigest;
+    // kLightAuto or kLightDirect (direct-sensor mode forced). Recordings made before: auto.
+    std::string light = kLightAuto;
+    // Direct-sensor mode's level (state::LightEstimatorSetup::directCdM2PerY): the emitter's
+    // luminance per unit of the reading's Y, recorded in "sensing". Recordings made before have
+    // none and replay with 0 (the booth's mean luminance), frame for frame.
+    double directCdM2PerY = kDefaultDirectCdM2PerY;
+    int boothLights = 32; // median-cut point lights
     // Specular samples per pixel or grid node; kAutoSpecularSamples: shading::
     // defaultSpecularSamples for the scene (8 on relief, 24 on a flat surface), chosen when the
     // appliance is built and recorded as chosen. Recordings made before hold the count they used.
@@ -207,11 +229,15 @@ struct Appliance {
 std::filesystem::path resolveSceneDir(const std::string& sceneDir);
 Expected<std::string> sceneDigest(const std::filesystem::path& dir);
 
+// The booth the configuration names (boothDir, relative: under the data folder), its digest
+// checked against the recorded one (boothDigest; refused when it differs) and then recorded.
+Expected<pipeline::booth::Booth> loadRunBooth(RunConfig& config);
+
 // A recording is untrusted: before replay builds anything from its configuration, the files it
 // names (scene folder, display profile, spectrometer calibration) must lie inside the data folder
 // or one of 'roots' (relative names without '..', or absolute paths inside a root), and the scene
-// and display digests must be recorded unless 'allowUndigested'. The error names the key and the
-// fix.
+// and display digests (and the booth's, when the recording names a booth folder) must be recorded
+// unless 'allowUndigested'. The error names the key and the fix.
 Expected<void> checkRecordedReferences(const RunConfig& config,
                                        const std::vector<std::filesystem::path>& roots,
                                        bool allowUndigested);

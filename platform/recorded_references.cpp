@@ -21,6 +21,7 @@
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
+#include <pipeline/scene/booth.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
@@ -28,6 +29,7 @@
 #include <platform/booth_dimmer.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_digest.h>
+#include <platform/render_plan.h>
 #include <platform/run_config_schema.h>
 
 namespace replica::platform {
@@ -118,6 +120,9 @@ Expected<void> checkRecordedReferences(const RunConfig& config,
                                          config.sceneDir.substr(0, 200)));
         }
     }
+    if (auto ok = checkReference("booth_dir", config.boothDir, roots); !ok) {
+        return ok;
+    }
     if (config.display != kUncalibratedDisplay) {
         if (auto ok = checkReference("display", config.display, roots); !ok) {
             return ok;
@@ -171,6 +176,30 @@ Expected<std::string> sceneDigest(const std::filesystem::path& dir)
         }
     }
     return fmt::format("{:016x}", h);
+}
+
+Expected<pipeline::booth::Booth> loadRunBooth(RunConfig& config)
+{
+    const auto dir = resolveSceneDir(config.boothDir);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(dir / "booth.json", ec)) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: no booth.json there; name a booth folder as 'replica "
+                                     "booth build' writes it (docs/booth-capture.md), e.g. {}",
+                                     dir.string(), (dataDir() / "booth").string()));
+    }
+    auto digest = boothDigest(dir);
+    if (!digest) {
+        return tl::unexpected(digest.error());
+    }
+    if (!config.boothDigest.empty() && config.boothDigest != *digest) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: the booth has changed since it was recorded (digest {}, "
+                                     "recorded {}); replay needs the recorded booth",
+                                     dir.string(), *digest, config.boothDigest));
+    }
+    config.boothDigest = *digest;
+    return pipeline::scene::loadApplianceBooth(dir, dataDir().string());
 }
 
 std::string displayProfileId(const RunConfig& config, const std::string& profileName)

@@ -53,6 +53,9 @@ std::string RunConfig::toJson() const
                      {"renderer", "booth"},
                      {"scene_dir", sceneDir},
                      {"scene_digest", sceneDigest},
+                     {"booth_dir", boothDir},
+                     {"booth_digest", boothDigest},
+                     {"light", light},
                      {"booth_lights", boothLights},
                      {"specular_samples", specularSamples},
                      {"specular_grid", specularGrid},
@@ -91,7 +94,8 @@ std::string RunConfig::toJson() const
                     {"average_spectra", sensing.averageSpectra},
                     {"steady_distance", sensing.steadyDistance},
                     {"stray_light_fraction", instrument.strayLightFraction},
-                    {"wavelength_offset_nm", instrument.wavelengthOffsetNm}};
+                    {"wavelength_offset_nm", instrument.wavelengthOffsetNm},
+                    {"direct_cdm2_per_y", directCdM2PerY}};
     if (!plannedLamps.empty()) {
         nlohmann::json lamps = nlohmann::json::object();
         for (const auto& [name, p] : plannedLamps) {
@@ -139,6 +143,11 @@ void readRendering(const nlohmann::json& j, RunConfig& c)
         c.sceneDir = RunConfig{}.sceneDir;
         c.sceneDigest.clear();
     }
+    // Absent before a booth could be named: the shipped one, undigested; and the classifier's
+    // light ("auto").
+    c.boothDir = j.value("booth_dir", c.boothDir);
+    c.boothDigest = j.value("booth_digest", c.boothDigest);
+    c.light = j.value("light", std::string(kLightAuto));
     c.boothLights = j.value("booth_lights", c.boothLights);
     c.specularSamples = j.value("specular_samples", c.specularSamples);
     c.specularGrid = j.value("specular_grid", c.specularGrid);
@@ -230,6 +239,8 @@ void readSensing(const nlohmann::json& j, RunConfig& c)
 {
     c.sensing = pipeline::spectral::LiveChainOptions::none();
     c.instrument = {};
+    // Absent before direct-sensor mode followed the reading: the booth's mean luminance.
+    c.directCdM2PerY = 0.0;
     if (j.contains("sensing")) {
         const auto& s = j.at("sensing");
         c.sensing.strayLight = s.at("stray_light").get<bool>();
@@ -238,6 +249,7 @@ void readSensing(const nlohmann::json& j, RunConfig& c)
         c.sensing.steadyDistance = s.at("steady_distance").get<double>();
         c.instrument.strayLightFraction = s.at("stray_light_fraction").get<double>();
         c.instrument.wavelengthOffsetNm = s.at("wavelength_offset_nm").get<double>();
+        c.directCdM2PerY = s.value("direct_cdm2_per_y", 0.0);
     }
 }
 
@@ -251,13 +263,14 @@ Expected<void> checkRanges(const RunConfig& c)
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
         c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 || c.cacheSlices < 1 ||
         c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights || c.areaLights > 1 ||
-        !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0) {
+        !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0 || !(c.directCdM2PerY >= 0.0) ||
+        c.directCdM2PerY > 1e12) {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("run configuration: size {}x{} (each side 1-{}, at most "
                                      "{}:1), rate {} Hz (1-1000), display peak/black, specular "
                                      "samples, specular or diffuse grid, horizon directions, "
-                                     "cache slices, area lights or booth dimmer (0 to 1) out of "
-                                     "range",
+                                     "cache slices, area lights, booth dimmer (0 to 1) or "
+                                     "direct_cdm2_per_y out of range",
                                      c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz));
     }
     const auto finite3 = [](const glm::dvec3& v) {
@@ -286,6 +299,11 @@ Expected<void> checkRanges(const RunConfig& c)
 // The names fromJson takes for the display inverse and the gamut mapping.
 Expected<void> checkNames(const RunConfig& c)
 {
+    if (c.light != kLightAuto && c.light != kLightDirect) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("run configuration: light '{}' is not '{}' or '{}'",
+                                     c.light.substr(0, 64), kLightAuto, kLightDirect));
+    }
     if ((c.displayInverse != "analytic" && c.displayInverse != "lut3d") ||
         (c.gamutMapping != "hue" && c.gamutMapping != "clip")) {
         return makeError(ErrorCode::InvalidArgument,

@@ -37,6 +37,9 @@ const JsonSchema& runConfigSchema()
                 {"lights_v", integer(1, 256).optional()},
                 {"scene_dir", name.optional()},
                 {"scene_digest", string(64).optional()},
+                {"booth_dir", name.optional()},
+                {"booth_digest", string(64).optional()},
+                {"light", string(64).optional()},
                 {"booth_lights", integer(1, 256).optional()},
                 {"specular_samples", integer(kAutoSpecularSamples, 256).optional()},
                 {"specular_grid", integer(kAutoSpecularGrid, 256).optional()},
@@ -90,7 +93,8 @@ const JsonSchema& runConfigSchema()
                                     {"average_spectra", integer(1, 1000)},
                                     {"steady_distance", number(0.0, 10.0)},
                                     {"stray_light_fraction", number(0.0, 0.5)},
-                                    {"wavelength_offset_nm", number(-5.0, 5.0)}})
+                                    {"wavelength_offset_nm", number(-5.0, 5.0)},
+                                    {"direct_cdm2_per_y", number(0.0, 1e12).optional()}})
                                     .optional()},
                 // The planner's choice per lamp name (platform/render_plan.h).
                 {"planned_lamps", map(object({{"lights", integer(1, 256)},

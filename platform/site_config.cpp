@@ -368,6 +368,8 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
     Reader r(root, out.problems, c);
     r.string("booth", "id", c.boothId);
     r.numberOrAuto("booth", "dimmer", c.boothDimmer, c.boothDimmerAuto, 0.0, 1.0);
+    r.string("booth", "dir", c.boothDir);
+    r.string("booth", "light", c.light, {"auto", "direct"});
     r.string("scene", "dir", c.sceneDir);
     r.string("scene", "renderer", c.renderer); // run_resolve.cpp refuses all but "booth"
     r.boolean("render", "planner", c.renderPlanner);
@@ -409,6 +411,13 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
     r.string("devices", "spectrometer_serial", c.spectrometerSerial);
     r.number("spectrometer", "stray_light_fraction", c.spectrometerStrayLight, 0.0, 0.05);
     r.number("spectrometer", "wavelength_offset_nm", c.spectrometerWavelengthOffsetNm, -5.0, 5.0);
+    {
+        double perY = 0.0;
+        r.number("spectrometer", "direct_cdm2_per_y", perY, 1e-12, 1e12);
+        if (perY > 0.0) { // given and good
+            c.spectrometerDirectCdM2PerY = perY;
+        }
+    }
     {
         double unused = 0.0; // the calibration's figures, for people
         r.number("spectrometer", "calibration_spectra", unused, 0.0, 1e9);
@@ -454,10 +463,15 @@ std::string SiteConfig::toJson() const
             {"source", source.string()},
             {"booth",
              {{"id", boothId},
-              {"dimmer", boothDimmerAuto ? nlohmann::json("auto") : nlohmann::json(boothDimmer)}}},
+              {"dimmer", boothDimmerAuto ? nlohmann::json("auto") : nlohmann::json(boothDimmer)},
+              {"dir", boothDir},
+              {"light", light}}},
             {"spectrometer",
              {{"stray_light_fraction", spectrometerStrayLight},
-              {"wavelength_offset_nm", spectrometerWavelengthOffsetNm}}},
+              {"wavelength_offset_nm", spectrometerWavelengthOffsetNm},
+              {"direct_cdm2_per_y", spectrometerDirectCdM2PerY
+                                            ? nlohmann::json(*spectrometerDirectCdM2PerY)
+                                            : nlohmann::json("default")}}},
             {"scene", {{"dir", sceneDir}, {"renderer", renderer}}},
             {"render",
              {{"planner",

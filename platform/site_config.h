@@ -32,11 +32,20 @@ struct SiteConfig {
     // dimmer = <number in (0, 1]> | "auto" (platform/booth_dimmer.h); absent: 1, undimmed.
     double boothDimmer = 1.0;
     bool boothDimmerAuto = false;
+    // dir = the booth model's folder ('replica booth build' writes one from a site's captures;
+    // under the data folder or absolute); empty: the shipped booth (data/booth).
+    std::string boothDir;
+    // light = "auto" (the classifier's lamp, the sensed spectrum where none matches) | "direct"
+    // (always the sensed spectrum: direct-sensor mode, 'replica run --light direct').
+    std::string light = "auto";
     // [spectrometer]: the instrument's calibration ('replica calibrate spectrometer';
     // pipeline/spectral/live_chain.h InstrumentCalibration): absent, the data sheet's stray light
     // and no shift.
     double spectrometerStrayLight = 5e-4;
     double spectrometerWavelengthOffsetNm = 0.0;
+    // direct_cdm2_per_y: direct-sensor mode's level, the emitter's luminance per unit of the
+    // reading's Y (RunConfig::directCdM2PerY); absent: the simulated instrument's.
+    std::optional<double> spectrometerDirectCdM2PerY;
     // [scene]
     std::string sceneDir;           // empty: the default scene (data/scenes/colorchecker)
     std::string renderer = "booth"; // the one renderer; "flat" is read to be refused by name

@@ -1,4 +1,6 @@
 // Spectrum -> classified (or sensed) light -> encoding decision.
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 #include <state/json_state.h>
 #include <state/light_estimator.h>
@@ -46,6 +48,16 @@ pipeline::spectral::LiveSpectrometerChain::State chainFromJson(const nlohmann::j
 
 } // namespace
 
+double directLuminance(const LightEstimatorSetup& setup, const pipeline::colour::Spectrum& spd)
+{
+    if (setup.directCdM2PerY == 0.0) {
+        return meanLuminance(setup.booth);
+    }
+    // A reading whose Y is negative (noise on no light) renders black, not a negative light.
+    return std::max(0.0,
+                    setup.directCdM2PerY * pipeline::colour::spectrumToXyz(setup.observer, spd).y);
+}
+
 Expected<LightEstimator> LightEstimator::create(LightEstimatorSetup setup)
 {
     if (setup.booth.lights.empty()) {
@@ -86,7 +98,8 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
 {
     if (selector != nullptr && selector->sequence != lastSelector_) {
         lastSelector_ = selector->sequence;
-        if (const auto lamp = arbiter_.onSelector(*selector)) {
+        // Forced direct-sensor mode: a turn of the switch is not shown (the recording keeps it).
+        if (const auto lamp = setup_.forceDirect ? std::nullopt : arbiter_.onSelector(*selector)) {
             showLamp(*lamp); // a turn of the switch shows at once
         }
     }
@@ -100,16 +113,19 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
         auto spd = spectrum->saturated ? makeError(ErrorCode::InvalidArgument, "saturated")
                                        : chain_.add(raw);
         if (spd) {
-            const int lamp = arbiter_.onClassified(classifier_ ? classifier_->classify(*spd) : -1,
-                                                   spectrum->timestampNs);
+            const int lamp =
+                    setup_.forceDirect
+                            ? -1
+                            : arbiter_.onClassified(classifier_ ? classifier_->classify(*spd) : -1,
+                                                    spectrum->timestampNs);
             haveSpectrum_ = true;
             if (lamp >= 0) {
                 showLamp(lamp);
             } else {
-                // Direct-sensor mode: the sensed shape, at the booth's typical luminance.
+                // Direct-sensor mode: the sensed spectrum, at the sensed level.
                 lamp_ = -1;
                 spd_ = *spd;
-                luminance_ = meanLuminance(setup_.booth);
+                luminance_ = directLuminance(setup_, *spd);
             }
         } else {
             ++rejected_;

@@ -16,6 +16,7 @@
 #include <hal/samples.h>
 #include <pipeline/base/expected.h>
 #include <pipeline/booth/booth_model.h>
+#include <pipeline/colour/xyz.h>
 #include <pipeline/scene/scene_state.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/light_classifier.h>
@@ -72,7 +73,22 @@ struct LightEstimatorSetup {
     // with) or for the sensed spectrum (pipeline/spectral/adaptive_encoding.h).
     std::shared_ptr<const pipeline::spectral::AdaptiveEncoder> adaptive;
     double reencodeDistance = pipeline::spectral::kAdaptiveReencodeDistance;
+    // Direct-sensor mode forced (the run's light "direct", the paper's mode 1): every usable
+    // spectrum is rendered as it is on the booth's uniform emitter; neither the classifier nor
+    // the lamp selector is consulted. Otherwise ("auto") only a spectrum the classifier does not
+    // recognise is.
+    bool forceDirect = false;
+    // Direct-sensor mode's level: the emitter's luminance (cd/m^2) is directCdM2PerY times the
+    // reading's Y (pipeline::colour::spectrumToXyz with 'observer' of the calibrated spectrum), so
+    // it follows the sensed light: twice the light, twice the luminance. 0: the booth's mean
+    // nominal luminance whatever the reading (what recordings made before it replay with).
+    double directCdM2PerY = 0.0;
+    pipeline::colour::Observer observer;
 };
+
+// The luminance (cd/m^2) direct-sensor mode renders a reading 'spd' at: directCdM2PerY times its
+// Y, or with directCdM2PerY 0 the booth's mean nominal luminance.
+double directLuminance(const LightEstimatorSetup& setup, const pipeline::colour::Spectrum& spd);
 
 class LightEstimator
 {

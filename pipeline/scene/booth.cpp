@@ -15,7 +15,12 @@ using booth::LampKind;
 
 Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir)
 {
-    const auto boothDir = std::filesystem::path(dataDir) / "booth";
+    return loadApplianceBooth(std::filesystem::path(dataDir) / "booth", dataDir);
+}
+
+Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
+                                          const std::string& dataDir)
+{
     const auto boothFile = (boothDir / "booth.json").string();
     auto model = booth::loadBooth(boothDir);
     if (!model) {

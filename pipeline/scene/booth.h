@@ -1,6 +1,7 @@
 // The appliance's booth (booth::Booth with its lamps' reference spectra and nominal luminances).
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -19,5 +20,11 @@ namespace replica::pipeline::scene {
 // not a lamp this build knows or when the lights do not share one ceiling (the appliance's booth
 // has one emitter, booth::Booth::ceiling(), whichever lamp it shows).
 Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir);
+
+// The same for the booth model in 'boothDir' (one 'replica booth build' made from a site's
+// captures): its lights must be named after lamps this build knows and share one ceiling, as
+// above; the reference spectra come from dataDir/spectra.
+Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
+                                          const std::string& dataDir);
 
 } // namespace replica::pipeline::scene

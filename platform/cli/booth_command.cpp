@@ -113,6 +113,7 @@ const JsonSchema& captureSchema()
 // "edge_u", "edge_v", "texels": [w, h], "corners": [[x, y] x 4] (image pixels of ceiling uv
 // (0,0),(1,0),(1,1),(0,1)), "exposures": [{"file", "seconds"}], "calibration": {"cdm2_per_unit": k}
 // | {"spot": {"x", "y", "radius", "cdm2"}}}]}. Paths are relative to capture.json.
+// docs/booth-capture.md documents it, with a worked example.
 // The calibration's scale from the HDR image's units to cd/m^2: given, or from a spot of known
 // luminance.
 Expected<double> calibrationScale(const nlohmann::json& cal,
@@ -305,9 +306,10 @@ void registerBoothCommand(CLI::App& app, int& exitCode)
     CLI::App* build =
             booth->add_subcommand("build", "merge bracketed PNG exposures into a calibrated "
                                            "luminance image per light and warp it onto the "
-                                           "ceiling (see docs/rendering.md for capture.json)");
+                                           "ceiling (capture.json: docs/booth-capture.md)");
     build->add_option("--capture", *input,
-                      "capture.json describing exposures, corners, geometry and calibration")
+                      "capture.json describing exposures, corners, geometry and calibration "
+                      "(docs/booth-capture.md, with a worked example)")
             ->required();
     build->add_option("--out", *buildOut, "output booth folder")->required();
     build->callback([input, buildOut, &exitCode] { exitCode = runBuild(*input, *buildOut); });

@@ -334,7 +334,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
     cmd->add_option("--light", args->light,
                     "booth light name (tungsten, d50, d65 in the shipped booth)")
             ->required();
-    cmd->add_option("--booth", args->booth, "booth model folder (default: the shipped data/booth)");
+    cmd->add_option("--booth", args->booth,
+                    "booth model folder, e.g. one 'replica booth build' made from a site's "
+                    "captures (docs/booth-capture.md); default: the shipped data/booth");
     cmd->add_option("--eye", args->eye, "eye position X,Y,Z in metres, booth frame")
             ->capture_default_str();
     cmd->add_option("--tilt", args->tilt,

@@ -61,6 +61,14 @@ void logStart(const Appliance& appliance, const Sources& sources)
               appliance.output->name(), appliance.renderer->description(),
               appliance.output->glRenderer(), appliance.config.width, appliance.config.height,
               appliance.config.rateHz, appliance.displayProfileId);
+    log->info("booth {} ({}, digest {}; lamps {}); light {}{}", appliance.config.booth,
+              resolveSceneDir(appliance.config.boothDir).string(), appliance.config.boothDigest,
+              appliance.booth.names(), appliance.config.light,
+              appliance.config.light == kLightDirect
+                      ? fmt::format(" (direct-sensor mode: the sensed spectrum at {} cd/m^2 per "
+                                    "unit of its Y)",
+                                    appliance.config.directCdM2PerY)
+                      : std::string());
 }
 
 // The session as recorded in each file: the configuration as built (the scene folder and digest,

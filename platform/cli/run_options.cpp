@@ -52,6 +52,7 @@ constexpr std::array kSiteDefaults = {
                                                 &OutputChoice::kms,
                                                 &KmsOptions::connector>},
         SiteDefault{"--renderer", fromSite<&S::renderer, &O::renderer>},
+        SiteDefault{"--light", fromSite<&S::light, &O::light>},
         SiteDefault{"--tracker-port", fromSite<&S::trackerPort, &O::live, &L::trackerPort>},
         SiteDefault{"--tracker-bind", fromSite<&S::trackerBind, &O::live, &L::trackerBind>},
         SiteDefault{"--iio-root", fromSite<&S::iioRoot, &O::live, &L::iioRoot>},
@@ -182,6 +183,17 @@ void addRenderOptions(CLI::App& cmd, RunOptions& o)
     cmd.add_option("--scene", o.scene,
                    "surface scene folder (scene.json + EXRs); default: the shipped ColorChecker, "
                    "data/scenes/colorchecker");
+    cmd.add_option("--booth", o.booth,
+                   "booth model folder (booth.json and a luminance EXR per lamp, as 'replica booth "
+                   "build' makes it from a site's captures: docs/booth-capture.md); default: the "
+                   "shipped data/booth; the site file's [booth] dir");
+    cmd.add_option("--light", o.light,
+                   "auto: the booth lamp the spectrometer's reading matches (the sensed spectrum "
+                   "where none does); direct: always the sensed spectrum on a uniform emitter at "
+                   "the sensed level (the paper's direct-sensor mode; docs/rendering.md); the site "
+                   "file's [booth] light")
+            ->check(CLI::IsMember({"auto", "direct"}))
+            ->capture_default_str();
     cmd.add_option("--renderer", o.renderer,
                    "booth (the scene lit by the booth model; the one renderer, so the option can "
                    "be left out)")
@@ -275,12 +287,15 @@ void applySite(const SiteConfig& s, RunOptions& o)
             row.fill(s, o);
         }
     }
-    // The three whose site value is not taken as it is.
+    // The four whose site value is not taken as it is.
     if (unset("--size") && o.output != "kms") { // on KMS the frame is the mode's size
         o.size = s.size;
     }
     if (unset("--scene") && !s.sceneDir.empty()) {
         o.scene = dataPath(s.sceneDir);
+    }
+    if (unset("--booth") && !s.boothDir.empty()) {
+        o.booth = dataPath(s.boothDir);
     }
     if (unset("--display-profile") && unset("--uncalibrated") && !s.displayProfile.empty()) {
         o.displayProfile = dataPath(s.displayProfile);

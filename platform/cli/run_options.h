@@ -37,6 +37,8 @@ struct RunOptions {
     std::string snapshot;
     bool fast = false;
     std::string scene;
+    std::string booth;          // --booth: the booth model's folder; empty: the shipped one
+    std::string light = "auto"; // --light: auto or direct (direct-sensor mode)
     std::string renderer = "booth";
     std::string basis; // empty: adaptive_k6
     std::string displayProfile;

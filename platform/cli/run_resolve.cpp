@@ -171,7 +171,7 @@ std::string relativeToData(const std::filesystem::path& abs, const std::filesyst
     return !rel.empty() && *rel.begin() != ".." ? rel.string() : outside.string();
 }
 
-// The scene and the display profile the options name.
+// The scene, the booth, the light and the display profile the options name.
 Resolved<void> sceneAndDisplay(const RunOptions& o, RunConfig& config)
 {
     if (!o.scene.empty()) {
@@ -186,6 +186,19 @@ Resolved<void> sceneAndDisplay(const RunOptions& o, RunConfig& config)
                                        (dataDir() / "scenes" / "painting").string())));
         }
     }
+    if (!o.booth.empty()) {
+        std::error_code ec;
+        const auto abs = std::filesystem::weakly_canonical(o.booth, ec);
+        config.boothDir = relativeToData(abs, abs);
+        if (!std::filesystem::is_regular_file(std::filesystem::path(o.booth) / "booth.json", ec)) {
+            return tl::unexpected(refuse(
+                    o, "--booth", "booth.dir", o.booth,
+                    fmt::format("no booth.json there; name a booth folder such as 'replica booth "
+                                "build' writes (docs/booth-capture.md), e.g. {}",
+                                (dataDir() / "booth").string())));
+        }
+    }
+    config.light = o.light;
     if (o.uncalibrated && !o.displayProfile.empty()) {
         return tl::unexpected(usage(fmt::format("--uncalibrated and --display-profile {} "
                                                 "contradict each other: give one",
@@ -215,6 +228,7 @@ Resolved<void> siteGeometry(const RunOptions& o, RunConfig& config)
         config.boothDimmerAuto = site.boothDimmerAuto;
         config.instrument.strayLightFraction = site.spectrometerStrayLight;
         config.instrument.wavelengthOffsetNm = site.spectrometerWavelengthOffsetNm;
+        config.directCdM2PerY = site.spectrometerDirectCdM2PerY.value_or(config.directCdM2PerY);
         const double panelW = config.stand.panelWidthM, panelH = config.stand.panelHeightM;
         config.stand = site.stand;
         if (!o.panelSizeMm.empty()) { // the command line wins over the site file
@@ -336,9 +350,11 @@ Resolved<void> checkBooth(const RunOptions& o, const RunConfig& config)
                                      "unknown booth (this build has replica-booth-1)",
                                      kExitFailure));
     }
-    auto booth = pipeline::scene::loadDefaultBooth(dataDir().string());
+    auto booth = pipeline::scene::loadApplianceBooth(resolveSceneDir(config.boothDir),
+                                                     dataDir().string());
     if (!booth) {
-        return tl::unexpected(makeRefusal(kExitFailure, {booth.error().message}));
+        return tl::unexpected(refuse(o, "--booth", "booth.dir", config.boothDir,
+                                     booth.error().message, kExitFailure));
     }
     if (!config.defaultLamp.empty()) {
         const auto& lamps = booth->lights;

@@ -191,9 +191,14 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
         l.name = "unknown";
         l.why = !frame.sequence(recordings::spectrometerKind())
                         ? std::string("no spectrum yet: the starting light")
+                : appliance_.config.light == kLightDirect
+                        ? fmt::format("direct-sensor mode forced (light = \"direct\"): "
+                                      "rendering the sensed light at {:.0f} cd/m^2",
+                                      s.emitterLuminanceCdM2)
                         : fmt::format("no stored lamp matches the sensed spectrum (nearest "
-                                      "shape distance {:.4f}): rendering the sensed light",
-                                      c.distance);
+                                      "shape distance {:.4f}): rendering the sensed light at "
+                                      "{:.0f} cd/m^2",
+                                      c.distance, s.emitterLuminanceCdM2);
     }
     if (observer_) {
         const auto xyz = pipeline::colour::spectrumToXyz(*observer_, s.illuminant);

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <pipeline/base/data_dir.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/run_options.h>
 #include <platform/cli/run_resolve.h>
@@ -78,6 +79,34 @@ TEST(RunOptions, TheSiteFileFillsOnlyWhatTheCommandLineLeavesOpen)
     ASSERT_TRUE(plan) << plan.error().lines.front();
     EXPECT_TRUE(plan->config.warmUp);
     EXPECT_TRUE(parseRun({"--no-warm-up"}, "").noWarmUp);
+}
+
+TEST(RunOptions, TheLightAndTheBoothComeFromTheSiteFileOrTheCommandLine)
+{
+    // [booth] light, dir and [spectrometer] direct_cdm2_per_y reach the run configuration.
+    const std::string site = fmt::format("[run]\nhal = \"sim\"\n[booth]\nlight = \"direct\"\n"
+                                         "dir = \"{}\"\n[spectrometer]\ndirect_cdm2_per_y = 0.25\n",
+                                         (dataDir() / "booth").string());
+    RunOptions o = parseRun({}, site);
+    EXPECT_EQ(o.light, "direct");
+    EXPECT_EQ(o.booth, (dataDir() / "booth").string());
+    auto file = std::filesystem::temp_directory_path() /
+                ("replica-run-light-" + std::to_string(::getpid()) + ".toml");
+    std::ofstream(file) << site;
+    o.config = file.string();
+    auto plan = resolveRun(o);
+    std::filesystem::remove(file);
+    ASSERT_TRUE(plan) << plan.error().lines.front();
+    EXPECT_EQ(plan->config.light, kLightDirect);
+    EXPECT_EQ(plan->config.boothDir, "booth"); // inside the data folder: recorded relative to it
+    EXPECT_DOUBLE_EQ(plan->config.directCdM2PerY, 0.25);
+    // The command line wins; without either: auto, the shipped booth, the default scale.
+    EXPECT_EQ(parseRun({"--light", "auto"}, site).light, "auto");
+    plan = resolveRun(parseRun({}, "[run]\nhal = \"sim\"\n"));
+    ASSERT_TRUE(plan) << plan.error().lines.front();
+    EXPECT_EQ(plan->config.light, kLightAuto);
+    EXPECT_EQ(plan->config.boothDir, "booth");
+    EXPECT_DOUBLE_EQ(plan->config.directCdM2PerY, kDefaultDirectCdM2PerY);
 }
 
 TEST(RunOptions, EveryDeviceKindHasItsSourceOptionDefaultedFromHal)
