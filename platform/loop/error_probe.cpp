@@ -198,7 +198,10 @@ void ErrorProbe::setWriter(recordings::RecordingWriter* writer)
 void ErrorProbe::onFrame(const recordings::FrameRecord& frame,
                          const pipeline::scene::SceneState& state)
 {
-    if (frame.tickNs < nextNs_) {
+    // Before the first light (the default lamp unset) the frame is black, as is its reference:
+    // nothing to measure yet.
+    const bool unlit = state.lampIndex < 0 && !(state.emitterLuminanceCdM2 > 0.0);
+    if (frame.tickNs < nextNs_ || unlit) {
         return;
     }
     const auto period = static_cast<std::int64_t>(std::llround(options_.periodS * 1e9));

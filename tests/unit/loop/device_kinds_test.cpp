@@ -99,7 +99,7 @@ TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAnd
             {"accel2",
              "second accelerometer",
              "samples",
-             {16, "/hal/accel2", schema.first, schema.second},
+             {17, "/hal/accel2", schema.first, schema.second},
              std::nullopt,
              "accel2_seq",
              "dropped_accel2",
@@ -186,7 +186,7 @@ TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAnd
     for (const auto& c : report->channels) {
         if (c.topic == "/hal/accel2") {
             listed = true;
-            EXPECT_EQ(c.id, 16);
+            EXPECT_EQ(c.id, 17);
             EXPECT_EQ(c.schemaName, "replica.AccelSample");
             EXPECT_EQ(c.messages, polled);
         }
@@ -229,7 +229,7 @@ TEST(DeviceKinds, TheEstimatorsGetTypedSamplesOfTheStateKindsAndADataKindIsPolle
             {"accel2",
              "second accelerometer",
              "samples",
-             {16, "/hal/accel2", schema.first, schema.second},
+             {17, "/hal/accel2", schema.first, schema.second},
              std::nullopt,
              "accel2_seq",
              "dropped_accel2",
@@ -252,7 +252,7 @@ TEST(DeviceKinds, TheEstimatorsGetTypedSamplesOfTheStateKindsAndADataKindIsPolle
     recordings::DeviceSink* tee = nullptr;
     const recordings::StateSlots slots(recordings::stateKinds(), sources, &tee);
     ASSERT_EQ(slots.all().size(), 2u);
-    EXPECT_EQ(&slots.all()[0]->kind(), &recordings::accelKind()); // channel order: 4, then 16
+    EXPECT_EQ(&slots.all()[0]->kind(), &recordings::accelKind()); // channel order: 4, then 17
     EXPECT_EQ(&slots.all()[1]->kind(), &secondAccel);
     std::uint64_t mismatches = 0;
     for (const auto& slot : slots.all()) {
