@@ -139,6 +139,10 @@ struct RunConfig {
     // Not recorded (no pixel depends on it): draw every lamp's shading pass once at start
     // (BoothScenePass::warmUp) so that no lamp switch waits for a shader compilation.
     bool warmUp = true;
+    // Seconds of session time between the running appliance's error probes, 0: none
+    // (platform/loop/error_probe.h). Recorded ("error_probe_s") to say what the session measured;
+    // no pixel depends on it and a replay never probes. Recordings made before have none.
+    double errorProbeS = 0.0;
     std::map<std::string, LampPlan> plannedLamps;
     // docs/accuracy.md. adaptive_k6 re-encodes the surface for each new light; recordings made
     // with replica_k6 or box6 replay as such.

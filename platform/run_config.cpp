@@ -64,6 +64,7 @@ std::string RunConfig::toJson() const
                      {"booth_dimmer", boothDimmer},
                      {"booth_dimmer_auto", boothDimmerAuto || boothDimmerChosenAuto},
                      {"cache_slices", cacheSlices},
+                     {"error_probe_s", errorProbeS},
                      {"render_profile", renderProfile},
                      {"horizon_directions", horizonDirections},
                      {"display_digest", displayDigest},
@@ -157,6 +158,7 @@ void readRendering(const nlohmann::json& j, RunConfig& c)
     c.boothDimmer = j.value("booth_dimmer", c.boothDimmer);
     c.boothDimmerChosenAuto = j.value("booth_dimmer_auto", false);
     c.cacheSlices = j.value("cache_slices", c.cacheSlices);
+    c.errorProbeS = j.value("error_probe_s", c.errorProbeS);
     c.renderProfile = j.value("render_profile", 0);
     c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
     c.displayDigest = j.value("display_digest", c.displayDigest);

@@ -375,6 +375,7 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
     r.boolean("render", "planner", c.renderPlanner);
     c.renderPlannerSet = root.at_path("render.planner").as_boolean() != nullptr;
     r.boolean("render", "warm_up", c.warmUp);
+    r.number("render", "error_probe", c.errorProbeS, 0.0, 3600.0);
     r.string("display", "profile", c.displayProfile);
     r.boolean("display", "allow_synthetic", c.allowSynthetic);
     r.string("display", "output", c.output, {"kms", "headless"});
@@ -476,7 +477,8 @@ std::string SiteConfig::toJson() const
             {"render",
              {{"planner",
                renderPlannerSet ? nlohmann::json(renderPlanner) : nlohmann::json("auto")},
-              {"warm_up", warmUp}}},
+              {"warm_up", warmUp},
+              {"error_probe", errorProbeS}}},
             {"display",
              {{"profile", displayProfile},
               {"allow_synthetic", allowSynthetic},

@@ -56,6 +56,9 @@ struct SiteConfig {
     bool renderPlannerSet = false;
     // [render] warm_up = false: 'replica run --no-warm-up' (RunConfig::warmUp).
     bool warmUp = true;
+    // [render] error_probe = seconds between the error probes, 0: none ('replica run
+    // --error-probe'; platform/loop/error_probe.h). Absent: every 10 s (kKioskErrorProbeS).
+    double errorProbeS = 10.0;
     // [display]
     std::string displayProfile;   // empty: the shipped synthetic profile
     bool allowSynthetic = false;  // the kiosk refuses a live run on the synthetic profile

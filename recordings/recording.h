@@ -33,7 +33,7 @@ namespace replica::recordings {
 // 5: raw in, processed out: /replica/raw/tracker (id 14: opentrack datagrams, HID input reports
 // and descriptors) and /replica/raw/accel (id 15: IIO raw values, scale, offset, mounting) beside
 // the processed samples; the reader attaches them to their samples by sequence number.
-constexpr int kFormatVersion = 5;
+constexpr int kFormatVersion = 6;
 
 // Limits on a recording, which is untrusted input (docs/recordings.md, 'Limits'): its file size,
 // one message's size (a 2048-pixel spectrum is about 12 KiB of JSON), and a spectrum's pixels
@@ -108,6 +108,19 @@ struct LogRecord {
     int level = 3;
     std::string name; // the logger's area
     std::string message;
+};
+
+// The running appliance's error (platform/loop/error_probe.h): CIEDE2000 between the frame's XYZ
+// and the exact reference at n random pixels of the surface, at frame frameIndex. Not replayed.
+struct ErrorProbeRecord {
+    std::int64_t tNs = 0;
+    std::uint64_t frameIndex = 0;
+    std::uint64_t n = 0;
+    double meanDe00 = 0.0;
+    double p95De00 = 0.0;
+    double maxDe00 = 0.0;
+    double budgetP95 = 1.0; // the error budget the probe is held to
+    double cpuMs = 0.0;     // the probe's CPU time (reference and ΔE00, at idle priority)
 };
 
 // Describes the session: enough to re-create the renderer's inputs other than the samples.
@@ -234,6 +247,7 @@ public:
     // dropped and counted when full, never blocking for long.
     virtual void write(const ThumbnailRecord& t) = 0;
     virtual void write(const LogRecord& l) = 0;
+    virtual void write(const ErrorProbeRecord& e) = 0;
     // Flushes everything and writes the summary and footer. Safe to call once; the destructor calls
     // it.
     virtual Expected<void> close() = 0;

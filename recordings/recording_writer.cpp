@@ -29,7 +29,7 @@ using Item = std::variant<DeviceItem, FrameRecord, DisplayDigestRecord, PosesRec
 // The most device kinds a writer takes (each has its own drop counter).
 constexpr std::size_t kMaxDeviceKinds = 32;
 // Written from any thread (thumbnail encoder, log sink), through a mutex.
-using SharedItem = std::variant<ThumbnailRecord, LogRecord>;
+using SharedItem = std::variant<ThumbnailRecord, LogRecord, ErrorProbeRecord>;
 // What the shared queue holds at most: a minute of 1 Hz thumbnails and a burst of warnings.
 constexpr std::size_t kSharedCapacity = 256;
 using Clock = std::chrono::steady_clock;
@@ -97,6 +97,7 @@ public:
     void write(const LightRecord& l) override { push(l, droppedShown_); }
     void write(const ThumbnailRecord& t) override { pushShared(t); }
     void write(const LogRecord& l) override { pushShared(l); }
+    void write(const ErrorProbeRecord& e) override { pushShared(e); }
 
     Expected<void> close() override
     {
@@ -170,6 +171,12 @@ private:
                         using R = std::decay_t<decltype(r)>;
                         if constexpr (std::is_same_v<R, ThumbnailRecord>) {
                             message(ChannelId::Thumbnail, r.tNs, encodeThumbnail(r, wallStart_));
+                        } else if constexpr (std::is_same_v<R, ErrorProbeRecord>) {
+                            if (auto payload = encodeErrorProbe(r)) {
+                                message(ChannelId::ErrorProbe, r.tNs, std::move(*payload));
+                            } else {
+                                rejected_.fetch_add(1, std::memory_order_relaxed);
+                            }
                         } else {
                             message(ChannelId::Log, r.tNs, encodeLog(r, wallStart_));
                         }

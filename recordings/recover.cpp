@@ -185,7 +185,7 @@ mcap::ScanOptions recoverOptions(std::string_view bytes)
     options.chunkedOnly = true; // the writer chunks every record that carries samples
     // Replica's channel ids are fixed per format version: a file whose first chunk (the channel
     // definitions) was lost can still have its samples recovered.
-    // Each format only added channels (3: id 7, 4: ids 8-13, 5: ids 14-15), so today's
+    // Each format only added channels (3: id 7, 4: ids 8-13, 5: ids 14-15, 6: id 16), so today's
     // definitions serve every chunked format (2 and later) as well.
     const auto probe = bytes.substr(0, 256);
     bool knownFormat = false;

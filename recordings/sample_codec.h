@@ -38,6 +38,8 @@ enum class ChannelId : std::uint16_t {
     // processed samples on 3 and 4, so that 'replay --reprocess' can re-derive them.
     RawTracker = 14,
     RawAccel = 15,
+    // The running appliance's error probe (not replayed; a reader skips it).
+    ErrorProbe = 16,
 };
 
 inline constexpr std::string_view kSessionTopic = "/replica/session";
@@ -55,6 +57,7 @@ inline constexpr std::string_view kLightTopic = "/replica/light";
 inline constexpr std::string_view kLogTopic = "/replica/log";
 inline constexpr std::string_view kRawTrackerTopic = "/replica/raw/tracker";
 inline constexpr std::string_view kRawAccelTopic = "/replica/raw/accel";
+inline constexpr std::string_view kErrorProbeTopic = "/replica/error_probe";
 // Foxglove frame ids of the transforms and poses.
 inline constexpr std::string_view kBoothFrame = "booth";
 inline constexpr std::string_view kPanelFrame = "panel";
@@ -134,6 +137,7 @@ std::optional<std::string> encodeTransforms(const PosesRecord& p, std::int64_t w
 std::optional<std::string> encodeEye(const PosesRecord& p, std::int64_t wallStartNs);
 std::string encodeLight(const LightRecord& l);
 std::string encodeLog(const LogRecord& l, std::int64_t wallStartNs);
+std::optional<std::string> encodeErrorProbe(const ErrorProbeRecord& e);
 std::string base64Encode(const std::vector<std::uint8_t>& bytes);
 // Strict (padding required, no whitespace); throws std::out_of_range on anything else.
 std::vector<std::uint8_t> base64Decode(const std::string& text);

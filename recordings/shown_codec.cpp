@@ -117,6 +117,20 @@ std::vector<ChannelText> shownChannels()
       {"title": "FATAL", "const": 5}]},
     "message": {"type": "string"}, "name": {"type": "string"}, "file": {"type": "string"},
     "line": {"type": "integer", "minimum": 0})")},
+            {static_cast<std::uint16_t>(ChannelId::ErrorProbe), std::string(kErrorProbeTopic),
+             "replica.ErrorProbe",
+             schemaText(
+                     "replica.ErrorProbe",
+                     "The running appliance's error: CIEDE2000 between the frame's XYZ and the "
+                     "exact reference at n random pixels of the surface, every few seconds",
+                     R"json("t": {"type": "integer", "description": "session time (ns) of the probed frame"},
+    "frame": {"type": "integer"},
+    "n": {"type": "integer", "description": "pixels compared"},
+    "de00_mean": {"type": "number"}, "de00_p95": {"type": "number"}, "de00_max": {"type": "number"},
+    "budget_p95": {"type": "number", "description": "the error budget: p95 above it is over"},
+    "over_budget": {"type": "boolean"},
+    "cpu_ms": {"type": "number", "description": "the probe's CPU time, at idle priority"})json",
+                     R"("t", "frame", "n", "de00_p95", "de00_max")")},
     };
 }
 
@@ -226,6 +240,25 @@ std::string encodeLog(const LogRecord& l, std::int64_t wallStartNs)
                 {"file", ""},
                 {"line", 0}}
             .dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::optional<std::string> encodeErrorProbe(const ErrorProbeRecord& e)
+{
+    for (const double v : {e.meanDe00, e.p95De00, e.maxDe00, e.budgetP95, e.cpuMs}) {
+        if (!std::isfinite(v)) {
+            return std::nullopt;
+        }
+    }
+    return json{{"t", e.tNs},
+                {"frame", e.frameIndex},
+                {"n", e.n},
+                {"de00_mean", e.meanDe00},
+                {"de00_p95", e.p95De00},
+                {"de00_max", e.maxDe00},
+                {"budget_p95", e.budgetP95},
+                {"over_budget", e.p95De00 > e.budgetP95},
+                {"cpu_ms", e.cpuMs}}
+            .dump();
 }
 
 } // namespace replica::recordings

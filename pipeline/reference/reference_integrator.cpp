@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 #include <thread>
+#include <tuple>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -88,6 +90,94 @@ TexelSums integrateTexels(const TexelCloud& light,
     return s;
 }
 
+namespace {
+
+// What every pixel of a reference frame shares: the light's texels, its unit-luminance spectrum
+// and white, the scene's normal map; and the per-pixel evaluation itself (renderReference's
+// frame and referenceAt's samples both go through pixel()).
+struct PixelCounts {
+    long flare = 0, behind = 0, bad = 0;
+};
+
+class PixelReference
+{
+public:
+    PixelReference(const surface::SurfaceScene& scene,
+                   const booth::BoothLight& light,
+                   const shading::View& view,
+                   const colour::Observer& obs,
+                   const ReferenceOptions& options)
+        : scene_(scene), view_(view), obs_(obs), options_(options), cloud_(texelCloud(light)),
+          unitSpd_(booth::unitLuminanceSpd(obs, light.spd)),
+          white_(colour::spectrumToXyz(obs, unitSpd_)), flat_(scene.flat()),
+          normals_(flat_ ? std::vector<Vec3>{} : surface::normalMap(scene.relief)),
+          glossy_(scene.glossy())
+    {}
+
+    const std::vector<Vec3>& normals() const { return normals_; }
+    std::size_t horizonSize() const
+    {
+        return static_cast<std::size_t>(flat_ ? 0 : options_.horizonAzimuths);
+    }
+
+    // The exact XYZ at one shading point; 'horizon' is scratch of horizonSize() entries.
+    colour::Xyz
+    pixel(const shading::ShadingPoint& sp, std::vector<double>& horizon, PixelCounts& c) const
+    {
+        for (std::size_t k = 0; k < horizon.size(); ++k) {
+            const double phi = 2.0 * std::numbers::pi * static_cast<double>(k) /
+                               static_cast<double>(horizon.size());
+            horizon[k] = surface::exactSinHorizon(scene_.relief, sp.texX, sp.texY, phi,
+                                                  options_.horizonDistanceM);
+        }
+        Vec3 toEye = view_.eye - sp.p;
+        const double eyeDist = glm::length(toEye);
+        toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
+        const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
+        c.behind += behind ? 1 : 0;
+        const TexelSums t =
+                integrateTexels(cloud_, sp.p, sp.nGeo, sp.nShade, toEye, scene_.model, scene_.alpha,
+                                glossy_ && !behind, flat_ ? nullptr : &horizon, sp.right, sp.up);
+        const colour::Spectrum rho = scene_.reflectance(sp.tx, sp.ty);
+        const colour::Spectrum radiance =
+                (rho * (t.irradiance / std::numbers::pi) + scene_.rhoS * t.specular) * unitSpd_;
+        const colour::Xyz surfaceXyz = colour::spectrumToXyz(obs_, radiance);
+        const colour::Xyz flare =
+                white_ * (shading::kScreenFlareRho * t.geoIrradiance / std::numbers::pi);
+        colour::Xyz out = shading::subtractFlare(surfaceXyz, flare, c.flare);
+        if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z)) {
+            ++c.bad;
+            out = colour::Xyz(0.0);
+        }
+        return out;
+    }
+
+    // A perfect diffuser at the panel centre: the frame's Lab white, and its Y.
+    std::pair<colour::Xyz, double> white() const
+    {
+        const Vec3 n = view_.panel.normal;
+        const TexelSums centre =
+                integrateTexels(cloud_, view_.panel.centre, n, n, n, scene_.model, scene_.alpha,
+                                false, nullptr, view_.panel.right, view_.panel.up);
+        const double y = centre.geoIrradiance / std::numbers::pi;
+        return {white_ * y, y};
+    }
+
+private:
+    const surface::SurfaceScene& scene_;
+    const shading::View& view_;
+    const colour::Observer& obs_;
+    const ReferenceOptions& options_;
+    TexelCloud cloud_;
+    colour::Spectrum unitSpd_;
+    colour::Xyz white_;
+    bool flat_;
+    std::vector<Vec3> normals_;
+    bool glossy_;
+};
+
+} // namespace
+
 shading::XyzFrame renderReference(const surface::SurfaceScene& scene,
                                   const booth::BoothLight& light,
                                   const shading::View& view,
@@ -99,54 +189,20 @@ shading::XyzFrame renderReference(const surface::SurfaceScene& scene,
     frame.height = view.pixelsY;
     frame.xyz.assign(static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height),
                      colour::Xyz(0.0));
-    const TexelCloud cloud = texelCloud(light);
-    const colour::Spectrum unitSpd = booth::unitLuminanceSpd(obs, light.spd);
-    const colour::Xyz white = colour::spectrumToXyz(obs, unitSpd);
-    const bool flat = scene.flat();
-    const std::vector<Vec3> normals = flat ? std::vector<Vec3>{} : surface::normalMap(scene.relief);
-    const bool glossy = scene.glossy();
-
-    struct Counts {
-        long flare = 0, behind = 0, bad = 0;
-    };
-    const auto renderRows = [&](int y0, int y1, Counts& c) {
-        std::vector<double> horizon(static_cast<std::size_t>(flat ? 0 : options.horizonAzimuths));
+    const PixelReference ref(scene, light, view, obs, options);
+    const auto renderRows = [&](int y0, int y1, PixelCounts& c) {
+        std::vector<double> horizon(ref.horizonSize());
         for (int py = y0; py < y1; ++py) {
             for (int px = 0; px < frame.width; ++px) {
                 const shading::ShadingPoint sp =
-                        shading::shadingPoint(view, scene, normals, px, py);
-                for (std::size_t k = 0; k < horizon.size(); ++k) {
-                    const double phi = 2.0 * std::numbers::pi * static_cast<double>(k) /
-                                       static_cast<double>(horizon.size());
-                    horizon[k] = surface::exactSinHorizon(scene.relief, sp.texX, sp.texY, phi,
-                                                          options.horizonDistanceM);
-                }
-                Vec3 toEye = view.eye - sp.p;
-                const double eyeDist = glm::length(toEye);
-                toEye = eyeDist > 0.0 ? toEye / eyeDist : sp.nGeo;
-                const bool behind = !(glm::dot(toEye, sp.nGeo) > 0.0);
-                c.behind += behind ? 1 : 0;
-                const TexelSums t = integrateTexels(cloud, sp.p, sp.nGeo, sp.nShade, toEye,
-                                                    scene.model, scene.alpha, glossy && !behind,
-                                                    flat ? nullptr : &horizon, sp.right, sp.up);
-                const colour::Spectrum rho = scene.reflectance(sp.tx, sp.ty);
-                const colour::Spectrum radiance =
-                        (rho * (t.irradiance / std::numbers::pi) + scene.rhoS * t.specular) *
-                        unitSpd;
-                const colour::Xyz surfaceXyz = colour::spectrumToXyz(obs, radiance);
-                const colour::Xyz flare =
-                        white * (shading::kScreenFlareRho * t.geoIrradiance / std::numbers::pi);
-                colour::Xyz out = shading::subtractFlare(surfaceXyz, flare, c.flare);
-                if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z)) {
-                    ++c.bad;
-                    out = colour::Xyz(0.0);
-                }
-                frame.xyz[static_cast<std::size_t>(py) * frame.width + px] = out;
+                        shading::shadingPoint(view, scene, ref.normals(), px, py);
+                frame.xyz[static_cast<std::size_t>(py) * frame.width + px] =
+                        ref.pixel(sp, horizon, c);
             }
         }
     };
     const int threads = std::clamp(options.threads, 1, std::max(frame.height, 1));
-    std::vector<Counts> counts(static_cast<std::size_t>(threads));
+    std::vector<PixelCounts> counts(static_cast<std::size_t>(threads));
     std::vector<std::thread> pool;
     for (int t = 0; t < threads; ++t) {
         const int y0 = frame.height * t / threads;
@@ -161,13 +217,33 @@ shading::XyzFrame renderReference(const surface::SurfaceScene& scene,
         frame.eyeBehindPixels += c.behind;
         frame.nonFinite += c.bad;
     }
-    const Vec3 n = view.panel.normal;
-    const TexelSums centre =
-            integrateTexels(cloud, view.panel.centre, n, n, n, scene.model, scene.alpha, false,
-                            nullptr, view.panel.right, view.panel.up);
-    frame.whiteY = centre.geoIrradiance / std::numbers::pi;
-    frame.whiteXyz = white * frame.whiteY;
+    std::tie(frame.whiteXyz, frame.whiteY) = ref.white();
     return frame;
+}
+
+ReferenceSamples referenceAt(const surface::SurfaceScene& scene,
+                             const booth::BoothLight& light,
+                             const shading::View& view,
+                             const colour::Observer& obs,
+                             const std::vector<SurfaceSample>& points,
+                             const ReferenceOptions& options,
+                             const std::function<bool()>& stop)
+{
+    const PixelReference ref(scene, light, view, obs, options);
+    ReferenceSamples out;
+    out.xyz.reserve(points.size());
+    std::vector<double> horizon(ref.horizonSize());
+    PixelCounts c;
+    for (const auto& p : points) {
+        if (stop && stop()) {
+            break;
+        }
+        const shading::ShadingPoint sp =
+                shading::shadingPointAt(view, scene, ref.normals(), p.u, p.v, p.texel);
+        out.xyz.push_back(ref.pixel(sp, horizon, c));
+    }
+    std::tie(out.whiteXyz, out.whiteY) = ref.white();
+    return out;
 }
 
 double

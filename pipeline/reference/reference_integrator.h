@@ -3,6 +3,11 @@
 // right.
 #pragma once
 
+#include <functional>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
 #include <pipeline/booth/booth_light.h>
 #include <pipeline/colour/xyz.h>
 #include <pipeline/shading/frame.h>
@@ -56,6 +61,32 @@ shading::XyzFrame renderReference(const surface::SurfaceScene& scene,
                                   const shading::View& view,
                                   const colour::Observer& obs,
                                   const ReferenceOptions& options = {});
+
+// One point of the surface to evaluate: surface (u, v) in [0, 1]^2 (v down the surface) and its
+// fractional texel position (what a frame's pixel centre maps to: shading::shadingPointAt).
+struct SurfaceSample {
+    double u = 0.5;
+    double v = 0.5;
+    glm::dvec2 texel{0.0};
+};
+
+struct ReferenceSamples {
+    std::vector<colour::Xyz> xyz; // one per point, as renderReference computes a pixel
+    colour::Xyz whiteXyz{0.0};    // the frame's Lab white (XyzFrame::whiteXyz)
+    double whiteY = 0.0;
+};
+
+// The exact reference at a list of surface points instead of every pixel: what the running
+// appliance's error probe compares a few hundred of its frame's pixels with (renderReference's
+// per-pixel code, on the calling thread). 'stop', when given, is asked before each point: once it
+// says true the samples end there (xyz shorter than points).
+ReferenceSamples referenceAt(const surface::SurfaceScene& scene,
+                             const booth::BoothLight& light,
+                             const shading::View& view,
+                             const colour::Observer& obs,
+                             const std::vector<SurfaceSample>& points,
+                             const ReferenceOptions& options = {},
+                             const std::function<bool()>& stop = {});
 
 // Lambert's contour formula: irradiance at p (normal n) from a uniform Lambertian polygon of
 // luminance L: E = L/2 * sum_edges angle_k * (n . unit(v_k x v_{k+1})), with v_k the unit vectors

@@ -82,6 +82,9 @@ public:
     bool surroundIlluminance() const { return pass_->surroundIlluminance(); }
 
     std::string description() const;
+    // What the pass was made from (the scene, the booth, the stand, the observer): what the error
+    // probe evaluates the exact reference with.
+    const BoothSceneSetup& setup() const { return setup_; }
 
     // Draws every shading pass once (one per distinct lamp setting, each with a lamp that uses
     // it) into a width x height target of its own, so that the shaders' first-use compilation

@@ -106,6 +106,28 @@ public:
         return {};
     }
 
+    Expected<void> readXyzPixels(const std::vector<FramePixel>& pixels,
+                                 std::vector<float>& out) override
+    {
+        out.assign(pixels.size() * 4, 0.0f);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+        for (std::size_t k = 0; k < pixels.size(); ++k) {
+            const auto& p = pixels[k];
+            if (p.x < 0 || p.y < 0 || p.x >= setup_.width || p.y >= setup_.height) {
+                return makeError(ErrorCode::InvalidArgument,
+                                 fmt::format("render: pixel ({}, {}) is outside the {}x{} frame",
+                                             p.x, p.y, setup_.width, setup_.height));
+            }
+            glReadPixels(p.x, p.y, 1, 1, GL_RGBA, GL_FLOAT, out.data() + 4 * k);
+        }
+        if (GLenum err = glGetError(); err != GL_NO_ERROR) {
+            return makeError(ErrorCode::DeviceFailure,
+                             fmt::format("render: GL error 0x{:04x} reading XYZ pixels", err));
+        }
+        return {};
+    }
+
 private:
     GlesRendererSetup setup_;
     GlVertexArray vao_;

@@ -28,6 +28,12 @@ struct RenderedFrame {
 // it uses (digests need both images; a snapshot needs the display values).
 enum class Readback { None, Display, DisplayAndXyz };
 
+// A pixel of a frame: column x, row y counted from the bottom (GL order, as RenderedFrame).
+struct FramePixel {
+    int x = 0;
+    int y = 0;
+};
+
 class Renderer
 {
 public:
@@ -38,6 +44,17 @@ public:
     virtual Expected<void> render(const scene::SceneState& state,
                                   RenderedFrame& out,
                                   Readback readback = Readback::DisplayAndXyz) = 0;
+    // Pass 1's XYZ of the last frame render() drew, at these pixels only (4 floats each, as
+    // RenderedFrame::xyz), without drawing anything: what the error probe compares with the
+    // exact reference, a few hundred pixels instead of the whole frame. Call on the thread that
+    // renders, between frames.
+    virtual Expected<void> readXyzPixels(const std::vector<FramePixel>& pixels,
+                                         std::vector<float>& out)
+    {
+        (void)pixels;
+        out.clear();
+        return makeError(ErrorCode::Unsupported, "render: this renderer keeps no XYZ frame");
+    }
 };
 
 } // namespace replica::pipeline::render

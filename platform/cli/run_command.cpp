@@ -32,6 +32,7 @@
 #include <platform/image/png_writer.h>
 #include <platform/live_sources.h>
 #include <platform/logging.h>
+#include <platform/loop/error_probe.h>
 #include <platform/loop/frame_loop.h>
 #include <platform/loop/shown_recorder.h>
 #include <platform/output/service_screen.h>
@@ -121,6 +122,7 @@ struct RunRecording {
     std::unique_ptr<recordings::RecordingWriter> file;
     std::unique_ptr<SessionRecorder> sessions;
     std::unique_ptr<ShownRecorder> shown;
+    std::unique_ptr<ErrorProbe> probe; // with or without a recording (the summary reports it)
     bool failed = false; // --record could not be opened: the run reports failure at the end
 
     recordings::RecordingWriter* writer() const
@@ -278,6 +280,9 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
         if (rec.shown) {
             rec.shown->onFrame(f, state, image);
         }
+        if (rec.probe) {
+            rec.probe->onFrame(f, state); // after the frame was presented, before the next
+        }
     };
     SystemdNotifier notifier;
     LoopOptions loopOptions;
@@ -292,6 +297,9 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
             if (rec.shown) {
                 rec.shown->setWriter(next); // the next file holds what was shown too
             }
+            if (rec.probe) {
+                rec.probe->setWriter(next);
+            }
             return next;
         };
     }
@@ -303,6 +311,9 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
     if (rec.shown) {
         rec.shown->finish(); // the last thumbnail and the log tap, before the writer closes
     }
+    if (rec.probe) {
+        rec.probe->finish(); // the probe in hand written, before the writer closes
+    }
     return stats;
 }
 
@@ -312,6 +323,7 @@ int finishRun(const run_cli::RunOptions& o,
               const Sources& sources,
               FrameOutputs& outputs,
               const LoopStats& stats,
+              const ErrorProbe* probe,
               nlohmann::json& summary,
               int code)
 {
@@ -340,6 +352,12 @@ int finishRun(const run_cli::RunOptions& o,
     const double periodMs = 1000.0 / o.rateHz;
     logLoopSummary(stats, periodMs, !o.digests.empty());
     summary.update(loopSummaryJson(stats, periodMs));
+    if (probe != nullptr) {
+        const double wallS = summary.value("wall_s", 0.0);
+        logSpeedAndError(probe->stats(), probe->options(), stats.frameTimes.atLeast(periodMs),
+                         stats.frames, wallS);
+        summary["error_probe"] = errorProbeJson(probe->stats(), probe->options(), wallS);
+    }
     summary["exit_code"] = code;
     if (o.json) {
         fmt::print("{}\n", summary.dump(2));
@@ -503,6 +521,9 @@ int runMain(const run_cli::RunOptions& given)
     startup.reset(); // from here a stop ends the loop at a frame, the recording closed
     logStart(**appliance, *sources);
     RunRecording rec = openRecording(o, **appliance, plan->output, *sources);
+    ErrorProbeOptions probeOptions;
+    probeOptions.periodS = o.errorProbeS;
+    rec.probe = ErrorProbe::create(**appliance, probeOptions, rec.writer());
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
     double wallS = 0.0;
     auto stats = runLoop(o, **appliance, *sources, rec, outputs, wallS);
@@ -512,7 +533,7 @@ int runMain(const run_cli::RunOptions& given)
     }
     nlohmann::json summary{{"command", "run"}, {"wall_s", wallS}};
     const int code = closeRecording(rec, o, summary);
-    return finishRun(o, **appliance, *sources, outputs, *stats, summary, code);
+    return finishRun(o, **appliance, *sources, outputs, *stats, rec.probe.get(), summary, code);
 }
 
 } // namespace

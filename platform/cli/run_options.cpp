@@ -63,6 +63,7 @@ constexpr std::array kSiteDefaults = {
                     fromSite<&S::spectrometerSerial, &O::live, &L::spectrometerSerial>},
         SiteDefault{"--record-flush-ms", fromSite<&S::flushMs, &O::recordFlushMs>},
         SiteDefault{"--no-warm-up", [](const S& s, O& o) { o.noWarmUp = !s.warmUp; }},
+        SiteDefault{"--error-probe", fromSite<&S::errorProbeS, &O::errorProbeS>},
 };
 
 // The site file, the sensor sources and the live devices' settings.
@@ -169,6 +170,13 @@ void addOutputOptions(CLI::App& cmd, RunOptions& o)
             ->capture_default_str();
     cmd.add_option("--thumbnail-width", o.thumbnailWidth, "thumbnail width (pixels)")
             ->check(CLI::Range(16, 4096))
+            ->capture_default_str();
+    cmd.add_option("--error-probe", o.errorProbeS,
+                   "every SECONDS of session time, the exact reference at a few hundred random "
+                   "pixels of the frame against the frame, at idle priority: ΔE00 p95/max into "
+                   "the recording (/replica/error_probe) and the summary; 0: off (the default "
+                   "without a site file; the site file's [render] error_probe, 10 s when absent)")
+            ->check(CLI::Range(0.0, 3600.0))
             ->capture_default_str();
     cmd.add_flag("--json", o.json,
                  "print a JSON summary (frames, frame times, drops, recording, outputs) on "

@@ -54,6 +54,7 @@ struct RunOptions {
     bool noWarmUp = false;     // --no-warm-up: RunConfig::warmUp false
     bool recordDigests = true; // format 4: XXH3-64 of every displayed frame in the recording
     double thumbnailHz = 1.0;
+    double errorProbeS = 0.0; // --error-probe: seconds between error probes, 0: none
     int thumbnailWidth = 320;
     bool json = false;
     LiveOptions live;

@@ -278,6 +278,7 @@ void renderChoices(const RunOptions& o, RunConfig& config)
     }
     config.plannerCache = o.planCache;
     config.warmUp = !o.noWarmUp;
+    config.errorProbeS = o.errorProbeS;
 }
 
 // A live run on a synthetic display profile: warned loudly, and refused by the kiosk unless the

@@ -48,7 +48,7 @@ fi
 grep -q "no frame between" "$work/after.err" || fail "no clear message for an empty slice"
 # inspect: several files, wall-clock start, the decided light.
 "$replica" inspect "$work/none.mcap" "$work/thumbs.mcap" > "$work/inspect.txt"
-[ "$(grep -c 'replica recording, format 5' "$work/inspect.txt")" -eq 2 ] || fail "inspect did not show both files"
+[ "$(grep -c 'replica recording, format 6' "$work/inspect.txt")" -eq 2 ] || fail "inspect did not show both files"
 grep -q "started 20[0-9-]*T" "$work/inspect.txt" || fail "inspect shows no wall-clock start"
 grep -q "shown: tungsten, 2856 K" "$work/inspect.txt" || fail "inspect shows no decided tungsten lamp at 2856 K"
 "$replica" inspect --json "$work/none.mcap" "$work/thumbs.mcap" > "$work/inspect.json"

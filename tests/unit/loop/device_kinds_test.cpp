@@ -1,8 +1,10 @@
-// Devices as data: the registry writes exactly the channels format 5 always had, and a device kind
-// that is nothing but data (a second accelerometer: new names and channel, the accelerometer's
-// sample type and codec) is polled by the loop, recorded, read back, listed and replayed; the
-// state stage's kinds reach the estimators typed, a data-only kind does not reach them.
+// Devices as data: the registry writes exactly the channels format 5 always had (and format 6's),
+// and a device kind that is nothing but data (a second accelerometer: new names and channel, the
+// accelerometer's sample type and codec) is polled by the loop, recorded, read back, listed and
+// replayed; the state stage's kinds reach the estimators typed, a data-only kind does not reach
+// them.
 #include <filesystem>
+#include <set>
 
 #include <pipeline/base/data_dir.h>
 #include <platform/appliance.h>
@@ -25,24 +27,45 @@ using recordings::DeviceKinds;
 
 // The schemas and channels of the current format as the registry makes them, against those the
 // code before the registry wrote into the committed format-5 sample (byte for byte: a viewer and
-// 'recover' see the same file).
-TEST(DeviceKinds, WriteTheChannelsAndSchemasOfTheCommittedFormat5Sample)
+// 'recover' see the same file), and against the committed format-6 sample, which adds only the
+// error probe's channel (id 16).
+::testing::AssertionResult sameChannels(const std::string& sample,
+                                        const std::set<std::uint16_t>& addedSince)
 {
-    const std::string file = tests::slurp(std::filesystem::path(REPLICA_SOURCE_DIR) /
-                                          "recordings/samples/walk-v5.mcap");
-    ASSERT_FALSE(file.empty());
+    const std::string file =
+            tests::slurp(std::filesystem::path(REPLICA_SOURCE_DIR) / "recordings/samples" / sample);
+    if (file.empty()) {
+        return ::testing::AssertionFailure() << sample << " is missing";
+    }
     const auto scan = recordings::mcap::scan(file);
-    ASSERT_TRUE(scan.damage.empty());
+    if (!scan.damage.empty()) {
+        return ::testing::AssertionFailure() << sample << " is damaged";
+    }
     const auto& defs = recordings::channelDefinitions();
-    ASSERT_EQ(defs.size(), scan.channels.size());
+    if (defs.size() != scan.channels.size() + addedSince.size()) {
+        return ::testing::AssertionFailure()
+               << sample << ": " << scan.channels.size() << " channels, today " << defs.size();
+    }
     for (const auto& d : defs) {
         const auto c = scan.channels.find(d.channel.id);
-        ASSERT_NE(c, scan.channels.end()) << d.channel.topic;
-        EXPECT_EQ(c->second, d.channel) << d.channel.topic;
+        if (c == scan.channels.end()) {
+            if (addedSince.count(d.channel.id) == 0) {
+                return ::testing::AssertionFailure() << sample << ": no " << d.channel.topic;
+            }
+            continue;
+        }
         const auto s = scan.schemas.find(d.schema.id);
-        ASSERT_NE(s, scan.schemas.end()) << d.schema.name;
-        EXPECT_EQ(s->second, d.schema) << d.schema.name;
+        if (!(c->second == d.channel) || s == scan.schemas.end() || !(s->second == d.schema)) {
+            return ::testing::AssertionFailure() << sample << ": " << d.channel.topic << " differs";
+        }
     }
+    return ::testing::AssertionSuccess();
+}
+
+TEST(DeviceKinds, WriteTheChannelsAndSchemasOfTheCommittedFormat5Sample)
+{
+    EXPECT_TRUE(sameChannels("walk-v5.mcap", {16}));
+    EXPECT_TRUE(sameChannels("walk-v6.mcap", {}));
     // One registration each: the four devices, in channel order.
     const auto& kinds = recordings::deviceKinds();
     ASSERT_EQ(kinds.size(), 4u);
@@ -76,7 +99,7 @@ TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAnd
             {"accel2",
              "second accelerometer",
              "samples",
-             {16, "/hal/accel2", schema.first, schema.second},
+             {17, "/hal/accel2", schema.first, schema.second},
              std::nullopt,
              "accel2_seq",
              "dropped_accel2",
@@ -163,7 +186,7 @@ TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAnd
     for (const auto& c : report->channels) {
         if (c.topic == "/hal/accel2") {
             listed = true;
-            EXPECT_EQ(c.id, 16);
+            EXPECT_EQ(c.id, 17);
             EXPECT_EQ(c.schemaName, "replica.AccelSample");
             EXPECT_EQ(c.messages, polled);
         }
@@ -206,7 +229,7 @@ TEST(DeviceKinds, TheEstimatorsGetTypedSamplesOfTheStateKindsAndADataKindIsPolle
             {"accel2",
              "second accelerometer",
              "samples",
-             {16, "/hal/accel2", schema.first, schema.second},
+             {17, "/hal/accel2", schema.first, schema.second},
              std::nullopt,
              "accel2_seq",
              "dropped_accel2",
@@ -229,7 +252,7 @@ TEST(DeviceKinds, TheEstimatorsGetTypedSamplesOfTheStateKindsAndADataKindIsPolle
     recordings::DeviceSink* tee = nullptr;
     const recordings::StateSlots slots(recordings::stateKinds(), sources, &tee);
     ASSERT_EQ(slots.all().size(), 2u);
-    EXPECT_EQ(&slots.all()[0]->kind(), &recordings::accelKind()); // channel order: 4, then 16
+    EXPECT_EQ(&slots.all()[0]->kind(), &recordings::accelKind()); // channel order: 4, then 17
     EXPECT_EQ(&slots.all()[1]->kind(), &secondAccel);
     std::uint64_t mismatches = 0;
     for (const auto& slot : slots.all()) {

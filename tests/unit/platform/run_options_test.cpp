@@ -15,6 +15,7 @@
 #include <platform/cli/run_options.h>
 #include <platform/cli/run_resolve.h>
 #include <platform/cli/run_sources.h>
+#include <platform/loop/error_probe.h>
 #include <platform/site_config.h>
 #include <recordings/device_kind.h>
 
@@ -107,6 +108,24 @@ TEST(RunOptions, TheLightAndTheBoothComeFromTheSiteFileOrTheCommandLine)
     EXPECT_EQ(plan->config.light, kLightAuto);
     EXPECT_EQ(plan->config.boothDir, "booth");
     EXPECT_DOUBLE_EQ(plan->config.directCdM2PerY, kDefaultDirectCdM2PerY);
+}
+
+TEST(RunOptions, TheErrorProbeIsOffWithoutASiteFileAndEvery10sFromOne)
+{
+    // No site file: off. A site file without the key (the kiosk's): every 10 s. The key, then the
+    // command line, win; the period chosen is recorded in the RunConfig.
+    EXPECT_EQ(parseRun({}, "").errorProbeS, 0.0);
+    EXPECT_EQ(parseRun({}, "[run]\nhal = \"sim\"\n").errorProbeS, kKioskErrorProbeS);
+    EXPECT_EQ(parseRun({}, "[render]\nerror_probe = 3.5\n").errorProbeS, 3.5);
+    EXPECT_EQ(parseRun({}, "[render]\nerror_probe = 0\n").errorProbeS, 0.0);
+    const RunOptions o = parseRun({"--error-probe", "2"}, "[render]\nerror_probe = 30\n");
+    EXPECT_EQ(o.errorProbeS, 2.0);
+    auto plan = resolveRun(o);
+    ASSERT_TRUE(plan) << plan.error().lines.front();
+    EXPECT_EQ(plan->config.errorProbeS, 2.0);
+    auto back = RunConfig::fromJson(plan->config.toJson());
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->errorProbeS, 2.0);
 }
 
 TEST(RunOptions, EveryDeviceKindHasItsSourceOptionDefaultedFromHal)
