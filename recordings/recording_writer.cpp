@@ -114,6 +114,8 @@ public:
         return {};
     }
 
+    std::int64_t wallClockStartNs() const override { return wallStart_; }
+
     WriterStats stats() const override
     {
         WriterStats s;
