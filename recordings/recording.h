@@ -253,6 +253,8 @@ public:
     virtual Expected<void> close() = 0;
     // Thread-safe snapshot of what the writer has done so far.
     virtual WriterStats stats() const = 0;
+    // The session's Unix time (ns) at session time 0 (SessionInfo::wallClockStartNs).
+    virtual std::int64_t wallClockStartNs() const = 0;
 };
 
 // Reads a whole recording. Fails with a one-line reason (missing, empty, not a recording, damaged).

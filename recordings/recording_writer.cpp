@@ -115,6 +115,8 @@ public:
         return {};
     }
 
+    std::int64_t wallClockStartNs() const override { return wallStart_; }
+
     WriterStats stats() const override
     {
         WriterStats s;

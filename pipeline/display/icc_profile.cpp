@@ -1,7 +1,9 @@
 // ICC v4 display profile through Little CMS 2.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include <fmt/format.h>
 #include <glm/matrix.hpp>
@@ -48,15 +50,43 @@ glm::dmat3 bradfordToD50(const glm::dvec3& white)
     return glm::inverse(b) * scale * b;
 }
 
-Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
-                                         const std::filesystem::path& path)
+namespace {
+
+// The tone curve of channel c as 'samples' 16-bit entries (an exact curve for 8-bit pixels when
+// samples is 256), or 4096 float samples when samples is 0.
+std::unique_ptr<cmsToneCurve, CurveFree>
+trcCurve(const DisplayModel& model, int c, double bc, int samples)
 {
-    IccWriteReport report;
+    const int n = samples > 1 ? samples : 4096;
+    std::vector<double> v(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const double d = model.maxCount() * static_cast<double>(i) / (n - 1);
+        v[static_cast<std::size_t>(i)] = std::clamp((model.tone[c](d) + bc) / (1.0 + bc), 0.0, 1.0);
+    }
+    if (samples > 1) {
+        std::vector<cmsUInt16Number> t(v.size());
+        std::transform(v.begin(), v.end(), t.begin(), [](double x) {
+            return static_cast<cmsUInt16Number>(std::lround(x * 65535.0));
+        });
+        return std::unique_ptr<cmsToneCurve, CurveFree>(
+                cmsBuildTabulatedToneCurve16(nullptr, static_cast<cmsUInt32Number>(n), t.data()));
+    }
+    std::vector<cmsFloat32Number> f(v.begin(), v.end());
+    return std::unique_ptr<cmsToneCurve, CurveFree>(
+            cmsBuildTabulatedToneCurveFloat(nullptr, static_cast<cmsUInt32Number>(n), f.data()));
+}
+
+// The profile of the model (writeIccProfile's header comment); 'where' names it in errors.
+Expected<ProfilePtr> buildProfile(const DisplayModel& model,
+                                  IccWriteReport& report,
+                                  int samples,
+                                  const std::string& where)
+{
     report.crosstalkOmitted = model.hasCrosstalk();
     const glm::dvec3 white = model.whiteXyz();
     if (!(white.y > 0.0)) {
         return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("{}: the model's white has no luminance", path.string()));
+                         fmt::format("{}: the model's white has no luminance", where));
     }
     glm::dvec3 b = glm::inverse(model.matrix) * model.blackXyz;
     for (int c = 0; c < 3; ++c) {
@@ -99,30 +129,65 @@ Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
     ok = ok && cmsWriteTag(h, cmsSigChromaticAdaptationTag, chad) != 0;
     const cmsCIEXYZ lumi{0.0, white.y, 0.0};
     ok = ok && cmsWriteTag(h, cmsSigLuminanceTag, &lumi) != 0;
-    // TRCs sampled at 4096 points over the count range (the curv tag holds 16-bit values).
-    constexpr int kSamples = 4096;
     const cmsTagSignature trcTags[3] = {cmsSigRedTRCTag, cmsSigGreenTRCTag, cmsSigBlueTRCTag};
-    for (std::size_t c = 0; ok && c < 3; ++c) {
-        std::vector<cmsFloat32Number> v(kSamples);
-        const double bc = b[static_cast<int>(c)];
-        for (int i = 0; i < kSamples; ++i) {
-            const double d = model.maxCount() * static_cast<double>(i) / (kSamples - 1);
-            v[static_cast<std::size_t>(i)] = static_cast<cmsFloat32Number>(
-                    std::clamp((model.tone[c](d) + bc) / (1.0 + bc), 0.0, 1.0));
-        }
-        std::unique_ptr<cmsToneCurve, CurveFree> curve(
-                cmsBuildTabulatedToneCurveFloat(nullptr, kSamples, v.data()));
+    for (int c = 0; ok && c < 3; ++c) {
+        const auto curve = trcCurve(model, c, b[c], samples);
         ok = curve != nullptr && cmsWriteTag(h, trcTags[c], curve.get()) != 0;
     }
     if (!ok) {
-        return makeError(ErrorCode::Io, fmt::format("{}: lcms2 could not build the profile's tags",
-                                                    path.string()));
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: lcms2 could not build the profile's tags", where));
     }
-    if (cmsSaveProfileToFile(h, path.string().c_str()) == 0) {
+    return guard;
+}
+
+} // namespace
+
+Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
+                                         const std::filesystem::path& path)
+{
+    IccWriteReport report;
+    // TRCs sampled at 4096 points over the count range (the curv tag holds 16-bit values).
+    auto h = buildProfile(model, report, 0, path.string());
+    if (!h) {
+        return tl::unexpected(h.error());
+    }
+    if (cmsSaveProfileToFile(h->get(), path.string().c_str()) == 0) {
         return makeError(ErrorCode::Io,
                          fmt::format("{}: cannot write the ICC profile", path.string()));
     }
     return report;
+}
+
+Expected<std::vector<std::uint8_t>> iccProfileBytes(const DisplayModel& model, int trcSamples)
+{
+    IccWriteReport report;
+    auto h = buildProfile(model, report, std::max(trcSamples, 2), model.name);
+    if (!h) {
+        return tl::unexpected(h.error());
+    }
+    cmsUInt32Number size = 0;
+    if (cmsSaveProfileToMem(h->get(), nullptr, &size) == 0 || size == 0) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: lcms2 cannot serialise the ICC profile", model.name));
+    }
+    std::vector<std::uint8_t> out(size);
+    if (cmsSaveProfileToMem(h->get(), out.data(), &size) == 0) {
+        return makeError(ErrorCode::Io,
+                         fmt::format("{}: lcms2 cannot serialise the ICC profile", model.name));
+    }
+    out.resize(size);
+    // The header's creation date (bytes 24-35, six big-endian 16-bit numbers) is the moment lcms2
+    // built the profile; the model has no date of its own. A fixed one (1970-01-01 00:00:00) keeps
+    // the bytes, and so every PNG that embeds them, the same from run to run.
+    if (out.size() >= 36) {
+        const std::uint16_t date[6] = {1970, 1, 1, 0, 0, 0};
+        for (std::size_t i = 0; i < 6; ++i) {
+            out[24 + 2 * i] = static_cast<std::uint8_t>(date[i] >> 8);
+            out[25 + 2 * i] = static_cast<std::uint8_t>(date[i] & 0xff);
+        }
+    }
+    return out;
 }
 
 Expected<IccInfo> readIccInfo(const std::filesystem::path& path)

@@ -8,6 +8,7 @@
 // (C = 0) and the report says so.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -25,6 +26,12 @@ struct IccWriteReport {
 
 Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
                                          const std::filesystem::path& path);
+
+// The same profile in memory, its tone curves as 'trcSamples' 16-bit entries over the count range:
+// 256 entries are exact at every value of an 8-bit image's pixels (a PNG's iCCP chunk). Its
+// creation date is fixed at 1970-01-01 00:00:00: the same model gives the same bytes.
+Expected<std::vector<std::uint8_t>> iccProfileBytes(const DisplayModel& model,
+                                                    int trcSamples = 256);
 
 // Bradford adaptation matrix from 'white' (any scale) to D50 (X 0.9642, Y 1, Z 0.8249).
 glm::dmat3 bradfordToD50(const glm::dvec3& white);

@@ -1,5 +1,6 @@
 // Digest and snapshot collection.
 #include <platform/cli/frame_outputs.h>
+#include <platform/image/png_metadata.h>
 #include <platform/image/png_writer.h>
 
 namespace replica::platform {
@@ -24,6 +25,8 @@ FrameCallback FrameOutputs::callback()
             lastWidth_ = image.width;
             lastHeight_ = image.height;
             lastRgba_ = image.rgba;
+            lastTickNs_ = f.tickNs;
+            lastFrame_ = f.frameIndex;
         }
     };
 }
@@ -41,6 +44,11 @@ Expected<void> FrameOutputs::finish(const std::string& digestPath,
             return makeError(ErrorCode::InvalidArgument,
                              snapshotPath +
                                      ": no frame was rendered, so there is nothing to snapshot");
+        }
+        if (tagged_) {
+            const PngMetadata meta =
+                    shownFrameMetadata(icc_, iccName_, wallStartNs_, lastTickNs_, lastFrame_);
+            return writePng(snapshotPath, lastWidth_, lastHeight_, lastRgba_, &meta);
         }
         return writePng(snapshotPath, lastWidth_, lastHeight_, lastRgba_);
     }

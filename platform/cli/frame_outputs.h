@@ -1,7 +1,9 @@
 // What the run and replay commands keep from each frame: digests and the last frame for a snapshot.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <pipeline/render/renderer.h>
@@ -22,6 +24,16 @@ public:
     pipeline::render::Readback readback() const;
     FrameCallback callback();
     const std::vector<FrameDigest>& digests() const { return digests_; }
+    // The snapshot's colour space and time chunks (png_metadata.h): the display profile as ICC
+    // (empty: sRGB) and the session's wall-clock start (0: unknown).
+    void
+    tagSnapshot(std::vector<std::uint8_t> icc, std::string profileName, std::int64_t wallStartNs)
+    {
+        icc_ = std::move(icc);
+        iccName_ = std::move(profileName);
+        wallStartNs_ = wallStartNs;
+        tagged_ = true;
+    }
     // Writes the digest file and the PNG snapshot of the last frame (either path may be empty).
     Expected<void> finish(const std::string& digestPath, const std::string& snapshotPath) const;
 
@@ -33,6 +45,12 @@ private:
     int lastWidth_ = 0;
     int lastHeight_ = 0;
     std::vector<std::uint8_t> lastRgba_;
+    std::int64_t lastTickNs_ = 0;
+    std::uint64_t lastFrame_ = 0;
+    bool tagged_ = false;
+    std::vector<std::uint8_t> icc_;
+    std::string iccName_;
+    std::int64_t wallStartNs_ = 0;
 };
 
 } // namespace replica::platform

@@ -35,7 +35,11 @@ struct ReplayOptions {
     std::string mismatchDir; // where --check writes the first differing frame
     std::vector<std::string> dataRoots; // folders besides data/ a recording may name files in
     bool allowUndigested = false;       // replay a recording without scene/display digests
-    std::optional<double> fromS, toS;   // the slice, in seconds of session time
+    // --from/--to as given (session seconds, a time of day or ISO 8601: wall_clock_time.h), and
+    // the slice they make in seconds of session time (resolveSliceTimes).
+    std::string fromArg, toArg;
+    std::optional<double> fromS, toS;
+    std::string fromWallClock, toWallClock; // the instants a wall-clock --from/--to named
     std::string framesOut; // PNG of every displayed frame of the slice (--frames-out, --save-png)
     bool json = false;
     bool progress = false; // progress lines even when standard error is not a terminal
@@ -67,6 +71,11 @@ struct ReplaySlice {
     std::size_t frames = 0; // in the slice
     bool contains(std::int64_t tickNs) const { return tickNs >= fromNs && tickNs <= untilNs; }
 };
+// --from/--to (o.fromArg, o.toArg) as seconds of session time into o.fromS, o.toS: session seconds
+// as given, wall-clock times against the recording's start; the lines saying where each wall-clock
+// time landed ("--from 14:32:05 is session second 1925.5 (...)"), or a usage error (exit 2).
+Expected<std::vector<std::string>> resolveSliceTimes(ReplayOptions& o,
+                                                     const recordings::Recording& recording);
 // The slice of 'recording' the options ask for; a usage error (the message, exit 2) when it is
 // empty or backwards.
 Expected<ReplaySlice> makeSlice(const ReplayOptions& o, const recordings::Recording& recording);

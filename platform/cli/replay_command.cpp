@@ -14,6 +14,7 @@
 #include <pthread.h>
 #include <unistd.h>
 
+#include <pipeline/display/icc_profile.h>
 #include <pipeline/render/render_profile.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
@@ -21,6 +22,7 @@
 #include <platform/cli/loop_summary.h>
 #include <platform/cli/replay.h>
 #include <platform/cli/replay_shown.h>
+#include <platform/image/png_metadata.h>
 #include <platform/image/png_writer.h>
 #include <platform/image/xyz_frame.h>
 #include <platform/logging.h>
@@ -138,10 +140,28 @@ struct ReplayRun {
     std::optional<std::vector<std::uint64_t>> saveOnly;
     std::optional<Error> error;
     std::uint64_t framesWritten = 0;
+    // --frames-out's PNGs: the display profile they are in (empty: sRGB) and the recording's
+    // wall-clock start (png_metadata.h).
+    std::vector<std::uint8_t> icc;
+    std::string iccName;
+    std::int64_t wallStartNs = 0;
     std::uint64_t done = 0;
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
     std::chrono::steady_clock::time_point lastProgress = start;
     bool showProgress = false;
+
+    // The PNGs' colour space (the display profile) and time (png_metadata.h).
+    void tagPngs(const pipeline::display::DisplayModel& model, std::int64_t wallStart)
+    {
+        if (auto profile = pipeline::display::iccProfileBytes(model); profile) {
+            icc = std::move(*profile);
+            iccName = model.name;
+        } else {
+            logger("replica")->warn("the PNGs are tagged sRGB: {}", profile.error().message);
+        }
+        wallStartNs = wallStart;
+        outputs.tagSnapshot(icc, iccName, wallStartNs);
+    }
 
     void progress(const recordings::FrameRecord& f)
     {
@@ -169,8 +189,10 @@ struct ReplayRun {
     {
         const auto frameNo = static_cast<long>(f.frameIndex);
         if (!o.framesOut.empty()) {
+            const PngMetadata meta =
+                    shownFrameMetadata(icc, iccName, wallStartNs, f.tickNs, f.frameIndex);
             if (auto ok = writePng(framePath(o.framesOut, frameNo, ".png"), image.width,
-                                   image.height, image.rgba);
+                                   image.height, image.rgba, &meta);
                 !ok) {
                 return ok;
             }
@@ -303,6 +325,14 @@ nlohmann::json baseSummary(const ReplayOptions& o,
     summary.update(loopSummaryJson(stats, 1000.0 / loaded.config.rateHz));
     if (o.fromS || o.toS) {
         summary["slice"] = {{"from_s", o.fromS.value_or(0.0)}, {"frames", slice.frames}};
+        if (!o.fromWallClock.empty()) {
+            summary["slice"]["from"] = o.fromArg;
+            summary["slice"]["from_wall_clock"] = o.fromWallClock;
+        }
+        if (!o.toWallClock.empty()) {
+            summary["slice"]["to"] = o.toArg;
+            summary["slice"]["to_wall_clock"] = o.toWallClock;
+        }
         if (o.toS) {
             summary["slice"]["to_s"] = *o.toS;
         }
@@ -340,6 +370,9 @@ int runReplay(const ReplayOptions& o,
     }
     ReplayRun run{o, slice, outputs, golden, shownDigests, shown, std::move(saveOnly)};
     run.showProgress = !o.noProgress && (o.progress || ::isatty(STDERR_FILENO) == 1);
+    if (!o.framesOut.empty() || !o.snapshot.empty()) {
+        run.tagPngs(appliance.displayModel, loaded.recording.session.wallClockStartNs);
+    }
     // The frames before a slice are only estimated (TickPlan::warmup): they reach no callback.
     run.done = slice.plan.size() - slice.frames;
     auto keep = outputs.callback();
@@ -411,9 +444,10 @@ int runReplay(const ReplayOptions& o,
 
 } // namespace
 
-int replayMain(const ReplayOptions& o)
+int replayMain(const ReplayOptions& given)
 {
     auto log = logger("replica");
+    ReplayOptions o = given; // --from/--to resolved below
     if (o.output != "headless" && o.output != "kms") {
         log->error("--output {}: expected 'headless' or 'kms'", o.output);
         return kExitUsage;
@@ -425,6 +459,17 @@ int replayMain(const ReplayOptions& o)
     LoadedReplay& loaded = std::get<LoadedReplay>(loadedOr);
     const recordings::Recording& recording = loaded.recording;
     RunConfig& config = loaded.config;
+    // Wall-clock --from/--to against the recording's start, before anything is built.
+    auto sliceLines = resolveSliceTimes(o, recording);
+    if (!sliceLines) {
+        log->error("{}: {}", o.file, sliceLines.error().message);
+        return kExitUsage;
+    }
+    for (const auto& line : *sliceLines) {
+        if (!o.json) {
+            fmt::print("{}\n", line);
+        }
+    }
     // This build draws with the booth pass, today's profile: a recording of another profile or
     // drawn by the flat renderer is bit for bit the build that made it's promise.
     const bool exact =

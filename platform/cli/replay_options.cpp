@@ -4,6 +4,7 @@
 #include <platform/cli/commands.h>
 #include <platform/cli/replay.h>
 #include <platform/cli/replay_shown.h>
+#include <platform/cli/wall_clock_time.h>
 
 namespace replica::platform {
 
@@ -81,12 +82,24 @@ void registerReplayCommand(CLI::App& app, int& exitCode)
                   "after the last frame, keep it on the display until SIGTERM or SIGINT (a still "
                   "for a demo, or for a screen check: with --from T --to T the display shows "
                   "exactly the frame at T)");
-    cmd->add_option("--from", opts->fromS,
-                    "replay only the frames from T seconds of session time on (the frames before "
-                    "are rendered first, fast, since each frame depends on those before it)")
-            ->check(CLI::Range(0.0, 1e9));
-    cmd->add_option("--to", opts->toS, "... up to T seconds of session time (inclusive)")
-            ->check(CLI::Range(0.0, 1e9));
+    const CLI::Validator timeArg(
+            [](std::string& s) {
+                auto a = parseTimeArg(s);
+                return a ? std::string() : a.error().message;
+            },
+            "TIME", "");
+    cmd->add_option("--from", opts->fromArg,
+                    "replay only the frames from T on (the frames before are rendered first, "
+                    "fast, since each frame depends on those before it). T is seconds of session "
+                    "time (75.5), a time of day (14:32:05[.fff], in the local time zone: TZ), or "
+                    "an ISO 8601 date and time (2026-12-06T14:32:05Z, ...+01:00, fractional "
+                    "seconds allowed); a line says which session second a time maps to, and a "
+                    "time outside the recording is refused (exit 2) with its span in both clocks")
+            ->check(timeArg);
+    cmd->add_option("--to", opts->toArg,
+                    "... up to T (inclusive): seconds of session time, a time of day or ISO 8601, "
+                    "as --from")
+            ->check(timeArg);
     // One option under two names: --save-png is its older name, kept so that scripts using it
     // (deploy/boot-test once did) go on working.
     cmd->add_option("--frames-out,--save-png", opts->framesOut,

@@ -1,12 +1,67 @@
 // The slice of a recording 'replica replay' outputs (--from, --to).
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 #include <fmt/format.h>
 
 #include <platform/cli/replay.h>
+#include <platform/cli/wall_clock_time.h>
 
 namespace replica::platform {
+
+namespace {
+
+// One of --from/--to: its session seconds, and the line saying where a wall-clock time landed.
+Expected<std::optional<std::string>> resolveOne(const std::string& option,
+                                                const std::string& text,
+                                                const RecordingSpan& span,
+                                                std::optional<double>& seconds,
+                                                std::string& wallClock)
+{
+    if (text.empty()) {
+        return std::optional<std::string>();
+    }
+    auto arg = parseTimeArg(text);
+    if (!arg) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{} {}", option, arg.error().message));
+    }
+    if (arg->form == TimeArg::Form::SessionSeconds) {
+        seconds = arg->seconds;
+        return std::optional<std::string>();
+    }
+    auto at = resolveWallClock(option, text, *arg, span);
+    if (!at) {
+        return tl::unexpected(at.error());
+    }
+    seconds = at->sessionS;
+    wallClock = isoLocal(at->unixNs);
+    return fmt::format("{} {} is session second {} ({}, {})", option, text, at->sessionS, wallClock,
+                       isoUtcMs(at->unixNs));
+}
+
+} // namespace
+
+Expected<std::vector<std::string>> resolveSliceTimes(ReplayOptions& o,
+                                                     const recordings::Recording& recording)
+{
+    const RecordingSpan span{recording.session.wallClockStartNs,
+                             recording.frames.empty() ? 0 : recording.frames.back().tickNs};
+    std::vector<std::string> lines;
+    for (auto [option, text, seconds, wall] :
+         {std::tuple{"--from", &o.fromArg, &o.fromS, &o.fromWallClock},
+          std::tuple{"--to", &o.toArg, &o.toS, &o.toWallClock}}) {
+        auto line = resolveOne(option, *text, span, *seconds, *wall);
+        if (!line) {
+            return tl::unexpected(line.error());
+        }
+        if (*line) {
+            lines.push_back(**line);
+        }
+    }
+    return lines;
+}
 
 Expected<ReplaySlice> makeSlice(const ReplayOptions& o, const recordings::Recording& recording)
 {

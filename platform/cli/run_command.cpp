@@ -20,6 +20,7 @@
 #include <sys/stat.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/display/icc_profile.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
@@ -525,6 +526,13 @@ int runMain(const run_cli::RunOptions& given)
     probeOptions.periodS = o.errorProbeS;
     rec.probe = ErrorProbe::create(**appliance, probeOptions, rec.writer());
     FrameOutputs outputs(!o.digests.empty(), !o.snapshot.empty());
+    if (!o.snapshot.empty()) {
+        // The snapshot says the panel's colour space, and its time where a recording gives one.
+        auto icc = pipeline::display::iccProfileBytes((*appliance)->displayModel);
+        outputs.tagSnapshot(icc ? std::move(*icc) : std::vector<std::uint8_t>{},
+                            (*appliance)->displayModel.name,
+                            rec.writer() != nullptr ? rec.writer()->wallClockStartNs() : 0);
+    }
     double wallS = 0.0;
     auto stats = runLoop(o, **appliance, *sources, rec, outputs, wallS);
     if (!stats) {

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <png.h>
 
+#include <platform/image/png_metadata.h>
 #include <platform/image/png_writer.h>
 
 namespace replica::platform {
@@ -12,7 +13,8 @@ namespace replica::platform {
 Expected<void> writePng(const std::filesystem::path& path,
                         int width,
                         int height,
-                        const std::vector<std::uint8_t>& rgba)
+                        const std::vector<std::uint8_t>& rgba,
+                        const PngMetadata* meta)
 {
     if (width <= 0 || height <= 0 ||
         rgba.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 4) {
@@ -38,6 +40,7 @@ Expected<void> writePng(const std::filesystem::path& path,
                 const_cast<png_bytep>(rgba.data() + static_cast<std::size_t>(height - 1 - y) *
                                                             static_cast<std::size_t>(width) * 4);
     }
+    const PngChunks chunks(meta);
     // libpng reports errors by longjmp; nothing with a destructor is created after this point.
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_write_struct(&png, &info);
@@ -47,6 +50,7 @@ Expected<void> writePng(const std::filesystem::path& path,
     png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                  PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
+    chunks.apply(png, info);
     png_write_info(png, info);
     png_write_image(png, rows.data());
     png_write_end(png, nullptr);

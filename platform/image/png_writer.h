@@ -9,10 +9,14 @@
 
 namespace replica::platform {
 
-// rgba: width * height * 4 bytes, rows bottom-up (GL order); the PNG is written top-down.
+struct PngMetadata; // png_metadata.h
+
+// rgba: width * height * 4 bytes, rows bottom-up (GL order); the PNG is written top-down. 'meta':
+// the colour space and time chunks (png_metadata.h), none when null.
 Expected<void> writePng(const std::filesystem::path& path,
                         int width,
                         int height,
-                        const std::vector<std::uint8_t>& rgba);
+                        const std::vector<std::uint8_t>& rgba,
+                        const PngMetadata* meta = nullptr);
 
 } // namespace replica::platform

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <png.h>
 
+#include <platform/image/png_metadata.h>
 #include <platform/image/thumbnail.h>
 
 namespace replica::platform {
@@ -69,7 +70,7 @@ void noFlush(png_structp)
 
 } // namespace
 
-Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image)
+Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image, const PngMetadata* meta)
 {
     if (image.width <= 0 || image.height <= 0 ||
         image.rgb.size() != static_cast<std::size_t>(image.width) *
@@ -89,6 +90,7 @@ Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image)
                 image.rgb.data() +
                 static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) * 3);
     }
+    const PngChunks chunks(meta);
     // libpng reports errors by longjmp; nothing with a destructor is created after this point.
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_write_struct(&png, &info);
@@ -99,6 +101,7 @@ Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image)
     png_set_IHDR(png, info, static_cast<png_uint_32>(image.width),
                  static_cast<png_uint_32>(image.height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    chunks.apply(png, info);
     png_write_info(png, info);
     png_write_image(png, rows.data());
     png_write_end(png, nullptr);

@@ -21,8 +21,12 @@ struct RgbImage {
 // recomputes this rule independently. A width at or above the frame's keeps the frame's size.
 RgbImage downscaleRgba(int width, int height, const std::vector<std::uint8_t>& rgba, int toWidth);
 
-// PNG (8-bit RGB, zlib level 6) of the image, in memory.
-Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image);
+struct PngMetadata; // png_metadata.h
+
+// PNG (8-bit RGB, zlib level 6) of the image, in memory; 'meta': its colour space and time chunks
+// (png_metadata.h), none when null.
+Expected<std::vector<std::uint8_t>> encodePngRgb(const RgbImage& image,
+                                                 const PngMetadata* meta = nullptr);
 
 // The image of a PNG in memory (any colour type, converted to 8-bit RGB by libpng), at most
 // kMaxThumbnailPixels; fails with the reason on anything else.

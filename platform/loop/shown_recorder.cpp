@@ -5,6 +5,8 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/cct.h>
+#include <pipeline/display/icc_profile.h>
+#include <platform/image/png_metadata.h>
 #include <platform/image/thumbnail.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_digest.h>
@@ -68,6 +70,12 @@ ShownRecorder::ShownRecorder(recordings::RecordingWriter* writer,
         });
     }
     if (options_.thumbnailHz > 0.0 && options_.thumbnailWidth > 0) {
+        if (auto icc = pipeline::display::iccProfileBytes(appliance_.displayModel); icc) {
+            icc_ = std::move(*icc);
+            iccName_ = appliance_.displayModel.name;
+        } else {
+            logger("rec")->warn("thumbnails are tagged sRGB: {}", icc.error().message);
+        }
         encoder_ = std::thread([this] { encoderLoop(); });
     }
 }
@@ -136,6 +144,7 @@ void ShownRecorder::onFrame(const recordings::FrameRecord& frame,
         {
             std::lock_guard writerLock(writerMutex_);
             p.generation = writerGeneration_;
+            p.wallStartNs = writer_ != nullptr ? writer_->wallClockStartNs() : 0;
         }
         p.width = image.width;
         p.height = image.height;
@@ -230,7 +239,9 @@ void ShownRecorder::encoderLoop()
         }
         const auto t0 = Clock::now();
         const RgbImage small = downscaleRgba(p.width, p.height, p.rgba, options_.thumbnailWidth);
-        auto png = encodePngRgb(small);
+        const PngMetadata meta =
+                shownFrameMetadata(icc_, iccName_, p.wallStartNs, p.tNs, p.frameIndex);
+        auto png = encodePngRgb(small, &meta);
         const double ms = msSince(t0);
         if (!png) {
             logger("rec")->warn("thumbnail of frame {}: {}", p.frameIndex, png.error().message);

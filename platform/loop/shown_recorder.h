@@ -1,9 +1,10 @@
 // What the panel showed, into the recording (format 4): a digest of every displayed frame, a PNG
 // thumbnail at a low rate (downscaled and encoded on a thread of its own, never in the frame's
-// time), the eye, panel and tracker frames, the decided light when it changes, and the
-// appliance's warnings and errors (those logged before the recorder was made included). None of
-// it changes a frame: it reads the frame after it was rendered and handed to the output. One
-// recorder serves a single --record file and a kiosk session's rotated files alike (setWriter).
+// time; tagged with the display profile and its time, png_metadata.h), the eye, panel and tracker
+// frames, the decided light when it changes, and the appliance's warnings and errors (those logged
+// before the recorder was made included). None of it changes a frame: it reads the frame after it
+// was rendered and handed to the output. One recorder serves a single --record file and a kiosk
+// session's rotated files alike (setWriter).
 #pragma once
 
 #include <atomic>
@@ -13,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -93,6 +95,9 @@ private:
     const Appliance& appliance_;
     ShownOptions options_;
     std::optional<pipeline::colour::Observer> observer_;
+    // The thumbnails' colour space: the display profile as ICC (empty: sRGB; png_metadata.h).
+    std::vector<std::uint8_t> icc_;
+    std::string iccName_;
     std::shared_ptr<void> logTap_;
     std::int64_t nextThumbnailNs_ = 0;
     std::int64_t lastPoseNs_ = 0;
@@ -106,6 +111,7 @@ private:
         std::int64_t tNs = 0;
         std::uint64_t frameIndex = 0;
         std::uint64_t generation = 0; // the writer it belongs in
+        std::int64_t wallStartNs = 0; // its session's Unix time at session time 0
         int width = 0, height = 0;
         std::vector<std::uint8_t> rgba;
     };
