@@ -3,10 +3,68 @@
 // across fields (aspect ratio, names of renderers and inverses) stay in
 // RunConfig::fromJson. A key added to RunConfig::toJson must be added here too
 // (RunConfigSchema.EveryKeyTheRunWritesIsKnown fails otherwise).
+#include <vector>
+
 #include <platform/appliance.h>
 #include <platform/run_config_schema.h>
 
 namespace replica::platform {
+
+namespace {
+
+using namespace json_schema;
+
+// Render profile 0's switches, one key each: older render paths, not read (such a recording
+// replays on today's path, approximately).
+std::vector<JsonSchemaField> legacyRenderKeys()
+{
+    const auto flag = boolean().optional();
+    return {
+            {"hardware_filter", flag},        {"specular_lod_bias", number(-8.0, 8.0).optional()},
+            {"specular_nearest_level", flag}, {"horizon_spread", flag},
+            {"horizon_half", flag},           {"horizon_bilinear", flag},
+            {"specular_branch_free", flag},   {"specular_exact_level", flag},
+            {"texel_exact_ties", flag},       {"horizon_pick", flag},
+            {"surround_illuminance", flag},   {"viewing_filtered", flag},
+    };
+}
+
+// The keys holding objects: the tracker's transform, the sensing chain, the planner's choices and
+// what is kept for people.
+std::vector<JsonSchemaField> nestedKeys()
+{
+    const auto metres3 = array(number(-100.0, 100.0), 3, 3);
+    return {
+            // A rotation matrix (row-major; entries within [-1, 1] up to rounding) and a
+            // translation in metres.
+            {"t_booth_tracker", object({{"rotation", array(number(-1.000001, 1.000001), 9, 9)},
+                                        {"translation", metres3}})
+                                        .optional()},
+            // The live spectrometer chain (pipeline/spectral/live_chain.h).
+            {"sensing", object({{"stray_light", boolean()},
+                                {"wavelength_lines", boolean()},
+                                {"average_spectra", integer(1, 1000)},
+                                {"steady_distance", number(0.0, 10.0)},
+                                {"stray_light_fraction", number(0.0, 0.5)},
+                                {"wavelength_offset_nm", number(-5.0, 5.0)},
+                                {"direct_cdm2_per_y", number(0.0, 1e12).optional()}})
+                                .optional()},
+            // The planner's choice per lamp name (platform/render_plan.h).
+            {"planned_lamps", map(object({{"lights", integer(1, 256)},
+                                          {"specular_samples", integer(0, 256)},
+                                          {"horizon_directions", integer(0, 32)}}),
+                                  64)
+                                      .optional()},
+            // What 'replica run' adds for people (never read back): any values.
+            {"run_options", map(any(), 64).optional()},
+            {"site", map(any(), 64).optional()},
+            // The estimators' state at the head of a rotated session file
+            // (state::SceneEstimator::save; checked field by field by restore).
+            {"state_at_start", map(any(), 16).optional()},
+    };
+}
+
+} // namespace
 
 const JsonSchema& runConfigSchema()
 {
@@ -15,7 +73,7 @@ const JsonSchema& runConfigSchema()
         const auto metres3 = array(number(-100.0, 100.0), 3, 3);
         const auto flag = boolean().optional();
         const auto name = string(4096);
-        return object({
+        std::vector<JsonSchemaField> fields = {
                 // Read by every version (required).
                 {"width", integer(1, kMaxFrameSide)},
                 {"height", integer(1, kMaxFrameSide)},
@@ -54,20 +112,6 @@ const JsonSchema& runConfigSchema()
                 // The render path (pipeline/render/render_profile.h); RunConfig::fromJson
                 // refuses one newer than this build's.
                 {"render_profile", integer(0, 65535).optional()},
-                // Render profile 0's switches, one key each: older render paths, not read (such
-                // a recording replays on today's path, approximately).
-                {"hardware_filter", flag},
-                {"specular_lod_bias", number(-8.0, 8.0).optional()},
-                {"specular_nearest_level", flag},
-                {"horizon_spread", flag},
-                {"horizon_half", flag},
-                {"horizon_bilinear", flag},
-                {"specular_branch_free", flag},
-                {"specular_exact_level", flag},
-                {"texel_exact_ties", flag},
-                {"horizon_pick", flag},
-                {"surround_illuminance", flag},
-                {"viewing_filtered", flag},
                 {"horizon_directions", integer(0, 32).optional()},
                 {"display_digest", string(64).optional()},
                 {"display_inverse", string(64).optional()},
@@ -84,33 +128,11 @@ const JsonSchema& runConfigSchema()
                 {"default_lamp", string(256).optional()},
                 {"default_eye_m", metres3.optional()},
                 {"default_tilt_rad", number(-3.2, 3.2).optional()},
-                // A rotation matrix (row-major; entries within [-1, 1] up to rounding) and a
-                // translation in metres.
-                {"t_booth_tracker", object({{"rotation", array(number(-1.000001, 1.000001), 9, 9)},
-                                            {"translation", metres3}})
-                                            .optional()},
-                // The live spectrometer chain (pipeline/spectral/live_chain.h).
-                {"sensing", object({{"stray_light", boolean()},
-                                    {"wavelength_lines", boolean()},
-                                    {"average_spectra", integer(1, 1000)},
-                                    {"steady_distance", number(0.0, 10.0)},
-                                    {"stray_light_fraction", number(0.0, 0.5)},
-                                    {"wavelength_offset_nm", number(-5.0, 5.0)},
-                                    {"direct_cdm2_per_y", number(0.0, 1e12).optional()}})
-                                    .optional()},
-                // The planner's choice per lamp name (platform/render_plan.h).
-                {"planned_lamps", map(object({{"lights", integer(1, 256)},
-                                              {"specular_samples", integer(0, 256)},
-                                              {"horizon_directions", integer(0, 32)}}),
-                                      64)
-                                          .optional()},
-                // What 'replica run' adds for people (never read back): any values.
-                {"run_options", map(any(), 64).optional()},
-                {"site", map(any(), 64).optional()},
-                // The estimators' state at the head of a rotated session file
-                // (state::SceneEstimator::save; checked field by field by restore).
-                {"state_at_start", map(any(), 16).optional()},
-        });
+        };
+        for (auto more : {legacyRenderKeys(), nestedKeys()}) {
+            fields.insert(fields.end(), more.begin(), more.end());
+        }
+        return object(std::move(fields));
     }();
     return s;
 }

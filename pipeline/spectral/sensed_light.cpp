@@ -398,4 +398,37 @@ Expected<SensedLight> senseLight(const FineLight& light,
     return out;
 }
 
+Expected<std::optional<ShiftCalibration>>
+calibrateShiftOnSimulatedInstrument(const FineLight& light,
+                                    const InstrumentImpairments& imp,
+                                    int scans,
+                                    int group,
+                                    std::uint64_t seed)
+{
+    if (scans < 1 || group < 1 || !(std::abs(imp.wavelengthErrorNm) <= 5.0)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "simulated calibration: at least one scan and a group of one, the "
+                         "wavelength error within 5 nm");
+    }
+    auto rate = pixelRates(light, imp);
+    if (!rate) {
+        return tl::unexpected(rate.error());
+    }
+    Detector detector(std::move(*rate), imp, seed);
+    const std::uint32_t us = detector.settle();
+    // The counts outlive the spans the raw spectra hold.
+    std::vector<std::vector<std::uint16_t>> counts;
+    counts.reserve(static_cast<std::size_t>(scans));
+    for (int s = 0; s < scans; ++s) {
+        detector.scan(us);
+        counts.push_back(detector.counts());
+    }
+    std::vector<RawSpectrum> raw;
+    raw.reserve(counts.size());
+    for (const auto& c : counts) {
+        raw.push_back(rawSpectrum(c, us));
+    }
+    return calibrateWavelengthShift(raw, simulatedCalibration(), group);
+}
+
 } // namespace replica::pipeline::spectral

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -93,5 +94,15 @@ Expected<SensedLight> senseLight(const FineLight& light,
                                  const InstrumentImpairments& impairments,
                                  const SensingCorrections& corrections,
                                  std::uint64_t seed);
+
+// 'replica calibrate spectrometer' (calibrateWavelengthShift) on this simulated instrument:
+// 'scans' spectra of 'light' after auto-integration settles, in runs of 'group'. Nullopt as
+// calibrateWavelengthShift (no lines); an error for an impossible light or instrument.
+Expected<std::optional<ShiftCalibration>>
+calibrateShiftOnSimulatedInstrument(const FineLight& light,
+                                    const InstrumentImpairments& impairments,
+                                    int scans,
+                                    int group,
+                                    std::uint64_t seed);
 
 } // namespace replica::pipeline::spectral
