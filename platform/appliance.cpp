@@ -204,13 +204,10 @@ boothSceneSetup(RunConfig& config,
     if (!digest) {
         return tl::unexpected(digest.error());
     }
-    if (!config.sceneDigest.empty() && config.sceneDigest != *digest) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: the scene has changed since it was recorded (digest {}, "
-                                     "recorded {}); replay needs the recorded scene",
-                                     dir.string(), *digest, config.sceneDigest));
+    if (auto same = checkAndRecordDigest(config.sceneDigest, *digest, "scene", dir.string());
+        !same) {
+        return tl::unexpected(same.error());
     }
-    config.sceneDigest = *digest;
     auto scene = pipeline::surface::loadScene(dir);
     if (!scene) {
         return tl::unexpected(scene.error());
@@ -354,14 +351,11 @@ Expected<pipeline::render::DisplayPassSetup> displaySetup(RunConfig& config, std
         const std::string digest = fmt::format(
                 "{:016x}", fnv1a64(std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()),
                                              bytes.size())));
-        if (!config.displayDigest.empty() && config.displayDigest != digest) {
-            return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("display profile {} has changed since it was recorded "
-                                         "(fnv1a64 {} now, {} then): restore that file to replay "
-                                         "the recording as it was",
-                                         path.string(), digest, config.displayDigest));
+        if (auto same = checkAndRecordDigest(config.displayDigest, digest, "display profile",
+                                             path.string());
+            !same) {
+            return tl::unexpected(same.error());
         }
-        config.displayDigest = digest;
         auto model = pd::profileFromJson(bytes, path.string());
         if (!model) {
             return tl::unexpected(model.error());

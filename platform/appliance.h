@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -232,6 +233,14 @@ struct Appliance {
 // files that make the scene (scene.json, channels.exr, height.exr, material.exr).
 std::filesystem::path resolveSceneDir(const std::string& sceneDir);
 Expected<std::string> sceneDigest(const std::filesystem::path& dir);
+
+// What every file a recording names (scene, booth, display profile) goes through: the digest of
+// the file as it is now must equal the one recorded (when one was), and becomes the recorded one.
+// 'what' names the file's kind and 'where' its path in the error ("the booth has changed ...").
+Expected<void> checkAndRecordDigest(std::string& recorded,
+                                    const std::string& now,
+                                    std::string_view what,
+                                    const std::string& where);
 
 // The booth the configuration names (boothDir, relative: under the data folder), its digest
 // checked against the recorded one (boothDigest; refused when it differs) and then recorded.

@@ -178,6 +178,22 @@ Expected<std::string> sceneDigest(const std::filesystem::path& dir)
     return fmt::format("{:016x}", h);
 }
 
+Expected<void> checkAndRecordDigest(std::string& recorded,
+                                    const std::string& now,
+                                    std::string_view what,
+                                    const std::string& where)
+{
+    if (!recorded.empty() && recorded != now) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: the {} has changed since it was recorded (digest {}, "
+                                     "recorded {}); replay needs the recorded {}: restore that "
+                                     "file or folder to replay the recording as it was",
+                                     where, what, now, recorded, what));
+    }
+    recorded = now;
+    return {};
+}
+
 Expected<pipeline::booth::Booth> loadRunBooth(RunConfig& config)
 {
     const auto dir = resolveSceneDir(config.boothDir);
@@ -192,13 +208,10 @@ Expected<pipeline::booth::Booth> loadRunBooth(RunConfig& config)
     if (!digest) {
         return tl::unexpected(digest.error());
     }
-    if (!config.boothDigest.empty() && config.boothDigest != *digest) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: the booth has changed since it was recorded (digest {}, "
-                                     "recorded {}); replay needs the recorded booth",
-                                     dir.string(), *digest, config.boothDigest));
+    if (auto same = checkAndRecordDigest(config.boothDigest, *digest, "booth", dir.string());
+        !same) {
+        return tl::unexpected(same.error());
     }
-    config.boothDigest = *digest;
     return pipeline::scene::loadApplianceBooth(dir, dataDir().string());
 }
 
