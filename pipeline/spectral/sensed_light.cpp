@@ -327,6 +327,26 @@ Expected<colour::Spectrum> studyChain(Detector& detector,
     return countsToSpectrum(raw, cal, options);
 }
 
+// The simulated instrument pointed at 'light', its integration time settled as the appliance's
+// auto-integration settles it: what senseLight and the simulated shift calibration both start
+// from, so that the two see one instrument.
+struct SettledDetector {
+    Detector detector;
+    std::uint32_t integrationTimeUs = 0;
+};
+
+Expected<SettledDetector>
+settledDetector(const FineLight& light, const InstrumentImpairments& imp, std::uint64_t seed)
+{
+    auto rate = pixelRates(light, imp);
+    if (!rate) {
+        return tl::unexpected(rate.error());
+    }
+    SettledDetector settled{Detector(std::move(*rate), imp, seed), 0};
+    settled.integrationTimeUs = settled.detector.settle();
+    return settled;
+}
+
 // The appliance's own chain (LiveSpectrometerChain with its defaults), fed one scan at a time
 // for scansAveraged scans of the steady light, calibrated with the instrument's characterised
 // stray light and the shift remembered from the site's calibration.
@@ -372,13 +392,13 @@ Expected<SensedLight> senseLight(const FineLight& light,
                          "sensed light: FWHM and stray light must be >= 0, the wavelength error "
                          "within 5 nm and at least one scan averaged");
     }
-    auto rate = pixelRates(light, imp);
-    if (!rate) {
-        return tl::unexpected(rate.error());
+    auto settled = settledDetector(light, imp, seed);
+    if (!settled) {
+        return tl::unexpected(settled.error());
     }
-    Detector detector(std::move(*rate), imp, seed);
+    Detector& detector = settled->detector;
     SensedLight out;
-    out.integrationTimeUs = detector.settle();
+    out.integrationTimeUs = settled->integrationTimeUs;
     auto spd = corr.applianceChain ? applianceChain(detector, out.integrationTimeUs, imp, corr, out)
                                    : studyChain(detector, out.integrationTimeUs, imp, corr, out);
     if (!spd) {
@@ -410,12 +430,12 @@ calibrateShiftOnSimulatedInstrument(const FineLight& light,
                          "simulated calibration: at least one scan and a group of one, the "
                          "wavelength error within 5 nm");
     }
-    auto rate = pixelRates(light, imp);
-    if (!rate) {
-        return tl::unexpected(rate.error());
+    auto settled = settledDetector(light, imp, seed);
+    if (!settled) {
+        return tl::unexpected(settled.error());
     }
-    Detector detector(std::move(*rate), imp, seed);
-    const std::uint32_t us = detector.settle();
+    Detector& detector = settled->detector;
+    const std::uint32_t us = settled->integrationTimeUs;
     // The counts outlive the spans the raw spectra hold.
     std::vector<std::vector<std::uint16_t>> counts;
     counts.reserve(static_cast<std::size_t>(scans));
