@@ -28,22 +28,33 @@ void TiltEstimator::update(const hal::AccelSample* accel)
     }
 }
 
+double TiltEstimator::windowMean() const
+{
+    // The window fills from slot 0 after a start (count_ < size: slots 0..count_-1 hold it).
+    double sum = 0.0;
+    for (std::size_t i = 0; i < count_; ++i) {
+        sum += window_[i];
+    }
+    return count_ > 0 ? sum / static_cast<double>(count_) : held_;
+}
+
 void TiltEstimator::write(pipeline::scene::SceneState& state)
 {
     // The held tilt: the mean of the last kTiltWindow frames' tilts, taken when the light changes
     // (the cache is drawn whole anyway) or when that mean has moved more than kTiltHoldRad from
-    // the held tilt. Non-finite tilts are left out.
+    // the held tilt; a tilt kTiltMotionRad from the mean starts the window again (motion: the
+    // mean would lag it). Non-finite tilts are left out.
     if (std::isfinite(tilt_)) {
+        if (count_ > 0 && std::abs(tilt_ - windowMean()) > kTiltMotionRad) {
+            count_ = 0;
+            next_ = 0;
+        }
         window_[next_] = tilt_;
         next_ = (next_ + 1) % window_.size();
         count_ = std::min(count_ + 1, window_.size());
     }
     if (count_ > 0) {
-        double sum = 0.0;
-        for (std::size_t i = 0; i < count_; ++i) {
-            sum += window_[i];
-        }
-        const double mean = sum / static_cast<double>(count_);
+        const double mean = windowMean();
         if (state.lightChanged || !heldValid_ || std::abs(mean - held_) > kTiltHoldRad) {
             held_ = mean;
             heldValid_ = true;
@@ -52,8 +63,8 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
     // The diffuse term's tilt: one frame of the cache's refresh schedule, and what the frame
     // draws of it (the band of a refresh under way).
     const auto last = diffuse_;
-    diffuse_ =
-            pipeline::scene::nextDiffuse(diffuse_, held_, state.lightChanged, setup_.cacheSlices);
+    diffuse_ = pipeline::scene::nextDiffuse(diffuse_, held_, state.lightChanged, setup_.cacheSlices,
+                                            kDiffuseMaxLagRad);
     // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel); a
     // non-finite one (set from elsewhere: sense()) shows the held tilt.
     state.tiltRad = std::isfinite(tilt_) ? tilt_ : held_;

@@ -23,8 +23,23 @@ namespace replica::state {
 // 0.15 degrees off costs at most ΔE00 p95 0.25 at a 5-degree tilt (the ceiling light grazes the
 // panel there; the painting's relief) and 0.11 from 20 degrees up, on every shipped scene and
 // light (CPU model, booth_cache_test.cpp; docs/rendering.md): about what one sample's noise costs.
+//
+// The mean lags a panel that is moving: by half the window (8 frames: 0.8 s at 10 Hz, where the
+// error probe saw the diffuse term 15 degrees behind under the simulator's sweep). So a sensed tilt
+// more than kTiltMotionRad from the window's mean (0.5 degrees: 4 standard deviations of one
+// sample's noise about the mean, about once in 5 minutes at 60 Hz on noise alone) is motion: the
+// window starts again from that tilt and the held tilt is re-taken at it.
 constexpr std::size_t kTiltWindow = 16;
 constexpr double kTiltHoldRad = 0.15 * 3.14159265358979323846 / 180.0;
+constexpr double kTiltMotionRad = 0.5 * 3.14159265358979323846 / 180.0;
+// The most the diffuse term shown may lag the held tilt before it is drawn whole at once rather
+// than waiting for a sliced refresh (scene::nextDiffuse): 2 degrees. At 60 Hz the simulator's
+// fastest sweep (18 degrees a second) lags at most 1.5 degrees with K = 3, so the bound never
+// costs a 60 Hz frame a whole draw; at 10 Hz every other frame is drawn whole. The lag's price
+// is linear (docs/rendering.md: ΔE00 p95 0.36 per half degree on the flat scenes from 20 degrees
+// up), so 2 degrees is about 1.4 at most; the error probe measured p95 0.45-1.33 at 10 Hz on the
+// ColorChecker with this bound, against 0.6-13.6 with the 16-frame mean alone.
+constexpr double kDiffuseMaxLagRad = 2.0 * 3.14159265358979323846 / 180.0;
 
 struct TiltEstimatorSetup {
     double defaultTiltRad = 0.0; // shown until the first usable sample
@@ -69,6 +84,8 @@ private:
     // The diffuse term of the last frame (none before the first):
     // pipeline/scene/diffuse_schedule.h.
     std::optional<pipeline::scene::DiffuseTilt> diffuse_;
+
+    double windowMean() const;
 };
 
 } // namespace replica::state

@@ -1,15 +1,21 @@
 // The cached diffuse term's refresh schedule.
 #include <algorithm>
+#include <cmath>
 
 #include <pipeline/scene/diffuse_schedule.h>
 
 namespace replica::pipeline::scene {
 
-DiffuseTilt
-nextDiffuse(const std::optional<DiffuseTilt>& last, double heldRad, bool lightChanged, int slices)
+DiffuseTilt nextDiffuse(const std::optional<DiffuseTilt>& last,
+                        double heldRad,
+                        bool lightChanged,
+                        int slices,
+                        double maxLagRad)
 {
     const int k = std::max(slices, 1);
-    if (lightChanged || !last) {
+    // '!(lag <= max)' also draws whole on a NaN lag (a non-finite held tilt never reaches here:
+    // the estimator holds finite tilts only).
+    if (lightChanged || !last || !(std::abs(heldRad - last->shownRad) <= maxLagRad)) {
         return {heldRad, std::nullopt, 0};
     }
     DiffuseTilt d = *last;
@@ -38,7 +44,8 @@ DiffuseDraw diffuseDraw(const std::optional<DiffuseTilt>& last,
     DiffuseDraw d{now.shownRad, std::nullopt};
     if (now.refreshRad) {
         d.band = DiffuseBand{*now.refreshRad, now.refreshBands - 1, k};
-    } else if (!lightChanged && last && last->refreshRad && k > 1) {
+    } else if (!lightChanged && last && last->refreshRad && k > 1 && last->refreshBands + 1 == k &&
+               now.shownRad == *last->refreshRad) {
         // The refresh's last band, drawn this frame: it shows its tilt from this frame on.
         d.band = DiffuseBand{*last->refreshRad, k - 1, k};
     }

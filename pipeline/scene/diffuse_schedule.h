@@ -4,6 +4,7 @@
 // buffers it holds (render::BoothDiffuseCache) and keeps no schedule of its own.
 #pragma once
 
+#include <limits>
 #include <optional>
 
 #include <pipeline/scene/scene_state.h>
@@ -16,14 +17,19 @@ namespace replica::pipeline::scene {
 // - otherwise a held tilt other than the one shown starts a refresh toward it, drawn in K bands,
 //   one a frame (this frame's the first), into a second cache that the K-th frame shows; with
 //   K = 1 it is shown at once;
-// - a held tilt that moves meanwhile waits for those K frames.
-DiffuseTilt
-nextDiffuse(const std::optional<DiffuseTilt>& last, double heldRad, bool lightChanged, int slices);
+// - a held tilt that moves meanwhile waits for those K frames,
+// - unless the term shown is more than 'maxLagRad' from the held tilt: then it is drawn whole at
+//   once (a refresh under way is dropped), bounding what a lagging term costs (infinite: never).
+DiffuseTilt nextDiffuse(const std::optional<DiffuseTilt>& last,
+                        double heldRad,
+                        bool lightChanged,
+                        int slices,
+                        double maxLagRad = std::numeric_limits<double>::infinity());
 
 // What the frame whose diffuse term is 'now' draws, 'last' being the previous frame's (none: the
 // first): the term shown, and the band of a refresh this frame draws (its bands are drawn one a
 // frame; the frame that draws the last one shows its tilt). A new light or a first frame draws
-// the term whole; so does any frame with K = 1.
+// the term whole; so does any frame with K = 1, and a frame that dropped a refresh for its lag.
 DiffuseDraw diffuseDraw(const std::optional<DiffuseTilt>& last,
                         const DiffuseTilt& now,
                         bool lightChanged,

@@ -42,6 +42,40 @@ TEST(DiffuseSchedule, ANewHeldTiltIsDrawnInKBandsAndAMoveMeanwhileWaits)
     }
 }
 
+// The same moves with a lag bound of 0.15: frame 3's held tilt (0.2) is 0.2 from the term shown
+// (0.0), so the refresh toward 0.1 is dropped and 0.2 drawn whole at once; frame 2's 0.1 is
+// within the bound and refreshed in bands as before.
+TEST(DiffuseSchedule, ATermLaggingMoreThanTheBoundIsDrawnWholeAtOnce)
+{
+    const int k = 3;
+    const double bound = 0.15;
+    const std::vector<double> held{0.0, 0.0, 0.1, 0.2, 0.2, 0.34, 0.34, 0.34};
+    const std::vector<DiffuseTilt> expect{
+            {0.0, std::nullopt, 0}, {0.0, std::nullopt, 0},
+            {0.0, 0.1, 1},          // within the bound: banded
+            {0.2, std::nullopt, 0}, // 0.2 from the shown 0.0: whole, the refresh dropped
+            {0.2, std::nullopt, 0}, {0.2, 0.34, 1}, // 0.14 from the shown 0.2: within the bound
+            {0.2, 0.34, 2},         {0.34, std::nullopt, 0},
+    };
+    const std::vector<DiffuseDraw> draws{
+            {0.0, std::nullopt},
+            {0.0, std::nullopt},
+            {0.0, DiffuseBand{0.1, 0, 3}},
+            {0.2, std::nullopt}, // whole: no band, not the dropped refresh's last
+            {0.2, std::nullopt},
+            {0.2, DiffuseBand{0.34, 0, 3}},
+            {0.2, DiffuseBand{0.34, 1, 3}},
+            {0.34, DiffuseBand{0.34, 2, 3}},
+    };
+    std::optional<DiffuseTilt> last;
+    for (std::size_t f = 0; f < held.size(); ++f) {
+        const DiffuseTilt d = nextDiffuse(last, held[f], false, k, bound);
+        EXPECT_EQ(d, expect[f]) << "frame " << f;
+        EXPECT_EQ(diffuseDraw(last, d, false, k), draws[f]) << "frame " << f;
+        last = d;
+    }
+}
+
 TEST(DiffuseSchedule, ANewLightOrOneBandIsDrawnWhole)
 {
     const DiffuseTilt underWay{0.0, 0.1, 1};

@@ -1,8 +1,10 @@
 // The tilt estimator's hold filter and sliced refresh, against the schedule worked out by hand: a
-// step of 1 degree enters the 16-frame mean 1/16 degree a frame, so the mean passes the 0.15-degree
-// hold on the 3rd frame after the step (3/16 > 0.15 > 2/16), and again every 3 frames after the
-// last re-take, until the mean settles within 1/16 degree of the step; each new held tilt shows K
-// frames after it was taken (the frame that draws the refresh's last band).
+// step of 0.45 degree (under the 0.5-degree motion threshold) enters the 16-frame mean 0.45/16 =
+// 0.028125 degree a frame, so the mean passes the 0.15-degree hold on the 6th frame after the step
+// (6 x 0.028125 = 0.169 > 0.15 > 5 x 0.028125 = 0.141) and again 6 frames after that, then settles
+// within 4 x 0.028125 = 0.1125 degree of the step; each new held tilt shows K frames after it was
+// taken (the frame that draws the refresh's last band). A step of 1 degree is motion: taken at
+// once.
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -29,9 +31,11 @@ pipeline::scene::SceneState frame(TiltEstimator& t, double tilt, bool lightChang
 TEST(TiltEstimator, AStepIsHeldThenShownKFramesAfterEachReTake)
 {
     const double a = 0.3;
-    const double b = a + 1.0 * kDeg;
-    ASSERT_GT(3.0 / 16.0 * kDeg, kTiltHoldRad);
-    ASSERT_LT(2.0 / 16.0 * kDeg, kTiltHoldRad);
+    const double step = 0.45 * kDeg;
+    const double b = a + step;
+    ASSERT_LT(step, kTiltMotionRad);
+    ASSERT_GT(6.0 / 16.0 * step, kTiltHoldRad);
+    ASSERT_LT(5.0 / 16.0 * step, kTiltHoldRad);
     for (const int k : {1, 3}) {
         TiltEstimator t({0.0, k});
         auto st = frame(t, a, true);
@@ -50,9 +54,9 @@ TEST(TiltEstimator, AStepIsHeldThenShownKFramesAfterEachReTake)
         for (int j = 1; j <= 24; ++j) {
             st = frame(t, b);
             EXPECT_NEAR(st.tiltRad, b, 0.0) << j;
-            // The held tilt: re-taken at j = 3, 6, 9, 12 and 15 (a + j/16 degree), then kept.
-            if (j <= 15 && j % 3 == 0) {
-                heldWant = a + j / 16.0 * kDeg;
+            // The held tilt: re-taken at j = 6 and 12 (a + j/16 of the step), then kept.
+            if (j == 6 || j == 12) {
+                heldWant = a + j / 16.0 * step;
                 refreshSince = j;
             }
             EXPECT_NEAR(st.heldTiltRad, heldWant, 1e-12) << "frame " << j << ", K " << k;
@@ -71,12 +75,73 @@ TEST(TiltEstimator, AStepIsHeldThenShownKFramesAfterEachReTake)
                 EXPECT_EQ(st.diffuse->band->bands, k) << j;
             }
         }
-        EXPECT_NEAR(st.diffuse->shownRad, a + 15.0 / 16.0 * kDeg, 1e-12);
+        EXPECT_NEAR(st.diffuse->shownRad, a + 12.0 / 16.0 * step, 1e-12);
         // A new light takes the mean at once (the renderer draws the diffuse term whole).
         st = frame(t, b, true);
         EXPECT_NEAR(st.heldTiltRad, b, 1e-12);
         EXPECT_EQ(st.diffuse->shownRad, st.heldTiltRad);
         EXPECT_FALSE(st.diffuse->band);
+    }
+}
+
+// A step past the motion threshold is taken at once: the window starts again from it, the held
+// tilt is the new tilt on the step's own frame, and it shows K frames later (K - 1 bands after).
+TEST(TiltEstimator, AStepPastTheMotionThresholdIsTakenAtOnce)
+{
+    const double a = 0.3;
+    const double b = a + 1.0 * kDeg;
+    ASSERT_GT(b - a, kTiltMotionRad);
+    ASSERT_LT(b - a, kDiffuseMaxLagRad);
+    for (const int k : {1, 3}) {
+        TiltEstimator t({0.0, k});
+        frame(t, a, true);
+        for (int i = 0; i < 20; ++i) {
+            frame(t, a);
+        }
+        for (int j = 1; j <= k; ++j) {
+            const auto st = frame(t, b);
+            EXPECT_EQ(st.heldTiltRad, b) << "frame " << j << ", K " << k;
+            EXPECT_EQ(st.diffuse->shownRad, j == k ? b : a) << "frame " << j << ", K " << k;
+        }
+        // Noise about the new tilt does not move it (the window restarted at b).
+        for (int j = 0; j < 20; ++j) {
+            const auto st = frame(t, b + (j % 2 == 0 ? 0.2 : -0.2) * kDeg);
+            EXPECT_LE(std::abs(st.heldTiltRad - b), kTiltHoldRad) << j;
+        }
+    }
+}
+
+// A steady sweep (the simulator's fastest: 18 degrees a second) at 60 and at 10 frames a second:
+// the held tilt stays within the motion threshold and a frame's travel of the sensed one (the
+// 16-frame mean alone lags by 7.5 frames: 2.25 and 13.5 degrees), and the term shown within the
+// lag bound of the held tilt: at 60 Hz (0.3 degrees a frame) by sliced refreshes alone, at 10 Hz
+// (1.8 a frame) every other frame drawn whole (a refresh's first band, then a lag of 3.6 degrees).
+TEST(TiltEstimator, ASweepIsFollowedWithinTheMotionThresholdAndTheLagBound)
+{
+    for (const double hz : {60.0, 10.0}) {
+        const double perFrame = 18.0 * kDeg / hz;
+        TiltEstimator t({0.0, 3});
+        double shown = frame(t, 0.1, true).diffuse->shownRad;
+        int whole = 0;
+        int banded = 0;
+        for (int j = 1; j <= 200; ++j) {
+            const double sensed = 0.1 + j * perFrame;
+            const auto st = frame(t, sensed);
+            EXPECT_LE(std::abs(st.heldTiltRad - sensed), kTiltMotionRad + perFrame + 1e-12)
+                    << hz << " Hz, frame " << j;
+            EXPECT_LE(std::abs(st.diffuse->shownRad - st.heldTiltRad), kDiffuseMaxLagRad)
+                    << hz << " Hz, frame " << j;
+            banded += st.diffuse->band ? 1 : 0;
+            whole += !st.diffuse->band && st.diffuse->shownRad != shown ? 1 : 0;
+            shown = st.diffuse->shownRad;
+        }
+        if (hz == 60.0) {
+            EXPECT_EQ(whole, 0);
+            EXPECT_EQ(banded, 200);
+        } else {
+            EXPECT_EQ(whole, 100);
+            EXPECT_EQ(banded, 100);
+        }
     }
 }
 
