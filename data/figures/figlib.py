@@ -186,7 +186,7 @@ def progress(line):
 def write_csv(path, header, rows, comment):
     with open(path, 'w', newline='') as f:
         f.write(f'# {comment}\n')
-        w = csv.writer(f)
+        w = csv.writer(f, lineterminator='\n')
         w.writerow(header)
         for r in rows:
             w.writerow([f'{v:.6g}' if isinstance(v, float) else v for v in r])

@@ -4,6 +4,7 @@
 // the CIE 1931 observer and the lamps' CIE illuminants (this library's colorimetry, not the
 // script's), Fig. 2's scale from the booth's EXRs read here. Pixels are not compared.
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,9 @@ std::vector<std::map<std::string, std::string>> readCsv(const fs::path& path)
     std::vector<std::string> head;
     std::vector<std::map<std::string, std::string>> rows;
     while (std::getline(in, line)) {
+        if (!line.empty() && line.back() == '\r') {
+            line.pop_back();
+        }
         if (line.empty() || line[0] == '#') {
             continue;
         }
@@ -66,7 +70,11 @@ std::vector<std::map<std::string, std::string>> readCsv(const fs::path& path)
 double num(const std::map<std::string, std::string>& row, const std::string& key)
 {
     const auto it = row.find(key);
-    return it == row.end() ? -1e9 : std::stod(it->second);
+    if (it == row.end()) {
+        ADD_FAILURE() << "no column " << key;
+        return std::nan("");
+    }
+    return std::stod(it->second);
 }
 
 Spectrum illuminant(const std::string& lamp)

@@ -165,5 +165,34 @@ TEST(RenderCli, WritesFiniteAbsoluteXyzCloseToTheReference)
     }
 }
 
+// --shading-only (the paper's Fig. 3): every texel a neutral white, so the ColorChecker's 24
+// colours all take the light's chromaticity and only their shading differs; without it they spread.
+TEST(RenderCli, ShadingOnlyLeavesOnlyTheLightsColour)
+{
+    const auto dir = std::filesystem::temp_directory_path();
+    const auto spread = [&](const std::string& extra) {
+        const std::string out =
+                (dir / ("replica_cli_shading_" + std::to_string(::getpid()) + ".exr")).string();
+        const CliResult r = run("render --scene " + kScenes +
+                                "/colorchecker --light tungsten --tilt 10 --size 55x37 " + extra +
+                                "--out " + out);
+        EXPECT_EQ(r.code, 0) << r.err;
+        auto img = pipeline::image::readExr(out, {"X", "Y", "Z"});
+        EXPECT_TRUE(img);
+        double lo = 1.0, hi = 0.0;
+        for (std::size_t k = 0; img && k < img->planes[1].size(); ++k) {
+            const double s = img->planes[0][k] + img->planes[1][k] + img->planes[2][k];
+            if (s > 0.0) {
+                lo = std::min(lo, img->planes[0][k] / s);
+                hi = std::max(hi, img->planes[0][k] / s);
+            }
+        }
+        std::filesystem::remove(out);
+        return hi - lo; // the spread of chromaticity x over the frame
+    };
+    EXPECT_LT(spread("--shading-only "), 0.002);
+    EXPECT_GT(spread(""), 0.1);
+}
+
 } // namespace
 } // namespace replica
