@@ -121,7 +121,63 @@ colour::Spectrum metamericBlack(const colour::Observer& obs,
 
 namespace {
 
+// Pairs side by side, one pair a row, on a neutral surround (palette 0): pair p's two halves are
+// palette entries 1 + 2p and 2 + 2p. Three rows keep the 40 mm patches of the first target.
+void layOutPairs(SurfaceScene& s, int rows)
+{
+    const int pitch = 150 / rows, patchH = pitch * 4 / 5;
+    const int top = (s.height - rows * pitch + (pitch - patchH)) / 2;
+    for (int y = 0; y < s.height; ++y) {
+        for (int x = 0; x < s.width; ++x) {
+            const std::size_t k = static_cast<std::size_t>(y) * s.width + x;
+            const int row = (y - top) / pitch;
+            const int yy = (y - top) % pitch;
+            int pig = 0;
+            if (y >= top && row < rows && yy < patchH && x >= 20 && x < 220 &&
+                !(x >= 118 && x < 122)) {
+                pig = 1 + 2 * row + (x >= 120 ? 1 : 0);
+            }
+            s.pigmentA[k] = s.pigmentB[k] = pig;
+        }
+    }
+    s.alpha = 0.3;
+    s.rhoS = colour::Spectrum{}; // matte: the planner skips the specular pass
+}
+
+// The paper's target (Fig. 7): the six pairs of 'replica spectral metamers'
+// (data/scenes/metamers/metamers_A_D65.csv), each a match under tungsten (CIE A) and a visible
+// difference under D65 and the booth's D65 simulator.
 Expected<SurfaceScene> metamerTarget(const std::filesystem::path& dataDir)
+{
+    auto cc = colour::loadSpectralCsv(dataDir / "spectra" /
+                                      "colorchecker24_babelcolor_avg_10nm_380_730.csv");
+    auto pairs = colour::loadSpectralCsv(dataDir / "scenes" / "metamers" / "metamers_A_D65.csv");
+    if (!cc || !pairs) {
+        return tl::unexpected(!cc ? cc.error() : pairs.error());
+    }
+    auto spectra = pairs->allSpectra();
+    if (!spectra) {
+        return tl::unexpected(spectra.error());
+    }
+    if (spectra->empty() || spectra->size() % 2 != 0 || spectra->size() > 12) {
+        return makeError(ErrorCode::InvalidArgument,
+                         "metamers_A_D65.csv: expected 1 to 6 pairs of columns (_a, _b)");
+    }
+    SurfaceScene s = blank("metamer", 240, 160, 0.001);
+    s.palette.push_back(*cc->spectrum("neutral_6.5") * 0.9);
+    s.paletteNames.push_back("surround");
+    for (std::size_t i = 0; i < spectra->size(); ++i) {
+        s.palette.push_back((*spectra)[i]);
+        s.paletteNames.push_back(i % 2 == 0 ? pairs->columns[i]
+                                            : pairs->columns[i] + "_metamer_under_A");
+    }
+    layOutPairs(s, static_cast<int>(spectra->size() / 2));
+    return s;
+}
+
+// The reverse target (the first one shipped): three ColorChecker colours, each paired with a
+// metamer under the booth's D65 simulator (CIE F7) that differs under tungsten.
+Expected<SurfaceScene> metamerD65Target(const std::filesystem::path& dataDir)
 {
     auto cc = colour::loadSpectralCsv(dataDir / "spectra" /
                                       "colorchecker24_babelcolor_avg_10nm_380_730.csv");
@@ -134,7 +190,7 @@ Expected<SurfaceScene> metamerTarget(const std::filesystem::path& dataDir)
     const colour::Spectrum f7 = *ill->spectrum("F7");
     // Three pairs, matched under the booth's D65 simulator (F7): a grey, a skin tone, a foliage
     // green.
-    SurfaceScene s = blank("metamer", 240, 160, 0.001);
+    SurfaceScene s = blank("metamer-d65", 240, 160, 0.001);
     const char* bases[3] = {"neutral_5", "light_skin", "foliage"};
     s.palette.push_back(*cc->spectrum("neutral_6.5") * 0.9);
     s.paletteNames.push_back("surround");
@@ -179,20 +235,7 @@ Expected<SurfaceScene> metamerTarget(const std::filesystem::path& dataDir)
         s.paletteNames.push_back(fmt::format("{}_a", bases[p]));
         s.paletteNames.push_back(fmt::format("{}_b_metamer_under_F7", bases[p]));
     }
-    for (int y = 0; y < s.height; ++y) {
-        for (int x = 0; x < s.width; ++x) {
-            const std::size_t k = static_cast<std::size_t>(y) * s.width + x;
-            const int row = (y - 10) / 50;
-            const int yy = (y - 10) % 50;
-            int pig = 0;
-            if (y >= 10 && row < 3 && yy < 40 && x >= 20 && x < 220 && !(x >= 118 && x < 122)) {
-                pig = 1 + 2 * row + (x >= 120 ? 1 : 0);
-            }
-            s.pigmentA[k] = s.pigmentB[k] = pig;
-        }
-    }
-    s.alpha = 0.3;
-    s.rhoS = colour::Spectrum{}; // matte: the planner skips the specular pass
+    layOutPairs(s, 3);
     return s;
 }
 
@@ -284,6 +327,34 @@ Expected<SurfaceScene> painting(const std::filesystem::path& dataDir)
     return s;
 }
 
+// The paper's Fig. 5: a curved glossy surface that mirrors the booth lamp. A horizontal cylinder
+// segment (radius 0.15 m, its axis along the panel's width, so that the lamp's tubes run along
+// it) painted a deep blue under a clear gloss coat; the curvature comes from the height field, so
+// the normal map and the horizons follow it.
+Expected<SurfaceScene> glossyCylinder(const std::filesystem::path& dataDir)
+{
+    auto cc = colour::loadSpectralCsv(dataDir / "spectra" /
+                                      "colorchecker24_babelcolor_avg_10nm_380_730.csv");
+    if (!cc) {
+        return tl::unexpected(cc.error());
+    }
+    SurfaceScene s = blank("glossy-cylinder", 240, 160, 0.001);
+    s.palette.push_back(*cc->spectrum("blue"));
+    s.paletteNames.emplace_back("blue");
+    const double radius = 0.15, half = 0.5 * s.heightM;
+    const double rim = std::sqrt(radius * radius - half * half);
+    for (int y = 0; y < s.height; ++y) {
+        const double v = (y + 0.5) * 0.001 - half;
+        const double h = std::sqrt(radius * radius - v * v) - rim;
+        for (int x = 0; x < s.width; ++x) {
+            s.relief.m[static_cast<std::size_t>(y) * s.width + x] = h;
+        }
+    }
+    s.alpha = 0.05; // a high-gloss coat
+    s.rhoS = colour::Spectrum::constant(0.05);
+    return s;
+}
+
 } // namespace
 
 Expected<SurfaceScene> generateScene(const std::string& kind, const std::filesystem::path& dataDir)
@@ -294,12 +365,19 @@ Expected<SurfaceScene> generateScene(const std::string& kind, const std::filesys
     if (kind == "metamer") {
         return metamerTarget(dataDir);
     }
+    if (kind == "metamer-d65") {
+        return metamerD65Target(dataDir);
+    }
     if (kind == "painting") {
         return painting(dataDir);
     }
-    return makeError(
-            ErrorCode::InvalidArgument,
-            fmt::format("unknown scene kind '{}'; use colorchecker, metamer or painting", kind));
+    if (kind == "glossy-cylinder") {
+        return glossyCylinder(dataDir);
+    }
+    return makeError(ErrorCode::InvalidArgument,
+                     fmt::format("unknown scene kind '{}'; use colorchecker, metamer, metamer-d65, "
+                                 "painting or glossy-cylinder",
+                                 kind));
 }
 
 } // namespace replica::pipeline::surface

@@ -1,6 +1,6 @@
-// The three shipped scenes: a semi-gloss ColorChecker, a metamer target and a varnished
-// painting-like surface (canvas weave, impasto strokes, measured reflectances). Deterministic on
-// every machine.
+// The shipped scenes: a semi-gloss ColorChecker, two metamer targets (matched under tungsten, as
+// the paper's, and under the D65 simulator), a varnished painting-like surface (canvas weave,
+// impasto strokes, measured reflectances) and a glossy cylinder. Deterministic on every machine.
 #pragma once
 
 #include <filesystem>
@@ -12,7 +12,9 @@
 
 namespace replica::pipeline::surface {
 
-// kind: "colorchecker", "metamer" or "painting".
+// kind: "colorchecker", "metamer" (pairs matched under tungsten, the paper's Fig. 7),
+// "metamer-d65" (pairs matched under the booth's D65 simulator), "painting" or "glossy-cylinder"
+// (a curved high-gloss surface, the paper's Fig. 5).
 Expected<SurfaceScene> generateScene(const std::string& kind, const std::filesystem::path& dataDir);
 
 // Metamer pairs: r2 = r1 + a metameric black for 'light' (CIE 1931), scaled to stay in [0.02,

@@ -118,6 +118,7 @@ int runCli(int argc, char** argv)
     registerProbeCommand(app, exitCode);
     registerCalibrateCommand(app, exitCode);
     registerConfigCommand(app, exitCode);
+    registerFiguresCommand(app, exitCode);
     requireFiniteFloats(app);
 
     app.parse_complete_callback([&] {

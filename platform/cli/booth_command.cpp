@@ -321,9 +321,13 @@ void registerSceneCommand(CLI::App& app, int& exitCode)
     scene->require_subcommand(1);
     auto kind = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
-    CLI::App* gen = scene->add_subcommand("generate",
-                                          "write a scene folder (colorchecker, metamer, painting)");
-    gen->add_option("--kind", *kind, "colorchecker, metamer or painting")->required();
+    CLI::App* gen = scene->add_subcommand(
+            "generate",
+            "write a scene folder (colorchecker, metamer, metamer-d65, painting, glossy-cylinder)");
+    gen->add_option("--kind", *kind,
+                    "colorchecker, metamer (matched under tungsten), metamer-d65, painting or "
+                    "glossy-cylinder")
+            ->required();
     gen->add_option("--out", *out, "output folder")->required();
     gen->callback([kind, out, &exitCode] { exitCode = runSceneGenerate(*kind, *out); });
 }

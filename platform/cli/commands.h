@@ -28,6 +28,7 @@ void registerSpectralCommand(CLI::App& app, int& exitCode);
 void registerProbeCommand(CLI::App& app, int& exitCode);
 void registerCalibrateCommand(CLI::App& app, int& exitCode);
 void registerConfigCommand(CLI::App& app, int& exitCode);
+void registerFiguresCommand(CLI::App& app, int& exitCode);
 
 // --kms-device, --kms-connector, --kms-mode, --kms-modeset, --kms-path (run and replay).
 void addKmsOptions(CLI::App& cmd, KmsOptions& kms);

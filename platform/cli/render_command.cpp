@@ -1,5 +1,6 @@
 // 'replica render': one frame of absolute XYZ (cd/m^2) for a scene, light, eye and tilt, as
 // OpenEXR.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -47,7 +48,20 @@ struct RenderArgs {
     std::string basis = "adaptive_k6";
     std::string out;
     bool json = false;
+    bool shadingOnly = false;
 };
+
+// --shading-only: every texel a neutral white (reflectance 0.8 at every wavelength), so that the
+// frame shows only the shading and shadowing of the relief and the gloss (the paper's Fig. 3).
+constexpr double kShadingOnlyReflectance = 0.8;
+
+void neutralise(pipeline::surface::SurfaceScene& scene)
+{
+    for (auto& p : scene.palette) {
+        p = pipeline::colour::Spectrum::constant(kShadingOnlyReflectance);
+    }
+    std::fill(scene.shade.begin(), scene.shade.end(), 1.0f);
+}
 
 // The channel basis by name: adaptive_k6 is built for the light rendered (the appliance's
 // default: exact for that light), the others are fixed (box6 built in, the rest fitted files under
@@ -272,6 +286,9 @@ int runRender(const RenderArgs& a)
     if (!scene) {
         return fail(kExitFailure, scene.error().message);
     }
+    if (a.shadingOnly) {
+        neutralise(*scene);
+    }
     auto obs = colour::loadCie1931(dataDir());
     if (!obs) {
         return fail(kExitFailure, obs.error().message);
@@ -401,6 +418,10 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
                     },
                     "", "FILE.exr"));
     cmd->add_flag("--json", args->json, "print the summary as JSON");
+    cmd->add_flag("--shading-only", args->shadingOnly,
+                  "replace the surface's colour by a neutral white (reflectance 0.8 at every "
+                  "wavelength): only the shading and shadowing of its relief and gloss show (the "
+                  "paper's Fig. 3)");
     cmd->callback([args, &exitCode] { exitCode = runRender(*args); });
 }
 
