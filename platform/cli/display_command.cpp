@@ -198,8 +198,13 @@ void registerFit(CLI::App* display, int& exitCode)
             ->check(CLI::IsMember({"robust", "interpolate"}))
             ->capture_default_str();
     fitCmd->add_option("--icc", fit->icc,
-                       "also write the profile as an ICC v4 display profile (matrix/TRC, D50 PCS, "
-                       "white's luminance in the lumi tag)");
+                       "also write the profile as an ICC display profile (matrix/TRC, D50 PCS, "
+                       "white's luminance in the lumi tag), v2.4 unless --icc-version 4");
+    fitCmd->add_option("--icc-version", fit->iccVersion,
+                       "ICC version of --icc: 2 (v2.4, which ArgyllCMS's iccdump, xicclu and "
+                       "profcheck read) or 4 (v4.3)")
+            ->check(CLI::IsMember({2, 4}))
+            ->capture_default_str();
     fitCmd->add_flag("--json", fit->json, "print the fit report as JSON");
     fitCmd->callback([fit, &exitCode] { exitCode = displayFitMain(*fit); });
 }

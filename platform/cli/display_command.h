@@ -31,6 +31,7 @@ struct DisplayOptions {
     std::string basis = "replica_k6";
     std::string tone = "robust";
     std::string icc;
+    int iccVersion = 2; // --icc-version: 2 (v2.4, what ArgyllCMS reads) or 4 (v4.3)
     SensedReportOptions sensed;
 };
 

@@ -1,5 +1,5 @@
 // 'replica display fit': a display profile fitted to measurements (pipeline/display/display_fit.h),
-// written as JSON (and ICC v4 on request), and its fit report printed.
+// written as JSON (and ICC v2.4 or v4 on request), and its fit report printed.
 #include <filesystem>
 #include <fstream>
 
@@ -83,10 +83,11 @@ bool attachViewingTable(const DisplayOptions& o, pd::DisplayModel& model)
     return true;
 }
 
-bool writeIcc(const pd::DisplayModel& model, const std::string& path)
+bool writeIcc(const pd::DisplayModel& model, const std::string& path, int version)
 {
     auto log = logger("replica");
-    auto icc = pd::writeIccProfile(model, path);
+    auto icc = pd::writeIccProfile(model, path,
+                                   version == 4 ? pd::IccVersion::V4_3 : pd::IccVersion::V2_4);
     if (!icc) {
         log->error("{}", icc.error().message);
         return false;
@@ -172,7 +173,9 @@ void printFitText(const pd::DisplayModel& model, const DisplayOptions& o)
     // The model's white (with a crosstalk term, below black + R + G + B).
     const glm::dvec3 w = model.forward(glm::dvec3(model.maxCount()));
     fmt::print("profile: {}{}\n", o.out,
-               o.icc.empty() ? std::string() : fmt::format(" (and ICC v4: {})", o.icc));
+               o.icc.empty() ? std::string()
+                             : fmt::format(" (and ICC {}: {})", o.iccVersion == 4 ? "v4.3" : "v2.4",
+                                           o.icc));
     fmt::print("white {:.1f} cd/m^2, black {:.3f} cd/m^2, {}-bit\n", w.y, model.blackXyz.y,
                model.bitDepth);
     fmt::print("held-out dE00 over {} colours: mean {:.3f}, 90th {:.3f}, max {:.3f} "
@@ -229,7 +232,7 @@ int displayFitMain(const DisplayOptions& o)
         log->error("{}", ok.error().message);
         return kExitFailure;
     }
-    if (!o.icc.empty() && !writeIcc(*model, o.icc)) {
+    if (!o.icc.empty() && !writeIcc(*model, o.icc, o.iccVersion)) {
         return kExitFailure;
     }
     if (o.json) {

@@ -1,5 +1,6 @@
 // ArgyllCMS CGATS files in and out (hand-written in dispread's and targen's layout, and broken
-// ones), and the ICC v4 profile read back with Little CMS against the model it was written from.
+// ones), and the ICC v2.4 and v4 profiles read back with Little CMS against the model it was
+// written from.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -222,17 +223,31 @@ TEST(IccProfile, ReadsBackAsTheModelThroughLittleCms)
     auto withCrosstalk = writeIccProfile(fitted, path);
     ASSERT_TRUE(withCrosstalk.has_value()) << withCrosstalk.error().message;
     EXPECT_TRUE(withCrosstalk->crosstalkOmitted);
+    // v2.4 by default (ArgyllCMS 2.3 refuses v4): wtpt is the display's own white (Y = 1), not
+    // D50, and relative colorimetric reads the same as from v4.
     auto written = writeIccProfile(model, path);
     ASSERT_TRUE(written.has_value()) << written.error().message;
     EXPECT_FALSE(written->blackClipped);
     EXPECT_FALSE(written->crosstalkOmitted);
     auto info = readIccInfo(path);
     ASSERT_TRUE(info.has_value()) << info.error().message;
-    EXPECT_GE(info->version, 4.0);
+    EXPECT_DOUBLE_EQ(info->version, 2.4);
     EXPECT_TRUE(info->displayClass);
     EXPECT_TRUE(info->rgbToXyz);
     EXPECT_NEAR(info->luminanceCdM2, model.whiteXyz().y, 1e-3 * model.whiteXyz().y);
     EXPECT_EQ(info->description, model.name);
+    const glm::dvec3 ownWhite = model.whiteXyz() / model.whiteXyz().y;
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(info->mediaWhite[k], ownWhite[k], 1e-4) << k; // s15Fixed16
+    }
+    const auto v4path = path.string() + ".v4.icc";
+    ASSERT_TRUE(writeIccProfile(model, v4path, IccVersion::V4_3).has_value());
+    auto v4 = readIccInfo(v4path);
+    ASSERT_TRUE(v4.has_value()) << v4.error().message;
+    EXPECT_GE(v4->version, 4.0);
+    EXPECT_NEAR(v4->mediaWhite.x, 0.9642, 1e-4); // v4: the PCS's D50
+    EXPECT_NEAR(v4->mediaWhite.z, 0.8249, 1e-4);
+    EXPECT_EQ(v4->description, model.name);
 
     std::vector<glm::dvec3> counts{glm::dvec3(0.0), glm::dvec3(255.0)};
     std::mt19937_64 rng(5);
@@ -245,8 +260,11 @@ TEST(IccProfile, ReadsBackAsTheModelThroughLittleCms)
         counts.emplace_back(0, 0, v);
     }
     auto xyz = iccForward(path, counts, 8);
+    auto xyz4 = iccForward(v4path, counts, 8);
     std::filesystem::remove(path);
+    std::filesystem::remove(v4path);
     ASSERT_TRUE(xyz.has_value()) << xyz.error().message;
+    ASSERT_TRUE(xyz4.has_value()) << xyz4.error().message;
     const glm::dvec3 white = model.whiteXyz();
     const glm::dmat3 adapt = bradfordToD50(white);
     const glm::dvec3 d50(0.9642, 1.0, 0.8249);
@@ -254,8 +272,10 @@ TEST(IccProfile, ReadsBackAsTheModelThroughLittleCms)
     double worstY = 0.0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
         const glm::dvec3 want = adapt * (model.forward(counts[i]) / white.y);
-        worstDe = std::max(worstDe, deltaE2000Xyz((*xyz)[i], want, d50));
-        worstY = std::max(worstY, std::abs((*xyz)[i].y - want.y));
+        for (const auto* got : {&*xyz, &*xyz4}) {
+            worstDe = std::max(worstDe, deltaE2000Xyz((*got)[i], want, d50));
+            worstY = std::max(worstY, std::abs((*got)[i].y - want.y));
+        }
     }
     // The curv tags hold 16-bit values and the colorants s15Fixed16 numbers: 1/65535 of white.
     RecordProperty("icc_max_de00", std::to_string(worstDe));
