@@ -349,7 +349,41 @@ std::string cgatsText(const CgatsTable& t)
     return out;
 }
 
-Expected<MeasurementSet> parseTi3(const std::string& text, const std::string& source, int bitDepth)
+namespace {
+
+// The factor from a .ti3's XYZ to cd/m^2: 1 for NORMALIZED_TO_Y_100 "NO", else white's luminance
+// (whiteCdM2, or LUMINANCE_XYZ_CDM2's Y) / 100.
+Expected<double> ti3Scale(const CgatsTable& t, const std::string& source, double whiteCdM2)
+{
+    const auto* normed = t.keyword("NORMALIZED_TO_Y_100");
+    if (normed != nullptr && *normed == "NO") {
+        return 1.0;
+    }
+    if (whiteCdM2 > 0.0 && std::isfinite(whiteCdM2)) {
+        return whiteCdM2 / 100.0;
+    }
+    const auto* lum = t.keyword("LUMINANCE_XYZ_CDM2");
+    double x = 0.0;
+    double y = 0.0;
+    double z = 0.0;
+    if (lum == nullptr || std::sscanf(lum->c_str(), " %lf %lf %lf", &x, &y, &z) != 3 ||
+        !(y > 0.0) || !std::isfinite(y)) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: XYZ normalised to white Y = 100 and no usable "
+                                     "LUMINANCE_XYZ_CDM2 \"X Y Z\": the absolute luminance is "
+                                     "unknown; give white's luminance in cd/m^2 (display fit "
+                                     "--white-cdm2 VALUE, e.g. spotread's reading of full white), "
+                                     "or measure with dispread, which writes it (or set "
+                                     "NORMALIZED_TO_Y_100 \"NO\" for readings in cd/m^2)",
+                                     source));
+    }
+    return y / 100.0;
+}
+
+} // namespace
+
+Expected<MeasurementSet>
+parseTi3(const std::string& text, const std::string& source, int bitDepth, double whiteCdM2)
 {
     auto t = parseCgats(text, source);
     if (!t) {
@@ -368,24 +402,11 @@ Expected<MeasurementSet> parseTi3(const std::string& text, const std::string& so
                                      source, *rep));
     }
     // Display readings are normalised to white Y = 100 unless the file says NO (Argyll's rule).
-    double scale = 1.0;
-    const auto* normed = t->keyword("NORMALIZED_TO_Y_100");
-    if (normed == nullptr || *normed != "NO") {
-        const auto* lum = t->keyword("LUMINANCE_XYZ_CDM2");
-        double x = 0.0;
-        double y = 0.0;
-        double z = 0.0;
-        if (lum == nullptr || std::sscanf(lum->c_str(), " %lf %lf %lf", &x, &y, &z) != 3 ||
-            !(y > 0.0) || !std::isfinite(y)) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: XYZ normalised to white Y = 100 and no usable "
-                                         "LUMINANCE_XYZ_CDM2 \"X Y Z\": the absolute luminance is "
-                                         "unknown (dispread writes it; or set NORMALIZED_TO_Y_100 "
-                                         "\"NO\" for readings in cd/m^2)",
-                                         source));
-        }
-        scale = y / 100.0;
+    auto scaleOr = ti3Scale(*t, source, whiteCdM2);
+    if (!scaleOr) {
+        return tl::unexpected(scaleOr.error());
     }
+    const double scale = *scaleOr;
     auto counts = countsOf(*t, source, bitDepth);
     if (!counts) {
         return tl::unexpected(counts.error());
@@ -492,12 +513,24 @@ ti1Text(const std::vector<glm::dvec3>& counts, int bitDepth, const std::string& 
     return cgatsText(t);
 }
 
-Expected<MeasurementSet> loadMeasurements(const std::filesystem::path& path, int bitDepth)
+bool isTi3Path(const std::filesystem::path& path)
 {
     auto ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (ext != ".ti3") {
+    return ext == ".ti3";
+}
+
+Expected<MeasurementSet>
+loadMeasurements(const std::filesystem::path& path, int bitDepth, double whiteCdM2)
+{
+    if (!isTi3Path(path)) {
+        if (whiteCdM2 > 0.0) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: white's luminance is for a .ti3 normalised to "
+                                         "white Y = 100; a CSV's XYZ are cd/m^2 already",
+                                         path.string()));
+        }
         return loadMeasurementCsv(path, bitDepth);
     }
     auto text = readInputFile(path, kMaxCsvBytes, "measurement");
@@ -508,7 +541,7 @@ Expected<MeasurementSet> loadMeasurements(const std::filesystem::path& path, int
         }
         return tl::unexpected(text.error());
     }
-    return parseTi3(*text, path.string(), bitDepth == 0 ? 8 : bitDepth);
+    return parseTi3(*text, path.string(), bitDepth == 0 ? 8 : bitDepth, whiteCdM2);
 }
 
 } // namespace replica::pipeline::display

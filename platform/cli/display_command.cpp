@@ -181,6 +181,11 @@ void registerFit(CLI::App* display, int& exitCode)
     fitCmd->add_option("--bits", fit->bits,
                        "panel bit depth (default: from the largest count; 8 for a .ti3)")
             ->check(CLI::Range(1, 16));
+    fitCmd->add_option("--white-cdm2", fit->whiteCdM2,
+                       "white's luminance in cd/m^2 for a .ti3 whose XYZ are relative (white Y = "
+                       "100) and that has no LUMINANCE_XYZ_CDM2 (fakeread's, dispread's without "
+                       "-Y); it wins over the keyword where both are given")
+            ->check(CLI::PositiveNumber);
     fitCmd->add_option("--measured-in", fit->measuredIn,
                        "dark, or lit-booth (the black then already holds the screen's reflection "
                        "of the booth light, which is then not subtracted again)")

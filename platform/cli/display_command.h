@@ -21,6 +21,7 @@ struct DisplayOptions {
     std::string triple;
     std::string viewingTable;
     int bits = 0;
+    double whiteCdM2 = 0.0; // --white-cdm2: white's luminance for a .ti3 normalised to Y = 100
     bool synthetic = false;
     bool json = false;
     bool clip = false;

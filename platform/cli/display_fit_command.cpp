@@ -212,7 +212,7 @@ int displayFitMain(const DisplayOptions& o)
         log->error("--measured-in {}: expected 'dark' or 'lit-booth'", o.measuredIn);
         return kExitUsage;
     }
-    auto set = pd::loadMeasurements(o.measurements, o.bits);
+    auto set = pd::loadMeasurements(o.measurements, o.bits, o.whiteCdM2);
     if (!set) {
         log->error("{}", set.error().message);
         return kExitFailure;

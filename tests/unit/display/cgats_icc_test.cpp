@@ -86,6 +86,53 @@ TEST(Cgats, ReadsDispreadReadingsInAbsoluteUnits)
     EXPECT_DOUBLE_EQ(abs->rows[0].xyz.y, 100.0);
 }
 
+// fakeread's layout (and dispread's without -Y): relative XYZ, white Y = 100, neither
+// LUMINANCE_XYZ_CDM2 nor NORMALIZED_TO_Y_100.
+const char* kFakereadTi3 = R"(CTI3   
+
+DESCRIPTOR "Argyll Calibration Target chart information 3"
+ORIGINATOR "Argyll fakeread"
+CREATED "Sun Dec  6 09:02:17 2026"
+DEVICE_CLASS "DISPLAY"
+COLOR_REP "RGB_XYZ"
+
+NUMBER_OF_FIELDS 7
+BEGIN_DATA_FORMAT
+SAMPLE_ID RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z 
+END_DATA_FORMAT
+
+NUMBER_OF_SETS 2
+BEGIN_DATA
+1 100 100 100 95.0455 100 108.905 
+2 12.871 13.5316 33.7491 2.89009 2.16636 9.08295 
+END_DATA
+)";
+
+TEST(Cgats, RelativeReadingsTakeWhitesLuminanceFromTheCaller)
+{
+    auto none = parseTi3(kFakereadTi3, "f.ti3");
+    ASSERT_FALSE(none.has_value());
+    EXPECT_NE(none.error().message.find("f.ti3: XYZ normalised to white Y = 100 and no usable "
+                                        "LUMINANCE_XYZ_CDM2"),
+              std::string::npos);
+    EXPECT_NE(none.error().message.find("--white-cdm2 VALUE"), std::string::npos)
+            << none.error().message;
+    auto set = parseTi3(kFakereadTi3, "f.ti3", 8, 250.0);
+    ASSERT_TRUE(set.has_value()) << set.error().message;
+    EXPECT_DOUBLE_EQ(set->rows[0].xyz.y, 250.0);
+    EXPECT_DOUBLE_EQ(set->rows[1].xyz.z, 9.08295 * 2.5);
+    // Given both, the caller's luminance wins over the file's keyword.
+    auto both = parseTi3(kDispreadTi3, "d.ti3", 8, 250.0);
+    ASSERT_TRUE(both.has_value());
+    EXPECT_DOUBLE_EQ(both->rows[0].xyz.y, 250.0);
+    // Readings in cd/m^2 are not scaled again.
+    auto abs = parseTi3(
+            withLine(kDispreadTi3, "NORMALIZED_TO_Y_100 \"YES\"", "NORMALIZED_TO_Y_100 \"NO\""),
+            "d.ti3", 8, 250.0);
+    ASSERT_TRUE(abs.has_value());
+    EXPECT_DOUBLE_EQ(abs->rows[0].xyz.y, 100.0);
+}
+
 TEST(Cgats, MalformedFilesFailNamingTheLine)
 {
     auto err = [](const std::string& text) {
