@@ -129,7 +129,9 @@ void printFitJson(const pd::DisplayModel& model, const std::string& out)
                        {"inverse_counts_max", f.inverseCountsMax},
                        {"gamut_edge_tolerance", model.gamutEdgeTolerance},
                        {"crosstalk_model", f.crosstalkModel},
-                       {"crosstalk_gain_de00", f.crosstalkGainDe00}}
+                       {"crosstalk_gain_de00", f.crosstalkGainDe00},
+                       {"ramp_levels", f.rampLevels},
+                       {"gog_only_for_short_ramps", f.gogOnlyForShortRamps}}
                        .dump());
 }
 
@@ -196,6 +198,13 @@ void printFitText(const pd::DisplayModel& model, const DisplayOptions& o)
     } else if (f.additivityDe00 >= 0.0) {
         fmt::print("additivity: white vs R+G+B dE00 {:.3f}, luminance {:+.2f}%\n", f.additivityDe00,
                    f.additivityLuminancePercent);
+    }
+    if (f.gogOnlyForShortRamps) {
+        fmt::print("short ramps: R {} G {} B {} non-zero levels; a channel with fewer than 8 has "
+                   "the GOG curve alone (not cross-validated against GOGO or a spline, its noise "
+                   "estimate from 3 parameters' residuals); for those, add single-channel steps "
+                   "(ArgyllCMS: targen -d3 -s 9)\n",
+                   f.rampLevels[0], f.rampLevels[1], f.rampLevels[2]);
     }
     fmt::print("primary chromaticity drift along ramps (max |dxy|): R {:.4f} G {:.4f} B "
                "{:.4f}; ramp points pooled for monotonicity: {}\n",
