@@ -70,6 +70,13 @@ awk -v w="$white" '/^BEGIN_DATA$/ { d = 1; next } /^END_DATA$/ { exit }
 "$replica" --log-level warn display fit shown.ti3 --out shown.json >/dev/null ||
     fail "display fit of what display patches read"
 
+# The .ti1 replica writes (lcms2's IT8 writer) is one Argyll reads: fakeread measures it.
+"$replica" --log-level warn display patches --make-set made.ti1 --step 15 --colours 20 >/dev/null ||
+    fail "display patches --make-set"
+fakeread -v0 "$ref" made >/dev/null || fail "fakeread cannot read replica's made.ti1"
+"$replica" --log-level warn display fit made.ti3 --white-cdm2 "$white" --out made.json >/dev/null ||
+    fail "display fit of fakeread's readings of replica's own set"
+
 # profcheck's CIEDE2000 "avg peak" of a profile against a .ti3.
 de00() {
     profcheck -v1 -k "$1" "$2" 2>&1 |
