@@ -1,4 +1,5 @@
-// ArgyllCMS CGATS reading and writing.
+// ArgyllCMS CGATS reading and writing: the tables through Little CMS 2's IT8 functions
+// (cgats_it8.cpp); Argyll's row layout and the lines for messages checked here first.
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -14,6 +15,7 @@
 #include <pipeline/base/input_file.h>
 #include <pipeline/csv/csv_cells.h>
 #include <pipeline/display/cgats.h>
+#include <pipeline/display/cgats_it8.h>
 
 namespace replica::pipeline::display {
 namespace {
@@ -125,181 +127,169 @@ int CgatsTable::field(const std::string& name) const
 
 namespace {
 
-// The CGATS reader, one line at a time: the identifier, the header's keywords, the field list
-// (BEGIN_DATA_FORMAT ... END_DATA_FORMAT) and the rows (BEGIN_DATA ... END_DATA).
-class CgatsParser
+bool isIdentifier(const std::vector<std::string>& tok)
+{
+    return tok.size() == 1 && tok[0].size() >= 3 &&
+           std::all_of(tok[0].begin(), tok[0].end(), [](unsigned char ch) {
+               return std::isupper(ch) != 0 || std::isdigit(ch) != 0;
+           });
+}
+
+// What lcms2's IT8 reader leaves to its caller, from the text of the first table: the line of each
+// data row (for messages) and the checks lcms2 does not make, or makes without the line a person
+// needs: a first line that is a type, quotes closed (lcms2 runs an open one to the line's end),
+// the field list closed and as long as NUMBER_OF_FIELDS says, END_DATA present (lcms2 takes a file
+// cut short inside its data), one row a line with every field, as Argyll writes them (lcms2 lets a
+// short row take the next line's values), NUMBER_OF_SETS rows, and no .INCLUDE (lcms2 follows it).
+struct Layout {
+    std::vector<std::string> fields;
+    std::vector<int> rowLines;
+};
+
+class LayoutScan
 {
 public:
-    enum class State { Identifier, Header, Format, Data, Done };
+    explicit LayoutScan(const std::string& source) : source_(source) {}
 
-    explicit CgatsParser(const std::string& source) : source_(source) {}
-
-    State state() const { return state_; }
-
-    // One line's tokens (not empty).
-    Expected<void> read(const std::vector<std::string>& tok, const std::string& text, int lineNo)
+    // One line's tokens (not empty); true once the first table's END_DATA is read.
+    Expected<bool> line(const std::vector<std::string>& tok, const std::string& text, int lineNo)
     {
-        switch (state_) {
-        case State::Identifier:
-            return identifier(tok, text, lineNo);
-        case State::Header:
+        if (at_ == At::Identifier) {
+            if (!isIdentifier(tok)) {
+                return fail(lineNo, fmt::format("not a CGATS file: the first line must be its type "
+                                                "(CTI1, CTI3), found '{}'",
+                                                csv::trimCell(text)));
+            }
+            at_ = At::Header;
+        } else if (at_ == At::Header) {
             return header(tok, lineNo);
-        case State::Format:
-            return format(tok);
-        case State::Data:
-            return data(tok, lineNo);
-        case State::Done:
-            break;
+        } else if (at_ == At::Format) {
+            if (tok[0] != "END_DATA_FORMAT") {
+                layout_.fields.insert(layout_.fields.end(), tok.begin(), tok.end());
+            } else if (fields_ >= 0 && static_cast<long>(layout_.fields.size()) != fields_) {
+                return fail(formatLine_, fmt::format("NUMBER_OF_FIELDS is {} but the format "
+                                                     "lists {} fields",
+                                                     fields_, layout_.fields.size()));
+            } else {
+                at_ = At::Header;
+            }
+        } else if (tok[0] == "END_DATA") {
+            if (sets_ >= 0 && static_cast<long>(layout_.rowLines.size()) != sets_) {
+                return fail(lineNo, fmt::format("NUMBER_OF_SETS is {} but the data has {} rows",
+                                                sets_, layout_.rowLines.size()));
+            }
+            return true;
+        } else if (tok.size() != layout_.fields.size()) {
+            return fail(lineNo, fmt::format("{} values, expected {} ({})", tok.size(),
+                                            layout_.fields.size(), fmt::join(layout_.fields, " ")));
+        } else {
+            layout_.rowLines.push_back(lineNo);
         }
-        return {};
+        return false;
     }
 
-    // The table, or what the file lacks where it ends early.
-    Expected<CgatsTable> finish()
+    // The layout once END_DATA was read, or what the file lacks where it ends early.
+    Expected<Layout> finish(bool done) const
     {
-        const std::string& source = source_;
-        if (state_ == State::Identifier) {
-            return makeError(ErrorCode::Corrupt, fmt::format("{}: empty file", source));
+        if (done) {
+            return layout_;
         }
-        if (state_ == State::Header) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: no BEGIN_DATA: no readings", source));
+        switch (at_) {
+        case At::Identifier:
+            return fail(0, "empty file");
+        case At::Header:
+            return fail(0, "no BEGIN_DATA: no readings");
+        case At::Format:
+            return fail(formatLine_, "BEGIN_DATA_FORMAT without END_DATA_FORMAT");
+        case At::Data:
+            break;
         }
-        if (state_ == State::Format) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}:{}: BEGIN_DATA_FORMAT without END_DATA_FORMAT", source,
-                                         formatLine_));
-        }
-        if (state_ == State::Data) {
-            return makeError(
-                    ErrorCode::Corrupt,
-                    fmt::format("{}:{}: BEGIN_DATA without END_DATA (the file is cut short)",
-                                source, dataLine_));
-        }
-        return std::move(table_);
+        return fail(dataLine_, "BEGIN_DATA without END_DATA (the file is cut short)");
     }
 
 private:
-    Expected<void>
-    identifier(const std::vector<std::string>& tok, const std::string& line, int lineNo)
-    {
-        const std::string& source = source_;
-        if (tok.size() != 1 || tok[0].size() < 3 ||
-            !std::all_of(tok[0].begin(), tok[0].end(), [](unsigned char ch) {
-                return std::isupper(ch) != 0 || std::isdigit(ch) != 0;
-            })) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}:{}: not a CGATS file: the first line must be "
-                                         "its type (CTI1, CTI3), found '{}'",
-                                         source, lineNo, csv::trimCell(line)));
-        }
-        table_.identifier = tok[0];
-        state_ = State::Header;
-        return {};
-    }
+    enum class At { Identifier, Header, Format, Data };
 
-    Expected<void> header(const std::vector<std::string>& tok, int lineNo)
+    Expected<bool> header(const std::vector<std::string>& tok, int lineNo)
     {
-        const std::string& source = source_;
         if (tok[0] == "BEGIN_DATA_FORMAT") {
-            state_ = State::Format;
+            at_ = At::Format;
             formatLine_ = lineNo;
         } else if (tok[0] == "BEGIN_DATA") {
-            if (table_.fields.empty()) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("{}:{}: BEGIN_DATA before the field list "
-                                             "(BEGIN_DATA_FORMAT ... END_DATA_FORMAT)",
-                                             source, lineNo));
+            if (layout_.fields.empty()) {
+                return fail(lineNo, "BEGIN_DATA before the field list (BEGIN_DATA_FORMAT ... "
+                                    "END_DATA_FORMAT)");
             }
-            state_ = State::Data;
+            at_ = At::Data;
             dataLine_ = lineNo;
         } else if (tok[0] == "NUMBER_OF_FIELDS" || tok[0] == "NUMBER_OF_SETS") {
             double v = 0.0;
             if (tok.size() != 2 || !parseNumber(tok[1], v) || v < 0 || v != std::floor(v)) {
-                return makeError(ErrorCode::Corrupt, fmt::format("{}:{}: {} needs a whole number",
-                                                                 source, lineNo, tok[0]));
+                return fail(lineNo, fmt::format("{} needs a whole number", tok[0]));
             }
-            (tok[0] == "NUMBER_OF_FIELDS" ? declaredFields_ : declaredSets_) = static_cast<long>(v);
-        } else if (tok[0] == "KEYWORD") {
-            // Declares a private keyword; its value follows on its own line.
-        } else if (tok.size() >= 2) {
-            std::string value = tok[1];
-            for (std::size_t i = 2; i < tok.size(); ++i) {
-                value += " " + tok[i];
-            }
-            table_.keywords.emplace_back(tok[0], value);
-        } else {
-            table_.keywords.emplace_back(tok[0], "");
+            (tok[0] == "NUMBER_OF_FIELDS" ? fields_ : sets_) = static_cast<long>(v);
         }
-        return {};
+        return false;
     }
 
-    Expected<void> format(const std::vector<std::string>& tok)
+    tl::unexpected<Error> fail(int lineNo, const std::string& what) const
     {
-        const std::string& source = source_;
-        if (tok[0] == "END_DATA_FORMAT") {
-            if (declaredFields_ >= 0 &&
-                static_cast<long>(table_.fields.size()) != declaredFields_) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("{}:{}: NUMBER_OF_FIELDS is {} but the format "
-                                             "lists {} fields",
-                                             source, formatLine_, declaredFields_,
-                                             table_.fields.size()));
-            }
-            state_ = State::Header;
-        } else {
-            table_.fields.insert(table_.fields.end(), tok.begin(), tok.end());
-        }
-        return {};
-    }
-
-    Expected<void> data(const std::vector<std::string>& tok, int lineNo)
-    {
-        const std::string& source = source_;
-        if (tok[0] == "END_DATA") {
-            if (!pending_.empty()) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("{}:{}: the last row has {} values, expected {}",
-                                             source, pendingLine_, pending_.size(),
-                                             table_.fields.size()));
-            }
-            if (declaredSets_ >= 0 && static_cast<long>(table_.rows.size()) != declaredSets_) {
-                return makeError(ErrorCode::Corrupt,
-                                 fmt::format("{}:{}: NUMBER_OF_SETS is {} but the data has "
-                                             "{} rows",
-                                             source, lineNo, declaredSets_, table_.rows.size()));
-            }
-            state_ = State::Done;
-            return {};
-        }
-        // Argyll writes a row a line; a row that does not fill its line is an error there.
-        if (pending_.empty()) {
-            pendingLine_ = lineNo;
-        }
-        pending_.insert(pending_.end(), tok.begin(), tok.end());
-        if (pending_.size() == table_.fields.size()) {
-            table_.rows.push_back(pending_);
-            table_.rowLines.push_back(pendingLine_);
-            pending_.clear();
-        } else {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}:{}: {} values, expected {} ({})", source, pendingLine_,
-                                         pending_.size(), table_.fields.size(),
-                                         fmt::join(table_.fields, " ")));
-        }
-        return {};
+        return makeError(ErrorCode::Corrupt,
+                         lineNo > 0 ? fmt::format("{}:{}: {}", source_, lineNo, what)
+                                    : fmt::format("{}: {}", source_, what));
     }
 
     const std::string& source_;
-    CgatsTable table_;
-    State state_ = State::Identifier;
-    long declaredFields_ = -1;
-    long declaredSets_ = -1;
+    Layout layout_;
+    At at_ = At::Identifier;
+    long fields_ = -1;
+    long sets_ = -1;
     int formatLine_ = 0;
     int dataLine_ = 0;
-    std::vector<std::string> pending_; // data tokens of the row being read
-    int pendingLine_ = 0;
 };
+
+bool isInclude(const std::string& token)
+{
+    return token.size() == 8 && token[0] == '.' &&
+           std::equal(token.begin() + 1, token.end(), "INCLUDE", [](char a, char b) {
+               return std::toupper(static_cast<unsigned char>(a)) == b;
+           });
+}
+
+Expected<Layout> scanLayout(const std::string& text, const std::string& source)
+{
+    LayoutScan scan(source);
+    std::istringstream in(text);
+    std::string line;
+    std::vector<std::string> tok;
+    bool done = false;
+    for (int lineNo = 1; std::getline(in, line); ++lineNo) {
+        const bool closed = tokenize(line, tok);
+        if (std::any_of(tok.begin(), tok.end(), isInclude)) {
+            // lcms2 would open the file it names, in any table: a measurement file stands alone.
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}:{}: .INCLUDE is not followed: give the readings "
+                                         "in one file",
+                                         source, lineNo));
+        }
+        if (done) {
+            continue;
+        }
+        if (!closed) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}:{}: unterminated quoted string", source, lineNo));
+        }
+        if (tok.empty()) {
+            continue;
+        }
+        auto end = scan.line(tok, line, lineNo);
+        if (!end) {
+            return tl::unexpected(end.error());
+        }
+        done = *end;
+    }
+    return scan.finish(done);
+}
 
 } // namespace
 
@@ -308,48 +298,53 @@ Expected<CgatsTable> parseCgats(const std::string& text, const std::string& sour
     if (auto ok = checkTableLimits(text, source, ' '); !ok) {
         return tl::unexpected(ok.error());
     }
-    CgatsParser parser(source);
-    std::istringstream in(text);
-    std::string line;
-    int lineNo = 0;
-    std::vector<std::string> tok;
-    while (parser.state() != CgatsParser::State::Done && std::getline(in, line)) {
-        ++lineNo;
-        if (!tokenize(line, tok)) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}:{}: unterminated quoted string", source, lineNo));
-        }
-        if (tok.empty()) {
-            continue;
-        }
-        if (auto ok = parser.read(tok, line, lineNo); !ok) {
-            return tl::unexpected(ok.error());
-        }
+    auto layout = scanLayout(text, source);
+    if (!layout) {
+        return tl::unexpected(layout.error());
     }
-    return parser.finish();
+    return readIt8Table(text, source, layout->fields.size(), layout->rowLines);
 }
 
 std::string cgatsText(const CgatsTable& t)
 {
-    static const std::vector<std::string> standard{"DESCRIPTOR", "ORIGINATOR", "CREATED"};
-    std::string out = t.identifier + "\n\n";
-    for (const auto& [k, v] : t.keywords) {
-        if (std::find(standard.begin(), standard.end(), k) == standard.end()) {
-            out += fmt::format("KEYWORD \"{}\"\n", k);
-        }
-        out += fmt::format("{} \"{}\"\n", k, v);
-    }
-    out += fmt::format("\nNUMBER_OF_FIELDS {}\nBEGIN_DATA_FORMAT\n{}\nEND_DATA_FORMAT\n\n",
-                       t.fields.size(), fmt::join(t.fields, " "));
-    out += fmt::format("NUMBER_OF_SETS {}\nBEGIN_DATA\n", t.rows.size());
-    for (const auto& r : t.rows) {
-        out += fmt::format("{}\n", fmt::join(r, " "));
-    }
-    out += "END_DATA\n";
-    return out;
+    return writeIt8Table(t);
 }
 
-Expected<MeasurementSet> parseTi3(const std::string& text, const std::string& source, int bitDepth)
+namespace {
+
+// The factor from a .ti3's XYZ to cd/m^2: 1 for NORMALIZED_TO_Y_100 "NO", else white's luminance
+// (whiteCdM2, or LUMINANCE_XYZ_CDM2's Y) / 100.
+Expected<double> ti3Scale(const CgatsTable& t, const std::string& source, double whiteCdM2)
+{
+    const auto* normed = t.keyword("NORMALIZED_TO_Y_100");
+    if (normed != nullptr && *normed == "NO") {
+        return 1.0;
+    }
+    if (whiteCdM2 > 0.0 && std::isfinite(whiteCdM2)) {
+        return whiteCdM2 / 100.0;
+    }
+    const auto* lum = t.keyword("LUMINANCE_XYZ_CDM2");
+    double x = 0.0;
+    double y = 0.0;
+    double z = 0.0;
+    if (lum == nullptr || std::sscanf(lum->c_str(), " %lf %lf %lf", &x, &y, &z) != 3 ||
+        !(y > 0.0) || !std::isfinite(y)) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: XYZ normalised to white Y = 100 and no usable "
+                                     "LUMINANCE_XYZ_CDM2 \"X Y Z\": the absolute luminance is "
+                                     "unknown; give white's luminance in cd/m^2 (display fit "
+                                     "--white-cdm2 VALUE, e.g. spotread's reading of full white), "
+                                     "or measure with dispread, which writes it (or set "
+                                     "NORMALIZED_TO_Y_100 \"NO\" for readings in cd/m^2)",
+                                     source));
+    }
+    return y / 100.0;
+}
+
+} // namespace
+
+Expected<MeasurementSet>
+parseTi3(const std::string& text, const std::string& source, int bitDepth, double whiteCdM2)
 {
     auto t = parseCgats(text, source);
     if (!t) {
@@ -368,24 +363,11 @@ Expected<MeasurementSet> parseTi3(const std::string& text, const std::string& so
                                      source, *rep));
     }
     // Display readings are normalised to white Y = 100 unless the file says NO (Argyll's rule).
-    double scale = 1.0;
-    const auto* normed = t->keyword("NORMALIZED_TO_Y_100");
-    if (normed == nullptr || *normed != "NO") {
-        const auto* lum = t->keyword("LUMINANCE_XYZ_CDM2");
-        double x = 0.0;
-        double y = 0.0;
-        double z = 0.0;
-        if (lum == nullptr || std::sscanf(lum->c_str(), " %lf %lf %lf", &x, &y, &z) != 3 ||
-            !(y > 0.0) || !std::isfinite(y)) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: XYZ normalised to white Y = 100 and no usable "
-                                         "LUMINANCE_XYZ_CDM2 \"X Y Z\": the absolute luminance is "
-                                         "unknown (dispread writes it; or set NORMALIZED_TO_Y_100 "
-                                         "\"NO\" for readings in cd/m^2)",
-                                         source));
-        }
-        scale = y / 100.0;
+    auto scaleOr = ti3Scale(*t, source, whiteCdM2);
+    if (!scaleOr) {
+        return tl::unexpected(scaleOr.error());
     }
+    const double scale = *scaleOr;
     auto counts = countsOf(*t, source, bitDepth);
     if (!counts) {
         return tl::unexpected(counts.error());
@@ -492,12 +474,24 @@ ti1Text(const std::vector<glm::dvec3>& counts, int bitDepth, const std::string& 
     return cgatsText(t);
 }
 
-Expected<MeasurementSet> loadMeasurements(const std::filesystem::path& path, int bitDepth)
+bool isTi3Path(const std::filesystem::path& path)
 {
     auto ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (ext != ".ti3") {
+    return ext == ".ti3";
+}
+
+Expected<MeasurementSet>
+loadMeasurements(const std::filesystem::path& path, int bitDepth, double whiteCdM2)
+{
+    if (!isTi3Path(path)) {
+        if (whiteCdM2 > 0.0) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: white's luminance is for a .ti3 normalised to "
+                                         "white Y = 100; a CSV's XYZ are cd/m^2 already",
+                                         path.string()));
+        }
         return loadMeasurementCsv(path, bitDepth);
     }
     auto text = readInputFile(path, kMaxCsvBytes, "measurement");
@@ -508,7 +502,7 @@ Expected<MeasurementSet> loadMeasurements(const std::filesystem::path& path, int
         }
         return tl::unexpected(text.error());
     }
-    return parseTi3(*text, path.string(), bitDepth == 0 ? 8 : bitDepth);
+    return parseTi3(*text, path.string(), bitDepth == 0 ? 8 : bitDepth, whiteCdM2);
 }
 
 } // namespace replica::pipeline::display

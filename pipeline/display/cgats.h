@@ -3,8 +3,10 @@
 // is and a set measured here reads in Argyll. Only the first table of a file is read (targen's
 // extra tables are skipped). XYZ in a display .ti3 is normalised to white Y = 100 unless
 // NORMALIZED_TO_Y_100 is "NO"; LUMINANCE_XYZ_CDM2 then gives white's absolute XYZ (Argyll's own
-// reading of the keywords). Counts are RGB / 100 x (2^bits - 1), rounded to the nearest count: what
-// a frame buffer of that depth shows.
+// reading of the keywords). Files without it (fakeread's, dispread's without -Y) take white's
+// luminance from the caller (display fit --white-cdm2), which also wins over the keyword. Counts
+// are RGB / 100 x (2^bits - 1), rounded to the nearest count: what a frame buffer of that depth
+// shows.
 #pragma once
 
 #include <filesystem>
@@ -35,8 +37,12 @@ Expected<CgatsTable> parseCgats(const std::string& text, const std::string& sour
 std::string cgatsText(const CgatsTable& table);
 
 // .ti3 readings -> a measurement set at 'bitDepth' (Argyll's RGB carry no depth; 8 unless told).
-Expected<MeasurementSet>
-parseTi3(const std::string& text, const std::string& source, int bitDepth = 8);
+// whiteCdM2 > 0: white's luminance for readings normalised to white Y = 100 (scale whiteCdM2 /
+// 100), in place of LUMINANCE_XYZ_CDM2; 0: the keyword, and an error without it.
+Expected<MeasurementSet> parseTi3(const std::string& text,
+                                  const std::string& source,
+                                  int bitDepth = 8,
+                                  double whiteCdM2 = 0.0);
 // .ti3 text of readings in absolute cd/m^2: normalised to the brightest reading's Y = 100 with
 // LUMINANCE_XYZ_CDM2 set to that reading, as dispread writes it.
 std::string
@@ -49,7 +55,10 @@ std::string
 ti1Text(const std::vector<glm::dvec3>& counts, int bitDepth, const std::string& originator);
 
 // Measurements from a .ti3 (by its extension) or the R,G,B,X,Y,Z CSV. bitDepth 0: the CSV infers
-// it, a .ti3 takes 8.
-Expected<MeasurementSet> loadMeasurements(const std::filesystem::path& path, int bitDepth = 0);
+// it, a .ti3 takes 8. whiteCdM2: parseTi3's (a CSV is in cd/m^2 already: an error there).
+Expected<MeasurementSet>
+loadMeasurements(const std::filesystem::path& path, int bitDepth = 0, double whiteCdM2 = 0.0);
+// True for a path that loadMeasurements reads as a .ti3.
+bool isTi3Path(const std::filesystem::path& path);
 
 } // namespace replica::pipeline::display

@@ -97,14 +97,20 @@ Expected<void> splitRamps(const std::vector<Measurement>& rows,
         std::sort(r.begin(), r.end(),
                   [](const RampPoint& a, const RampPoint& b) { return a.count < b.count; });
         const bool hasFull = !r.empty() && r.back().count == data.maxCount;
-        if (static_cast<int>(r.size()) < options.minRampLevels || !hasFull) {
+        const int need = options.toneMethod == ToneMethod::Robust ? options.minGogRampLevels
+                                                                  : options.minRampLevels;
+        if (static_cast<int>(r.size()) < need || !hasFull) {
             return makeError(ErrorCode::InvalidArgument,
                              fmt::format("{}: missing ramp: channel {} has {} non-zero levels{} "
                                          "(needs at least {} with the others at 0, full drive "
-                                         "{} included)",
+                                         "{} included; {} for the cross-validated tone shapes); "
+                                         "with ArgyllCMS, add single-channel steps: targen -d3 "
+                                         "-s {} (0 to full drive in {} steps) with the rest of "
+                                         "the set",
                                          data.source, kChannelNames[c], r.size(),
-                                         hasFull ? "" : " and no full-drive point",
-                                         options.minRampLevels, data.maxCount));
+                                         hasFull ? "" : " and no full-drive point", need,
+                                         data.maxCount, options.minRampLevels,
+                                         options.minRampLevels + 1, options.minRampLevels + 1));
         }
     }
     return {};
@@ -379,6 +385,11 @@ Expected<DisplayModel> fitDisplay(const MeasurementSet& set, const FitOptions& o
                 sum.y > 0.0 ? 100.0 * (data->white->y - sum.y) / sum.y : 0.0;
     }
     reportChromaticityDrift(*data, report);
+    for (std::size_t c = 0; c < 3; ++c) {
+        report.rampLevels[c] = static_cast<int>(data->ramps[c].size());
+        report.gogOnlyForShortRamps = report.gogOnlyForShortRamps ||
+                                      (robust && report.rampLevels[c] < options.minRampLevels);
+    }
     model->fit = report;
     if (auto ok = model->validate(); !ok) {
         return tl::unexpected(ok.error());

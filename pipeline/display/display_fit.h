@@ -29,8 +29,13 @@ struct FitOptions {
     std::string description;
     bool synthetic = false;
     MeasurementCondition condition = MeasurementCondition::Dark;
-    int minRampLevels = 8; // distinct non-zero levels per channel ramp, full drive included
-    int minColours = 6;    // off-ramp colours (training + held-out)
+    // Distinct non-zero levels per channel ramp, full drive included: the cross-validated tone
+    // shapes need minRampLevels; a ramp with at least minGogRampLevels but fewer (an ordinary
+    // 'targen -d3 -f200' set has 4) gets the parametric GOG curve alone (the robust fit), and the
+    // report says so (FitReport::rampLevels).
+    int minRampLevels = 8;
+    int minGogRampLevels = 4;
+    int minColours = 6;                 // off-ramp colours (training + held-out)
     double monotonicTolerance = 0.02;   // a ramp may dip by this fraction of its range (noise), or
                                         // by six sigma of the noise the ramp shows where larger
     double deadChannelFraction = 0.005; // X+Y+Z of a primary below this share of all three: dead

@@ -236,6 +236,15 @@ public:
                 robust_ ? glm::dmat3(rampPrimary(r[0], data.black), rampPrimary(r[1], data.black),
                                      rampPrimary(r[2], data.black))
                         : data.primaries;
+        // A ramp too short for the cross-validated shapes (FitOptions::minGogRampLevels) gets
+        // the GOG curve, its three parameters fitted by weighted least squares.
+        for (std::size_t c = 0; robust_ && c < 3; ++c) {
+            if (static_cast<int>(data.ramps[c].size()) < options.minRampLevels) {
+                toneOptions_[c].forceShape = true;
+                toneOptions_[c].shape = ToneShape::Gog;
+                toneOptions_[c].lambda = 0.0;
+            }
+        }
         direct_ = derive(mDirect_);
         if (robust_) {
             for (std::size_t c = 0; c < 3; ++c) {

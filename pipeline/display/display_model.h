@@ -53,6 +53,10 @@ struct FitReport {
     std::string crosstalkModel;
     double crosstalkGainDe00 = 0.0;
     double crosstalkZ = 0.0; // the uniform coefficient over its standard error
+    // Non-zero ramp levels per channel, and whether the tone curves were limited to GOG because
+    // a ramp had fewer than FitOptions::minRampLevels (not stored in the profile).
+    std::array<int, 3> rampLevels{};
+    bool gogOnlyForShortRamps = false;
 };
 
 struct DisplayModel {

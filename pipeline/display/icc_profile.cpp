@@ -1,4 +1,4 @@
-// ICC v4 display profile through Little CMS 2.
+// ICC v2.4 or v4.3 display profile through Little CMS 2.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -80,6 +80,7 @@ trcCurve(const DisplayModel& model, int c, double bc, int samples)
 Expected<ProfilePtr> buildProfile(const DisplayModel& model,
                                   IccWriteReport& report,
                                   int samples,
+                                  IccVersion version,
                                   const std::string& where)
 {
     report.crosstalkOmitted = model.hasCrosstalk();
@@ -103,19 +104,21 @@ Expected<ProfilePtr> buildProfile(const DisplayModel& model,
         const glm::dvec3 col = adapt * (model.matrix[c] * (1.0 + b[c]) / white.y);
         colorant[static_cast<std::size_t>(c)] = {col.x, col.y, col.z};
     }
+    const cmsCIEXYZ mediaWhite{white.x / white.y, 1.0, white.z / white.y};
     cmsHPROFILE h = cmsCreateProfilePlaceholder(nullptr);
     if (h == nullptr) {
         return makeError(ErrorCode::Io, "lcms2: cannot create a profile");
     }
     ProfilePtr guard(h);
-    cmsSetProfileVersion(h, 4.3);
+    const bool v4 = version == IccVersion::V4_3;
+    cmsSetProfileVersion(h, v4 ? 4.3 : 2.4);
     cmsSetDeviceClass(h, cmsSigDisplayClass);
     cmsSetColorSpace(h, cmsSigRgbData);
     cmsSetPCS(h, cmsSigXYZData);
     cmsSetHeaderRenderingIntent(h, INTENT_RELATIVE_COLORIMETRIC);
     bool ok = writeText(h, cmsSigProfileDescriptionTag, model.name) &&
               writeText(h, cmsSigCopyrightTag, "No copyright; written by replica display fit") &&
-              cmsWriteTag(h, cmsSigMediaWhitePointTag, cmsD50_XYZ()) != 0 &&
+              cmsWriteTag(h, cmsSigMediaWhitePointTag, v4 ? cmsD50_XYZ() : &mediaWhite) != 0 &&
               cmsWriteTag(h, cmsSigRedColorantTag, &colorant[0]) != 0 &&
               cmsWriteTag(h, cmsSigGreenColorantTag, &colorant[1]) != 0 &&
               cmsWriteTag(h, cmsSigBlueColorantTag, &colorant[2]) != 0;
@@ -143,12 +146,12 @@ Expected<ProfilePtr> buildProfile(const DisplayModel& model,
 
 } // namespace
 
-Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
-                                         const std::filesystem::path& path)
+Expected<IccWriteReport>
+writeIccProfile(const DisplayModel& model, const std::filesystem::path& path, IccVersion version)
 {
     IccWriteReport report;
     // TRCs sampled at 4096 points over the count range (the curv tag holds 16-bit values).
-    auto h = buildProfile(model, report, 0, path.string());
+    auto h = buildProfile(model, report, 0, version, path.string());
     if (!h) {
         return tl::unexpected(h.error());
     }
@@ -159,10 +162,11 @@ Expected<IccWriteReport> writeIccProfile(const DisplayModel& model,
     return report;
 }
 
-Expected<std::vector<std::uint8_t>> iccProfileBytes(const DisplayModel& model, int trcSamples)
+Expected<std::vector<std::uint8_t>>
+iccProfileBytes(const DisplayModel& model, int trcSamples, IccVersion version)
 {
     IccWriteReport report;
-    auto h = buildProfile(model, report, std::max(trcSamples, 2), model.name);
+    auto h = buildProfile(model, report, std::max(trcSamples, 2), version, model.name);
     if (!h) {
         return tl::unexpected(h.error());
     }
@@ -205,6 +209,11 @@ Expected<IccInfo> readIccInfo(const std::filesystem::path& path)
     if (const auto* lumi = static_cast<const cmsCIEXYZ*>(cmsReadTag(in.get(), cmsSigLuminanceTag));
         lumi != nullptr) {
         info.luminanceCdM2 = lumi->Y;
+    }
+    if (const auto* wtpt =
+                static_cast<const cmsCIEXYZ*>(cmsReadTag(in.get(), cmsSigMediaWhitePointTag));
+        wtpt != nullptr) {
+        info.mediaWhite = glm::dvec3(wtpt->X, wtpt->Y, wtpt->Z);
     }
     char buf[256] = {};
     cmsGetProfileInfoASCII(in.get(), cmsInfoDescription, "en", "US", buf, sizeof buf);

@@ -181,6 +181,11 @@ void registerFit(CLI::App* display, int& exitCode)
     fitCmd->add_option("--bits", fit->bits,
                        "panel bit depth (default: from the largest count; 8 for a .ti3)")
             ->check(CLI::Range(1, 16));
+    fitCmd->add_option("--white-cdm2", fit->whiteCdM2,
+                       "white's luminance in cd/m^2 for a .ti3 whose XYZ are relative (white Y = "
+                       "100) and that has no LUMINANCE_XYZ_CDM2 (fakeread's, dispread's without "
+                       "-Y); it wins over the keyword where both are given")
+            ->check(CLI::PositiveNumber);
     fitCmd->add_option("--measured-in", fit->measuredIn,
                        "dark, or lit-booth (the black then already holds the screen's reflection "
                        "of the booth light, which is then not subtracted again)")
@@ -198,8 +203,13 @@ void registerFit(CLI::App* display, int& exitCode)
             ->check(CLI::IsMember({"robust", "interpolate"}))
             ->capture_default_str();
     fitCmd->add_option("--icc", fit->icc,
-                       "also write the profile as an ICC v4 display profile (matrix/TRC, D50 PCS, "
-                       "white's luminance in the lumi tag)");
+                       "also write the profile as an ICC display profile (matrix/TRC, D50 PCS, "
+                       "white's luminance in the lumi tag), v2.4 unless --icc-version 4");
+    fitCmd->add_option("--icc-version", fit->iccVersion,
+                       "ICC version of --icc: 2 (v2.4, which ArgyllCMS's iccdump, xicclu and "
+                       "profcheck read) or 4 (v4.3)")
+            ->check(CLI::IsMember({2, 4}))
+            ->capture_default_str();
     fitCmd->add_flag("--json", fit->json, "print the fit report as JSON");
     fitCmd->callback([fit, &exitCode] { exitCode = displayFitMain(*fit); });
 }

@@ -21,6 +21,7 @@ struct DisplayOptions {
     std::string triple;
     std::string viewingTable;
     int bits = 0;
+    double whiteCdM2 = 0.0; // --white-cdm2: white's luminance for a .ti3 normalised to Y = 100
     bool synthetic = false;
     bool json = false;
     bool clip = false;
@@ -31,6 +32,7 @@ struct DisplayOptions {
     std::string basis = "replica_k6";
     std::string tone = "robust";
     std::string icc;
+    int iccVersion = 2; // --icc-version: 2 (v2.4, what ArgyllCMS reads) or 4 (v4.3)
     SensedReportOptions sensed;
 };
 

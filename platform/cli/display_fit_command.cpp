@@ -1,5 +1,5 @@
 // 'replica display fit': a display profile fitted to measurements (pipeline/display/display_fit.h),
-// written as JSON (and ICC v4 on request), and its fit report printed.
+// written as JSON (and ICC v2.4 or v4 on request), and its fit report printed.
 #include <filesystem>
 #include <fstream>
 
@@ -83,10 +83,11 @@ bool attachViewingTable(const DisplayOptions& o, pd::DisplayModel& model)
     return true;
 }
 
-bool writeIcc(const pd::DisplayModel& model, const std::string& path)
+bool writeIcc(const pd::DisplayModel& model, const std::string& path, int version)
 {
     auto log = logger("replica");
-    auto icc = pd::writeIccProfile(model, path);
+    auto icc = pd::writeIccProfile(model, path,
+                                   version == 4 ? pd::IccVersion::V4_3 : pd::IccVersion::V2_4);
     if (!icc) {
         log->error("{}", icc.error().message);
         return false;
@@ -128,7 +129,9 @@ void printFitJson(const pd::DisplayModel& model, const std::string& out)
                        {"inverse_counts_max", f.inverseCountsMax},
                        {"gamut_edge_tolerance", model.gamutEdgeTolerance},
                        {"crosstalk_model", f.crosstalkModel},
-                       {"crosstalk_gain_de00", f.crosstalkGainDe00}}
+                       {"crosstalk_gain_de00", f.crosstalkGainDe00},
+                       {"ramp_levels", f.rampLevels},
+                       {"gog_only_for_short_ramps", f.gogOnlyForShortRamps}}
                        .dump());
 }
 
@@ -172,7 +175,9 @@ void printFitText(const pd::DisplayModel& model, const DisplayOptions& o)
     // The model's white (with a crosstalk term, below black + R + G + B).
     const glm::dvec3 w = model.forward(glm::dvec3(model.maxCount()));
     fmt::print("profile: {}{}\n", o.out,
-               o.icc.empty() ? std::string() : fmt::format(" (and ICC v4: {})", o.icc));
+               o.icc.empty() ? std::string()
+                             : fmt::format(" (and ICC {}: {})", o.iccVersion == 4 ? "v4.3" : "v2.4",
+                                           o.icc));
     fmt::print("white {:.1f} cd/m^2, black {:.3f} cd/m^2, {}-bit\n", w.y, model.blackXyz.y,
                model.bitDepth);
     fmt::print("held-out dE00 over {} colours: mean {:.3f}, 90th {:.3f}, max {:.3f} "
@@ -194,6 +199,13 @@ void printFitText(const pd::DisplayModel& model, const DisplayOptions& o)
         fmt::print("additivity: white vs R+G+B dE00 {:.3f}, luminance {:+.2f}%\n", f.additivityDe00,
                    f.additivityLuminancePercent);
     }
+    if (f.gogOnlyForShortRamps) {
+        fmt::print("short ramps: R {} G {} B {} non-zero levels; a channel with fewer than 8 has "
+                   "the GOG curve alone (not cross-validated against GOGO or a spline, its noise "
+                   "estimate from 3 parameters' residuals); for those, add single-channel steps "
+                   "(ArgyllCMS: targen -d3 -s 9)\n",
+                   f.rampLevels[0], f.rampLevels[1], f.rampLevels[2]);
+    }
     fmt::print("primary chromaticity drift along ramps (max |dxy|): R {:.4f} G {:.4f} B "
                "{:.4f}; ramp points pooled for monotonicity: {}\n",
                f.chromaticityDrift[0], f.chromaticityDrift[1], f.chromaticityDrift[2],
@@ -209,7 +221,7 @@ int displayFitMain(const DisplayOptions& o)
         log->error("--measured-in {}: expected 'dark' or 'lit-booth'", o.measuredIn);
         return kExitUsage;
     }
-    auto set = pd::loadMeasurements(o.measurements, o.bits);
+    auto set = pd::loadMeasurements(o.measurements, o.bits, o.whiteCdM2);
     if (!set) {
         log->error("{}", set.error().message);
         return kExitFailure;
@@ -229,7 +241,7 @@ int displayFitMain(const DisplayOptions& o)
         log->error("{}", ok.error().message);
         return kExitFailure;
     }
-    if (!o.icc.empty() && !writeIcc(*model, o.icc)) {
+    if (!o.icc.empty() && !writeIcc(*model, o.icc, o.iccVersion)) {
         return kExitFailure;
     }
     if (o.json) {

@@ -1,5 +1,6 @@
 // ArgyllCMS CGATS files in and out (hand-written in dispread's and targen's layout, and broken
-// ones), and the ICC v4 profile read back with Little CMS against the model it was written from.
+// ones), and the ICC v2.4 and v4 profiles read back with Little CMS against the model it was
+// written from.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -81,6 +82,53 @@ TEST(Cgats, ReadsDispreadReadingsInAbsoluteUnits)
     auto abs = parseTi3(
             withLine(kDispreadTi3, "NORMALIZED_TO_Y_100 \"YES\"", "NORMALIZED_TO_Y_100 \"NO\""),
             "d.ti3");
+    ASSERT_TRUE(abs.has_value());
+    EXPECT_DOUBLE_EQ(abs->rows[0].xyz.y, 100.0);
+}
+
+// fakeread's layout (and dispread's without -Y): relative XYZ, white Y = 100, neither
+// LUMINANCE_XYZ_CDM2 nor NORMALIZED_TO_Y_100.
+const char* kFakereadTi3 = R"(CTI3   
+
+DESCRIPTOR "Argyll Calibration Target chart information 3"
+ORIGINATOR "Argyll fakeread"
+CREATED "Sun Dec  6 09:02:17 2026"
+DEVICE_CLASS "DISPLAY"
+COLOR_REP "RGB_XYZ"
+
+NUMBER_OF_FIELDS 7
+BEGIN_DATA_FORMAT
+SAMPLE_ID RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z 
+END_DATA_FORMAT
+
+NUMBER_OF_SETS 2
+BEGIN_DATA
+1 100 100 100 95.0455 100 108.905 
+2 12.871 13.5316 33.7491 2.89009 2.16636 9.08295 
+END_DATA
+)";
+
+TEST(Cgats, RelativeReadingsTakeWhitesLuminanceFromTheCaller)
+{
+    auto none = parseTi3(kFakereadTi3, "f.ti3");
+    ASSERT_FALSE(none.has_value());
+    EXPECT_NE(none.error().message.find("f.ti3: XYZ normalised to white Y = 100 and no usable "
+                                        "LUMINANCE_XYZ_CDM2"),
+              std::string::npos);
+    EXPECT_NE(none.error().message.find("--white-cdm2 VALUE"), std::string::npos)
+            << none.error().message;
+    auto set = parseTi3(kFakereadTi3, "f.ti3", 8, 250.0);
+    ASSERT_TRUE(set.has_value()) << set.error().message;
+    EXPECT_DOUBLE_EQ(set->rows[0].xyz.y, 250.0);
+    EXPECT_DOUBLE_EQ(set->rows[1].xyz.z, 9.08295 * 2.5);
+    // Given both, the caller's luminance wins over the file's keyword.
+    auto both = parseTi3(kDispreadTi3, "d.ti3", 8, 250.0);
+    ASSERT_TRUE(both.has_value());
+    EXPECT_DOUBLE_EQ(both->rows[0].xyz.y, 250.0);
+    // Readings in cd/m^2 are not scaled again.
+    auto abs = parseTi3(
+            withLine(kDispreadTi3, "NORMALIZED_TO_Y_100 \"YES\"", "NORMALIZED_TO_Y_100 \"NO\""),
+            "d.ti3", 8, 250.0);
     ASSERT_TRUE(abs.has_value());
     EXPECT_DOUBLE_EQ(abs->rows[0].xyz.y, 100.0);
 }
@@ -189,6 +237,113 @@ END_DATA
     EXPECT_EQ(cmyk.error().message, "t.ti1: COLOR_REP is 'CMYK', a display patch set is RGB");
 }
 
+// targen 2.3.1's own output ('targen -d3 -f200', its first table cut to 3 rows; the two more
+// tables as written), read through lcms2's IT8 parser.
+const char* kTargenTi1 = R"(CTI1   
+
+DESCRIPTOR "Argyll Calibration Target chart information 1"
+ORIGINATOR "Argyll targen"
+CREATED "Sun Dec  6 09:02:14 2026"
+APPROX_WHITE_POINT "95.106486 100.000000 108.844025"
+COLOR_REP "RGB"
+WHITE_COLOR_PATCHES "4"
+BLACK_COLOR_PATCHES "4"
+OFPS_PATCHES "192"
+
+NUMBER_OF_FIELDS 7
+BEGIN_DATA_FORMAT
+SAMPLE_ID RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z 
+END_DATA_FORMAT
+
+NUMBER_OF_SETS 3
+BEGIN_DATA
+1 100 100 100 95.1065 100 108.844 
+2 12.871 13.5316 33.7491 3.86155 3.14471 9.99463 
+3 74.6785 11.7314 48.1323 26.1118 14.2192 20.7011 
+END_DATA
+CTI1   
+
+DESCRIPTOR "Argyll Calibration Target chart information 1"
+ORIGINATOR "Argyll targen"
+DENSITY_EXTREME_VALUES "8"
+CREATED "December 6, 2026"
+
+NUMBER_OF_FIELDS 7
+BEGIN_DATA_FORMAT
+INDEX RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z 
+END_DATA_FORMAT
+
+NUMBER_OF_SETS 8
+BEGIN_DATA
+0 100 100 100 95.1065 100 108.844 
+1 0.00000 47.3607 100 25.613 21.6292 97.3763 
+2 100 0.00000 79.3514 52.4258 26.2898 58.7215 
+3 0.00000 0.00000 58.9971 6.48583 3.19399 29.8945 
+4 100 66.6593 0.00000 56.0588 50.5054 7.65614 
+5 0.00000 35.6011 0.00000 4.68562 8.37021 2.22855 
+6 84.4444 0.00000 0.00000 28.8428 15.3558 2.30466 
+7 0.00000 0.00000 0.00000 1 1 1 
+END_DATA
+CTI1   
+
+DESCRIPTOR "Argyll Calibration Target chart information 1"
+ORIGINATOR "Argyll targen"
+DEVICE_COMBINATION_VALUES "9"
+CREATED "December 6, 2026"
+
+NUMBER_OF_FIELDS 7
+BEGIN_DATA_FORMAT
+INDEX RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z 
+END_DATA_FORMAT
+
+NUMBER_OF_SETS 9
+BEGIN_DATA
+0 100 100 100 95.1065 100 108.844 
+1 0.00000 100 100 54.2763 78.9478 106.931 
+2 100 0.00000 100 59.7013 29.1995 97.0422 
+3 0.00000 0.00000 100 18.8711 8.14731 95.129 
+4 100 100 0.00000 77.2354 92.8527 14.7151 
+5 0.00000 100 0.00000 36.4052 71.8005 12.8018 
+6 100 0.00000 0.00000 41.8302 22.0522 2.91323 
+7 0.00000 0.00000 0.00000 1 1 1 
+8 50 50 50 21.1427 22.1901 24.0831 
+END_DATA
+)";
+
+TEST(Cgats, ReadsTargensThreeTableFileThroughLcms)
+{
+    auto p = parseTi1(kTargenTi1, "t.ti1");
+    ASSERT_TRUE(p.has_value()) << p.error().message;
+    ASSERT_EQ(p->size(), 3u);
+    EXPECT_EQ((*p)[0], glm::dvec3(255.0));
+    // 12.871, 13.5316, 33.7491 % of 255.
+    EXPECT_EQ((*p)[1], glm::dvec3(33.0, 35.0, 86.0));
+    auto t = parseCgats(kTargenTi1, "t.ti1");
+    ASSERT_TRUE(t.has_value());
+    EXPECT_EQ(t->identifier, "CTI1");
+    ASSERT_NE(t->keyword("APPROX_WHITE_POINT"), nullptr);
+    EXPECT_EQ(*t->keyword("APPROX_WHITE_POINT"), "95.106486 100.000000 108.844025");
+    EXPECT_EQ(t->keyword("NUMBER_OF_SETS"), nullptr); // the layout, not a keyword
+    EXPECT_EQ(t->field("XYZ_Z"), 6);
+    EXPECT_EQ(t->rowLines, (std::vector<int>{19, 20, 21}));
+    // What lcms2 itself refuses comes back with its line: a later table's count (lcms2 names the
+    // line after that table's END_DATA, 69).
+    auto later = parseTi1(withLine(kTargenTi1, "NUMBER_OF_SETS 9", "NUMBER_OF_SETS 10"), "t.ti1");
+    ASSERT_FALSE(later.has_value());
+    EXPECT_EQ(later.error().message, "t.ti1:70: Count mismatch. NUMBER_OF_SETS was 10, found 9");
+    // lcms2 follows .INCLUDE to another file: refused, wherever it is.
+    auto include = parseTi1(
+            withLine(kTargenTi1, "DEVICE_COMBINATION_VALUES \"9\"", ".INCLUDE \"/etc/passwd\""),
+            "t.ti1");
+    ASSERT_FALSE(include.has_value());
+    EXPECT_EQ(include.error().message,
+              "t.ti1:50: .INCLUDE is not followed: give the readings in one file");
+    // And what it writes, it and Argyll read back (fakeread in interop.argyll_profile).
+    auto back = parseTi1(ti1Text(*p, 8, "Replica test"), "w.ti1");
+    ASSERT_TRUE(back.has_value()) << back.error().message;
+    EXPECT_EQ(*back, *p);
+}
+
 TEST(IccProfile, BradfordMatchesThePublishedMatrix)
 {
     // Lindbloom's Bradford D65 -> D50 matrix (brucelindbloom.com, chromatic adaptation).
@@ -222,17 +377,31 @@ TEST(IccProfile, ReadsBackAsTheModelThroughLittleCms)
     auto withCrosstalk = writeIccProfile(fitted, path);
     ASSERT_TRUE(withCrosstalk.has_value()) << withCrosstalk.error().message;
     EXPECT_TRUE(withCrosstalk->crosstalkOmitted);
+    // v2.4 by default (ArgyllCMS 2.3 refuses v4): wtpt is the display's own white (Y = 1), not
+    // D50, and relative colorimetric reads the same as from v4.
     auto written = writeIccProfile(model, path);
     ASSERT_TRUE(written.has_value()) << written.error().message;
     EXPECT_FALSE(written->blackClipped);
     EXPECT_FALSE(written->crosstalkOmitted);
     auto info = readIccInfo(path);
     ASSERT_TRUE(info.has_value()) << info.error().message;
-    EXPECT_GE(info->version, 4.0);
+    EXPECT_DOUBLE_EQ(info->version, 2.4);
     EXPECT_TRUE(info->displayClass);
     EXPECT_TRUE(info->rgbToXyz);
     EXPECT_NEAR(info->luminanceCdM2, model.whiteXyz().y, 1e-3 * model.whiteXyz().y);
     EXPECT_EQ(info->description, model.name);
+    const glm::dvec3 ownWhite = model.whiteXyz() / model.whiteXyz().y;
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(info->mediaWhite[k], ownWhite[k], 1e-4) << k; // s15Fixed16
+    }
+    const auto v4path = path.string() + ".v4.icc";
+    ASSERT_TRUE(writeIccProfile(model, v4path, IccVersion::V4_3).has_value());
+    auto v4 = readIccInfo(v4path);
+    ASSERT_TRUE(v4.has_value()) << v4.error().message;
+    EXPECT_GE(v4->version, 4.0);
+    EXPECT_NEAR(v4->mediaWhite.x, 0.9642, 1e-4); // v4: the PCS's D50
+    EXPECT_NEAR(v4->mediaWhite.z, 0.8249, 1e-4);
+    EXPECT_EQ(v4->description, model.name);
 
     std::vector<glm::dvec3> counts{glm::dvec3(0.0), glm::dvec3(255.0)};
     std::mt19937_64 rng(5);
@@ -245,8 +414,11 @@ TEST(IccProfile, ReadsBackAsTheModelThroughLittleCms)
         counts.emplace_back(0, 0, v);
     }
     auto xyz = iccForward(path, counts, 8);
+    auto xyz4 = iccForward(v4path, counts, 8);
     std::filesystem::remove(path);
+    std::filesystem::remove(v4path);
     ASSERT_TRUE(xyz.has_value()) << xyz.error().message;
+    ASSERT_TRUE(xyz4.has_value()) << xyz4.error().message;
     const glm::dvec3 white = model.whiteXyz();
     const glm::dmat3 adapt = bradfordToD50(white);
     const glm::dvec3 d50(0.9642, 1.0, 0.8249);
@@ -254,8 +426,10 @@ TEST(IccProfile, ReadsBackAsTheModelThroughLittleCms)
     double worstY = 0.0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
         const glm::dvec3 want = adapt * (model.forward(counts[i]) / white.y);
-        worstDe = std::max(worstDe, deltaE2000Xyz((*xyz)[i], want, d50));
-        worstY = std::max(worstY, std::abs((*xyz)[i].y - want.y));
+        for (const auto* got : {&*xyz, &*xyz4}) {
+            worstDe = std::max(worstDe, deltaE2000Xyz((*got)[i], want, d50));
+            worstY = std::max(worstY, std::abs((*got)[i].y - want.y));
+        }
     }
     // The curv tags hold 16-bit values and the colorants s15Fixed16 numbers: 1/65535 of white.
     RecordProperty("icc_max_de00", std::to_string(worstDe));

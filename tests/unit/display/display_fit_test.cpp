@@ -200,6 +200,54 @@ TEST(DisplayFit, DegenerateSetsFailWithClearMessages)
     }
 }
 
+// An ordinary ArgyllCMS set (targen -d3 -f200) has four levels per ramp: the robust fit takes
+// them with the GOG curve alone and says so; two levels (targen -d3 -f64) are refused, naming the
+// targen option that adds ramp steps.
+TEST(DisplayFit, ShortRampsFitGogAloneAndSaySo)
+{
+    SyntheticDisplay truth = wideIpsGroundTruth();
+    truth.interaction = 0.0;
+    SessionPlan plan;
+    plan.rampStep = 64; // 64, 128, 192 and full drive
+    plan.fullDriveRepeats = 1;
+    plan.randomColours = 150;
+    const auto rows = syntheticSession(truth, MeterNoise{}, plan, 3);
+    auto model = fitDisplay(setFrom(rows), FitOptions{});
+    ASSERT_TRUE(model.has_value()) << model.error().message;
+    EXPECT_TRUE(model->fit.gogOnlyForShortRamps);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(model->fit.rampLevels[static_cast<std::size_t>(c)], 4) << c;
+        EXPECT_EQ(model->fit.toneShape[static_cast<std::size_t>(c)], "gog") << c;
+    }
+    // The S-shaped panel through a GOG curve from four levels, against the panel on colours
+    // never measured: ΔE00 mean 0.62, max 2.70 (seed 3; the S-shoulder GOG cannot follow); bounds
+    // 1.6 and 1.5 times that.
+    const glm::dvec3 white = truth.forward(glm::dvec3(255.0));
+    std::mt19937_64 rng(99);
+    double sum = 0.0;
+    double worst = 0.0;
+    for (int i = 0; i < 400; ++i) {
+        const glm::dvec3 d(static_cast<double>(rng() % 256), static_cast<double>(rng() % 256),
+                           static_cast<double>(rng() % 256));
+        const double de = deltaE2000Xyz(model->forward(d), truth.forward(d), white);
+        sum += de;
+        worst = std::max(worst, de);
+    }
+    RecordProperty("short_ramps_truth_mean_de00", std::to_string(sum / 400.0));
+    RecordProperty("short_ramps_truth_max_de00", std::to_string(worst));
+    EXPECT_LT(sum / 400.0, 1.0);
+    EXPECT_LT(worst, 4.0);
+    // The cross-validated fit of the dense plan does not take the short-ramp path.
+    auto dense = fitDisplay(setFrom(syntheticMeasurements(truth, MeterNoise{}, 3)), FitOptions{});
+    ASSERT_TRUE(dense.has_value());
+    EXPECT_FALSE(dense->fit.gogOnlyForShortRamps);
+
+    plan.rampStep = 128; // 128 and full drive: two levels
+    const auto msg = fitError(syntheticSession(truth, MeterNoise{}, plan, 3));
+    EXPECT_NE(msg.find("missing ramp: channel R has 2 non-zero levels"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("targen -d3 -s 9"), std::string::npos) << msg;
+}
+
 TEST(MeasurementCsv, ParsesAndRejectsBadInputNamingTheLine)
 {
     const std::string ok = "# comment\nR,G,B,X,Y,Z\n0,0,0,0.5,0.6,0.8\n255,255,255,850,900,980\n";
