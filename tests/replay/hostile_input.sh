@@ -310,6 +310,30 @@ if [ -x /usr/bin/time ]; then
 else
     fail "/usr/bin/time is missing: the bounded cases did not run"
 fi
+# replay --reprocess with an accelerometer scale that cannot be used (issue 32): a warning naming
+# the device, the sample and the value, the samples counted; before, 1e308 and 0 showed the default
+# tilt throughout, exit 0, without a word. NaN cannot be written in JSON: null is a damaged message.
+v6="$2/recordings/samples/walk-v6.mcap"
+for scale in 1e308 0; do
+    python3 "$here/alter_recording.py" "$v6" "$work/scale-$scale.mcap" --accel-scale "$scale"
+    out=$( (ulimit -v "$limit_kb"; timeout 60 "$replica" --log-level warn replay "$work/scale-$scale.mcap" --reprocess) 2>&1 >/dev/null)
+    got=$?
+    shown=0,0,0
+    [ "$scale" = 1e308 ] && shown='1e\+308,1e\+308,1e\+308'
+    want="249 accelerometer samples came out not finite.*accelerometer 'accelerometer \(simulated\) SIM-ACCEL-0001' sample 0: raw [^ ]+, scale $shown,"
+    if [ $got -ne 0 ]; then
+        fail "replay --reprocess with an accelerometer scale of $scale: exit $got: $out"
+    elif ! printf '%s' "$out" | grep -qE -- "$want"; then
+        fail "replay --reprocess with an accelerometer scale of $scale did not say /$want/: $out"
+    else
+        pass=$((pass + 1))
+        echo "ok: accelerometer scale $scale named: $(printf '%s' "$out" | head -1 | cut -c1-160)..."
+    fi
+done
+python3 "$here/alter_recording.py" "$v6" "$work/scale-null.mcap" --accel-scale null
+expect 1 "scale-null.mcap: damaged /replica/raw/accel message \(sequence 0\).*must be number" -- \
+    "${R[@]}" replay "$work/scale-null.mcap" --reprocess
+
 # replay shows a recording's text with its control characters escaped, as inspect does.
 out=$("$replica" --log-level info replay "$rec/escapes.mcap" 2>&1)
 if printf '%s' "$out" | grep -q $'\x1b'; then
