@@ -2,11 +2,13 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <hal/accel/iio_accel.h>
 #include <hal/lamp/lamp_debouncer.h>
@@ -145,9 +147,27 @@ reprocessPoses(recordings::Recording& rec, const ReprocessOptions& options, Repr
     return {};
 }
 
+// What the live source accepts (hal/accel: IioAccelDevice::open): scales positive and finite,
+// offsets finite.
+bool usableScale(const hal::RawAccelInput& raw)
+{
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!(raw.scale[k] > 0.0) || !std::isfinite(raw.scale[k]) ||
+            !std::isfinite(raw.offset[k])) {
+            return false;
+        }
+    }
+    return true;
+}
+
 Expected<void>
 reprocessAccel(recordings::Recording& rec, const ReprocessOptions& options, ReprocessReport& report)
 {
+    const auto info = rec.session.devices.find(recordings::accelKind().name());
+    const std::string device =
+            info != rec.session.devices.end()
+                    ? fmt::format("'{} {}'", info->second.model, info->second.serial)
+                    : std::string("(not named in the session)");
     for (auto& s : rec.samples(recordings::accelKind())) {
         ++report.accel;
         if (!s.raw) {
@@ -157,10 +177,26 @@ reprocessAccel(recordings::Recording& rec, const ReprocessOptions& options, Repr
         if (!m) {
             return tl::unexpected(m.error());
         }
-        const glm::dvec3 g = hal::accel::gravityFromRaw(*s.raw, *m);
+        glm::dvec3 g = hal::accel::gravityFromRaw(*s.raw, *m);
+        const bool usable = usableScale(*s.raw);
+        if (!usable) {
+            ++report.accelBadScale; // a zero scale would give a finite but meaningless (0,0,0)
+            g = glm::dvec3(std::numeric_limits<double>::quiet_NaN());
+        }
         ++report.accelReprocessed;
         report.accelChanged += sameBits(g, s.gravity) ? 0 : 1;
-        report.accelNonFinite += finite(g) ? 0 : 1;
+        if (!finite(g)) {
+            ++report.accelNonFinite;
+            if (report.accelFirstNonFinite.empty()) {
+                report.accelFirstNonFinite = fmt::format(
+                        "accelerometer {} sample {}: raw {}, scale {}, offset {} ({})", device,
+                        s.sequence, fmt::join(s.raw->raw, ","), fmt::join(s.raw->scale, ","),
+                        fmt::join(s.raw->offset, ","),
+                        usable ? "the product overflows"
+                               : "the scale is not a positive finite number or the offset not "
+                                 "finite");
+            }
+        }
         s.gravity = g;
     }
     return {};

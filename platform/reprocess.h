@@ -34,6 +34,13 @@ struct ReprocessReport {
     // kept as they came out, which the loop ignores as it does a live device's NaN; counted so that
     // replay warns and its summary says how many.
     std::size_t posesNonFinite = 0, accelNonFinite = 0;
+    // Accelerometer samples whose recorded scale or offset cannot be used (a scale that is not a
+    // positive finite number: 0, NaN, inf; an offset that is not finite): their gravity is made
+    // not finite (counted above too) rather than a zero vector that would pass for a tilt.
+    std::size_t accelBadScale = 0;
+    // The first accelerometer sample not finite, in words naming the device, the sample and the
+    // values (empty: none), for replay's warning.
+    std::string accelFirstNonFinite;
 };
 
 // Replaces the values of every sample that has a raw input with what today's code makes of it;

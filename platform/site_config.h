@@ -96,9 +96,10 @@ struct SiteConfig {
     // [recording]
     bool recordingEnabled = true;
     std::string recordingDirectory = "/var/lib/replica/sessions";
-    std::uint64_t rotateBytes = 1ull << 30; // a new session file after this many bytes
-    std::uint64_t rotateSeconds = 3600;     // or after this long
-    std::uint64_t keepBytes = 20ull << 30;  // the oldest sessions go beyond this total
+    std::uint64_t rotateBytes = 256ull << 20; // a new session file after this many bytes (recovered
+                                              // at start in about 4.1 x that: replica.service)
+    std::uint64_t rotateSeconds = 3600;       // or after this long
+    std::uint64_t keepBytes = 20ull << 30;    // the oldest sessions go beyond this total
     int flushMs = 500;
     // [log]
     std::string logLevel = "info";

@@ -1,16 +1,19 @@
 // IIO accelerometer over sysfs.
 #include <atomic>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <hal/accel/iio_accel.h>
 #include <hal/live_queue.h>
 #include <hal/log.h>
+#include <hal/log_limiter.h>
 
 namespace replica::hal::accel {
 namespace fs = std::filesystem;
@@ -87,14 +90,19 @@ Expected<IioAccelDevice> IioAccelDevice::open(const fs::path& dir)
         if (!scale) {
             return tl::unexpected(scale.error());
         }
-        if (!(*scale > 0.0)) {
+        if (!(*scale > 0.0) || !std::isfinite(*scale)) {
             return makeError(ErrorCode::DeviceFailure,
-                             fmt::format("{}: accelerometer scale {} is not positive", dir.string(),
-                                         *scale));
+                             fmt::format("{}: accelerometer scale {} is not positive or not finite",
+                                         dir.string(), *scale));
         }
         auto offset = axisAttribute(dir, kAxes[i], "offset", 0.0);
         if (!offset) {
             return tl::unexpected(offset.error());
+        }
+        if (!std::isfinite(*offset)) {
+            return makeError(ErrorCode::DeviceFailure,
+                             fmt::format("{}: accelerometer offset {} is not finite", dir.string(),
+                                         *offset));
         }
         d.scale_[static_cast<std::size_t>(i)] = *scale;
         d.offset_[static_cast<std::size_t>(i)] = *offset;
@@ -274,70 +282,131 @@ private:
     void run()
     {
         std::optional<IioAccelDevice> dev;
-        std::string lastError;
         std::uint32_t sequence = 0;
-        bool announced = false;
+        std::int64_t attributesReadNs = 0;
         while (!queue_.stopping()) {
             if (!dev) {
                 auto d = IioAccelDevice::find(options_.root, options_.name);
                 if (!d) {
-                    state_ = LinkState::Lost;
-                    if (d.error().message != lastError) {
-                        deviceLog("hal.accel")
-                                ->error("{}; the display keeps its last tilt", d.error().message);
-                        lastError = d.error().message;
-                    }
-                    if (!waitFor(options_.reconnectNs)) {
+                    if (!lose(d.error().message, "the display keeps its last tilt")) {
                         return;
                     }
                     continue;
                 }
-                if (!announced) {
+                if (!announced_) {
                     deviceLog("hal.accel")->info("'{}' at {}", d->name(), d->dir().string());
-                    announced = true;
+                    announced_ = true;
                 }
                 dev = std::move(*d);
+                attributesReadNs = clock_.nowNs();
             }
             const std::int64_t started = clock_.nowNs();
+            if (started - attributesReadNs >= options_.attributesNs) {
+                // The scale and offset follow the driver: a range change (2 g to 4 g) changes the
+                // scale while the device stays open, and a stale one halves gravity silently.
+                attributesReadNs = started;
+                if (!refreshAttributes(dev)) {
+                    if (!lose(lastError_, "the display keeps its last tilt")) {
+                        return;
+                    }
+                    continue;
+                }
+            }
             auto a = dev->readRaw();
             if (!a) {
                 // A value file that exists but reads empty, junk or EIO (a glitching I2C sensor)
                 // is handled like an unplugged device: Lost, one line per new error, and a retry
                 // every reconnectNs, never a busy loop.
-                if (a.error().message != lastError) {
-                    deviceLog("hal.accel")
-                            ->error("{}; the display keeps its last tilt and retries every {} ms",
-                                    a.error().message, options_.reconnectNs / 1'000'000);
-                    lastError = a.error().message;
-                }
                 dev.reset();
-                state_ = LinkState::Lost;
-                if (!waitFor(options_.reconnectNs)) {
+                if (!lose(a.error().message,
+                          fmt::format("the display keeps its last tilt and retries every {} ms",
+                                      options_.reconnectNs / 1'000'000))) {
                     return;
                 }
                 continue;
             }
-            if (!lastError.empty()) {
+            if (!lastError_.empty()) {
                 deviceLog("hal.accel")
                         ->info("'{}' at {} reads again", dev->name(), dev->dir().string());
-                lastError.clear();
+                lastError_.clear();
+                lastLogged_.clear();
             }
             state_ = LinkState::Connected;
-            auto raw = std::make_shared<RawAccelInput>();
-            raw->raw = *a;
-            raw->scale = dev->scale();
-            raw->offset = dev->offset();
-            raw->axes = axesText_;
-            AccelSample s;
-            s.timestampNs = clock_.nowNs();
-            s.sequence = sequence++;
-            s.gravity = gravityFromRaw(*raw, options_.mounting);
-            s.raw = std::move(raw);
-            queue_.push(s);
+            if (auto s = sample(*dev, *a, started)) {
+                s->sequence = sequence++;
+                queue_.push(*s);
+            }
             if (!waitFor(options_.periodNs - (clock_.nowNs() - started))) {
                 return;
             }
         }
+    }
+
+    // The device is lost (not found, or a read failed): one line per new error, Lost, and a wait
+    // of reconnectNs. False when the source is stopping.
+    bool lose(const std::string& message, const std::string& consequence)
+    {
+        if (message != lastLogged_) {
+            deviceLog("hal.accel")->error("{}; {}", message, consequence);
+            lastLogged_ = message;
+        }
+        lastError_ = message;
+        state_ = LinkState::Lost;
+        return waitFor(options_.reconnectNs);
+    }
+
+    // Re-reads the scale and offset; logs a change. False (dev reset, lastError_ set) when they
+    // no longer read or are not usable.
+    bool refreshAttributes(std::optional<IioAccelDevice>& dev)
+    {
+        auto fresh = IioAccelDevice::open(dev->dir());
+        if (!fresh) {
+            lastError_ = fresh.error().message;
+            dev.reset();
+            return false;
+        }
+        if (fresh->scale() != dev->scale() || fresh->offset() != dev->offset()) {
+            deviceLog("hal.accel")
+                    ->info("'{}' at {}: scale {} -> {}, offset {} -> {} (the driver's range "
+                           "changed); following it",
+                           dev->name(), dev->dir().string(), fmt::join(dev->scale(), ","),
+                           fmt::join(fresh->scale(), ","), fmt::join(dev->offset(), ","),
+                           fmt::join(fresh->offset(), ","));
+        }
+        dev = std::move(*fresh);
+        return true;
+    }
+
+    // The sample of one reading, or none for a reading that is not finite (a raw "nan" or "inf",
+    // or a product that overflows): counted and logged at most once per logIntervalNs.
+    std::optional<AccelSample>
+    sample(const IioAccelDevice& dev, const std::array<double, 3>& reading, std::int64_t nowNs)
+    {
+        auto raw = std::make_shared<RawAccelInput>();
+        raw->raw = reading;
+        raw->scale = dev.scale();
+        raw->offset = dev.offset();
+        raw->axes = axesText_;
+        AccelSample s;
+        s.timestampNs = clock_.nowNs();
+        s.gravity = gravityFromRaw(*raw, options_.mounting);
+        const bool finite = std::isfinite(s.gravity.x) && std::isfinite(s.gravity.y) &&
+                            std::isfinite(s.gravity.z);
+        if (const auto n = nonFinite_.add(finite ? 0 : 1, nowNs); n > 0) {
+            deviceLog("hal.accel")
+                    ->warn("'{}' at {}: {} reading{} not finite (the last: raw {} scale {} offset "
+                           "{}), {} in all: not used, the display keeps its last tilt (at most "
+                           "one line per {:g} s)",
+                           dev.name(), dev.dir().string(), n, n == 1 ? "" : "s",
+                           fmt::join(reading, ","), fmt::join(dev.scale(), ","),
+                           fmt::join(dev.offset(), ","), nonFinite_.total(),
+                           static_cast<double>(options_.logIntervalNs) * 1e-9);
+        }
+        if (!finite) {
+            return std::nullopt;
+        }
+        s.raw = std::move(raw);
+        return s;
     }
 
     const Clock& clock_;
@@ -345,6 +414,11 @@ private:
     std::string axesText_;
     DeviceInfo info_;
     std::atomic<LinkState> state_{LinkState::Lost};
+    // The source's thread only:
+    std::string lastError_;  // the error the device is lost on (empty: reading)
+    std::string lastLogged_; // the last error logged: a repeated one is not logged again
+    bool announced_ = false;
+    LogLimiter nonFinite_{options_.logIntervalNs};
     LiveQueue<AccelSample> queue_{1024};
     std::thread thread_;
 };

@@ -76,10 +76,16 @@ struct IioAccelSourceOptions {
     std::string name;                   // the device's 'name' attribute; empty = the first
     std::int64_t periodNs = 10'000'000; // 100 Hz
     std::int64_t reconnectNs = 1'000'000'000;
+    // The scale and offset are read again this often (a driver's range change alters them while
+    // the device stays open): three small sysfs reads a second against 300 for the values.
+    std::int64_t attributesNs = 1'000'000'000;
+    // Readings that are not finite are counted and logged at most once per this long.
+    std::int64_t logIntervalNs = 10'000'000'000;
 };
 
 // Live source: reads the device at a fixed period on its own thread; if it disappears, reports
-// Lost and looks for it again every second.
+// Lost and looks for it again every second. Follows changes of the scale and offset; a reading
+// that is not finite is counted, logged at a bounded rate and not used.
 std::unique_ptr<AccelSource> makeIioAccelSource(const Clock& clock, IioAccelSourceOptions options);
 
 } // namespace replica::hal::accel

@@ -187,8 +187,13 @@ decodeTracking(const Layout& layout, std::span<const std::uint8_t> report, Track
     out = {};
     if (layout.timestamp) {
         if (const auto t = extractField(*layout.timestamp, data)) {
-            out.deviceTimeNs = static_cast<std::int64_t>(
-                    std::llround(static_cast<double>(*t) * layout.secondsPerTick * 1e9));
+            // A device time beyond 2^62 ns (146 years) is garbage (a hostile or broken device):
+            // rounding it would overflow, and so would the anchoring's arithmetic. The arrival
+            // time stands in, as for a device without a timestamp.
+            const double ns = static_cast<double>(*t) * layout.secondsPerTick * 1e9;
+            if (std::isfinite(ns) && std::abs(ns) < 0x1p62) {
+                out.deviceTimeNs = static_cast<std::int64_t>(std::llround(ns));
+            }
         }
     }
     if (layout.head) {

@@ -81,6 +81,10 @@ Expected<void> HidTrackerReader::configure()
             std::make_shared<const std::vector<std::uint8_t>>(bytes->begin(), bytes->end());
     axesText_ = accel::toString(options_.axes);
     buffer_.assign(std::max<std::size_t>(layout->inputReportBytes, 1) + 64, 0);
+    knownIds_ = {};
+    for (const auto& f : descriptor->fields) {
+        knownIds_[f.reportId] = true;
+    }
 
     // Read one feature value; a device that refuses a feature request is still usable.
     std::vector<std::uint8_t> feature(kFeatureBytes);
@@ -198,6 +202,17 @@ std::int64_t HidReportProcessor::sessionTime(std::optional<std::int64_t> deviceN
     return lastNs_;
 }
 
+void HidTrackerReader::reject(const std::string& why, std::size_t bytes, std::int64_t nowNs)
+{
+    ++rejected_;
+    if (const auto n = rejectedLog_.add(1, nowNs); n > 0) {
+        deviceLog("hal.tracker")
+                ->warn("HID tracker {}: dropped {} report{}, the last {} bytes {}; {} in all (at "
+                       "most one line per 10 s)",
+                       description_.where, n, n == 1 ? "" : "s", bytes, why, rejected_);
+    }
+}
+
 Expected<std::optional<PoseSample>> HidTrackerReader::next()
 {
     const auto got = device_->readInput(buffer_, options_.readTimeoutMs);
@@ -212,14 +227,18 @@ Expected<std::optional<PoseSample>> HidTrackerReader::next()
     PoseSample s;
     switch (processor_->process(report, host, s)) {
     case eht::DecodeResult::OtherReport:
+        // Another report the descriptor declares is of no use here; an ID it does not declare is
+        // a device (or an attacker on the USB port) not keeping to its own descriptor: counted.
+        if (!knownIds_[report[0]]) {
+            reject(fmt::format("with report ID {}, which the descriptor does not declare",
+                               report[0]),
+                   got.bytes, host);
+        }
         return std::optional<PoseSample>();
     case eht::DecodeResult::Short:
-        if (++rejected_ == 1) {
-            deviceLog("hal.tracker")
-                    ->warn("HID tracker {}: dropped a {}-byte report (the descriptor says {}); "
-                           "further ones are counted",
-                           description_.where, got.bytes, description_.layout.inputReportBytes);
-        }
+        reject(fmt::format("shorter than the descriptor says ({} bytes)",
+                           description_.layout.inputReportBytes),
+               got.bytes, host);
         return std::optional<PoseSample>();
     case eht::DecodeResult::Ok:
         break;

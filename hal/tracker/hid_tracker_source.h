@@ -5,6 +5,7 @@
 // time. The threaded source survives unplugging: Lost, one error line, retry every second.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -15,6 +16,7 @@
 
 #include <hal/accel/iio_accel.h>
 #include <hal/clock.h>
+#include <hal/log_limiter.h>
 #include <hal/sources.h>
 #include <hal/tracker/hid_device.h>
 #include <hal/tracker/hid_eye_head.h>
@@ -85,7 +87,8 @@ public:
     open(std::unique_ptr<hid::HidDevice> device, const Clock& clock, HidTrackerOptions options);
 
     // Waits up to the read timeout for a report. A sample when one arrived (tracked or not); none
-    // on timeout or a report of no use (counted in rejectedReports when too short); an error when
+    // on timeout or a report of no use (counted in rejectedReports when too short or of an ID the
+    // descriptor does not declare); an error when
     // the device is gone (NotFound) or failing.
     Expected<std::optional<PoseSample>> next();
 
@@ -108,7 +111,12 @@ private:
     std::shared_ptr<const std::vector<std::uint8_t>> descriptorBytes_; // handed up as raw
     std::string axesText_;
     std::vector<std::uint8_t> buffer_;
+    // Reports dropped: shorter than the descriptor says, or numbered with an ID it does not
+    // declare. A line for the first, then one per 10 s with the count.
+    void reject(const std::string& why, std::size_t bytes, std::int64_t nowNs);
+    std::array<bool, 256> knownIds_{}; // report IDs the descriptor declares
     long rejected_ = 0;
+    LogLimiter rejectedLog_;
 };
 
 // The eye point a tracking report gives: the midpoint of the eyes when both are tracked, else

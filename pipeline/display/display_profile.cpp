@@ -8,6 +8,7 @@
 #include <pipeline/base/input_file.h>
 #include <pipeline/base/json_limits.h>
 #include <pipeline/base/json_schema.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/display/display_profile.h>
 
 namespace replica::pipeline::display {
@@ -268,14 +269,7 @@ Expected<DisplayModel> loadProfile(const std::filesystem::path& path)
 
 Expected<void> saveProfile(const DisplayModel& model, const std::filesystem::path& path)
 {
-    std::ofstream f(path, std::ios::binary | std::ios::trunc);
-    f << profileToJson(model);
-    f.close();
-    if (!f) {
-        return makeError(ErrorCode::Io,
-                         fmt::format("{}: cannot write the display profile", path.string()));
-    }
-    return {};
+    return writeOutputFile(path, profileToJson(model), "display profile");
 }
 
 } // namespace replica::pipeline::display

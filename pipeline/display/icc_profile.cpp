@@ -9,6 +9,7 @@
 #include <glm/matrix.hpp>
 #include <lcms2.h>
 
+#include <pipeline/base/output_file.h>
 #include <pipeline/display/icc_profile.h>
 
 namespace replica::pipeline::display {
@@ -155,9 +156,22 @@ writeIccProfile(const DisplayModel& model, const std::filesystem::path& path, Ic
     if (!h) {
         return tl::unexpected(h.error());
     }
-    if (cmsSaveProfileToFile(h->get(), path.string().c_str()) == 0) {
+    cmsUInt32Number size = 0;
+    std::string bytes;
+    if (cmsSaveProfileToMem(h->get(), nullptr, &size) != 0 && size > 0) {
+        bytes.resize(size);
+        if (cmsSaveProfileToMem(h->get(), bytes.data(), &size) == 0) {
+            size = 0;
+        }
+    }
+    if (size == 0) {
         return makeError(ErrorCode::Io,
-                         fmt::format("{}: cannot write the ICC profile", path.string()));
+                         fmt::format("{}: lcms2 cannot serialise the ICC profile", path.string()));
+    }
+    bytes.resize(size);
+    // Written the one safe way (pipeline/base/output_file.h).
+    if (auto ok = writeOutputFile(path, bytes, "ICC profile"); !ok) {
+        return tl::unexpected(ok.error());
     }
     return report;
 }

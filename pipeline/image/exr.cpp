@@ -9,10 +9,12 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <fmt/format.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/image/exr.h>
 
 namespace replica::pipeline::image {
@@ -130,14 +132,18 @@ Expected<void> writeExr(const std::filesystem::path& path,
                             const_cast<char*>(reinterpret_cast<const char*>(img.planes[c].data())),
                             sizeof(float), sizeof(float) * static_cast<std::size_t>(img.width)));
         }
-        Imf::OutputFile file(path.c_str(), header);
-        file.setFrameBuffer(fb);
-        file.writePixels(img.height);
+        // Encoded in memory, then written the one safe way (pipeline/base/output_file.h).
+        Imf::StdOSStream encoded;
+        {
+            Imf::OutputFile file(encoded, header);
+            file.setFrameBuffer(fb);
+            file.writePixels(img.height);
+        }
+        return writeOutputFile(path, encoded.str(), "OpenEXR image");
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Io,
                          fmt::format("{}: cannot write OpenEXR ({})", path.string(), e.what()));
     }
-    return {};
 }
 
 } // namespace replica::pipeline::image

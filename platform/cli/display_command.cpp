@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/measurement_set.h>
@@ -137,11 +138,9 @@ int synthMain(const DisplayOptions& o)
             "through\n"
             "a simulated meter with 0.2 % + 0.005 cd/m^2 noise. Counts 8-bit; XYZ in cd/m^2.",
             o.seed);
-    std::ofstream f(o.out, std::ios::binary | std::ios::trunc);
-    f << pd::measurementCsv(rows, comment);
-    f.close();
-    if (!f) {
-        logger("replica")->error("{}: cannot write the measurement file", o.out);
+    if (auto ok = writeOutputFile(o.out, pd::measurementCsv(rows, comment), "measurement file");
+        !ok) {
+        logger("replica")->error("{}", ok.error().message);
         return kExitFailure;
     }
     fmt::print("measurements: {} ({} rows)\n", o.out, rows.size());

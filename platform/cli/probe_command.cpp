@@ -148,11 +148,15 @@ nlohmann::json probeTracker(const ProbeOptions& o)
     nlohmann::json j{{"listening", fmt::format("udp {}:{}", o.trackerBind, (*src)->boundPort())},
                      {"poses", tracked},
                      {"rejected_datagrams", (*src)->rejectedDatagrams()},
+                     {"coalesced_datagrams", (*src)->coalescedDatagrams()},
                      {"found", tracked > 0}};
     if (tracked > 0) {
         const auto& last = got.back().tracked ? got.back() : got.front();
         j["eye_tracker_m"] = {last.eyeTrackerM.x, last.eyeTrackerM.y, last.eyeTrackerM.z};
-        j["rate_hz"] = static_cast<double>(tracked) / o.trackerWaitS;
+        // The sender's rate: poses coalesced (more than one per 2 ms) were sent too.
+        j["rate_hz"] = static_cast<double>(tracked +
+                                           static_cast<std::size_t>((*src)->coalescedDatagrams())) /
+                       o.trackerWaitS;
     } else {
         j["error"] = fmt::format("no head poses on UDP port {} in {} s: start opentrack with "
                                  "output 'UDP over network' to {}:{}",

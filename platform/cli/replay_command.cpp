@@ -76,10 +76,12 @@ std::variant<LoadedReplay, int> loadReplay(const ReplayOptions& o)
         }
         loaded.reprocessed = *r;
         if (r->posesNonFinite + r->accelNonFinite > 0) {
-            log->warn("{}: --reprocess: {} poses and {} accelerometer samples came out not finite "
-                      "(a recorded scale or raw value out of range); the loop ignores them as it "
-                      "does a device's NaN",
-                      o.file, r->posesNonFinite, r->accelNonFinite);
+            log->warn(
+                    "{}: --reprocess: {} poses and {} accelerometer samples came out not finite "
+                    "(a recorded scale or raw value out of range{}{}); the loop ignores them as "
+                    "it does a device's NaN",
+                    o.file, r->posesNonFinite, r->accelNonFinite,
+                    r->accelFirstNonFinite.empty() ? "" : "; the first: ", r->accelFirstNonFinite);
         }
         if (r->posesReprocessed + r->accelReprocessed == 0) {
             log->warn("{}: --reprocess: the recording holds no raw inputs of the tracker or "

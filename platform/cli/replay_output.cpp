@@ -38,7 +38,8 @@ void reportReprocess(const ReprocessReport& r,
                             {"lamp_reprocessed", r.lampReprocessed},
                             {"lamp_changed", r.lampChanged},
                             {"poses_non_finite", r.posesNonFinite},
-                            {"accel_non_finite", r.accelNonFinite}};
+                            {"accel_non_finite", r.accelNonFinite},
+                            {"accel_bad_scale", r.accelBadScale}};
     say(fmt::format("reprocessed: {} of {} poses ({} changed) and {} of {} accelerometer "
                     "samples ({} changed) from their raw inputs; the rest as recorded",
                     r.posesReprocessed, r.poses, r.posesChanged, r.accelReprocessed, r.accel,

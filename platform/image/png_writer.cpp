@@ -1,10 +1,10 @@
 // libpng snapshot writer.
-#include <cstdio>
-#include <memory>
+#include <string>
 
 #include <fmt/format.h>
 #include <png.h>
 
+#include <pipeline/base/output_file.h>
 #include <platform/image/png_metadata.h>
 #include <platform/image/png_writer.h>
 
@@ -21,12 +21,8 @@ Expected<void> writePng(const std::filesystem::path& path,
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("{}: frame has no pixels or the wrong size", path.string()));
     }
-    std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "wb"), &std::fclose);
-    if (!file) {
-        return makeError(
-                ErrorCode::Io,
-                fmt::format("{}: cannot create PNG (is the directory writable?)", path.string()));
-    }
+    // Encoded in memory, then written the one safe way (pipeline/base/output_file.h).
+    std::string encoded;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
     png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
     if (png == nullptr || info == nullptr) {
@@ -46,7 +42,13 @@ Expected<void> writePng(const std::filesystem::path& path,
         png_destroy_write_struct(&png, &info);
         return makeError(ErrorCode::Io, fmt::format("{}: writing PNG failed", path.string()));
     }
-    png_init_io(png, file.get());
+    png_set_write_fn(
+            png, &encoded,
+            [](png_structp p, png_bytep data, png_size_t n) {
+                static_cast<std::string*>(png_get_io_ptr(p))
+                        ->append(reinterpret_cast<const char*>(data), n);
+            },
+            nullptr);
     png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                  PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
@@ -55,7 +57,7 @@ Expected<void> writePng(const std::filesystem::path& path,
     png_write_image(png, rows.data());
     png_write_end(png, nullptr);
     png_destroy_write_struct(&png, &info);
-    return {};
+    return writeOutputFile(path, encoded, "PNG");
 }
 
 } // namespace replica::platform

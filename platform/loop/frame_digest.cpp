@@ -8,6 +8,7 @@
 
 #include <pipeline/base/input_file.h>
 #include <pipeline/base/json_limits.h>
+#include <pipeline/base/output_file.h>
 #include <platform/loop/frame_digest.h>
 
 namespace replica::platform {
@@ -40,33 +41,24 @@ const char* digestHashName(DigestHash hash)
 Expected<void>
 writeDigests(const std::filesystem::path& path, const std::vector<FrameDigest>& d, DigestHash hash)
 {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) {
-        return makeError(ErrorCode::Io,
-                         fmt::format("{}: cannot write digests (is the directory writable?)",
-                                     path.string()));
-    }
     // One frame per line so that a diff of two digest files points at the frame.
     // Version 1 files name no hash (FNV-1a); version 2 says it.
+    std::string out;
     if (hash == DigestHash::Fnv1a64) {
-        out << "{\"format\": \"replica-digests\", \"version\": 1, \"frames\": [\n";
+        out += "{\"format\": \"replica-digests\", \"version\": 1, \"frames\": [\n";
     } else {
-        out << fmt::format("{{\"format\": \"replica-digests\", \"version\": {}, \"hash\": "
+        out += fmt::format("{{\"format\": \"replica-digests\", \"version\": {}, \"hash\": "
                            "\"{}\", \"frames\": [\n",
                            static_cast<int>(hash), digestHashName(hash));
     }
     for (std::size_t i = 0; i < d.size(); ++i) {
-        out << fmt::format("  {{\"frame\": {}, \"tick_ns\": {}, \"xyz\": \"{:016x}\", \"rgba\": "
+        out += fmt::format("  {{\"frame\": {}, \"tick_ns\": {}, \"xyz\": \"{:016x}\", \"rgba\": "
                            "\"{:016x}\"}}{}\n",
                            d[i].frameIndex, d[i].tickNs, d[i].xyz, d[i].rgba,
                            i + 1 < d.size() ? "," : "");
     }
-    out << "]}\n";
-    out.flush();
-    if (!out) {
-        return makeError(ErrorCode::Io, fmt::format("{}: writing digests failed", path.string()));
-    }
-    return {};
+    out += "]}\n";
+    return writeOutputFile(path, out, "digests");
 }
 
 Expected<DigestFile> readDigestFile(const std::filesystem::path& path)

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <csignal>
 #include <iostream>
+#include <map>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -11,6 +12,7 @@
 
 #include <state/scene_estimator.h>
 
+#include <hal/log_limiter.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 #include <recordings/device_kind.h>
@@ -214,17 +216,29 @@ private:
 using Slots = decltype(recordings::DeviceSlots(
         recordings::stateKinds(), std::declval<Sources&>(), nullptr));
 
-// Every source polled up to the tick, then each slot's sample for the frame chosen.
-void pollAndChoose(const Slots& slots, const TickPlan& tick, LoopStats& stats)
+// Every source polled up to the tick, then each slot's sample for the frame chosen. Lost
+// samples are counted in the stats and logged at most once per 10 s per device (wall clock),
+// with the count since the last line: a device losing some every frame is one line, not 50 a
+// second.
+void pollAndChoose(const Slots& slots,
+                   const TickPlan& tick,
+                   LoopStats& stats,
+                   std::map<std::string, hal::LogLimiter>& droppedLog)
 {
     const bool replaying = tick.recorded.has_value();
+    const std::int64_t wallNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::steady_clock::now().time_since_epoch())
+                                        .count();
     for (const auto& slot : slots.all()) {
         const auto& kind = slot->kind();
-        if (auto d = slot->poll(tick.tickNs); d > 0) {
-            stats.dropped[kind.name()] += d;
-            logger("loop")->warn("{} {}: {} {} dropped before t={} ns", kind.names().displayName,
-                                 slot->source().info().serial, d, kind.names().samplesNoun,
-                                 tick.tickNs);
+        const auto d = slot->poll(tick.tickNs);
+        stats.dropped[kind.name()] += d;
+        auto& limiter = droppedLog[kind.name()];
+        if (const auto n = limiter.add(d, wallNs); n > 0) {
+            logger("loop")->warn("{} {}: {} {} dropped before t={} ns ({} in all; at most one "
+                                 "line per 10 s)",
+                                 kind.names().displayName, slot->source().info().serial, n,
+                                 kind.names().samplesNoun, tick.tickNs, limiter.total());
         }
     }
     for (const auto& slot : slots.all()) {
@@ -300,6 +314,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     pipeline::scene::SceneState state;
     pipeline::render::RenderedFrame image;
     Pacer pacer(pacing, options);
+    std::map<std::string, hal::LogLimiter> droppedLog;
     while (!stopRequested()) {
         const std::optional<TickPlan> next = pacer.next(ticks, stats);
         if (!next) {
@@ -308,7 +323,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         const TickPlan& tick = *next;
         pacer.wait(tick, stats);
         const auto workStart = std::chrono::steady_clock::now();
-        pollAndChoose(slots, tick, stats);
+        pollAndChoose(slots, tick, stats, droppedLog);
         state.frameIndex = tick.frameIndex;
         state.tickNs = tick.tickNs;
         std::apply(

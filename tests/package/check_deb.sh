@@ -133,8 +133,24 @@ elif command -v readelf >/dev/null; then
     echo "hardening: PIE, RELRO, BIND_NOW, $fortified fortified functions, stack protector"
 fi
 
+# The unit caps what a fault can take and ranks the kiosk above ordinary processes (issue 32):
+# MemoryHigh below MemoryMax, both sizes; a task limit; a negative nice; the error probe's thread
+# allowed to lower itself.
+unit="$root/lib/systemd/system/replica.service"
+setting() { sed -n "s/^$1=//p" "$unit" | tail -1; }
+bytes() { numfmt --from=iec "$1" 2>/dev/null; }
+high=$(bytes "$(setting MemoryHigh)") || true
+max=$(bytes "$(setting MemoryMax)") || true
+[ -n "$max" ] && [ "$max" -ge $((256 << 20)) ] || fail "MemoryMax='$(setting MemoryMax)': no size of at least 256M"
+[ -n "$high" ] && [ "$high" -lt "$max" ] || fail "MemoryHigh='$(setting MemoryHigh)' is not below MemoryMax"
+tasks=$(setting TasksMax)
+[[ "$tasks" =~ ^[0-9]+$ ]] && [ "$tasks" -ge 64 ] && [ "$tasks" -le 1024 ] || fail "TasksMax='$tasks'"
+nice=$(setting Nice)
+[[ "$nice" =~ ^-[0-9]+$ ]] || fail "Nice='$nice': the kiosk must outrank ordinary processes"
+grep -q '^SystemCallFilter=setpriority sched_setscheduler$' "$unit" ||
+    fail "the error probe's thread may not lower its own priority (SystemCallFilter)"
+echo "unit bounds: MemoryHigh $(setting MemoryHigh), MemoryMax $(setting MemoryMax), TasksMax $tasks, Nice $nice"
 if command -v systemd-analyze >/dev/null; then
-    unit="$root/lib/systemd/system/replica.service"
     score=$(systemd-analyze security --offline=true "$unit" 2>/dev/null |
         sed -n 's/.*Overall exposure level for replica.service: \([0-9.]*\).*/\1/p')
     [ -n "$score" ] || fail "systemd-analyze gave no score"

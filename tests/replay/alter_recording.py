@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Writes a copy of a recording with changes, for tests/replay/older_recording.sh: keys of its run
 configuration set (as an older build would have recorded them) and thumbnails replaced by a flat
-colour (what was shown, tampered with). The copy is unchunked MCAP (as format 1 wrote it; the
+colour (what was shown, tampered with), and for tests/replay/hostile_input.sh the accelerometer's
+recorded scale on every raw input (a JSON value: 1e308, 0, null). The copy is unchunked MCAP (as format 1 wrote it; the
 reader takes it for every format), its zstd chunks decompressed with the zstd command.
 
 usage: alter_recording.py IN OUT [--config KEY=JSON]... [--session KEY=JSON]...
-                          [--tamper-thumbnails N] [--drop-thumbnails]
+                          [--tamper-thumbnails N] [--drop-thumbnails] [--accel-scale JSON]
 """
 import argparse
 import base64
@@ -59,6 +60,8 @@ def main():
     p.add_argument("--tamper-thumbnails", type=int, default=0,
                    help="replace the first N thumbnails by a flat magenta")
     p.add_argument("--drop-thumbnails", action="store_true")
+    p.add_argument("--accel-scale", help="JSON value for each axis of every raw accelerometer "
+                   "input's scale")
     a = p.parse_args()
     data = open(a.input, "rb").read()
     if data[:8] != MAGIC:
@@ -102,6 +105,11 @@ def main():
                     key, value = item.split("=", 1)
                     session[key] = json.loads(value)
                 payload = json.dumps(session).encode()
+            elif topic == "/replica/raw/accel" and a.accel_scale is not None:
+                msg = json.loads(payload)
+                v = json.loads(a.accel_scale)
+                msg["scale"] = [v, v, v]
+                payload = json.dumps(msg).encode()
             elif topic == "/replica/thumbnail":
                 if a.drop_thumbnails:
                     continue

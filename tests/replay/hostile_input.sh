@@ -310,6 +310,74 @@ if [ -x /usr/bin/time ]; then
 else
     fail "/usr/bin/time is missing: the bounded cases did not run"
 fi
+# replay --reprocess with an accelerometer scale that cannot be used (issue 32): a warning naming
+# the device, the sample and the value, the samples counted; before, 1e308 and 0 showed the default
+# tilt throughout, exit 0, without a word. NaN cannot be written in JSON: null is a damaged message.
+v6="$2/recordings/samples/walk-v6.mcap"
+for scale in 1e308 0; do
+    python3 "$here/alter_recording.py" "$v6" "$work/scale-$scale.mcap" --accel-scale "$scale"
+    out=$( (ulimit -v "$limit_kb"; timeout 60 "$replica" --log-level warn replay "$work/scale-$scale.mcap" --reprocess) 2>&1 >/dev/null)
+    got=$?
+    shown=0,0,0
+    [ "$scale" = 1e308 ] && shown='1e\+308,1e\+308,1e\+308'
+    want="249 accelerometer samples came out not finite.*accelerometer 'accelerometer \(simulated\) SIM-ACCEL-0001' sample 0: raw [^ ]+, scale $shown,"
+    if [ $got -ne 0 ]; then
+        fail "replay --reprocess with an accelerometer scale of $scale: exit $got: $out"
+    elif ! printf '%s' "$out" | grep -qE -- "$want"; then
+        fail "replay --reprocess with an accelerometer scale of $scale did not say /$want/: $out"
+    else
+        pass=$((pass + 1))
+        echo "ok: accelerometer scale $scale named: $(printf '%s' "$out" | head -1 | cut -c1-160)..."
+    fi
+done
+python3 "$here/alter_recording.py" "$v6" "$work/scale-null.mcap" --accel-scale null
+expect 1 "scale-null.mcap: damaged /replica/raw/accel message \(sequence 0\).*must be number" -- \
+    "${R[@]}" replay "$work/scale-null.mcap" --reprocess
+
+# --- Every output a command writes goes through one writer (pipeline/base/output_file.h): never
+# through a symbolic link (before, its target was overwritten), never into a FIFO (before, a hang),
+# a device or a directory, and a full disk is an error with exit 1 (before, --snapshot and render
+# --out wrote a short file or nothing and exited 0). The link's target must stay untouched.
+out_dir="$work/outputs"
+mkdir -p "$out_dir"
+"$replica" --log-level error display synth --out "$out_dir/m.csv" >/dev/null || fail "display synth"
+# writes OUTPUT_NAME EXT ARGS_BEFORE_THE_PATH...: the command with each bad path appended.
+writes() {
+    local label="$1" ext="$2"
+    shift 2
+    echo "precious" > "$out_dir/target.$ext"
+    ln -sfn "$out_dir/target.$ext" "$out_dir/link.$ext"
+    [ -e "$out_dir/fifo.$ext" ] || mkfifo "$out_dir/fifo.$ext"
+    mkdir -p "$out_dir/adir.$ext"
+    expect 1 "link.$ext: is a symbolic link; the .* never through a link" -- "${R[@]}" "$@" "$out_dir/link.$ext"
+    [ "$(cat "$out_dir/target.$ext")" = precious ] || fail "$label wrote through a symbolic link"
+    # display fit checks its outputs before fitting ("not a regular file"); the rest when writing.
+    expect 1 "fifo.$ext: (is a FIFO, not a .* file|not a regular file)" -- "${R[@]}" "$@" "$out_dir/fifo.$ext"
+    expect 1 "adir.$ext: (is a directory, not a .* file|not a regular file)" -- "${R[@]}" "$@" "$out_dir/adir.$ext"
+    if [ "$ext" != exr ]; then # render takes only a name ending in .exr
+        expect 1 "/dev/null: (is a device, not a .* file|not a regular file)" -- "${R[@]}" "$@" /dev/null
+    fi
+    if [ -n "${full:-}" ]; then
+        expect 1 "full/x.$ext: writing the .* failed: No space left on device; nothing written" -- \
+            "${R[@]}" "$@" "$full/x.$ext"
+        [ ! -e "$full/x.$ext" ] || fail "$label left a partial file on a full disk"
+    fi
+}
+full=""
+if mkdir -p "$out_dir/full" && mount -t tmpfs -o size=64k tmpfs "$out_dir/full" 2>/dev/null; then
+    full="$out_dir/full"
+    head -c 65536 /dev/zero > "$full/filler" 2>/dev/null # to the last block: not even 1 KB fits
+else
+    echo "note: no tmpfs can be mounted here (not root): the full-disk cases are skipped"
+fi
+writes "replay --digests" json replay "$sample" --no-progress --digests
+writes "run --snapshot" png run --hal sim --output headless --size 48x30 --frames 2 --fast --snapshot
+writes "render --out" exr render --scene "$data/scenes/metamer" --light d65 --out
+writes "display fit --out" json display fit "$out_dir/m.csv" --out
+writes "display fit --icc" icc display fit "$out_dir/m.csv" --out "$out_dir/p.json" --icc
+writes "display synth --out" csv display synth --out
+if [ -n "$full" ]; then umount "$full"; fi
+
 # replay shows a recording's text with its control characters escaped, as inspect does.
 out=$("$replica" --log-level info replay "$rec/escapes.mcap" 2>&1)
 if printf '%s' "$out" | grep -q $'\x1b'; then

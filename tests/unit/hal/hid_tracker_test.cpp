@@ -441,6 +441,63 @@ TEST(HidTracker, NumberedDeviceIsConfiguredAndGivesTheEyeMidpoint)
     EXPECT_EQ((*p)->timestampNs, 2'008'333'000);
 }
 
+// Hostile input reports (issue 32): longer and shorter than the descriptor says, an ID the
+// descriptor does not declare, every field at its type's extremes. Each is a counted drop or a
+// sample, finite and untracked where nothing is in range; never a crash, a hang or a NaN.
+TEST(HidTracker, HostileReportsAreCountedOrDecodedNeverACrash)
+{
+    auto s = deviceA();
+    hal::VirtualClock clock;
+    auto r = HidTrackerReader::open(std::make_unique<FakeHidTracker>(s), clock, {});
+    ASSERT_TRUE(r) << r.error().message;
+    auto good = reportA(1'000'000, {-32'000, 10'000, 600'000}, {32'000, 12'000, 610'000},
+                        {0, 60'000, 650'000});
+    auto longer = good;
+    longer.resize(4096, 0xAB); // the reader's buffer takes the descriptor's size + 64
+    std::vector<std::uint8_t> shorter(good.begin(), good.begin() + 20);
+    auto unknownId = good;
+    unknownId[0] = 0x7F; // the descriptor declares IDs 1-5
+    auto featureId = good;
+    featureId[0] = 3; // declared (a feature report): of no use here, not a fault
+    // A device time of 2^63-1 us: 9.2e27 ns, which overflowed the rounding and the anchoring.
+    // The eyes at the logical minimum's wrong side (out of range), the head at the logical maximum
+    // (in range: 2147 m, absurd but finite).
+    auto extremes = reportA(0x7FFF'FFFF'FFFF'FFFF, {INT32_MIN, INT32_MAX, INT32_MAX},
+                            {INT32_MAX, INT32_MIN, INT32_MIN}, {INT32_MAX, INT32_MAX, INT32_MAX});
+    auto allOut = reportA(1'050'000, {INT32_MIN, INT32_MIN, INT32_MIN},
+                          {INT32_MIN, INT32_MIN, INT32_MIN}, {INT32_MIN, INT32_MIN, INT32_MIN});
+    std::vector<std::uint8_t> idOnly{1};
+    std::vector<std::uint8_t> empty;
+    for (auto* rep :
+         {&longer, &shorter, &unknownId, &featureId, &extremes, &idOnly, &empty, &allOut}) {
+        s->inputs.push_back(*rep);
+    }
+    std::vector<hal::PoseSample> got;
+    for (int i = 0; i < 8; ++i) {
+        clock.set(2'000'000'000 + i * 10'000'000);
+        auto p = r->next();
+        ASSERT_TRUE(p) << i << ": " << p.error().message;
+        if (*p) {
+            got.push_back(**p);
+        }
+    }
+    // The longer report decodes as its first 53 bytes. The extremes give the head's position,
+    // finite, stamped at arrival (the device time is refused). Every position out of range: a
+    // sample, untracked.
+    ASSERT_EQ(got.size(), 3u);
+    EXPECT_TRUE(got[0].tracked);
+    EXPECT_NEAR(got[0].eyeTrackerM.z, 0.605, 1e-12);
+    EXPECT_TRUE(got[1].tracked);
+    EXPECT_NEAR(std::abs(got[1].eyeTrackerM.z), 2147.483647, 1e-6);
+    EXPECT_TRUE(std::isfinite(got[1].eyeTrackerM.x) && std::isfinite(got[1].eyeTrackerM.y));
+    EXPECT_EQ(got[1].timestampNs, 2'040'000'000);
+    EXPECT_FALSE(got[2].tracked);
+    EXPECT_EQ(got[2].eyeTrackerM, glm::dvec3(0.0));
+    // Counted: the short one, the undeclared ID, the ID byte alone, the empty one; a declared
+    // feature report's ID is of no use here but not a fault.
+    EXPECT_EQ(r->rejectedReports(), 4);
+}
+
 TEST(HidTracker, UnnumberedDeviceKeepsOtherFeatureBytesAndReadsMillimetres)
 {
     auto s = deviceB();

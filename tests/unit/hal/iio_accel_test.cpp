@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/eventually.h"
+
 namespace replica::tests {
 namespace {
 namespace fs = std::filesystem;
@@ -41,9 +43,13 @@ protected:
         write("iio:device1/in_accel_scale", "0.009806650");
     }
     void TearDown() override { fs::remove_all(root_); }
+    // Whole or not at all (a rename), as sysfs gives an attribute: the source never reads a
+    // half-written file, which it would rightly take for a device fault.
     void write(const std::string& rel, const std::string& text)
     {
-        std::ofstream(root_ / rel) << text << "\n";
+        const fs::path tmp = root_ / (rel + ".tmp");
+        std::ofstream(tmp) << text << "\n";
+        fs::rename(tmp, root_ / rel);
     }
     fs::path root_;
     fs::path dev_;
@@ -101,15 +107,6 @@ TEST_F(FakeIio, SourceSamplesLosesTheDeviceAndFindsItAgain)
     opt.reconnectNs = 10'000'000;
     auto src = hal::accel::makeIioAccelSource(clock, opt);
     std::vector<hal::AccelSample> got;
-    auto eventually = [](auto f) {
-        for (int i = 0; i < 500; ++i) {
-            if (f()) {
-                return true;
-            }
-            std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        }
-        return false;
-    };
     ASSERT_TRUE(eventually([&] {
         src->poll(clock.nowNs(), got);
         return got.size() >= 3;
@@ -183,6 +180,90 @@ TEST_F(FakeIio, FailingValueFileBacksOffLogsOnceAndStops)
     const auto t0 = std::chrono::steady_clock::now();
     src.reset();
     EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(60));
+}
+
+// A driver's range change (2 g to 4 g) changes in_accel_scale while the device stays open: the
+// source reads it again (attributesNs) and the next samples carry the new scale, gravity still
+// right. Before, the scale was read once at open and a range change halved gravity silently.
+TEST_F(FakeIio, FollowsAScaleChangeWhileOpen)
+{
+    std::ostringstream captured;
+    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(captured);
+    spdlog::drop("hal.accel");
+    spdlog::register_logger(std::make_shared<spdlog::logger>("hal.accel", sink));
+    hal::SteadyClock clock;
+    hal::accel::IioAccelSourceOptions opt;
+    opt.root = root_;
+    opt.periodNs = 2'000'000;
+    opt.attributesNs = 20'000'000;
+    auto src = hal::accel::makeIioAccelSource(clock, opt);
+    std::vector<hal::AccelSample> got;
+    ASSERT_TRUE(eventually([&] {
+        src->poll(clock.nowNs(), got);
+        return !got.empty();
+    }));
+    EXPECT_DOUBLE_EQ(got.back().gravity.y, -1000 * 0.00980665);
+    // The new range: twice the scale, half the counts for the same gravity.
+    write("iio:device1/in_accel_y_raw", "500");
+    write("iio:device1/in_accel_scale", "0.019613300");
+    ASSERT_TRUE(eventually([&] {
+        got.clear();
+        src->poll(clock.nowNs(), got);
+        return !got.empty() && got.back().raw->scale[1] == 0.0196133;
+    }));
+    EXPECT_DOUBLE_EQ(got.back().gravity.y, -500 * 0.0196133);
+    EXPECT_EQ(src->state(), hal::LinkState::Connected);
+    // A scale that turns unusable (0, NaN, inf) is a device fault: Lost, one line naming it.
+    write("iio:device1/in_accel_scale", "nan");
+    ASSERT_TRUE(eventually([&] { return src->state() == hal::LinkState::Lost; }));
+    src.reset();
+    spdlog::drop("hal.accel");
+    const std::string text = captured.str();
+    EXPECT_NE(text.find("scale 0.00980665,0.00980665,0.00980665 -> 0.0196133,0.0196133,0.0196133"),
+              std::string::npos)
+            << text;
+    EXPECT_NE(text.find("accelerometer scale nan is not positive or not finite"), std::string::npos)
+            << text;
+}
+
+// A reading that is not finite ("nan" from a driver, or a product that overflows) is counted and
+// logged at a bounded rate, not used, and not one line per sample. Before, it reached the
+// estimator as a NaN gravity without a word.
+TEST_F(FakeIio, NonFiniteReadingsAreCountedAndLoggedAtABoundedRate)
+{
+    std::ostringstream captured;
+    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(captured);
+    spdlog::drop("hal.accel");
+    spdlog::register_logger(std::make_shared<spdlog::logger>("hal.accel", sink));
+    write("iio:device1/in_accel_y_raw", "nan");
+    hal::SteadyClock clock;
+    hal::accel::IioAccelSourceOptions opt;
+    opt.root = root_;
+    opt.periodNs = 1'000'000;        // 1 kHz: ~300 readings below
+    opt.logIntervalNs = 100'000'000; // a line per 100 ms at most
+    auto src = hal::accel::makeIioAccelSource(clock, opt);
+    std::this_thread::sleep_for(std::chrono::milliseconds(350));
+    std::vector<hal::AccelSample> got;
+    src->poll(clock.nowNs(), got);
+    EXPECT_TRUE(got.empty()) << "a NaN reading was used";
+    // Good again: samples flow, with consecutive sequence numbers.
+    write("iio:device1/in_accel_y_raw", "1000");
+    ASSERT_TRUE(eventually([&] {
+        src->poll(clock.nowNs(), got);
+        return got.size() >= 2;
+    }));
+    EXPECT_DOUBLE_EQ(got.back().gravity.y, -1000 * 0.00980665);
+    src.reset();
+    spdlog::drop("hal.accel");
+    const std::string text = captured.str();
+    const auto lines = std::count(text.begin(), text.end(), '\n');
+    // The find line, the first NaN at once, then one per 100 ms of the 350 ms (and one more for
+    // the last ones, reported when the readings are good again): 6 at most; one per sample was 300.
+    EXPECT_GE(lines, 3) << text;
+    EXPECT_LE(lines, 6) << text;
+    EXPECT_NE(text.find("1 reading not finite (the last: raw -12,nan,40"), std::string::npos)
+            << text;
+    EXPECT_NE(text.find(" readings not finite"), std::string::npos) << "no count > 1: " << text;
 }
 
 TEST(AxisMapping, ParsesSignedPermutationsAndRejectsTheRest)

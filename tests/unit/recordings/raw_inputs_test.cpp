@@ -6,7 +6,10 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
+
+#include <fmt/format.h>
 
 #include <hal/accel/iio_accel.h>
 #include <hal/tracker/opentrack_udp.h>
@@ -206,6 +209,35 @@ TEST(RawInputs, DatagramsAndSysfsReadingsComeBackAndReprocessBitExactly)
     EXPECT_EQ(r->posesNonFinite, 0u);
     EXPECT_FALSE(std::isfinite(huge.samples(recordings::accelKind())[0].gravity.y));
     EXPECT_EQ(platform::reprocess(same, {})->accelNonFinite, 0u);
+    EXPECT_NE(r->accelFirstNonFinite.find("scale 1e+308,1e+308,1e+308"), std::string::npos)
+            << r->accelFirstNonFinite;
+    EXPECT_NE(r->accelFirstNonFinite.find("the product overflows"), std::string::npos);
+    EXPECT_EQ(r->accelBadScale, 0u);
+
+    // A scale of zero gave gravity (0,0,0), finite, which passed for a reading and showed the
+    // default tilt without a word; NaN and a negative scale likewise. Each is now counted as a
+    // bad scale, its gravity made not finite (ignored like a device's NaN), and named.
+    for (const double bad : {0.0, std::numeric_limits<double>::quiet_NaN(), -0.0098,
+                             std::numeric_limits<double>::infinity()}) {
+        auto zero = *rec;
+        auto z =
+                std::make_shared<hal::RawAccelInput>(*zero.samples(recordings::accelKind())[1].raw);
+        z->scale = {0.0098, bad, 0.0098};
+        zero.samples(recordings::accelKind())[1].raw = z;
+        r = platform::reprocess(zero, {});
+        ASSERT_TRUE(r);
+        EXPECT_EQ(r->accelBadScale, 1u) << bad;
+        EXPECT_EQ(r->accelNonFinite, 1u) << bad;
+        EXPECT_FALSE(std::isfinite(zero.samples(recordings::accelKind())[1].gravity.x)) << bad;
+        EXPECT_NE(r->accelFirstNonFinite.find(fmt::format(
+                          "sample {}: raw", zero.samples(recordings::accelKind())[1].sequence)),
+                  std::string::npos)
+                << r->accelFirstNonFinite;
+        EXPECT_NE(r->accelFirstNonFinite.find(fmt::format("scale 0.0098,{},0.0098", bad)),
+                  std::string::npos)
+                << r->accelFirstNonFinite;
+        EXPECT_NE(r->accelFirstNonFinite.find("not a positive finite number"), std::string::npos);
+    }
 
     // A datagram that is not a pose: one line naming the pose.
     auto bad = *rec;
