@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <pipeline/base/output_file.h>
 #include <pipeline/display/cgats.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/display_patches.h>
@@ -27,21 +28,6 @@ namespace replica::platform {
 namespace {
 
 namespace pd = pipeline::display;
-
-bool writeAtomically(const std::filesystem::path& path, const std::string& text)
-{
-    const auto tmp = path.string() + ".tmp";
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        f << text;
-        if (!f) {
-            return false;
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    return !ec;
-}
 
 // The default set: black three times, R, G and B ramps every 'step' counts and full drive (read
 // 'fullRepeats' times: their mean sets the primary's scale, and with it every count near the
@@ -163,8 +149,10 @@ private:
 int makeSetMain(const PatchesOptions& o)
 {
     const auto set = defaultSet(o.bits, o.step, o.fullDriveRepeats, o.colours, o.seed);
-    if (!writeAtomically(o.makeSet, pd::ti1Text(set, o.bits, "Replica display patches"))) {
-        logger("replica")->error("{}: cannot write the patch set", o.makeSet);
+    if (auto ok = writeOutputFile(o.makeSet, pd::ti1Text(set, o.bits, "Replica display patches"),
+                                  "patch set");
+        !ok) {
+        logger("replica")->error("{}", ok.error().message);
         return kExitFailure;
     }
     fmt::print("patch set: {} ({} patches)\n", o.makeSet, set.size());
@@ -303,7 +291,8 @@ public:
         }
         const auto dir = std::filesystem::path(o.showDir);
         if (auto ok = writePng(dir / "patch.png", width, height, rgba);
-            !ok || !writeAtomically(dir / "patch.txt", fmt::format("{} {} {}\n", c.x, c.y, c.z))) {
+            !ok || !writeOutputFile(dir / "patch.txt", fmt::format("{} {} {}\n", c.x, c.y, c.z),
+                                    "patch shown")) {
             log->error("{}: cannot show the patch", o.showDir);
             return false;
         }
@@ -407,8 +396,10 @@ int patchesMain(const PatchesOptions& o)
         m.counts = c;
         m.xyz = *xyz;
         readings.push_back(m);
-        if (!writeAtomically(o.out, pd::ti3Text(readings, o.bits, "Replica display patches"))) {
-            log->error("{}: cannot write the readings", o.out);
+        if (auto ok = writeOutputFile(
+                    o.out, pd::ti3Text(readings, o.bits, "Replica display patches"), "readings");
+            !ok) {
+            log->error("{}", ok.error().message);
             return kExitFailure;
         }
         fmt::print("[{}/{}] {},{},{} -> XYZ {:.4f} {:.4f} {:.4f}\n", i + 1, set.size(), c.x, c.y,
