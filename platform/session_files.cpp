@@ -182,10 +182,46 @@ bool recordingFinished(const fs::path& file)
     return in.gcount() == 8 && tail == kMagic;
 }
 
+// What a recovery cut short leaves beside a kiosk file NAME (a stop signal or a kill during
+// start-up ends the process without unwinding): NAME.recovering, the finished copy not yet renamed
+// back, and .NAME.recovering.recover-PID-HEX, recover's temporary file. Either may be as large as
+// the session, and no other code looks at them, so they are deleted before recovery starts again
+// (the original NAME is still there, and is recovered anew). Only for the kiosk's registered
+// names, only regular files, and only under the folder's lock (this kiosk is the one recovering).
+void removeInterruptedRecoveries(const fs::path& dir)
+{
+    static const std::regex temp(R"(\.(.+)\.recovering\.recover-\d+-[0-9a-f]{8})");
+    const auto mine = registered(dir);
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        std::smatch m;
+        std::string owner;
+        if (std::regex_match(name, m, temp)) {
+            owner = m[1].str();
+        } else if (name.ends_with(".recovering")) {
+            owner = name.substr(0, name.size() - std::strlen(".recovering"));
+        }
+        std::error_code typeEc;
+        if (owner.empty() || !mine.contains(owner) ||
+            it->symlink_status(typeEc).type() != fs::file_type::regular ||
+            heldOpenElsewhere(it->path())) {
+            continue;
+        }
+        std::error_code rmEc;
+        if (fs::remove(it->path(), rmEc)) {
+            logger("rec")->warn("{}: left by a recovery that was cut short; deleted (the session "
+                                "itself is recovered again)",
+                                it->path().string());
+        }
+    }
+}
+
 std::vector<fs::path> recoverUnfinished(const fs::path& dir, const FreeSpace& free)
 {
     auto log = logger("rec");
     std::vector<fs::path> recovered;
+    removeInterruptedRecoveries(dir);
     for (const auto& f : kioskFiles(dir)) {
         if (f.extension() != ".mcap" || recordingFinished(f)) {
             continue;

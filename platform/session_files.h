@@ -56,7 +56,9 @@ std::uint64_t freeBytes(const std::filesystem::path& dir);
 // then renamed over the original); returns the files recovered. One without room for its copy
 // (less free space than its size) is left as it is and tried again at the next start; one
 // nothing can be recovered from is renamed to NAME.unrecoverable so that it is not tried again.
-// A file another process holds open is not touched.
+// A file another process holds open is not touched. What an earlier recovery cut short by a stop
+// or a kill left beside a kiosk file (NAME.recovering and recover's temporary file) is deleted
+// first.
 std::vector<std::filesystem::path> recoverUnfinished(const std::filesystem::path& dir,
                                                      const FreeSpace& free = freeBytes);
 

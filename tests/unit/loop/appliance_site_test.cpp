@@ -476,6 +476,38 @@ TEST(SessionFolder, ACrashedSessionIsRecoveredInPlace)
     fs::remove_all(dir);
 }
 
+TEST(SessionFolder, WhatAnInterruptedRecoveryLeftIsDeletedAndTheSessionRecoveredAgain)
+{
+    const fs::path dir = scratch("interrupted");
+    const fs::path crashed = newSessionPath(dir);
+    writeRecording(crashed, 500);
+    fs::resize_file(crashed, fs::file_size(crashed) - 100);
+    const std::string name = crashed.filename().string();
+    // A stop signal during the last start's recovery: both of recovery's files left behind.
+    const fs::path copy = dir / (name + ".recovering");
+    const fs::path temp = dir / ("." + name + ".recovering.recover-4242-0badcafe");
+    tests::spit(copy, "a finished copy never renamed back");
+    tests::spit(temp, "half of recover's output");
+    // Look-alikes that are not this kiosk's: an unregistered name, and a symbolic link.
+    const fs::path stranger = dir / "19990101T000000Z.mcap.recovering";
+    tests::spit(stranger, "someone else's");
+    const fs::path outside = scratch("interrupted-outside") / "target";
+    tests::spit(outside, "outside the folder");
+    const fs::path link = dir / ("." + name + ".recovering.recover-1-00000000");
+    fs::create_symlink(outside, link);
+
+    const auto recovered = recoverUnfinished(dir);
+    ASSERT_EQ(recovered.size(), 1u);
+    EXPECT_TRUE(recordingFinished(crashed));
+    EXPECT_FALSE(fs::exists(copy));
+    EXPECT_FALSE(fs::exists(temp));
+    EXPECT_TRUE(fs::exists(stranger));
+    EXPECT_TRUE(fs::is_symlink(link));
+    EXPECT_TRUE(fs::exists(outside));
+    fs::remove_all(dir);
+    fs::remove_all(outside.parent_path());
+}
+
 TEST(SessionFolder, AFileAnotherWriterHoldsOpenIsLeftAlone)
 {
     const fs::path dir = scratch("held");
