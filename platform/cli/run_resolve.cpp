@@ -23,6 +23,7 @@
 #include <platform/logging.h>
 #include <platform/output/display_geometry.h>
 #include <platform/site_file.h>
+#include <recordings/recording.h>
 
 namespace replica::platform::run_cli {
 namespace {
@@ -385,11 +386,39 @@ Resolved<void> checkBooth(const RunOptions& o, const RunConfig& config)
     return {};
 }
 
+// The files the run reads or writes beside the scene: the recording a replay run plays (read as
+// the replay sources will read it, so that a file they would refuse is refused here, by config
+// check too), and the kiosk's sessions folder, which must be a folder where it exists (a missing
+// one is created at start; one that cannot be written is a fault the kiosk runs through, without
+// recording, and says so).
+Resolved<void> checkRunFiles(const RunOptions& o)
+{
+    if (o.hal == "replay" && !o.replayFile.empty()) {
+        if (auto rec = recordings::readRecording(o.replayFile); !rec) {
+            return tl::unexpected(refuse(o, "--replay-file", "run.replay_file", o.replayFile,
+                                         rec.error().message, kExitFailure));
+        }
+    }
+    const bool kioskRecording = o.kiosk && o.site && o.site->recordingEnabled && o.record.empty();
+    std::error_code ec;
+    if (kioskRecording && std::filesystem::exists(o.site->recordingDirectory, ec) &&
+        !std::filesystem::is_directory(o.site->recordingDirectory, ec)) {
+        return tl::unexpected(refuse(o, "", "recording.directory", o.site->recordingDirectory,
+                                     "exists and is not a folder; name a folder for the "
+                                     "sessions (created at start when missing)",
+                                     kExitFailure));
+    }
+    return {};
+}
+
 // What the appliance will load (the display profile, the scene) and the devices will parse (the
 // accelerometer's axes, the tracker's bind address), read and parsed now, opening no device.
 Resolved<void> checkLoadable(const RunOptions& o, const RunConfig& config)
 {
     if (auto ok = checkBooth(o, config); !ok) {
+        return ok;
+    }
+    if (auto ok = checkRunFiles(o); !ok) {
         return ok;
     }
     if (config.display != kUncalibratedDisplay) {

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """'replica config check' resolves what the kiosk resolves: over a corpus of site files, each the
 shipped deploy/replica.toml (set to simulated sensors, headless, a small frame, no recording) with
-one key given a wrong value of some kind (wrong type, out of range, a missing file, a junk string),
+one key given a wrong value of some kind (wrong type, out of range, a missing file, a folder, a
+file of another kind, a junk string), the keys it leaves commented out included,
 the check says ok exactly when 'replica run --kiosk' starts, and when it does not, the kiosk exits
 78 (EX_CONFIG) with the check's lines, each naming the file, the line and the key.
 
@@ -39,6 +40,11 @@ def parse(text):
         m = re.match(r"\s*(\w+)\s*=\s*(.*?)\s*(#.*)?$", line)
         if m and section:
             keys[(section, m.group(1))] = (i, m.group(2))
+            continue
+        # A key the shipped file leaves commented out ("# dir = ..."): mutated by uncommenting it.
+        m = re.match(r"#\s*(\w+)\s*=\s*(\"[^\"]*\"|[-+0-9.eE]+|true|false)\s*$", line)
+        if m and section and (section, m.group(1)) not in keys:
+            keys[(section, m.group(1))] = (i, m.group(2))
     return keys
 
 
@@ -54,7 +60,7 @@ def wrong_values(value):
     kinds = [("junk string", '"j#nk value!"')]
     if value.startswith('"'):
         kinds += [("wrong type", "42"), ("missing file", '"/nonexistent/replica/file.json"'),
-                  ("empty", '""')]
+                  ("empty", '""'), ("a folder", '"/tmp"'), ("a file of another kind", f'"{shipped}"')]
     elif value in ("true", "false"):
         kinds += [("wrong type", "1")]
     elif value.startswith("["):
