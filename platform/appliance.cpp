@@ -15,6 +15,7 @@
 #include <hal/sim/sim_devices.h>
 #include <pipeline/base/data_dir.h>
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/parallel_for.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/display/display_inverse.h>
@@ -108,27 +109,28 @@ std::vector<DimmerView> dimmerViews(const RunConfig& config,
     const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
                                      0.01, basis);
     const auto pl = sh::prepareLight(light, setup.observer, setup.settings.lights, basis);
-    std::vector<DimmerView> views;
-    for (const double tiltDeg : kDimmerTiltsDeg) {
-        for (const double offsetM : kDimmerEyeOffsetsM) {
-            sh::View view;
-            view.panel = pipeline::scene::panelPose(config.stand,
-                                                    pipeline::scene::degreesToRadians(tiltDeg));
-            view.eye = config.defaultEyeM + glm::dvec3(offsetM, 0.0, 0.0);
-            view.pixelsX = 32;
-            view.pixelsY = 20;
-            DimmerView v;
-            v.frame = sh::renderRealtime(ps, pl, view, setup.observer, setup.settings);
-            for (int py = 0; py < view.pixelsY; ++py) {
-                for (int px = 0; px < view.pixelsX; ++px) {
-                    v.pixelM.push_back(sh::shadingPoint(view, setup.scene, {}, px, py).p);
-                }
+    // The views share nothing but the prepared scene and light: drawn on every core (start-up
+    // waits for them), each into its own slot, so the choice is the same on any machine.
+    std::vector<DimmerView> views(kDimmerTiltsDeg.size() * kDimmerEyeOffsetsM.size());
+    pipeline::parallelFor(views.size(), [&](std::size_t i) {
+        const double tiltDeg = kDimmerTiltsDeg[i / kDimmerEyeOffsetsM.size()];
+        const double offsetM = kDimmerEyeOffsetsM[i % kDimmerEyeOffsetsM.size()];
+        sh::View view;
+        view.panel = pipeline::scene::panelPose(config.stand,
+                                                pipeline::scene::degreesToRadians(tiltDeg));
+        view.eye = config.defaultEyeM + glm::dvec3(offsetM, 0.0, 0.0);
+        view.pixelsX = 32;
+        view.pixelsY = 20;
+        DimmerView& v = views[i];
+        v.frame = sh::renderRealtime(ps, pl, view, setup.observer, setup.settings);
+        for (int py = 0; py < view.pixelsY; ++py) {
+            for (int px = 0; px < view.pixelsX; ++px) {
+                v.pixelM.push_back(sh::shadingPoint(view, setup.scene, {}, px, py).p);
             }
-            v.normal = view.panel.normal;
-            v.eyeM = view.eye;
-            views.push_back(std::move(v));
         }
-    }
+        v.normal = view.panel.normal;
+        v.eyeM = view.eye;
+    });
     return views;
 }
 

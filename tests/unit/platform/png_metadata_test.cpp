@@ -24,8 +24,8 @@
 namespace replica::platform {
 namespace {
 
-constexpr std::int64_t kS = 1'000'000'000;
-constexpr std::int64_t k143205Z = 1796567525LL * kS; // 2026-12-06T14:32:05Z
+constexpr std::int64_t kPngSecondNs = 1'000'000'000;
+constexpr std::int64_t kPng143205Z = 1796567525LL * kPngSecondNs; // 2026-12-06T14:32:05Z
 
 struct ReadBack {
     bool ok = false;
@@ -185,7 +185,7 @@ TEST(PngMetadata, ThumbnailCarriesProfileTimeAndFrame)
 {
     auto icc = pipeline::display::iccProfileBytes(nominal());
     ASSERT_TRUE(icc.has_value());
-    const auto meta = shownFrameMetadata(*icc, "srgb-like-800", k143205Z, 1'250'000'000, 37);
+    const auto meta = shownFrameMetadata(*icc, "srgb-like-800", kPng143205Z, 1'250'000'000, 37);
     const RgbImage img = gradient();
     auto png = encodePngRgb(img, &meta);
     ASSERT_TRUE(png.has_value()) << png.error().message;
@@ -219,7 +219,7 @@ TEST(PngMetadata, ThumbnailCarriesProfileTimeAndFrame)
 
 TEST(PngMetadata, UnknownStartAndNoProfile)
 {
-    const auto meta = shownFrameMetadata({}, "", 0, 2 * kS, 5);
+    const auto meta = shownFrameMetadata({}, "", 0, 2 * kPngSecondNs, 5);
     auto png = encodePngRgb(gradient(), &meta);
     ASSERT_TRUE(png.has_value());
     const auto r = readPng(*png);
@@ -244,7 +244,7 @@ TEST(PngMetadata, WrittenFramesCarryThemToo)
 {
     auto icc = pipeline::display::iccProfileBytes(nominal());
     ASSERT_TRUE(icc.has_value());
-    const auto meta = shownFrameMetadata(*icc, "a panel\twith  odd\nname", k143205Z, 0, 0);
+    const auto meta = shownFrameMetadata(*icc, "a panel\twith  odd\nname", kPng143205Z, 0, 0);
     const std::vector<std::uint8_t> rgba(8 * 4 * 4, 200);
     const auto path = std::filesystem::temp_directory_path() /
                       ("replica_png_metadata_" + std::to_string(::getpid()) + ".png");
