@@ -12,10 +12,15 @@
 #include <unistd.h>
 
 #include <hal/accel/iio_accel.h>
+#include <pipeline/base/data_dir.h>
+#include <pipeline/colour/xyz.h>
 #include <pipeline/scene/calibration.h>
+#include <pipeline/spectral/direct_level.h>
 #include <pipeline/spectral/live_chain.h>
+#include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
+#include <platform/site_config.h>
 #include <platform/site_file.h>
 #include <recordings/device_kind.h>
 #include <recordings/recording.h>
@@ -36,6 +41,8 @@ struct CalibrateOptions {
     std::string longPass;
     double cutOnNm = 0.0;
     double strayLight = -1.0;
+    double luminanceCdM2 = 0.0; // direct-sensor mode's level: the metered lamp's luminance
+    std::string levelRecording; // its readings (default: --recording)
 };
 
 // Rows of 'columns' numbers, comma- or space-separated; '#' starts a comment; a first row that is
@@ -248,6 +255,47 @@ rawSpectra(const std::vector<hal::SpectrumSample>& samples)
     return raw;
 }
 
+// Direct-sensor mode's level (pipeline/spectral/direct_level.h): the metered lamp's readings
+// (--level-recording, else --recording) through the live chain with the calibration just found;
+// the site file's line, or why not.
+Expected<std::string> directLevel(const CalibrateOptions& o,
+                                  const pipeline::spectral::InstrumentCalibration& instrument)
+{
+    const std::string file = o.levelRecording.empty() ? o.recording : o.levelRecording;
+    auto samples = recordedSpectra(file);
+    if (!samples) {
+        return tl::unexpected(samples.error());
+    }
+    auto observer = pipeline::colour::loadCie1931(dataDir());
+    if (!observer) {
+        return tl::unexpected(observer.error());
+    }
+    // The responsivity the appliance converts with (its spectra's Y is what the level scales).
+    auto cal = pipeline::spectral::loadSpectrometerCalibration(dataDir() /
+                                                               RunConfig{}.spectrometerCalibration);
+    if (!cal) {
+        return tl::unexpected(cal.error());
+    }
+    auto level = pipeline::spectral::calibrateDirectLevel(rawSpectra(*samples), *cal, instrument,
+                                                          *observer, o.luminanceCdM2);
+    if (!level) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: {}", file, level.error().message));
+    }
+    fmt::print("direct-sensor level {:.6g} cd/m^2 per unit of Y: {} cd/m^2 metered over the "
+               "median Y {:.6g} of {} steady readings (spread {:.1f} %)\n",
+               level->cdm2PerY, o.luminanceCdM2, level->medianY, level->spectra,
+               100.0 * level->spreadFraction);
+    if (level->spreadFraction > 0.05) {
+        logger("replica")->warn("{}: the readings of the metered lamp vary by {:.1f} % (max - "
+                                "min over median): was the lamp warmed up and steady?",
+                                file, 100.0 * level->spreadFraction);
+    }
+    return fmt::format("# direct-sensor level from {} ({} cd/m^2 metered)\n"
+                       "direct_cdm2_per_y = {:.6g}\n",
+                       file, o.luminanceCdM2, level->cdm2PerY);
+}
+
 // The instrument's calibration for the live chain (pipeline/spectral/live_chain.h): the
 // wavelength shift from the mercury lines of a fluorescent lamp, recorded; the stray light from a
 // recording through a long-pass filter, or the instrument's data (a number), or the data sheet's.
@@ -289,11 +337,24 @@ int calibrateSpectrometer(const CalibrateOptions& o)
     fmt::print("wavelength shift {:+.3f} nm (median of {} runs of 10 spectra, spread {:.3f} nm); "
                "stray light {:.3g} of the peak ({})\n",
                shift->offsetNm, shift->runs, shift->spreadNm, stray, strayFrom);
-    const std::string body = fmt::format(
+    std::string body = fmt::format(
             "# 'replica calibrate spectrometer' from {}; stray light from {}\n"
             "stray_light_fraction = {:.6g}\nwavelength_offset_nm = {:.4f}\n"
             "calibration_spectra = {}\ncalibration_spread_nm = {:.4f}\n",
             o.recording, strayFrom, stray, shift->offsetNm, lamp->size(), shift->spreadNm);
+    if (o.luminanceCdM2 > 0.0) {
+        auto level = directLevel(o, {stray, shift->offsetNm});
+        if (!level) {
+            log->error("{}", level.error().message);
+            return kExitFailure;
+        }
+        body += *level;
+    } else if (auto site = loadSiteConfig(o.site);
+               site && site->config.spectrometerDirectCdM2PerY) {
+        // The section is written whole: a level calibrated before is kept, not dropped.
+        body += fmt::format("direct_cdm2_per_y = {:.6g}\n",
+                            *site->config.spectrometerDirectCdM2PerY);
+    }
     return finish(o, "spectrometer", body);
 }
 
@@ -352,6 +413,15 @@ void registerCalibrateCommand(CLI::App& app, int& exitCode)
                          "the stray light from the instrument's data, as a fraction of the peak "
                          "(without it and --long-pass: the data sheet's 0.0005)")
             ->check(CLI::Range(0.0, 0.05));
+    spectrometer
+            ->add_option("--luminance-cdm2", o->luminanceCdM2,
+                         "direct-sensor mode's level: the luminance (cd/m^2) a luminance meter "
+                         "reads of the lamp recorded in --level-recording (or --recording), e.g. "
+                         "of a white tile under it; writes direct_cdm2_per_y")
+            ->check(CLI::Range(1e-3, 1e6));
+    spectrometer->add_option("--level-recording", o->levelRecording,
+                             "a recording of the metered lamp alone, steady for some seconds "
+                             "(default: --recording)");
     spectrometer->add_option("--site", o->site, "site configuration file to write the result into")
             ->capture_default_str();
     spectrometer->add_flag("--dry-run", o->dryRun, "print the section instead of writing the file");

@@ -116,3 +116,65 @@ if cmp -s "$work/run.json" "$work/plain.json"; then
     echo "FAIL: the calibrated tracker pose changed nothing" >&2
     exit 1
 fi
+
+# 'replica calibrate spectrometer --luminance-cdm2': direct-sensor mode's level from a recording
+# and the metered lamp's luminance. The sim scenario's first steady lamp is tungsten (0.5-2.5 s),
+# which the shipped booth has at 2200 cd/m^2; the simulated instrument's own figure for it is
+# 7.3451e-5 (kDefaultDirectCdM2PerY, found with the bare chain; this is the corrected chain's).
+"$replica" run --hal sim --output headless --size 32x20 --frames 200 --rate 10 --fast \
+    --uncalibrated --record "$work/lamps.mcap" > /dev/null 2>&1
+cat > "$work/kiosk.toml" <<TOML
+[booth]
+light = "direct"
+[run]
+hal = "sim"
+[display]
+output = "headless"
+size = "48x30"
+[recording]
+enabled = false
+TOML
+"$replica" calibrate spectrometer --recording "$work/lamps.mcap" --luminance-cdm2 2200 \
+    --site "$work/kiosk.toml" > "$work/level.log" 2>&1 || {
+    echo "FAIL: calibrate spectrometer --luminance-cdm2:" >&2; cat "$work/level.log" >&2; exit 1; }
+# Recalibrating the shift alone keeps the level.
+"$replica" calibrate spectrometer --recording "$work/lamps.mcap" --site "$work/kiosk.toml" \
+    > /dev/null 2>&1
+# A luminance that is no number, and a recording without one steady light, are refused.
+if "$replica" calibrate spectrometer --recording "$work/lamps.mcap" --luminance-cdm2 0 \
+    --dry-run > /dev/null 2>&1; then
+    echo "FAIL: --luminance-cdm2 0 was accepted" >&2; exit 1
+fi
+# The kiosk reads it from the site file (config check resolves it; the run records it).
+"$replica" config check "$work/kiosk.toml" --print > "$work/resolved.json" 2> "$work/check.log" || {
+    echo "FAIL: config check of the calibrated site file:" >&2; cat "$work/check.log" >&2; exit 1; }
+"$replica" run --kiosk --config "$work/kiosk.toml" --frames 20 --fast \
+    --record "$work/direct.mcap" --uncalibrated > /dev/null 2> "$work/direct.log" || {
+    echo "FAIL: the kiosk on the calibrated site file:" >&2; cat "$work/direct.log" >&2; exit 1; }
+"$replica" inspect "$work/direct.mcap" --json > "$work/direct.json"
+python3 - "$work" <<'PY'
+import json, re, sys
+work = sys.argv[1]
+toml = open(f"{work}/kiosk.toml").read()
+m = re.findall(r"^direct_cdm2_per_y = (\S+)$", toml, re.M)
+if len(m) != 1:
+    sys.exit(f"FAIL: the site file holds {len(m)} direct_cdm2_per_y lines:\n{toml}")
+k = float(m[0])
+if not abs(k - 7.3451e-5) <= 0.02 * 7.3451e-5:
+    sys.exit(f"FAIL: direct_cdm2_per_y {k:.6g}, the simulated instrument's is 7.3451e-05 (2 %)")
+cfg = json.load(open(f"{work}/direct.json"))["config"]
+def find(o, key):
+    if isinstance(o, dict):
+        if key in o:
+            return o[key]
+        for v in o.values():
+            r = find(v, key)
+            if r is not None:
+                return r
+    return None
+rec = find(cfg, "direct_cdm2_per_y")
+if rec is None or abs(rec - k) > 1e-9 * k:
+    sys.exit(f"FAIL: the kiosk's recording holds direct_cdm2_per_y {rec}, the site file {k}")
+print(f"ok: direct-sensor level {k:.6g} cd/m^2 per Y (the sim's 7.3451e-05), kept by a shift-only "
+      f"recalibration, read and recorded by the kiosk")
+PY

@@ -2,6 +2,8 @@
 // classifier matches no lamp, it renders the calibrated reading on the booth's uniform emitter at
 // the sensed level, L = directCdM2PerY * Y(reading), not at the booth's mean luminance.
 #include <algorithm>
+#include <cmath>
+#include <span>
 #include <vector>
 
 #include <state/light_estimator.h>
@@ -10,6 +12,7 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/spectral/direct_level.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 #include <platform/appliance.h>
 
@@ -200,6 +203,66 @@ TEST_F(DirectSensorTest, TheDefaultScaleRendersTheSimulatedTungstenReadingAtItsN
         sum += readingY(s) * platform::kDefaultDirectCdM2PerY;
     }
     EXPECT_NEAR(sum / static_cast<double>(f7_.size()), 1420.0, 10.0);
+}
+
+// 'replica calibrate spectrometer --luminance-cdm2': from readings of one steady lamp and that
+// lamp's metered luminance, the level at which the kiosk's own estimator (its live chain, the
+// corrections on) renders that lamp at the metered luminance, whatever the instrument's scale.
+TEST_F(DirectSensorTest, TheCalibratedLevelRendersTheMeteredLampAtItsLuminance)
+{
+    auto a = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" /
+                                               "cie_illuminants_A_D50_D65_5nm_300_780.csv");
+    ASSERT_TRUE(a) << a.error().message;
+    auto power = a->values("A");
+    ASSERT_TRUE(power) << power.error().message;
+    hal::sim::ScenarioParams scenario;
+    scenario.lampCount = 1;
+    hal::sim::SimSpectrometerParams p;
+    p.lamps = {hal::sim::SimLamp{"A", a->wavelengthNm, *power}};
+    p.responsivityNm = setup_.calibration.wavelengthNm;
+    p.responsivity = setup_.calibration.responsivity;
+    std::vector<hal::SpectrumSample> tungsten;
+    makeSimSpectrometer(scenario, p)->poll(2'400'000'000, tungsten);
+    ASSERT_GE(tungsten.size(), 10u);
+    // A lamp switch before it: three F7 readings, which the longest steady run leaves out.
+    std::vector<hal::SpectrumSample> recorded(f7_.begin(), f7_.begin() + 3);
+    recorded.insert(recorded.end(), tungsten.begin(), tungsten.end());
+    std::vector<pipeline::spectral::RawSpectrum> raw;
+    for (const auto& s : recorded) {
+        raw.push_back({s.counts, s.integrationTimeUs, s.wavelengthCoeffs, s.nonlinearityCoeffs});
+    }
+    const pipeline::spectral::InstrumentCalibration instrument; // the data sheet's
+    for (const double metered : {2200.0, 350.0}) {
+        auto level = pipeline::spectral::calibrateDirectLevel(raw, setup_.calibration, instrument,
+                                                              setup_.observer, metered);
+        ASSERT_TRUE(level) << level.error().message;
+        EXPECT_EQ(level->spectra, static_cast<int>(tungsten.size()));
+        EXPECT_LT(level->spreadFraction, 0.05);
+        // The kiosk's estimator with its default chain and that level.
+        setup_.forceDirect = true;
+        setup_.chain = pipeline::spectral::LiveChainOptions{};
+        setup_.instrument = instrument;
+        setup_.directCdM2PerY = level->cdm2PerY;
+        LightEstimator e = make();
+        double sum = 0.0;
+        for (const auto& s : tungsten) {
+            sum += feed(e, s).emitterLuminanceCdM2;
+        }
+        EXPECT_NEAR(sum / static_cast<double>(tungsten.size()), metered, 0.005 * metered);
+        if (metered == 2200.0) {
+            // The simulated instrument's own figure, found with the bare chain, is within the
+            // stray light's share of this one.
+            EXPECT_NEAR(level->cdm2PerY, platform::kDefaultDirectCdM2PerY,
+                        0.02 * platform::kDefaultDirectCdM2PerY);
+        }
+    }
+    // Refused: too few steady readings, no light, a luminance that is not a positive number.
+    EXPECT_FALSE(pipeline::spectral::calibrateDirectLevel(
+            std::span(raw).first(4), setup_.calibration, instrument, setup_.observer, 2200.0));
+    EXPECT_FALSE(pipeline::spectral::calibrateDirectLevel(raw, setup_.calibration, instrument,
+                                                          setup_.observer, -1.0));
+    EXPECT_FALSE(pipeline::spectral::calibrateDirectLevel(raw, setup_.calibration, instrument,
+                                                          setup_.observer, std::nan("")));
 }
 
 } // namespace
