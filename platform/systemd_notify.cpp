@@ -1,7 +1,14 @@
 // sd_notify through libsystemd (when built with it).
 #include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <sstream>
+#include <string>
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <platform/logging.h>
 #include <platform/systemd_notify.h>
@@ -11,6 +18,34 @@
 #endif
 
 namespace replica::platform {
+namespace {
+
+// Seconds since this process was started (exec), from /proc/self/stat's start time (clock ticks
+// since boot) and CLOCK_BOOTTIME: what a visitor waits from the service's start to the first
+// frame, dynamic linking included. Nullopt where /proc cannot say.
+std::optional<double> secondsSinceProcessStart()
+{
+    std::ifstream in("/proc/self/stat");
+    std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto paren = stat.rfind(')'); // the command name may hold spaces and parentheses
+    const long ticks = ::sysconf(_SC_CLK_TCK);
+    timespec now{};
+    if (paren == std::string::npos || ticks <= 0 || ::clock_gettime(CLOCK_BOOTTIME, &now) != 0) {
+        return std::nullopt;
+    }
+    std::istringstream fields(stat.substr(paren + 2));
+    std::string field;
+    for (int i = 3; i <= 22 && fields >> field; ++i) { // field 22: starttime
+    }
+    try {
+        const double started = std::stod(field) / static_cast<double>(ticks);
+        return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec) - started;
+    } catch (const std::exception&) {
+        return std::nullopt;
+    }
+}
+
+} // namespace
 
 SystemdNotifier::SystemdNotifier()
 {
@@ -41,6 +76,9 @@ void SystemdNotifier::frameShown(std::uint64_t frames, std::uint64_t skippedTick
     };
     if (!ready_) {
         ready_ = true;
+        if (const auto s = secondsSinceProcessStart()) {
+            logger("replica")->info("first frame shown {:.2f} s after the process started", *s);
+        }
         lastPing_ = now;
         send("READY=1\n" + status() + (watchdogEnabled() ? "\nWATCHDOG=1" : ""));
         return;
