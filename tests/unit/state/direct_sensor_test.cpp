@@ -58,6 +58,31 @@ protected:
         return spd ? pipeline::colour::spectrumToXyz(setup_.observer, *spd).y : 0.0;
     }
 
+    // The simulated instrument's readings of the shipped tungsten lamp (CIE A) over 'ns'.
+    std::vector<hal::SpectrumSample> simTungsten(std::int64_t ns) const
+    {
+        std::vector<hal::SpectrumSample> out;
+        auto a = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" /
+                                                   "cie_illuminants_A_D50_D65_5nm_300_780.csv");
+        EXPECT_TRUE(a) << a.error().message;
+        if (!a) {
+            return out;
+        }
+        auto power = a->values("A");
+        EXPECT_TRUE(power) << power.error().message;
+        if (!power) {
+            return out;
+        }
+        hal::sim::ScenarioParams scenario;
+        scenario.lampCount = 1;
+        hal::sim::SimSpectrometerParams p;
+        p.lamps = {hal::sim::SimLamp{"A", a->wavelengthNm, *power}};
+        p.responsivityNm = setup_.calibration.wavelengthNm;
+        p.responsivity = setup_.calibration.responsivity;
+        hal::sim::makeSimSpectrometer(scenario, p)->poll(ns, out);
+        return out;
+    }
+
     pipeline::scene::SceneState feed(LightEstimator& e, const hal::SpectrumSample& s) const
     {
         pipeline::scene::SceneState st;
@@ -174,19 +199,7 @@ TEST_F(DirectSensorTest, TheDefaultScaleRendersTheSimulatedTungstenReadingAtItsN
 {
     // platform::kDefaultDirectCdM2PerY is the simulated instrument's calibration: its readings
     // of the shipped tungsten lamp (CIE A) come out at that lamp's 2200 cd/m^2, within the noise.
-    auto a = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" /
-                                               "cie_illuminants_A_D50_D65_5nm_300_780.csv");
-    ASSERT_TRUE(a) << a.error().message;
-    auto power = a->values("A");
-    ASSERT_TRUE(power) << power.error().message;
-    hal::sim::ScenarioParams scenario;
-    scenario.lampCount = 1;
-    hal::sim::SimSpectrometerParams p;
-    p.lamps = {hal::sim::SimLamp{"A", a->wavelengthNm, *power}};
-    p.responsivityNm = setup_.calibration.wavelengthNm;
-    p.responsivity = setup_.calibration.responsivity;
-    std::vector<hal::SpectrumSample> tungsten;
-    hal::sim::makeSimSpectrometer(scenario, p)->poll(1'200'000'000, tungsten);
+    const auto tungsten = simTungsten(1'200'000'000);
     ASSERT_EQ(tungsten.size(), 6u);
     setup_.forceDirect = true;
     setup_.directCdM2PerY = platform::kDefaultDirectCdM2PerY;
@@ -210,19 +223,7 @@ TEST_F(DirectSensorTest, TheDefaultScaleRendersTheSimulatedTungstenReadingAtItsN
 // corrections on) renders that lamp at the metered luminance, whatever the instrument's scale.
 TEST_F(DirectSensorTest, TheCalibratedLevelRendersTheMeteredLampAtItsLuminance)
 {
-    auto a = pipeline::colour::loadSpectralCsv(dataDir() / "spectra" /
-                                               "cie_illuminants_A_D50_D65_5nm_300_780.csv");
-    ASSERT_TRUE(a) << a.error().message;
-    auto power = a->values("A");
-    ASSERT_TRUE(power) << power.error().message;
-    hal::sim::ScenarioParams scenario;
-    scenario.lampCount = 1;
-    hal::sim::SimSpectrometerParams p;
-    p.lamps = {hal::sim::SimLamp{"A", a->wavelengthNm, *power}};
-    p.responsivityNm = setup_.calibration.wavelengthNm;
-    p.responsivity = setup_.calibration.responsivity;
-    std::vector<hal::SpectrumSample> tungsten;
-    makeSimSpectrometer(scenario, p)->poll(2'400'000'000, tungsten);
+    const auto tungsten = simTungsten(2'400'000'000);
     ASSERT_GE(tungsten.size(), 10u);
     // A lamp switch before it: three F7 readings, which the longest steady run leaves out.
     std::vector<hal::SpectrumSample> recorded(f7_.begin(), f7_.begin() + 3);
