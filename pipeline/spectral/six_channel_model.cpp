@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/base/output_file.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/csv/csv_cells.h>
 #include <pipeline/spectral/dense_matrix.h>
@@ -450,12 +451,8 @@ Expected<void> saveSixChannelModel(const SixChannelModel& model,
     }
     for (const auto& [path, body] :
          {std::pair{csvPath, text}, std::pair{toXyzPath(csvPath), xyz}}) {
-        std::ofstream out(path, std::ios::binary | std::ios::trunc);
-        out << body;
-        if (!out) {
-            return makeError(
-                    ErrorCode::Io,
-                    fmt::format("{}: cannot write (is the folder writable?)", path.string()));
+        if (auto ok = writeOutputFile(path, body, "six-channel model"); !ok) {
+            return ok;
         }
     }
     return {};

@@ -345,12 +345,12 @@ mkdir -p "$out_dir"
 writes() {
     local label="$1" ext="$2"
     shift 2
-    echo "precious" > "$out_dir/target.$ext"
+    echo "# precious" > "$out_dir/target.$ext" # a valid site file too
     ln -sfn "$out_dir/target.$ext" "$out_dir/link.$ext"
     [ -e "$out_dir/fifo.$ext" ] || mkfifo "$out_dir/fifo.$ext"
     mkdir -p "$out_dir/adir.$ext"
     expect 1 "link.$ext: is a symbolic link; the .* never through a link" -- "${R[@]}" "$@" "$out_dir/link.$ext"
-    [ "$(cat "$out_dir/target.$ext")" = precious ] || fail "$label wrote through a symbolic link"
+    [ "$(cat "$out_dir/target.$ext")" = "# precious" ] || fail "$label wrote through a symbolic link"
     # display fit checks its outputs before fitting ("not a regular file"); the rest when writing.
     expect 1 "fifo.$ext: (is a FIFO, not a .* file|not a regular file)" -- "${R[@]}" "$@" "$out_dir/fifo.$ext"
     expect 1 "adir.$ext: (is a directory, not a .* file|not a regular file)" -- "${R[@]}" "$@" "$out_dir/adir.$ext"
@@ -376,6 +376,34 @@ writes "render --out" exr render --scene "$data/scenes/metamer" --light d65 --ou
 writes "display fit --out" json display fit "$out_dir/m.csv" --out
 writes "display fit --icc" icc display fit "$out_dir/m.csv" --out "$out_dir/p.json" --icc
 writes "display synth --out" csv display synth --out
+# Tracker points that fit exactly (booth = tracker), for the site file's rewrite.
+printf '%s\n' 0,0.4,0.5,0,0.4,0.5 0.2,0.4,0.5,0.2,0.4,0.5 0,0.6,0.5,0,0.6,0.5 0,0.4,0.7,0,0.4,0.7 \
+    0.2,0.6,0.7,0.2,0.6,0.7 -0.1,0.5,0.6,-0.1,0.5,0.6 > "$out_dir/points.csv"
+writes "calibrate tracker --site" toml calibrate tracker --points "$out_dir/points.csv" --site
+writes "spectral metamers --out" csv spectral metamers --count 1 --out
+# writes_into LABEL FILE ARGS...: the command writes FILE into the folder appended to ARGS; FILE
+# there a link, a FIFO and a directory in turn, then the folder on the full disk (no file left).
+writes_into() {
+    local label="$1" file="$2"
+    shift 2
+    local d="$out_dir/into-$label"
+    rm -rf "$d" && mkdir -p "$d"
+    echo "# precious" > "$out_dir/target-$file"
+    ln -sfn "$out_dir/target-$file" "$d/$file"
+    expect 1 "$file: is a symbolic link; the .* never through a link" -- "${R[@]}" "$@" "$d"
+    [ "$(cat "$out_dir/target-$file")" = "# precious" ] || fail "$label wrote through a symbolic link"
+    rm -f "$d/$file" && mkfifo "$d/$file"
+    expect 1 "$file: is a FIFO, not a .* file" -- "${R[@]}" "$@" "$d"
+    rm -f "$d/$file" && mkdir "$d/$file"
+    expect 1 "$file: is a directory, not a .* file" -- "${R[@]}" "$@" "$d"
+    if [ -n "${full:-}" ]; then
+        expect 1 "full/$label/.*: writing the .* failed: No space left on device; nothing written" -- \
+            "${R[@]}" "$@" "$full/$label"
+        [ -z "$(find "$full/$label" -type f 2>/dev/null)" ] || fail "$label left a file on a full disk"
+    fi
+}
+writes_into booth-generate booth.json booth generate --out
+writes_into scene-generate scene.json scene generate --kind metamer --out
 if [ -n "$full" ]; then umount "$full"; fi
 
 # replay shows a recording's text with its control characters escaped, as inspect does.
