@@ -1,7 +1,6 @@
 // The planner's per-lamp choice: computed, cached in a file, read back with every field checked.
 #include <algorithm>
 #include <cstdlib>
-#include <fstream>
 #include <vector>
 
 #include <fmt/format.h>
@@ -10,6 +9,7 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/base/input_file.h>
 #include <pipeline/base/json_limits.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/reference/reference_integrator.h>
@@ -131,22 +131,11 @@ Expected<RenderPlan> readRenderPlan(const std::filesystem::path& path)
 
 Expected<void> writeRenderPlan(const std::filesystem::path& path, const RenderPlan& plan)
 {
-    std::error_code ec;
-    std::filesystem::create_directories(path.parent_path(), ec);
-    const auto tmp = path.string() + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << renderPlanJson(plan);
-        if (!out) {
-            return makeError(ErrorCode::Io, fmt::format("{}: cannot write the render plan", tmp));
-        }
+    if (path.has_parent_path()) {
+        std::error_code ec;
+        std::filesystem::create_directories(path.parent_path(), ec);
     }
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot write the render plan ({})",
-                                                    path.string(), ec.message()));
-    }
-    return {};
+    return writeOutputFile(path, renderPlanJson(plan), "render plan");
 }
 
 Expected<std::string> boothDigest(const std::filesystem::path& boothDir)

@@ -1,8 +1,9 @@
 // Site file sections: text replacement checked with toml++.
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
-#include <fstream>
 #include <sstream>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/output_file.h>
 #include <platform/site_config.h>
 #include <platform/site_file.h>
 #include <recordings/device_kind.h>
@@ -100,22 +102,13 @@ Expected<void> writeSiteSection(const std::filesystem::path& file,
     if (file.has_parent_path()) {
         std::filesystem::create_directories(file.parent_path(), ec);
     }
-    const auto tmp = std::filesystem::path(file.string() + ".tmp");
-    {
-        std::ofstream out(tmp);
-        out << result;
-        out.flush();
-        if (!out) {
-            return makeError(ErrorCode::Io,
-                             fmt::format("{}: cannot write it (run as root, or give --site a "
-                                         "writable path)",
-                                         tmp.string()));
-        }
-    }
-    std::filesystem::rename(tmp, file, ec);
-    if (ec) {
-        return makeError(ErrorCode::Io,
-                         fmt::format("{}: cannot replace it: {}", file.string(), ec.message()));
+    auto written = writeOutputFile(file, result, "site file");
+    if (!written) {
+        const std::string& why = written.error().message;
+        const bool denied = why.find(std::strerror(EACCES)) != std::string::npos ||
+                            why.find(std::strerror(EROFS)) != std::string::npos;
+        return makeError(written.error().code,
+                         why + (denied ? " (run as root, or give --site a writable path)" : ""));
     }
     return {};
 }

@@ -15,7 +15,8 @@ namespace replica::platform {
 constexpr const char* kDefaultSiteFile = "/etc/replica/replica.toml";
 
 // Replaces table [section] (and its [section.*] subtables) in 'file' by 'body' (key = value
-// lines), creating the file if it does not exist; written to a temporary file and renamed.
+// lines), creating the file if it does not exist; written by writeOutputFile (a temporary file,
+// fsynced, renamed; never through a symbolic link: a linked site file is refused, name its target).
 // Fails, naming the file and line, when the existing file is not valid TOML.
 Expected<void> writeSiteSection(const std::filesystem::path& file,
                                 const std::string& section,

@@ -1,14 +1,19 @@
 // IIO accelerometer over sysfs.
 #include <atomic>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <fstream>
+#include <cstring>
 #include <sstream>
 #include <thread>
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <glm/geometric.hpp>
+#include <poll.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <hal/accel/iio_accel.h>
 #include <hal/live_queue.h>
@@ -18,20 +23,50 @@
 namespace replica::hal::accel {
 namespace fs = std::filesystem;
 
-Expected<double> readSysfsNumber(const fs::path& file)
+Expected<std::string> readSysfsText(const fs::path& file)
 {
-    std::ifstream in(file);
-    if (!in) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot be read", file.string()));
+    // O_NONBLOCK: opening a FIFO does not wait for a writer, reading one does not wait for data;
+    // poll() bounds the wait for anything else that does not answer at once.
+    const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot be read ({})", file.string(),
+                                                          std::strerror(errno)));
     }
+    pollfd p{fd, POLLIN, 0};
+    int ready = 0;
+    do {
+        ready = ::poll(&p, 1, kSysfsWaitMs);
+    } while (ready < 0 && errno == EINTR);
     // A sysfs attribute is a few bytes; read at most 64 so that a wrong path (/dev/zero, a big
     // file) cannot make us read without end.
     std::string text(64, '\0');
-    in.read(text.data(), static_cast<std::streamsize>(text.size()));
-    text.resize(static_cast<std::size_t>(in.gcount()));
+    const ssize_t got = ready > 0 ? ::read(fd, text.data(), text.size()) : -1;
+    const int err = ready > 0 ? errno : EAGAIN;
+    ::close(fd);
+    if (got < 0 && err == EAGAIN) {
+        return makeError(ErrorCode::DeviceFailure,
+                         fmt::format("{}: no answer within {} ms (a sysfs attribute answers at "
+                                     "once: is it a FIFO or a device?)",
+                                     file.string(), kSysfsWaitMs));
+    }
+    if (got < 0) {
+        return makeError(ErrorCode::DeviceFailure,
+                         fmt::format("{}: cannot be read ({})", file.string(), std::strerror(err)));
+    }
+    text.resize(static_cast<std::size_t>(got));
     if (const auto nl = text.find('\n'); nl != std::string::npos) {
         text.resize(nl);
     }
+    return text;
+}
+
+Expected<double> readSysfsNumber(const fs::path& file)
+{
+    auto read = readSysfsText(file);
+    if (!read) {
+        return tl::unexpected(read.error());
+    }
+    std::string& text = *read;
     while (!text.empty() && (text.back() == '\n' || text.back() == ' ' || text.back() == '\r')) {
         text.pop_back();
     }
@@ -77,8 +112,9 @@ Expected<IioAccelDevice> IioAccelDevice::open(const fs::path& dir)
 {
     IioAccelDevice d;
     d.dir_ = dir;
-    std::ifstream nameFile(dir / "name");
-    std::getline(nameFile, d.name_);
+    if (auto name = readSysfsText(dir / "name")) {
+        d.name_ = std::move(*name);
+    }
     for (int i = 0; i < 3; ++i) {
         std::error_code ec;
         if (!fs::exists(dir / fmt::format("in_accel_{}_raw", kAxes[i]), ec)) {
@@ -378,7 +414,8 @@ private:
     }
 
     // The sample of one reading, or none for a reading that is not finite (a raw "nan" or "inf",
-    // or a product that overflows): counted and logged at most once per logIntervalNs.
+    // or a product that overflows) or out of range (kMinGravityMs2..kMaxGravityMs2): each kind
+    // counted and logged at most once per logIntervalNs.
     std::optional<AccelSample>
     sample(const IioAccelDevice& dev, const std::array<double, 3>& reading, std::int64_t nowNs)
     {
@@ -402,7 +439,20 @@ private:
                            fmt::join(dev.offset(), ","), nonFinite_.total(),
                            static_cast<double>(options_.logIntervalNs) * 1e-9);
         }
-        if (!finite) {
+        const double g = finite ? glm::length(s.gravity) : 0.0;
+        const bool inRange = !finite || (g >= kMinGravityMs2 && g <= kMaxGravityMs2);
+        if (const auto n = outOfRange_.add(inRange ? 0 : 1, nowNs); n > 0) {
+            deviceLog("hal.accel")
+                    ->warn("'{}' at {}: {} reading{} out of range (the last: {:.4g} m/s^2 from raw "
+                           "{} scale {} offset {}; a panel reads 9.81, {:.4g}..{:.4g} is used), {} "
+                           "in all: not used, the display keeps its last tilt (at most one line "
+                           "per {:g} s)",
+                           dev.name(), dev.dir().string(), n, n == 1 ? "" : "s", g,
+                           fmt::join(reading, ","), fmt::join(dev.scale(), ","),
+                           fmt::join(dev.offset(), ","), kMinGravityMs2, kMaxGravityMs2,
+                           outOfRange_.total(), static_cast<double>(options_.logIntervalNs) * 1e-9);
+        }
+        if (!finite || !inRange) {
             return std::nullopt;
         }
         s.raw = std::move(raw);
@@ -419,6 +469,7 @@ private:
     std::string lastLogged_; // the last error logged: a repeated one is not logged again
     bool announced_ = false;
     LogLimiter nonFinite_{options_.logIntervalNs};
+    LogLimiter outOfRange_{options_.logIntervalNs};
     LiveQueue<AccelSample> queue_{1024};
     std::thread thread_;
 };

@@ -48,8 +48,19 @@ private:
     std::array<double, 3> offset_{};
 };
 
+// One sysfs attribute's text (at most 64 bytes, up to its first newline), opened without waiting
+// and read within kSysfsWaitMs: a FIFO, a device or a file that never answers in its place is an
+// error, never a read that holds the source's thread (and SIGTERM) without end.
+constexpr int kSysfsWaitMs = 200;
+Expected<std::string> readSysfsText(const std::filesystem::path& file);
 // Parses one sysfs attribute: a single C-locale number and a newline.
 Expected<double> readSysfsNumber(const std::filesystem::path& file);
+
+// A reading is used when its magnitude lies within these (m/s^2): a panel on its stand reads 1 g
+// (9.81); below 0.25 g the tilt is undefined (a sensor stuck at zero, free fall), above 4 g it is
+// a knock or a wrong scale. Outside, it is counted and logged like a reading that is not finite.
+constexpr double kMinGravityMs2 = 0.25 * 9.80665;
+constexpr double kMaxGravityMs2 = 4.0 * 9.80665;
 
 // How the sensor is mounted on the panel: for each panel axis (x right, y up the panel, z out of
 // the screen), which sensor axis and sign, e.g. "x,y,z" (aligned) or "-y,x,z".
@@ -79,13 +90,15 @@ struct IioAccelSourceOptions {
     // The scale and offset are read again this often (a driver's range change alters them while
     // the device stays open): three small sysfs reads a second against 300 for the values.
     std::int64_t attributesNs = 1'000'000'000;
-    // Readings that are not finite are counted and logged at most once per this long.
+    // Readings that are not finite or out of range are counted and logged at most once per this
+    // long.
     std::int64_t logIntervalNs = 10'000'000'000;
 };
 
 // Live source: reads the device at a fixed period on its own thread; if it disappears, reports
 // Lost and looks for it again every second. Follows changes of the scale and offset; a reading
-// that is not finite is counted, logged at a bounded rate and not used.
+// that is not finite or out of range (kMinGravityMs2..kMaxGravityMs2) is counted, logged at a
+// bounded rate and not used.
 std::unique_ptr<AccelSource> makeIioAccelSource(const Clock& clock, IioAccelSourceOptions options);
 
 } // namespace replica::hal::accel

@@ -36,6 +36,10 @@ constexpr std::uintmax_t kMaxTomlBytes = 1u << 20;
 // Images (EXR, PNG): file size, and pixels per side checked from the header before allocating.
 constexpr std::uintmax_t kMaxImageBytes = 1024u << 20;
 constexpr int kMaxImageSide = 16384;
+// Pixels of one EXR in all (a few hundred bytes of header can declare 16384 x 16384, a GiB per
+// float channel): 4096 x 4096, the largest booth 'booth build' makes; the shipped ones hold at most
+// 110,592.
+constexpr std::int64_t kMaxExrPixels = std::int64_t{4096} * 4096;
 
 namespace input_file_detail {
 

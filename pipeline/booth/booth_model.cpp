@@ -1,5 +1,4 @@
 // booth.json reading and writing; nlohmann exceptions are caught here and become Error values.
-#include <fstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -7,6 +6,7 @@
 #include <pipeline/base/input_file.h>
 #include <pipeline/base/json_file.h>
 #include <pipeline/base/json_schema.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
 
@@ -197,12 +197,7 @@ Expected<void> saveBooth(const std::filesystem::path& dir, const Booth& booth)
             return ok;
         }
     }
-    std::ofstream out(dir / "booth.json");
-    out << j.dump(2) << "\n";
-    if (!out) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot write booth.json", dir.string()));
-    }
-    return {};
+    return writeOutputFile(dir / "booth.json", j.dump(2) + "\n", "booth model");
 }
 
 } // namespace replica::pipeline::booth

@@ -1,9 +1,9 @@
 // Channel bases and the per-light channel-to-XYZ matrix.
 #include <algorithm>
-#include <fstream>
 
 #include <fmt/format.h>
 
+#include <pipeline/base/output_file.h>
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/colour/spectral_table.h>
 
@@ -96,14 +96,7 @@ Expected<void> saveChannelBasis(const ChannelBasis& basis,
         }
         text += "\n";
     }
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out) {
-        return makeError(ErrorCode::Io,
-                         fmt::format("{}: cannot write the channel basis (is the folder writable?)",
-                                     path.string()));
-    }
-    return {};
+    return writeOutputFile(path, text, "channel basis");
 }
 
 Expected<ChannelBasis> loadDefaultChannelBasis(const std::filesystem::path& dataDir)

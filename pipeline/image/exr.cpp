@@ -1,7 +1,9 @@
 // OpenEXR wrappers: exceptions from the library stop here and become Error values.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
+#include <stdexcept>
 
 #include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
@@ -29,20 +31,52 @@ const std::vector<float>* ChannelImage::plane(const std::string& name) const
     return nullptr;
 }
 
+namespace {
+
+// The bytes the bounded reader read, as OpenEXR's input: OpenEXR never opens the file by name
+// itself (a name checked and then opened again could be a FIFO by then).
+class MemoryIStream final : public Imf::IStream
+{
+public:
+    MemoryIStream(const std::string& name, const std::string& bytes)
+        : Imf::IStream(name.c_str()), bytes_(bytes)
+    {}
+    bool read(char c[], int n) override
+    {
+        if (n < 0 || pos_ > bytes_.size() || static_cast<std::size_t>(n) > bytes_.size() - pos_) {
+            throw std::runtime_error("unexpected end of file");
+        }
+        std::memcpy(c, bytes_.data() + pos_, static_cast<std::size_t>(n));
+        pos_ += static_cast<std::size_t>(n);
+        return pos_ < bytes_.size();
+    }
+    std::uint64_t tellg() override { return pos_; }
+    void seekg(std::uint64_t pos) override { pos_ = static_cast<std::size_t>(pos); }
+    void clear() override {}
+
+private:
+    const std::string& bytes_;
+    std::size_t pos_ = 0;
+};
+
+} // namespace
+
 Expected<ChannelImage> readExr(const std::filesystem::path& path,
                                const std::vector<std::string>& names)
 {
-    // A regular file of bounded size (not a directory, FIFO or symlink loop), then a bounded
-    // data window, before anything is allocated.
-    if (auto ok = checkInputFile(path, kMaxImageBytes, "OpenEXR"); !ok) {
-        if (ok.error().code == ErrorCode::NotFound) {
+    // Read by the bounded reader (a regular file of bounded size: not a directory, FIFO, device
+    // or symlink loop), then a bounded data window, before anything is allocated.
+    auto bytes = readInputFile(path, kMaxImageBytes, "OpenEXR");
+    if (!bytes) {
+        if (bytes.error().code == ErrorCode::NotFound) {
             return makeError(ErrorCode::NotFound, fmt::format("{}: no such file", path.string()));
         }
-        return tl::unexpected(ok.error());
+        return tl::unexpected(bytes.error());
     }
     ChannelImage img;
     try {
-        Imf::InputFile file(path.c_str());
+        MemoryIStream stream(path.string(), *bytes);
+        Imf::InputFile file(stream);
         const Imath::Box2i dw = file.header().dataWindow();
         const std::int64_t w = std::int64_t{dw.max.x} - dw.min.x + 1;
         const std::int64_t h = std::int64_t{dw.max.y} - dw.min.y + 1;
@@ -50,10 +84,11 @@ Expected<ChannelImage> readExr(const std::filesystem::path& path,
             return makeError(ErrorCode::Corrupt,
                              fmt::format("{}: empty data window", path.string()));
         }
-        if (w > kMaxImageSide || h > kMaxImageSide) {
+        if (w > kMaxImageSide || h > kMaxImageSide || w * h > kMaxExrPixels) {
             return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("{}: {}x{} pixels; at most {} per side are read",
-                                         path.string(), w, h, kMaxImageSide));
+                             fmt::format("{}: {}x{} pixels; at most {} per side and {} in all are "
+                                         "read",
+                                         path.string(), w, h, kMaxImageSide, kMaxExrPixels));
         }
         img.width = static_cast<int>(w);
         img.height = static_cast<int>(h);

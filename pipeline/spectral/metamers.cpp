@@ -1,12 +1,12 @@
 // Metamer pairs in the null space of a light's channel matrix.
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
 
+#include <pipeline/base/output_file.h>
 #include <pipeline/colour/ciede2000.h>
 #include <pipeline/colour/cielab.h>
 #include <pipeline/spectral/dense_matrix.h>
@@ -219,15 +219,11 @@ Expected<void> saveMetamerPairs(const std::vector<MetamerPair>& pairs,
         }
         text += "\n";
     }
-    std::error_code ec;
-    std::filesystem::create_directories(path.parent_path(), ec);
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out) {
-        return makeError(ErrorCode::Io,
-                         fmt::format("{}: cannot write the metamer pairs", path.string()));
+    if (path.has_parent_path()) {
+        std::error_code ec;
+        std::filesystem::create_directories(path.parent_path(), ec);
     }
-    return {};
+    return writeOutputFile(path, text, "metamer pairs");
 }
 
 } // namespace replica::pipeline::spectral

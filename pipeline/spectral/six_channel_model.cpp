@@ -1,10 +1,11 @@
 // Fitting, applying and storing the paper's six-channel representation.
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include <pipeline/base/input_file.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/csv/csv_cells.h>
 #include <pipeline/spectral/dense_matrix.h>
@@ -360,13 +361,19 @@ Expected<SixChannelModel> loadSixChannelModel(const std::filesystem::path& csvPa
         model.reflectProject[k] = *r;
     }
     const auto xyzPath = toXyzPath(csvPath);
-    std::ifstream file(xyzPath);
-    if (!file) {
+    // Through the bounded reader: a regular file of at most kMaxCsvBytes (a FIFO, /dev/zero or a
+    // directory in its place is refused in one line).
+    auto xyzText = readInputFile(xyzPath, kMaxCsvBytes, "six-channel [6 x 3] matrix");
+    if (!xyzText) {
+        if (xyzText.error().code != ErrorCode::NotFound) {
+            return tl::unexpected(xyzText.error());
+        }
         return makeError(
                 ErrorCode::NotFound,
                 fmt::format("{}: cannot open the six-channel [6 x 3] matrix (it belongs beside {})",
                             xyzPath.string(), csvPath.filename().string()));
     }
+    std::istringstream file(*xyzText);
     std::string line;
     int lineNo = 0;
     std::size_t rows = 0;
@@ -450,12 +457,8 @@ Expected<void> saveSixChannelModel(const SixChannelModel& model,
     }
     for (const auto& [path, body] :
          {std::pair{csvPath, text}, std::pair{toXyzPath(csvPath), xyz}}) {
-        std::ofstream out(path, std::ios::binary | std::ios::trunc);
-        out << body;
-        if (!out) {
-            return makeError(
-                    ErrorCode::Io,
-                    fmt::format("{}: cannot write (is the folder writable?)", path.string()));
+        if (auto ok = writeOutputFile(path, body, "six-channel model"); !ok) {
+            return ok;
         }
     }
     return {};

@@ -1,12 +1,12 @@
 // Scene folder reading and writing with checks that name the file and the field or texel.
 #include <cmath>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/json_file.h>
 #include <pipeline/base/json_schema.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/image/exr.h>
 #include <pipeline/surface/scene.h>
 
@@ -261,10 +261,8 @@ Expected<void> saveScene(const std::filesystem::path& dir, const SurfaceScene& s
     j["ward"] = {{"alpha", s.alpha},
                  {"rho_s", std::vector<double>(s.rhoS.v.begin(), s.rhoS.v.end())},
                  {"model", brdf::wardModelName(s.model)}};
-    std::ofstream out(dir / "scene.json");
-    out << j.dump(1) << "\n";
-    if (!out) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot write scene.json", dir.string()));
+    if (auto ok = writeOutputFile(dir / "scene.json", j.dump(1) + "\n", "scene manifest"); !ok) {
+        return ok;
     }
     const std::size_t n = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
     image::ChannelImage mat;

@@ -3,7 +3,6 @@
 // result is checked (residual, degenerate points) and written into the site TOML file.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <vector>
@@ -13,6 +12,7 @@
 
 #include <hal/accel/iio_accel.h>
 #include <pipeline/base/data_dir.h>
+#include <pipeline/base/input_file.h>
 #include <pipeline/colour/xyz.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/spectral/direct_level.h>
@@ -119,10 +119,16 @@ readingsFrom(const std::string& file, std::size_t columns, const char* what)
         fmt::print(stderr, "Type the {}, one per line.\n", what);
         return readRows(std::cin, "stdin", columns, true);
     }
-    std::ifstream in(file);
-    if (!in) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot read it", file));
+    // The bounded reader: a regular file of at most kMaxCsvBytes and a table within its limits (a
+    // FIFO, /dev/zero or a directory is refused in one line, never a hang or bad_alloc).
+    auto text = readInputFile(file, kMaxCsvBytes, "calibration points");
+    if (!text) {
+        return tl::unexpected(text.error());
     }
+    if (auto ok = checkTableLimits(*text, file, ','); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    std::istringstream in(*text);
     return readRows(in, file, columns, false);
 }
 

@@ -4,11 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <random>
-#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -16,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <pipeline/base/input_file.h>
 #include <pipeline/base/output_file.h>
 #include <pipeline/display/cgats.h>
 #include <platform/cli/commands.h>
@@ -193,14 +192,13 @@ struct PatchSession {
 std::optional<PatchSession> loadSession(const PatchesOptions& o)
 {
     auto log = logger("replica");
-    std::ifstream sf(o.set, std::ios::binary);
-    if (!sf) {
-        log->error("{}: cannot open the patch set", o.set);
+    // The bounded reader: a FIFO, /dev/zero or a directory is refused in one line.
+    auto text = readInputFile(o.set, kMaxCsvBytes, "patch set (.ti1)");
+    if (!text) {
+        log->error("{}", text.error().message);
         return std::nullopt;
     }
-    std::ostringstream ss;
-    ss << sf.rdbuf();
-    auto set = pd::parseTi1(ss.str(), o.set, o.bits);
+    auto set = pd::parseTi1(*text, o.set, o.bits);
     if (!set) {
         log->error("{}", set.error().message);
         return std::nullopt;

@@ -1,7 +1,6 @@
 // The one resolution of a run's options and site file (run_resolve.h).
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <numbers>
 
@@ -14,6 +13,7 @@
 #include <hal/lamp/gpio_lines.h>
 #include <pipeline/base/data_dir.h>
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/json_limits.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/scene/booth.h>
 #include <pipeline/surface/scene.h>
@@ -152,10 +152,13 @@ bool syntheticDisplay(const RunConfig& config)
     if (config.display == kUncalibratedDisplay) {
         return true;
     }
-    std::ifstream in(dataPath(config.display));
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The bounded reader (a FIFO here hung the start before checkLoadable could refuse it).
+    auto text = readInputFile(dataPath(config.display), kMaxJsonBytes, "display profile");
+    if (!text || !checkJsonLimits(*text, config.display)) {
+        return false; // checkLoadable reports an unreadable profile
+    }
     try {
-        const auto j = nlohmann::json::parse(text);
+        const auto j = nlohmann::json::parse(*text);
         return j.value("description", std::string()).find("SYNTHETIC") != std::string::npos;
     } catch (const std::exception&) {
         return false; // checkLoadable reports an unreadable profile

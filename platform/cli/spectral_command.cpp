@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -18,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/base/output_file.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
@@ -328,7 +328,7 @@ Expected<void> checkOutDir(const std::filesystem::path& outDir)
                                      outDir.string(), ec ? ec.message() : "not a folder"));
     }
     const std::filesystem::path probe = outDir / ".replica-spectral-fit-write-test";
-    const bool writable = static_cast<bool>(std::ofstream(probe));
+    const bool writable = static_cast<bool>(writeOutputFile(probe, "", "write test"));
     std::filesystem::remove(probe, ec);
     if (!writable) {
         return makeError(ErrorCode::InvalidArgument,

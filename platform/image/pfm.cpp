@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/output_file.h>
 #include <platform/image/pfm.h>
 
 namespace replica::platform {
@@ -21,26 +22,19 @@ Expected<void> writePfm(const std::filesystem::path& path, const FloatImage& ima
                          fmt::format("{}: no image to write ({}x{}, {} values)", path.string(),
                                      image.width, image.height, image.rgba.size()));
     }
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) {
-        return makeError(ErrorCode::Io, fmt::format("{}: cannot create file", path.string()));
-    }
     // Negative scale: little-endian floats (this writer only runs on little-endian machines).
     static_assert(std::endian::native == std::endian::little);
-    out << "PF\n" << image.width << ' ' << image.height << "\n-1.0\n";
-    std::vector<float> rgb(pixels * 3);
+    std::string bytes = fmt::format("PF\n{} {}\n-1.0\n", image.width, image.height);
+    const std::size_t header = bytes.size();
+    bytes.resize(header + pixels * 3 * sizeof(float));
+    char* raster = bytes.data() + header;
     for (std::size_t p = 0; p < pixels; ++p) {
         for (std::size_t c = 0; c < 3; ++c) {
-            rgb[p * 3 + c] = image.rgba[p * 4 + c];
+            std::memcpy(raster + (p * 3 + c) * sizeof(float), &image.rgba[p * 4 + c],
+                        sizeof(float));
         }
     }
-    out.write(reinterpret_cast<const char*>(rgb.data()),
-              static_cast<std::streamsize>(rgb.size() * sizeof(float)));
-    if (!out) {
-        return makeError(ErrorCode::Io,
-                         fmt::format("{}: write failed (disk full?)", path.string()));
-    }
-    return {};
+    return writeOutputFile(path, bytes, "PFM image");
 }
 
 Expected<FloatImage> readPfm(const std::filesystem::path& path)

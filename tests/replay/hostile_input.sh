@@ -345,12 +345,12 @@ mkdir -p "$out_dir"
 writes() {
     local label="$1" ext="$2"
     shift 2
-    echo "precious" > "$out_dir/target.$ext"
+    echo "# precious" > "$out_dir/target.$ext" # a valid site file too
     ln -sfn "$out_dir/target.$ext" "$out_dir/link.$ext"
     [ -e "$out_dir/fifo.$ext" ] || mkfifo "$out_dir/fifo.$ext"
     mkdir -p "$out_dir/adir.$ext"
     expect 1 "link.$ext: is a symbolic link; the .* never through a link" -- "${R[@]}" "$@" "$out_dir/link.$ext"
-    [ "$(cat "$out_dir/target.$ext")" = precious ] || fail "$label wrote through a symbolic link"
+    [ "$(cat "$out_dir/target.$ext")" = "# precious" ] || fail "$label wrote through a symbolic link"
     # display fit checks its outputs before fitting ("not a regular file"); the rest when writing.
     expect 1 "fifo.$ext: (is a FIFO, not a .* file|not a regular file)" -- "${R[@]}" "$@" "$out_dir/fifo.$ext"
     expect 1 "adir.$ext: (is a directory, not a .* file|not a regular file)" -- "${R[@]}" "$@" "$out_dir/adir.$ext"
@@ -376,7 +376,89 @@ writes "render --out" exr render --scene "$data/scenes/metamer" --light d65 --ou
 writes "display fit --out" json display fit "$out_dir/m.csv" --out
 writes "display fit --icc" icc display fit "$out_dir/m.csv" --out "$out_dir/p.json" --icc
 writes "display synth --out" csv display synth --out
+# Tracker points that fit exactly (booth = tracker), for the site file's rewrite.
+printf '%s\n' 0,0.4,0.5,0,0.4,0.5 0.2,0.4,0.5,0.2,0.4,0.5 0,0.6,0.5,0,0.6,0.5 0,0.4,0.7,0,0.4,0.7 \
+    0.2,0.6,0.7,0.2,0.6,0.7 -0.1,0.5,0.6,-0.1,0.5,0.6 > "$out_dir/points.csv"
+writes "calibrate tracker --site" toml calibrate tracker --points "$out_dir/points.csv" --site
+writes "spectral metamers --out" csv spectral metamers --count 1 --out
+# writes_into LABEL FILE ARGS...: the command writes FILE into the folder appended to ARGS; FILE
+# there a link, a FIFO and a directory in turn, then the folder on the full disk (no file left).
+writes_into() {
+    local label="$1" file="$2"
+    shift 2
+    local d="$out_dir/into-$label"
+    rm -rf "$d" && mkdir -p "$d"
+    echo "# precious" > "$out_dir/target-$file"
+    ln -sfn "$out_dir/target-$file" "$d/$file"
+    expect 1 "$file: is a symbolic link; the .* never through a link" -- "${R[@]}" "$@" "$d"
+    [ "$(cat "$out_dir/target-$file")" = "# precious" ] || fail "$label wrote through a symbolic link"
+    rm -f "$d/$file" && mkfifo "$d/$file"
+    expect 1 "$file: is a FIFO, not a .* file" -- "${R[@]}" "$@" "$d"
+    rm -f "$d/$file" && mkdir "$d/$file"
+    expect 1 "$file: is a directory, not a .* file" -- "${R[@]}" "$@" "$d"
+    if [ -n "${full:-}" ]; then
+        expect 1 "full/$label/.*: writing the .* failed: No space left on device; nothing written" -- \
+            "${R[@]}" "$@" "$full/$label"
+        [ -z "$(find "$full/$label" -type f 2>/dev/null)" ] || fail "$label left a file on a full disk"
+    fi
+}
+writes_into booth-generate booth.json booth generate --out
+writes_into scene-generate scene.json scene generate --kind metamer --out
 if [ -n "$full" ]; then umount "$full"; fi
+
+# --- Every file a command reads goes through the bounded reader (pipeline/base/input_file.h): a
+# FIFO (never a hang: expect runs each command under timeout), /dev/zero (a link to it, named as
+# the command wants) and a directory are each refused in one line naming the file. Before, the
+# points, the .ti1, the live display profile and an EXR opened by name hung on a FIFO.
+in_dir="$work/inputs"
+mkdir -p "$in_dir"
+# reads CODE WHAT EXT ARGS...: the command with "@" in ARGS replaced by each bad file, named
+# *.EXT; exit CODE (calibrate says a bad points file is a usage error, 2, as it always has).
+reads() {
+    local code="$1" what="$2" ext="$3"
+    shift 3
+    [ -e "$in_dir/fifo.$ext" ] || mkfifo "$in_dir/fifo.$ext"
+    ln -sfn /dev/zero "$in_dir/zero.$ext"
+    mkdir -p "$in_dir/adir.$ext"
+    local bad a args
+    for bad in fifo zero adir; do
+        args=()
+        for a in "$@"; do args+=("${a//@/$in_dir/$bad.$ext}"); done
+        expect "$code" "$bad.$ext: is (a FIFO|a device|a directory), not a $what file" -- "${R[@]}" "${args[@]}"
+    done
+}
+reads 2 "calibration points" csv calibrate tracker --points @ --dry-run
+reads 1 "patch set \(\.ti1\)" ti1 display patches @ --out "$in_dir/r.ti3" --show-dir "$in_dir/show"
+reads 1 "measurement" ti3 display fit @ --out "$in_dir/p.json"
+reads 1 "display profile" json run --hal sim --output headless --size 48x30 --frames 1 --fast --display-profile @
+reads 1 "site" toml config check @
+# An EXR of the booth, and the booth's JSON, replaced.
+for bad in fifo zero adir; do
+    rm -rf "$in_dir/booth-$bad" && cp -r "$data/booth" "$in_dir/booth-$bad"
+    exr=$(cd "$in_dir/booth-$bad" && ls ./*.exr | head -1)
+    exr=${exr#./}
+    rm -f "$in_dir/booth-$bad/$exr"
+    case $bad in
+        fifo) mkfifo "$in_dir/booth-$bad/$exr" ;;
+        zero) ln -s /dev/zero "$in_dir/booth-$bad/$exr" ;;
+        adir) mkdir "$in_dir/booth-$bad/$exr" ;;
+    esac
+    expect 1 "$exr: is (a FIFO|a device|a directory), not a OpenEXR file" -- "${R[@]}" render \
+        --booth "$in_dir/booth-$bad" --scene "$data/scenes/metamer" --light d65 --out "$in_dir/x.exr"
+done
+# An EXR that declares 16384 x 16384 pixels in a few hundred bytes is refused before allocating.
+python3 - "$data/booth" "$in_dir/booth-huge" <<'PY'
+import glob, os, shutil, struct, sys
+shutil.copytree(sys.argv[1], sys.argv[2], dirs_exist_ok=True)
+f = sorted(glob.glob(os.path.join(sys.argv[2], "*.exr")))[0]
+b = bytearray(open(f, "rb").read())
+key = b"dataWindow\x00box2i\x00"
+i = b.index(key) + len(key) + 4
+b[i:i + 16] = struct.pack("<4i", 0, 0, 16383, 16383)
+open(f, "wb").write(bytes(b))
+PY
+expect 1 "16384x16384 pixels; at most 16384 per side and 16777216 in all" -- "${R[@]}" render \
+    --booth "$in_dir/booth-huge" --scene "$data/scenes/metamer" --light d65 --out "$in_dir/x.exr"
 
 # replay shows a recording's text with its control characters escaped, as inspect does.
 out=$("$replica" --log-level info replay "$rec/escapes.mcap" 2>&1)

@@ -9,6 +9,7 @@
 
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
 
 #include <hal/accel/iio_accel.h>
 
@@ -264,6 +265,70 @@ TEST_F(FakeIio, NonFiniteReadingsAreCountedAndLoggedAtABoundedRate)
     EXPECT_NE(text.find("1 reading not finite (the last: raw -12,nan,40"), std::string::npos)
             << text;
     EXPECT_NE(text.find(" readings not finite"), std::string::npos) << "no count > 1: " << text;
+}
+
+// A reading out of range (a sensor stuck at zero: 0.04 g; a knock or a wrong scale: 10 g) is
+// counted and logged at a bounded rate like a NaN, and not used. Before, it reached the estimator.
+TEST_F(FakeIio, OutOfRangeReadingsAreCountedAndLoggedAtABoundedRate)
+{
+    for (const std::string y : {"0", "10000"}) { // |g| 0.41 and 98 m/s^2
+        std::ostringstream captured;
+        auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(captured);
+        spdlog::drop("hal.accel");
+        spdlog::register_logger(std::make_shared<spdlog::logger>("hal.accel", sink));
+        write("iio:device1/in_accel_y_raw", y);
+        hal::SteadyClock clock;
+        hal::accel::IioAccelSourceOptions opt;
+        opt.root = root_;
+        opt.periodNs = 1'000'000;        // 1 kHz: ~300 readings below
+        opt.logIntervalNs = 100'000'000; // a line per 100 ms at most
+        auto src = hal::accel::makeIioAccelSource(clock, opt);
+        std::this_thread::sleep_for(std::chrono::milliseconds(350));
+        std::vector<hal::AccelSample> got;
+        src->poll(clock.nowNs(), got);
+        EXPECT_TRUE(got.empty()) << "an out-of-range reading was used: y raw " << y;
+        write("iio:device1/in_accel_y_raw", "1000");
+        ASSERT_TRUE(eventually([&] {
+            src->poll(clock.nowNs(), got);
+            return got.size() >= 2;
+        }));
+        EXPECT_DOUBLE_EQ(got.back().gravity.y, -1000 * 0.00980665);
+        src.reset();
+        spdlog::drop("hal.accel");
+        const std::string text = captured.str();
+        const auto lines = std::count(text.begin(), text.end(), '\n');
+        EXPECT_GE(lines, 3) << text;
+        EXPECT_LE(lines, 6) << text;
+        EXPECT_NE(text.find("1 reading out of range (the last: "), std::string::npos) << text;
+        EXPECT_NE(text.find("raw -12," + y + ",40"), std::string::npos) << text;
+        EXPECT_NE(text.find(" readings out of range"), std::string::npos) << "no count: " << text;
+    }
+}
+
+// A FIFO in place of a value file (or a device that never answers) does not hold the source's
+// thread: the read gives up after kSysfsWaitMs, the device is Lost and the source stops promptly.
+// Before, the open waited for a writer without end and held SIGTERM with it.
+TEST_F(FakeIio, AFifoValueFileNeverBlocks)
+{
+    fs::remove(dev_ / "in_accel_y_raw");
+    ASSERT_EQ(::mkfifo((dev_ / "in_accel_y_raw").c_str(), 0600), 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto v = hal::accel::readSysfsNumber(dev_ / "in_accel_y_raw");
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+    ASSERT_FALSE(v);
+    EXPECT_NE(v.error().message.find("no answer within"), std::string::npos) << v.error().message;
+    hal::SteadyClock clock;
+    hal::accel::IioAccelSourceOptions opt;
+    opt.root = root_;
+    opt.periodNs = 1'000'000;
+    opt.reconnectNs = 20'000'000;
+    auto src = hal::accel::makeIioAccelSource(clock, opt);
+    ASSERT_TRUE(eventually([&] { return src->state() == hal::LinkState::Lost; }));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_EQ(src->state(), hal::LinkState::Lost);
+    const auto t1 = std::chrono::steady_clock::now();
+    src.reset();
+    EXPECT_LT(std::chrono::steady_clock::now() - t1, std::chrono::seconds(5));
 }
 
 TEST(AxisMapping, ParsesSignedPermutationsAndRejectsTheRest)

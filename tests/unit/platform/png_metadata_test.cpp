@@ -21,7 +21,9 @@
 
 #include <gtest/gtest.h>
 
-namespace replica::platform {
+namespace replica::platform::png_metadata_tests {
+// A namespace of its own: in a unity batch beside wall_clock_time_test.cpp, whose kS and k143205Z
+// are the same names.
 namespace {
 
 constexpr std::int64_t kPngSecondNs = 1'000'000'000;
@@ -273,4 +275,4 @@ TEST(PngMetadata, Keywords)
 }
 
 } // namespace
-} // namespace replica::platform
+} // namespace replica::platform::png_metadata_tests
