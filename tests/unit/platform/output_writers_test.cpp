@@ -23,6 +23,8 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/files.h"
+
 namespace replica::tests {
 namespace {
 namespace fs = std::filesystem;
@@ -70,14 +72,6 @@ std::vector<Writer> writers()
                  return pipeline::spectral::saveSixChannelModel({}, p, "a test");
              }},
     };
-}
-
-std::string slurp(const fs::path& p)
-{
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
 }
 
 class OutputWriters : public ::testing::Test

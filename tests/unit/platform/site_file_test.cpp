@@ -11,18 +11,12 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/files.h"
+
 namespace replica::tests {
 namespace {
 
 using namespace platform;
-
-std::string slurp(const std::filesystem::path& p)
-{
-    std::ifstream in(p);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 class CalibrationSiteFile : public ::testing::Test
 {
