@@ -120,8 +120,8 @@ candidateErrors(const Candidate& cand, const FitData& data, const std::vector<Me
 namespace {
 
 // The direction of a primary from every ramp reading above a fifth of its full drive (the sum of
-// the readings above black), scaled to the full-drive reading's length along it: one reading's
-// noise no longer sets the primary's chromaticity.
+// the readings above black), scaled to the full-drive reading's length along it, so that no one
+// reading's noise sets the primary's chromaticity.
 glm::dvec3 rampPrimary(const std::vector<RampPoint>& ramp, const glm::dvec3& black)
 {
     const glm::dvec3 full = ramp.back().xyz - black;
