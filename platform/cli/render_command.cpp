@@ -18,7 +18,7 @@
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 #include <pipeline/tuning/planner.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
