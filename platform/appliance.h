@@ -68,7 +68,7 @@ struct RunConfig {
     double rateHz = 60.0;
     std::string booth = "replica-booth-1";
     std::string scene = "colorchecker";
-    // A recording drawn by the flat renderer, which this build no longer has (its "renderer" is
+    // A recording drawn by the flat renderer, which this build does not have (its "renderer" is
     // "flat", or it has no such key: it was made before the booth renderer). Replay draws it with
     // the booth pass like any other and compares the frames with what the recording showed, as
     // for an older render profile. A new run records "renderer": "booth".

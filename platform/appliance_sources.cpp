@@ -92,14 +92,14 @@ Sources makeReplaySources(const recordings::Recording& recording,
 {
     Sources s;
     for (const auto* kind : kinds) {
-        const auto it = recording.devices.find(kind->name());
-        const bool has = it != recording.devices.end() && it->second.has_value();
+        const auto* samples = recording.samplesOf(*kind);
         const auto& info = recording.session.device(*kind);
         // An optional device the session did not have (no model, no samples) gets no source.
         if (kind->names().optional && info.model.empty() && recording.count(*kind) == 0) {
             continue;
         }
-        s.set(*kind, kind->replaySource(info, has ? it->second : kind->emptySamples()));
+        s.set(*kind,
+              kind->replaySource(info, samples != nullptr ? *samples : kind->emptySamples()));
     }
     return s;
 }

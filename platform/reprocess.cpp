@@ -163,7 +163,7 @@ bool usableScale(const hal::RawAccelInput& raw)
 Expected<void>
 reprocessAccel(recordings::Recording& rec, const ReprocessOptions& options, ReprocessReport& report)
 {
-    const auto info = rec.session.devices.find(recordings::accelKind().name());
+    const auto info = rec.session.devices.find(&recordings::accelKind());
     const std::string device =
             info != rec.session.devices.end()
                     ? fmt::format("'{} {}'", info->second.model, info->second.serial)

@@ -85,7 +85,7 @@ const JsonSchema& runConfigSchema()
                 {"display", name},
                 {"display_peak_cd_m2", number(0.0, 1e5)},
                 {"display_black_cd_m2", number(0.0, 1e5)},
-                // Added later: absent in older recordings, which replay with the old behaviour.
+                // Optional keys: a recording without one replays with the key's default.
                 // "renderer": "booth", or "flat" (absent: made before the booth renderer), which
                 // replays on the booth pass, approximately.
                 {"renderer", name.optional()},

@@ -3,11 +3,6 @@
 #include <recordings/codec_json.h>
 
 namespace replica::recordings {
-namespace {
-
-using RawAccelReaderState = std::map<std::uint32_t, std::shared_ptr<const hal::RawAccelInput>>;
-
-} // namespace
 
 std::optional<std::string> encodeAccel(const hal::AccelSample& s)
 {
@@ -76,8 +71,8 @@ SampleCodec<hal::AccelSample> accelCodec()
     SampleCodec<hal::AccelSample> c;
     c.encode = encodeAccel;
     c.decode = decodeAccel;
-    c.encodeRaw = [](const hal::AccelSample& a, std::uint16_t channel, std::any&,
-                     const DeviceEmitter& emit) {
+    c.encodeRaw = [](const hal::AccelSample& a, std::uint16_t channel,
+                     RawCodecState<hal::AccelSample>::Writer&, const DeviceEmitter& emit) {
         if (!a.raw) {
             return;
         }
@@ -87,13 +82,14 @@ SampleCodec<hal::AccelSample> accelCodec()
             emit.rejectRaw();
         }
     };
-    c.decodeRaw = [](const json& j, std::any& state) {
+    c.decodeRaw = [](const json& j, RawCodecState<hal::AccelSample>::Reader& st) {
         auto [seq, raw] = decodeRawAccel(j);
-        stateOf<RawAccelReaderState>(state)[seq] = std::move(raw);
+        st.raw[seq] = std::move(raw);
         return true;
     };
-    c.attachRaw = [](std::vector<hal::AccelSample>& samples, std::any& state) {
-        return attachRawBySequence(samples, stateOf<RawAccelReaderState>(state));
+    c.attachRaw = [](std::vector<hal::AccelSample>& samples,
+                     RawCodecState<hal::AccelSample>::Reader& st) {
+        return attachRawBySequence(samples, st.raw);
     };
     c.hasRaw = [](const hal::AccelSample& a) { return a.raw != nullptr; };
     return c;

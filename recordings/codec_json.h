@@ -1,9 +1,8 @@
-// What the codecs of recordings/sample_codec.h share: JSON helpers, the raw channels' reader
-// state, and the channels of what was shown (format 4, shown_codec.cpp). Not for use outside
-// recordings/.
+// What the codecs of recordings/sample_codec.h share: JSON helpers, attaching raw inputs to
+// their samples, and the channels of what was shown (format 4, shown_codec.cpp). Not for use
+// outside recordings/.
 #pragma once
 
-#include <any>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -64,15 +63,6 @@ struct ChannelText {
 // The channels of what was shown (format 4): display digest, thumbnail, transforms, eye, light,
 // log.
 std::vector<ChannelText> shownChannels();
-
-template <typename State>
-State& stateOf(std::any& a)
-{
-    if (!a.has_value()) {
-        a = State{};
-    }
-    return std::any_cast<State&>(a);
-}
 
 // Gives each sample its raw input; returns how many raw inputs found no sample.
 template <typename Sample, typename Raw>

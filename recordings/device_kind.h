@@ -4,7 +4,6 @@
 // codec, and one line there (recordings/README.md, "Device kinds").
 #pragma once
 
-#include <any>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -62,10 +61,59 @@ struct DeviceEmitter {
 
 class DeviceKindBase;
 
-// A sample of one of the sample types the device kinds have, as the recorder's queue carries it.
-// A kind of another type does not compile (DeviceKind's static_assert): its type joins this list.
-using AnySample =
-        std::variant<hal::SpectrumSample, hal::PoseSample, hal::AccelSample, hal::LampSample>;
+// What a sample type's raw-channel codec (format 5) keeps: the writer from one sample to the next,
+// the reader from the first raw message until every raw input is attached to its sample. A type
+// without a raw channel keeps nothing; a type with one specializes this (below).
+template <typename Sample>
+struct RawCodecState {
+    struct Writer {
+    };
+    struct Reader {
+    };
+};
+
+// The head tracker's: the HID descriptor written last and its id (a descriptor is written once
+// per opening of the device, before its first report); the reader's descriptors by id and raw
+// inputs by pose sequence.
+template <>
+struct RawCodecState<hal::PoseSample> {
+    struct Writer {
+        std::shared_ptr<const std::vector<std::uint8_t>> lastDescriptor;
+        std::uint32_t descriptorId = 0;
+    };
+    struct Reader {
+        std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>> descriptors;
+        std::map<std::uint32_t, std::shared_ptr<const hal::RawTrackerInput>> raw;
+    };
+};
+
+// The accelerometer's: the writer keeps nothing; the reader its raw inputs by sample sequence.
+template <>
+struct RawCodecState<hal::AccelSample> {
+    struct Writer {
+    };
+    struct Reader {
+        std::map<std::uint32_t, std::shared_ptr<const hal::RawAccelInput>> raw;
+    };
+};
+
+// The sample types the device kinds have, and what is held of each as a closed set (variants):
+// one sample (the recorder's queue), a recording's samples of a kind (the reader), the raw
+// codec's state (writer and reader). A kind of another type does not compile (DeviceKind's
+// static_assert): its type joins SampleTypes.
+template <typename... Samples>
+struct SampleTypeList {
+    using Sample = std::variant<Samples...>;
+    using SampleVectors = std::variant<std::vector<Samples>...>;
+    using WriterState = std::variant<typename RawCodecState<Samples>::Writer...>;
+    using ReaderState = std::variant<typename RawCodecState<Samples>::Reader...>;
+};
+using SampleTypes =
+        SampleTypeList<hal::SpectrumSample, hal::PoseSample, hal::AccelSample, hal::LampSample>;
+using AnySample = SampleTypes::Sample;
+using AnySamples = SampleTypes::SampleVectors;
+using AnyWriterState = SampleTypes::WriterState;
+using AnyReaderState = SampleTypes::ReaderState;
 
 // What a sample of any kind is written to: the recording writer, and in tests anything else.
 class DeviceSink
@@ -97,7 +145,10 @@ public:
 
 // The one description of a device kind, its sample type erased: what the recorder, reader,
 // replay and inspect need. A sample to write travels as an AnySample holding the kind's Sample;
-// a recording's samples of a kind (the reader's side) as std::any holding std::vector<Sample>.
+// a recording's samples of a kind (the reader's side) as an AnySamples holding
+// std::vector<Sample>; the raw codec's state as an AnyWriterState / AnyReaderState holding
+// RawCodecState<Sample>'s. Each kind makes its own (emptySamples, writerState, readerState), so
+// the alternative a kind is handed is always its own.
 class DeviceKindBase
 {
 public:
@@ -113,27 +164,29 @@ public:
     // Writer thread: the sample's messages through 'emit' (its own channel, then any raw input);
     // false when the sample cannot be written (a NaN or infinite value). 'state' is the kind's
     // own, kept by the writer from sample to sample (e.g. the HID descriptor written last).
+    virtual AnyWriterState writerState() const = 0;
     virtual bool
-    encode(const AnySample& sample, std::any& state, const DeviceEmitter& emit) const = 0;
+    encode(const AnySample& sample, AnyWriterState& state, const DeviceEmitter& emit) const = 0;
 
     // Reader. decode throws nlohmann::json exceptions on a missing or mistyped field.
-    virtual std::any emptySamples() const = 0;
-    virtual std::size_t count(const std::any& samples) const = 0;
-    virtual void decode(const nlohmann::json& j, std::any& samples) const = 0;
+    virtual AnySamples emptySamples() const = 0;
+    virtual std::size_t count(const AnySamples& samples) const = 0;
+    virtual void decode(const nlohmann::json& j, AnySamples& samples) const = 0;
+    virtual AnyReaderState readerState() const = 0;
     // A raw-channel message; returns false when it names what the file does not hold (unusable).
-    virtual bool decodeRaw(const nlohmann::json& j, std::any& state) const = 0;
+    virtual bool decodeRaw(const nlohmann::json& j, AnyReaderState& state) const = 0;
     // Gives each sample its raw input; returns how many raw inputs found no sample.
-    virtual std::uint64_t attachRaw(std::any& samples, std::any& state) const = 0;
+    virtual std::uint64_t attachRaw(AnySamples& samples, AnyReaderState& state) const = 0;
     // How many samples carry a raw input (inspect).
-    virtual std::uint64_t countWithRaw(const std::any& samples) const = 0;
+    virtual std::uint64_t countWithRaw(const AnySamples& samples) const = 0;
     // Each sample's time, in the recording's order.
-    virtual std::vector<std::int64_t> times(const std::any& samples) const = 0;
+    virtual std::vector<std::int64_t> times(const AnySamples& samples) const = 0;
     // Sample i as its channel's message (JSON); nullopt when it cannot be written.
-    virtual std::optional<std::string> encodeAt(const std::any& samples, std::size_t i) const = 0;
+    virtual std::optional<std::string> encodeAt(const AnySamples& samples, std::size_t i) const = 0;
 
     // Replay: a source that returns exactly these samples.
     virtual std::unique_ptr<hal::AnySource> replaySource(const hal::DeviceInfo& recorded,
-                                                         const std::any& samples) const = 0;
+                                                         const AnySamples& samples) const = 0;
     // The loop: a slot polling 'source' (which must deliver this kind's Sample); with 'tee',
     // every polled sample is also written there (recording as a decorator on the source).
     virtual std::unique_ptr<DeviceSlot> makeSlot(hal::AnySource& source,
@@ -150,10 +203,12 @@ struct SampleCodec {
     std::function<std::optional<std::string>(const Sample&)> encode; // nullopt: not finite
     std::function<Sample(const nlohmann::json&)> decode;
     // Format 5, optional: the raw input beside the sample, on DeviceNames::rawChannel.
-    std::function<void(const Sample&, std::uint16_t channel, std::any& state, const DeviceEmitter&)>
+    using WriterState = typename RawCodecState<Sample>::Writer;
+    using ReaderState = typename RawCodecState<Sample>::Reader;
+    std::function<void(const Sample&, std::uint16_t channel, WriterState&, const DeviceEmitter&)>
             encodeRaw;
-    std::function<bool(const nlohmann::json&, std::any& state)> decodeRaw;
-    std::function<std::uint64_t(std::vector<Sample>&, std::any& state)> attachRaw;
+    std::function<bool(const nlohmann::json&, ReaderState&)> decodeRaw;
+    std::function<std::uint64_t(std::vector<Sample>&, ReaderState&)> attachRaw;
     std::function<bool(const Sample&)> hasRaw;
 };
 
@@ -243,13 +298,18 @@ class DeviceKind final : public DeviceKindBase
     static_assert(std::is_constructible_v<AnySample, Sample>,
                   "a device kind's sample type must be one of AnySample's");
 
+    using WriterState = typename SampleCodec<Sample>::WriterState;
+    using ReaderState = typename SampleCodec<Sample>::ReaderState;
+
 public:
     DeviceKind(DeviceNames names, SampleCodec<Sample> codec)
         : DeviceKindBase(std::move(names)), codec_(std::move(codec))
     {}
     const std::type_info& sampleType() const override { return typeid(Sample); }
 
-    bool encode(const AnySample& sample, std::any& state, const DeviceEmitter& emit) const override
+    AnyWriterState writerState() const override { return WriterState{}; }
+    bool
+    encode(const AnySample& sample, AnyWriterState& state, const DeviceEmitter& emit) const override
     {
         const auto& s = std::get<Sample>(sample);
         auto payload = codec_.encode(s);
@@ -258,25 +318,26 @@ public:
         }
         emit.message(names().channel.id, s.timestampNs, std::move(*payload));
         if (codec_.encodeRaw && names().rawChannel) {
-            codec_.encodeRaw(s, names().rawChannel->id, state, emit);
+            codec_.encodeRaw(s, names().rawChannel->id, std::get<WriterState>(state), emit);
         }
         return true;
     }
-    std::any emptySamples() const override { return std::vector<Sample>{}; }
-    std::size_t count(const std::any& samples) const override { return of(samples).size(); }
-    void decode(const nlohmann::json& j, std::any& samples) const override
+    AnySamples emptySamples() const override { return std::vector<Sample>{}; }
+    std::size_t count(const AnySamples& samples) const override { return of(samples).size(); }
+    void decode(const nlohmann::json& j, AnySamples& samples) const override
     {
         of(samples).push_back(codec_.decode(j));
     }
-    bool decodeRaw(const nlohmann::json& j, std::any& state) const override
+    AnyReaderState readerState() const override { return ReaderState{}; }
+    bool decodeRaw(const nlohmann::json& j, AnyReaderState& state) const override
     {
-        return codec_.decodeRaw ? codec_.decodeRaw(j, state) : false;
+        return codec_.decodeRaw ? codec_.decodeRaw(j, std::get<ReaderState>(state)) : false;
     }
-    std::uint64_t attachRaw(std::any& samples, std::any& state) const override
+    std::uint64_t attachRaw(AnySamples& samples, AnyReaderState& state) const override
     {
-        return codec_.attachRaw ? codec_.attachRaw(of(samples), state) : 0;
+        return codec_.attachRaw ? codec_.attachRaw(of(samples), std::get<ReaderState>(state)) : 0;
     }
-    std::uint64_t countWithRaw(const std::any& samples) const override
+    std::uint64_t countWithRaw(const AnySamples& samples) const override
     {
         std::uint64_t n = 0;
         if (codec_.hasRaw) {
@@ -286,7 +347,7 @@ public:
         }
         return n;
     }
-    std::vector<std::int64_t> times(const std::any& samples) const override
+    std::vector<std::int64_t> times(const AnySamples& samples) const override
     {
         std::vector<std::int64_t> t;
         for (const auto& s : of(samples)) {
@@ -294,12 +355,12 @@ public:
         }
         return t;
     }
-    std::optional<std::string> encodeAt(const std::any& samples, std::size_t i) const override
+    std::optional<std::string> encodeAt(const AnySamples& samples, std::size_t i) const override
     {
         return codec_.encode(of(samples).at(i));
     }
     std::unique_ptr<hal::AnySource> replaySource(const hal::DeviceInfo& recorded,
-                                                 const std::any& samples) const override
+                                                 const AnySamples& samples) const override
     {
         return std::make_unique<hal::ReplaySource<Sample>>(recorded, of(samples));
     }
@@ -310,13 +371,14 @@ public:
                 *this, dynamic_cast<hal::Source<Sample>&>(source), tee);
     }
 
-    static std::vector<Sample>& of(std::any& samples)
+    // This kind's alternative of samples it made (emptySamples).
+    static std::vector<Sample>& of(AnySamples& samples)
     {
-        return std::any_cast<std::vector<Sample>&>(samples);
+        return std::get<std::vector<Sample>>(samples);
     }
-    static const std::vector<Sample>& of(const std::any& samples)
+    static const std::vector<Sample>& of(const AnySamples& samples)
     {
-        return std::any_cast<const std::vector<Sample>&>(samples);
+        return std::get<std::vector<Sample>>(samples);
     }
 
 private:
@@ -346,10 +408,9 @@ const DeviceKind<hal::PoseSample>& trackerKind();
 const DeviceKind<hal::AccelSample>& accelKind();
 const DeviceKind<hal::LampSample>& lampSelectorKind();
 
-// The first registered kind of this sample type (what RecordingWriter::write(sample) and
-// Recording::samples<Sample>() use); null when none.
+// The first registered kind of this sample type (what RecordingWriter::write(sample) uses); null
+// when none.
 const DeviceKindBase* kindOfType(const DeviceKinds& kinds, const std::type_info& type);
-const DeviceKindBase* kindNamed(const DeviceKinds& kinds, const std::string& name);
 
 // The sources of a run, one per device kind present, kept in channel-id order (the order they
 // are polled and recorded in).

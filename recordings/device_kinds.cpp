@@ -119,16 +119,6 @@ const DeviceKindBase* kindOfType(const DeviceKinds& kinds, const std::type_info&
     return nullptr;
 }
 
-const DeviceKindBase* kindNamed(const DeviceKinds& kinds, const std::string& name)
-{
-    for (const auto* k : kinds) {
-        if (k->name() == name) {
-            return k;
-        }
-    }
-    return nullptr;
-}
-
 void Sources::set(const DeviceKindBase& kind, std::unique_ptr<hal::AnySource> source)
 {
     for (auto& e : entries_) {

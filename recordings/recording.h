@@ -1,7 +1,6 @@
 // What a Replica recording holds and the API to write and read one (MCAP on disk; see README.md).
 #pragma once
 
-#include <any>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -47,20 +46,20 @@ constexpr std::size_t kMaxSpectrumCounts = 16384;
 struct FrameRecord {
     std::uint64_t frameIndex = 0;
     std::int64_t tickNs = 0;
-    // Device kind name -> sequence number of the sample consumed; absent: no sample yet (or, in
-    // recordings before the device existed, none recorded).
-    std::map<std::string, std::uint32_t> sequences;
+    // Device kind -> sequence number of the sample consumed; absent: no sample yet (or, in
+    // recordings made before the device kind, none recorded).
+    std::map<const DeviceKindBase*, std::uint32_t> sequences;
     std::optional<std::uint32_t> sequence(const DeviceKindBase& kind) const
     {
-        const auto it = sequences.find(kind.name());
+        const auto it = sequences.find(&kind);
         return it != sequences.end() ? std::optional<std::uint32_t>(it->second) : std::nullopt;
     }
     void setSequence(const DeviceKindBase& kind, std::optional<std::uint32_t> seq)
     {
         if (seq) {
-            sequences[kind.name()] = *seq;
+            sequences[&kind] = *seq;
         } else {
-            sequences.erase(kind.name());
+            sequences.erase(&kind);
         }
     }
 };
@@ -131,13 +130,13 @@ struct SessionInfo {
     std::string scene;           // scene identifier
     std::string displayProfile;  // display profile identifier
     std::int64_t wallClockStartNs = 0; // Unix time (ns) at session time 0, for viewers' dates
-    // Device kind name -> the source behind it. An optional kind without an entry (or with an
-    // empty model) was not there: e.g. no lamp selector, or a recording older than it.
-    std::map<std::string, hal::DeviceInfo> devices;
+    // Device kind -> the source behind it. An optional kind without an entry (or with an empty
+    // model) was not there: e.g. no lamp selector, or a recording older than it.
+    std::map<const DeviceKindBase*, hal::DeviceInfo> devices;
     const hal::DeviceInfo& device(const DeviceKindBase& kind) const
     {
         static const hal::DeviceInfo kNone;
-        const auto it = devices.find(kind.name());
+        const auto it = devices.find(&kind);
         return it != devices.end() ? it->second : kNone;
     }
 };
@@ -145,9 +144,14 @@ struct SessionInfo {
 struct Recording {
     int formatVersion = 0;
     SessionInfo session;
-    // Device kind name -> its samples in time order (std::vector<Sample>, see device_kind.h);
-    // the reader puts an entry for every kind it knows, empty when the file has none.
-    std::map<std::string, std::any> devices;
+    // Each device kind's samples in time order (an AnySamples holding std::vector<Sample>, see
+    // device_kind.h), in the order of the kinds read; the reader puts an entry for every kind it
+    // knows, empty when the file has none.
+    struct DeviceSamples {
+        const DeviceKindBase* kind = nullptr;
+        AnySamples samples;
+    };
+    std::vector<DeviceSamples> devices;
     std::vector<FrameRecord> frames;
     std::vector<DisplayDigestRecord> displayDigests; // format 4; empty when none were recorded
     std::vector<LightRecord> lights;                 // format 4: the decided light, on change
@@ -160,28 +164,40 @@ struct Recording {
     std::uint64_t droppedMessages = 0;   // what the writer recorded as dropped (queue full)
     std::uint64_t rejectedNonFinite = 0; // samples the writer refused: a value was NaN or infinite
 
+    // The kind's samples (a kind the recording has no entry for gets an empty one).
     template <typename Sample>
     std::vector<Sample>& samples(const DeviceKind<Sample>& kind)
     {
-        auto& a = devices[kind.name()];
-        if (!a.has_value()) {
-            a = std::vector<Sample>{};
+        for (auto& d : devices) {
+            if (d.kind == &kind) {
+                return DeviceKind<Sample>::of(d.samples);
+            }
         }
-        return DeviceKind<Sample>::of(a);
+        devices.push_back({&kind, kind.emptySamples()});
+        return DeviceKind<Sample>::of(devices.back().samples);
     }
     template <typename Sample>
     const std::vector<Sample>& samples(const DeviceKind<Sample>& kind) const
     {
         static const std::vector<Sample> kNone;
-        const auto it = devices.find(kind.name());
-        return it != devices.end() && it->second.has_value() ? DeviceKind<Sample>::of(it->second)
-                                                             : kNone;
+        const auto* s = samplesOf(kind);
+        return s != nullptr ? DeviceKind<Sample>::of(*s) : kNone;
+    }
+    // The kind's samples; null when the recording has no entry for it.
+    const AnySamples* samplesOf(const DeviceKindBase& kind) const
+    {
+        for (const auto& d : devices) {
+            if (d.kind == &kind) {
+                return &d.samples;
+            }
+        }
+        return nullptr;
     }
     // How many samples of this kind the recording holds.
     std::size_t count(const DeviceKindBase& kind) const
     {
-        const auto it = devices.find(kind.name());
-        return it != devices.end() && it->second.has_value() ? kind.count(it->second) : 0;
+        const auto* s = samplesOf(kind);
+        return s != nullptr ? kind.count(*s) : 0;
     }
 };
 

@@ -129,11 +129,13 @@ class MessageDecoder
 {
 public:
     MessageDecoder(Recording& rec, const DeviceKinds& kinds, std::string name)
-        : rec_(rec), kinds_(kinds), name_(std::move(name)), rawState_(kinds.size())
+        : rec_(rec), kinds_(kinds), name_(std::move(name))
     {
+        rec.devices.clear();
         for (std::size_t i = 0; i < kinds.size(); ++i) {
             const auto& n = kinds[i]->names();
-            rec.devices[n.name] = kinds[i]->emptySamples();
+            rec.devices.push_back({kinds[i], kinds[i]->emptySamples()});
+            rawState_.push_back(kinds[i]->readerState());
             sampleTopics_[n.channel.topic] = i;
             if (n.rawChannel) {
                 rawTopics_[n.rawChannel->topic] = i;
@@ -171,10 +173,7 @@ public:
     {
         rec_.unmatchedRaw = unusableRaw_;
         for (std::size_t i = 0; i < kinds_.size(); ++i) {
-            if (rawState_[i].has_value()) {
-                rec_.unmatchedRaw +=
-                        kinds_[i]->attachRaw(rec_.devices[kinds_[i]->name()], rawState_[i]);
-            }
+            rec_.unmatchedRaw += kinds_[i]->attachRaw(rec_.devices[i].samples, rawState_[i]);
         }
     }
 
@@ -203,8 +202,7 @@ private:
             return decodeSessionMessage(topic, j);
         }
         if (auto k = sampleTopics_.find(topic); k != sampleTopics_.end()) {
-            const auto* kind = kinds_[k->second];
-            kind->decode(j, rec_.devices[kind->name()]);
+            kinds_[k->second]->decode(j, rec_.devices[k->second].samples);
         } else if (auto rk = rawTopics_.find(topic); rk != rawTopics_.end()) { // format 5
             if (!kinds_[rk->second]->decodeRaw(j, rawState_[rk->second])) {
                 ++unusableRaw_;
@@ -229,7 +227,7 @@ private:
     const DeviceKinds& kinds_;
     std::string name_;
     std::map<std::string, std::size_t> sampleTopics_, rawTopics_;
-    std::vector<std::any> rawState_;
+    std::vector<AnyReaderState> rawState_; // in the kinds' order, as rec_.devices
     std::uint64_t unusableRaw_ = 0;
     bool haveSession_ = false;
 };

@@ -1,7 +1,6 @@
 // The recording writer: callers enqueue samples; a writer thread encodes them into chunks and
 // closes (and syncs) a chunk at least every flush interval, so a power cut loses at most that much.
 #include <algorithm>
-#include <any>
 #include <array>
 #include <condition_variable>
 #include <csignal>
@@ -44,6 +43,17 @@ std::uint64_t logTime(std::int64_t wallStart, std::int64_t t)
     return v > 0 ? static_cast<std::uint64_t>(v) : 0;
 }
 
+// Each kind's raw codec state, as the kind makes it, in the kinds' order.
+std::vector<AnyWriterState> writerStates(const DeviceKinds& kinds)
+{
+    std::vector<AnyWriterState> states;
+    states.reserve(kinds.size());
+    for (const auto* kind : kinds) {
+        states.push_back(kind->writerState());
+    }
+    return states;
+}
+
 class ThreadedWriter final : public RecordingWriter
 {
 public:
@@ -51,7 +61,7 @@ public:
                    const SessionInfo& session,
                    WriterOptions options)
         : file_(std::move(file)), options_(std::move(options)), queue_(options_.queueCapacity),
-          wallStart_(session.wallClockStartNs), kindState_(options_.kinds.size())
+          wallStart_(session.wallClockStartNs), kindState_(writerStates(options_.kinds))
     {
         status_.queueCapacity = queue_.capacity();
         bytes_ = file_->bytesWritten();
@@ -368,7 +378,7 @@ private:
     std::int64_t wallStart_ = 0;
     std::int64_t lastTime_ = 0;
     std::map<std::uint16_t, std::uint32_t> sequence_;
-    std::vector<std::any> kindState_; // each device kind's codec state, writer thread only
+    std::vector<AnyWriterState> kindState_; // each device kind's codec state, writer thread only
     RecorderStatus status_;
     // Per device kind (options_.kinds), frames, and the format 4 channels of what was shown.
     std::array<std::atomic<std::uint64_t>, kMaxDeviceKinds> droppedDevice_{};

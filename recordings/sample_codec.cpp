@@ -172,7 +172,7 @@ SessionInfo decodeSession(const json& j, int& formatVersion, const DeviceKinds& 
     for (const auto* k : kinds) {
         // An optional kind is absent from recordings made before it (the lamp selector: 1, 2).
         if (!k->names().optional || j.contains(k->name())) {
-            s.devices[k->name()] = deviceFromJson(j.at(k->name()));
+            s.devices[k] = deviceFromJson(j.at(k->name()));
         }
     }
     return s;
@@ -196,7 +196,7 @@ FrameRecord decodeFrame(const json& j, const DeviceKinds& kinds)
     f.tickNs = j.at("tick_ns");
     for (const auto* k : kinds) {
         if (j.contains(k->names().frameKey)) {
-            f.sequences[k->name()] = j.at(k->names().frameKey).get<std::uint32_t>();
+            f.sequences[k] = j.at(k->names().frameKey).get<std::uint32_t>();
         }
     }
     return f;

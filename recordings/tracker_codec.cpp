@@ -22,18 +22,6 @@ std::vector<std::uint8_t> rawBytes(const json& j)
     return bytes;
 }
 
-// Writer state of the raw tracker channel: the HID descriptor written last and its id.
-struct RawTrackerWriterState {
-    std::shared_ptr<const std::vector<std::uint8_t>> lastDescriptor;
-    std::uint32_t descriptorId = 0;
-};
-
-// Reader state: descriptors by id, raw inputs by pose sequence.
-struct RawTrackerReaderState {
-    std::map<std::uint32_t, std::shared_ptr<const std::vector<std::uint8_t>>> descriptors;
-    std::map<std::uint32_t, std::shared_ptr<const hal::RawTrackerInput>> raw;
-};
-
 } // namespace
 
 std::optional<std::string> encodePose(const hal::PoseSample& s)
@@ -170,12 +158,11 @@ SampleCodec<hal::PoseSample> poseCodec()
     SampleCodec<hal::PoseSample> c;
     c.encode = encodePose;
     c.decode = decodePose;
-    c.encodeRaw = [](const hal::PoseSample& p, std::uint16_t channel, std::any& state,
-                     const DeviceEmitter& emit) {
+    c.encodeRaw = [](const hal::PoseSample& p, std::uint16_t channel,
+                     RawCodecState<hal::PoseSample>::Writer& st, const DeviceEmitter& emit) {
         if (!p.raw) {
             return;
         }
-        auto& st = stateOf<RawTrackerWriterState>(state);
         const auto& d = p.raw->hidDescriptor;
         if (p.raw->kind == hal::RawTrackerInput::Kind::HidReport && d &&
             d.get() != st.lastDescriptor.get()) {
@@ -191,8 +178,7 @@ SampleCodec<hal::PoseSample> poseCodec()
             emit.rejectRaw();
         }
     };
-    c.decodeRaw = [](const json& j, std::any& state) {
-        auto& st = stateOf<RawTrackerReaderState>(state);
+    c.decodeRaw = [](const json& j, RawCodecState<hal::PoseSample>::Reader& st) {
         auto r = decodeRawTracker(j, st.descriptors);
         if (r.descriptorId) {
             st.descriptors[*r.descriptorId] = r.descriptor;
@@ -203,8 +189,9 @@ SampleCodec<hal::PoseSample> poseCodec()
         }
         return true;
     };
-    c.attachRaw = [](std::vector<hal::PoseSample>& poses, std::any& state) {
-        return attachRawBySequence(poses, stateOf<RawTrackerReaderState>(state).raw);
+    c.attachRaw = [](std::vector<hal::PoseSample>& poses,
+                     RawCodecState<hal::PoseSample>::Reader& st) {
+        return attachRawBySequence(poses, st.raw);
     };
     c.hasRaw = [](const hal::PoseSample& p) { return p.raw != nullptr; };
     return c;

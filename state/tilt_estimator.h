@@ -1,7 +1,7 @@
 // The tilt estimator: gravity -> the panel's tilt (the specular term's, each sample), and the tilt
 // of the booth pass's cached diffuse term: a hold filter against sensor noise, then the sliced
-// refresh that spreads a new held tilt's recomputation over K frames. Both used to live inside the
-// renderer; as state they make a frame a function of its SceneState.
+// refresh that spreads a new held tilt's recomputation over K frames. Both are state, not render:
+// the renderer draws what SceneState names, so a frame is a function of its SceneState.
 #pragma once
 
 #include <array>

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Shows tests/layering_check.sh failing on one planted violation of the given kind:
 #   layering_check_test.sh SOURCE_ROOT KIND
-# It builds a minimal tree in a temporary folder (the layers' folders, the pipeline's folders and
-# pipeline/CMakeLists.txt with its offline list), asserts the check passes on it, plants the
+# It builds a minimal tree in a temporary folder (the layers' folders, the pipeline's folders and a
+# CLI file that includes an offline tool), asserts the check passes on it, plants the
 # violation, and asserts the check then fails with the expected message naming the planted file.
 set -uo pipefail
 src="$1"
@@ -10,10 +10,13 @@ kind="$2"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 for layer in hal pipeline platform recordings state tests; do mkdir -p "$tmp/$layer"; done
-for folder in base csv colour spectral image brdf booth scene surface shading reference display tuning render; do
+for folder in base csv colour spectral image brdf booth scene surface shading reference display tuning render \
+              offline/display; do
     mkdir -p "$tmp/pipeline/$folder"
 done
-cp "$src/pipeline/CMakeLists.txt" "$tmp/pipeline/"
+# The CLI may include an offline tool (its subcommands run them): the minimal tree does.
+mkdir -p "$tmp/platform/cli"
+printf '#include <pipeline/offline/display/display_fit.h>\n' >"$tmp/platform/cli/fit_command.cpp"
 
 if ! bash "$src/tests/layering_check.sh" "$tmp" >/dev/null 2>"$tmp.err"; then
     echo "FAIL: the minimal tree fails the check before anything is planted:" >&2
@@ -30,9 +33,8 @@ plant() {
     mkdir -p "$(dirname "$tmp/$file")"
     printf '%s\n' "$@" >"$tmp/$file"
 }
-# The first offline tool of the list, so that the test follows the list wherever the tools move.
-offline_tool=$(sed -n '/# offline-sources-begin/,/# offline-sources-end/p' "$tmp/pipeline/CMakeLists.txt" |
-               grep -oE '[a-z_0-9/]+\.cpp' | head -n1 | sed 's/\.cpp$//')
+# An offline tool: any header under pipeline/offline/.
+offline_tool=offline/display/display_fit
 expect=()
 case "$kind" in
 quoted)
@@ -70,6 +72,9 @@ state_offline)
 pipeline_offline)
     plant pipeline/render/planted.cpp "#include <pipeline/$offline_tool.h>"
     expect=("includes an offline tool's header" "pipeline/render/planted.cpp:1:pipeline/$offline_tool.h") ;;
+platform_offline)
+    plant platform/loop/planted.cpp "#include <pipeline/$offline_tool.h>"
+    expect=("includes an offline tool's header" "platform/loop/planted.cpp:1:pipeline/$offline_tool.h") ;;
 top_folder)
     mkdir -p "$tmp/plugins"
     plant plugins/planted.cpp '#include <pipeline/render/renderer.h>'

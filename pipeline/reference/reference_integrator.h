@@ -12,7 +12,7 @@
 #include <pipeline/colour/xyz.h>
 #include <pipeline/shading/frame.h>
 #include <pipeline/shading/view.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace replica::pipeline::reference {
 

@@ -6,7 +6,7 @@
 
 #include <pipeline/render/pixel_rect.h>
 #include <pipeline/scene/stand.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace replica::pipeline::render {
 

@@ -15,7 +15,7 @@
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/shading/frame.h>
 #include <pipeline/shading/view.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace replica::pipeline::shading {
 

@@ -9,7 +9,7 @@
 
 #include <pipeline/brdf/ward.h>
 #include <pipeline/scene/stand.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace replica::pipeline::shading {
 

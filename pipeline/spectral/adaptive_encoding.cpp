@@ -7,9 +7,9 @@
 #include <fmt/format.h>
 
 #include <pipeline/spectral/adaptive_encoding.h>
-#include <pipeline/spectral/basis_fit.h>
 #include <pipeline/spectral/fit_metric.h>
 #include <pipeline/spectral/light_classifier.h>
+#include <pipeline/spectral/light_weights.h>
 
 namespace replica::pipeline::spectral {
 namespace {

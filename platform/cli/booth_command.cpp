@@ -11,10 +11,10 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/base/input_file.h>
 #include <pipeline/base/json_schema.h>
-#include <pipeline/booth/booth_generator.h>
-#include <pipeline/booth/hdr_capture.h>
 #include <pipeline/colour/spectral_table.h>
-#include <pipeline/surface/scene_generator.h>
+#include <pipeline/offline/booth/booth_generator.h>
+#include <pipeline/offline/booth/hdr_capture.h>
+#include <pipeline/offline/surface/scene_generator.h>
 #include <platform/cli/commands.h>
 
 namespace replica::platform {

@@ -13,8 +13,8 @@
 #include <pipeline/base/output_file.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
-#include <pipeline/display/measurement_set.h>
-#include <pipeline/display/synthetic_display.h>
+#include <pipeline/offline/display/measurement_set.h>
+#include <pipeline/offline/display/synthetic_display.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/display_command.h>
 #include <platform/cli/display_patches.h>
@@ -134,7 +134,8 @@ int synthMain(const DisplayOptions& o)
     const std::string comment = fmt::format(
             "SYNTHETIC display measurements (not a real panel), written by 'replica display synth "
             "--seed {}':\n"
-            "the ground-truth wide-luminance IPS of pipeline/display/synthetic_display.cpp read "
+            "the ground-truth wide-luminance IPS of pipeline/offline/display/synthetic_display.cpp "
+            "read "
             "through\n"
             "a simulated meter with 0.2 % + 0.005 cd/m^2 noise. Counts 8-bit; XYZ in cd/m^2.",
             o.seed);

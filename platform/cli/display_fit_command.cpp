@@ -1,5 +1,6 @@
-// 'replica display fit': a display profile fitted to measurements (pipeline/display/display_fit.h),
-// written as JSON (and ICC v2.4 or v4 on request), and its fit report printed.
+// 'replica display fit': a display profile fitted to measurements
+// (pipeline/offline/display/display_fit.h), written as JSON (and ICC v2.4 or v4 on request), and
+// its fit report printed.
 #include <filesystem>
 #include <fstream>
 
@@ -7,12 +8,12 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
-#include <pipeline/display/cgats.h>
-#include <pipeline/display/display_fit.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/display/icc_profile.h>
-#include <pipeline/display/synthetic_display.h>
-#include <pipeline/display/viewing_angle_csv.h>
+#include <pipeline/offline/display/cgats.h>
+#include <pipeline/offline/display/display_fit.h>
+#include <pipeline/offline/display/synthetic_display.h>
+#include <pipeline/offline/display/viewing_angle_csv.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/display_command.h>
 #include <platform/logging.h>

@@ -16,7 +16,7 @@
 
 #include <pipeline/base/input_file.h>
 #include <pipeline/base/output_file.h>
-#include <pipeline/display/cgats.h>
+#include <pipeline/offline/display/cgats.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/display_patches.h>
 #include <platform/image/png_writer.h>

@@ -1,5 +1,5 @@
 // 'replica display study' and 'replica display flare': the ColorChecker through the whole chain
-// (pipeline/display/colorchecker_study.h) under the booth lights, as the paper's Table 1.
+// (pipeline/offline/display/colorchecker_study.h) under the booth lights, as the paper's Table 1.
 #include <functional>
 #include <numbers>
 #include <optional>
@@ -10,8 +10,8 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/channel_basis.h>
-#include <pipeline/display/colorchecker_study.h>
-#include <pipeline/display/synthetic_display.h>
+#include <pipeline/offline/display/colorchecker_study.h>
+#include <pipeline/offline/display/synthetic_display.h>
 #include <pipeline/spectral/reference_sets.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <platform/cli/commands.h>

@@ -80,7 +80,7 @@ nlohmann::json streamJson(const recordings::Recording& rec, const recordings::De
                      {"source", hal::toString(info.kind)},
                      {"count", count}};
     if (count > 0) {
-        const auto& samples = rec.devices.at(kind.name());
+        const auto& samples = *rec.samplesOf(kind);
         const auto t = kind.times(samples);
         j["first_ns"] = t.front();
         j["last_ns"] = t.back();
@@ -106,10 +106,8 @@ nlohmann::json rawInputsJson(const recordings::Recording& rec)
     nlohmann::json j{{"unmatched", rec.unmatchedRaw}};
     for (const auto* kind : recordings::deviceKinds()) {
         if (kind->names().rawChannel) {
-            const auto it = rec.devices.find(kind->name());
-            j[samplesKey(*kind)] = it != rec.devices.end() && it->second.has_value()
-                                           ? kind->countWithRaw(it->second)
-                                           : 0;
+            const auto* samples = rec.samplesOf(*kind);
+            j[samplesKey(*kind)] = samples != nullptr ? kind->countWithRaw(*samples) : 0;
         }
     }
     return j;
@@ -174,12 +172,9 @@ TimeSpan timeSpan(const recordings::Recording& rec)
         s.first = std::min(s.first, t);
         s.last = std::max(s.last, t);
     };
-    for (const auto& [name, samples] : rec.devices) {
-        if (const auto* kind = recordings::kindNamed(recordings::deviceKinds(), name);
-            kind != nullptr && samples.has_value()) {
-            for (const auto t : kind->times(samples)) {
-                span(t);
-            }
+    for (const auto& [kind, samples] : rec.devices) {
+        for (const auto t : kind->times(samples)) {
+            span(t);
         }
     }
     for (const auto& f : rec.frames) {

@@ -18,7 +18,7 @@
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/spectral/representation_catalogue.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 #include <pipeline/tuning/planner.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
@@ -389,10 +389,11 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
             ->check(CLI::Range(kAutoDiffuseGrid, 256));
     cmd->add_flag("--specular-trilinear", args->trilinear,
                   "read each specular sample between the two mip levels around its own instead "
-                  "of from the nearest one (slower; the default before 2026-12-01)");
-    cmd->add_flag("--point-lights", args->pointLights,
-                  "light the diffuse term from each median-cut region's centroid as a point light "
-                  "instead of from the region's area (what renderers did before 2026-12-03)");
+                  "of from the nearest one (slower)");
+    cmd->add_flag(
+            "--point-lights", args->pointLights,
+            "light the diffuse term from each median-cut region's centroid as a point light "
+            "instead of from the region's area (an approximation of the area's exact integral)");
     cmd->add_option("--specular-lod-bias", args->lodBias,
                     "added to each specular sample's mip level: more blurs the light under each "
                     "sample, less aliases it (docs/rendering.md measures the choice)")

@@ -1,7 +1,7 @@
 // An older recording on this build: the replayed frames against what the recording holds of what
 // the panel showed (its thumbnails, and its display digests where they match), colorimetrically.
 // A recording made with an older render profile (pipeline/render/render_profile.h), or drawn by
-// the flat renderer this build no longer has, replays on today's render path; bit-exact replay of
+// the flat renderer (not in this build), replays on this build's render path; bit-exact replay of
 // it is the build that made it's to promise.
 #pragma once
 

@@ -110,7 +110,7 @@ recordings::SessionInfo sessionInfo(const run_cli::RunOptions& o,
                                        .count();
     for (const auto& e : sources.entries()) {
         if (e.source) {
-            session.devices[e.kind->name()] = e.source->info();
+            session.devices[e.kind] = e.source->info();
         }
     }
     return session;

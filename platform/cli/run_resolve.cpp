@@ -16,7 +16,7 @@
 #include <pipeline/base/json_limits.h>
 #include <pipeline/display/display_profile.h>
 #include <pipeline/scene/booth.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 #include <platform/cli/commands.h>
 #include <platform/cli/run_resolve.h>
 #include <platform/cli/run_sources.h>

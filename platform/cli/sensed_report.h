@@ -10,7 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include <pipeline/display/colorchecker_study.h>
+#include <pipeline/offline/display/colorchecker_study.h>
 
 namespace replica::platform {
 

@@ -21,9 +21,9 @@
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/display/display_inverse.h>
 #include <pipeline/display/display_profile.h>
-#include <pipeline/spectral/accuracy.h>
-#include <pipeline/spectral/basis_fit.h>
-#include <pipeline/spectral/metamers.h>
+#include <pipeline/offline/spectral/accuracy.h>
+#include <pipeline/offline/spectral/basis_fit.h>
+#include <pipeline/offline/spectral/metamers.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/spectral/six_channel_model.h>
 #include <platform/cli/commands.h>

@@ -29,11 +29,6 @@ extern "C" void onStopSignal(int)
 
 } // namespace
 
-void requestStop()
-{
-    gStop = 1;
-}
-
 bool stopRequested()
 {
     return gStop != 0;

@@ -19,7 +19,7 @@
 #include <pipeline/display/xyz_difference.h>
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/gles_renderer.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 #include <platform/output/output.h>
 
 namespace {

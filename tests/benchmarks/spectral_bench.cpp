@@ -14,9 +14,9 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/cct.h>
-#include <pipeline/spectral/accuracy.h>
+#include <pipeline/offline/spectral/accuracy.h>
+#include <pipeline/offline/spectral/classifier_study.h>
 #include <pipeline/spectral/adaptive_encoding.h>
-#include <pipeline/spectral/classifier_study.h>
 #include <pipeline/spectral/representation_catalogue.h>
 
 namespace {

@@ -17,9 +17,9 @@
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/display/display_profile.h>
-#include <pipeline/display/measurement_set.h>
-#include <pipeline/display/viewing_angle_csv.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/offline/display/measurement_set.h>
+#include <pipeline/offline/display/viewing_angle_csv.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace {
 

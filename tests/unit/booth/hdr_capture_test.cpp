@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include <pipeline/base/data_dir.h>
-#include <pipeline/booth/booth_generator.h>
-#include <pipeline/booth/hdr_capture.h>
+#include <pipeline/offline/booth/booth_generator.h>
+#include <pipeline/offline/booth/hdr_capture.h>
 
 #include <gtest/gtest.h>
 

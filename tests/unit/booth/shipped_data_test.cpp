@@ -6,11 +6,11 @@
 #include <vector>
 
 #include <pipeline/base/data_dir.h>
-#include <pipeline/booth/booth_generator.h>
 #include <pipeline/colour/ciede2000.h>
 #include <pipeline/colour/cielab.h>
 #include <pipeline/colour/spectral_table.h>
-#include <pipeline/surface/scene_generator.h>
+#include <pipeline/offline/booth/booth_generator.h>
+#include <pipeline/offline/surface/scene_generator.h>
 
 #include <gtest/gtest.h>
 

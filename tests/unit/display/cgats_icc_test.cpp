@@ -8,10 +8,10 @@
 
 #include <unistd.h>
 
-#include <pipeline/display/cgats.h>
 #include <pipeline/display/icc_profile.h>
-#include <pipeline/display/synthetic_display.h>
 #include <pipeline/display/xyz_difference.h>
+#include <pipeline/offline/display/cgats.h>
+#include <pipeline/offline/display/synthetic_display.h>
 
 #include <gtest/gtest.h>
 

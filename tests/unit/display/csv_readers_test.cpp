@@ -1,7 +1,7 @@
 // The display layer's CSV readers on the shared cell rules (pipeline/csv/csv_cells.h, tested in
 // tests/unit/csv): errors name source:line, and a row with a missing or non-finite value is
 // refused, not shortened.
-#include <pipeline/display/viewing_angle_csv.h>
+#include <pipeline/offline/display/viewing_angle_csv.h>
 
 #include <gtest/gtest.h>
 

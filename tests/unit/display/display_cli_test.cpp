@@ -13,8 +13,8 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/xyz.h>
-#include <pipeline/display/cgats.h>
-#include <pipeline/spectral/accuracy.h>
+#include <pipeline/offline/display/cgats.h>
+#include <pipeline/offline/spectral/accuracy.h>
 #include <pipeline/spectral/reference_sets.h>
 #include <pipeline/spectral/representation_catalogue.h>
 

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <random>
 
-#include <pipeline/display/display_fit.h>
-#include <pipeline/display/synthetic_display.h>
 #include <pipeline/display/xyz_difference.h>
+#include <pipeline/offline/display/display_fit.h>
+#include <pipeline/offline/display/synthetic_display.h>
 
 #include <gtest/gtest.h>
 

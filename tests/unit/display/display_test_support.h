@@ -2,8 +2,8 @@
 #pragma once
 
 #include <pipeline/base/assert.h>
-#include <pipeline/display/display_fit.h>
-#include <pipeline/display/synthetic_display.h>
+#include <pipeline/offline/display/display_fit.h>
+#include <pipeline/offline/display/synthetic_display.h>
 
 namespace replica::pipeline::display::test {
 

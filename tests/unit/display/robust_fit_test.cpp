@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <random>
 
-#include <pipeline/display/display_fit.h>
 #include <pipeline/display/display_inverse.h>
-#include <pipeline/display/synthetic_display.h>
-#include <pipeline/display/tone_fit.h>
 #include <pipeline/display/xyz_difference.h>
+#include <pipeline/offline/display/display_fit.h>
+#include <pipeline/offline/display/synthetic_display.h>
+#include <pipeline/offline/display/tone_fit.h>
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
-// End to end from the sensed light (display/colorchecker_study.h sensedStudy): an unimpaired
-// instrument leaves only the display's own error; the data-sheet instrument costs a tenth of a
-// CIEDE2000 on average; the classifier names every booth lamp.
+// End to end from the sensed light (offline/display/colorchecker_study.h sensedStudy): an
+// unimpaired instrument leaves only the display's own error; the data-sheet instrument costs a
+// tenth of a CIEDE2000 on average; the classifier names every booth lamp.
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/xyz.h>
-#include <pipeline/display/colorchecker_study.h>
+#include <pipeline/offline/display/colorchecker_study.h>
 
 #include <gtest/gtest.h>
 

@@ -4,8 +4,8 @@
 #include <numbers>
 
 #include <pipeline/display/display_inverse.h>
-#include <pipeline/display/synthetic_display.h>
 #include <pipeline/display/xyz_difference.h>
+#include <pipeline/offline/display/synthetic_display.h>
 
 #include <gtest/gtest.h>
 

@@ -126,7 +126,7 @@ TEST(DeviceKinds, ASecondAccelerometerIsOnlyDataAndIsPolledRecordedReadListedAnd
     session.softwareVersion = "test";
     session.configJson = (*app)->config.toJson();
     for (const auto& e : sources->entries()) {
-        session.devices[e.kind->name()] = e.source->info();
+        session.devices[e.kind] = e.source->info();
     }
     recordings::WriterOptions options;
     options.kinds = kinds;

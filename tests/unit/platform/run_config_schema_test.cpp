@@ -131,9 +131,9 @@ nlohmann::json recordedSession()
     s.scene = "colorchecker";
     s.displayProfile = "wide-ips-synthetic";
     s.wallClockStartNs = 1'795'445'344'985'983'302;
-    s.devices["spectrometer"] = {"USB2000+", "S1", "fw", hal::SourceKind::Live};
-    s.devices["tracker"] = {"TrackIR", "T1", "", hal::SourceKind::Sim};
-    s.devices["accel"] = {"accel", "A1", "", hal::SourceKind::Replay};
+    s.devices[&recordings::spectrometerKind()] = {"USB2000+", "S1", "fw", hal::SourceKind::Live};
+    s.devices[&recordings::trackerKind()] = {"TrackIR", "T1", "", hal::SourceKind::Sim};
+    s.devices[&recordings::accelKind()] = {"accel", "A1", "", hal::SourceKind::Replay};
     return nlohmann::json::parse(recordings::encodeSession(s, recordings::kFormatVersion));
 }
 

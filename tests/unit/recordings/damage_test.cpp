@@ -72,8 +72,7 @@ const Sample& sample()
                 (*w)->write(sp);
             }
             if (i % 2 == 0) {
-                (*w)->write(FrameRecord{
-                        i / 2, t, {{trackerKind().name(), i}, {accelKind().name(), i}}});
+                (*w)->write(FrameRecord{i / 2, t, {{&trackerKind(), i}, {&accelKind(), i}}});
             }
         }
         EXPECT_TRUE((*w)->close());

@@ -31,11 +31,12 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     session.scene = "scene";
     session.displayProfile = "display";
     session.wallClockStartNs = 1'700'000'000'123'456'789;
-    session.devices["spectrometer"] = {"USB2000+", "S1", "fw", hal::SourceKind::Live};
-    session.devices["tracker"] = {"TrackIR", "T1", "", hal::SourceKind::Sim};
-    session.devices["accel"] = {"accel", "A1", "", hal::SourceKind::Replay};
-    session.devices["lamp_selector"] = {"lamp selector (GPIO)", "gpiochip0:17,27,22", "",
-                                        hal::SourceKind::Live};
+    session.devices[&recordings::spectrometerKind()] = {"USB2000+", "S1", "fw",
+                                                        hal::SourceKind::Live};
+    session.devices[&recordings::trackerKind()] = {"TrackIR", "T1", "", hal::SourceKind::Sim};
+    session.devices[&recordings::accelKind()] = {"accel", "A1", "", hal::SourceKind::Replay};
+    session.devices[&recordings::lampSelectorKind()] = {
+            "lamp selector (GPIO)", "gpiochip0:17,27,22", "", hal::SourceKind::Live};
 
     hal::SpectrumSample s;
     s.timestampNs = 100'000'000;
@@ -64,11 +65,8 @@ TEST(RecordingRoundTrip, EverySampleTypeComesBackBitExactly)
     invalid.sequence = 5;
     invalid.lamp = hal::kLampInvalid;
     invalid.lineLevels = 0b101;
-    FrameRecord f{3,
-                  50'000'001,
-                  {{spectrometerKind().name(), 7},
-                   {accelKind().name(), 2},
-                   {lampSelectorKind().name(), 4}}};
+    FrameRecord f{
+            3, 50'000'001, {{&spectrometerKind(), 7}, {&accelKind(), 2}, {&lampSelectorKind(), 4}}};
     {
         auto w = RecordingWriter::create(path, session);
         ASSERT_TRUE(w) << w.error().message;

@@ -12,7 +12,7 @@
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/spectral/adaptive_encoding.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/booth/booth_light.h>
 #include <pipeline/colour/xyz.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace replica::test {
 

@@ -5,8 +5,8 @@
 #include <glm/geometric.hpp>
 
 #include <pipeline/base/data_dir.h>
-#include <pipeline/booth/booth_generator.h>
 #include <pipeline/booth/booth_model.h>
+#include <pipeline/offline/booth/booth_generator.h>
 #include <pipeline/scene/booth.h>
 
 #include <gtest/gtest.h>

@@ -8,9 +8,9 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/ciede2000.h>
 #include <pipeline/colour/cielab.h>
-#include <pipeline/spectral/accuracy.h>
+#include <pipeline/offline/spectral/accuracy.h>
+#include <pipeline/offline/spectral/basis_fit.h>
 #include <pipeline/spectral/adaptive_encoding.h>
-#include <pipeline/spectral/basis_fit.h>
 #include <pipeline/spectral/light_classifier.h>
 #include <pipeline/spectral/representation_catalogue.h>
 

@@ -4,7 +4,7 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/cct.h>
-#include <pipeline/spectral/classifier_study.h>
+#include <pipeline/offline/spectral/classifier_study.h>
 #include <pipeline/spectral/reference_sets.h>
 
 #include <gtest/gtest.h>

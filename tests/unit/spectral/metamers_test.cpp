@@ -2,7 +2,7 @@
 // the full-spectral calculation and through the K = 6 rendering path.
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/ciede2000.h>
-#include <pipeline/spectral/metamers.h>
+#include <pipeline/offline/spectral/metamers.h>
 #include <pipeline/spectral/representation_catalogue.h>
 
 #include <gtest/gtest.h>

@@ -4,8 +4,8 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/cat02.h>
 #include <pipeline/colour/ciede2000.h>
-#include <pipeline/spectral/accuracy.h>
-#include <pipeline/spectral/basis_fit.h>
+#include <pipeline/offline/spectral/accuracy.h>
+#include <pipeline/offline/spectral/basis_fit.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/spectral/six_channel_model.h>
 #include <platform/appliance.h>

@@ -1,13 +1,13 @@
-// The pixel-level spectrometer model (spectral/sensed_light.h) and the chain's corrections for
-// stray light and wavelength shift (spectral/spectrometer_chain.h), against closed forms and
+// The pixel-level spectrometer model (offline/spectral/sensed_light.h) and the chain's corrections
+// for stray light and wavelength shift (spectral/spectrometer_chain.h), against closed forms and
 // injected values.
 #include <cmath>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/offline/spectral/sensed_light.h>
 #include <pipeline/spectral/light_classifier.h>
-#include <pipeline/spectral/sensed_light.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 
 #include <gtest/gtest.h>

@@ -10,7 +10,7 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/colour/spectral_table.h>
-#include <pipeline/spectral/accuracy.h>
+#include <pipeline/offline/spectral/accuracy.h>
 #include <pipeline/spectral/representation_catalogue.h>
 #include <pipeline/spectral/six_channel_model.h>
 

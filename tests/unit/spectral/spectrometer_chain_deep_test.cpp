@@ -6,7 +6,7 @@
 #include <vector>
 
 #include <pipeline/base/data_dir.h>
-#include <pipeline/spectral/classifier_study.h>
+#include <pipeline/offline/spectral/classifier_study.h>
 #include <pipeline/spectral/reference_sets.h>
 #include <pipeline/spectral/spectrometer_chain.h>
 

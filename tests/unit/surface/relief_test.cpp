@@ -5,7 +5,7 @@
 
 #include <pipeline/image/exr.h>
 #include <pipeline/surface/relief.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 #include <gtest/gtest.h>
 
