@@ -15,7 +15,7 @@
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/channel_basis.h>
-#include <pipeline/spectral/metamers.h>
+#include <pipeline/offline/spectral/metamers.h>
 #include <pipeline/spectral/six_channel_model.h>
 #include <platform/image/pfm.h>
 #include <platform/render_plan.h>
