@@ -30,6 +30,9 @@ const JsonSchema& boothSchema()
                            {"edge_v", array(number(-100.0, 100.0), 3, 3)},
                            {"spd", array(number(-1e6, 1e9), colour::kBands, colour::kBands)}}),
                    1, 64)},
+            {"walls", object({{"reflectance",
+                               array(number(0.0, 1.0), colour::kBands, colour::kBands).optional()}})
+                              .optional()},
     });
     return s;
 }
@@ -161,6 +164,16 @@ Expected<Booth> loadBooth(const std::filesystem::path& dir)
         }
         booth.lights.push_back(std::move(l));
     }
+    if (j.contains("walls")) {
+        BoothWalls w;
+        w.reflectance = colour::Spectrum::constant(kMunsellN7Reflectance);
+        if (j["walls"].contains("reflectance")) {
+            for (std::size_t b = 0; b < colour::kBands; ++b) {
+                w.reflectance[b] = j["walls"]["reflectance"][b].get<double>();
+            }
+        }
+        booth.walls = w;
+    }
     return booth;
 }
 
@@ -196,6 +209,10 @@ Expected<void> saveBooth(const std::filesystem::path& dir, const Booth& booth)
         if (auto ok = image::writeExr(dir / (l.name + ".exr"), img, {{"units", "cd/m^2"}}); !ok) {
             return ok;
         }
+    }
+    if (booth.walls) {
+        j["walls"]["reflectance"] = std::vector<double>(booth.walls->reflectance.v.begin(),
+                                                        booth.walls->reflectance.v.end());
     }
     return writeOutputFile(dir / "booth.json", j.dump(2) + "\n", "booth model");
 }

@@ -2,11 +2,13 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <pipeline/base/expected.h>
 #include <pipeline/booth/booth_light.h>
+#include <pipeline/booth/booth_walls.h>
 
 namespace replica::pipeline::booth {
 
@@ -16,6 +18,12 @@ namespace replica::pipeline::booth {
 struct Booth {
     std::string id; // "replica-booth-1" from scene::loadDefaultBooth; empty from loadBooth
     std::vector<BoothLight> lights;
+    // The booth's walls when booth.json declares them ("walls": {"reflectance": [36 values],
+    // optional, default Munsell N7}): the appliance then lights the surface with them too
+    // (docs/rendering.md, "The booth's walls"). Their box is the ceiling's down to the floor,
+    // deep enough for the stand (scene::defaultBoothWalls fills it in; loadBooth leaves it 0).
+    // None: the walls are not modelled (every shipped booth).
+    std::optional<BoothWalls> walls;
 
     // The ceiling, the one emitter of every lamp: the first light's rectangle (loadDefaultBooth
     // checks that all lights share it).

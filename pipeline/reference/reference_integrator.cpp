@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include <pipeline/reference/reference_integrator.h>
+#include <pipeline/reference/wall_radiosity.h>
 
 namespace replica::pipeline::reference {
 
@@ -139,11 +140,21 @@ public:
                 integrateTexels(cloud_, sp.p, sp.nGeo, sp.nShade, toEye, scene_.model, scene_.alpha,
                                 glossy_ && !behind, flat_ ? nullptr : &horizon, sp.right, sp.up);
         const colour::Spectrum rho = scene_.reflectance(sp.tx, sp.ty);
-        const colour::Spectrum radiance =
+        colour::Spectrum radiance =
                 (rho * (t.irradiance / std::numbers::pi) + scene_.rhoS * t.specular) * unitSpd_;
+        double geoIrradiance = t.geoIrradiance;
+        if (options_.walls != nullptr) {
+            const WallSums w = integrateWalls(*options_.walls, sp.p, sp.nGeo, sp.nShade, toEye,
+                                              scene_.model, scene_.alpha, glossy_ && !behind,
+                                              flat_ ? nullptr : &horizon, sp.right, sp.up);
+            radiance = radiance +
+                       (rho * w.irradiance * (1.0 / std::numbers::pi) + scene_.rhoS * w.specular) *
+                               unitSpd_;
+            geoIrradiance += w.geoIrradianceY;
+        }
         const colour::Xyz surfaceXyz = colour::spectrumToXyz(obs_, radiance);
         const colour::Xyz flare =
-                white_ * (shading::kScreenFlareRho * t.geoIrradiance / std::numbers::pi);
+                white_ * (shading::kScreenFlareRho * geoIrradiance / std::numbers::pi);
         colour::Xyz out = shading::subtractFlare(surfaceXyz, flare, c.flare);
         if (!std::isfinite(out.x) || !std::isfinite(out.y) || !std::isfinite(out.z)) {
             ++c.bad;
@@ -159,7 +170,13 @@ public:
         const TexelSums centre =
                 integrateTexels(cloud_, view_.panel.centre, n, n, n, scene_.model, scene_.alpha,
                                 false, nullptr, view_.panel.right, view_.panel.up);
-        const double y = centre.geoIrradiance / std::numbers::pi;
+        double e = centre.geoIrradiance;
+        if (options_.walls != nullptr) {
+            e += integrateWalls(*options_.walls, view_.panel.centre, n, n, n, scene_.model,
+                                scene_.alpha, false, nullptr, view_.panel.right, view_.panel.up)
+                         .geoIrradianceY;
+        }
+        const double y = e / std::numbers::pi;
         return {white_ * y, y};
     }
 

@@ -9,6 +9,7 @@
 #include <glm/vec2.hpp>
 
 #include <pipeline/booth/booth_light.h>
+#include <pipeline/booth/booth_walls.h>
 #include <pipeline/colour/xyz.h>
 #include <pipeline/shading/frame.h>
 #include <pipeline/shading/view.h>
@@ -22,6 +23,9 @@ struct ReferenceOptions {
     double horizonDistanceM = 0.01; // how far the exact horizon march reaches
     int horizonAzimuths = 360;      // per-pixel exact horizon resolution (1 degree)
     int threads = 2;
+    // The booth's walls lit by this light (reference::solveWalls), or none: their light is added
+    // to every pixel (diffuse and specular), to the flare and to the white. Not owned.
+    const booth::WallLight* walls = nullptr;
 };
 
 // The emitter's texels with non-zero luminance, as points in the booth frame.

@@ -5,6 +5,7 @@
 
 #include <pipeline/render/booth_programs.h>
 #include <pipeline/render/gl_program.h>
+#include <pipeline/shading/wall_field.h>
 
 namespace replica::pipeline::render {
 
@@ -12,6 +13,7 @@ Expected<void> BoothPrograms::compile(booth_upload::BoothShaderConfig config,
                                       const shading::RenderSettings& settings,
                                       int modes)
 {
+    wallsOn_ = settings.walls;
     for (int mode = 0; mode < modes; ++mode) {
         config.mode = mode;
         const std::string source = booth_upload::boothShaderSource(config, settings);
@@ -62,7 +64,25 @@ void BoothPrograms::usePose(BoothMode mode, const shading::PanelPose& panel) con
     set("uRight", panel.right);
     set("uUp", panel.up);
     set("uNormal", panel.normal);
+    if (mode == BoothMode::Cache && wallsOn_) {
+        setWallField(p, panel);
+    }
     glUseProgram(p);
+}
+
+void BoothPrograms::setWallField(GLuint program, const shading::PanelPose& panel) const
+{
+    shading::WallField field;
+    if (walls_ != nullptr && wallScene_ != nullptr) {
+        field = shading::wallField(*walls_, panel, *wallScene_);
+    }
+    std::array<float, 9> e{};
+    for (std::size_t k = 0; k < e.size(); ++k) {
+        e[k] = static_cast<float>(field.nodes[k]);
+    }
+    glProgramUniform1fv(program, glGetUniformLocation(program, "uWallE"), 9, e.data());
+    const glm::vec3 v = booth_upload::f3(field.vector);
+    glProgramUniform3f(program, glGetUniformLocation(program, "uWallVec"), v.x, v.y, v.z);
 }
 
 } // namespace replica::pipeline::render

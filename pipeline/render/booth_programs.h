@@ -8,10 +8,12 @@
 #include <glm/vec3.hpp>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/booth/booth_walls.h>
 #include <pipeline/render/booth_upload.h>
 #include <pipeline/render/gl_handles.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/shading/view.h>
+#include <pipeline/surface/scene.h>
 
 namespace replica::pipeline::render {
 
@@ -57,9 +59,22 @@ public:
     // Sets the panel pose in one mode's program and makes that program current: each mode draws
     // at its own pose (the cache at the held one).
     void usePose(BoothMode mode, const shading::PanelPose& panel) const;
+    // In a pass that lights with the walls (RenderSettings::walls), usePose(Cache, pose) also
+    // sets the walls' field for the pose (shading::wallField: uWallE, uWallVec) from these walls
+    // lit by the current light on this surface; none (a light without walls): no wall light.
+    void setWalls(const booth::WallLight* walls, const surface::SurfaceScene* scene)
+    {
+        walls_ = walls;
+        wallScene_ = scene;
+    }
 
 private:
+    void setWallField(GLuint program, const shading::PanelPose& panel) const;
+
     std::array<GlProgram, 4> programs_{};
+    bool wallsOn_ = false;
+    const booth::WallLight* walls_ = nullptr;
+    const surface::SurfaceScene* wallScene_ = nullptr;
 };
 
 } // namespace replica::pipeline::render

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <pipeline/reference/wall_radiosity.h>
 #include <pipeline/render/booth_scene_pass.h>
 
 namespace replica::pipeline::render {
@@ -28,6 +29,15 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
         return makeError(ErrorCode::InvalidArgument, "render: the booth model has no lights");
     }
     std::unique_ptr<BoothScenePass> p(new BoothScenePass());
+    // A booth with walls lights every lamp's passes with them, each lamp's solved once here.
+    setup.settings.walls = setup.booth.walls.has_value();
+    if (setup.booth.walls) {
+        reference::WallSolveOptions o;
+        o.patchM = kRealtimeWallPatchM;
+        for (const auto& lamp : setup.booth.lights) {
+            p->walls_.push_back(reference::solveWalls(*setup.booth.walls, lamp, setup.observer, o));
+        }
+    }
     p->setup_ = std::move(setup);
     const auto& s = p->setup_;
     const auto makeVariant = [&](const shading::RenderSettings& settings) -> Expected<void> {
@@ -163,6 +173,7 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
     if (isLamp) {
         light_ = shading::prepareLight(setup_.booth.lights[static_cast<std::size_t>(lamp)],
                                        setup_.observer, pass_->settings().lights, basis_);
+        light_.walls = walls_.empty() ? nullptr : &walls_[static_cast<std::size_t>(lamp)];
     } else {
         // Direct-sensor mode: a uniform emitter with the sensed spectrum.
         direct_ = uniformEmitter(setup_.booth.lights.front(),

@@ -33,6 +33,12 @@ struct LampSettings {
     int horizonDirections = 8; // scenes with relief only; 0 keeps the setup's
 };
 
+// The wall patches' side the appliance solves a booth's walls with: 35 cm, each wall two to
+// three patches, the panel's share of them (shading::wallField) a few tens of microseconds per
+// pose; against the exact reference (5 cm patches) it adds no ΔE00 measurable above the
+// renderer's own error (docs/rendering.md, "The booth's walls").
+inline constexpr double kRealtimeWallPatchM = 0.35;
+
 struct BoothSceneSetup {
     booth::Booth booth; // lights with luminance images (data/booth); lampIndex indexes them
     surface::SurfaceScene scene;
@@ -132,6 +138,9 @@ private:
     std::optional<std::uint64_t> heldLight_;
     booth::BoothLight direct_;
     shading::PreparedLight light_;
+    // A booth that declares walls (booth::Booth::walls): each lamp's walls, solved at create()
+    // (reference::solveWalls, kRealtimeWallPatchM), lampIndex indexing them; empty otherwise.
+    std::vector<booth::WallLight> walls_;
     // The encoding on the GPU (SceneState::encoding) and its basis.
     colour::ChannelBasis basis_;
     int encodings_ = 0;

@@ -149,6 +149,7 @@ Expected<void> BoothShadingPass::setLight(const shading::PreparedLight& pl)
                          "render: the booth pass needs a prepared light");
     }
     light_ = &pl;
+    programs_.setWalls(pl.walls, scene_->scene);
     cache_.invalidate();
     return inputs_.uploadLight(pl, *scene_->scene, *observer_, hwFilter_, programs_);
 }

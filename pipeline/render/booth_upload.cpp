@@ -162,7 +162,9 @@ std::string boothShaderSource(const BoothShaderConfig& c, const shading::RenderS
                        c.specularSamples, wardModelIndex(c.wardModel), c.facetCache ? 1 : 0,
                        lightCalls, c.unrolledLights, specCalls, c.unrolledSpecularSamples,
                        s.areaLights ? 1 : 0) +
-           kBoothXyzShader;
+           // Only a pass that lights with the walls says so: every other program's source stays
+           // as it was.
+           (s.walls ? "#define BOOTH_WALLS 1\n" : "") + kBoothXyzShader;
 }
 
 } // namespace replica::pipeline::render::booth_upload

@@ -5,6 +5,7 @@
 #include <pipeline/render/booth_shading_pass.h>
 #include <pipeline/render/booth_upload.h>
 #include <pipeline/render/xyz_target.h>
+#include <pipeline/shading/wall_field.h>
 
 namespace replica::pipeline::render {
 
@@ -94,7 +95,8 @@ Expected<shading::XyzFrame> renderBoothFrame(BoothShadingPass& pass,
     shading::XyzFrame f =
             (*target)->read(light, view, s.subtractFlare ? shading::kScreenFlareRho : 0.0);
     if (light.light != nullptr) {
-        f.whiteY = shading::panelWhiteY(light, view.panel, s.areaLights);
+        f.whiteY = shading::panelWhiteY(light, view.panel, s.areaLights) +
+                   shading::wallsWhiteY(light.walls, view.panel, s.walls);
         f.whiteXyz = light.white * f.whiteY;
     }
     // The eye's side of the surface, pixel by pixel as the CPU model tests it.

@@ -70,7 +70,18 @@ Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
         }
         light.referenceSpectrum = *s;
     }
+    if (b.walls) {
+        const colour::Spectrum reflectance = b.walls->reflectance;
+        b.walls = defaultBoothWalls(b.ceiling());
+        b.walls->reflectance = reflectance;
+    }
     return b;
+}
+
+booth::BoothWalls defaultBoothWalls(const booth::BoothLight& ceiling, const StandModel& stand)
+{
+    return booth::defaultWalls(ceiling,
+                               stand.hingeM.z - stand.hingeToPanelM - stand.panelHeightM - 0.05);
 }
 
 } // namespace replica::pipeline::scene

@@ -8,6 +8,8 @@
 #include <pipeline/base/expected.h>
 #include <pipeline/booth/booth_light.h>
 #include <pipeline/booth/booth_model.h>
+#include <pipeline/booth/booth_walls.h>
+#include <pipeline/scene/stand.h>
 
 namespace replica::pipeline::scene {
 
@@ -26,5 +28,9 @@ Expected<booth::Booth> loadDefaultBooth(const std::string& dataDir);
 // above; the reference spectra come from dataDir/spectra.
 Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
                                           const std::string& dataDir);
+
+// The booth's walls as the appliance models them (booth::defaultWalls: N7, the box under the
+// ceiling), the back wall 5 cm behind the furthest the stand's panel reaches when tilted back.
+booth::BoothWalls defaultBoothWalls(const booth::BoothLight& ceiling, const StandModel& stand = {});
 
 } // namespace replica::pipeline::scene

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -10,6 +11,7 @@
 
 #include <pipeline/shading/frame.h>
 #include <pipeline/shading/realtime_model.h>
+#include <pipeline/shading/wall_field.h>
 
 namespace replica::pipeline::shading {
 namespace {
@@ -68,6 +70,9 @@ public:
             return diffuse_(light_.points, nl_, texelArea_, withMacroNormal(sp), nullptr, 0.0,
                             false);
         });
+        if (settings_.walls && light_.walls != nullptr) {
+            walls_ = wallField(*light_.walls, view_.panel, scene_);
+        }
         std::vector<Counts> counts(static_cast<std::size_t>(threads_));
         inParallel(threads_, frame.height, [&](int t, int y0, int y1) {
             for (int py = y0; py < y1; ++py) {
@@ -83,6 +88,9 @@ public:
             frame.nonFinite += c.bad;
         }
         frame.whiteY = panelWhiteY(light_, view_.panel, settings_.areaLights);
+        if (walls_) {
+            frame.whiteY += walls_->whiteLux / std::numbers::pi;
+        }
         frame.whiteXyz = light_.white * frame.whiteY;
         return frame;
     }
@@ -141,15 +149,19 @@ private:
         c.behind += behind ? 1 : 0;
         const double u = (px + 0.5) / view_.pixelsX;
         const double v = (py + 0.5) / view_.pixelsY;
-        const double eGeo = diffuseNodes_.x > 0
-                                    ? gridValue(diffuseGrid_, diffuseNodes_, u, v)
-                                    : diffuse_(light_.points, nl_, texelArea_, withMacroNormal(sp),
-                                               nullptr, 0.0, false);
+        double eGeo = diffuseNodes_.x > 0 ? gridValue(diffuseGrid_, diffuseNodes_, u, v)
+                                          : diffuse_(light_.points, nl_, texelArea_,
+                                                     withMacroNormal(sp), nullptr, 0.0, false);
         double e = eGeo;
         if (relief_) {
             // Eq. (1)'s horizons bilinear at the pixel's point on the surface.
             e = diffuse_(light_.points, nl_, texelArea_, sp, horizon_, settings_.horizonSoftness,
                          true);
+        }
+        if (walls_) {
+            const double wallGeo = wallFieldAt(*walls_, u, v, sp.nGeo, sp.nGeo);
+            e += relief_ ? wallFieldAt(*walls_, u, v, sp.nGeo, sp.nShade) : wallGeo;
+            eGeo += wallGeo;
         }
         if (!settings_.diffusePass) {
             e = 0.0;
@@ -197,6 +209,7 @@ private:
     const int threads_;
     GridNodes specularNodes_, diffuseNodes_;
     std::vector<double> specularGrid_, diffuseGrid_;
+    std::optional<WallField> walls_;
 };
 
 } // namespace

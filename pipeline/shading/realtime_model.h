@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 
 #include <pipeline/booth/booth_light.h>
+#include <pipeline/booth/booth_walls.h>
 #include <pipeline/booth/luminance_image.h>
 #include <pipeline/colour/channel_basis.h>
 #include <pipeline/shading/frame.h>
@@ -99,6 +100,11 @@ struct RenderSettings {
     // refuses other settings).
     bool specularNearestLevel = true;
     int threads = 2;
+    // Light the surface from the booth's walls too, where the light carries them
+    // (PreparedLight::walls): their light on the panel is baked into a WallField whenever the
+    // panel moves (shading/wall_field.h) and added to eq. (1), the flare and the white. Off (the
+    // default) costs nothing and leaves every frame as it was.
+    bool walls = false;
 };
 
 // Nodes of a grid (specular or diffuse) for a spacing in texels: (ceil(width / s) + 1) x
@@ -152,6 +158,9 @@ struct PreparedLight {
     colour::Spectrum unitSpd;
     colour::Xyz white{0.0};            // XYZ of the unit-luminance light (Y = 1)
     colour::ChannelToXyz channelXyz{}; // M_k for the Basis6 path
+    // The booth's walls lit by this light (solved once at start-up, reference::solveWalls), or
+    // none; used where RenderSettings::walls says. Not owned.
+    const booth::WallLight* walls = nullptr;
 };
 
 // 'basis' must be the one the scene was prepared with (box6 when not given).

@@ -313,6 +313,7 @@ void registerBoothCommand(CLI::App& app, int& exitCode)
             ->required();
     build->add_option("--out", *buildOut, "output booth folder")->required();
     build->callback([input, buildOut, &exitCode] { exitCode = runBuild(*input, *buildOut); });
+    registerBoothWallsCommand(*booth, exitCode);
 }
 
 void registerSceneCommand(CLI::App& app, int& exitCode)

@@ -20,6 +20,8 @@ void registerInspectCommand(CLI::App& app, int& exitCode);
 void registerRenderCommand(CLI::App& app, int& exitCode);
 void registerPlanCommand(CLI::App& app, int& exitCode);
 void registerBoothCommand(CLI::App& app, int& exitCode);
+// 'replica booth walls' under 'booth' (booth_walls_command.cpp).
+void registerBoothWallsCommand(CLI::App& booth, int& exitCode);
 void registerSceneCommand(CLI::App& app, int& exitCode);
 void registerDisplayCommand(CLI::App& app, int& exitCode);
 void registerRecoverCommand(CLI::App& app, int& exitCode);

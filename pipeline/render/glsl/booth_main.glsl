@@ -89,8 +89,11 @@ void diffuseNode(vec3 p) {
 // cosines clamped instead of tested: the same sum, and on llvmpipe about half the cost of the full
 // loop of the cache, which ran here on every pixel of the panel (measured: a metamer frame that
 // recomputes the cache, 393 -> 217 ms on the loaded 2-core machine).
-void flareOnly(vec3 p) {
+void flareOnly(vec3 p, vec2 uv) {
     float eg = 0.0;
+#if defined(BOOTH_WALLS)
+    eg += wallLight(uv, uNormal); // the nearest edge's, around the surface
+#endif
 #if BOOTH_AREA_LIGHTS
     float unused = 0.0;
     for (int i = 0; i < uLightCount; ++i) {
@@ -133,6 +136,13 @@ void diffuseCache(vec3 p, vec3 nShade, vec2 uv, ivec2 tc, bool inside) {
     if (!relief) {
         e = eGeo;
     }
+#if defined(BOOTH_WALLS)
+    {
+        float wallGeo = wallLight(uv, uNormal);
+        e += relief ? wallLight(uv, nShade) : wallGeo;
+        eGeo += wallGeo;
+    }
+#endif
     if (!uDiffuse) {
         e = 0.0;
     }
@@ -200,7 +210,7 @@ void main() {
     } else if (uMode == 3) {
         diffuseNode(p);
     } else if (uMode == 0 && !inside) {
-        flareOnly(p);
+        flareOnly(p, uv);
     } else if (uMode == 0) {
         diffuseCache(p, nShade, uv, tc, inside);
     } else {

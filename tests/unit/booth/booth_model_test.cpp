@@ -1,6 +1,8 @@
 // booth.json + EXR round trip and the messages for broken booth folders.
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
@@ -41,6 +43,40 @@ TEST(BoothModel, RoundTripsThroughJsonAndExr)
     }
     EXPECT_NE(r->find("d50"), nullptr);
     EXPECT_EQ(r->find("nope"), nullptr);
+}
+
+TEST(BoothModel, WallsAreDeclaredOrNotModelled)
+{
+    Booth b;
+    b.lights.push_back(test::stripedLight(8, 4));
+    const auto dir = freshDir("walls");
+    ASSERT_TRUE(saveBooth(dir, b));
+    auto none = loadBooth(dir);
+    ASSERT_TRUE(none) << none.error().message;
+    EXPECT_FALSE(none->walls.has_value()); // no "walls": not modelled
+    BoothWalls w;
+    w.reflectance = colour::Spectrum::constant(0.2);
+    w.reflectance[3] = 0.6;
+    b.walls = w;
+    ASSERT_TRUE(saveBooth(dir, b));
+    auto with = loadBooth(dir);
+    ASSERT_TRUE(with) << with.error().message;
+    ASSERT_TRUE(with->walls.has_value());
+    EXPECT_EQ(with->walls->reflectance[3], 0.6);
+    EXPECT_EQ(with->walls->reflectance[4], 0.2);
+    // "walls": {} is N7 (booth.json's keys are sorted: "walls" comes last).
+    {
+        std::ifstream in(dir / "booth.json");
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const auto at = text.find("\"walls\"");
+        ASSERT_NE(at, std::string::npos);
+        text = text.substr(0, at) + "\"walls\": {}\n}\n";
+        std::ofstream(dir / "booth.json") << text;
+    }
+    auto n7 = loadBooth(dir);
+    ASSERT_TRUE(n7) << n7.error().message;
+    ASSERT_TRUE(n7->walls.has_value());
+    EXPECT_EQ(n7->walls->reflectance[0], kMunsellN7Reflectance);
 }
 
 TEST(BoothModel, ReportsMissingFolderAndBadFields)

@@ -75,6 +75,34 @@ TEST_F(BoothScenePassTest, ClassifiedLampUsesItsBoothLight)
     EXPECT_GT(lit, 0.0);
 }
 
+TEST_F(BoothScenePassTest, ABoothThatDeclaresItsWallsIsLitByThemToo)
+{
+    // The shipped booth declares none: its frames stay as they were.
+    ASSERT_FALSE(setup_.booth.walls.has_value());
+    scene::SceneState st;
+    st.lampIndex = 0;
+    st.tiltRad = 0.5;
+    auto plain = BoothScenePass::create(setup_);
+    ASSERT_TRUE(plain) << plain.error().message;
+    EXPECT_FALSE((*plain)->setup().settings.walls);
+    const auto without = frame(**plain, st);
+    BoothSceneSetup walled = setup_;
+    walled.booth.walls = scene::defaultBoothWalls(walled.booth.ceiling());
+    auto pass = BoothScenePass::create(walled);
+    ASSERT_TRUE(pass) << pass.error().message;
+    EXPECT_TRUE((*pass)->setup().settings.walls);
+    const auto with = frame(**pass, st);
+    ASSERT_EQ(with.size(), without.size());
+    double a = 0.0, b = 0.0;
+    for (std::size_t i = 0; i < with.size(); ++i) {
+        a += without[i].y;
+        b += with[i].y;
+    }
+    // N7 walls add a few percent to the frame.
+    EXPECT_GT(b, 1.01 * a);
+    EXPECT_LT(b, 1.3 * a);
+}
+
 TEST_F(BoothScenePassTest, UnknownLightIsTheSensedSpectrumOnAUniformEmitter)
 {
     auto pass = BoothScenePass::create(setup_);
