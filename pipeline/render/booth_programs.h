@@ -13,7 +13,7 @@
 #include <pipeline/render/gl_handles.h>
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/shading/view.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace replica::pipeline::render {
 

@@ -11,7 +11,7 @@
 
 #include <pipeline/booth/booth_walls.h>
 #include <pipeline/shading/view.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 namespace replica::pipeline::shading {
 

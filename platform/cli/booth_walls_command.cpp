@@ -20,7 +20,7 @@
 #include <pipeline/shading/realtime_model.h>
 #include <pipeline/shading/wall_field.h>
 #include <pipeline/spectral/adaptive_encoding.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 #include <platform/cli/commands.h>
 
 namespace replica::platform {

@@ -13,7 +13,7 @@
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/reference/wall_radiosity.h>
 #include <pipeline/scene/booth.h>
-#include <pipeline/surface/scene.h>
+#include <pipeline/surface/surface_scene.h>
 
 #include <gtest/gtest.h>
 
