@@ -44,8 +44,6 @@ TexelSums integrateTexels(const TexelCloud& light,
 {
     TexelSums s;
     const double a = light.texelAreaM2;
-    const int azimuths =
-            sinHorizonByAzimuth != nullptr ? static_cast<int>(sinHorizonByAzimuth->size()) : 0;
     for (std::size_t k = 0; k < light.position.size(); ++k) {
         Vec3 d = light.position[k] - p;
         const double d2 = glm::dot(d, d);
@@ -66,22 +64,8 @@ TexelSums integrateTexels(const TexelCloud& light,
         if (!(cosS > 0.0)) {
             continue;
         }
-        if (azimuths > 0) {
-            const double lx = glm::dot(d, right);
-            const double ly = glm::dot(d, up);
-            double phi = std::atan2(ly, lx);
-            if (phi < 0.0) {
-                phi += 2.0 * std::numbers::pi;
-            }
-            const double f = phi / (2.0 * std::numbers::pi) * azimuths;
-            const int k0 = static_cast<int>(std::floor(f)) % azimuths;
-            const int k1 = (k0 + 1) % azimuths;
-            const double t = f - std::floor(f);
-            const double sinB = (1.0 - t) * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k0)] +
-                                t * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k1)];
-            if (!(cosG > sinB)) {
-                continue; // below the relief's horizon
-            }
+        if (!aboveHorizon(sinHorizonByAzimuth, d, cosG, right, up)) {
+            continue; // below the relief's horizon
         }
         s.irradiance += l * cosS * dw;
         if (specular) {
