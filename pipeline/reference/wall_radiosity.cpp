@@ -8,6 +8,7 @@
 #include <pipeline/reference/reference_integrator.h>
 #include <pipeline/reference/wall_radiosity.h>
 #include <pipeline/shading/realtime_model.h>
+#include <pipeline/surface/relief.h>
 
 namespace replica::pipeline::reference {
 namespace {
@@ -148,17 +149,8 @@ bool aboveHorizon(const std::vector<double>* sinHorizonByAzimuth,
     if (azimuths == 0) {
         return true;
     }
-    double phi = std::atan2(glm::dot(d, up), glm::dot(d, right));
-    if (phi < 0.0) {
-        phi += 2.0 * std::numbers::pi;
-    }
-    const double f = phi / (2.0 * std::numbers::pi) * azimuths;
-    const int k0 = static_cast<int>(std::floor(f)) % azimuths;
-    const int k1 = (k0 + 1) % azimuths;
-    const double t = f - std::floor(f);
-    const double sinB = (1.0 - t) * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k0)] +
-                        t * (*sinHorizonByAzimuth)[static_cast<std::size_t>(k1)];
-    return cosG > sinB;
+    return cosG > surface::atAzimuth(sinHorizonByAzimuth->data(), azimuths, glm::dot(d, right),
+                                     glm::dot(d, up));
 }
 
 WallSums integrateWalls(const booth::WallLight& walls,

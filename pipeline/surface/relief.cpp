@@ -112,16 +112,8 @@ double HorizonMap::sinHorizon(int x, int y, const Vec3& l) const
     }
     x = std::clamp(x, 0, width - 1);
     y = std::clamp(y, 0, height - 1);
-    double phi = std::atan2(l.y, l.x); // atan2(0, 0) = 0: defined for a light straight overhead
-    if (phi < 0.0) {
-        phi += 2.0 * std::numbers::pi;
-    }
-    const double f = phi / (2.0 * std::numbers::pi) * directions;
-    const int k0 = static_cast<int>(std::floor(f)) % directions;
-    const int k1 = (k0 + 1) % directions;
-    const double t = f - std::floor(f);
-    const float* b = &sinBeta[(static_cast<std::size_t>(y) * width + x) * directions];
-    return (1.0 - t) * b[k0] + t * b[k1];
+    return atAzimuth(&sinBeta[(static_cast<std::size_t>(y) * width + x) * directions], directions,
+                     l.x, l.y);
 }
 
 double HorizonMap::sinHorizonBilinear(double x, double y, const Vec3& l) const

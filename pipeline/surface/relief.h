@@ -2,6 +2,8 @@
 // horizon map.
 #pragma once
 
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -27,6 +29,23 @@ struct HeightField {
 // Central differences over 2 pitches (one-sided at the edges), renormalised; a vertical cliff gives
 // a finite, nearly horizontal normal and never normalises a zero vector.
 std::vector<Vec3> normalMap(const HeightField& h);
+
+// A horizon table of n entries at azimuths 2 pi k / n (k = 0 along +x, n/4 along +y), linear in
+// azimuth, at the direction whose components along x and y are (lx, ly): the one rule the horizon
+// map and the exact reference's horizon tests read a table by.
+template <typename T>
+double atAzimuth(const T* table, int n, double lx, double ly)
+{
+    double phi = std::atan2(ly, lx); // atan2(0, 0) = 0: defined for a light straight overhead
+    if (phi < 0.0) {
+        phi += 2.0 * std::numbers::pi;
+    }
+    const double f = phi / (2.0 * std::numbers::pi) * n;
+    const int k0 = static_cast<int>(std::floor(f)) % n;
+    const int k1 = (k0 + 1) % n;
+    const double t = f - std::floor(f);
+    return (1.0 - t) * table[k0] + t * table[k1];
+}
 
 // Horizon map: for each texel and k azimuths phi_k = 2 pi k / K (phi = 0 along +x, pi/2 along +y),
 // the sine of the highest occluder's elevation, floored at 0 (the macro plane's own horizon).
