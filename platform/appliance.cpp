@@ -268,9 +268,12 @@ Expected<void> applyRenderPlan(RunConfig& config, pipeline::render::BoothSceneSe
         ls.lights = p.lights;
         ls.specularSamples = p.specularSamples;
         ls.horizonDirections = p.horizonDirections;
+        ls.walls = p.walls;
         setup.perLamp[name] = ls;
-        logger("planner")->info("lamp {}: {} lights, {} specular samples, {} horizon directions",
-                                name, p.lights, p.specularSamples, p.horizonDirections);
+        logger("planner")->info("lamp {}: {} lights, {} specular samples, {} horizon directions{}",
+                                name, p.lights, p.specularSamples, p.horizonDirections,
+                                setup.booth.walls ? (p.walls ? ", the walls' light" : ", no walls")
+                                                  : "");
     }
     return {};
 }

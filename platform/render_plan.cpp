@@ -1,6 +1,7 @@
 // The planner's per-lamp choice: computed, cached in a file, read back with every field checked.
 #include <algorithm>
 #include <cstdlib>
+#include <optional>
 #include <vector>
 
 #include <fmt/format.h>
@@ -13,6 +14,9 @@
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/reference/reference_integrator.h>
+#include <pipeline/reference/wall_radiosity.h>
+#include <pipeline/render/booth_scene_pass.h>
+#include <pipeline/scene/booth.h>
 #include <pipeline/scene/stand.h>
 #include <pipeline/spectral/adaptive_encoding.h>
 #include <pipeline/tuning/planner.h>
@@ -36,6 +40,7 @@ std::string renderPlanJson(const RenderPlan& plan)
         lamps[name] = {{"lights", p.lights},
                        {"specular_samples", p.specularSamples},
                        {"horizon_directions", p.horizonDirections},
+                       {"walls", p.walls},
                        {"probe_de00_p95", p.probeP95},
                        {"probe_de00_max", p.probeMax},
                        {"met_budget", p.met}};
@@ -111,6 +116,12 @@ Expected<RenderPlan> parseRenderPlan(const std::string& text, const std::string&
         if (!count("horizon_directions", 0, 32, p.horizonDirections)) {
             return bad(fmt::format("lamp '{}': \"horizon_directions\" must be an integer in 0..32",
                                    name));
+        }
+        if (l.contains("walls")) {
+            if (!l["walls"].is_boolean()) {
+                return bad(fmt::format("lamp '{}': \"walls\" must be true or false", name));
+            }
+            p.walls = l["walls"].get<bool>();
         }
         p.probeP95 = l.value("probe_de00_p95", 0.0);
         p.probeMax = l.value("probe_de00_max", 0.0);
@@ -227,6 +238,7 @@ Expected<PlanInputs> loadPlanInputs(const std::filesystem::path& sceneDir,
         return tl::unexpected(booth.error());
     }
     in.booth = std::move(*booth);
+    pipeline::scene::placeBoothWalls(in.booth); // their box, as the appliance draws them
     auto obs = pipeline::colour::loadCie1931(dataDir());
     if (!obs) {
         return tl::unexpected(obs.error());
@@ -262,6 +274,30 @@ Expected<PlanInputs> loadPlanInputs(const std::filesystem::path& sceneDir,
     return in;
 }
 
+// The booth's walls under one lamp, for planning: solved at the exact reference's patches (the
+// truth) and at the appliance's (what it draws); neither for a booth without walls.
+struct PlanWallLight {
+    std::optional<pipeline::booth::WallLight> exact;
+    std::optional<pipeline::booth::WallLight> realtime;
+
+    pipeline::shading::PlanWalls forPlanner() const
+    {
+        return {exact ? &*exact : nullptr, realtime ? &*realtime : nullptr};
+    }
+};
+
+PlanWallLight planWalls(const PlanInputs& in, const pipeline::booth::BoothLight& light)
+{
+    PlanWallLight w;
+    if (in.booth.walls) {
+        w.exact = pipeline::reference::solveWalls(*in.booth.walls, light, in.obs);
+        pipeline::reference::WallSolveOptions o;
+        o.patchM = pipeline::render::kRealtimeWallPatchM;
+        w.realtime = pipeline::reference::solveWalls(*in.booth.walls, light, in.obs, o);
+    }
+    return w;
+}
+
 } // namespace
 
 Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
@@ -286,8 +322,9 @@ Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
         }
         const sh::ErrorBudget probeBudget{kPlanBudget.p95 * kPlanMargin,
                                           kPlanBudget.max * kPlanMargin};
+        const PlanWallLight walls = planWalls(*in, light);
         const sh::Plan p = sh::planRenderViews(in->scene, light, views, in->obs, probeBudget,
-                                               in->base, *basis);
+                                               in->base, *basis, walls.forPlanner());
         LampPlan lp;
         lp.lights = p.settings.lights;
         lp.specularSamples = in->scene.glossy() ? p.settings.specularSamples : 0;
@@ -295,6 +332,7 @@ Expected<RenderPlan> computeRenderPlan(const std::filesystem::path& sceneDir,
         lp.probeP95 = p.probeError.p95;
         lp.probeMax = p.probeError.max;
         lp.met = p.met;
+        lp.walls = p.settings.walls;
         plan.lamps[light.name] = lp;
     }
     return plan;
@@ -330,11 +368,16 @@ checkRenderPlan(const std::filesystem::path& sceneDir,
         s.specularPass = in->scene.glossy();
         s.horizonDirections = it->second.horizonDirections;
         s.reliefPass = !in->scene.flat();
-        const auto pl = sh::prepareLight(light, in->obs, s.lights, *basis);
+        const PlanWallLight walls = planWalls(*in, light);
+        s.walls = walls.exact.has_value() && it->second.walls;
+        auto pl = sh::prepareLight(light, in->obs, s.lights, *basis);
+        pl.walls = s.walls ? &*walls.realtime : nullptr;
+        pipeline::reference::ReferenceOptions ro;
+        ro.walls = walls.exact ? &*walls.exact : nullptr;
         const auto ps = sh::prepareScene(in->scene, std::max(s.horizonDirections, 1), 0.01, *basis);
         pipeline::reference::FrameError worst{0.0, 0.0, 0.0};
         for (const auto& v : views) {
-            const auto ref = pipeline::reference::renderReference(in->scene, light, v, in->obs);
+            const auto ref = pipeline::reference::renderReference(in->scene, light, v, in->obs, ro);
             const auto e = pipeline::reference::compareFrames(
                     ref, sh::renderRealtime(ps, pl, v, in->obs, s));
             worst.mean = std::max(worst.mean, e.mean);

@@ -1,5 +1,6 @@
 // The planner in the loop: for a scene and every booth lamp, the cheapest lights / specular samples
-// / horizon directions that meet the ΔE00 budget from the planner's probe views
+// / horizon directions (and, under a booth with walls, whether to draw them) that meet the ΔE00
+// budget from the planner's probe views
 // (shading::planRenderViews), computed once and cached in a file keyed by the scene, booth and
 // basis, and recorded in a run's configuration (RunConfig::plannedLamps) so replay draws the same.
 #pragma once
@@ -22,10 +23,14 @@ struct LampPlan {
     double probeP95 = 0.0; // worst over the probe views, against the exact reference
     double probeMax = 0.0;
     bool met = false; // false: nothing met the budget; the most accurate setting tried
+    // Light the surface from the booth's walls (a booth that declares them; no effect otherwise).
+    // True where a plan or a recording does not say: every lamp of a booth with walls drew them
+    // before the planner chose.
+    bool walls = true;
     bool operator==(const LampPlan& o) const
     {
         return lights == o.lights && specularSamples == o.specularSamples &&
-               horizonDirections == o.horizonDirections;
+               horizonDirections == o.horizonDirections && walls == o.walls;
     }
 };
 

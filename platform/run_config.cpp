@@ -102,7 +102,8 @@ std::string RunConfig::toJson() const
         for (const auto& [name, p] : plannedLamps) {
             lamps[name] = {{"lights", p.lights},
                            {"specular_samples", p.specularSamples},
-                           {"horizon_directions", p.horizonDirections}};
+                           {"horizon_directions", p.horizonDirections},
+                           {"walls", p.walls}};
         }
         j["planned_lamps"] = lamps;
     }
@@ -173,6 +174,7 @@ void readRendering(const nlohmann::json& j, RunConfig& c)
             p.lights = l.at("lights").get<int>();
             p.specularSamples = l.at("specular_samples").get<int>();
             p.horizonDirections = l.at("horizon_directions").get<int>();
+            p.walls = l.value("walls", true); // absent: recorded before the planner chose walls
             if (p.lights < 1 || p.lights > 256 || p.specularSamples < 0 ||
                 p.specularSamples > 256 || p.horizonDirections < 0 || p.horizonDirections > 32) {
                 throw std::runtime_error(

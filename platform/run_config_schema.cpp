@@ -52,7 +52,8 @@ std::vector<JsonSchemaField> nestedKeys()
             // The planner's choice per lamp name (platform/render_plan.h).
             {"planned_lamps", map(object({{"lights", integer(1, 256)},
                                           {"specular_samples", integer(0, 256)},
-                                          {"horizon_directions", integer(0, 32)}}),
+                                          {"horizon_directions", integer(0, 32)},
+                                          {"walls", boolean().optional()}}),
                                   64)
                                       .optional()},
             // What 'replica run' adds for people (never read back): any values.

@@ -29,7 +29,8 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
         return makeError(ErrorCode::InvalidArgument, "render: the booth model has no lights");
     }
     std::unique_ptr<BoothScenePass> p(new BoothScenePass());
-    // A booth with walls lights every lamp's passes with them, each lamp's solved once here.
+    // A booth with walls lights each lamp's passes with them unless the lamp's plan leaves them
+    // out (LampSettings::walls); each lamp's walls solved once here.
     setup.settings.walls = setup.booth.walls.has_value();
     if (setup.booth.walls) {
         reference::WallSolveOptions o;
@@ -68,10 +69,12 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
             if (!s.scene.flat() && it->second.horizonDirections > 0) {
                 settings.horizonDirections = it->second.horizonDirections;
             }
+            settings.walls = settings.walls && it->second.walls;
             const auto same = [&](const Variant& v) {
                 return v.settings.lights == settings.lights &&
                        v.settings.specularSamples == settings.specularSamples &&
-                       v.settings.horizonDirections == settings.horizonDirections;
+                       v.settings.horizonDirections == settings.horizonDirections &&
+                       v.settings.walls == settings.walls;
             };
             const auto found = std::find_if(p->variants_.begin(), p->variants_.end(), same);
             if (found == p->variants_.end()) {

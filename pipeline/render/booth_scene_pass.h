@@ -31,6 +31,7 @@ struct LampSettings {
     int lights = 32;
     int specularSamples = 24;  // glossy scenes only
     int horizonDirections = 8; // scenes with relief only; 0 keeps the setup's
+    bool walls = true;         // a booth with walls only: light this lamp's passes with them
 };
 
 // The wall patches' side the appliance solves a booth's walls with: 35 cm, each wall two to

@@ -70,12 +70,17 @@ Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
         }
         light.referenceSpectrum = *s;
     }
-    if (b.walls) {
+    placeBoothWalls(b);
+    return b;
+}
+
+void placeBoothWalls(booth::Booth& b, const StandModel& stand)
+{
+    if (b.walls && !b.lights.empty()) {
         const colour::Spectrum reflectance = b.walls->reflectance;
-        b.walls = defaultBoothWalls(b.ceiling());
+        b.walls = defaultBoothWalls(b.ceiling(), stand);
         b.walls->reflectance = reflectance;
     }
-    return b;
 }
 
 booth::BoothWalls defaultBoothWalls(const booth::BoothLight& ceiling, const StandModel& stand)

@@ -33,4 +33,9 @@ Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
 // ceiling), the back wall 5 cm behind the furthest the stand's panel reaches when tilted back.
 booth::BoothWalls defaultBoothWalls(const booth::BoothLight& ceiling, const StandModel& stand = {});
 
+// A booth read by booth::loadBooth declares its walls' reflectance only: give them the box
+// defaultBoothWalls makes (what loadApplianceBooth does), keeping the reflectance. No walls: no
+// change.
+void placeBoothWalls(booth::Booth& booth, const StandModel& stand = {});
+
 } // namespace replica::pipeline::scene

@@ -20,13 +20,22 @@ double settingCost(const RenderSettings& s, bool glossy, bool relief)
     // grid, so a sample costs nothing measurable (fit -0.003 +- noise ms): 0.002 ms keeps the
     // fewer samples first among settings of as many lights. Refit: run replica_bench_cost_model
     // (docs/rendering.md, "Planner").
+    //
+    // The walls (RenderSettings::walls: a biquadratic and a dot product a pixel in the cache
+    // pass, and the field baked on the CPU once per pose) measured as whole frames, `replica run
+    // --hal sim --output headless --no-planner --rate 60 --frames 300 --size 960x600 --fast` under
+    // the shipped booth and the same booth declaring N7 walls, three pairs interleaved: the
+    // painting's median frame 0.3 ms longer in each pair; the ColorChecker's within the runs'
+    // noise (0.1 +- 0.4 ms), taken as 0.05. Small, but not zero: walls that change nothing
+    // visible are not drawn.
     struct Coefficients {
         double light;
         double direction;
         double sample;
+        double walls;
     };
-    constexpr Coefficients kFlat{0.082, 0.0, 0.002};  // area lights, specular and diffuse grids
-    constexpr Coefficients kRelief{0.43, 0.46, 1.35}; // point lights, per-pixel specular
+    constexpr Coefficients kFlat{0.082, 0.0, 0.002, 0.05}; // area lights, specular, diffuse grids
+    constexpr Coefficients kRelief{0.43, 0.46, 1.35, 0.3}; // point lights, per-pixel specular
     const Coefficients& k = relief && s.reliefPass ? kRelief : kFlat;
     double c = s.lights * k.light;
     if (relief && s.reliefPass) {
@@ -34,6 +43,9 @@ double settingCost(const RenderSettings& s, bool glossy, bool relief)
     }
     if (glossy && s.specularPass) {
         c += s.specularSamples * k.sample;
+    }
+    if (s.walls) {
+        c += k.walls;
     }
     return c;
 }
@@ -77,9 +89,11 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
                      const colour::Observer& obs,
                      const ErrorBudget& budget,
                      const RenderSettings& base,
-                     const colour::ChannelBasis& basis)
+                     const colour::ChannelBasis& basis,
+                     const PlanWalls& walls)
 {
     Plan plan;
+    const bool hasWalls = walls.exact != nullptr && walls.realtime != nullptr;
     const bool glossy = scene.glossy();
     const bool relief = !scene.flat();
     if (!glossy) {
@@ -91,7 +105,9 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
     std::vector<XyzFrame> refs;
     refs.reserve(views.size());
     for (const View& v : views) {
-        refs.push_back(reference::renderReference(scene, light, v, obs));
+        reference::ReferenceOptions ro;
+        ro.walls = hasWalls ? walls.exact : nullptr;
+        refs.push_back(reference::renderReference(scene, light, v, obs, ro));
     }
 
     std::vector<RenderSettings> candidates;
@@ -99,13 +115,17 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
         for (int samples :
              glossy ? std::vector<int>{1, 4, 8, 12, 16, 24, 32, 48, 64} : std::vector<int>{0}) {
             for (int dirs : relief ? std::vector<int>{8, 16} : std::vector<int>{0}) {
-                RenderSettings s = base;
-                s.lights = lights;
-                s.specularSamples = samples;
-                s.specularPass = glossy;
-                s.horizonDirections = dirs;
-                s.reliefPass = relief;
-                candidates.push_back(s);
+                for (bool withWalls :
+                     hasWalls ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
+                    RenderSettings s = base;
+                    s.lights = lights;
+                    s.specularSamples = samples;
+                    s.specularPass = glossy;
+                    s.horizonDirections = dirs;
+                    s.reliefPass = relief;
+                    s.walls = withWalls;
+                    candidates.push_back(s);
+                }
             }
         }
     }
@@ -131,7 +151,8 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
                                  prepareScene(scene, std::max(s.horizonDirections, 1), 0.01, basis))
                          .first;
         }
-        const PreparedLight& pl = li->second;
+        PreparedLight& pl = li->second;
+        pl.walls = s.walls ? walls.realtime : nullptr;
         const PreparedScene& ps = si->second;
         // The worst over the views; a view past the budget ends the candidate early.
         reference::FrameError worst{0.0, 0.0, 0.0};
@@ -149,6 +170,10 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
         }
         ++plan.evaluated;
         if (within) {
+            if (hasWalls && !s.walls) {
+                plan.skipped.emplace_back(
+                        "walls: the probe meets the budget without the walls' light");
+            }
             plan.settings = s;
             plan.probeError = worst;
             plan.relativeCost = settingCost(s, glossy, relief);

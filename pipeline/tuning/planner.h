@@ -23,6 +23,15 @@ struct ErrorBudget {
 std::vector<View>
 probeViews(const scene::StandModel& stand, int probeX = 32, int probeY = 20, int eyes = 2);
 
+// The booth's walls under the light being planned, solved twice (reference::solveWalls): 'exact'
+// at the reference's patches, the truth every candidate is measured against; 'realtime' at the
+// appliance's patches, what a candidate with RenderSettings::walls draws. Both null: a booth
+// without walls, whose candidates never light with them.
+struct PlanWalls {
+    const booth::WallLight* exact = nullptr;
+    const booth::WallLight* realtime = nullptr;
+};
+
 struct Plan {
     RenderSettings settings;
     reference::FrameError probeError; // of the chosen setting: worst p95 and max over the views
@@ -38,15 +47,19 @@ struct Plan {
 double settingCost(const RenderSettings& s, bool glossy, bool relief);
 
 // The cheapest setting (by settingCost) whose worst p95 and max over 'views' meet the budget.
-// 'base' gives everything but lights, specular samples and horizon directions (grids, area
+// 'base' gives everything but lights, specular samples, horizon directions and walls (grids, area
 // lights, mip rules: the appliance's own), so the probe measures what the appliance will draw.
+// With 'walls' the reference lights the surface from the booth's walls too, and each candidate is
+// tried without them and with them: the walls are drawn where leaving them out would cost the
+// budget.
 Plan planRenderViews(const surface::SurfaceScene& scene,
                      const booth::BoothLight& light,
                      const std::vector<View>& views,
                      const colour::Observer& obs,
                      const ErrorBudget& budget,
                      const RenderSettings& base,
-                     const colour::ChannelBasis& basis);
+                     const colour::ChannelBasis& basis,
+                     const PlanWalls& walls = {});
 
 // One view ('replica render --plan'): planRenderViews on 'view' at probeX x probeY.
 Plan planRender(const surface::SurfaceScene& scene,

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/booth/booth_model.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/render_plan.h>
@@ -17,6 +18,7 @@ namespace {
 
 struct PlanArgs {
     std::string scene;
+    std::string booth; // empty: the shipped data/booth
     std::string basis = "adaptive_k6";
     std::string cache;
     bool force = false;
@@ -31,7 +33,19 @@ int runPlan(const PlanArgs& a)
     const std::filesystem::path scene = std::filesystem::is_directory(a.scene, ec)
                                                 ? std::filesystem::absolute(a.scene, ec)
                                                 : resolveSceneDir(a.scene);
-    const std::filesystem::path booth = dataDir() / "booth";
+    const std::filesystem::path booth = a.booth.empty() ? dataDir() / "booth"
+                                        : std::filesystem::is_directory(a.booth, ec)
+                                                ? std::filesystem::absolute(a.booth, ec)
+                                                : resolveSceneDir(a.booth);
+    if (!std::filesystem::is_regular_file(booth / "booth.json", ec)) {
+        std::fprintf(stderr,
+                     "replica plan: --booth %s: no booth.json there; name a booth folder such as "
+                     "'replica booth build' makes\n",
+                     booth.string().c_str());
+        return kExitUsage;
+    }
+    const auto boothModel = pipeline::booth::loadBooth(booth);
+    const bool boothWalls = boothModel && boothModel->walls.has_value();
     const std::filesystem::path cache =
             a.cache.empty() ? defaultPlanCacheDir() : std::filesystem::path(a.cache);
     auto sd = sceneDigest(scene);
@@ -51,9 +65,10 @@ int runPlan(const PlanArgs& a)
     }
     std::printf("%s\n", path.string().c_str());
     for (const auto& [name, p] : plan->lamps) {
-        std::printf("%s: %d lights, %d specular samples, %d horizon directions; worst dE00 p95 "
+        std::printf("%s: %d lights, %d specular samples, %d horizon directions%s; worst dE00 p95 "
                     "%.3f, max %.3f over the probe views%s\n",
-                    name.c_str(), p.lights, p.specularSamples, p.horizonDirections, p.probeP95,
+                    name.c_str(), p.lights, p.specularSamples, p.horizonDirections,
+                    !boothWalls ? "" : (p.walls ? ", the walls' light" : ", no walls"), p.probeP95,
                     p.probeMax, p.met ? "" : " (the budget is not met)");
     }
     if (!a.check.empty()) {
@@ -90,11 +105,16 @@ void registerPlanCommand(CLI::App& app, int& exitCode)
 {
     auto args = std::make_shared<PlanArgs>();
     CLI::App* cmd = app.add_subcommand(
-            "plan", "the planner's lights, specular samples and horizon directions for each lamp "
-                    "of the booth on a scene, written to the cache 'replica run --planner' reads");
+            "plan", "the planner's lights, specular samples and horizon directions (and the "
+                    "booth's walls, where it has them) for each lamp of the booth on a scene, "
+                    "written to the cache 'replica run --planner' reads");
     cmd->add_option("--scene", args->scene,
                     "scene folder (one that does not exist from here: under the data folder)")
             ->required();
+    cmd->add_option("--booth", args->booth,
+                    "booth model folder to plan under (as 'replica run --booth'; default: the "
+                    "shipped data/booth); a booth whose booth.json declares walls is planned with "
+                    "them, each lamp drawing them where leaving them out would cost the budget");
     cmd->add_option("--basis", args->basis, "channel basis the appliance will run with")
             ->capture_default_str();
     cmd->add_option("--plan-cache", args->cache,

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include <pipeline/base/data_dir.h>
 #include <platform/appliance.h>
 #include <platform/render_plan.h>
@@ -22,8 +24,8 @@ RenderPlan samplePlan()
     p.sceneDigest = "0123456789abcdef";
     p.boothDigest = "fedcba9876543210";
     p.basis = "adaptive_k6";
-    p.lamps["tungsten"] = {16, 8, 8, 0.886, 1.981, true};
-    p.lamps["d65-fluorescent"] = {32, 4, 8, 0.789, 2.309, true};
+    p.lamps["tungsten"] = {16, 8, 8, 0.886, 1.981, true, true};
+    p.lamps["d65-fluorescent"] = {32, 4, 8, 0.789, 2.309, true, false};
     return p;
 }
 
@@ -41,6 +43,24 @@ TEST(RenderPlan, RoundTripsEveryLampsChoice)
     EXPECT_EQ(back->lamps.at("d65-fluorescent").lights, 32);
     EXPECT_EQ(back->lamps.at("d65-fluorescent").specularSamples, 4);
     EXPECT_DOUBLE_EQ(back->lamps.at("tungsten").probeMax, 1.981);
+    EXPECT_TRUE(back->lamps.at("tungsten").walls);
+    EXPECT_FALSE(back->lamps.at("d65-fluorescent").walls);
+}
+
+TEST(RenderPlan, APlanThatDoesNotSayDrawsTheBoothsWalls)
+{
+    // Plans written before the planner chose the walls: a booth with walls drew them for every
+    // lamp, so an absent "walls" keeps them.
+    auto j = nlohmann::json::parse(renderPlanJson(samplePlan()));
+    for (auto& [name, lamp] : j["lamps"].items()) {
+        ASSERT_EQ(lamp.erase("walls"), 1u) << name;
+    }
+    const std::string text = j.dump(2);
+    auto back = parseRenderPlan(text, "old-plan.json");
+    ASSERT_TRUE(back) << back.error().message;
+    for (const auto& [name, p] : back->lamps) {
+        EXPECT_TRUE(p.walls) << name;
+    }
 }
 
 TEST(RenderPlan, RefusesMalformedFilesNamingThem)
@@ -69,6 +89,8 @@ TEST(RenderPlan, RefusesMalformedFilesNamingThem)
     refused(replaced("\"horizon_directions\": 8", "\"horizon_directions\": 33"),
             "horizon_directions");
     refused(replaced("\"basis\": \"adaptive_k6\"", "\"basis\": 6"), "basis");
+    refused(replaced("\"walls\": false", "\"walls\": 0"), "walls");
+    refused(replaced("\"walls\": false", "\"walls\": \"no\""), "walls");
     std::string noLamps = good.substr(0, good.find("\"lamps\"")) +
                           "\"lamps\": {}, \"scene_digest\": \"0123456789abcdef\"}";
     refused(noLamps, "lamps");

@@ -101,6 +101,33 @@ TEST_F(BoothScenePassTest, ABoothThatDeclaresItsWallsIsLitByThemToo)
     // N7 walls add a few percent to the frame.
     EXPECT_GT(b, 1.01 * a);
     EXPECT_LT(b, 1.3 * a);
+
+    // A lamp whose plan leaves the walls out draws as under a booth without them, bit for bit;
+    // the other lamps keep them.
+    BoothSceneSetup planned = walled;
+    LampSettings off;
+    off.lights = setup_.settings.lights;
+    off.specularSamples = setup_.settings.specularSamples;
+    off.horizonDirections = setup_.settings.horizonDirections;
+    off.walls = false;
+    planned.perLamp[walled.booth.lights[0].name] = off;
+    auto mixed = BoothScenePass::create(planned);
+    ASSERT_TRUE(mixed) << mixed.error().message;
+    const auto left = frame(**mixed, st);
+    ASSERT_EQ(left.size(), without.size());
+    for (std::size_t i = 0; i < left.size(); ++i) {
+        ASSERT_EQ(left[i].x, without[i].x) << i;
+        ASSERT_EQ(left[i].y, without[i].y) << i;
+        ASSERT_EQ(left[i].z, without[i].z) << i;
+    }
+    scene::SceneState other = st;
+    other.lampIndex = 1;
+    const auto kept = frame(**mixed, other);
+    const auto keptWalled = frame(**pass, other);
+    ASSERT_EQ(kept.size(), keptWalled.size());
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+        ASSERT_EQ(kept[i].y, keptWalled[i].y) << i;
+    }
 }
 
 TEST_F(BoothScenePassTest, UnknownLightIsTheSensedSpectrumOnAUniformEmitter)
