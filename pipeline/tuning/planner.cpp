@@ -68,6 +68,41 @@ std::vector<View> probeViews(const scene::StandModel& stand, int probeX, int pro
     return views;
 }
 
+namespace {
+
+// Every setting the planner may pick, cheapest first (settingCost; ties keep this order: fewer
+// samples, fewer directions, without the walls first).
+std::vector<RenderSettings>
+candidateSettings(const RenderSettings& base, bool glossy, bool relief, bool hasWalls)
+{
+    std::vector<RenderSettings> candidates;
+    for (int lights : {8, 16, 32, 64, 128, 256}) {
+        for (int samples :
+             glossy ? std::vector<int>{1, 4, 8, 12, 16, 24, 32, 48, 64} : std::vector<int>{0}) {
+            for (int dirs : relief ? std::vector<int>{8, 16} : std::vector<int>{0}) {
+                for (bool withWalls :
+                     hasWalls ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
+                    RenderSettings s = base;
+                    s.lights = lights;
+                    s.specularSamples = samples;
+                    s.specularPass = glossy;
+                    s.horizonDirections = dirs;
+                    s.reliefPass = relief;
+                    s.walls = withWalls;
+                    candidates.push_back(s);
+                }
+            }
+        }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [&](const RenderSettings& a, const RenderSettings& b) {
+                         return settingCost(a, glossy, relief) < settingCost(b, glossy, relief);
+                     });
+    return candidates;
+}
+
+} // namespace
+
 Plan planRender(const surface::SurfaceScene& scene,
                 const booth::BoothLight& light,
                 const View& view,
@@ -110,29 +145,8 @@ Plan planRenderViews(const surface::SurfaceScene& scene,
         refs.push_back(reference::renderReference(scene, light, v, obs, ro));
     }
 
-    std::vector<RenderSettings> candidates;
-    for (int lights : {8, 16, 32, 64, 128, 256}) {
-        for (int samples :
-             glossy ? std::vector<int>{1, 4, 8, 12, 16, 24, 32, 48, 64} : std::vector<int>{0}) {
-            for (int dirs : relief ? std::vector<int>{8, 16} : std::vector<int>{0}) {
-                for (bool withWalls :
-                     hasWalls ? std::vector<bool>{false, true} : std::vector<bool>{false}) {
-                    RenderSettings s = base;
-                    s.lights = lights;
-                    s.specularSamples = samples;
-                    s.specularPass = glossy;
-                    s.horizonDirections = dirs;
-                    s.reliefPass = relief;
-                    s.walls = withWalls;
-                    candidates.push_back(s);
-                }
-            }
-        }
-    }
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [&](const RenderSettings& a, const RenderSettings& b) {
-                         return settingCost(a, glossy, relief) < settingCost(b, glossy, relief);
-                     });
+    const std::vector<RenderSettings> candidates =
+            candidateSettings(base, glossy, relief, hasWalls);
     // Prepared once per light count and per horizon direction count: the candidates, in cost
     // order, go back and forth between them (a painting's horizon map takes seconds).
     std::map<int, PreparedLight> lightsPrepared;
