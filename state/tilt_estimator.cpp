@@ -1,6 +1,7 @@
 // Gravity -> tilt; the hold filter and the sliced refresh of the diffuse term's tilt.
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <state/json_state.h>
 #include <state/tilt_estimator.h>
@@ -38,6 +39,34 @@ double TiltEstimator::windowMean() const
     return count_ > 0 ? sum / static_cast<double>(count_) : held_;
 }
 
+double TiltEstimator::refreshTarget() const
+{
+    // The least-squares slope of the trend's tilts against their frame numbers (0, 1, ...).
+    const std::size_t n = trendCount_;
+    if (n < trend_.size()) {
+        return held_; // too few tilts since the start for a slope its noise allows
+    }
+    const double meanX = static_cast<double>(n - 1) / 2.0;
+    double meanY = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        meanY += trend_[i];
+    }
+    meanY /= static_cast<double>(n);
+    double sxy = 0.0;
+    double sxx = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double dx = static_cast<double>(i) - meanX;
+        sxy += dx * (trend_[i] - meanY);
+        sxx += dx * dx;
+    }
+    // sxx > 0: n >= 2 distinct frame numbers.
+    const double ahead = (sxy / sxx) * (3.0 * setup_.cacheSlices - 3.0) / 2.0;
+    if (!(std::abs(ahead) > kTiltMotionRad)) {
+        return held_;
+    }
+    return held_ + std::clamp(ahead, -kDiffuseMaxLagRad, kDiffuseMaxLagRad);
+}
+
 void TiltEstimator::write(pipeline::scene::SceneState& state)
 {
     // The held tilt: the mean of the last kTiltWindow frames' tilts, taken when the light changes
@@ -45,6 +74,11 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
     // the held tilt; a tilt kTiltMotionRad from the mean starts the window again (motion: the
     // mean would lag it). Non-finite tilts are left out.
     if (std::isfinite(tilt_)) {
+        if (trendCount_ == trend_.size()) {
+            std::rotate(trend_.begin(), trend_.begin() + 1, trend_.end());
+        }
+        trend_[std::min(trendCount_, trend_.size() - 1)] = tilt_;
+        trendCount_ = std::min(trendCount_ + 1, trend_.size());
         if (count_ > 0 && std::abs(tilt_ - windowMean()) > kTiltMotionRad) {
             count_ = 0;
             next_ = 0;
@@ -64,7 +98,7 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
     // draws of it (the band of a refresh under way).
     const auto last = diffuse_;
     diffuse_ = pipeline::scene::nextDiffuse(diffuse_, held_, state.lightChanged, setup_.cacheSlices,
-                                            kDiffuseMaxLagRad);
+                                            kDiffuseMaxLagRad, refreshTarget());
     // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel); a
     // non-finite one (set from elsewhere: sense()) shows the held tilt.
     state.tiltRad = std::isfinite(tilt_) ? tilt_ : held_;
@@ -84,6 +118,8 @@ nlohmann::json TiltEstimator::save() const
             {"count", count_},
             {"held_rad", held_},
             {"held_valid", heldValid_},
+            {"trend",
+             std::vector<double>(trend_.begin(), trend_.begin() + static_cast<long>(trendCount_))},
             {"shown_rad", diffuse_ ? nlohmann::json(diffuse_->shownRad) : nlohmann::json()},
             {"refresh_rad", optionalJson(diffuse_ ? diffuse_->refreshRad : std::nullopt)},
             {"refresh_bands", diffuse_ ? diffuse_->refreshBands : 0}};
@@ -109,6 +145,18 @@ Expected<void> TiltEstimator::restore(const nlohmann::json& j)
             throw std::out_of_range("window position out of range");
         }
         held_ = finiteFromJson(j.at("held_rad"));
+        // Absent in states saved before the refresh aimed ahead: no trend yet.
+        trendCount_ = 0;
+        if (j.contains("trend")) {
+            const auto& tr = j.at("trend");
+            if (!tr.is_array() || tr.size() > trend_.size()) {
+                throw std::out_of_range(
+                        fmt::format("the trend holds at most {} tilts", trend_.size()));
+            }
+            for (const auto& v : tr) {
+                trend_[trendCount_++] = finiteFromJson(v);
+            }
+        }
         heldValid_ = j.at("held_valid").get<bool>();
         const auto shown = j.at("shown_rad");
         const auto refresh = j.at("refresh_rad");

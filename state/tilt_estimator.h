@@ -40,6 +40,16 @@ constexpr double kTiltMotionRad = 0.5 * 3.14159265358979323846 / 180.0;
 // up), so 2 degrees is about 1.4 at most; the error probe measured p95 0.45-1.33 at 10 Hz on the
 // ColorChecker with this bound, against 0.6-13.6 with the 16-frame mean alone.
 constexpr double kDiffuseMaxLagRad = 2.0 * 3.14159265358979323846 / 180.0;
+// A refresh takes K frames to show and is then shown for K more, so on a moving panel a refresh
+// aimed at the held tilt shows a term K to 2K - 1 frames old, and the lag bound above draws whole
+// whenever that passes 2 degrees (with K = 3, from 0.34 degrees a frame: the painting's 40 frames a
+// second under the simulator's 18-degree sweep). A refresh started while the panel moves is aimed
+// where the panel will be in the middle of the frames it is shown, (3K - 3) / 2 frames ahead at
+// the sensed tilts' trend: the least-squares slope of the last kTiltTrend sensed tilts (0.029
+// degrees a frame of noise at 0.12 a sample), followed only when that travel is past the motion
+// threshold (six times its noise: a still panel never extrapolates), and never further than the
+// lag bound.
+constexpr std::size_t kTiltTrend = 6;
 
 struct TiltEstimatorSetup {
     double defaultTiltRad = 0.0; // shown until the first usable sample
@@ -81,11 +91,16 @@ private:
     std::size_t count_ = 0;
     double held_ = 0.0;
     bool heldValid_ = false;
+    // The last kTiltTrend finite sensed tilts, oldest first once full (trendCount_ of them).
+    std::array<double, kTiltTrend> trend_{};
+    std::size_t trendCount_ = 0;
     // The diffuse term of the last frame (none before the first):
     // pipeline/scene/diffuse_schedule.h.
     std::optional<pipeline::scene::DiffuseTilt> diffuse_;
 
     double windowMean() const;
+    // Where a refresh started this frame aims: the held tilt, or ahead of it on a moving panel.
+    double refreshTarget() const;
 };
 
 } // namespace replica::state

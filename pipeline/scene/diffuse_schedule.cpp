@@ -10,7 +10,8 @@ DiffuseTilt nextDiffuse(const std::optional<DiffuseTilt>& last,
                         double heldRad,
                         bool lightChanged,
                         int slices,
-                        double maxLagRad)
+                        double maxLagRad,
+                        std::optional<double> aimRad)
 {
     const int k = std::max(slices, 1);
     // '!(lag <= max)' also draws whole on a NaN lag (a non-finite held tilt never reaches here:
@@ -19,11 +20,12 @@ DiffuseTilt nextDiffuse(const std::optional<DiffuseTilt>& last,
         return {heldRad, std::nullopt, 0};
     }
     DiffuseTilt d = *last;
-    if (!d.refreshRad && heldRad != d.shownRad) {
+    const double aim = aimRad.value_or(heldRad);
+    if (!d.refreshRad && aim != d.shownRad) {
         if (k == 1) {
-            d.shownRad = heldRad;
+            d.shownRad = aim;
         } else {
-            d.refreshRad = heldRad;
+            d.refreshRad = aim;
             d.refreshBands = 0;
         }
     }

@@ -20,11 +20,15 @@ namespace replica::pipeline::scene {
 // - a held tilt that moves meanwhile waits for those K frames,
 // - unless the term shown is more than 'maxLagRad' from the held tilt: then it is drawn whole at
 //   once (a refresh under way is dropped), bounding what a lagging term costs (infinite: never).
+// A refresh started here aims at 'aimRad' when given (where a moving panel will be when the
+// refresh shows: state/tilt_estimator.h) instead of the held tilt; a whole draw is always at the
+// held tilt, since it shows at once.
 DiffuseTilt nextDiffuse(const std::optional<DiffuseTilt>& last,
                         double heldRad,
                         bool lightChanged,
                         int slices,
-                        double maxLagRad = std::numeric_limits<double>::infinity());
+                        double maxLagRad = std::numeric_limits<double>::infinity(),
+                        std::optional<double> aimRad = std::nullopt);
 
 // What the frame whose diffuse term is 'now' draws, 'last' being the previous frame's (none: the
 // first): the term shown, and the band of a refresh this frame draws (its bands are drawn one a
