@@ -13,10 +13,13 @@
 # first frame's own draw with its compilation (ms, 'drew its shading pass for the first time'),
 # the first frame shown; and the warm-up: before the first frame ('warmed up in') or after it
 # ('background compile ... done in'). Logs in OUTDIR. The environment may set SCENES
-# ("colorchecker metamer painting glossy-cylinder") and FRAMES (60).
+# ("colorchecker metamer painting glossy-cylinder"), FRAMES (60) and KIOSK=1: the kiosk from the
+# shipped site file instead (deploy/replica.toml with hal = "sim", output = "headless", recording
+# off and dir = "scenes/S": its automatic booth dimmer and 60 Hz; `REPLICA --log-level debug run
+# --kiosk --config SITE --frames FRAMES`).
 set -uo pipefail
 if [ $# -ne 2 ] || [ "$1" = "-h" ] || [ "$1" = "--help" ]; then
-    sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'
     exit 2
 fi
 replica="$1"
@@ -30,8 +33,18 @@ for s in $scenes; do
     cache=$(mktemp -d "$out/cache-$s-XXXXXX")
     for kind in cold warm; do
         log="$out/$s-$kind.log"
-        MESA_SHADER_CACHE_DIR="$cache" "$replica" --log-level debug run --hal sim --output headless \
-            --scene "data/scenes/$s" --rate 30 --frames "$frames" --size 960x600 >"$log" 2>&1
+        if [ "${KIOSK:-0}" = 1 ]; then
+            site="$out/site-$s.toml"
+            sed -e 's/^hal = "live"/hal = "sim"/' -e 's/^output = "kms"/output = "headless"/' \
+                -e 's/^enabled = true/enabled = false/' -e "s|^dir = \"scenes/[a-z0-9-]*\"|dir = \"scenes/$s\"|" \
+                deploy/replica.toml >"$site"
+            MESA_SHADER_CACHE_DIR="$cache" "$replica" --log-level debug run --kiosk --config "$site" \
+                --frames "$frames" >"$log" 2>&1
+        else
+            MESA_SHADER_CACHE_DIR="$cache" "$replica" --log-level debug run --hal sim \
+                --output headless --scene "data/scenes/$s" --rate 30 --frames "$frames" \
+                --size 960x600 >"$log" 2>&1
+        fi
         python3 - "$log" "$s" "$kind" <<'PY'
 import re, sys
 log, scene, kind = sys.argv[1:]
