@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include <GLES3/gl31.h>
 #include <fmt/format.h>
 
 #include <pipeline/reference/wall_radiosity.h>
@@ -93,7 +94,21 @@ Expected<void> BoothScenePass::makeVariant(std::size_t v)
     // useVariant brings its channels to the encoding drawn).
     auto prepared = std::make_unique<shading::PreparedScene>(shading::prepareScene(
             setup_.scene, std::max(var.settings.horizonDirections, 1), 0.01, setup_.basis));
+    // Made in the middle of a frame (its first use): the pass's creation binds framebuffers and
+    // textures of its own; the frame's target, viewport and texture unit come back.
+    GLint drawFb = 0;
+    GLint readFb = 0;
+    GLint unit = 0;
+    GLint viewport[4] = {0, 0, 0, 0};
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFb);
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readFb);
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &unit);
+    glGetIntegerv(GL_VIEWPORT, viewport);
     auto pass = BoothShadingPass::create(*prepared, var.settings, setup_.observer);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(drawFb));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readFb));
+    glActiveTexture(static_cast<GLenum>(unit));
+    glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
     if (!pass) {
         return tl::unexpected(pass.error());
     }
