@@ -141,8 +141,9 @@ struct RunConfig {
     // (BoothScenePass::warmUp) so that no lamp switch waits for a shader compilation.
     bool warmUp = true;
     // Not recorded: with warmUp, compile before the first frame only the pass that frame draws
-    // and the others after it (platform/pass_warm_up.h: a thread of its own, then the loop's idle
-    // time); what 'replica run' does. Off (replay, the benchmarks): every pass before the loop.
+    // and the others after it (platform/output/pass_warm_up.h: a thread of its own, then the loop's
+    // idle time); what 'replica run' does. Off (replay, the benchmarks): every pass before the
+    // loop.
     bool warmUpAfterFirstFrame = false;
     // Seconds of session time between the running appliance's error probes, 0: none
     // (platform/loop/error_probe.h). Recorded ("error_probe_s") to say what the session measured;

@@ -36,8 +36,8 @@
 #include <platform/loop/error_probe.h>
 #include <platform/loop/frame_loop.h>
 #include <platform/loop/shown_recorder.h>
+#include <platform/output/pass_warm_up.h>
 #include <platform/output/service_screen.h>
-#include <platform/pass_warm_up.h>
 #include <platform/session_files.h>
 #include <platform/site_config.h>
 #include <platform/site_file.h>
@@ -287,7 +287,8 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
         }
     };
     SystemdNotifier notifier;
-    // The other lamps' shading passes, compiled after the first frame (platform/pass_warm_up.h).
+    // The other lamps' shading passes, compiled after the first frame
+    // (platform/output/pass_warm_up.h).
     std::optional<PassWarmUp> warmUp;
     if (appliance.config.warmUp && appliance.config.warmUpAfterFirstFrame && appliance.boothScene) {
         warmUp.emplace(appliance.boothScene, appliance.config.width, appliance.config.height);

@@ -1,22 +1,21 @@
 // What a lamp switch costs the appliance's frame: for each shipped scene, the appliance is built as
 // 'replica run' builds it (the planner's per-lamp settings from the shipped plan, or the fixed
 // rules), with no warm-up, with every pass warmed up at start (BoothScenePass::warmUp), and as
-// 'replica run' does (platform/pass_warm_up.h: the first frame's pass alone before it, the others
-// compiled by a thread of its own after it, then drawn once each in the loop's idle time; the
-// frames on the first lamp, 33 ms apart, go on until that is done), and the lamps are
-// visited in turn twice (A B C A B C), 'frames' frames each with the viewer walking past. Printed
-// per configuration: the build time (the warm-up included), the time to the first frame shown
-// (build and first frame), the median of the frames that follow
-// no switch, each switch frame (the first frame of a lamp) and the worst of them. The first visit
-// to a lamp is where a pass not yet drawn compiles its shaders; the second visit is the switch as
-// it costs once everything is compiled. Wall clock, whole frame (both passes, display read-back).
-// Run it with MESA_SHADER_CACHE_DISABLE=true: Mesa's on-disk shader cache otherwise hides the
-// compilation after the first run (the appliance's first start after an install or upgrade is
-// cold). The 'replica run' rows need the cache (the thread's compilation reaches the loop's
-// context through it): each gets an empty one of its own (MESA_SHADER_CACHE_DIR, a fresh
-// folder), the cold cache of a first start. Their warm-up cell says how long the thread took and
-// each idle-time warm-up's delay to the next frame.
-// Usage: replica_bench_lamp_switch [--frames N] [--size WxH] [--scene NAME]
+// 'replica run' does (platform/output/pass_warm_up.h: the first frame's pass alone before it, the
+// others compiled by a thread of its own after it, then drawn once each in the loop's idle time;
+// the frames on the first lamp, 33 ms apart, go on until that is done), and the lamps are visited
+// in turn twice (A B C A B C), 'frames' frames each with the viewer walking past. Printed per
+// configuration: the build time (the warm-up included), the time to the first frame shown (build
+// and first frame), the median of the frames that follow no switch, each switch frame (the first
+// frame of a lamp) and the worst of them. The first visit to a lamp is where a pass not yet drawn
+// compiles its shaders; the second visit is the switch as it costs once everything is compiled.
+// Wall clock, whole frame (both passes, display read-back). Run it with
+// MESA_SHADER_CACHE_DISABLE=true: Mesa's on-disk shader cache otherwise hides the compilation after
+// the first run (the appliance's first start after an install or upgrade is cold). The 'replica
+// run' rows need the cache (the thread's compilation reaches the loop's context through it): each
+// gets an empty one of its own (MESA_SHADER_CACHE_DIR, a fresh folder), the cold cache of a first
+// start. Their warm-up cell says how long the thread took and each idle-time warm-up's delay to the
+// next frame. Usage: replica_bench_lamp_switch [--frames N] [--size WxH] [--scene NAME]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -33,7 +32,7 @@
 
 #include <pipeline/base/data_dir.h>
 #include <platform/appliance.h>
-#include <platform/pass_warm_up.h>
+#include <platform/output/pass_warm_up.h>
 
 using namespace replica;
 using namespace replica::pipeline;

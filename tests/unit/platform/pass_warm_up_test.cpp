@@ -1,14 +1,14 @@
-// The shading passes compiled around the first frame (platform/pass_warm_up.h): a thread of its own
-// compiling the other lamps' passes in its own EGL context while the loop switches lamps at once,
-// and the loop's idle-time warm-ups between frames, change no frame of the renderer (XYZ and the
-// display's counts, bit for bit, across switches between passes of different settings) and, once
-// done, leave no switch that compiles.
+// The shading passes compiled around the first frame (platform/output/pass_warm_up.h): a thread of
+// its own compiling the other lamps' passes in its own EGL context while the loop switches lamps at
+// once, and the loop's idle-time warm-ups between frames, change no frame of the renderer (XYZ and
+// the display's counts, bit for bit, across switches between passes of different settings) and,
+// once done, leave no switch that compiles.
 #include <chrono>
 #include <thread>
 
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
-#include <platform/pass_warm_up.h>
+#include <platform/output/pass_warm_up.h>
 
 #include <gtest/gtest.h>
 

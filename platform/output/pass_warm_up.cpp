@@ -12,7 +12,7 @@
 
 #include <platform/logging.h>
 #include <platform/output/egl_util.h>
-#include <platform/pass_warm_up.h>
+#include <platform/output/pass_warm_up.h>
 
 namespace replica::platform {
 namespace {
