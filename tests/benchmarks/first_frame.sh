@@ -7,12 +7,13 @@
 # Each scene S runs `REPLICA --log-level debug run --hal sim --output headless --scene
 # data/scenes/S --rate 30 --frames FRAMES --size 960x600` twice with MESA_SHADER_CACHE_DIR an
 # empty folder of its own: cold (a fresh install's first start), then warm (the second start).
-# Printed per run, seconds since the process started (the 'first frame shown N s' line dates the
-# start): the log's first line (process and logging up), the booth / plan lines (scene, booth and
-# plan loaded, GL context up), the booth dimmer's line, the appliance built ('hal:' line), the
-# first frame's own draw with its compilation (ms, 'drew its shading pass for the first time'),
-# the first frame shown; and the warm-up: before the first frame ('warmed up in') or after it
-# ('background compile ... done in'). Logs in OUTDIR. The environment may set SCENES
+# Printed per run, from the run's log (s: since the process started, which the 'first frame
+# shown N s' line dates; ms: a step's own time): the plan loaded (the first planner line: data,
+# state stage, GL context and scene loaded before it), the GL context's creation, the automatic
+# booth dimmer, the booth pass made, the warm-up before the first frame, the renderer (display
+# pass) made, the appliance built ('hal:' line), frame 0's work, the first frame shown, the later
+# frames that drew a pass for the first time (a lamp switch that compiled), the background
+# compile, and each idle-time warm-up. Logs in OUTDIR. The environment may set SCENES
 # ("colorchecker metamer painting glossy-cylinder"), FRAMES (60) and KIOSK=1: the kiosk from the
 # shipped site file instead (deploy/replica.toml with hal = "sim", output = "headless", recording
 # off and dir = "scenes/S": its automatic booth dimmer and 60 Hz; `REPLICA --log-level debug run
@@ -27,8 +28,8 @@ out="$2"
 mkdir -p "$out"
 scenes="${SCENES:-colorchecker metamer painting glossy-cylinder}"
 frames="${FRAMES:-60}"
-echo "| scene | cache | log up s | booth, plan s | dimmer s | built s | warm-up before frame 1 ms | first frame's draw ms | first frame s | background compile ms |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
+echo "| scene | cache | plan loaded s | GL context ms | dimmer ms | booth pass made ms | warm-up before frame 1 ms | renderer ms | built s | frame 0 ms | first frame s | later first draws ms | background ms | idle warm-ups ms |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for s in $scenes; do
     cache=$(mktemp -d "$out/cache-$s-XXXXXX")
     for kind in cold warm; do
@@ -68,15 +69,18 @@ def at(pattern):
         if re.search(pattern, l):
             return f"{t - start:.2f}"
     return "-"
-def ms(pattern):
-    for _, l in stamped:
-        m = re.search(pattern, l)
-        if m:
-            return m[1]
-    return "-"
-cols = [at(r""), at(r"\] \[(planner|booth)\]"), at(r"booth dimmer"), at(r"\] hal: "),
-        ms(r"warmed up in (\d+) ms"), ms(r"drew its shading pass for the first time: (\d+) ms"),
-        f"{shown:.2f}", ms(r"background compile of the other shading passes done in (\d+) ms")]
+def ms(pattern, every=False, skip=0):
+    found = [m[1] for m in (re.search(pattern, l) for _, l in stamped) if m][skip:]
+    if not found:
+        return "-"
+    return ", ".join(f"{float(x):.0f}" for x in found) if every else f"{float(found[0]):.0f}"
+cols = [at(r"\] \[planner\]"), ms(r"output and GL context up in (\d+) ms"),
+        ms(r"booth dimmer \(auto\) chosen in (\d+) ms"), ms(r"booth pass made in (\d+) ms"),
+        ms(r"warmed up in (\d+) ms"), ms(r"renderer \(display pass\) made in (\d+) ms"),
+        at(r"\] hal: "), ms(r"frame 0: ([\d.]+) ms$"), f"{shown:.2f}",
+        ms(r"drew its shading pass for the first time: (\d+) ms", every=True, skip=1),
+        ms(r"background compile of the other shading passes done in (\d+) ms"),
+        ms(r"shading pass \d+ compiled after frame \d+ in (\d+) ms", every=True)]
 print(f"| {scene} | {kind} | " + " | ".join(cols) + " |")
 PY
     done
