@@ -1,6 +1,7 @@
 // Assembling the appliance.
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -278,18 +279,32 @@ Expected<void> applyRenderPlan(RunConfig& config, pipeline::render::BoothSceneSe
     return {};
 }
 
+// Milliseconds since 'start', for the start-up's debug lines.
+double startupMs(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count();
+}
+
 // The booth pass, its shading passes compiled before the first frame unless --no-warm-up.
 Expected<std::shared_ptr<pipeline::render::BoothScenePass>>
 createBoothScene(const RunConfig& config, pipeline::render::BoothSceneSetup setup)
 {
+    const auto start = std::chrono::steady_clock::now();
     auto pass = pipeline::render::BoothScenePass::create(std::move(setup));
     if (!pass) {
         return tl::unexpected(pass.error());
     }
+    logger("render")->debug("booth pass made in {:.0f} ms ({} shading pass(es), one made now)",
+                            startupMs(start), (*pass)->variantCount());
     // --no-warm-up skips it (frames are the same either way): under software emulation (the boot
     // test's TCG guest) compiling every pass before the first frame takes minutes.
     if (!config.warmUp) {
         logger("render")->info("no warm-up: shading passes compile at their first use");
+    } else if (config.warmUpAfterFirstFrame) {
+        logger("render")->info("the first frame compiles the shading pass it draws; the other "
+                               "{} compile after it",
+                               (*pass)->variantCount() - 1);
     } else {
         // Each lamp's pass compiled now, not at the loop's first switch to it.
         auto ms = (*pass)->warmUp(config.width, config.height);
@@ -318,7 +333,9 @@ makeBoothScene(RunConfig& config,
         return tl::unexpected(ok.error());
     }
     if (config.boothDimmerAuto) {
+        const auto start = std::chrono::steady_clock::now();
         chooseBoothDimmer(config, *setup, displayModel);
+        logger("booth")->debug("booth dimmer (auto) chosen in {:.0f} ms", startupMs(start));
     }
     setup->luminanceScale = config.boothDimmer;
     if (config.boothDimmer != 1.0) {
@@ -493,10 +510,12 @@ Expected<void> makeRenderer(Appliance& app,
     }
     app.boothScene = *boothScene;
     setup.boothScene = std::move(*boothScene);
+    const auto start = std::chrono::steady_clock::now();
     auto renderer = pipeline::render::createGlesRenderer(std::move(setup));
     if (!renderer) {
         return tl::unexpected(renderer.error());
     }
+    logger("render")->debug("renderer (display pass) made in {:.0f} ms", startupMs(start));
     app.renderer = std::move(*renderer);
     return {};
 }
@@ -539,11 +558,13 @@ Expected<std::unique_ptr<Appliance>> buildAppliance(const RunConfig& configIn,
     }
     app->sceneEstimator = std::move(*estimator);
 
+    const auto outputStart = std::chrono::steady_clock::now();
     auto output =
             outputChoice.kind == "kms" ? createKmsOutput(outputChoice.kms) : createHeadlessOutput();
     if (!output) {
         return tl::unexpected(output.error());
     }
+    logger("output")->debug("output and GL context up in {:.0f} ms", startupMs(outputStart));
     app->output = std::move(*output);
     applyDisplayGeometry(config, *app->output, outputChoice);
     app->config = config;

@@ -140,6 +140,11 @@ struct RunConfig {
     // Not recorded (no pixel depends on it): draw every lamp's shading pass once at start
     // (BoothScenePass::warmUp) so that no lamp switch waits for a shader compilation.
     bool warmUp = true;
+    // Not recorded: with warmUp, compile before the first frame only the pass that frame draws
+    // and the others after it (platform/output/pass_warm_up.h: a thread of its own, then the loop's
+    // idle time); what 'replica run' does. Off (replay, the benchmarks): every pass before the
+    // loop.
+    bool warmUpAfterFirstFrame = false;
     // Seconds of session time between the running appliance's error probes, 0: none
     // (platform/loop/error_probe.h). Recorded ("error_probe_s") to say what the session measured;
     // no pixel depends on it and a replay never probes. Recordings made before have none.

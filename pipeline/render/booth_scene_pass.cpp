@@ -1,7 +1,9 @@
 // Scene state to booth pass: the state's light, encoding and tilts uploaded where the GPU holds
 // others, then drawn.
 #include <algorithm>
+#include <chrono>
 
+#include <GLES3/gl31.h>
 #include <fmt/format.h>
 
 #include <pipeline/reference/wall_radiosity.h>
@@ -41,20 +43,11 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
     }
     p->setup_ = std::move(setup);
     const auto& s = p->setup_;
-    const auto makeVariant = [&](const shading::RenderSettings& settings) -> Expected<void> {
-        Variant v;
-        v.settings = settings;
-        v.prepared = std::make_unique<shading::PreparedScene>(shading::prepareScene(
-                s.scene, std::max(settings.horizonDirections, 1), 0.01, s.basis));
-        auto pass = BoothShadingPass::create(*v.prepared, settings, p->setup_.observer);
-        if (!pass) {
-            return tl::unexpected(pass.error());
-        }
-        v.pass = std::move(*pass);
-        p->variants_.push_back(std::move(v));
-        return {};
-    };
-    if (auto ok = makeVariant(s.settings); !ok) {
+    // Variant 0 (the setup's settings: the direct-sensor mode's, and a lamp's without settings of
+    // its own) is made now; the others at their first use or warm-up (makeVariant): what only a
+    // lamp that is not shown yet needs is not done before the first frame.
+    p->variants_.push_back(Variant{s.settings, nullptr, nullptr, 0});
+    if (auto ok = p->makeVariant(0); !ok) {
         return tl::unexpected(ok.error());
     }
     for (const auto& lamp : s.booth.lights) {
@@ -78,9 +71,7 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
             };
             const auto found = std::find_if(p->variants_.begin(), p->variants_.end(), same);
             if (found == p->variants_.end()) {
-                if (auto ok = makeVariant(settings); !ok) {
-                    return tl::unexpected(ok.error());
-                }
+                p->variants_.push_back(Variant{settings, nullptr, nullptr, 0});
                 index = p->variants_.size() - 1;
             } else {
                 index = static_cast<std::size_t>(found - p->variants_.begin());
@@ -89,14 +80,55 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
         p->lampVariant_.push_back(index);
     }
     p->active_ = 0;
+    p->drawn_.assign(p->variants_.size(), false);
     p->basis_ = s.basis;
     p->prepared_ = p->variants_[0].prepared.get();
     p->pass_ = p->variants_[0].pass.get();
     return p;
 }
 
+Expected<void> BoothScenePass::makeVariant(std::size_t v)
+{
+    Variant& var = variants_[v];
+    if (var.pass) {
+        return {};
+    }
+    // The scene prepared for the variant's horizon directions, in the setup's basis (encoding 0:
+    // useVariant brings its channels to the encoding drawn).
+    auto prepared = std::make_unique<shading::PreparedScene>(shading::prepareScene(
+            setup_.scene, std::max(var.settings.horizonDirections, 1), 0.01, setup_.basis));
+    // Made in the middle of a frame (its first use): the pass's creation binds framebuffers and
+    // textures of its own; the frame's target, viewport and texture unit come back.
+    GLint drawFb = 0;
+    GLint readFb = 0;
+    GLint unit = 0;
+    GLint viewport[4] = {0, 0, 0, 0};
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFb);
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readFb);
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &unit);
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    auto pass = BoothShadingPass::create(*prepared, var.settings, setup_.observer);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(drawFb));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readFb));
+    glActiveTexture(static_cast<GLenum>(unit));
+    glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+    if (!pass) {
+        return tl::unexpected(pass.error());
+    }
+    if (pass_ != nullptr) {
+        (*pass)->setSurroundIlluminance(pass_->surroundIlluminance());
+    }
+    var.prepared = std::move(prepared);
+    var.pass = std::move(*pass);
+    var.encodings = 0;
+    return {};
+}
+
 Expected<void> BoothScenePass::useVariant(std::size_t v)
 {
+    if (auto ok = makeVariant(v); !ok) {
+        return ok;
+    }
     Variant& var = variants_[v];
     if (var.encodings != encodings_) {
         var.prepared->paletteCoeffs = prepared_->paletteCoeffs;
@@ -119,7 +151,7 @@ long BoothScenePass::cacheRefreshes() const
 {
     long n = 0;
     for (const auto& v : variants_) {
-        n += v.pass->cacheRefreshes();
+        n += v.pass ? v.pass->cacheRefreshes() : 0;
     }
     return n - warmUpRefreshes_;
 }
@@ -127,14 +159,18 @@ long BoothScenePass::cacheRefreshes() const
 void BoothScenePass::invalidateCache()
 {
     for (auto& v : variants_) {
-        v.pass->invalidateCache();
+        if (v.pass) {
+            v.pass->invalidateCache();
+        }
     }
 }
 
 void BoothScenePass::setSurroundIlluminance(bool on)
 {
     for (auto& v : variants_) {
-        v.pass->setSurroundIlluminance(on);
+        if (v.pass) {
+            v.pass->setSurroundIlluminance(on); // one made later takes it from pass_
+        }
     }
 }
 
@@ -211,6 +247,7 @@ Expected<void> BoothScenePass::applyEncoding(const scene::SceneState& state)
 
 Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, int height)
 {
+    const auto start = std::chrono::steady_clock::now();
     if (auto ok = selectLight(state); !ok) {
         return ok;
     }
@@ -229,7 +266,30 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
             want.band = CacheBand{pose(b->towardRad), b->band, b->bands};
         }
     }
-    return pass_->draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand), &want);
+    const auto layout = layoutOnPanel(setup_.scene, setup_.stand);
+    if (drawn_[active_]) {
+        return pass_->draw(view, width, height, layout, &want);
+    }
+    // The pass's first draw in this context: its shaders compile now (llvmpipe: at the draw),
+    // and it was made in selectLight unless it was warmed up.
+    auto ok = pass_->draw(view, width, height, layout, &want);
+    drawn_[active_] = true;
+    ++firstUseDraws_;
+    lastFirstUseMs_ =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count();
+    return ok;
+}
+
+std::vector<std::size_t> BoothScenePass::variantsNotDrawn() const
+{
+    std::vector<std::size_t> v;
+    for (std::size_t i = 0; i < drawn_.size(); ++i) {
+        if (!drawn_[i]) {
+            v.push_back(i);
+        }
+    }
+    return v;
 }
 
 PixelRect BoothScenePass::surfaceRect(int width, int height) const

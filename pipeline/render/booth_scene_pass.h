@@ -102,8 +102,20 @@ public:
     // every frame as it would be without (each pass is given its lamp's light again before it
     // draws; booth_warm_up_test.cpp) and cacheRefreshes() as it was. Returns how long it took, ms.
     Expected<double> warmUp(int width, int height);
+    // warmUp for shading pass v alone (drawn with a lamp that uses it): what the appliance does in
+    // the loop's idle time for the passes the first frame did not need. The active pass's light
+    // and cache stay as they were unless v is the active pass (then its light is selected afresh
+    // at the next draw); frames and cacheRefreshes() as without. Returns how long it took, ms.
+    Expected<double> warmUpVariant(std::size_t v, int width, int height);
     // How many shading passes there are (one per distinct setting).
     std::size_t variantCount() const { return variants_.size(); }
+    // The shading passes not drawn yet in this context (neither by a frame nor by a warm-up):
+    // each compiles its shaders at its first draw.
+    std::vector<std::size_t> variantsNotDrawn() const;
+    // The frames whose draw was their shading pass's first (its shaders compiled in the frame: a
+    // lamp switch to a pass not warmed up, or the first frame), and the last such draw's time, ms.
+    long firstUseDraws() const { return firstUseDraws_; }
+    double lastFirstUseMs() const { return lastFirstUseMs_; }
 
     // The basis the surface is encoded in now, and the encoding it is (SceneState::encoding: 0
     // without an adaptive encoder or before its first light).
@@ -119,15 +131,19 @@ private:
     Expected<void> applyEncoding(const scene::SceneState& state);
 
     // One shading pass per distinct setting (variants_[0]: setup_.settings), each with the scene
-    // prepared for its horizon directions; 'encodings' is the encoding its channels hold.
+    // prepared for its horizon directions; 'encodings' is the encoding its channels hold. Only
+    // variant 0 is made at create(); another has no scene or pass until makeVariant.
     struct Variant {
         shading::RenderSettings settings;
         std::unique_ptr<shading::PreparedScene> prepared;
         std::unique_ptr<BoothShadingPass> pass;
         int encodings = 0;
     };
-    // Makes variant v the one drawn, its channels brought up to date.
+    // Makes variant v the one drawn (made first when it was not: makeVariant), its channels
+    // brought up to date.
     Expected<void> useVariant(std::size_t v);
+    // Prepares variant v's scene and creates its shading pass (textures, programs) unless done.
+    Expected<void> makeVariant(std::size_t v);
     BoothSceneSetup setup_;
     std::vector<Variant> variants_;
     std::vector<std::size_t> lampVariant_; // by lamp index
@@ -146,6 +162,13 @@ private:
     colour::ChannelBasis basis_;
     int encodings_ = 0;
     long warmUpRefreshes_ = 0; // cache refreshes of warmUp()'s draws, not counted
+    // Per variant: drawn at least once in this context (its shaders compiled).
+    std::vector<bool> drawn_;
+    long firstUseDraws_ = 0;
+    double lastFirstUseMs_ = 0.0;
+    // The light warmUpVariant draws a pass with that is not the active one (light_ stays the
+    // active pass's).
+    shading::PreparedLight warmLight_;
 };
 
 // A uniform emitter with the geometry of 'like', the given luminance and spectrum: what the booth

@@ -1,5 +1,5 @@
-// BoothScenePass::warmUp: every shading pass drawn once into a small target before the loop starts,
-// so that no lamp switch pays for the shader's first-use compilation.
+// BoothScenePass::warmUp and warmUpVariant: a shading pass drawn once into a small target of its
+// own, so that no frame pays for the shader's first-use compilation.
 #include <chrono>
 
 #include <GLES3/gl31.h>
@@ -13,6 +13,21 @@ namespace replica::pipeline::render {
 Expected<double> BoothScenePass::warmUp(int width, int height)
 {
     const auto start = std::chrono::steady_clock::now();
+    for (std::size_t v = 0; v < variants_.size(); ++v) {
+        if (auto ms = warmUpVariant(v, width, height); !ms) {
+            return tl::unexpected(ms.error());
+        }
+    }
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count();
+}
+
+Expected<double> BoothScenePass::warmUpVariant(std::size_t v, int width, int height)
+{
+    const auto start = std::chrono::steady_clock::now();
+    if (auto ok = makeVariant(v); !ok) {
+        return tl::unexpected(ok.error());
+    }
     // What is bound now (before the target of our own, whose creation binds it) comes back.
     GLint framebuffer = 0;
     GLint viewport[4] = {0, 0, 0, 0};
@@ -35,34 +50,35 @@ Expected<double> BoothScenePass::warmUp(int width, int height)
     view.eye = {0.0, 0.45, 0.60};
     view.pixelsX = width;
     view.pixelsY = height;
-    for (std::size_t v = 0; v < variants_.size(); ++v) {
-        // A lamp drawn with this pass (variant 0 may have none: the direct-sensor mode's).
-        const booth::BoothLight* light = &setup_.booth.lights.front();
-        for (std::size_t l = 0; l < lampVariant_.size(); ++l) {
-            if (lampVariant_[l] == v) {
-                light = &setup_.booth.lights[l];
-                break;
-            }
+    // A lamp drawn with this pass (variant 0 may have none: the direct-sensor mode's).
+    const booth::BoothLight* light = &setup_.booth.lights.front();
+    for (std::size_t l = 0; l < lampVariant_.size(); ++l) {
+        if (lampVariant_[l] == v) {
+            light = &setup_.booth.lights[l];
+            break;
         }
-        BoothShadingPass& pass = *variants_[v].pass;
-        // light_ is the member every pass points at; selectLight replaces it (and calls setLight
-        // on the pass it draws with) before any frame, so the loop never draws this one.
-        light_ = shading::prepareLight(*light, setup_.observer, pass.settings().lights,
-                                       setup_.basis);
-        heldLight_.reset(); // the next draw selects its light afresh
-        if (auto ok = pass.setLight(light_); !ok) {
-            restore();
-            return tl::unexpected(ok.error());
-        }
-        (*target)->bind();
-        if (auto ok = pass.draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand));
-            !ok) {
-            restore();
-            return tl::unexpected(ok.error());
-        }
-        glFinish(); // the compilation is done once the frame is
-        pass.invalidateCache();
     }
+    BoothShadingPass& pass = *variants_[v].pass;
+    // warmLight_, not light_ (the active pass's): a pass that is not the active one gets its
+    // lamp's light from selectLight (a switch to it is a change of light) before it draws a
+    // frame; the active one is told to select its light afresh at the next draw.
+    warmLight_ =
+            shading::prepareLight(*light, setup_.observer, pass.settings().lights, setup_.basis);
+    if (v == active_) {
+        heldLight_.reset();
+    }
+    if (auto ok = pass.setLight(warmLight_); !ok) {
+        restore();
+        return tl::unexpected(ok.error());
+    }
+    (*target)->bind();
+    if (auto ok = pass.draw(view, width, height, layoutOnPanel(setup_.scene, setup_.stand)); !ok) {
+        restore();
+        return tl::unexpected(ok.error());
+    }
+    glFinish(); // the compilation is done once the frame is
+    pass.invalidateCache();
+    drawn_[v] = true;
     restore();
     warmUpRefreshes_ += cacheRefreshes() + warmUpRefreshes_ - before;
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)

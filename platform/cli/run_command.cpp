@@ -36,6 +36,7 @@
 #include <platform/loop/error_probe.h>
 #include <platform/loop/frame_loop.h>
 #include <platform/loop/shown_recorder.h>
+#include <platform/output/pass_warm_up.h>
 #include <platform/output/service_screen.h>
 #include <platform/session_files.h>
 #include <platform/site_config.h>
@@ -286,11 +287,20 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
         }
     };
     SystemdNotifier notifier;
+    // The other lamps' shading passes, compiled after the first frame
+    // (platform/output/pass_warm_up.h).
+    std::optional<PassWarmUp> warmUp;
+    if (appliance.config.warmUp && appliance.config.warmUpAfterFirstFrame && appliance.boothScene) {
+        warmUp.emplace(appliance.boothScene, appliance.config.width, appliance.config.height);
+    }
     LoopOptions loopOptions;
     loopOptions.skipLateTicks = true;
     loopOptions.periodNs = periodNs;
-    loopOptions.afterFrame = [&notifier](const LoopStats& s) {
+    loopOptions.afterFrame = [&notifier, &warmUp](const LoopStats& s) {
         notifier.frameShown(s.frames, s.skippedTicks);
+        if (warmUp) {
+            warmUp->afterFrame(s.frames);
+        }
     };
     if (rec.sessions) {
         loopOptions.nextRecorder = [&rec](recordings::RecordingWriter*) {
@@ -308,6 +318,9 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
     auto stats = runFrames(appliance, sources, ticks, o.fast ? Pacing::Fast : Pacing::Realtime,
                            rec.writer(), readback, onFrame, loopOptions);
     wallS = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    if (warmUp) {
+        warmUp->finish();
+    }
     notifier.stopping();
     if (rec.shown) {
         rec.shown->finish(); // the last thumbnail and the log tap, before the writer closes

@@ -330,10 +330,11 @@ namespace replica::platform {
 void addWarmUpOption(CLI::App& cmd, bool& noWarmUp, const std::string& also)
 {
     cmd.add_flag("--no-warm-up", noWarmUp,
-                 "do not draw every lamp's shading pass once before the first frame: each then "
-                 "compiles at its first use, and the first switch to a lamp waits for it (the "
-                 "frames are the same; for software emulation, where the warm-up takes "
-                 "minutes)" +
+                 "compile no lamp's shading pass ahead (run: the first frame's alone before it, "
+                 "the others after it in the background; replay: every one before the first "
+                 "frame): each then compiles at its first use, and the first switch to a lamp "
+                 "waits for it (the frames are the same; for software emulation, where the "
+                 "compilation takes minutes)" +
                          also);
 }
 

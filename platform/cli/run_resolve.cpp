@@ -282,6 +282,7 @@ void renderChoices(const RunOptions& o, RunConfig& config)
     }
     config.plannerCache = o.planCache;
     config.warmUp = !o.noWarmUp;
+    config.warmUpAfterFirstFrame = true; // the first frame first (platform/output/pass_warm_up.h)
     config.errorProbeS = o.errorProbeS;
 }
 

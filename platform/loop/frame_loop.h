@@ -101,7 +101,8 @@ struct LoopOptions {
     // replay renders every recorded frame and leaves it off.
     bool skipLateTicks = false;
     std::int64_t periodNs = 0;
-    // After each frame: the systemd watchdog ping and readiness.
+    // After each frame: the systemd watchdog ping and readiness, and the shading passes' warm-up
+    // after the first frame (platform/output/pass_warm_up.h); its time is not the frame's.
     std::function<void(const LoopStats&)> afterFrame;
     // After each frame: the recorder for the next frames, 'current' or a new one (rotation). A
     // new one first gets the latest sample of each sensor, so that it replays on its own.

@@ -85,7 +85,7 @@ runs, out, skip, frames, rate = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.
 frame_re = re.compile(r"\[loop\] \[debug\] frame (\d+): ([0-9.]+) ms")
 gl_re = re.compile(r"renderer=.* on ([^;]+); \d+x\d+ at ")
 version_re = re.compile(r"\[info\] (replica [^;]+); data ")
-warm_re = re.compile(r"shading pass\(es\) warmed up in (\d+) ms")
+warm_re = re.compile(r"(?:shading pass\(es\) warmed up|background compile of the other shading passes done) in (\d+) ms")
 
 
 def rank(v, q):
