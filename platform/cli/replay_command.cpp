@@ -363,6 +363,33 @@ nlohmann::json baseSummary(const ReplayOptions& o,
     return summary;
 }
 
+// The slice's frames drawn on this thread, each checked on the checks' thread (the results in
+// 'run'); the loop's figures, and how long the frame thread waited for the checks.
+Expected<LoopStats> drawAndCheck(const ReplayOptions& o,
+                                 const LoadedReplay& loaded,
+                                 Appliance& appliance,
+                                 const ReplaySlice& slice,
+                                 ReplayRun& run,
+                                 pipeline::render::Readback readback,
+                                 double& checksWaitedS)
+{
+    const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
+                          : o.clock == "step"   ? Pacing::Step
+                                                : Pacing::Fast;
+    Sources sources = makeReplaySources(loaded.recording);
+    // The checks overlap the drawing of the next frames; the frames reach them in order.
+    FrameWorker worker([&run](const auto& f, const auto& image) { run.check(f, image); });
+    auto stats = runFrames(appliance, sources, slice.plan, pacing, nullptr, readback,
+                           [&](const auto& f, const auto&, auto& image) {
+                               if (run.wanted(f)) {
+                                   worker.push(f, image);
+                               }
+                           });
+    worker.finish();
+    checksWaitedS = worker.waitedS();
+    return stats;
+}
+
 // Renders the slice through the checks and reports; the exit code.
 int runReplay(const ReplayOptions& o,
               const LoadedReplay& loaded,
@@ -398,19 +425,8 @@ int runReplay(const ReplayOptions& o,
     }
     // The frames before a slice are only estimated (TickPlan::warmup): they reach no callback.
     run.done = slice.plan.size() - slice.frames;
-    const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
-                          : o.clock == "step"   ? Pacing::Step
-                                                : Pacing::Fast;
-    Sources sources = makeReplaySources(loaded.recording);
-    // The checks overlap the drawing of the next frames; the frames reach them in order.
-    FrameWorker worker([&run](const auto& f, const auto& image) { run.check(f, image); });
-    auto stats = runFrames(appliance, sources, slice.plan, pacing, nullptr, readback,
-                           [&](const auto& f, const auto&, auto& image) {
-                               if (run.wanted(f)) {
-                                   worker.push(f, image);
-                               }
-                           });
-    worker.finish();
+    double checksWaitedS = 0.0;
+    auto stats = drawAndCheck(o, loaded, appliance, slice, run, readback, checksWaitedS);
     const double wallS =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
     if (run.error) {
@@ -432,7 +448,7 @@ int runReplay(const ReplayOptions& o,
     };
     nlohmann::json summary = baseSummary(o, loaded, appliance, slice, *stats, outputs, wallS);
     // The frame thread's wait for the checks' thread: 0 while the checks keep up with the frames.
-    summary["checks_waited_s"] = worker.waitedS();
+    summary["checks_waited_s"] = checksWaitedS;
     if (!exact) {
         summary["older_recording"] =
                 olderRecordingLine(o.file, loaded.recording.session.softwareVersion,
