@@ -11,24 +11,22 @@ pipeline::render::Readback FrameOutputs::readback() const
     return digest_ ? Readback::DisplayAndXyz : (keepLast_ ? Readback::Display : Readback::None);
 }
 
-FrameCallback FrameOutputs::callback()
+void FrameOutputs::add(const recordings::FrameRecord& f,
+                       const pipeline::render::RenderedFrame& image)
 {
-    return [this](const recordings::FrameRecord& f, const pipeline::scene::SceneState&,
-                  const pipeline::render::RenderedFrame& image) {
-        if (digest_) {
-            const auto* xyzBytes = reinterpret_cast<const std::uint8_t*>(image.xyz.data());
-            digests_.push_back({f.frameIndex, f.tickNs,
-                                frameHash(hash_, {xyzBytes, image.xyz.size() * sizeof(float)}),
-                                frameHash(hash_, image.rgba)});
-        }
-        if (keepLast_) {
-            lastWidth_ = image.width;
-            lastHeight_ = image.height;
-            lastRgba_ = image.rgba;
-            lastTickNs_ = f.tickNs;
-            lastFrame_ = f.frameIndex;
-        }
-    };
+    if (digest_) {
+        const auto* xyzBytes = reinterpret_cast<const std::uint8_t*>(image.xyz.data());
+        digests_.push_back({f.frameIndex, f.tickNs,
+                            frameHash(hash_, {xyzBytes, image.xyz.size() * sizeof(float)}),
+                            frameHash(hash_, image.rgba)});
+    }
+    if (keepLast_) {
+        lastWidth_ = image.width;
+        lastHeight_ = image.height;
+        lastRgba_ = image.rgba;
+        lastTickNs_ = f.tickNs;
+        lastFrame_ = f.frameIndex;
+    }
 }
 
 Expected<void> FrameOutputs::finish(const std::string& digestPath,

@@ -22,8 +22,10 @@ public:
     {}
     // What the loop must read back for this.
     pipeline::render::Readback readback() const;
-    FrameCallback callback();
+    // One frame's digests and, when kept, its display values.
+    void add(const recordings::FrameRecord& f, const pipeline::render::RenderedFrame& image);
     const std::vector<FrameDigest>& digests() const { return digests_; }
+    DigestHash hash() const { return hash_; }
     // The snapshot's colour space and time chunks (png_metadata.h): the display profile as ICC
     // (empty: sRGB) and the session's wall-clock start (0: unknown).
     void

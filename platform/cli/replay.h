@@ -137,7 +137,11 @@ struct ShownDigests {
     std::map<std::uint64_t, std::uint64_t> byFrame;
     std::uint64_t matched = 0, differing = 0;
     long firstDiffering = -1;
-    void frame(std::uint64_t frameIndex, const std::vector<std::uint8_t>& rgba);
+    // 'rgbaXxh3': the frame's XXH3-64 when the caller has it already (the digests'), else
+    // hashed here.
+    void frame(std::uint64_t frameIndex,
+               const std::vector<std::uint8_t>& rgba,
+               std::optional<std::uint64_t> rgbaXxh3 = std::nullopt);
 };
 
 // What replay prints at the end, besides the checks: the reprocessing report and the display

@@ -2,6 +2,7 @@
 // The steps in order: read and check the recording, build its appliance, run the slice's frames
 // through the checks, report (replay.h names the pieces).
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include <platform/cli/loop_summary.h>
 #include <platform/cli/replay.h>
 #include <platform/cli/replay_shown.h>
+#include <platform/cli/replay_worker.h>
 #include <platform/image/png_metadata.h>
 #include <platform/image/png_writer.h>
 #include <platform/image/xyz_frame.h>
@@ -140,7 +142,8 @@ struct ReplayRun {
     ShownDigests& shownDigests;
     std::optional<ShownComparison>& shown;
     std::optional<std::vector<std::uint64_t>> saveOnly;
-    std::optional<Error> error;
+    std::optional<Error> error;      // written by the checks' thread
+    std::atomic<bool> failed{false}; // the same, read by the frame thread
     std::uint64_t framesWritten = 0;
     // --frames-out's PNGs: the display profile they are in (empty: sRGB) and the recording's
     // wall-clock start (png_metadata.h).
@@ -210,20 +213,33 @@ struct ReplayRun {
         return {};
     }
 
-    void frame(const recordings::FrameRecord& f,
-               const pipeline::scene::SceneState& scene,
-               const pipeline::render::RenderedFrame& image,
-               const FrameCallback& keep)
+    // On the frame thread: counts the frame (the progress line) and says whether it goes to the
+    // checks: a frame of the slice, while none of them failed.
+    bool wanted(const recordings::FrameRecord& f)
     {
         ++done;
         if (showProgress) {
             progress(f);
         }
-        if (!slice.contains(f.tickNs) || error) {
+        return slice.contains(f.tickNs) && !failed.load(std::memory_order_relaxed);
+    }
+
+    // On the checks' thread (replay_worker.h), the frames in order: digests, what was shown, the
+    // frames written, the golden.
+    void check(const recordings::FrameRecord& f, const pipeline::render::RenderedFrame& image)
+    {
+        if (error) {
             return;
         }
-        keep(f, scene, image);
-        shownDigests.frame(f.frameIndex, image.rgba);
+        outputs.add(f, image);
+        // The recorded display digest is XXH3 of the display values: the digests' own when they
+        // hash with it.
+        std::optional<std::uint64_t> rgbaHash;
+        if (outputs.hash() == DigestHash::Xxh3_64 && !outputs.digests().empty() &&
+            outputs.digests().back().frameIndex == f.frameIndex) {
+            rgbaHash = outputs.digests().back().rgba;
+        }
+        shownDigests.frame(f.frameIndex, image.rgba, rgbaHash);
         Expected<void> ok = save(f, image);
         if (ok && shown) {
             ok = shown->add(f.frameIndex, f.tickNs, image.width, image.height, image.rgba);
@@ -233,6 +249,7 @@ struct ReplayRun {
         }
         if (!ok) {
             error = ok.error();
+            failed.store(true, std::memory_order_relaxed);
         }
     }
 };
@@ -321,6 +338,10 @@ nlohmann::json baseSummary(const ReplayOptions& o,
             {"frames_rendered", stats.frames},
             {"frames_output", outputs.digests().empty() ? slice.frames : outputs.digests().size()},
             {"wall_s", wallS},
+            // Session seconds of the frames drawn over the wall seconds they took with their checks
+            // (from the first frame to the last check; start-up not counted).
+            {"x_real_time",
+             wallS > 0.0 ? static_cast<double>(stats.frames) / loaded.config.rateHz / wallS : 0.0},
             {"replay_mismatches", stats.replayMismatches}};
     // The loop's keys as 'run --json' writes them (frame times, drops, gamut); "frames" is
     // frames_rendered.
@@ -340,6 +361,33 @@ nlohmann::json baseSummary(const ReplayOptions& o,
         }
     }
     return summary;
+}
+
+// The slice's frames drawn on this thread, each checked on the checks' thread (the results in
+// 'run'); the loop's figures, and how long the frame thread waited for the checks.
+Expected<LoopStats> drawAndCheck(const ReplayOptions& o,
+                                 const LoadedReplay& loaded,
+                                 Appliance& appliance,
+                                 const ReplaySlice& slice,
+                                 ReplayRun& run,
+                                 pipeline::render::Readback readback,
+                                 double& checksWaitedS)
+{
+    const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
+                          : o.clock == "step"   ? Pacing::Step
+                                                : Pacing::Fast;
+    Sources sources = makeReplaySources(loaded.recording);
+    // The checks overlap the drawing of the next frames; the frames reach them in order.
+    FrameWorker worker([&run](const auto& f, const auto& image) { run.check(f, image); });
+    auto stats = runFrames(appliance, sources, slice.plan, pacing, nullptr, readback,
+                           [&](const auto& f, const auto&, auto& image) {
+                               if (run.wanted(f)) {
+                                   worker.push(f, image);
+                               }
+                           });
+    worker.finish();
+    checksWaitedS = worker.waitedS();
+    return stats;
 }
 
 // Renders the slice through the checks and reports; the exit code.
@@ -377,15 +425,8 @@ int runReplay(const ReplayOptions& o,
     }
     // The frames before a slice are only estimated (TickPlan::warmup): they reach no callback.
     run.done = slice.plan.size() - slice.frames;
-    auto keep = outputs.callback();
-    const Pacing pacing = o.clock == "recorded" ? Pacing::Realtime
-                          : o.clock == "step"   ? Pacing::Step
-                                                : Pacing::Fast;
-    Sources sources = makeReplaySources(loaded.recording);
-    auto stats = runFrames(appliance, sources, slice.plan, pacing, nullptr, readback,
-                           [&](const auto& f, const auto& scene, const auto& image) {
-                               run.frame(f, scene, image, keep);
-                           });
+    double checksWaitedS = 0.0;
+    auto stats = drawAndCheck(o, loaded, appliance, slice, run, readback, checksWaitedS);
     const double wallS =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - run.start).count();
     if (run.error) {
@@ -406,6 +447,8 @@ int runReplay(const ReplayOptions& o,
         }
     };
     nlohmann::json summary = baseSummary(o, loaded, appliance, slice, *stats, outputs, wallS);
+    // The frame thread's wait for the checks' thread: 0 while the checks keep up with the frames.
+    summary["checks_waited_s"] = checksWaitedS;
     if (!exact) {
         summary["older_recording"] =
                 olderRecordingLine(o.file, loaded.recording.session.softwareVersion,

@@ -7,13 +7,15 @@
 
 namespace replica::platform {
 
-void ShownDigests::frame(std::uint64_t frameIndex, const std::vector<std::uint8_t>& rgba)
+void ShownDigests::frame(std::uint64_t frameIndex,
+                         const std::vector<std::uint8_t>& rgba,
+                         std::optional<std::uint64_t> rgbaXxh3)
 {
     const auto it = byFrame.find(frameIndex);
     if (it == byFrame.end() || rgba.empty()) {
         return;
     }
-    if (xxh3_64(rgba) == it->second) {
+    if ((rgbaXxh3 ? *rgbaXxh3 : xxh3_64(rgba)) == it->second) {
         ++matched;
     } else {
         ++differing;

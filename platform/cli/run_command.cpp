@@ -274,11 +274,10 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
     if (rec.shown) {
         readback = std::max(readback, rec.shown->readback());
     }
-    auto keep = outputs.callback();
     const FrameCallback onFrame = [&](const recordings::FrameRecord& f,
                                       const pipeline::scene::SceneState& state,
                                       const pipeline::render::RenderedFrame& image) {
-        keep(f, state, image);
+        outputs.add(f, image);
         if (rec.shown) {
             rec.shown->onFrame(f, state, image);
         }

@@ -70,9 +70,12 @@ struct LoopStats {
     }
 };
 
+// The image is the loop's own, drawn again at the next tick: a callback may take its buffers
+// (swap xyz and rgba for others, best of the same size, so the next read-back allocates nothing)
+// to use them after it returns, as replay's checks on their own thread do (replay_worker.h).
 using FrameCallback = std::function<void(const recordings::FrameRecord& frame,
                                          const pipeline::scene::SceneState& state,
-                                         const pipeline::render::RenderedFrame& image)>;
+                                         pipeline::render::RenderedFrame& image)>;
 
 // Yields the next tick, or nothing when the run is over. Lets the appliance run without end.
 using TickSource = std::function<std::optional<TickPlan>()>;
