@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <numbers>
 #include <span>
@@ -14,7 +13,7 @@
 #include <hal/replay/replay_source.h>
 #include <hal/sim/sim_devices.h>
 #include <pipeline/base/data_dir.h>
-#include <pipeline/base/input_file.h>
+#include <pipeline/base/input_file_parts.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/colour/spectral_table.h>
 #include <pipeline/display/display_inverse.h>
@@ -151,28 +150,23 @@ Expected<std::string> sceneDigest(const std::filesystem::path& dir)
 {
     std::uint64_t h = 14695981039346656037ull;
     for (const char* name : {"scene.json", "channels.exr", "height.exr", "material.exr"}) {
-        // Regular files only: a FIFO would block here and a directory throw from the stream.
-        if (auto ok = checkInputFile(dir / name, kMaxImageBytes, "scene"); !ok) {
-            if (ok.error().code == ErrorCode::NotFound) {
-                return makeError(ErrorCode::NotFound, fmt::format("{}: cannot read the scene file",
-                                                                  (dir / name).string()));
-            }
-            return tl::unexpected(ok.error());
-        }
-        std::ifstream in(dir / name, std::ios::binary);
-        if (!in) {
-            return makeError(ErrorCode::NotFound,
-                             fmt::format("{}: cannot read the scene file", (dir / name).string()));
-        }
         for (const char c : std::string(name)) {
             h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
         }
-        std::array<char, 65536> buf{};
-        while (in.read(buf.data(), buf.size()) || in.gcount() > 0) {
-            for (std::streamsize i = 0; i < in.gcount(); ++i) {
-                h = (h ^ static_cast<unsigned char>(buf[static_cast<std::size_t>(i)])) *
-                    1099511628211ull;
+        // Regular files only, opened once and hashed piece by piece: a FIFO would block a stream
+        // and a directory throw from it.
+        auto read = readInputFilePieces(
+                dir / name, kMaxImageBytes, "scene", [&h](std::string_view piece) {
+                    for (const char c : piece) {
+                        h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+                    }
+                });
+        if (!read) {
+            if (read.error().code == ErrorCode::NotFound) {
+                return makeError(ErrorCode::NotFound, fmt::format("{}: cannot read the scene file",
+                                                                  (dir / name).string()));
             }
+            return tl::unexpected(read.error());
         }
     }
     return fmt::format("{:016x}", h);

@@ -4,7 +4,6 @@
 #include <cerrno>
 #include <cstring>
 #include <ctime>
-#include <fstream>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -15,6 +14,7 @@
 #include <sys/statvfs.h>
 #include <unistd.h>
 
+#include <pipeline/base/input_file_parts.h>
 #include <platform/logging.h>
 #include <platform/session_files.h>
 #include <recordings/recover.h>
@@ -167,19 +167,11 @@ SessionFolderLock::~SessionFolderLock()
 
 bool recordingFinished(const fs::path& file)
 {
-    static constexpr std::array<char, 8> kMagic{'\x89', 'M', 'C', 'A', 'P', '0', '\r', '\n'};
-    std::ifstream in(file, std::ios::binary | std::ios::ate);
-    if (!in) {
-        return false;
-    }
-    const auto size = static_cast<std::streamoff>(in.tellg());
-    if (size < 16) {
-        return false;
-    }
-    std::array<char, 8> tail{};
-    in.seekg(size - 8);
-    in.read(tail.data(), tail.size());
-    return in.gcount() == 8 && tail == kMagic;
+    static constexpr std::string_view kMagic{"\x89MCAP0\r\n", 8};
+    // Opened once, without waiting, a regular file only (a FIFO in a session's place is not
+    // finished, and is never waited for); only its last bytes read.
+    const auto tail = readInputFileTail(file, 16, UINTMAX_MAX, "recording");
+    return tail && tail->size() == 16 && std::string_view(*tail).substr(8) == kMagic;
 }
 
 // What a recovery cut short leaves beside a kiosk file NAME (a stop signal or a kill during

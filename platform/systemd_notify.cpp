@@ -1,8 +1,6 @@
 // sd_notify through libsystemd (when built with it).
 #include <cstdlib>
 #include <ctime>
-#include <fstream>
-#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -10,6 +8,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <pipeline/base/input_file.h>
 #include <platform/logging.h>
 #include <platform/systemd_notify.h>
 
@@ -25,8 +24,9 @@ namespace {
 // frame, dynamic linking included. Nullopt where /proc cannot say.
 std::optional<double> secondsSinceProcessStart()
 {
-    std::ifstream in("/proc/self/stat");
-    std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // A line of a few hundred bytes; through the bounded reader like every other file.
+    const std::string stat =
+            readInputFile("/proc/self/stat", 4096, "process status").value_or(std::string());
     const auto paren = stat.rfind(')'); // the command name may hold spaces and parentheses
     const long ticks = ::sysconf(_SC_CLK_TCK);
     timespec now{};

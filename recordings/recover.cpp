@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -135,9 +136,20 @@ Expected<void> moveIntoPlace(const fs::path& tmp, const fs::path& out, ExistingO
     return {};
 }
 
-// Every kept message into a fresh, complete recording at `path` (finish() syncs it).
-Expected<void> writeRecovered(const mcap::Scan& s, const fs::path& path)
+// What the first pass found that the output needs before its first message.
+struct Plan {
+    mcap::Scan scan; // the first pass (no messages held)
+    mcap::ScanOptions options;
+    std::optional<mcap::Message> session; // restored from the metadata, written first
+};
+
+// Every kept message into a fresh, complete recording at `path` (finish() syncs it): the metadata,
+// schemas and channels the first pass found, then a second pass over `in` giving its messages to
+// the writer as they come, so that nothing grows with the file. The second pass must find what
+// the first did.
+Expected<void> writeRecovered(const Plan& plan, mcap::Source& in, const fs::path& path)
 {
+    const auto& s = plan.scan;
     auto w = mcap::FileWriter::create(path, s.library.empty() ? "replica recover" : s.library,
                                       false);
     if (!w) {
@@ -161,13 +173,31 @@ Expected<void> writeRecovered(const mcap::Scan& s, const fs::path& path)
         (*w)->addChannel(c);
     }
     constexpr std::size_t kChunkBytes = 256 * 1024;
-    for (const auto& m : s.messages) {
+    std::optional<Error> failed;
+    auto add = [&](mcap::Message&& m) {
         (*w)->addMessage(m);
         if ((*w)->pendingBytes() >= kChunkBytes) {
             if (auto ok = (*w)->closeChunk(false); !ok) {
-                return tl::unexpected(ok.error());
+                failed = ok.error();
+                return false;
             }
         }
+        return true;
+    };
+    if (plan.session) {
+        add(mcap::Message(*plan.session));
+    }
+    const auto again = mcap::scan(in, plan.options, add);
+    if (failed) {
+        return tl::unexpected(*failed);
+    }
+    if (!again.readError.empty()) {
+        return makeError(ErrorCode::Io, again.readError);
+    }
+    if (again.messageCount != s.messageCount || again.chunks.size() != s.chunks.size() ||
+        again.damageCount != s.damageCount) {
+        return makeError(ErrorCode::Io, "the recording changed while it was being recovered "
+                                        "(is something still writing it?)");
     }
     if (auto ok = (*w)->finish(); !ok) {
         return tl::unexpected(ok.error());
@@ -177,7 +207,7 @@ Expected<void> writeRecovered(const mcap::Scan& s, const fs::path& path)
 
 // How recover scans: resynchronising, chunked records only, and (for a file whose first chunk,
 // with the channel definitions, was lost) the fixed channels of Replica's formats assumed.
-mcap::ScanOptions recoverOptions(std::string_view bytes)
+mcap::ScanOptions recoverOptions(std::string_view head)
 {
     mcap::ScanOptions options;
     options.resync = true;
@@ -187,7 +217,7 @@ mcap::ScanOptions recoverOptions(std::string_view bytes)
     // definitions) was lost can still have its samples recovered.
     // Each format only added channels (3: id 7, 4: ids 8-13, 5: ids 14-15, 6: id 16), so today's
     // definitions serve every chunked format (2 and later) as well.
-    const auto probe = bytes.substr(0, 256);
+    const auto probe = head.substr(0, 256);
     bool knownFormat = false;
     for (int v = 2; v <= kFormatVersion; ++v) {
         knownFormat = knownFormat || probe.find(fmt::format("(format {})", v)) != std::string::npos;
@@ -202,13 +232,15 @@ mcap::ScanOptions recoverOptions(std::string_view bytes)
 }
 
 // The session message lives in the first chunk; if that chunk was lost, restores it from the
-// copy in the replica.session Metadata record. Whether it did.
-bool restoreSession(mcap::Scan& s, const mcap::ScanOptions& options)
+// copy in the replica.session Metadata record (in plan.session, written before every other
+// message). Whether it did.
+bool restoreSession(Plan& plan)
 {
+    auto& s = plan.scan;
+    const auto& options = plan.options;
     const auto sessionId = static_cast<std::uint16_t>(ChannelId::Session);
-    const bool haveSession = std::any_of(s.messages.begin(), s.messages.end(),
-                                         [&](const auto& m) { return m.channelId == sessionId; });
-    if (haveSession || s.messages.empty() || !options.fallbackChannels.contains(sessionId)) {
+    const bool haveSession = s.channelMessages.contains(sessionId);
+    if (haveSession || s.messageCount == 0 || !options.fallbackChannels.contains(sessionId)) {
         return false;
     }
     for (const auto& md : s.metadata) {
@@ -233,7 +265,7 @@ bool restoreSession(mcap::Scan& s, const mcap::ScanOptions& options)
             s.schemas.emplace(def.schemaId, options.fallbackSchemas.at(def.schemaId));
             s.channelsAssumed.push_back(sessionId);
         }
-        s.messages.insert(s.messages.begin(), mcap::Message{sessionId, 0, t, t, it->second});
+        plan.session = mcap::Message{sessionId, 0, t, t, it->second};
         return true;
     }
     return false;
@@ -241,19 +273,20 @@ bool restoreSession(mcap::Scan& s, const mcap::ScanOptions& options)
 
 RecoverReport reportOf(const mcap::Scan& s, bool sessionRestored)
 {
+    const std::uint64_t kept = s.messageCount + (sessionRestored ? 1 : 0);
     RecoverReport r;
     r.problems = s.damage;
     if (s.damageCount > s.damage.size()) {
         r.problems.push_back(
                 fmt::format("... and {} more problems", s.damageCount - s.damage.size()));
     }
-    r.messagesKept = s.messages.size();
+    r.messagesKept = kept;
     r.chunksKept = s.chunks.size();
     r.chunksDamaged = s.chunksDamaged;
     r.bytesDropped = s.bytesSkipped;
     r.messagesDropped = s.messagesDropped;
-    if (s.summaryMessageCount && *s.summaryMessageCount > s.messages.size()) {
-        r.messagesDropped += *s.summaryMessageCount - s.messages.size();
+    if (s.summaryMessageCount && *s.summaryMessageCount > kept) {
+        r.messagesDropped += *s.summaryMessageCount - kept;
     }
     r.channelsAssumed = s.channelsAssumed;
     r.sessionRestored = sessionRestored;
@@ -262,13 +295,14 @@ RecoverReport reportOf(const mcap::Scan& s, bool sessionRestored)
 
 // Writes the kept messages to a new file beside `out` and puts it in place; whatever goes wrong,
 // the temporary file goes and `out` stays as it was.
-Expected<void> writeInPlace(const mcap::Scan& s, const fs::path& out, ExistingOutput existing)
+Expected<void>
+writeInPlace(const Plan& plan, mcap::Source& in, const fs::path& out, ExistingOutput existing)
 {
     auto tmp = createTemporaryBeside(out);
     if (!tmp) {
         return tl::unexpected(tmp.error());
     }
-    auto written = writeRecovered(s, *tmp);
+    auto written = writeRecovered(plan, in, *tmp);
     if (!written) {
         written =
                 makeError(written.error().code, fmt::format("{}: not written (left as it was): {}",
@@ -297,20 +331,32 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
     if (auto ok = checkOutput(in, out, existing); !ok) {
         return tl::unexpected(ok.error());
     }
-    auto read = readInputFile(in, kMaxRecordingBytes, "recording");
-    if (!read) {
-        return tl::unexpected(read.error());
+    // Read twice through a bounded window, never whole: once to learn the channels, metadata and
+    // damage the output starts with, once to copy the messages (docs/limits.md).
+    auto source = mcap::FileSource::open(in, kMaxRecordingBytes, "recording");
+    if (!source) {
+        return tl::unexpected(source.error());
     }
-    const auto options = recoverOptions(*read);
-    auto s = mcap::scan(*read, options);
-    const bool sessionRestored = restoreSession(s, options);
-    if (s.messages.empty()) {
+    Plan plan;
+    const auto size = (*source)->size();
+    const auto head = (*source)->bytes(0, std::min<std::uint64_t>(size, 256));
+    if (!head) {
+        return makeError(ErrorCode::Io, (*source)->error());
+    }
+    plan.options = recoverOptions(*head);
+    plan.scan = mcap::scan(**source, plan.options, [](mcap::Message&&) { return true; });
+    if (!plan.scan.readError.empty()) {
+        return makeError(ErrorCode::Io, plan.scan.readError);
+    }
+    const bool sessionRestored = restoreSession(plan);
+    const auto& s = plan.scan;
+    if (s.messageCount == 0) {
         return makeError(
                 ErrorCode::Corrupt,
                 fmt::format("{}: nothing recoverable: {}", in.string(),
                             s.damage.empty() ? "the file holds no messages" : s.damage.front()));
     }
-    if (auto ok = writeInPlace(s, out, existing); !ok) {
+    if (auto ok = writeInPlace(plan, **source, out, existing); !ok) {
         return tl::unexpected(ok.error());
     }
     return reportOf(s, sessionRestored);

@@ -27,7 +27,10 @@ enum class ExistingOutput { Refuse, Replace };
 
 // Reads `in` linearly (no footer needed), resynchronising on the next intact chunk after damage,
 // and writes every message it could keep to `out` as a complete, indexed recording. Fails when
-// `in` cannot be read, nothing is recoverable, or `out` cannot be written.
+// `in` cannot be read, nothing is recoverable, or `out` cannot be written (ErrorCode::Io: a read or
+// write failed, or `in` changed between the two passes). `in` is read twice through a bounded
+// window (mcap::FileSource), once for its channels, metadata and damage, once to copy its messages
+// into the writer as they come: memory does not grow with the file (docs/limits.md).
 // The output is written to a new file beside `out` and renamed onto it only once complete and
 // synced, so an interrupted or failed recover leaves `out` as it was (and `in` is only read).
 // `out` must not be `in`, a symbolic link (never followed nor replaced), a directory or any other

@@ -25,39 +25,9 @@ namespace fs = std::filesystem;
 
 Expected<std::string> readSysfsText(const fs::path& file)
 {
-    // O_NONBLOCK: opening a FIFO does not wait for a writer, reading one does not wait for data;
-    // poll() bounds the wait for anything else that does not answer at once.
-    const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-    if (fd < 0) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot be read ({})", file.string(),
-                                                          std::strerror(errno)));
-    }
-    pollfd p{fd, POLLIN, 0};
-    int ready = 0;
-    do {
-        ready = ::poll(&p, 1, kSysfsWaitMs);
-    } while (ready < 0 && errno == EINTR);
-    // A sysfs attribute is a few bytes; read at most 64 so that a wrong path (/dev/zero, a big
-    // file) cannot make us read without end.
-    std::string text(64, '\0');
-    const ssize_t got = ready > 0 ? ::read(fd, text.data(), text.size()) : -1;
-    const int err = ready > 0 ? errno : EAGAIN;
-    ::close(fd);
-    if (got < 0 && err == EAGAIN) {
-        return makeError(ErrorCode::DeviceFailure,
-                         fmt::format("{}: no answer within {} ms (a sysfs attribute answers at "
-                                     "once: is it a FIFO or a device?)",
-                                     file.string(), kSysfsWaitMs));
-    }
-    if (got < 0) {
-        return makeError(ErrorCode::DeviceFailure,
-                         fmt::format("{}: cannot be read ({})", file.string(), std::strerror(err)));
-    }
-    text.resize(static_cast<std::size_t>(got));
-    if (const auto nl = text.find('\n'); nl != std::string::npos) {
-        text.resize(nl);
-    }
-    return text;
+    // A sysfs attribute is a few bytes: at most 64, so that a wrong path (/dev/zero, a big file)
+    // cannot make us read without end.
+    return readSysfsFile(file, 64, SysfsRead::FirstLine);
 }
 
 Expected<double> readSysfsNumber(const fs::path& file)

@@ -14,6 +14,7 @@
 
 #include <hal/clock.h>
 #include <hal/sources.h>
+#include <hal/sysfs_file.h>
 #include <pipeline/base/expected.h>
 
 namespace replica::hal::accel {
@@ -48,10 +49,10 @@ private:
     std::array<double, 3> offset_{};
 };
 
-// One sysfs attribute's text (at most 64 bytes, up to its first newline), opened without waiting
-// and read within kSysfsWaitMs: a FIFO, a device or a file that never answers in its place is an
-// error, never a read that holds the source's thread (and SIGTERM) without end.
-constexpr int kSysfsWaitMs = 200;
+// One sysfs attribute's text (at most 64 bytes, up to its first newline), through
+// hal::readSysfsFile: opened without waiting and read within kSysfsWaitMs, so that a FIFO, a
+// device or a file that never answers in its place is an error, never a read that holds the
+// source's thread (and SIGTERM) without end.
 Expected<std::string> readSysfsText(const std::filesystem::path& file);
 // Parses one sysfs attribute: a single C-locale number and a newline.
 Expected<double> readSysfsNumber(const std::filesystem::path& file);

@@ -1,7 +1,6 @@
 // libusb-1.0 implementation of UsbTransport.
 #include <array>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <vector>
 
@@ -9,6 +8,7 @@
 #include <libusb.h>
 
 #include <hal/spectrometer/libusb_transport.h>
+#include <hal/sysfs_file.h>
 
 namespace replica::hal::spectrometer {
 namespace {
@@ -100,12 +100,12 @@ private:
     UsbDeviceId id_;
 };
 
-// The first line of a sysfs attribute, without trailing white space ("" if unreadable).
+// The first line of a sysfs attribute, without trailing white space ("" if unreadable, or not an
+// attribute that answers at once: a FIFO or a device in its place is never waited for).
 std::string sysfsLine(const std::filesystem::path& file)
 {
-    std::ifstream in(file);
-    std::string line;
-    std::getline(in, line);
+    // A USB string descriptor is at most 126 UTF-16 units: a few hundred bytes of UTF-8.
+    std::string line = readSysfsFile(file, 4096, SysfsRead::FirstLine).value_or(std::string());
     while (!line.empty() && (line.back() == '\n' || line.back() == ' ' || line.back() == '\r')) {
         line.pop_back();
     }

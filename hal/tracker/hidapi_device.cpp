@@ -3,14 +3,15 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <mutex>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <hidapi/hidapi.h>
 #include <unistd.h>
 
+#include <hal/sysfs_file.h>
+#include <hal/tracker/hid_descriptor.h>
 #include <hal/tracker/hid_eye_head.h>
 #include <hal/tracker/hidapi_device.h>
 
@@ -92,10 +93,15 @@ private:
     HidrawNode node_;
 };
 
+// A HID device's uevent: DRIVER, HID_ID, HID_NAME, HID_PHYS, HID_UNIQ, MODALIAS (a few hundred
+// bytes; sysfs gives at most a page).
+constexpr std::size_t kMaxUeventBytes = 4096;
+
 // HID_ID=0003:0000046D:0000C52B and HID_NAME=... from the HID device's uevent.
 void readUevent(const std::filesystem::path& file, HidrawNode& n)
 {
-    std::ifstream in(file);
+    // A uevent is a few hundred bytes; a FIFO or a device in its place is never waited for.
+    std::istringstream in(readSysfsFile(file, kMaxUeventBytes, SysfsRead::Whole).value_or(""));
     std::string line;
     while (std::getline(in, line)) {
         if (line.rfind("HID_NAME=", 0) == 0) {
@@ -132,15 +138,14 @@ const char* toString(HidStatus s)
 Expected<std::vector<std::uint8_t>> readSysfsReportDescriptor(const std::filesystem::path& sysfsDir)
 {
     const auto file = sysfsDir / "device" / "report_descriptor";
-    std::ifstream in(file, std::ios::binary);
-    if (!in) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot read the HID report descriptor: {}", file.string(),
-                                     std::strerror(errno)));
+    // At most the kernel's HID_MAX_DESCRIPTOR_SIZE, read without waiting: a FIFO, /dev/zero or a
+    // directory in its place is an error in bounded time.
+    auto read = readSysfsFile(file, kMaxDescriptorBytes, SysfsRead::Whole);
+    if (!read) {
+        return makeError(read.error().code, fmt::format("cannot read the HID report descriptor: {}",
+                                                        read.error().message));
     }
-    std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                                    std::istreambuf_iterator<char>());
-    return bytes;
+    return std::vector<std::uint8_t>(read->begin(), read->end());
 }
 
 std::vector<HidrawNode> listHidTrackers(const std::filesystem::path& sysfsRoot,

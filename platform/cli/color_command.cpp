@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -37,17 +36,20 @@ struct PairFile {
 
 Expected<PairFile> readPairs(const std::string& path)
 {
-    // Regular files only: a directory would throw from the stream, a FIFO block it.
-    if (auto ok = checkInputFile(path, kMaxCsvBytes, "CSV"); !ok) {
-        if (ok.error().code != ErrorCode::NotFound) {
-            return tl::unexpected(ok.error());
+    // Regular files only, opened once and read whole within the CSV limits: a directory would
+    // throw from a stream, a FIFO block it, /dev/zero fill memory.
+    auto text = readInputFile(path, kMaxCsvBytes, "CSV");
+    if (!text) {
+        if (text.error().code == ErrorCode::NotFound) {
+            return makeError(ErrorCode::NotFound,
+                             fmt::format("{}: cannot open (does the file exist?)", path));
         }
+        return tl::unexpected(text.error());
     }
-    std::ifstream file(path, std::ios::binary);
-    if (!file) {
-        return makeError(ErrorCode::NotFound,
-                         fmt::format("{}: cannot open (does the file exist?)", path));
+    if (auto ok = checkTableLimits(*text, path, ','); !ok) {
+        return tl::unexpected(ok.error());
     }
+    std::istringstream file(std::move(*text));
     static const char* const kColumns[6] = {"L1", "a1", "b1", "L2", "a2", "b2"};
     PairFile out;
     std::size_t columnIndex[6] = {};

@@ -2,7 +2,6 @@
 // raw 32-bit floats, rows bottom-up.
 #include <bit>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -39,17 +38,15 @@ Expected<void> writePfm(const std::filesystem::path& path, const FloatImage& ima
 
 Expected<FloatImage> readPfm(const std::filesystem::path& path)
 {
-    // A regular file of bounded size; the header's size is checked against it before the raster
-    // is allocated.
-    if (auto ok = checkInputFile(path, kMaxImageBytes, "PFM"); !ok) {
-        return tl::unexpected(ok.error());
+    // A regular file of bounded size, opened once and read whole (a FIFO, a directory or /dev/zero
+    // is an error naming it); the header's size is checked against it before the image is
+    // allocated.
+    auto bytes = readInputFile(path, kMaxImageBytes, "PFM");
+    if (!bytes) {
+        return tl::unexpected(bytes.error());
     }
-    std::error_code ec;
-    const std::uintmax_t fileBytes = std::filesystem::file_size(path, ec);
-    std::ifstream in(path, std::ios::binary);
-    if (!in || ec) {
-        return makeError(ErrorCode::NotFound, fmt::format("{}: cannot open", path.string()));
-    }
+    // The header is a few dozen bytes: "PF", width, height, scale, one white space byte.
+    std::istringstream in(bytes->substr(0, 256));
     std::string magic;
     FloatImage image;
     double scale = 0.0;
@@ -60,21 +57,18 @@ Expected<FloatImage> readPfm(const std::filesystem::path& path)
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: not a 3-channel PFM image (bad header)", path.string()));
     }
+    const auto rasterAt = static_cast<std::size_t>(in.tellg());
     const auto pixels =
             static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-    if (pixels * 3 * sizeof(std::uint32_t) > fileBytes) {
+    if (pixels * 3 * sizeof(std::uint32_t) > bytes->size() - rasterAt) {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: truncated PFM ({}x{} pixels expected)", path.string(),
                                      image.width, image.height));
     }
     std::vector<std::uint32_t> raw(pixels * 3);
-    in.read(reinterpret_cast<char*>(raw.data()),
-            static_cast<std::streamsize>(raw.size() * sizeof(std::uint32_t)));
-    if (in.gcount() != static_cast<std::streamsize>(raw.size() * sizeof(std::uint32_t))) {
-        return makeError(ErrorCode::Corrupt,
-                         fmt::format("{}: truncated PFM ({}x{} pixels expected)", path.string(),
-                                     image.width, image.height));
-    }
+    std::memcpy(raw.data(), bytes->data() + rasterAt, raw.size() * sizeof(std::uint32_t));
+    bytes->clear();
+    bytes->shrink_to_fit();
     const bool swap = (scale > 0.0) != (std::endian::native == std::endian::big);
     image.rgba.resize(pixels * 4);
     for (std::size_t p = 0; p < pixels; ++p) {

@@ -1,6 +1,7 @@
 // Linear MCAP scanning: records one after another, chunks decompressed and CRC-checked, the summary
 // checked against what the data section really holds, and resynchronisation for recovery.
 #include <algorithm>
+#include <cstring>
 #include <optional>
 
 #include <fmt/format.h>
@@ -8,17 +9,25 @@
 #include <recordings/mcap/chunk_unpack.h>
 #include <recordings/mcap/crc.h>
 #include <recordings/mcap/reader.h>
+#include <recordings/mcap/scan_state.h>
 
 namespace replica::recordings::mcap {
 namespace {
 
-class Scanner
+using detail::checkSummary;
+using detail::ScanState;
+
+// How far resynchronisation looks for a chunk's opcode at once.
+constexpr std::uint64_t kFindStep = 64 << 10;
+
+class Scanner : ScanState
 {
 public:
-    Scanner(std::string_view file, const ScanOptions& o) : f_(file), o_(o)
+    Scanner(Source& in, const ScanOptions& o, const MessageSink* sink)
+        : ScanState(in, o), sink_(sink)
     {
-        work_.budget = o.maxDecompressedBytes != 0 ? o.maxDecompressedBytes
-                                                   : decompressionBudget(file.size());
+        work_.budget =
+                o.maxDecompressedBytes != 0 ? o.maxDecompressedBytes : decompressionBudget(size_);
     }
 
     Scan run()
@@ -31,13 +40,15 @@ public:
 private:
     Scan records()
     {
-        if (f_.size() < kMagic.size() || f_.substr(0, kMagic.size()) != kMagic) {
-            problem("not an MCAP file (bad magic bytes at byte 0)");
+        if (size_ < kMagic.size() || read(0, kMagic.size()) != kMagic) {
+            if (s_.readError.empty()) {
+                problem("not an MCAP file (bad magic bytes at byte 0)");
+            }
             return std::move(s_);
         }
         std::size_t at = kMagic.size();
-        while (at < f_.size()) {
-            const std::size_t left = f_.size() - at;
+        while (at < size_) {
+            const std::size_t left = size_ - at;
             if (left < kRecordPrefix) {
                 problem(fmt::format("truncated: {} stray byte(s) at byte {} (the file was cut "
                                     "short)",
@@ -45,7 +56,11 @@ private:
                 s_.bytesSkipped += left;
                 break;
             }
-            ByteReader r(f_.substr(at, kRecordPrefix));
+            const auto prefix = read(at, kRecordPrefix);
+            if (!prefix) {
+                return std::move(s_);
+            }
+            ByteReader r(*prefix);
             const auto op = r.u8();
             const std::uint64_t len = r.u64();
             if (op == 0 || len > left - kRecordPrefix) {
@@ -59,10 +74,9 @@ private:
                 at = resyncAt_;
                 continue;
             }
-            const std::string_view content = f_.substr(at + kRecordPrefix, len);
             const std::size_t next = at + kRecordPrefix + static_cast<std::size_t>(len);
-            const Step step = dataRecord(op, content, at, next);
-            if (step == Step::Done) {
+            const Step step = dataRecord(op, len, at, next);
+            if (step == Step::Done || stopped_ || !s_.readError.empty()) {
                 return std::move(s_);
             }
             const bool ok = step == Step::Next;
@@ -71,7 +85,7 @@ private:
             }
             if (!ok) {
                 if (!resyncFrom(at)) {
-                    if (!o_.resync) {
+                    if (!o_.resync && s_.readError.empty()) {
                         at = next; // keep reporting: the length field looked sane
                         continue;
                     }
@@ -83,24 +97,28 @@ private:
             s_.dataSectionEnd = next;
             at = next;
         }
+        if (!s_.readError.empty()) {
+            return std::move(s_);
+        }
         if (work_.overBudget) {
             return overBudget();
         }
         problem(fmt::format("no Data End record: the recording was cut short at byte {} (power "
                             "cut or crash?); 'replica recover' rebuilds its index",
-                            f_.size()));
+                            size_));
         return std::move(s_);
     }
 
     // What a record of the data section leaves the scan to do.
     enum class Step { Next, Damaged, Done };
 
-    Step dataRecord(std::uint8_t op, std::string_view content, std::size_t at, std::size_t next)
+    Step dataRecord(std::uint8_t op, std::uint64_t len, std::size_t at, std::size_t next)
     {
         switch (static_cast<Op>(op)) {
         case Op::Header:
-            if (at == kMagic.size()) {
-                ByteReader h(content);
+            if (at == kMagic.size() && len <= kMaxRecordBytes) {
+                const auto c = content(at, len, "Header");
+                ByteReader h(c.value_or(std::string_view()));
                 h.str();
                 s_.library = h.str();
             }
@@ -120,21 +138,31 @@ private:
                 s_.bytesSkipped += next - at;
                 return Step::Next;
             }
-            return inner(static_cast<Op>(op), content, at) ? Step::Next : Step::Damaged;
-        case Op::Chunk:
-            return chunk(content, at, next - at) ? Step::Next : Step::Damaged;
-        case Op::Metadata:
-            if (auto m = decodeMetadata(content)) {
-                s_.metadata.push_back(std::move(*m));
-                return Step::Next;
+            if (const auto c = content(at, len, "a Schema, Channel or Message")) {
+                return inner(static_cast<Op>(op), *c, at) ? Step::Next : Step::Damaged;
             }
-            problem(fmt::format("malformed Metadata record at byte {}", at));
+            s_.messagesDropped += op == static_cast<std::uint8_t>(Op::Message) ? 1 : 0;
+            return Step::Damaged;
+        case Op::Chunk:
+            if (const auto c = content(at, len, "Chunk")) {
+                return chunk(*c, at, next - at) ? Step::Next : Step::Damaged;
+            }
+            ++s_.chunksDamaged;
+            return Step::Damaged;
+        case Op::Metadata:
+            if (const auto c = content(at, len, "Metadata")) {
+                if (auto m = decodeMetadata(*c)) {
+                    s_.metadata.push_back(std::move(*m));
+                    return Step::Next;
+                }
+                problem(fmt::format("malformed Metadata record at byte {}", at));
+            }
             return Step::Damaged;
         case Op::DataEnd:
             s_.dataEnd = true;
             s_.dataSectionEnd = at;
-            dataEnd(content, at);
-            summary(next);
+            dataEnd(at, len);
+            checkSummary(*this, next);
             return Step::Done;
         case Op::Footer:
             problem(fmt::format("footer at byte {} without a Data End record before it", at));
@@ -148,23 +176,15 @@ private:
     {
         // What is not read is lost: counted, so that recover says so (exit 3).
         ++s_.chunksDamaged;
-        s_.bytesSkipped += f_.size() - std::min<std::size_t>(s_.dataSectionEnd, f_.size());
+        s_.bytesSkipped += size_ - std::min<std::size_t>(s_.dataSectionEnd, size_);
         problem(fmt::format("the recording decompresses to more than {} MiB, the budget for a "
                             "{}-byte file ({}x its size, at least {} MiB; Replica's own "
                             "recordings take about 3x): not read further",
                             (o_.maxDecompressedBytes != 0 ? o_.maxDecompressedBytes
-                                                          : decompressionBudget(f_.size())) >>
+                                                          : decompressionBudget(size_)) >>
                                     20,
-                            f_.size(), kDecompressionRatio, kMinDecompressionBudget >> 20));
+                            size_, kDecompressionRatio, kMinDecompressionBudget >> 20));
         return std::move(s_);
-    }
-
-    void problem(std::string what)
-    {
-        ++s_.damageCount;
-        if (s_.damage.size() < o_.maxDamageReports) {
-            s_.damage.push_back(std::move(what));
-        }
     }
 
     // Finds the next plausible, intact chunk after `at`; without resync, reports failure.
@@ -173,32 +193,58 @@ private:
         if (!o_.resync) {
             return false;
         }
-        for (std::size_t p = at + 1; p + kRecordPrefix <= f_.size(); ++p) {
-            if (static_cast<std::uint8_t>(f_[p]) != static_cast<std::uint8_t>(Op::Chunk)) {
+        std::uint64_t p = at + 1;
+        while (p + kRecordPrefix <= size_) {
+            const auto piece = read(p, std::min<std::uint64_t>(kFindStep, size_ - p));
+            if (!piece) {
+                break;
+            }
+            const void* hit =
+                    std::memchr(piece->data(), static_cast<int>(Op::Chunk), piece->size());
+            if (hit == nullptr) {
+                p += piece->size();
                 continue;
             }
-            ByteReader r(f_.substr(p + 1, 8));
-            const std::uint64_t len = r.u64();
-            if (len > f_.size() - p - kRecordPrefix) {
-                continue;
+            p += static_cast<std::uint64_t>(static_cast<const char*>(hit) - piece->data());
+            if (p + kRecordPrefix > size_) {
+                break;
             }
-            const auto c = chunkFields(f_.substr(p + kRecordPrefix, len));
-            if (!c || (c->compression != "zstd" && !c->compression.empty()) || c->crc == 0) {
-                continue;
+            if (intactChunkAt(p)) {
+                s_.bytesSkipped += p - at;
+                resyncAt_ = p;
+                return true;
             }
-            std::string records;
-            if (!unpack(*c, records, work_).empty()) {
-                if (work_.overBudget) {
-                    break;
-                }
-                continue;
+            if (work_.overBudget || !s_.readError.empty()) {
+                break;
             }
-            s_.bytesSkipped += p - at;
-            resyncAt_ = p;
-            return true;
+            ++p;
         }
-        s_.bytesSkipped += f_.size() - at;
+        s_.bytesSkipped += size_ - at;
         return false;
+    }
+
+    // Whether a plausible chunk (zstd or uncompressed, with a CRC) starts at `p` and unpacks
+    // intact within the budget.
+    bool intactChunkAt(std::uint64_t p)
+    {
+        const auto prefix = read(p, kRecordPrefix);
+        if (!prefix) {
+            return false;
+        }
+        ByteReader r(prefix->substr(1));
+        const std::uint64_t len = r.u64();
+        if (len > size_ - p - kRecordPrefix || len > kMaxRecordBytes) {
+            return false;
+        }
+        const auto whole = read(p, kRecordPrefix + len);
+        if (!whole) {
+            return false;
+        }
+        const auto c = chunkFields(whole->substr(kRecordPrefix));
+        if (!c || (c->compression != "zstd" && !c->compression.empty()) || c->crc == 0) {
+            return false;
+        }
+        return unpack(*c, records_, work_).empty();
     }
 
     // A Schema, Channel or Message record, in the data section or inside a chunk.
@@ -251,7 +297,11 @@ private:
                 ++s_.messagesDropped;
                 return true;
             }
-            s_.messages.push_back(std::move(*m));
+            if (inChunk_) {
+                chunkMessages_.push_back(std::move(*m));
+            } else {
+                keep(std::move(*m));
+            }
         }
         return true;
     }
@@ -264,8 +314,7 @@ private:
             ++s_.chunksDamaged;
             return false;
         }
-        std::string records;
-        if (auto why = unpack(*c, records, work_); !why.empty()) {
+        if (auto why = unpack(*c, records_, work_); !why.empty()) {
             if (work_.overBudget) {
                 return false; // reported once, by run()
             }
@@ -273,262 +322,104 @@ private:
             ++s_.chunksDamaged;
             return false;
         }
-        const std::size_t before = s_.messages.size();
-        // A chunk whose CRC matched but whose records do not parse was written wrong: keep none of
-        // it.
-        auto reject = [&](std::string why) {
-            problem(fmt::format("chunk at byte {} {}", at, why));
+        // A chunk's messages are kept only once all its records parsed: one whose CRC matched but
+        // whose records do not parse was written wrong, and none of it is kept.
+        chunkMessages_.clear();
+        inChunk_ = true;
+        const auto why = chunkRecords(at);
+        inChunk_ = false;
+        if (!why.empty()) {
+            if (why != "-") {
+                problem(fmt::format("chunk at byte {} {}", at, why));
+            }
             ++s_.chunksDamaged;
-            s_.messages.resize(before);
+            chunkMessages_.clear();
             return false;
-        };
-        std::size_t p = 0;
-        while (p < records.size()) {
-            if (records.size() - p < kRecordPrefix) {
-                return reject("ends in a partial record");
-            }
-            ByteReader r(std::string_view(records).substr(p, kRecordPrefix));
-            const auto op = r.u8();
-            const std::uint64_t len = r.u64();
-            if (len > records.size() - p - kRecordPrefix) {
-                return reject("holds a record that overruns it");
-            }
-            const auto body = std::string_view(records).substr(p + kRecordPrefix, len);
-            const auto kind = static_cast<Op>(op);
-            if (kind == Op::Schema || kind == Op::Channel || kind == Op::Message) {
-                if (!inner(kind, body, at)) {
-                    ++s_.chunksDamaged;
-                    s_.messages.resize(before);
-                    return false;
-                }
-            }
-            p += kRecordPrefix + static_cast<std::size_t>(len);
         }
-        s_.chunks.push_back({at, length, s_.messages.size() - before});
+        s_.chunks.push_back({at, length, chunkMessages_.size()});
+        for (auto& m : chunkMessages_) {
+            keep(std::move(m));
+        }
+        chunkMessages_.clear();
         return true;
     }
 
-    void dataEnd(std::string_view content, std::size_t at)
+    // The records of the chunk at `at` (in records_): "" when all parsed, else what was wrong
+    // ("-": already reported).
+    std::string chunkRecords(std::size_t at)
     {
-        ByteReader r(content);
+        const std::string_view records = records_;
+        std::size_t p = 0;
+        while (p < records.size()) {
+            if (records.size() - p < kRecordPrefix) {
+                return "ends in a partial record";
+            }
+            ByteReader r(records.substr(p, kRecordPrefix));
+            const auto op = r.u8();
+            const std::uint64_t len = r.u64();
+            if (len > records.size() - p - kRecordPrefix) {
+                return "holds a record that overruns it";
+            }
+            const auto body = records.substr(p + kRecordPrefix, len);
+            const auto kind = static_cast<Op>(op);
+            if ((kind == Op::Schema || kind == Op::Channel || kind == Op::Message) &&
+                !inner(kind, body, at)) {
+                return "-";
+            }
+            p += kRecordPrefix + static_cast<std::size_t>(len);
+        }
+        return {};
+    }
+
+    // A message kept: to the sink, or into the Scan.
+    void keep(Message&& m)
+    {
+        ++s_.messageCount;
+        ++s_.channelMessages[m.channelId];
+        if (sink_ == nullptr) {
+            s_.messages.push_back(std::move(m));
+        } else if (!stopped_ && !(*sink_)(std::move(m))) {
+            stopped_ = true;
+        }
+    }
+
+    void dataEnd(std::size_t at, std::uint64_t len)
+    {
+        const auto content = read(at + kRecordPrefix, std::min<std::uint64_t>(len, 4));
+        if (!content) {
+            return;
+        }
+        ByteReader r(*content);
         const std::uint32_t crc = r.u32();
         if (r.failed()) {
             problem(fmt::format("Data End record at byte {} is malformed", at));
             return;
         }
-        if (crc != 0 && crc32(0, f_.substr(0, at)) != crc) {
+        if (crc != 0 && crcOf(0, at) != crc && s_.readError.empty()) {
             problem("data section CRC mismatch: some byte before the Data End record changed");
         }
     }
 
-    // Checks footer, trailing magic, summary CRC and the statistics against the data section.
-    void summary(std::size_t afterDataEnd)
-    {
-        const std::size_t size = f_.size();
-        if (size < afterDataEnd + kFooterRecordSize + kMagic.size()) {
-            problem("the summary or footer is missing or cut short (the recording was not closed)");
-            return;
-        }
-        if (f_.substr(size - kMagic.size()) != kMagic) {
-            problem("the file does not end with the MCAP magic bytes");
-            return;
-        }
-        const std::size_t footerAt = size - kMagic.size() - kFooterRecordSize;
-        ByteReader fr(f_.substr(footerAt, kFooterRecordSize));
-        const auto op = fr.u8();
-        const auto len = fr.u64();
-        const auto summaryStart = fr.u64();
-        const auto offsetsStart = fr.u64();
-        const auto summaryCrc = fr.u32();
-        if (op != static_cast<std::uint8_t>(Op::Footer) || len != 20) {
-            problem(fmt::format("no valid footer at byte {}", footerAt));
-            return;
-        }
-        if (summaryCrc != 0 &&
-            crc32(0, f_.substr(afterDataEnd, footerAt + kRecordPrefix + 16 - afterDataEnd)) !=
-                    summaryCrc) {
-            problem("summary CRC mismatch: the summary or footer was corrupted");
-            return;
-        }
-        if (summaryStart == 0) {
-            s_.footer = true; // an unindexed file: nothing more to check
-            return;
-        }
-        const std::size_t summaryEnd = offsetsStart != 0 ? offsetsStart : footerAt;
-        if (summaryStart != afterDataEnd || summaryEnd < summaryStart || summaryEnd > footerAt) {
-            problem("the footer's summary offsets are inconsistent");
-            return;
-        }
-        s_.footer = true;
-        std::size_t p = summaryStart;
-        std::uint64_t chunkIndexes = 0;
-        while (p < summaryEnd) {
-            if (summaryEnd - p < kRecordPrefix) {
-                problem("the summary ends in a partial record");
-                return;
-            }
-            ByteReader r(f_.substr(p, kRecordPrefix));
-            const auto rop = static_cast<Op>(r.u8());
-            const auto rlen = r.u64();
-            if (rlen > summaryEnd - p - kRecordPrefix) {
-                problem(fmt::format("summary record at byte {} overruns the summary", p));
-                return;
-            }
-            const auto body = f_.substr(p + kRecordPrefix, rlen);
-            if (rop == Op::ChunkIndex) {
-                ++chunkIndexes;
-                chunkIndex(body, p);
-            } else if (rop == Op::MetadataIndex) {
-                metadataIndex(body, p);
-            } else if (rop == Op::Statistics) {
-                statistics(body);
-            } else if (rop == Op::Channel) {
-                auto ch = decodeChannel(body);
-                if (!ch || s_.channels.count(ch->id) == 0 || !(s_.channels.at(ch->id) == *ch)) {
-                    problem(fmt::format("summary Channel record at byte {} does not match the "
-                                        "data section",
-                                        p));
-                }
-            }
-            p += kRecordPrefix + static_cast<std::size_t>(rlen);
-        }
-        if (chunkIndexes != s_.chunks.size()) {
-            problem(fmt::format("the summary indexes {} chunks but the data section holds {}",
-                                chunkIndexes, s_.chunks.size()));
-        }
-        if (offsetsStart != 0) {
-            summaryOffsets(offsetsStart, footerAt, summaryStart, summaryEnd);
-        }
-    }
-
-    // A Chunk Index must point at a chunk the scan found intact, exactly, and its message index
-    // offsets into the data section after that chunk: an index is how other readers seek.
-    void chunkIndex(std::string_view body, std::size_t at)
-    {
-        ByteReader r(body);
-        r.u64();
-        r.u64();
-        const auto offset = r.u64();
-        const auto length = r.u64();
-        ByteReader map(r.str());
-        if (r.failed()) {
-            problem(fmt::format("malformed Chunk Index record at byte {} in the summary", at));
-            return;
-        }
-        const auto it =
-                std::lower_bound(s_.chunks.begin(), s_.chunks.end(), offset,
-                                 [](const ChunkSpan& c, std::uint64_t o) { return c.offset < o; });
-        if (it == s_.chunks.end() || it->offset != offset || it->length != length) {
-            problem(fmt::format("the Chunk Index at byte {} points at bytes {}..+{}, where the "
-                                "data section holds no intact chunk of that length",
-                                at, offset, length));
-            return;
-        }
-        while (map.remaining() > 0 && !map.failed()) {
-            map.u16();
-            const auto indexAt = map.u64();
-            if (!map.failed() && (indexAt < offset + length || indexAt >= s_.dataSectionEnd)) {
-                problem(fmt::format("the Chunk Index at byte {} puts a message index at byte {}, "
-                                    "outside the data section after its chunk",
-                                    at, indexAt));
-                return;
-            }
-        }
-    }
-
-    void metadataIndex(std::string_view body, std::size_t at)
-    {
-        ByteReader r(body);
-        const auto offset = r.u64();
-        const auto length = r.u64();
-        if (r.failed() || offset < kMagic.size() || offset > s_.dataSectionEnd ||
-            length > s_.dataSectionEnd - offset) {
-            problem(fmt::format("the Metadata Index at byte {} points outside the data section "
-                                "(byte {}, {} bytes)",
-                                at, offset, length));
-        }
-    }
-
-    // Summary Offset records, between their start and the footer: each group within the summary.
-    void summaryOffsets(std::size_t from,
-                        std::size_t to,
-                        std::size_t summaryStart,
-                        std::size_t summaryEnd)
-    {
-        std::size_t p = from;
-        while (p + kRecordPrefix <= to) {
-            ByteReader r(f_.substr(p, kRecordPrefix));
-            const auto op = static_cast<Op>(r.u8());
-            const auto len = r.u64();
-            if (len > to - p - kRecordPrefix) {
-                problem(fmt::format("summary offset record at byte {} overruns the footer", p));
-                return;
-            }
-            ByteReader g(f_.substr(p + kRecordPrefix, len));
-            g.u8();
-            const auto start = g.u64();
-            const auto length = g.u64();
-            if (op == Op::SummaryOffset && (g.failed() || start < summaryStart ||
-                                            start > summaryEnd || length > summaryEnd - start)) {
-                problem(fmt::format("the Summary Offset at byte {} points outside the summary "
-                                    "(byte {}, {} bytes)",
-                                    p, start, length));
-                return;
-            }
-            p += kRecordPrefix + static_cast<std::size_t>(len);
-        }
-        if (p != to) {
-            problem(fmt::format("the summary offsets end in a partial record at byte {}", p));
-        }
-    }
-
-    void statistics(std::string_view body)
-    {
-        ByteReader r(body);
-        const auto messageCount = r.u64();
-        r.u16();
-        r.u32();
-        r.u32();
-        r.u32();
-        const auto chunkCount = r.u32();
-        r.u64();
-        r.u64();
-        ByteReader map(r.str());
-        if (r.failed()) {
-            problem("malformed Statistics record in the summary");
-            return;
-        }
-        s_.summary = true;
-        s_.summaryMessageCount = messageCount;
-        std::map<std::uint16_t, std::uint64_t> claimed;
-        while (map.remaining() > 0 && !map.failed()) {
-            const auto channel = map.u16();
-            claimed[channel] = map.u64();
-        }
-        std::map<std::uint16_t, std::uint64_t> found;
-        for (const auto& m : s_.messages) {
-            ++found[m.channelId];
-        }
-        if (messageCount != s_.messages.size() || chunkCount != s_.chunks.size() ||
-            (!claimed.empty() && claimed != found)) {
-            problem(fmt::format("the summary's statistics ({} messages in {} chunks) disagree "
-                                "with the data section ({} messages in {} chunks)",
-                                messageCount, chunkCount, s_.messages.size(), s_.chunks.size()));
-        }
-    }
-
-    std::string_view f_;
-    ScanOptions o_;
-    Scan s_;
+    const MessageSink* sink_ = nullptr;
     std::size_t resyncAt_ = 0;
     Work work_;
+    std::string records_;  // the chunk being unpacked
+    bool inChunk_ = false; // its messages go to chunkMessages_ until it proves whole
+    std::vector<Message> chunkMessages_;
+    bool stopped_ = false; // the sink asked to stop
 };
 
 } // namespace
 
 Scan scan(std::string_view file, const ScanOptions& options)
 {
-    return Scanner(file, options).run();
+    MemorySource in(file);
+    return Scanner(in, options, nullptr).run();
+}
+
+Scan scan(Source& source, const ScanOptions& options, const MessageSink& sink)
+{
+    return Scanner(source, options, &sink).run();
 }
 
 } // namespace replica::recordings::mcap

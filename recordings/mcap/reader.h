@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include <recordings/mcap/records.h>
+#include <recordings/mcap/source.h>
 
 namespace replica::recordings::mcap {
 
@@ -55,7 +57,10 @@ struct Scan {
     std::string library; // the Header's library string ("" if none)
     std::map<std::uint16_t, Schema> schemas;
     std::map<std::uint16_t, Channel> channels;
-    std::vector<Message> messages;     // in file order, every one on a known channel
+    std::vector<Message> messages;  // in file order, every one on a known channel (none kept
+                                    // when a sink takes them)
+    std::uint64_t messageCount = 0; // messages kept (or given to the sink)
+    std::map<std::uint16_t, std::uint64_t> channelMessages; // of those, per channel
     std::vector<Metadata> metadata;    // intact Metadata records of the data section
     std::vector<ChunkSpan> chunks;     // intact chunks
     std::vector<std::string> damage;   // one sentence each, with byte offsets; empty: file is sound
@@ -73,9 +78,19 @@ struct Scan {
     // tries each plausible chunk header after damage), zstd input included: at most the
     // decompression budget, so the work is linear in the file's size.
     std::uint64_t bytesExamined = 0;
+    std::string readError; // the file could not be read (an I/O error, or it shrank): scan ended
 };
+
+// Takes each kept message; false stops the scan (after the current record).
+using MessageSink = std::function<bool(Message&&)>;
 
 // Scans a whole file held in memory. Never throws on malformed input; reports it in damage.
 Scan scan(std::string_view file, const ScanOptions& options = {});
+
+// Scans `source` (recover: a file through a bounded window) and gives each kept message to `sink`
+// instead of keeping it, in file order; a chunk's messages once the whole chunk proved intact. What
+// the scan holds is one chunk and the window, whatever the file's size; the same file gives the
+// same Scan (less `messages`) as the scan above.
+Scan scan(Source& source, const ScanOptions& options, const MessageSink& sink);
 
 } // namespace replica::recordings::mcap

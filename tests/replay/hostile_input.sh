@@ -168,6 +168,14 @@ json.dump(j, open(sys.argv[2], "w"))
 PY
 expect 1 "profile-type.json: /bit_depth: expected an integer" -- "${R[@]}" display forward "$work/profile-type.json" --rgb 1,2,3
 
+# --- Files read once through the bounded reader (issue 32): 'color de2000' checked its pairs and
+# then opened them again (a FIFO swapped in between hung it); now one open, no wait, a size.
+mkfifo "$work/pairs-fifo.csv"
+expect 1 "pairs-fifo.csv: is a FIFO, not a CSV file" -- "${R[@]}" color de2000 "$work/pairs-fifo.csv"
+expect 1 "/dev/zero: is a device, not a CSV file" -- "${R[@]}" color de2000 /dev/zero
+expect 1 "is a directory, not a CSV file" -- "${R[@]}" color de2000 "$work"
+expect 1 "nope.csv: cannot open \(does the file exist\?\)" -- "${R[@]}" color de2000 "$work/nope.csv"
+
 # --- Errors that printed nothing on standard error, or one error several times (found by
 # running every command with bad inputs; the count is in docs/recordings.md).
 # probe's report goes to standard output; a failing probe also says so in one line.
@@ -300,6 +308,25 @@ if [ -x /usr/bin/time ]; then
     # Recover on 16 MiB of nested chunks: linear (143 s before), nothing recoverable.
     bounded 400 1 "nested-zero-16mib.mcap: nothing recoverable" -- "${R[@]}" recover "$rec/nested-zero-16mib.mcap" "$work/nested-out.mcap"
     bounded 400 1 "nested-crc-16mib.mcap: nothing recoverable" -- "${R[@]}" recover "$rec/nested-crc-16mib.mcap" "$work/nested-out.mcap"
+    # recover streams: a crashed 20 MiB session (no Data End, summary or footer) recovers within
+    # 64 MB whatever its size (before: the file and every message held, about 13 MB + 4 x the file:
+    # 93 MB here, 413 MB for 100 MiB).
+    python3 "$2/tests/benchmarks/crashed_recording.py" "$2/tests/replay/goldens/kiosk-painting.mcap" \
+        "$work/crashed-20mib.mcap" 64
+    err=$( (ulimit -v "$limit_kb"; /usr/bin/time -f "time %e s, peak %M KB" -o "$work/time.txt" \
+        timeout 60 "$replica" "${R[@]}" recover "$work/crashed-20mib.mcap" "$work/crashed-out.mcap") 2>&1 >/dev/null)
+    got=$?
+    stats=$(tail -1 "$work/time.txt")
+    kb=$(printf '%s' "$stats" | sed -E 's/.*peak ([0-9]+) KB.*/\1/')
+    if [ "$got" -ne 0 ] || [ -n "$err" ]; then
+        fail "recover of a crashed 20 MiB session: exit $got: $err"
+    elif [ "$limit_kb" != unlimited ] && [ "$kb" -gt $((64 * 1024)) ]; then
+        fail "recover of a crashed 20 MiB session peaked at $kb KB, more than 64 MB"
+    else
+        pass=$((pass + 1))
+        echo "ok: recover of a crashed 20 MiB session ($stats)"
+    fi
+    rm -f "$work/crashed-20mib.mcap" "$work/crashed-out.mcap"
     # A site file of 2 MiB, and tables past their row and field limits.
     { printf '[booth]\n'; head -c $((2 << 20)) /dev/zero | tr '\0' '#'; } > "$work/huge.toml"
     bounded 100 1 "huge.toml: [0-9]+ bytes, more than the 1 MiB a site file may hold" -- "${R[@]}" config check "$work/huge.toml"

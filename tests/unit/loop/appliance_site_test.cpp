@@ -2,6 +2,7 @@
 // file read with its line numbers, the geometry it sets (T_booth_tracker against closed-form
 // rotations), the default scene before the first samples, and the session folder's retention and
 // in-place recovery.
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 #include <state/scene_estimator.h>
+#include <sys/stat.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/scene/booth.h>
@@ -424,6 +426,62 @@ TEST(SessionFolder, RetentionDeletesTheKiosksOldestUntilTheTotalFits)
     EXPECT_TRUE(fs::exists(mine[3]));
     fs::remove_all(dir);
     fs::remove_all(outside.parent_path());
+}
+
+// Whether a session file was closed is read from its last bytes, opened once without waiting: a
+// FIFO, a directory or /dev/zero in a session's place is "not finished" at once, never a hang.
+TEST(SessionFolder, RecordingFinishedNeverWaitsOnAFifoNorReadsADevice)
+{
+    const fs::path dir = scratch("finished-hostile");
+    const fs::path fifo = dir / "fifo.mcap";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    fs::create_directory(dir / "dir.mcap");
+    fs::create_symlink("/dev/zero", dir / "zero.mcap");
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_FALSE(recordingFinished(fifo));
+    EXPECT_FALSE(recordingFinished(dir / "dir.mcap"));
+    EXPECT_FALSE(recordingFinished(dir / "zero.mcap"));
+    EXPECT_FALSE(recordingFinished(dir / "missing.mcap"));
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+    // Just the magic at both ends (16 bytes) is closed; 15 bytes are not.
+    const std::string magic("\x89MCAP0\r\n", 8);
+    tests::spit(dir / "tiny.mcap", magic + magic);
+    EXPECT_TRUE(recordingFinished(dir / "tiny.mcap"));
+    tests::spit(dir / "short.mcap", magic + magic.substr(1));
+    EXPECT_FALSE(recordingFinished(dir / "short.mcap"));
+    fs::remove_all(dir);
+}
+
+// The kiosk's start-up recovery runs under the unit's 180 s start timeout, so it must be bounded in
+// time whatever a session file holds: 4 MiB of chunks nested in chunks, each with a wrong CRC
+// (issue 32: quadratic before, minutes at 16 MB), is found unrecoverable and set aside in seconds.
+TEST(SessionFolder, AHostileSessionIsSetAsideInBoundedTime)
+{
+    const fs::path dir = scratch("recover-hostile");
+    const fs::path hostile = newSessionPath(dir);
+    auto u64 = [](std::uint64_t v) { return std::string(reinterpret_cast<const char*>(&v), 8); };
+    auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    // Each chunk: its header (times, sizes, CRC, no compression), then the next one inside it;
+    // built from the inside out, then written outermost first.
+    std::vector<std::string> heads;
+    std::uint64_t inner = 0;
+    while (inner < (4u << 20)) {
+        const std::uint64_t body = 40 + inner;
+        heads.push_back(std::string(1, '\x06') + u64(body) + u64(0) + u64(0) + u64(inner) +
+                        u32(0xDEADBEEF) + u32(0) + u64(inner));
+        inner += 9 + body;
+    }
+    std::string file("\x89MCAP0\r\n", 8);
+    for (auto it = heads.rbegin(); it != heads.rend(); ++it) {
+        file += *it;
+    }
+    tests::spit(hostile, file);
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_TRUE(recoverUnfinished(dir).empty());
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(60));
+    EXPECT_TRUE(fs::exists(hostile.string() + ".unrecoverable"));
+    EXPECT_FALSE(fs::exists(hostile));
+    fs::remove_all(dir);
 }
 
 TEST(SessionFolder, ACrashedSessionIsRecoveredInPlace)

@@ -309,5 +309,107 @@ TEST(RecordingDamage, ResyncWorkOnNestedChunksIsBoundedByTheBudget)
     }
 }
 
+// Scans `bytes` in memory, and from a file through the bounded window with a sink (as recover
+// does): the same messages in the same order, the same damage, chunks and work.
+void expectStreamedScanMatches(const std::string& bytes,
+                               const mcap::ScanOptions& options,
+                               const std::string& label)
+{
+    const auto whole = mcap::scan(bytes, options);
+    const auto path = tempPath("stream");
+    spit(path, bytes);
+    auto source = mcap::FileSource::open(path, kMaxRecordingBytes, "recording");
+    ASSERT_TRUE(source) << label;
+    std::vector<mcap::Message> got;
+    const auto streamed = mcap::scan(**source, options, [&](mcap::Message&& m) {
+        got.push_back(std::move(m));
+        return true;
+    });
+    std::filesystem::remove(path);
+    EXPECT_TRUE(streamed.readError.empty()) << label << ": " << streamed.readError;
+    EXPECT_TRUE(streamed.messages.empty()) << label << ": a sink's messages are not kept";
+    ASSERT_EQ(got.size(), whole.messages.size()) << label;
+    EXPECT_EQ(streamed.messageCount, whole.messages.size()) << label;
+    EXPECT_EQ(whole.messageCount, whole.messages.size()) << label;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i].channelId, whole.messages[i].channelId) << label << " #" << i;
+        ASSERT_EQ(got[i].sequence, whole.messages[i].sequence) << label << " #" << i;
+        ASSERT_EQ(got[i].logTime, whole.messages[i].logTime) << label << " #" << i;
+        ASSERT_EQ(got[i].data, whole.messages[i].data) << label << " #" << i;
+    }
+    EXPECT_EQ(streamed.damage, whole.damage) << label;
+    EXPECT_EQ(streamed.damageCount, whole.damageCount) << label;
+    EXPECT_EQ(streamed.chunks.size(), whole.chunks.size()) << label;
+    EXPECT_EQ(streamed.bytesSkipped, whole.bytesSkipped) << label;
+    EXPECT_EQ(streamed.bytesExamined, whole.bytesExamined) << label;
+    EXPECT_EQ(streamed.metadata, whole.metadata) << label;
+    EXPECT_EQ(streamed.channelMessages, whole.channelMessages) << label;
+    EXPECT_EQ(streamed.summary, whole.summary) << label;
+    EXPECT_EQ(streamed.footer, whole.footer) << label;
+    // The window never held more than one record and the read-ahead.
+    EXPECT_LE((*source)->peakWindow(), mcap::kMaxRecordBytes + (4u << 20)) << label;
+}
+
+// recover reads through a window and hands messages to the writer as they come; it must see
+// exactly what a scan of the whole file in memory sees, on sound, cut and damaged files.
+TEST(RecordingDamage, AStreamedScanSeesWhatAScanInMemorySees)
+{
+    const auto& s = sample();
+    mcap::ScanOptions plain;
+    mcap::ScanOptions resync;
+    resync.resync = true;
+    resync.chunkedOnly = true;
+    for (const auto* options : {&plain, &resync}) {
+        const std::string mode = options->resync ? " (resync)" : "";
+        expectStreamedScanMatches(s.bytes, *options, "whole" + mode);
+        expectStreamedScanMatches(s.bytes.substr(0, s.bytes.size() / 2), *options, "cut" + mode);
+        std::string flipped = s.bytes;
+        const auto& c = s.chunks[s.chunks.size() / 3];
+        flipped[c.offset + c.length / 2] ^= 0x10;
+        expectStreamedScanMatches(flipped, *options, "flipped" + mode);
+        std::mt19937 rng(7);
+        for (int i = 0; i < 8; ++i) {
+            std::string damaged = s.bytes;
+            damaged[rng() % damaged.size()] ^= static_cast<char>(1 << (rng() % 8));
+            expectStreamedScanMatches(damaged, *options, "random flip " + std::to_string(i) + mode);
+        }
+        expectStreamedScanMatches(nestedChunks(256 << 10, false), *options, "nested" + mode);
+        expectStreamedScanMatches(nestedChunks(256 << 10, true), *options, "nested zero" + mode);
+    }
+}
+
+// A file that shrinks after it was opened (something truncating it) is a read error, not damage:
+// recover must not write a "recovered" file from half of what it counted.
+TEST(RecordingDamage, AFileThatShrinksWhileStreamedIsAReadError)
+{
+    const auto path = tempPath("shrinks");
+    spit(path, sample().bytes);
+    auto source = mcap::FileSource::open(path, kMaxRecordingBytes, "recording");
+    ASSERT_TRUE(source);
+    std::filesystem::resize_file(path, sample().bytes.size() / 2);
+    std::uint64_t seen = 0;
+    const auto s = mcap::scan(**source, {}, [&](mcap::Message&&) {
+        ++seen;
+        return true;
+    });
+    std::filesystem::remove(path);
+    EXPECT_NE(s.readError.find("changed while being read"), std::string::npos) << s.readError;
+    EXPECT_EQ(seen, s.messageCount);
+}
+
+// The sink can stop the scan (recover's writer failing): no message is given after it said no.
+TEST(RecordingDamage, ASinkThatSaysNoStopsTheScan)
+{
+    const auto path = tempPath("stop");
+    spit(path, sample().bytes);
+    auto source = mcap::FileSource::open(path, kMaxRecordingBytes, "recording");
+    ASSERT_TRUE(source);
+    std::uint64_t seen = 0;
+    const auto s = mcap::scan(**source, {}, [&](mcap::Message&&) { return ++seen < 10; });
+    std::filesystem::remove(path);
+    EXPECT_EQ(seen, 10u);
+    EXPECT_LT(s.chunks.size(), sample().chunks.size());
+}
+
 } // namespace
 } // namespace replica::recordings

@@ -1,10 +1,12 @@
 // Replay comparison helpers: PFM frames round-trip bit-exactly, ΔE00 statistics are the order
 // statistics of the input, and the ΔE00 image agrees with CIELAB/CIEDE2000 applied by hand.
 #include <bit>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <pipeline/colour/ciede2000.h>
@@ -63,6 +65,29 @@ TEST(Pfm, TruncatedAndForeignFilesAreNamedErrors)
     ASSERT_FALSE(r);
     EXPECT_NE(r.error().message.find("not a 3-channel PFM"), std::string::npos);
     std::filesystem::remove(path);
+}
+
+// A reference frame is opened once through the bounded reader: a FIFO, /dev/zero or a directory
+// in its place is an error naming it at once (before, it was checked by name and then opened
+// again with a stream: a FIFO put there in between hung it).
+TEST(Pfm, AFifoADeviceAndADirectoryAreNamedErrorsAtOnce)
+{
+    const auto fifo = temp("fifo");
+    std::filesystem::remove(fifo);
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto r = readPfm(fifo);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("is a FIFO"), std::string::npos) << r.error().message;
+    r = readPfm("/dev/zero");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("/dev/zero: is a device"), std::string::npos)
+            << r.error().message;
+    r = readPfm(std::filesystem::temp_directory_path());
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("is a directory"), std::string::npos) << r.error().message;
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+    std::filesystem::remove(fifo);
 }
 
 TEST(FrameCompare, StatisticsAreOrderStatistics)
