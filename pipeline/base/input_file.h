@@ -124,19 +124,22 @@ checkInputFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::
     return {};
 }
 
-// The whole of 'path' as bytes, checked as above. Reads at most maxBytes + 1 whatever the size
-// says (a /proc file claims 0 bytes).
-inline Expected<std::string>
-readInputFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::string_view what)
+// 'path', checked as readInputFile does and opened once, read in pieces of at most 64 KiB given in
+// order to 'piece' (a digest): nothing is held, and no other open can find something else at the
+// name.
+template <typename Piece>
+Expected<void> readInputFilePieces(const std::filesystem::path& path,
+                                   std::uintmax_t maxBytes,
+                                   std::string_view what,
+                                   Piece&& piece)
 {
     input_file_detail::Fd f;
     auto st = input_file_detail::openChecked(f, path, maxBytes, what);
     if (!st) {
         return tl::unexpected(st.error());
     }
-    std::string text;
-    text.reserve(static_cast<std::size_t>(st->st_size));
     char buf[65536];
+    std::uintmax_t total = 0;
     for (;;) {
         const ssize_t got = ::read(f.fd, buf, sizeof buf);
         if (got < 0) {
@@ -147,14 +150,28 @@ readInputFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::s
                                                         what, std::strerror(errno)));
         }
         if (got == 0) {
-            break;
+            return {};
         }
-        text.append(buf, static_cast<std::size_t>(got));
-        if (text.size() > maxBytes) {
+        total += static_cast<std::uintmax_t>(got);
+        if (total > maxBytes) {
             return makeError(ErrorCode::InvalidArgument,
                              fmt::format("{}: more than the {} a {} file may hold", path.string(),
                                          input_file_detail::sizeText(maxBytes), what));
         }
+        piece(std::string_view(buf, static_cast<std::size_t>(got)));
+    }
+}
+
+// The whole of 'path' as bytes, checked as above. Reads at most maxBytes + 1 whatever the size
+// says (a /proc file claims 0 bytes).
+inline Expected<std::string>
+readInputFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::string_view what)
+{
+    std::string text;
+    auto ok = readInputFilePieces(path, maxBytes, what,
+                                  [&](std::string_view piece) { text.append(piece); });
+    if (!ok) {
+        return tl::unexpected(ok.error());
     }
     return text;
 }

@@ -1,5 +1,5 @@
-// Reading a file in parts through the bounded reader (input_file.h): piece by piece (a digest) or
-// only its end (is a recording closed?), opened once, never held whole.
+// Reading only a file's end through the bounded reader (input_file.h; piece by piece:
+// readInputFilePieces there), opened once, never held whole.
 #pragma once
 
 #include <algorithm>
@@ -17,44 +17,6 @@
 #include <pipeline/base/input_file.h>
 
 namespace replica {
-
-// 'path', checked as readInputFile does and opened once, read in pieces of at most 64 KiB given in
-// order to 'piece' (a digest): nothing is held, and no other open can find something else at the
-// name.
-template <typename Piece>
-Expected<void> readInputFilePieces(const std::filesystem::path& path,
-                                   std::uintmax_t maxBytes,
-                                   std::string_view what,
-                                   Piece&& piece)
-{
-    input_file_detail::Fd f;
-    auto st = input_file_detail::openChecked(f, path, maxBytes, what);
-    if (!st) {
-        return tl::unexpected(st.error());
-    }
-    char buf[65536];
-    std::uintmax_t total = 0;
-    for (;;) {
-        const ssize_t got = ::read(f.fd, buf, sizeof buf);
-        if (got < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            return makeError(ErrorCode::Io, fmt::format("{}: cannot read {} ({})", path.string(),
-                                                        what, std::strerror(errno)));
-        }
-        if (got == 0) {
-            return {};
-        }
-        total += static_cast<std::uintmax_t>(got);
-        if (total > maxBytes) {
-            return makeError(ErrorCode::InvalidArgument,
-                             fmt::format("{}: more than the {} a {} file may hold", path.string(),
-                                         input_file_detail::sizeText(maxBytes), what));
-        }
-        piece(std::string_view(buf, static_cast<std::size_t>(got)));
-    }
-}
 
 // The last 'n' bytes of 'path' (all of it when shorter), checked as readInputFile does and opened
 // once: for a reader that looks only at a file's end (is a recording closed?).

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The loss promise under disk I/O (issue 32): the kiosk (simulated sensors, headless, the shipped
-# flush_ms of 500) records while a disk writer beside it fills the same file system with O_DIRECT
-# writes (dd oflag=direct, in a loop); it is SIGKILLed KILLS times, each after a random 1.5-4.5 s of
-# recording; each killed session is recovered ('replica recover', as the next start would) and its
-# loss measured: the kill's wall-clock time minus the newest log_time the recovered file holds (a
+# flush_ms of 500; the environment's FLUSH_MS sets another) records while a disk writer beside it
+# fills the same file system with O_DIRECT writes (dd oflag=direct, in a loop); it is SIGKILLed
+# KILLS times, each after a random 1.5-4.5 s of recording; each killed session is recovered
+# ('replica recover', as the next start would) and its loss measured: the kill's wall-clock time minus the newest log_time the recovered file holds (a
 # sample's log_time is the session's wall-clock start plus the session time it reached the loop).
 # Prints each kill's loss, then the count, the maximum, the percentiles and how many exceeded the
 # promise (PROMISE_MS, 500). Exit 1 when a session did not recover or read; the figure is reported,
@@ -27,7 +27,7 @@ size = "96x60"
 [recording]
 directory = "$work/sessions"
 keep_bytes = 1073741824
-flush_ms = 500
+flush_ms = ${FLUSH_MS:-500}
 TOML
 "$replica" config check "$work/site.toml" >/dev/null || { echo "FAIL: site file" >&2; exit 1; }
 
