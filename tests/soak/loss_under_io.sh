@@ -4,11 +4,11 @@
 # fills the same file system with O_DIRECT writes (dd oflag=direct, in a loop); it is SIGKILLed
 # KILLS times, each after a random 1.5-4.5 s of recording; each killed session is recovered
 # ('replica recover', as the next start would) and its loss measured: the kill's wall-clock time
-# minus the newest log_time the recovered file holds (a sample's log_time is the session's wall-
-# clock start plus the session time it reached the loop). Prints each kill's loss, then the count,
-# the maximum, the percentiles and how many exceeded the promise (PROMISE_MS, 500). Exit 1 when a
-# session did not recover or read; the figure is reported, not asserted (docs/limits.md states what
-# it measured).
+# minus the newest log_time the recovered file holds (a sample's log_time is the session's
+# wall-clock start plus the session time it reached the loop). Prints each kill's loss, then the
+# count, the maximum, the percentiles and how many exceeded the promise (PROMISE_MS, 500). Exit 1
+# when a session did not recover or read; the figure is reported, not asserted (docs/limits.md
+# states what it measured).
 #   loss_under_io.sh REPLICA WORK [KILLS=100] [PROMISE_MS=500]
 # Not part of ctest: about 10 s per kill (REPLICA_LOSS_DD_MB sets the writer's file, default 512).
 set -uo pipefail
