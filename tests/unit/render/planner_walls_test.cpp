@@ -95,13 +95,24 @@ shading::RenderSettings base()
     return s;
 }
 
+// The planner's probe here: three tilts from the centre eye at 16 x 10 pixels.
+std::vector<shading::View> probe()
+{
+    return shading::probeViews(scene::StandModel{}, 16, 10, 1);
+}
+
+shading::Plan
+planWith(const WallsUnderTest& w, const std::vector<shading::View>& views, shading::PlanWalls walls)
+{
+    return shading::planRenderViews(checker(), w.light, views, test::observer(), kProbeBudget,
+                                    base(), w.basis, walls);
+}
+
 TEST(PlannerWalls, GreyWallsAreDrawnBecauseLeavingThemOutCostsTheBudget)
 {
     const WallsUnderTest w = solvedWalls(-1.0); // N7, the default
-    const auto views = shading::probeViews(scene::StandModel{}, 16, 10, 1);
-    const shading::Plan plan =
-            shading::planRenderViews(checker(), w.light, views, test::observer(), kProbeBudget,
-                                     base(), w.basis, {&w.exact, &w.realtime});
+    const auto views = probe();
+    const shading::Plan plan = planWith(w, views, {&w.exact, &w.realtime});
     ASSERT_TRUE(plan.met);
     EXPECT_TRUE(plan.settings.walls);
     // The pick holds against the truth with walls; the same setting without them does not.
@@ -122,10 +133,8 @@ TEST(PlannerWalls, GreyWallsAreDrawnBecauseLeavingThemOutCostsTheBudget)
 TEST(PlannerWalls, NearlyBlackWallsAreLeftOutAndThePlanSaysWhy)
 {
     const WallsUnderTest w = solvedWalls(0.02);
-    const auto views = shading::probeViews(scene::StandModel{}, 16, 10, 1);
-    const shading::Plan plan =
-            shading::planRenderViews(checker(), w.light, views, test::observer(), kProbeBudget,
-                                     base(), w.basis, {&w.exact, &w.realtime});
+    const auto views = probe();
+    const shading::Plan plan = planWith(w, views, {&w.exact, &w.realtime});
     ASSERT_TRUE(plan.met);
     EXPECT_FALSE(plan.settings.walls);
     const auto e = errorAgainstWalls(w, views, plan.settings);
@@ -144,11 +153,8 @@ TEST(PlannerWalls, NearlyBlackWallsAreLeftOutAndThePlanSaysWhy)
 TEST(PlannerWalls, WithoutWallsNoCandidateDrawsThem)
 {
     const WallsUnderTest w = solvedWalls(-1.0);
-    const auto views = shading::probeViews(scene::StandModel{}, 16, 10, 1);
     // Only one of the two solutions: the booth has no walls to plan with.
-    const shading::Plan plan =
-            shading::planRenderViews(checker(), w.light, views, test::observer(), kProbeBudget,
-                                     base(), w.basis, {&w.exact, nullptr});
+    const shading::Plan plan = planWith(w, probe(), {&w.exact, nullptr});
     EXPECT_TRUE(plan.met);
     EXPECT_FALSE(plan.settings.walls);
 
