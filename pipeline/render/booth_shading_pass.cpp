@@ -91,8 +91,13 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     // glsl/booth_main.glsl eq. (1) on a flat surface: one LIGHT_AT per light up to
     // kBoothUnrolledLights, a loop for any beyond. Not on relief: there each light's horizon test
     // is large, and 32 copies of it took LLVM seconds to compile (a test's pass 2 -> 16 s) for no
-    // measurable gain in the frame.
-    config.unrolledLights = relief ? 0 : std::clamp(settings_.lights, 0, kBoothUnrolledLights);
+    // measurable gain in the frame. Nor with the diffuse grid: eq. (1) then runs only at the
+    // grid's few hundred nodes (mode 3), where 64 copies of the area light's contour integral
+    // bought nothing in the frame and cost llvmpipe 4-5 s of JIT before the flat scenes' first
+    // frame (docs/performance.md, "Start-up"); the frames are bit for bit the same.
+    config.unrolledLights = relief || config.diffuseGrid
+                                    ? 0
+                                    : std::clamp(settings_.lights, 0, kBoothUnrolledLights);
     // The specular samples likewise, SPEC_AT(k) up to kBoothUnrolledSpecSamples: llvmpipe kept
     // the loop and read each sample's half vector as a gather per pixel. Written out, the
     // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md).
