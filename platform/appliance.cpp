@@ -107,8 +107,12 @@ std::vector<DimmerView> dimmerViews(const RunConfig& config,
             basis = std::move(*b);
         }
     }
-    const auto ps = sh::prepareScene(setup.scene, std::max(setup.settings.horizonDirections, 1),
-                                     0.01, basis);
+    // The relief's normals and horizons prepared once for every lamp (makeBoothScene), the
+    // palette in the lamp's basis.
+    const auto ps = setup.prepared ? sh::reprojectScene(*setup.prepared, setup.scene, basis)
+                                   : sh::prepareScene(setup.scene,
+                                                      std::max(setup.settings.horizonDirections, 1),
+                                                      0.01, basis);
     const auto pl = sh::prepareLight(light, setup.observer, setup.settings.lights, basis);
     // The views share nothing but the prepared scene and light: drawn on every core (start-up
     // waits for them), each into its own slot, so the choice is the same on any machine.
@@ -334,6 +338,12 @@ makeBoothScene(RunConfig& config,
     }
     if (config.boothDimmerAuto) {
         const auto start = std::chrono::steady_clock::now();
+        // Prepared once: each lamp's probe views and then the pass's first variant copy its
+        // horizons (the painting's took 0.4 s each, four times before the first frame).
+        setup->prepared = std::make_shared<const pipeline::shading::PreparedScene>(
+                pipeline::shading::prepareScene(setup->scene,
+                                                std::max(setup->settings.horizonDirections, 1),
+                                                0.01, setup->basis));
         chooseBoothDimmer(config, *setup, displayModel);
         logger("booth")->debug("booth dimmer (auto) chosen in {:.0f} ms", startupMs(start));
     }

@@ -95,8 +95,12 @@ Expected<void> BoothScenePass::makeVariant(std::size_t v)
     }
     // The scene prepared for the variant's horizon directions, in the setup's basis (encoding 0:
     // useVariant brings its channels to the encoding drawn).
-    auto prepared = std::make_unique<shading::PreparedScene>(shading::prepareScene(
-            setup_.scene, std::max(var.settings.horizonDirections, 1), 0.01, setup_.basis));
+    const int directions = std::max(var.settings.horizonDirections, 1);
+    auto prepared = std::make_unique<shading::PreparedScene>(
+            setup_.prepared && !setup_.scene.flat() &&
+                            setup_.prepared->horizon.directions == directions
+                    ? shading::reprojectScene(*setup_.prepared, setup_.scene, setup_.basis)
+                    : shading::prepareScene(setup_.scene, directions, 0.01, setup_.basis));
     // Made in the middle of a frame (its first use): the pass's creation binds framebuffers and
     // textures of its own; the frame's target, viewport and texture unit come back.
     GLint drawFb = 0;

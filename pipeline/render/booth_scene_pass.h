@@ -58,6 +58,11 @@ struct BoothSceneSetup {
     // here, and the direct-sensor mode, draw with 'settings'. Each distinct setting gets a shading
     // pass of its own, built by create(); a lamp change switches to its pass.
     std::map<std::string, LampSettings> perLamp;
+    // The scene already prepared (shading::prepareScene) with settings.horizonDirections, when the
+    // caller had to prepare it before the pass (the automatic dimmer's probe views): a pass with
+    // that many horizon directions copies its normals and horizons rather than computing them
+    // again before the first frame.
+    std::shared_ptr<const shading::PreparedScene> prepared;
 };
 
 class BoothScenePass

@@ -166,6 +166,21 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
     return p;
 }
 
+PreparedScene reprojectScene(const PreparedScene& prepared,
+                             const surface::SurfaceScene& scene,
+                             const colour::ChannelBasis& basis)
+{
+    PreparedScene p;
+    p.scene = &scene;
+    p.normals = prepared.normals;
+    p.horizon = prepared.horizon;
+    p.horizonHalf = prepared.horizonHalf;
+    for (const auto& s : scene.palette) {
+        p.paletteCoeffs.push_back(colour::projectReflectance(basis, s));
+    }
+    return p;
+}
+
 double pointLightIrradiance(const std::vector<booth::PointLight>& lights,
                             const Vec3& lightNormal,
                             double texelAreaM2,

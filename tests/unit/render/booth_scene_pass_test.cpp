@@ -75,6 +75,65 @@ TEST_F(BoothScenePassTest, ClassifiedLampUsesItsBoothLight)
     EXPECT_GT(lit, 0.0);
 }
 
+// The scene prepared once and reprojected (the automatic dimmer's probe views and the pass's first
+// variant share it) is the scene prepared anew in the other basis, value for value.
+TEST(ReprojectScene, IsTheScenePreparedAnewInTheOtherBasis)
+{
+    const auto setup = tests::boothPassSetup("painting");
+    ASSERT_FALSE(setup.scene.flat());
+    const auto box = shading::prepareScene(setup.scene, 8, 0.01, colour::boxBasis());
+    const auto got = shading::reprojectScene(box, setup.scene, setup.basis);
+    const auto want = shading::prepareScene(setup.scene, 8, 0.01, setup.basis);
+    EXPECT_EQ(got.scene, &setup.scene);
+    EXPECT_EQ(got.normals, want.normals);
+    EXPECT_EQ(got.horizon.directions, 8);
+    EXPECT_EQ(got.horizon.sinBeta, want.horizon.sinBeta);
+    EXPECT_EQ(got.horizonHalf.sinBeta, want.horizonHalf.sinBeta);
+    ASSERT_EQ(got.paletteCoeffs.size(), want.paletteCoeffs.size());
+    ASSERT_FALSE(want.paletteCoeffs.empty());
+    bool differs = false; // the box basis's coefficients are not the setup basis's
+    for (std::size_t i = 0; i < want.paletteCoeffs.size(); ++i) {
+        EXPECT_EQ(got.paletteCoeffs[i], want.paletteCoeffs[i]) << i;
+        differs = differs || box.paletteCoeffs[i] != want.paletteCoeffs[i];
+    }
+    EXPECT_TRUE(differs);
+}
+
+// A pass handed the prepared scene (BoothSceneSetup::prepared) draws what one that prepares it
+// itself draws, bit for bit; one with other horizon directions prepares its own.
+class BoothScenePassPrepared : public tests::HeadlessGlTest
+{
+};
+
+TEST_F(BoothScenePassPrepared, DrawsTheSameFramesAsOneThatPreparesTheSceneItself)
+{
+    auto setup = tests::boothPassSetup("painting");
+    auto own = BoothScenePass::create(setup);
+    ASSERT_TRUE(own) << own.error().message;
+    for (const int directions : {setup.settings.horizonDirections, 4}) {
+        SCOPED_TRACE(directions);
+        auto given = setup;
+        given.prepared = std::make_shared<const shading::PreparedScene>(
+                shading::prepareScene(setup.scene, directions, 0.01, colour::boxBasis()));
+        auto shared = BoothScenePass::create(given);
+        ASSERT_TRUE(shared) << shared.error().message;
+        scene::SceneState st;
+        st.lampIndex = 1;
+        st.tiltRad = 0.3;
+        const auto a = tests::drawXyz(**own, st, 52, 32);
+        const auto b = tests::drawXyz(**shared, st, 52, 32);
+        ASSERT_EQ(a.size(), b.size());
+        double lit = 0.0;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            ASSERT_EQ(a[i].x, b[i].x) << i;
+            ASSERT_EQ(a[i].y, b[i].y) << i;
+            ASSERT_EQ(a[i].z, b[i].z) << i;
+            lit += a[i].y;
+        }
+        EXPECT_GT(lit, 0.0);
+    }
+}
+
 TEST_F(BoothScenePassTest, ABoothThatDeclaresItsWallsIsLitByThemToo)
 {
     // The shipped booth declares none: its frames stay as they were.
