@@ -336,6 +336,14 @@ makeBoothScene(RunConfig& config,
     if (auto ok = applyRenderPlan(config, *setup); !ok) {
         return tl::unexpected(ok.error());
     }
+    // The default lamp is what the first frame shows until the first spectrum: its pass is the
+    // one made before the first frame (the direct-sensor mode draws variant 0's).
+    if (config.light != kLightDirect) {
+        const auto& lamps = setup->booth.lights;
+        const auto it = std::find_if(lamps.begin(), lamps.end(),
+                                     [&](const auto& l) { return l.name == config.defaultLamp; });
+        setup->firstLamp = it == lamps.end() ? -1 : static_cast<int>(it - lamps.begin());
+    }
     if (config.boothDimmerAuto) {
         const auto start = std::chrono::steady_clock::now();
         // Prepared once: each lamp's probe views and then the pass's first variant copy its

@@ -43,13 +43,11 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
     }
     p->setup_ = std::move(setup);
     const auto& s = p->setup_;
-    // Variant 0 (the setup's settings: the direct-sensor mode's, and a lamp's without settings of
-    // its own) is made now; the others at their first use or warm-up (makeVariant): what only a
-    // lamp that is not shown yet needs is not done before the first frame.
+    // Variant 0: the setup's settings (the direct-sensor mode's, and a lamp's without settings of
+    // its own). One pass is made now (below); the others at their first use or warm-up
+    // (makeVariant): what only a lamp that is not shown yet needs is not done before the first
+    // frame.
     p->variants_.push_back(Variant{s.settings, nullptr, nullptr, 0});
-    if (auto ok = p->makeVariant(0); !ok) {
-        return tl::unexpected(ok.error());
-    }
     for (const auto& lamp : s.booth.lights) {
         std::size_t index = 0;
         const auto it = s.perLamp.find(lamp.name);
@@ -79,11 +77,19 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
         }
         p->lampVariant_.push_back(index);
     }
-    p->active_ = 0;
+    // The first lamp's pass made now, or variant 0's; every other at its first use or warm-up.
+    const std::size_t first =
+            s.firstLamp >= 0 && static_cast<std::size_t>(s.firstLamp) < p->lampVariant_.size()
+                    ? p->lampVariant_[static_cast<std::size_t>(s.firstLamp)]
+                    : 0;
+    if (auto ok = p->makeVariant(first); !ok) {
+        return tl::unexpected(ok.error());
+    }
+    p->active_ = first;
     p->drawn_.assign(p->variants_.size(), false);
     p->basis_ = s.basis;
-    p->prepared_ = p->variants_[0].prepared.get();
-    p->pass_ = p->variants_[0].pass.get();
+    p->prepared_ = p->variants_[first].prepared.get();
+    p->pass_ = p->variants_[first].pass.get();
     return p;
 }
 
@@ -287,11 +293,19 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
 
 std::vector<std::size_t> BoothScenePass::variantsNotDrawn() const
 {
+    // The lamps' passes first, in lamp order, then any no lamp draws (variant 0 when every lamp
+    // has a setting of its own: only the direct-sensor mode draws it).
     std::vector<std::size_t> v;
-    for (std::size_t i = 0; i < drawn_.size(); ++i) {
-        if (!drawn_[i]) {
+    const auto add = [&](std::size_t i) {
+        if (!drawn_[i] && std::find(v.begin(), v.end(), i) == v.end()) {
             v.push_back(i);
         }
+    };
+    for (const std::size_t i : lampVariant_) {
+        add(i);
+    }
+    for (std::size_t i = 0; i < drawn_.size(); ++i) {
+        add(i);
     }
     return v;
 }

@@ -63,6 +63,10 @@ struct BoothSceneSetup {
     // that many horizon directions copies its normals and horizons rather than computing them
     // again before the first frame.
     std::shared_ptr<const shading::PreparedScene> prepared;
+    // The lamp (index into booth.lights) the first frame most likely shows (the site's default
+    // lamp, before the first spectrum): its pass is the one made at create(), so that the first
+    // frame makes no other; -1: variant 0's (setup's settings), as the direct-sensor mode draws.
+    int firstLamp = -1;
 };
 
 class BoothScenePass
@@ -115,7 +119,7 @@ public:
     // How many shading passes there are (one per distinct setting).
     std::size_t variantCount() const { return variants_.size(); }
     // The shading passes not drawn yet in this context (neither by a frame nor by a warm-up):
-    // each compiles its shaders at its first draw.
+    // each compiles its shaders at its first draw. The lamps' first, in lamp order.
     std::vector<std::size_t> variantsNotDrawn() const;
     // The frames whose draw was their shading pass's first (its shaders compiled in the frame: a
     // lamp switch to a pass not warmed up, or the first frame), and the last such draw's time, ms.
@@ -137,7 +141,8 @@ private:
 
     // One shading pass per distinct setting (variants_[0]: setup_.settings), each with the scene
     // prepared for its horizon directions; 'encodings' is the encoding its channels hold. Only
-    // variant 0 is made at create(); another has no scene or pass until makeVariant.
+    // the first lamp's (BoothSceneSetup::firstLamp) or variant 0 is made at create(); another has
+    // no scene or pass until makeVariant.
     struct Variant {
         shading::RenderSettings settings;
         std::unique_ptr<shading::PreparedScene> prepared;

@@ -97,5 +97,32 @@ TEST_F(BoothWarmUpTest, ChangesNoFrameAndNoCount)
     EXPECT_GT((*cold)->cacheRefreshes(), 0);
 }
 
+// The pass the first frame shows (BoothSceneSetup::firstLamp: the site's default lamp) is the one
+// made at create(); it draws what a pass made in the default order draws, and what is left to
+// compile lists the lamps' passes first, in lamp order, the one no lamp draws (variant 0: the
+// direct-sensor mode's) last.
+TEST_F(BoothWarmUpTest, TheFirstLampsPassComesFirstAndTheLampsPassesBeforeVariantZero)
+{
+    // Every lamp with a setting of its own: tungsten (lamp 0) -> 1, d50 -> 2, d65 -> 3.
+    setup_.perLamp["tungsten"] = LampSettings{16, 12, 0};
+    ASSERT_EQ(setup_.booth.lights[0].name, "tungsten");
+    auto plain = BoothScenePass::create(setup_);
+    auto first = setup_;
+    first.firstLamp = 2;
+    auto d65First = BoothScenePass::create(first);
+    ASSERT_TRUE(plain && d65First);
+    ASSERT_EQ((*plain)->variantCount(), 4u);
+    EXPECT_EQ((*plain)->variantsNotDrawn(), (std::vector<std::size_t>{1, 2, 3, 0}));
+    EXPECT_EQ((*d65First)->variantsNotDrawn(), (std::vector<std::size_t>{1, 2, 3, 0}));
+    const auto a = run(**plain);
+    const auto b = run(**d65First);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t f = 0; f < a.size(); ++f) {
+        ASSERT_TRUE(tests::sameFloats(a[f], b[f])) << "frame " << f;
+    }
+    // run() drew lamps 0, 1 and 2: variant 0 is left, and only it.
+    EXPECT_EQ((*d65First)->variantsNotDrawn(), (std::vector<std::size_t>{0}));
+}
+
 } // namespace
 } // namespace replica::pipeline::render
