@@ -8,7 +8,9 @@
 # records 344 times, 100 MiB, no summary) before the colorchecker at 960x600. Prints a row per run:
 # peak RSS (MiB), the most threads seen (/proc, sampled every 0.1 s) and the wall time.
 #   kiosk_peak_rss.sh REPLICA WORK [FRAMES=300]
-# SCENES and SIZES (space-separated) measure fewer; RECOVER=0 leaves out the crashed session.
+# SCENES and SIZES (space-separated) measure fewer; RECOVER=0 leaves out the crashed session;
+# RATE (Hz, default 60) sets rate_hz: 300 frames at 60 Hz on a loaded machine end before the other
+# lamps' passes have compiled in the background, 400 at 5 Hz do not (docs/appliance.md).
 # Not part of ctest: minutes on a software renderer.
 set -euo pipefail
 replica="$(realpath "$1")"
@@ -28,7 +30,7 @@ warm_up = true
 error_probe = 2
 [run]
 hal = "sim"
-rate_hz = 60.0
+rate_hz = ${RATE:-60}
 [display]
 output = "headless"
 size = "$2"
@@ -59,7 +61,8 @@ measure() { # LABEL: runs the kiosk on $work/site.toml, prints LABEL, peak RSS, 
     printf '%-52s %6d MiB %3d threads  %s\n' "$1" $((kb / 1024)) "$threads" "$wall"
 }
 
-echo "$("$replica" --version 2>/dev/null | head -1), $frames frames, $(nproc) cores," \
+echo "$("$replica" --version 2>/dev/null | head -1), $frames frames at ${RATE:-60} Hz," \
+    "$(nproc) cores," \
     "load average $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%F)"
 for size in ${SIZES:-960x600 1920x1200}; do
     for scene in ${SCENES:-colorchecker metamer painting glossy-cylinder}; do
