@@ -143,13 +143,20 @@ high=$(bytes "$(setting MemoryHigh)") || true
 max=$(bytes "$(setting MemoryMax)") || true
 [ -n "$max" ] && [ "$max" -ge $((256 << 20)) ] || fail "MemoryMax='$(setting MemoryMax)': no size of at least 256M"
 [ -n "$high" ] && [ "$high" -lt "$max" ] || fail "MemoryHigh='$(setting MemoryHigh)' is not below MemoryMax"
+# Not below what a 1920x1200 panel needs: its kiosk's measured peak (999 MiB, docs/appliance.md,
+# "Resource bounds") before the kernel starts to reclaim.
+[ "$high" -ge $((1024 << 20)) ] ||
+    fail "MemoryHigh='$(setting MemoryHigh)': below 1G, the 1920x1200 kiosk's measured peak"
+ioclass=$(setting IOSchedulingClass)
+[ "$ioclass" = best-effort ] || fail "IOSchedulingClass='$ioclass': the unit says best-effort (docs/limits.md)"
 tasks=$(setting TasksMax)
 [[ "$tasks" =~ ^[0-9]+$ ]] && [ "$tasks" -ge 64 ] && [ "$tasks" -le 1024 ] || fail "TasksMax='$tasks'"
 nice=$(setting Nice)
 [[ "$nice" =~ ^-[0-9]+$ ]] || fail "Nice='$nice': the kiosk must outrank ordinary processes"
 grep -q '^SystemCallFilter=setpriority sched_setscheduler$' "$unit" ||
     fail "the error probe's thread may not lower its own priority (SystemCallFilter)"
-echo "unit bounds: MemoryHigh $(setting MemoryHigh), MemoryMax $(setting MemoryMax), TasksMax $tasks, Nice $nice"
+echo "unit bounds: MemoryHigh $(setting MemoryHigh), MemoryMax $(setting MemoryMax), TasksMax $tasks, Nice $nice," \
+    "IOSchedulingClass $ioclass"
 if command -v systemd-analyze >/dev/null; then
     score=$(systemd-analyze security --offline=true "$unit" 2>/dev/null |
         sed -n 's/.*Overall exposure level for replica.service: \([0-9.]*\).*/\1/p')

@@ -9,7 +9,10 @@
 # count, the maximum, the percentiles and how many exceeded the promise (PROMISE_MS, 500). Exit 1
 # when a session did not recover or read; the figure is reported, not asserted (docs/limits.md
 # states what it measured).
-#   loss_under_io.sh REPLICA WORK [KILLS=100] [PROMISE_MS=500]
+#   [NICE=-15] [IONICE="-c2 -n0"] loss_under_io.sh REPLICA WORK [KILLS=100] [PROMISE_MS=500]
+# NICE and IONICE run the kiosk the way replica.service does (Nice=, IOSchedulingClass= and
+# IOSchedulingPriority=; a negative nice needs root): 'nice -n NICE' and 'ionice IONICE' before it.
+# Unset, the kiosk runs at the caller's nice and I/O priority.
 # Not part of ctest: about 10 s per kill (REPLICA_LOSS_DD_MB sets the writer's file, default 512).
 set -uo pipefail
 replica="$1"
@@ -17,6 +20,10 @@ work="$2"
 kills="${3:-100}"
 promise_ms="${4:-500}"
 dd_mb="${REPLICA_LOSS_DD_MB:-512}"
+launch=()
+[ -n "${NICE:-}" ] && launch+=(nice -n "$NICE")
+# shellcheck disable=SC2206 # IONICE is ionice's options, split on purpose ("-c2 -n0")
+[ -n "${IONICE:-}" ] && launch+=(ionice ${IONICE})
 rm -rf "$work" && mkdir -p "$work/sessions"
 cat > "$work/site.toml" <<TOML
 [run]
@@ -50,9 +57,10 @@ trap cleanup EXIT
 
 : > "$work/losses.txt"
 status=0
+echo "kiosk launched as: ${launch[*]} $replica run --kiosk (load average: $(cut -d' ' -f1-3 /proc/loadavg))"
 for k in $(seq "$kills"); do
     rm -f "$work"/sessions/*
-    "$replica" --log-level warn run --kiosk --config "$work/site.toml" --uncalibrated \
+    "${launch[@]}" "$replica" --log-level warn run --kiosk --config "$work/site.toml" --uncalibrated \
         > "$work/run.out" 2> "$work/run.log" &
     pid=$!
     file=""
@@ -93,6 +101,7 @@ print(f"{sys.argv[3]} {(int(sys.argv[2]) - newest) / 1e6:.1f}")
 PY
     echo "kill $k: lost $(tail -1 "$work/losses.txt" | cut -d' ' -f2) ms"
 done
+echo "load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)"
 python3 - "$work/losses.txt" "$promise_ms" <<'PY'
 import sys
 losses = sorted(float(l.split()[1]) for l in open(sys.argv[1]) if l.strip())
