@@ -12,30 +12,35 @@ double settingCost(const RenderSettings& s, bool glossy, bool relief)
 {
     // Calibrated on the GL frame: CPU milliseconds (every llvmpipe thread) that each count adds
     // to the appliance's 960x600 frame with the tilt moving (pass 1 recomputing its diffuse term
-    // in three bands; the frame the loop's deadline must hold while the panel moves), least
-    // squares over the grids of tests/benchmarks/cost_model_bench.cpp (flat surfaces: the
-    // ColorChecker, lights 8/32/128 x samples 4/16/48) and replica_bench_pareto (relief: the
-    // painting, lights 8/32/128 at 8 samples, samples 2/8/32 at 32 lights; horizon directions 8
-    // and 16 from cost_model_bench). On flat surfaces the specular term is shaded on the 8-texel
-    // grid, so a sample costs nothing measurable (fit -0.003 +- noise ms): 0.002 ms keeps the
-    // fewer samples first among settings of as many lights. Refit: run replica_bench_cost_model
-    // (docs/rendering.md, "Planner").
+    // in three bands through the tilt estimator, tests/benchmarks/frame_timing.h; the frame the
+    // loop's deadline must hold while the panel moves). Refitted 2026-12-06 on main 7c76def
+    // (flat passes loop over the lights with the diffuse grid, df303d4): runs of
+    // replica_bench_cost_model --scene colorchecker (7) and --scene painting (5) on the 2-core
+    // build machine at load average 5-20, the per-setting median of the runs fitted by least
+    // squares (tests/benchmarks/cost_model_pool.py over tests/benchmarks/measured/): the
+    // ColorChecker (flat; lights 8/32/128 x samples 4/16/48) 0.113 ms a light, R^2 0.92; the
+    // painting (relief; lights 8/32/128 x samples 4/16/48 x directions 8/16) 0.625 a light,
+    // 1.31 a horizon direction, 1.58 a sample, R^2 0.96, residual RMS 9.5 ms of 41-201.
+    // On flat surfaces the specular term is shaded on the 8-texel grid, so a sample costs
+    // nothing measurable (fit -0.030 ms, single runs -0.09 to +0.09): 0.002 ms keeps the fewer
+    // samples first among settings of as many lights. Refit: docs/rendering.md, "Planner".
     //
     // The walls (RenderSettings::walls: a biquadratic and a dot product a pixel in the cache
-    // pass, and the field baked on the CPU once per pose) measured as whole frames, `replica run
-    // --hal sim --output headless --no-planner --rate 60 --frames 300 --size 960x600 --fast` under
-    // the shipped booth and the same booth declaring N7 walls, three pairs interleaved: the
-    // painting's median frame 0.3 ms longer in each pair; the ColorChecker's within the runs'
-    // noise (0.1 +- 0.4 ms), taken as 0.05. Small, but not zero: walls that change nothing
-    // visible are not drawn.
+    // pass, and the field baked on the CPU once per pose, so every frame while the tilt moves),
+    // from the same runs: 32 lights, 16 samples (8 directions) under the shipped booth and under
+    // a copy declaring N7 walls, alternated, the median of the pairs' differences: the
+    // ColorChecker 1.1 ms (nine pairs, +0.1 to +5.4), the painting 0.5 ms (three pairs, -0.4
+    // to +2.7). (Before: 0.05 and 0.3, the median whole frame of 'replica run --hal sim
+    // --no-planner --rate 60 --frames 300', a different frame.) Small, but not zero: walls that
+    // change nothing visible are not drawn.
     struct Coefficients {
         double light;
         double direction;
         double sample;
         double walls;
     };
-    constexpr Coefficients kFlat{0.082, 0.0, 0.002, 0.05}; // area lights, specular, diffuse grids
-    constexpr Coefficients kRelief{0.43, 0.46, 1.35, 0.3}; // point lights, per-pixel specular
+    constexpr Coefficients kFlat{0.113, 0.0, 0.002, 1.1};   // area lights, specular, diffuse grids
+    constexpr Coefficients kRelief{0.625, 1.31, 1.58, 0.5}; // point lights, per-pixel specular
     const Coefficients& k = relief && s.reliefPass ? kRelief : kFlat;
     double c = s.lights * k.light;
     if (relief && s.reliefPass) {
