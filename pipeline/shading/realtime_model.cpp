@@ -148,6 +148,21 @@ PreparedLight prepareLight(const booth::BoothLight& light,
     return p;
 }
 
+namespace {
+
+// The palette's reflectances projected on the basis: what a basis change re-does.
+std::vector<colour::ChannelCoeffs> paletteCoeffs(const surface::SurfaceScene& scene,
+                                                 const colour::ChannelBasis& basis)
+{
+    std::vector<colour::ChannelCoeffs> c;
+    for (const auto& s : scene.palette) {
+        c.push_back(colour::projectReflectance(basis, s));
+    }
+    return c;
+}
+
+} // namespace
+
 PreparedScene prepareScene(const surface::SurfaceScene& scene,
                            int horizonDirections,
                            double horizonDistanceM,
@@ -160,9 +175,7 @@ PreparedScene prepareScene(const surface::SurfaceScene& scene,
         p.horizon = surface::horizonMap(scene.relief, horizonDirections, horizonDistanceM);
         p.horizonHalf = surface::halfPrecision(p.horizon);
     }
-    for (const auto& s : scene.palette) {
-        p.paletteCoeffs.push_back(colour::projectReflectance(basis, s));
-    }
+    p.paletteCoeffs = paletteCoeffs(scene, basis);
     return p;
 }
 
@@ -175,9 +188,7 @@ PreparedScene reprojectScene(const PreparedScene& prepared,
     p.normals = prepared.normals;
     p.horizon = prepared.horizon;
     p.horizonHalf = prepared.horizonHalf;
-    for (const auto& s : scene.palette) {
-        p.paletteCoeffs.push_back(colour::projectReflectance(basis, s));
-    }
+    p.paletteCoeffs = paletteCoeffs(scene, basis);
     return p;
 }
 
