@@ -170,6 +170,15 @@ Expected<void> applyRenderPlan(RunConfig& config, pipeline::render::BoothSceneSe
     return {};
 }
 
+// The index of the booth's lamp named exactly 'name' (a state's lampIndex), -1 when none is.
+int lampIndex(const pipeline::booth::Booth& booth, const std::string& name)
+{
+    const auto& lamps = booth.lights;
+    const auto it =
+            std::find_if(lamps.begin(), lamps.end(), [&](const auto& l) { return l.name == name; });
+    return it == lamps.end() ? -1 : static_cast<int>(it - lamps.begin());
+}
+
 // Milliseconds since 'start', for the start-up's debug lines.
 double startupMs(std::chrono::steady_clock::time_point start)
 {
@@ -226,10 +235,7 @@ makeBoothScene(RunConfig& config,
     // The default lamp is what the first frame shows until the first spectrum: its pass is the
     // one made before the first frame (the direct-sensor mode draws variant 0's).
     if (config.light != kLightDirect) {
-        const auto& lamps = setup->booth.lights;
-        const auto it = std::find_if(lamps.begin(), lamps.end(),
-                                     [&](const auto& l) { return l.name == config.defaultLamp; });
-        setup->firstLamp = it == lamps.end() ? -1 : static_cast<int>(it - lamps.begin());
+        setup->firstLamp = lampIndex(setup->booth, config.defaultLamp);
     }
     if (config.boothDimmerAuto) {
         const auto start = std::chrono::steady_clock::now();
@@ -376,15 +382,13 @@ makeStateStage(const RunConfig& config,
     setup.eye.defaultEyeM = config.defaultEyeM;
     setup.tilt.defaultTiltRad = config.defaultTiltRad;
     if (!config.defaultLamp.empty()) {
-        const auto& lamps = booth.lights;
-        const auto it = std::find_if(lamps.begin(), lamps.end(),
-                                     [&](const auto& l) { return l.name == config.defaultLamp; });
-        if (it == lamps.end()) {
+        const int lamp = lampIndex(booth, config.defaultLamp);
+        if (lamp < 0) {
             return makeError(ErrorCode::InvalidArgument,
                              fmt::format("default lamp '{}' is not a lamp of booth '{}' ({})",
                                          config.defaultLamp, config.booth, booth.names()));
         }
-        setup.light.defaultLamp = static_cast<int>(it - lamps.begin());
+        setup.light.defaultLamp = lamp;
     }
     auto estimator = state::SceneEstimator::create(std::move(setup));
     if (!estimator) {
