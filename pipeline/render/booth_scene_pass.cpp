@@ -47,12 +47,11 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
     // its own). One pass is made now (below); the others at their first use or warm-up
     // (makeVariant): what only a lamp that is not shown yet needs is not done before the first
     // frame.
-    p->variants_.push_back(Variant{s.settings, nullptr, nullptr, 0});
+    p->variants_.push_back(Variant{s.settings, {}, nullptr, nullptr, 0});
+    p->widen(p->variants_[0], s.settings);
     for (const auto& lamp : s.booth.lights) {
-        std::size_t index = 0;
-        const auto it = s.perLamp.find(lamp.name);
-        if (it != s.perLamp.end()) {
-            shading::RenderSettings settings = s.settings;
+        shading::RenderSettings settings = s.settings;
+        if (const auto it = s.perLamp.find(lamp.name); it != s.perLamp.end()) {
             settings.lights = it->second.lights;
             if (s.scene.glossy()) {
                 settings.specularSamples = it->second.specularSamples;
@@ -61,21 +60,24 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
                 settings.horizonDirections = it->second.horizonDirections;
             }
             settings.walls = settings.walls && it->second.walls;
-            const auto same = [&](const Variant& v) {
-                return v.settings.lights == settings.lights &&
-                       v.settings.specularSamples == settings.specularSamples &&
-                       v.settings.horizonDirections == settings.horizonDirections &&
-                       v.settings.walls == settings.walls;
-            };
-            const auto found = std::find_if(p->variants_.begin(), p->variants_.end(), same);
-            if (found == p->variants_.end()) {
-                p->variants_.push_back(Variant{settings, nullptr, nullptr, 0});
-                index = p->variants_.size() - 1;
-            } else {
-                index = static_cast<std::size_t>(found - p->variants_.begin());
-            }
         }
-        p->lampVariant_.push_back(index);
+        // Lamps whose programs would be the same share one pass: their counts of lights and
+        // specular samples are uniforms the pass takes at the switch (BoothShadingPass::
+        // setCounts), so the switch between them compiles nothing. What the programs are made
+        // of (horizon directions, the walls, a specular term or none) makes a pass of its own.
+        const auto same = [&](const Variant& v) {
+            return (v.settings.specularSamples > 0) == (settings.specularSamples > 0) &&
+                   v.settings.horizonDirections == settings.horizonDirections &&
+                   v.settings.walls == settings.walls;
+        };
+        auto found = std::find_if(p->variants_.begin(), p->variants_.end(), same);
+        if (found == p->variants_.end()) {
+            p->variants_.push_back(Variant{settings, {}, nullptr, nullptr, 0});
+            found = p->variants_.end() - 1;
+        }
+        p->widen(*found, settings);
+        p->lampVariant_.push_back(static_cast<std::size_t>(found - p->variants_.begin()));
+        p->lampSettings_.push_back(settings);
     }
     // The first lamp's pass made now, or variant 0's; every other at its first use or warm-up.
     const std::size_t first =
@@ -117,7 +119,7 @@ Expected<void> BoothScenePass::makeVariant(std::size_t v)
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readFb);
     glGetIntegerv(GL_ACTIVE_TEXTURE, &unit);
     glGetIntegerv(GL_VIEWPORT, viewport);
-    auto pass = BoothShadingPass::create(*prepared, var.settings, setup_.observer);
+    auto pass = BoothShadingPass::create(*prepared, var.settings, setup_.observer, var.unroll);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(drawFb));
     glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readFb));
     glActiveTexture(static_cast<GLenum>(unit));
@@ -186,7 +188,7 @@ void BoothScenePass::setSurroundIlluminance(bool on)
 
 std::string BoothScenePass::description() const
 {
-    const auto& s = variants_[active_].settings;
+    const auto& s = pass_->settings();
     const bool glossy = setup_.scene.glossy();
     const bool flat = setup_.scene.flat();
     const std::string grids =
@@ -217,6 +219,11 @@ Expected<void> BoothScenePass::selectLight(const scene::SceneState& state)
     const int lamp = state.lampIndex;
     const bool isLamp = lamp >= 0 && static_cast<std::size_t>(lamp) < setup_.booth.lights.size();
     if (auto ok = useVariant(isLamp ? lampVariant_[static_cast<std::size_t>(lamp)] : 0); !ok) {
+        return ok;
+    }
+    const shading::RenderSettings& counts =
+            isLamp ? lampSettings_[static_cast<std::size_t>(lamp)] : setup_.settings;
+    if (auto ok = pass_->setCounts(counts.lights, counts.specularSamples); !ok) {
         return ok;
     }
     if (isLamp) {
@@ -289,6 +296,12 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                     .count();
     return ok;
+}
+
+void BoothScenePass::widen(Variant& v, const shading::RenderSettings& member)
+{
+    v.unroll.lights = std::max(v.unroll.lights, member.lights);
+    v.unroll.specularSamples = std::max(v.unroll.specularSamples, member.specularSamples);
 }
 
 std::vector<std::size_t> BoothScenePass::variantsNotDrawn() const

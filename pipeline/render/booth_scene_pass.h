@@ -55,8 +55,10 @@ struct BoothSceneSetup {
     // the sensed luminance times this. The booth's own lamps come already scaled in 'booth'.
     double luminanceScale = 1.0;
     // Per lamp name: its own lights, specular samples and horizon directions. A lamp not named
-    // here, and the direct-sensor mode, draw with 'settings'. Each distinct setting gets a shading
-    // pass of its own, built by create(); a lamp change switches to its pass.
+    // here, and the direct-sensor mode, draw with 'settings'. Each distinct program (horizon
+    // directions, walls, a specular term or none) gets a shading pass of its own, built by
+    // create(); lamps that differ only in their counts of lights and specular samples share one,
+    // which takes each lamp's counts at the switch; a lamp change switches to its pass.
     std::map<std::string, LampSettings> perLamp;
     // The scene already prepared (shading::prepareScene) with settings.horizonDirections, when the
     // caller had to prepare it before the pass (the automatic dimmer's probe views): a pass with
@@ -102,7 +104,7 @@ public:
     // probe evaluates the exact reference with.
     const BoothSceneSetup& setup() const { return setup_; }
 
-    // Draws every shading pass once (one per distinct lamp setting, each with a lamp that uses
+    // Draws every shading pass once (one per distinct program, each with a lamp that uses
     // it) into a width x height target of its own, so that the shaders' first-use compilation
     // (llvmpipe compiles a program's code at its first draw, 0.7-10 s for the booth pass) happens
     // here, before the loop's first frame, and not at the first switch to each lamp. Give it the
@@ -116,7 +118,7 @@ public:
     // and cache stay as they were unless v is the active pass (then its light is selected afresh
     // at the next draw); frames and cacheRefreshes() as without. Returns how long it took, ms.
     Expected<double> warmUpVariant(std::size_t v, int width, int height);
-    // How many shading passes there are (one per distinct setting).
+    // How many shading passes there are (one per distinct program).
     std::size_t variantCount() const { return variants_.size(); }
     // The shading passes not drawn yet in this context (neither by a frame nor by a warm-up):
     // each compiles its shaders at its first draw. The lamps' first, in lamp order.
@@ -139,12 +141,15 @@ private:
     // re-projected onto the state's basis, the coefficient textures replaced).
     Expected<void> applyEncoding(const scene::SceneState& state);
 
-    // One shading pass per distinct setting (variants_[0]: setup_.settings), each with the scene
-    // prepared for its horizon directions; 'encodings' is the encoding its channels hold. Only
-    // the first lamp's (BoothSceneSetup::firstLamp) or variant 0 is made at create(); another has
-    // no scene or pass until makeVariant.
+    // One shading pass per distinct program (variants_[0]: setup_.settings'), each with the scene
+    // prepared for its horizon directions; lamps that differ only in their counts of lights and
+    // specular samples share one, made with the settings of the first of them and written out
+    // for the largest counts ('unroll'); 'encodings' is the encoding its channels hold. Only the
+    // first lamp's (BoothSceneSetup::firstLamp) or variant 0 is made at create(); another has no
+    // scene or pass until makeVariant.
     struct Variant {
         shading::RenderSettings settings;
+        BoothUnroll unroll;
         std::unique_ptr<shading::PreparedScene> prepared;
         std::unique_ptr<BoothShadingPass> pass;
         int encodings = 0;
@@ -154,9 +159,12 @@ private:
     Expected<void> useVariant(std::size_t v);
     // Prepares variant v's scene and creates its shading pass (textures, programs) unless done.
     Expected<void> makeVariant(std::size_t v);
+    // Takes 'member' (a lamp's settings, or variant 0's own) into v's counts to write out.
+    static void widen(Variant& v, const shading::RenderSettings& member);
     BoothSceneSetup setup_;
     std::vector<Variant> variants_;
-    std::vector<std::size_t> lampVariant_; // by lamp index
+    std::vector<std::size_t> lampVariant_;              // by lamp index
+    std::vector<shading::RenderSettings> lampSettings_; // by lamp index: its counts
     std::size_t active_ = 0;
     shading::PreparedScene* prepared_ = nullptr; // variants_[active_]'s
     BoothShadingPass* pass_ = nullptr;

@@ -20,7 +20,8 @@ using namespace booth_upload;
 Expected<std::unique_ptr<BoothShadingPass>>
 BoothShadingPass::create(const shading::PreparedScene& scene,
                          const shading::RenderSettings& settings,
-                         const colour::Observer& obs)
+                         const colour::Observer& obs,
+                         BoothUnroll unroll)
 {
     if (scene.scene == nullptr || scene.scene->width <= 0 || scene.scene->height <= 0) {
         return makeError(ErrorCode::InvalidArgument, "render: the booth pass needs a loaded scene");
@@ -28,13 +29,13 @@ BoothShadingPass::create(const shading::PreparedScene& scene,
     std::unique_ptr<BoothShadingPass> pass(new BoothShadingPass());
     pass->settings_ = settings;
     pass->observer_ = &obs;
-    if (auto ok = pass->init(scene); !ok) {
+    if (auto ok = pass->init(scene, unroll); !ok) {
         return tl::unexpected(ok.error());
     }
     return pass;
 }
 
-Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
+Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnroll unroll)
 {
     scene_ = &ps;
     const surface::SurfaceScene& s = *ps.scene;
@@ -85,7 +86,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     config.hardwareFilter = hwFilter_;
     config.horizonDirections = horizonDirs;
     config.horizonSlots = perLayer * layers;
-    config.specularSamples = samples;
+    config.specular = samples > 0;
     config.wardModel = s.model;
     config.facetCache = facetCache;
     // glsl/booth_main.glsl eq. (1) on a flat surface: one LIGHT_AT per light up to
@@ -95,13 +96,20 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     // grid's few hundred nodes (mode 3), where 64 copies of the area light's contour integral
     // bought nothing in the frame and cost llvmpipe 4-5 s of JIT before the flat scenes' first
     // frame (docs/performance.md, "Start-up"); the frames are bit for bit the same.
-    config.unrolledLights = relief || config.diffuseGrid
-                                    ? 0
-                                    : std::clamp(settings_.lights, 0, kBoothUnrolledLights);
+    // Each light kept to the light's count (LIGHT_AT), so a pass shared by lamps of several
+    // counts writes out the largest (BoothUnroll).
+    config.unrolledLights =
+            relief || config.diffuseGrid
+                    ? 0
+                    : std::clamp(unroll.lights >= 0 ? unroll.lights : settings_.lights, 0,
+                                 kBoothUnrolledLights);
     // The specular samples likewise, SPEC_AT(k) up to kBoothUnrolledSpecSamples: llvmpipe kept
     // the loop and read each sample's half vector as a gather per pixel. Written out, the
     // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md).
-    config.unrolledSpecularSamples = std::clamp(samples, 0, kBoothUnrolledSpecSamples);
+    config.unrolledSpecularSamples =
+            specular_ ? std::clamp(unroll.specularSamples >= 0 ? unroll.specularSamples : samples,
+                                   0, kBoothUnrolledSpecSamples)
+                      : 0;
     if (auto ok = programs_.compile(config, settings_, diffuseNodes.x > 0 ? 4 : 3); !ok) {
         return ok;
     }
@@ -131,6 +139,28 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
 }
 
 BoothShadingPass::~BoothShadingPass() = default;
+
+Expected<void> BoothShadingPass::setCounts(int lights, int specularSamples)
+{
+    if (lights < 1 || lights > kBoothMaxLights) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: {} lights; the GL pass holds 1 to {}", lights,
+                                     kBoothMaxLights));
+    }
+    if (specular_ && (specularSamples < 1 || specularSamples > kBoothMaxSpecularSamples)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("render: {} specular samples; a pass made with a specular "
+                                     "term takes 1 to {}",
+                                     specularSamples, kBoothMaxSpecularSamples));
+    }
+    settings_.lights = lights;
+    if (specular_ && specularSamples != specularTerm_.samples()) {
+        specularTerm_.setSamples(*scene_->scene, specularSamples, programs_);
+        settings_.specularSamples = specularSamples;
+        return glCheck("setting the specular samples");
+    }
+    return {};
+}
 
 Expected<void> BoothShadingPass::setChannels(const shading::PreparedScene& ps)
 {

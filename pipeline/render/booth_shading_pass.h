@@ -24,16 +24,27 @@
 
 namespace replica::pipeline::render {
 
+// How many lights and specular samples the pass's programs write out one by one (any beyond in a
+// loop), where not what its settings say: a pass that lamps of different counts share
+// (booth_scene_pass.h) writes out as many as the largest of them needs, each kept to the count
+// drawn (setCounts), so that it draws each lamp as fast as a pass of that lamp's own would.
+struct BoothUnroll {
+    int lights = -1;          // -1: settings.lights
+    int specularSamples = -1; // -1: settings.specularSamples
+};
+
 class BoothShadingPass
 {
 public:
     // Uploads the scene's textures: K = 6 coefficients per texel in the basis the scene was
     // prepared with, normal map and horizon map (when the settings use them). The settings stay
-    // fixed for the pass's life; 'scene' and 'obs' must outlive it.
+    // fixed for the pass's life but for the counts setCounts changes; 'scene' and 'obs' must
+    // outlive it.
     static Expected<std::unique_ptr<BoothShadingPass>>
     create(const shading::PreparedScene& scene,
            const shading::RenderSettings& settings,
-           const colour::Observer& obs);
+           const colour::Observer& obs,
+           BoothUnroll unroll = {});
     ~BoothShadingPass();
     BoothShadingPass(const BoothShadingPass&) = delete;
     BoothShadingPass& operator=(const BoothShadingPass&) = delete;
@@ -43,6 +54,13 @@ public:
     // draw uses them. The next setLight must carry XYZ vectors of the new basis. 'scene' must
     // outlive the pass or the next call.
     Expected<void> setChannels(const shading::PreparedScene& scene);
+
+    // The counts the programs read at run time, without compiling anything: the lights the next
+    // setLight's light is prepared with (settings().lights; the shader loops to the light's own
+    // count) and the specular samples (the sample table and its count; a pass made without a
+    // specular term takes none, one made with it 1 to kBoothMaxSpecularSamples). A frame drawn
+    // after it is the frame a pass made with these counts draws.
+    Expected<void> setCounts(int lights, int specularSamples);
 
     // Uploads a light: its median-cut point lights (at most 256), luminance mip chain and
     // per-channel XYZ vectors (prepared in the scene's basis). 'light' must outlive the pass or the
@@ -89,7 +107,7 @@ public:
 
 private:
     BoothShadingPass() = default;
-    Expected<void> init(const shading::PreparedScene& scene);
+    Expected<void> init(const shading::PreparedScene& scene, BoothUnroll unroll);
 
     shading::RenderSettings settings_;
     const shading::PreparedScene* scene_ = nullptr;

@@ -12,23 +12,8 @@ Expected<void> BoothSpecular::init(const surface::SurfaceScene& s,
                                    shading::GridNodes grid,
                                    const BoothPrograms& programs)
 {
-    // The samples' half vectors depend only on alpha and N: once here, in double.
-    std::vector<float> table(static_cast<std::size_t>(kBoothMaxSpecularSamples) * 4, 0.0f);
-    for (int k = 0; k < samples; ++k) {
-        const double u1 = (k + 0.5) / samples;
-        const shading::Vec3 hl = brdf::sampleWardHalfVectorLocal(
-                s.alpha, u1, shading::radicalInverse2(static_cast<unsigned>(k)));
-        const double w = brdf::wardSolidAngleWithoutOh(s.alpha, hl.z, u1, samples);
-        const auto i = static_cast<std::size_t>(k) * 4;
-        table[i] = static_cast<float>(hl.x);
-        table[i + 1] = static_cast<float>(hl.y);
-        table[i + 2] = static_cast<float>(hl.z);
-        table[i + 3] = static_cast<float>(w);
-    }
     samplesUbo_ = GlBuffer::make();
-    glBindBuffer(GL_UNIFORM_BUFFER, samplesUbo_.get());
-    glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(table.size() * sizeof(float)),
-                 table.data(), GL_STATIC_DRAW);
+    setSamples(s, samples, programs);
     programs.bindBlock("BoothSpecSamples", 1);
 
     gridNodes_ = grid;
@@ -41,6 +26,31 @@ Expected<void> BoothSpecular::init(const surface::SurfaceScene& s,
     }
     programs.uniformAll(glProgramUniform2i, "uGridNodes", gridNodes_.x, gridNodes_.y);
     return {};
+}
+
+void BoothSpecular::setSamples(const surface::SurfaceScene& s,
+                               int samples,
+                               const BoothPrograms& programs)
+{
+    // The samples' half vectors depend only on alpha and N: computed here, in double, whenever N
+    // changes (the same N gives the same table, so a lamp switch back draws the same frame).
+    std::vector<float> table(static_cast<std::size_t>(kBoothMaxSpecularSamples) * 4, 0.0f);
+    for (int k = 0; k < samples; ++k) {
+        const double u1 = (k + 0.5) / samples;
+        const shading::Vec3 hl = brdf::sampleWardHalfVectorLocal(
+                s.alpha, u1, shading::radicalInverse2(static_cast<unsigned>(k)));
+        const double w = brdf::wardSolidAngleWithoutOh(s.alpha, hl.z, u1, samples);
+        const auto i = static_cast<std::size_t>(k) * 4;
+        table[i] = static_cast<float>(hl.x);
+        table[i + 1] = static_cast<float>(hl.y);
+        table[i + 2] = static_cast<float>(hl.z);
+        table[i + 3] = static_cast<float>(w);
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, samplesUbo_.get());
+    glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(table.size() * sizeof(float)),
+                 table.data(), GL_STATIC_DRAW);
+    programs.uniformAll(glProgramUniform1i, "uSpecSamples", samples);
+    samples_ = samples;
 }
 
 void BoothSpecular::bind() const

@@ -1,6 +1,7 @@
 // The booth shading pass's specular term (paper eq. 3, Ward-Dur by filtered importance
-// sampling): the samples' half vectors and solid angles (a uniform block, fixed for the pass's
-// life) and, with a specular grid, the target the term is shaded into at the grid's nodes.
+// sampling): the samples' half vectors and solid angles (a uniform block, and their count a
+// uniform: each lamp may take its own) and, with a specular grid, the target the term is shaded
+// into at the grid's nodes.
 #pragma once
 
 #include <pipeline/base/expected.h>
@@ -19,6 +20,10 @@ public:
                         int samples,
                         shading::GridNodes grid,
                         const BoothPrograms& programs);
+    // Replaces the samples with 'samples' of them (each lamp's count, booth_scene_pass.h): the
+    // block's table and uSpecSamples in every program.
+    void setSamples(const surface::SurfaceScene& s, int samples, const BoothPrograms& programs);
+    int samples() const { return samples_; }
     // Binds the samples' block to binding 1.
     void bind() const;
     // This eye's specular term at the grid's nodes (mode 2), for the compose to interpolate;
@@ -31,6 +36,7 @@ public:
 
 private:
     GlBuffer samplesUbo_;
+    int samples_ = 0;
     shading::GridNodes gridNodes_;
     GlTexture gridTexture_;
     GlFramebuffer gridFbo_;

@@ -57,7 +57,7 @@ struct BoothShaderConfig {
     bool hardwareFilter = false;
     int horizonDirections = 0;
     int horizonSlots = 4;
-    int specularSamples = 0;
+    bool specular = false; // a specular term (its sample count is a uniform, uSpecSamples)
     brdf::WardModel wardModel = brdf::WardModel::WardDurGuarded;
     bool facetCache = false;
     int unrolledLights = 0;

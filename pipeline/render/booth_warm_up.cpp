@@ -52,13 +52,19 @@ Expected<double> BoothScenePass::warmUpVariant(std::size_t v, int width, int hei
     view.pixelsY = height;
     // A lamp drawn with this pass (variant 0 may have none: the direct-sensor mode's).
     const booth::BoothLight* light = &setup_.booth.lights.front();
+    const shading::RenderSettings* counts = &setup_.settings;
     for (std::size_t l = 0; l < lampVariant_.size(); ++l) {
         if (lampVariant_[l] == v) {
             light = &setup_.booth.lights[l];
+            counts = &lampSettings_[l];
             break;
         }
     }
     BoothShadingPass& pass = *variants_[v].pass;
+    if (auto ok = pass.setCounts(counts->lights, counts->specularSamples); !ok) {
+        restore();
+        return tl::unexpected(ok.error());
+    }
     // warmLight_, not light_ (the active pass's): a pass that is not the active one gets its
     // lamp's light from selectLight (a switch to it is a change of light) before it draws a
     // frame; the active one is told to select its light afresh at the next draw.

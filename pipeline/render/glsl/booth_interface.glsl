@@ -81,7 +81,11 @@ layout(location = 1) out vec4 outFacet;
 #endif
 uniform sampler2D uFacetCache;  // RGBA32F, the viewport's size: what mode 0 wrote
 
-const int uSpecSamples = BOOTH_SPEC_SAMPLES;
+// Whether the pass has a specular term (fixed for its life, like the modes); how many samples it
+// takes is a uniform: each lamp of a plan may take its own count, and lamps that share everything
+// else share one program, so that a lamp switch compiles nothing (booth_scene_pass.h).
+const bool kSpecular = BOOTH_SPECULAR != 0;
+uniform int uSpecSamples;
 // brdf::sampleWardHalfVectorLocal for sample k (u1 = (k + 1/2) / N, u2 = radicalInverse2(k)),
 // computed once on the CPU in double: xyz the half vector in the local frame, w the sample's
 // solid angle without its o.h factor, 4 pi alpha^2 cos^3 / (N u1).

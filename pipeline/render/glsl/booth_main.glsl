@@ -156,7 +156,7 @@ void diffuseCache(vec3 p, vec3 nShade, vec2 uv, ivec2 tc, bool inside) {
         xyz *= e / kPi;
     }
     eGeo = finiteOrZero(eGeo);
-    if (uSpecSamples == 0 && uFlareRho == 0.0) {
+    if (!kSpecular && uFlareRho == 0.0) {
         // Nothing left for the compose: the cache is the frame (clamped as mode 1 would).
         xyz = max(xyz, vec3(0.0));
         if (any(isnan(xyz)) || any(isinf(xyz))) {
@@ -176,7 +176,7 @@ void compose(vec3 p, vec3 nShade, vec2 uv, bool inside) {
         if (inside) {
             xyz += uSpecXyz * gridValue(uSpecGrid, uGridNodes, uv.x, uv.y);
         }
-    } else if (inside && uSpecSamples > 0) {
+    } else if (inside && kSpecular) {
         vec3 toEye = uEye - p;
         float eyeDist = length(toEye);
         toEye = eyeDist > 0.0 ? toEye / eyeDist : uNormal;
@@ -201,7 +201,7 @@ void main() {
     ivec2 tc = clamp(ivec2(floor(tex)), ivec2(0), uTexels - 1);
     vec3 nShade = uNormal;
     // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
-    bool facets = uMode == 0 || (uSpecSamples > 0 && (uMode == 2 || !kGrid));
+    bool facets = uMode == 0 || (kSpecular && (uMode == 2 || !kGrid));
     if (inside && uRelief && facets) {
         nShade = facetNormal(tex, tc);
     }

@@ -8,6 +8,7 @@
 
 #include <pipeline/display/nominal_display.h>
 #include <pipeline/render/gles_renderer.h>
+#include <pipeline/scene/booth.h>
 #include <platform/output/pass_warm_up.h>
 
 #include <gtest/gtest.h>
@@ -30,9 +31,11 @@ protected:
         }
         setup_ = tests::boothPassSetup("colorchecker"); // glossy
         setup_.settings.specularSamples = 8;
-        // Three passes: the setup's, and one of its own for each fluorescent.
-        setup_.perLamp["d50-fluorescent"] = pr::LampSettings{8, 24, 0};
-        setup_.perLamp["d65-fluorescent"] = pr::LampSettings{32, 4, 0};
+        // Three passes: the setup's (walls and a specular term; tungsten draws it), and one of its
+        // own for each fluorescent: d50 without the walls, d65 without the specular term.
+        setup_.booth.walls = pipeline::scene::defaultBoothWalls(setup_.booth.ceiling());
+        setup_.perLamp["d50-fluorescent"] = pr::LampSettings{8, 24, 0, false};
+        setup_.perLamp["d65-fluorescent"] = pr::LampSettings{32, 0, 0, true};
     }
 
     // A renderer (64 x 40) whose pass 1 is a booth pass of setup_; 'scene' is that pass.

@@ -3,6 +3,7 @@
 // no count the loop reports.
 #include <pipeline/render/booth_scene_pass.h>
 #include <pipeline/render/xyz_target.h>
+#include <pipeline/scene/booth.h>
 
 #include <gtest/gtest.h>
 
@@ -25,9 +26,12 @@ protected:
         setup_ = tests::boothPassSetup("colorchecker"); // glossy
         setup_.settings.specularSamples = 8;
         setup_.settings.subtractFlare = false;
-        // Three passes: the setup's, and one of its own for each fluorescent.
-        setup_.perLamp["d50-fluorescent"] = LampSettings{8, 24, 0};
-        setup_.perLamp["d65-fluorescent"] = LampSettings{32, 4, 0};
+        // Three passes: the setup's (walls and a specular term; tungsten draws it), and one of its
+        // own for each fluorescent: d50 without the walls, d65 without the specular term. (Counts
+        // alone do not make a pass: BoothLampShareTest.)
+        setup_.booth.walls = scene::defaultBoothWalls(setup_.booth.ceiling());
+        setup_.perLamp["d50-fluorescent"] = LampSettings{8, 24, 0, false};
+        setup_.perLamp["d65-fluorescent"] = LampSettings{32, 0, 0, true};
         auto t = XyzTarget::create(kWarmW, kWarmH);
         ASSERT_TRUE(t);
         target_ = std::move(*t);
@@ -103,8 +107,9 @@ TEST_F(BoothWarmUpTest, ChangesNoFrameAndNoCount)
 // direct-sensor mode's) last.
 TEST_F(BoothWarmUpTest, TheFirstLampsPassComesFirstAndTheLampsPassesBeforeVariantZero)
 {
-    // Every lamp with a setting of its own: tungsten (lamp 0) -> 1, d50 -> 2, d65 -> 3.
-    setup_.perLamp["tungsten"] = LampSettings{16, 12, 0};
+    // Every lamp with a program of its own: tungsten (lamp 0, neither walls nor a specular term)
+    // -> 1, d50 -> 2, d65 -> 3.
+    setup_.perLamp["tungsten"] = LampSettings{16, 0, 0, false};
     ASSERT_EQ(setup_.booth.lights[0].name, "tungsten");
     auto plain = BoothScenePass::create(setup_);
     auto first = setup_;
