@@ -20,8 +20,7 @@ using namespace booth_upload;
 Expected<std::unique_ptr<BoothShadingPass>>
 BoothShadingPass::create(const shading::PreparedScene& scene,
                          const shading::RenderSettings& settings,
-                         const colour::Observer& obs,
-                         BoothUnroll unroll)
+                         const colour::Observer& obs)
 {
     if (scene.scene == nullptr || scene.scene->width <= 0 || scene.scene->height <= 0) {
         return makeError(ErrorCode::InvalidArgument, "render: the booth pass needs a loaded scene");
@@ -29,13 +28,13 @@ BoothShadingPass::create(const shading::PreparedScene& scene,
     std::unique_ptr<BoothShadingPass> pass(new BoothShadingPass());
     pass->settings_ = settings;
     pass->observer_ = &obs;
-    if (auto ok = pass->init(scene, unroll); !ok) {
+    if (auto ok = pass->init(scene); !ok) {
         return tl::unexpected(ok.error());
     }
     return pass;
 }
 
-Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnroll unroll)
+Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
 {
     scene_ = &ps;
     const surface::SurfaceScene& s = *ps.scene;
@@ -96,20 +95,16 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
     // grid's few hundred nodes (mode 3), where 64 copies of the area light's contour integral
     // bought nothing in the frame and cost llvmpipe 4-5 s of JIT before the flat scenes' first
     // frame (docs/performance.md, "Start-up"); the frames are bit for bit the same.
-    // Each light kept to the light's count (LIGHT_AT), so a pass shared by lamps of several
-    // counts writes out the largest (BoothUnroll).
-    config.unrolledLights =
-            relief || config.diffuseGrid
-                    ? 0
-                    : std::clamp(unroll.lights >= 0 ? unroll.lights : settings_.lights, 0,
-                                 kBoothUnrolledLights);
     // The specular samples likewise, SPEC_AT(k) up to kBoothUnrolledSpecSamples: llvmpipe kept
     // the loop and read each sample's half vector as a gather per pixel. Written out, the
-    // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md).
+    // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md). Not with
+    // the specular grid, where the samples run at the grid's nodes only (mode 2).
+    const CompiledCounts compiled = compiledCounts(s, settings_);
+    config.unrolledLights =
+            compiled.lights ? std::clamp(settings_.lights, 0, kBoothUnrolledLights) : 0;
     config.unrolledSpecularSamples =
-            specular_ ? std::clamp(unroll.specularSamples >= 0 ? unroll.specularSamples : samples,
-                                   0, kBoothUnrolledSpecSamples)
-                      : 0;
+            compiled.specularSamples ? std::clamp(samples, 0, kBoothUnrolledSpecSamples) : 0;
+    unrolledSamples_ = config.unrolledSpecularSamples;
     if (auto ok = programs_.compile(config, settings_, diffuseNodes.x > 0 ? 4 : 3); !ok) {
         return ok;
     }
@@ -140,6 +135,18 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
 
 BoothShadingPass::~BoothShadingPass() = default;
 
+BoothShadingPass::CompiledCounts
+BoothShadingPass::compiledCounts(const surface::SurfaceScene& s,
+                                 const shading::RenderSettings& settings)
+{
+    // What init() decides, from the same inputs (prepareScene gives a flat surface no normals).
+    const bool relief = settings.reliefPass && !s.flat();
+    const bool specular = settings.specularPass && s.glossy() && settings.specularSamples > 0;
+    const bool diffuseGrid = !relief && shading::gridNodes(s, settings.diffuseGrid).x > 0;
+    const bool specularGrid = specular && shading::gridNodes(s, settings.specularGrid).x > 0;
+    return {!relief && !diffuseGrid, specular && !specularGrid};
+}
+
 Expected<void> BoothShadingPass::setCounts(int lights, int specularSamples)
 {
     if (lights < 1 || lights > kBoothMaxLights) {
@@ -147,11 +154,13 @@ Expected<void> BoothShadingPass::setCounts(int lights, int specularSamples)
                          fmt::format("render: {} lights; the GL pass holds 1 to {}", lights,
                                      kBoothMaxLights));
     }
-    if (specular_ && (specularSamples < 1 || specularSamples > kBoothMaxSpecularSamples)) {
+    if (specular_ && (specularSamples < std::max(unrolledSamples_, 1) ||
+                      specularSamples > kBoothMaxSpecularSamples)) {
         return makeError(ErrorCode::InvalidArgument,
-                         fmt::format("render: {} specular samples; a pass made with a specular "
-                                     "term takes 1 to {}",
-                                     specularSamples, kBoothMaxSpecularSamples));
+                         fmt::format("render: {} specular samples; this pass writes out {} and "
+                                     "takes {} to {}",
+                                     specularSamples, unrolledSamples_,
+                                     std::max(unrolledSamples_, 1), kBoothMaxSpecularSamples));
     }
     settings_.lights = lights;
     if (specular_ && specularSamples != specularTerm_.samples()) {

@@ -24,15 +24,6 @@
 
 namespace replica::pipeline::render {
 
-// How many lights and specular samples the pass's programs write out one by one (any beyond in a
-// loop), where not what its settings say: a pass that lamps of different counts share
-// (booth_scene_pass.h) writes out as many as the largest of them needs, each kept to the count
-// drawn (setCounts), so that it draws each lamp as fast as a pass of that lamp's own would.
-struct BoothUnroll {
-    int lights = -1;          // -1: settings.lights
-    int specularSamples = -1; // -1: settings.specularSamples
-};
-
 class BoothShadingPass
 {
 public:
@@ -43,8 +34,22 @@ public:
     static Expected<std::unique_ptr<BoothShadingPass>>
     create(const shading::PreparedScene& scene,
            const shading::RenderSettings& settings,
-           const colour::Observer& obs,
-           BoothUnroll unroll = {});
+           const colour::Observer& obs);
+
+    // Which of the settings' counts a pass's programs are compiled with, written out one by one
+    // where the term runs per pixel (the lights on a flat surface without the diffuse grid; the
+    // specular samples without the specular grid): a count compiled in makes a program of its
+    // own. A count not compiled in is looped to a uniform and set with setCounts, so passes that
+    // differ only in it can be one (booth_scene_pass.h). Kept compiled in where it runs per pixel
+    // because llvmpipe's loop reads each light or sample as a gather per pixel (the painting's
+    // frame: 12 % more instructions) and runs an `if` under a mask (a sample kept to a uniform
+    // count costs every lamp the most).
+    struct CompiledCounts {
+        bool lights = false;
+        bool specularSamples = false;
+    };
+    static CompiledCounts compiledCounts(const surface::SurfaceScene& scene,
+                                         const shading::RenderSettings& settings);
     ~BoothShadingPass();
     BoothShadingPass(const BoothShadingPass&) = delete;
     BoothShadingPass& operator=(const BoothShadingPass&) = delete;
@@ -58,8 +63,9 @@ public:
     // The counts the programs read at run time, without compiling anything: the lights the next
     // setLight's light is prepared with (settings().lights; the shader loops to the light's own
     // count) and the specular samples (the sample table and its count; a pass made without a
-    // specular term takes none, one made with it 1 to kBoothMaxSpecularSamples). A frame drawn
-    // after it is the frame a pass made with these counts draws.
+    // specular term takes none, one made with it as many as its programs write out, at least 1,
+    // to kBoothMaxSpecularSamples). A frame drawn after it is the frame a pass made with these
+    // counts draws where they are not compiled in (compiledCounts).
     Expected<void> setCounts(int lights, int specularSamples);
 
     // Uploads a light: its median-cut point lights (at most 256), luminance mip chain and
@@ -107,13 +113,14 @@ public:
 
 private:
     BoothShadingPass() = default;
-    Expected<void> init(const shading::PreparedScene& scene, BoothUnroll unroll);
+    Expected<void> init(const shading::PreparedScene& scene);
 
     shading::RenderSettings settings_;
     const shading::PreparedScene* scene_ = nullptr;
     const shading::PreparedLight* light_ = nullptr;
     const colour::Observer* observer_ = nullptr;
-    bool specular_ = false; // a specular term to shade: glossy scene, pass and samples on
+    bool specular_ = false;   // a specular term to shade: glossy scene, pass and samples on
+    int unrolledSamples_ = 0; // the specular samples written out in the programs
     bool hwFilter_ = false;
     BoothPrograms programs_;
     GlVertexArray vao_;

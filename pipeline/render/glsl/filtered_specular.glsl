@@ -84,13 +84,12 @@ float filteredSpecular(vec3 p, vec3 nGeo, vec3 n, vec3 o) {
     float sum = 0.0;
     float nf = float(uSpecSamples);
     // The first BOOTH_UNROLLED_SPEC samples at constant indices (BOOTH_SPEC_CALLS: SPEC_AT(0)
-    // SPEC_AT(1) ..., written out by the pass, as the lights are, each kept to the lamp's count
-    // like LIGHT_AT), then any beyond in a loop. The same samples summed in the same order.
+    // SPEC_AT(1) ..., written out by the pass, as the lights are), then any beyond in a loop to
+    // the lamp's count (a pass that several lamps share writes out the fewest of them: llvmpipe
+    // runs an `if` under a mask, so a sample kept to the count would cost every lamp the most).
+    // The same samples summed in the same order.
 #define SPEC_AT(k)                                                                             \
-    if (k < uSpecSamples) {                                                                    \
-        sum += specSample(k, n, o, co, ft, fbt, nGeo, planeDist, eu, ev, lu0, lv0, visFrom,    \
-                          visScale);                                                           \
-    }
+    sum += specSample(k, n, o, co, ft, fbt, nGeo, planeDist, eu, ev, lu0, lv0, visFrom, visScale);
     BOOTH_SPEC_CALLS
 #undef SPEC_AT
     for (int k = BOOTH_UNROLLED_SPEC; k < uSpecSamples; ++k) {

@@ -1,8 +1,8 @@
-// Lamps whose plans differ only in their counts of lights and specular samples share one shading
-// pass (BoothScenePass, booth_scene_pass.h): a switch between them compiles nothing, and every
-// frame is, bit for bit, the frame a pass made for that lamp alone draws (its programs written out
-// for its own counts), so replay, which draws a frame from its state with a fresh pass, is
-// unchanged.
+// Lamps whose plans differ only in counts the programs loop to (the lights on relief or with the
+// diffuse grid, the specular samples with the specular grid) share one shading pass
+// (BoothScenePass, booth_scene_pass.h): a switch between them compiles nothing, and every frame is,
+// bit for bit, the frame a pass made for that lamp alone draws, so replay, which draws a frame from
+// its state with a fresh pass, is unchanged.
 #include <vector>
 
 #include <pipeline/render/booth_scene_pass.h>
@@ -98,9 +98,8 @@ protected:
     }
 };
 
-// The ColorChecker as the appliance draws it (the specular term at the grid's nodes), with the
-// shipped plan's counts: 8 lights each, 24 / 48 / 32 specular samples (48: beyond the 32 a
-// program writes out, the rest in its loop).
+// The ColorChecker as the appliance draws it (the specular term at the grid's nodes, its samples
+// in a loop), with the shipped plan's counts: 8 lights each, 24 / 48 / 32 specular samples.
 TEST_F(BoothLampShareTest, TheColorCheckersLampsShareOnePassAndDrawTheirOwnFrames)
 {
     BoothSceneSetup setup = tests::boothPassSetup("colorchecker");
@@ -114,35 +113,42 @@ TEST_F(BoothLampShareTest, TheColorCheckersLampsShareOnePassAndDrawTheirOwnFrame
     expectSharedAndExact(setup);
 }
 
-// A relief with the specular term at every pixel (the glossy cylinder), with its plan's counts:
-// 16 / 32 / 128 lights and 16 / 24 / 48 specular samples, 8 horizon directions each.
-TEST_F(BoothLampShareTest, TheGlossyCylindersLampsShareOnePassAndDrawTheirOwnFrames)
+// A relief with the specular term at every pixel (the glossy cylinder): the lights loop on relief,
+// so lamps of 16 / 32 / 128 lights and one sample count share a pass.
+TEST_F(BoothLampShareTest, TheGlossyCylindersLampsOfOneSampleCountShareOnePass)
 {
     BoothSceneSetup setup = tests::boothPassSetup("glossy-cylinder");
-    setup.settings.specularSamples = 16;
+    setup.settings.specularSamples = 24;
     setup.settings.horizonDirections = 8;
-    setup.perLamp["tungsten"] = LampSettings{16, 16, 8};
+    setup.perLamp["tungsten"] = LampSettings{16, 24, 8};
     setup.perLamp["d50-fluorescent"] = LampSettings{32, 24, 8};
-    setup.perLamp["d65-fluorescent"] = LampSettings{128, 48, 8};
+    setup.perLamp["d65-fluorescent"] = LampSettings{128, 24, 8};
     expectSharedAndExact(setup);
 }
 
 // What a program is made of still makes a pass of its own: a lamp without the specular term, or
-// with other horizon directions.
+// with another count of samples where they are written out per pixel (relief), or other horizon
+// directions.
 TEST_F(BoothLampShareTest, APlanThatChangesTheProgramsMakesAPassOfItsOwn)
 {
     BoothSceneSetup setup = tests::boothPassSetup("glossy-cylinder");
     setup.settings.horizonDirections = 8;
-    setup.perLamp["tungsten"] = LampSettings{16, 16, 8};
-    setup.perLamp["d50-fluorescent"] = LampSettings{32, 0, 8};
-    setup.perLamp["d65-fluorescent"] = LampSettings{32, 16, 4};
+    setup.settings.specularSamples = 16;
+    setup.perLamp["tungsten"] = LampSettings{64, 16, 8};        // the setup's pass
+    setup.perLamp["d50-fluorescent"] = LampSettings{32, 0, 8};  // no specular term
+    setup.perLamp["d65-fluorescent"] = LampSettings{32, 24, 8}; // 24 samples written out
     auto pass = BoothScenePass::create(setup);
     ASSERT_TRUE(pass) << pass.error().message;
-    EXPECT_EQ((*pass)->variantCount(), 3u); // tungsten's is the setup's
+    EXPECT_EQ((*pass)->variantCount(), 3u);
+    setup.perLamp["d65-fluorescent"] = LampSettings{32, 16, 4}; // 4 horizon directions
+    auto other = BoothScenePass::create(setup);
+    ASSERT_TRUE(other) << other.error().message;
+    EXPECT_EQ((*other)->variantCount(), 3u);
 }
 
-// The counts a pass takes at run time are checked: lights 1 to 256, specular samples 1 to 256 in
-// a pass made with a specular term; the pass draws on with what it had.
+// The counts a pass takes at run time are checked: lights 1 to 256; specular samples, in a pass
+// made with a specular term, from those its programs write out to 256 (on relief, where they are
+// written out per pixel: fewer would read past the table); the pass draws on with what it had.
 TEST_F(BoothLampShareTest, CountsOutOfRangeAreRefused)
 {
     const BoothSceneSetup setup = tests::boothPassSetup("colorchecker");
@@ -160,6 +166,17 @@ TEST_F(BoothLampShareTest, CountsOutOfRangeAreRefused)
     ASSERT_TRUE((*pass)->setCounts(24, 12));
     EXPECT_EQ((*pass)->settings().lights, 24);
     EXPECT_EQ((*pass)->settings().specularSamples, 12);
+
+    const BoothSceneSetup relief = tests::boothPassSetup("glossy-cylinder");
+    const auto rs = shading::prepareScene(relief.scene, 4, 0.01, relief.basis);
+    shading::RenderSettings reliefSettings = relief.settings;
+    reliefSettings.specularSamples = 24;
+    reliefSettings.horizonDirections = 4;
+    auto perPixel = BoothShadingPass::create(rs, reliefSettings, relief.observer);
+    ASSERT_TRUE(perPixel) << perPixel.error().message;
+    EXPECT_TRUE(BoothShadingPass::compiledCounts(relief.scene, reliefSettings).specularSamples);
+    EXPECT_FALSE((*perPixel)->setCounts(8, 23));
+    EXPECT_TRUE((*perPixel)->setCounts(8, 24));
 }
 
 } // namespace
