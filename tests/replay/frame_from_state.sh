@@ -13,17 +13,17 @@ checked=0
 for rec in "$samples"/*.mcap; do
     golden="${rec%.mcap}.digests.json"
     name=$(basename "${rec%.mcap}")
-    # frame tick_ns xyz rgba, one line each. (--check writes the digests in the golden's own
-    # format version, so that they compare.)
+    # frame, its tick in seconds, xyz, rgba: one line each, the seconds written here rather than
+    # by a Python start per frame. (--check writes the digests in the golden's own format
+    # version, so that they compare.)
     frames=$(python3 -c '
 import json, sys
 for f in json.load(open(sys.argv[1]))["frames"]:
     n = f["frame"]
     if n % 10 == 3 or 117 <= n <= 127:
-        print(n, f["tick_ns"], f["xyz"], f["rgba"])
+        print(n, repr(f["tick_ns"] / 1e9), f["xyz"], f["rgba"])
 ' "$golden")
-    while read -r n tick xyz rgba; do
-        t=$(python3 -c "print(repr($tick / 1e9))")
+    while read -r n t xyz rgba; do
         out="$work/$name-$n.json"
         if ! "$replica" --log-level error replay "$rec" --from "$t" --to "$t" --digests "$out" \
                 --check "$golden" > "$work/$name-$n.log" 2>&1; then

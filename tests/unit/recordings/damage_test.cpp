@@ -272,17 +272,24 @@ TEST(RecordingDamage, FlippedChunkLosesOnlyThatChunk)
 // Chunks nested in chunks, each an uncompressed chunk record holding the next (the hostile
 // recordings of issue 32): 'claimZero' makes each claim 0 uncompressed bytes, otherwise each
 // claims its true size and fails its CRC. Built here from the MCAP specification's layout.
+// Every level is a 49-byte header (opcode, length, start and end time, uncompressed size, CRC,
+// compression "", records length) followed by the levels inside it, so the file is the headers
+// written outside in: linear in its size. (Wrapping the inner levels one at a time copied
+// n^2/90 bytes: 47 s of the test's 78 for 1 MiB, more under ASan; the bytes are the same.)
 std::string nestedChunks(std::size_t bytes, bool claimZero)
 {
     auto u64 = [](std::uint64_t v) { return std::string(reinterpret_cast<const char*>(&v), 8); };
     auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
-    std::string inner;
-    while (inner.size() < bytes) {
-        const std::string body = u64(0) + u64(0) + u64(claimZero ? 0 : inner.size()) +
-                                 u32(0xDEADBEEF) + u32(0) + u64(inner.size()) + inner;
-        inner = std::string(1, '\x06') + u64(body.size()) + body;
+    constexpr std::size_t kLevel = 1 + 8 + 8 + 8 + 8 + 4 + 4 + 8;
+    const std::size_t levels = (bytes + kLevel - 1) / kLevel;
+    std::string file(mcap::kMagic);
+    file.reserve(file.size() + levels * kLevel);
+    for (std::size_t k = levels; k-- > 0;) {
+        const std::uint64_t inner = k * kLevel; // the k levels inside this one
+        file += std::string(1, '\x06') + u64(kLevel - 9 + inner) + u64(0) + u64(0) +
+                u64(claimZero ? 0 : inner) + u32(0xDEADBEEF) + u32(0) + u64(inner);
     }
-    return std::string(mcap::kMagic) + inner;
+    return file;
 }
 
 // Recover tries every plausible chunk header after damage; each attempt's copying and checksumming
