@@ -47,7 +47,8 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
     // its own). One pass is made now (below); the others at their first use or warm-up
     // (makeVariant): what only a lamp that is not shown yet needs is not done before the first
     // frame.
-    p->variants_.push_back(Variant{s.settings, nullptr, nullptr, 0});
+    p->variants_.push_back(Variant{s.settings, {}, nullptr, nullptr, 0});
+    narrow(p->variants_[0], s.settings);
     for (const auto& lamp : s.booth.lights) {
         shading::RenderSettings settings = s.settings;
         if (const auto it = s.perLamp.find(lamp.name); it != s.perLamp.end()) {
@@ -60,26 +61,22 @@ Expected<std::unique_ptr<BoothScenePass>> BoothScenePass::create(BoothSceneSetup
             }
             settings.walls = settings.walls && it->second.walls;
         }
-        // Lamps whose programs would be the same share one pass: a count the programs only loop
-        // to (the lights on relief or with the diffuse grid; the specular samples with the
-        // specular grid) is a uniform the pass takes at the switch (BoothShadingPass::
-        // setCounts), so the switch between them compiles nothing. What the programs are made
-        // of (horizon directions, the walls, a specular term or none, a count written out per
-        // pixel: BoothShadingPass::compiledCounts) makes a pass of its own.
-        const auto compiled = BoothShadingPass::compiledCounts(s.scene, settings);
+        // Lamps whose programs would be the same share one pass: their counts of lights and
+        // specular samples are uniforms the pass takes at the switch (BoothShadingPass::
+        // setCounts), written out for the fewest of them where the programs write them out, so
+        // the switch between them compiles nothing. What the programs are made of (horizon
+        // directions, the walls, a specular term or none) makes a pass of its own.
         const auto same = [&](const Variant& v) {
             return (v.settings.specularSamples > 0) == (settings.specularSamples > 0) &&
                    v.settings.horizonDirections == settings.horizonDirections &&
-                   v.settings.walls == settings.walls &&
-                   (!compiled.lights || v.settings.lights == settings.lights) &&
-                   (!compiled.specularSamples ||
-                    v.settings.specularSamples == settings.specularSamples);
+                   v.settings.walls == settings.walls;
         };
         auto found = std::find_if(p->variants_.begin(), p->variants_.end(), same);
         if (found == p->variants_.end()) {
-            p->variants_.push_back(Variant{settings, nullptr, nullptr, 0});
+            p->variants_.push_back(Variant{settings, {}, nullptr, nullptr, 0});
             found = p->variants_.end() - 1;
         }
+        narrow(*found, settings);
         p->lampVariant_.push_back(static_cast<std::size_t>(found - p->variants_.begin()));
         p->lampSettings_.push_back(settings);
     }
@@ -123,7 +120,7 @@ Expected<void> BoothScenePass::makeVariant(std::size_t v)
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readFb);
     glGetIntegerv(GL_ACTIVE_TEXTURE, &unit);
     glGetIntegerv(GL_VIEWPORT, viewport);
-    auto pass = BoothShadingPass::create(*prepared, var.settings, setup_.observer);
+    auto pass = BoothShadingPass::create(*prepared, var.settings, setup_.observer, var.unroll);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(drawFb));
     glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readFb));
     glActiveTexture(static_cast<GLenum>(unit));
@@ -300,6 +297,15 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                     .count();
     return ok;
+}
+
+void BoothScenePass::narrow(Variant& v, const shading::RenderSettings& member)
+{
+    const auto fewest = [](int held, int count) {
+        return held < 0 ? count : std::min(held, count);
+    };
+    v.unroll.lights = fewest(v.unroll.lights, member.lights);
+    v.unroll.specularSamples = fewest(v.unroll.specularSamples, member.specularSamples);
 }
 
 std::vector<std::size_t> BoothScenePass::variantsNotDrawn() const

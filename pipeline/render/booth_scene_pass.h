@@ -56,10 +56,9 @@ struct BoothSceneSetup {
     double luminanceScale = 1.0;
     // Per lamp name: its own lights, specular samples and horizon directions. A lamp not named
     // here, and the direct-sensor mode, draw with 'settings'. Each distinct program (horizon
-    // directions, walls, a specular term or none, a count written out per pixel:
-    // BoothShadingPass::compiledCounts) gets a shading pass of its own, built by create(); lamps
-    // that differ only in counts the programs loop to share one, which takes each lamp's counts at
-    // the switch; a lamp change switches to its pass.
+    // directions, walls, a specular term or none) gets a shading pass of its own, built by
+    // create(); lamps that differ only in their counts of lights and specular samples share one,
+    // which takes each lamp's counts at the switch; a lamp change switches to its pass.
     std::map<std::string, LampSettings> perLamp;
     // The scene already prepared (shading::prepareScene) with settings.horizonDirections, when the
     // caller had to prepare it before the pass (the automatic dimmer's probe views): a pass with
@@ -143,13 +142,14 @@ private:
     Expected<void> applyEncoding(const scene::SceneState& state);
 
     // One shading pass per distinct program (variants_[0]: setup_.settings'), each with the scene
-    // prepared for its horizon directions; lamps that differ only in counts the programs loop to
-    // share one, made with the settings of the first of them; 'encodings' is the encoding its
-    // channels hold. Only the
+    // prepared for its horizon directions; lamps that differ only in their counts of lights and
+    // specular samples share one, made with the settings of the first of them and written out for
+    // the fewest counts ('unroll'); 'encodings' is the encoding its channels hold. Only the
     // first lamp's (BoothSceneSetup::firstLamp) or variant 0 is made at create(); another has no
     // scene or pass until makeVariant.
     struct Variant {
         shading::RenderSettings settings;
+        BoothUnroll unroll;
         std::unique_ptr<shading::PreparedScene> prepared;
         std::unique_ptr<BoothShadingPass> pass;
         int encodings = 0;
@@ -159,6 +159,9 @@ private:
     Expected<void> useVariant(std::size_t v);
     // Prepares variant v's scene and creates its shading pass (textures, programs) unless done.
     Expected<void> makeVariant(std::size_t v);
+    // Takes 'member' (a lamp's settings, or variant 0's own) into v's counts to write out: the
+    // fewest of its members'.
+    static void narrow(Variant& v, const shading::RenderSettings& member);
     BoothSceneSetup setup_;
     std::vector<Variant> variants_;
     std::vector<std::size_t> lampVariant_;              // by lamp index

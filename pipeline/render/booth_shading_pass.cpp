@@ -20,7 +20,8 @@ using namespace booth_upload;
 Expected<std::unique_ptr<BoothShadingPass>>
 BoothShadingPass::create(const shading::PreparedScene& scene,
                          const shading::RenderSettings& settings,
-                         const colour::Observer& obs)
+                         const colour::Observer& obs,
+                         BoothUnroll unroll)
 {
     if (scene.scene == nullptr || scene.scene->width <= 0 || scene.scene->height <= 0) {
         return makeError(ErrorCode::InvalidArgument, "render: the booth pass needs a loaded scene");
@@ -28,13 +29,13 @@ BoothShadingPass::create(const shading::PreparedScene& scene,
     std::unique_ptr<BoothShadingPass> pass(new BoothShadingPass());
     pass->settings_ = settings;
     pass->observer_ = &obs;
-    if (auto ok = pass->init(scene); !ok) {
+    if (auto ok = pass->init(scene, unroll); !ok) {
         return tl::unexpected(ok.error());
     }
     return pass;
 }
 
-Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
+Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnroll unroll)
 {
     scene_ = &ps;
     const surface::SurfaceScene& s = *ps.scene;
@@ -99,11 +100,15 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps)
     // the loop and read each sample's half vector as a gather per pixel. Written out, the
     // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md). Not with
     // the specular grid, where the samples run at the grid's nodes only (mode 2).
+    // A pass shared by lamps of several counts writes out the fewest (BoothUnroll).
     const CompiledCounts compiled = compiledCounts(s, settings_);
-    config.unrolledLights =
-            compiled.lights ? std::clamp(settings_.lights, 0, kBoothUnrolledLights) : 0;
+    const int lights =
+            unroll.lights >= 0 ? std::min(unroll.lights, settings_.lights) : settings_.lights;
+    const int written =
+            unroll.specularSamples >= 0 ? std::min(unroll.specularSamples, samples) : samples;
+    config.unrolledLights = compiled.lights ? std::clamp(lights, 0, kBoothUnrolledLights) : 0;
     config.unrolledSpecularSamples =
-            compiled.specularSamples ? std::clamp(samples, 0, kBoothUnrolledSpecSamples) : 0;
+            compiled.specularSamples ? std::clamp(written, 0, kBoothUnrolledSpecSamples) : 0;
     unrolledSamples_ = config.unrolledSpecularSamples;
     if (auto ok = programs_.compile(config, settings_, diffuseNodes.x > 0 ? 4 : 3); !ok) {
         return ok;

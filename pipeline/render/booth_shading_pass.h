@@ -24,6 +24,16 @@
 
 namespace replica::pipeline::render {
 
+// How many lights and specular samples the pass's programs write out, where they write them out
+// (compiledCounts) and not as many as the settings say: a pass that lamps of several counts share
+// (booth_scene_pass.h) writes out the fewest of them, each lamp looping to its own count. Not the
+// most, each kept to the count: llvmpipe runs such an `if` under a mask, so every lamp would pay
+// for the most samples (tried: the glossy cylinder's median frame 25 -> 31-51 ms under load).
+struct BoothUnroll {
+    int lights = -1;          // -1: settings.lights
+    int specularSamples = -1; // -1: settings.specularSamples
+};
+
 class BoothShadingPass
 {
 public:
@@ -34,16 +44,15 @@ public:
     static Expected<std::unique_ptr<BoothShadingPass>>
     create(const shading::PreparedScene& scene,
            const shading::RenderSettings& settings,
-           const colour::Observer& obs);
+           const colour::Observer& obs,
+           BoothUnroll unroll = {});
 
-    // Which of the settings' counts a pass's programs are compiled with, written out one by one
-    // where the term runs per pixel (the lights on a flat surface without the diffuse grid; the
-    // specular samples without the specular grid): a count compiled in makes a program of its
-    // own. A count not compiled in is looped to a uniform and set with setCounts, so passes that
-    // differ only in it can be one (booth_scene_pass.h). Kept compiled in where it runs per pixel
-    // because llvmpipe's loop reads each light or sample as a gather per pixel (the painting's
-    // frame: 12 % more instructions) and runs an `if` under a mask (a sample kept to a uniform
-    // count costs every lamp the most).
+    // Which of the settings' counts a pass's programs write out one by one, where the term runs
+    // per pixel (the lights on a flat surface without the diffuse grid; the specular samples
+    // without the specular grid): llvmpipe's loop reads each light or sample as a gather per
+    // pixel (the painting's frame: 12 % more instructions). A count not written out is looped to
+    // a uniform. Either way the count is set with setCounts: a pass written out for n takes n or
+    // more (the rest in its loop), so lamps of several counts can share one (booth_scene_pass.h).
     struct CompiledCounts {
         bool lights = false;
         bool specularSamples = false;
@@ -65,7 +74,7 @@ public:
     // count) and the specular samples (the sample table and its count; a pass made without a
     // specular term takes none, one made with it as many as its programs write out, at least 1,
     // to kBoothMaxSpecularSamples). A frame drawn after it is the frame a pass made with these
-    // counts draws where they are not compiled in (compiledCounts).
+    // counts draws.
     Expected<void> setCounts(int lights, int specularSamples);
 
     // Uploads a light: its median-cut point lights (at most 256), luminance mip chain and
@@ -113,7 +122,7 @@ public:
 
 private:
     BoothShadingPass() = default;
-    Expected<void> init(const shading::PreparedScene& scene);
+    Expected<void> init(const shading::PreparedScene& scene, BoothUnroll unroll);
 
     shading::RenderSettings settings_;
     const shading::PreparedScene* scene_ = nullptr;
