@@ -17,6 +17,35 @@
 namespace replica::pipeline::render {
 using namespace booth_upload;
 
+namespace {
+
+// glsl/booth_main.glsl eq. (1) on a flat surface: one LIGHT_AT per light up to
+// kBoothUnrolledLights, a loop for any beyond. Not on relief: there each light's horizon test
+// is large, and 32 copies of it took LLVM seconds to compile (a test's pass 2 -> 16 s) for no
+// measurable gain in the frame. Nor with the diffuse grid: eq. (1) then runs only at the
+// grid's few hundred nodes (mode 3), where 64 copies of the area light's contour integral
+// bought nothing in the frame and cost llvmpipe 4-5 s of JIT before the flat scenes' first
+// frame (docs/performance.md, "Start-up"); the frames are bit for bit the same.
+// The specular samples likewise, SPEC_AT(k) up to kBoothUnrolledSpecSamples: llvmpipe kept
+// the loop and read each sample's half vector as a gather per pixel. Written out, the
+// painting's frame took 12 % fewer instructions (callgrind, docs/performance.md). Not with
+// the specular grid, where the samples run at the grid's nodes only (mode 2).
+// A pass shared by lamps of several counts writes out the fewest (BoothUnroll).
+void writeOut(booth_upload::BoothShaderConfig& config,
+              BoothShadingPass::CompiledCounts compiled,
+              int lights,
+              int samples,
+              BoothUnroll unroll)
+{
+    const int l = unroll.lights >= 0 ? std::min(unroll.lights, lights) : lights;
+    const int k = unroll.specularSamples >= 0 ? std::min(unroll.specularSamples, samples) : samples;
+    config.unrolledLights = compiled.lights ? std::clamp(l, 0, kBoothUnrolledLights) : 0;
+    config.unrolledSpecularSamples =
+            compiled.specularSamples ? std::clamp(k, 0, kBoothUnrolledSpecSamples) : 0;
+}
+
+} // namespace
+
 Expected<std::unique_ptr<BoothShadingPass>>
 BoothShadingPass::create(const shading::PreparedScene& scene,
                          const shading::RenderSettings& settings,
@@ -89,26 +118,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
     config.specular = samples > 0;
     config.wardModel = s.model;
     config.facetCache = facetCache;
-    // glsl/booth_main.glsl eq. (1) on a flat surface: one LIGHT_AT per light up to
-    // kBoothUnrolledLights, a loop for any beyond. Not on relief: there each light's horizon test
-    // is large, and 32 copies of it took LLVM seconds to compile (a test's pass 2 -> 16 s) for no
-    // measurable gain in the frame. Nor with the diffuse grid: eq. (1) then runs only at the
-    // grid's few hundred nodes (mode 3), where 64 copies of the area light's contour integral
-    // bought nothing in the frame and cost llvmpipe 4-5 s of JIT before the flat scenes' first
-    // frame (docs/performance.md, "Start-up"); the frames are bit for bit the same.
-    // The specular samples likewise, SPEC_AT(k) up to kBoothUnrolledSpecSamples: llvmpipe kept
-    // the loop and read each sample's half vector as a gather per pixel. Written out, the
-    // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md). Not with
-    // the specular grid, where the samples run at the grid's nodes only (mode 2).
-    // A pass shared by lamps of several counts writes out the fewest (BoothUnroll).
-    const CompiledCounts compiled = compiledCounts(s, settings_);
-    const int lights =
-            unroll.lights >= 0 ? std::min(unroll.lights, settings_.lights) : settings_.lights;
-    const int written =
-            unroll.specularSamples >= 0 ? std::min(unroll.specularSamples, samples) : samples;
-    config.unrolledLights = compiled.lights ? std::clamp(lights, 0, kBoothUnrolledLights) : 0;
-    config.unrolledSpecularSamples =
-            compiled.specularSamples ? std::clamp(written, 0, kBoothUnrolledSpecSamples) : 0;
+    writeOut(config, compiledCounts(s, settings_), settings_.lights, samples, unroll);
     unrolledSamples_ = config.unrolledSpecularSamples;
     if (auto ok = programs_.compile(config, settings_, diffuseNodes.x > 0 ? 4 : 3); !ok) {
         return ok;
