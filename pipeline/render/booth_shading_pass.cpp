@@ -31,17 +31,20 @@ namespace {
 // painting's frame took 12 % fewer instructions (callgrind, docs/performance.md). Not with
 // the specular grid, where the samples run at the grid's nodes only (mode 2).
 // A pass shared by lamps of several counts writes out the fewest (BoothUnroll).
+// 'relief' and config's grids are the pass's own decisions (init).
 void writeOut(booth_upload::BoothShaderConfig& config,
-              BoothShadingPass::CompiledCounts compiled,
+              bool relief,
               int lights,
               int samples,
               BoothUnroll unroll)
 {
+    const bool lightsPerPixel = !relief && !config.diffuseGrid;
+    const bool samplesPerPixel = config.specular && !config.specularGrid;
     const int l = unroll.lights >= 0 ? std::min(unroll.lights, lights) : lights;
     const int k = unroll.specularSamples >= 0 ? std::min(unroll.specularSamples, samples) : samples;
-    config.unrolledLights = compiled.lights ? std::clamp(l, 0, kBoothUnrolledLights) : 0;
+    config.unrolledLights = lightsPerPixel ? std::clamp(l, 0, kBoothUnrolledLights) : 0;
     config.unrolledSpecularSamples =
-            compiled.specularSamples ? std::clamp(k, 0, kBoothUnrolledSpecSamples) : 0;
+            samplesPerPixel ? std::clamp(k, 0, kBoothUnrolledSpecSamples) : 0;
 }
 
 } // namespace
@@ -118,7 +121,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
     config.specular = samples > 0;
     config.wardModel = s.model;
     config.facetCache = facetCache;
-    writeOut(config, compiledCounts(s, settings_), settings_.lights, samples, unroll);
+    writeOut(config, relief, settings_.lights, samples, unroll);
     unrolledSamples_ = config.unrolledSpecularSamples;
     if (auto ok = programs_.compile(config, settings_, diffuseNodes.x > 0 ? 4 : 3); !ok) {
         return ok;
@@ -149,18 +152,6 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
 }
 
 BoothShadingPass::~BoothShadingPass() = default;
-
-BoothShadingPass::CompiledCounts
-BoothShadingPass::compiledCounts(const surface::SurfaceScene& s,
-                                 const shading::RenderSettings& settings)
-{
-    // What init() decides, from the same inputs (prepareScene gives a flat surface no normals).
-    const bool relief = settings.reliefPass && !s.flat();
-    const bool specular = settings.specularPass && s.glossy() && settings.specularSamples > 0;
-    const bool diffuseGrid = !relief && shading::gridNodes(s, settings.diffuseGrid).x > 0;
-    const bool specularGrid = specular && shading::gridNodes(s, settings.specularGrid).x > 0;
-    return {!relief && !diffuseGrid, specular && !specularGrid};
-}
 
 Expected<void> BoothShadingPass::setCounts(int lights, int specularSamples)
 {

@@ -25,7 +25,8 @@
 namespace replica::pipeline::render {
 
 // How many lights and specular samples the pass's programs write out, where they write them out
-// (compiledCounts) and not as many as the settings say: a pass that lamps of several counts share
+// (per pixel: the lights on a flat surface without the diffuse grid, the samples without the
+// specular grid), and not as many as the settings say: a pass that lamps of several counts share
 // (booth_scene_pass.h) writes out the fewest of them, each lamp looping to its own count. Not the
 // most, each kept to the count: llvmpipe runs such an `if` under a mask, so every lamp would pay
 // for the most samples (tried: the glossy cylinder's median frame 25 -> 31-51 ms under load).
@@ -47,18 +48,6 @@ public:
            const colour::Observer& obs,
            BoothUnroll unroll = {});
 
-    // Which of the settings' counts a pass's programs write out one by one, where the term runs
-    // per pixel (the lights on a flat surface without the diffuse grid; the specular samples
-    // without the specular grid): llvmpipe's loop reads each light or sample as a gather per
-    // pixel (the painting's frame: 12 % more instructions). A count not written out is looped to
-    // a uniform. Either way the count is set with setCounts: a pass written out for n takes n or
-    // more (the rest in its loop), so lamps of several counts can share one (booth_scene_pass.h).
-    struct CompiledCounts {
-        bool lights = false;
-        bool specularSamples = false;
-    };
-    static CompiledCounts compiledCounts(const surface::SurfaceScene& scene,
-                                         const shading::RenderSettings& settings);
     ~BoothShadingPass();
     BoothShadingPass(const BoothShadingPass&) = delete;
     BoothShadingPass& operator=(const BoothShadingPass&) = delete;
@@ -119,6 +108,9 @@ public:
     // Whether the luminance chain is filtered by the sampler (where the GL has the
     // float-filtering and border-clamp extensions) or by hand in the shader.
     bool hardwareFilter() const { return hwFilter_; }
+    // The specular samples the programs write out one by one (0: none, the samples loop): the
+    // fewest setCounts takes.
+    int writtenOutSamples() const { return unrolledSamples_; }
 
 private:
     BoothShadingPass() = default;
