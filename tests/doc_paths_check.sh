@@ -6,7 +6,9 @@
 # paths from a folder of their context: pipeline/ (`render/renderer.h`), pipeline/render/
 # (`glsl/dither.glsl`), platform/ (`cli/run_command.cpp`), tests/unit/ (the equation table's test
 # column) and data/. Not checked: CHANGELOG.md (history), absolute paths (/etc/replica/...: the
-# installed system's), paths out of the tree (../shared/...), and templates whose folders are in
+# installed system's), paths out of the tree (../shared/...), paths under build/ (what a build or a
+# test run writes: absent from a fresh clone, present in a worked-in tree, so checking them would
+# make the result depend on what ran before), and templates whose folders are in
 # capitals (`data/scenes/S/plan-*.json`, `DIR/patch.txt`).
 #   doc_paths_check.sh ROOT
 set -uo pipefail
@@ -50,6 +52,7 @@ for doc in $docs; do
         [ -n "$ref" ] || continue
         [[ " ${generated[*]} " == *" $ref "* ]] && continue
         [[ $ref == ../* ]] && continue
+        [[ $ref == build/* ]] && continue
         [[ $ref =~ (^|/)[A-Z][A-Z0-9_]*([.-][^/]*)?/ ]] && continue
         if ! exists "$doc" "$ref"; then
             echo "FAIL: $doc:$line: \`$ref\` names no file of the tree (fix the path or the text)" >&2
