@@ -245,6 +245,7 @@ makeBoothScene(RunConfig& config,
                 pipeline::shading::prepareScene(setup->scene,
                                                 std::max(setup->settings.horizonDirections, 1),
                                                 0.01, setup->basis));
+        logger("booth")->debug("relief prepared in {:.0f} ms", startupMs(start));
         chooseBoothDimmer(config, *setup, displayModel);
         logger("booth")->debug("booth dimmer (auto) chosen in {:.0f} ms", startupMs(start));
     }

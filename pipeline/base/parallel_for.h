@@ -1,6 +1,7 @@
 // Independent items spread over the machine's cores, for start-up work whose items share nothing
-// (the booth dimmer's probe views): each index is computed by exactly one thread and writes only
-// its own slot, so the result is the same, bit for bit, whatever the thread count or order.
+// (the booth dimmer's probe views, a relief's horizon map): each index is computed by exactly one
+// thread and writes only its own slot, so the result is the same, bit for bit, whatever the thread
+// count or order.
 #pragma once
 
 #include <algorithm>

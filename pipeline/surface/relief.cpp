@@ -6,6 +6,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include <pipeline/base/bilinear.h>
+#include <pipeline/base/parallel_for.h>
 #include <pipeline/surface/relief.h>
 
 namespace replica::pipeline::surface {
@@ -84,7 +85,11 @@ HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM)
     if (h.flat()) {
         return map; // every horizon is the macro plane: identical result, no marching
     }
-    for (int y = 0; y < h.height; ++y) {
+    // Rows on every core: each texel's march reads only the height field and writes only its own
+    // slots, so the map is the same, bit for bit, on any number of threads. It is on the way to
+    // the first frame (the painting's 384 x 288 x 8 marches: about 0.7 s on one core here).
+    parallelFor(static_cast<std::size_t>(h.height), [&](std::size_t row) {
+        const int y = static_cast<int>(row);
         for (int x = 0; x < h.width; ++x) {
             for (int k = 0; k < map.directions; ++k) {
                 const double phi = 2.0 * std::numbers::pi * k / map.directions;
@@ -92,7 +97,7 @@ HorizonMap horizonMap(const HeightField& h, int directions, double maxDistanceM)
                         static_cast<float>(exactSinHorizon(h, x + 0.5, y + 0.5, phi, maxDistanceM));
             }
         }
-    }
+    });
     return map;
 }
 

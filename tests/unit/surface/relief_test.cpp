@@ -2,6 +2,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 
 #include <pipeline/image/exr.h>
 #include <pipeline/surface/relief.h>
@@ -63,6 +64,37 @@ TEST(HorizonMap, FlatFieldHasZeroHorizonsEverywhere)
     for (float v : m.sinBeta) {
         EXPECT_EQ(v, 0.0f);
     }
+}
+
+TEST(HorizonMap, EverySlotIsItsTexelsOwnMarchWhateverThreadMadeIt)
+{
+    // The map's rows are made on every core: each slot must still be the march from its own
+    // texel centre in its own direction, bit for bit (a row or direction written to another's
+    // slot, or left unwritten, fails). A bumpy field of more rows than threads, not square.
+    HeightField f = field(23, 37, 0.0005);
+    for (int y = 0; y < f.height; ++y) {
+        for (int x = 0; x < f.width; ++x) {
+            f.m[static_cast<std::size_t>(y) * f.width + x] =
+                    0.0004 * std::sin(0.9 * x + 0.3 * y) * std::cos(0.5 * y - 0.2 * x);
+        }
+    }
+    const int dirs = 8;
+    const HorizonMap m = horizonMap(f, dirs, 0.004);
+    ASSERT_EQ(m.sinBeta.size(), static_cast<std::size_t>(f.width) * f.height * dirs);
+    int nonZero = 0;
+    for (int y = 0; y < f.height; ++y) {
+        for (int x = 0; x < f.width; ++x) {
+            for (int k = 0; k < dirs; ++k) {
+                const double phi = 2.0 * std::numbers::pi * k / dirs;
+                const float want =
+                        static_cast<float>(exactSinHorizon(f, x + 0.5, y + 0.5, phi, 0.004));
+                const float got = m.sinBeta[(static_cast<std::size_t>(y) * f.width + x) * dirs + k];
+                ASSERT_EQ(got, want) << "texel " << x << "," << y << " direction " << k;
+                nonZero += got > 0.0f;
+            }
+        }
+    }
+    EXPECT_GT(nonZero, 100); // the field casts horizons: the comparison is not of zeros
 }
 
 TEST(HorizonMap, HalfPrecisionRoundsEachSineToTheNearestHalfFloat)
