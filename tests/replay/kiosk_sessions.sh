@@ -17,9 +17,14 @@ size = "96x60"
 [recording]
 directory = "$work/sessions"
 rotate_bytes = 1048576
+rotate_seconds = 10
 keep_bytes = 1073741824
 TOML
-# 1 MiB is about 1000 frames of the sim scenario with thumbnails: two files or more.
+# 1 MiB is about 1000 frames of the sim scenario with thumbnails: two files or more. The loop
+# checks the file's size on disk once a second, and the writer compresses on a thread of its own:
+# on a loaded machine it can lag the frames so far that the first file is still under 1 MiB at the
+# last check (the test once failed so at load 4-6). A run that slow lasts over 10 s, so the age
+# rotates it instead: either way the session is two files or more.
 if ! "$replica" run --kiosk --config "$work/site.toml" --frames 2200 --fast --uncalibrated \
         > "$work/run.log" 2>&1; then
     echo "FAIL: the kiosk run failed:" >&2
