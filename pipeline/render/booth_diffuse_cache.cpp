@@ -86,6 +86,7 @@ void BoothDiffuseCache::update(const BoothPrograms& programs,
                                int height)
 {
     const Key shown = keyOf(want.shown, layout, width, height);
+    interior_ = surfaceInterior(layout, width, height);
     if (!want.band) {
         if (front_ != shown) {
             drawWhole(programs, shown, want.shown, rect);
@@ -199,10 +200,34 @@ void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
         y0 = slice == 0 ? region.y : edge(slice);
         y1 = slice == slices - 1 ? region.y + region.height : edge(slice + 1);
     }
+    // Mode 0 is two programs (booth_main.glsl): the surface's pixels over its rectangle, and
+    // those around it over the rest of the region and the rectangle's margin (the pixels between
+    // the interior, surely on the surface, and the rectangle's edge); each discards the other's.
+    // Same pixels as one program over the region, without the surround's light loop on every
+    // pixel of the surface (llvmpipe ran it under a mask: 5.4 of the ColorChecker's 7.9 ms).
     glEnable(GL_SCISSOR_TEST);
-    glScissor(region.x, y0, region.width, std::max(y1 - y0, 0));
-    programs.usePose(BoothMode::Cache, pose);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    const auto drawRows = [&](BoothMode mode, int x, int ya, int w, int yb) {
+        const int lo = std::max(ya, y0);
+        const int hi = std::min(yb, y1);
+        if (w > 0 && hi > lo) {
+            glScissor(x, lo, w, hi - lo);
+            programs.usePose(mode, pose);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        }
+    };
+    drawRows(BoothMode::Cache, rect.x, rect.y, rect.width, rect.y + rect.height);
+    const PixelRect& in = interior_;
+    const int regionTop = region.y + region.height;
+    if (in.width <= 0 || in.height <= 0) {
+        drawRows(BoothMode::CacheSurround, region.x, region.y, region.width, regionTop);
+    } else {
+        // Below the interior, above it, and beside it to the left and right.
+        drawRows(BoothMode::CacheSurround, region.x, region.y, region.width, in.y);
+        drawRows(BoothMode::CacheSurround, region.x, in.y + in.height, region.width, regionTop);
+        drawRows(BoothMode::CacheSurround, region.x, in.y, in.x - region.x, in.y + in.height);
+        drawRows(BoothMode::CacheSurround, in.x + in.width, in.y,
+                 region.x + region.width - (in.x + in.width), in.y + in.height);
+    }
     glDisable(GL_SCISSOR_TEST);
     if (diffuseNodes_.x > 0) {
         glActiveTexture(GL_TEXTURE0 + kUnitDiffGrid);

@@ -106,6 +106,9 @@ private:
     }
     // Band 'slice' of 'slices' of a refresh (slice 0 also draws the diffuse grid and clears what
     // needs clearing), for a frame of width x height whose surface is 'rect'.
+    // The pixels surely on the surface (surfaceInterior) of the layout update() draws now: what
+    // mode 0's surround program can leave out.
+    PixelRect interior_;
     struct Band {
         int slice = 0;
         int slices = 1;

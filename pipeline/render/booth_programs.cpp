@@ -14,15 +14,26 @@ Expected<void> BoothPrograms::compile(booth_upload::BoothShaderConfig config,
                                       int modes)
 {
     wallsOn_ = settings.walls;
-    for (int mode = 0; mode < modes; ++mode) {
+    const auto link = [&](BoothMode slot, int mode, bool surround) -> Expected<void> {
         config.mode = mode;
+        config.surround = surround;
         const std::string source = booth_upload::boothShaderSource(config, settings);
-        auto program = linkProgram(kFullscreenVertexShader, source.c_str(),
-                                   fmt::format("booth XYZ mode {}", mode).c_str());
+        auto program = linkProgram(
+                kFullscreenVertexShader, source.c_str(),
+                fmt::format("booth XYZ mode {}{}", mode, surround ? " (surround)" : "").c_str());
         if (!program) {
             return tl::unexpected(program.error());
         }
-        programs_[static_cast<std::size_t>(mode)] = std::move(*program);
+        programs_[static_cast<std::size_t>(slot)] = std::move(*program);
+        return {};
+    };
+    for (int mode = 0; mode < modes; ++mode) {
+        if (auto ok = link(static_cast<BoothMode>(mode), mode, false); !ok) {
+            return ok;
+        }
+    }
+    if (auto ok = link(BoothMode::CacheSurround, 0, true); !ok) {
+        return ok;
     }
     uniformAll(glProgramUniform1i, "uCoeffA", kUnitCoeffA);
     uniformAll(glProgramUniform1i, "uCoeffB", kUnitCoeffB);
@@ -64,7 +75,7 @@ void BoothPrograms::usePose(BoothMode mode, const shading::PanelPose& panel) con
     set("uRight", panel.right);
     set("uUp", panel.up);
     set("uNormal", panel.normal);
-    if (mode == BoothMode::Cache && wallsOn_) {
+    if ((mode == BoothMode::Cache || mode == BoothMode::CacheSurround) && wallsOn_) {
         setWallField(p, panel);
     }
     glUseProgram(p);

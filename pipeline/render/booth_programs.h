@@ -30,14 +30,21 @@ enum BoothTextureUnit : GLint {
     kUnitDiffGrid
 };
 
-// The shader's modes (BOOTH_MODE).
-enum class BoothMode : int { Cache = 0, Compose = 1, SpecularGrid = 2, DiffuseGrid = 3 };
+// The shader's modes (BOOTH_MODE), and mode 0's second program: the cache's pixels around the
+// surface (BOOTH_MODE 0 with BOOTH_SURROUND 1; Cache then draws the surface's alone).
+enum class BoothMode : int {
+    Cache = 0,
+    Compose = 1,
+    SpecularGrid = 2,
+    DiffuseGrid = 3,
+    CacheSurround = 4
+};
 
 class BoothPrograms
 {
 public:
     // Compiles modes 0 to modes - 1 from 'config' (its mode set for each) and the settings'
-    // switches, and points every sampler at its unit.
+    // switches, mode 0's surround program beside them, and points every sampler at its unit.
     Expected<void> compile(booth_upload::BoothShaderConfig config,
                            const shading::RenderSettings& settings,
                            int modes);
@@ -71,7 +78,7 @@ public:
 private:
     void setWallField(GLuint program, const shading::PanelPose& panel) const;
 
-    std::array<GlProgram, 4> programs_{};
+    std::array<GlProgram, 5> programs_{};
     bool wallsOn_ = false;
     const booth::WallLight* walls_ = nullptr;
     const surface::SurfaceScene* wallScene_ = nullptr;

@@ -149,7 +149,8 @@ std::string boothShaderSource(const BoothShaderConfig& c, const shading::RenderS
     for (int k = 0; k < c.unrolledSpecularSamples; ++k) {
         specCalls += fmt::format(" SPEC_AT({})", k);
     }
-    return fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_RELIEF {}\n"
+    return fmt::format("#version 310 es\n#define BOOTH_MODE {}\n#define BOOTH_SURROUND {}\n"
+                       "#define BOOTH_RELIEF {}\n"
                        "#define BOOTH_GRID {}\n#define BOOTH_DIFFUSE_GRID {}\n"
                        "#define BOOTH_HW_FILTER {}\n"
                        "#define BOOTH_HORIZON_DIRS {}\n#define BOOTH_HORIZON_SLOTS {}\n"
@@ -157,11 +158,11 @@ std::string boothShaderSource(const BoothShaderConfig& c, const shading::RenderS
                        "#define BOOTH_FACET_CACHE {}\n#define BOOTH_LIGHT_CALLS{}\n"
                        "#define BOOTH_UNROLLED_LIGHTS {}\n#define BOOTH_SPEC_CALLS{}\n"
                        "#define BOOTH_UNROLLED_SPEC {}\n#define BOOTH_AREA_LIGHTS {}\n",
-                       c.mode, c.relief ? 1 : 0, c.specularGrid ? 1 : 0, c.diffuseGrid ? 1 : 0,
-                       c.hardwareFilter ? 1 : 0, c.horizonDirections, c.horizonSlots,
-                       c.specular ? 1 : 0, wardModelIndex(c.wardModel), c.facetCache ? 1 : 0,
-                       lightCalls, c.unrolledLights, specCalls, c.unrolledSpecularSamples,
-                       s.areaLights ? 1 : 0) +
+                       c.mode, c.surround ? 1 : 0, c.relief ? 1 : 0, c.specularGrid ? 1 : 0,
+                       c.diffuseGrid ? 1 : 0, c.hardwareFilter ? 1 : 0, c.horizonDirections,
+                       c.horizonSlots, c.specular ? 1 : 0, wardModelIndex(c.wardModel),
+                       c.facetCache ? 1 : 0, lightCalls, c.unrolledLights, specCalls,
+                       c.unrolledSpecularSamples, s.areaLights ? 1 : 0) +
            // Only a pass that lights with the walls says so: every other program's source stays
            // as it was.
            (s.walls ? "#define BOOTH_WALLS 1\n" : "") + kBoothXyzShader;

@@ -34,4 +34,32 @@ PixelRect surfaceRect(const SurfaceLayout& layout, int width, int height)
     return {x0, height - r1, x1 - x0, r1 - r0};
 }
 
+PixelRect surfaceInterior(const SurfaceLayout& layout, int width, int height)
+{
+    if (!(layout.scale.x > 0.0) || !(layout.scale.y > 0.0)) {
+        return {0, 0, 0, 0};
+    }
+    // Pixel i's centre is i + 0.5; the surface spans [a, b] in pixels: the pixels whose centres
+    // lie in [a + 0.5, b - 0.5], that is the whole pixel on the surface (float's rounding of the
+    // shader's bounds test is some 1e-4 of a pixel here).
+    const auto span = [](double offset, double scale, int n) {
+        const double a = (0.0 - offset) / scale * n;
+        const double b = (1.0 - offset) / scale * n;
+        if (!std::isfinite(a) || !std::isfinite(b)) {
+            return std::pair<int, int>(0, 0); // no pixel is certain
+        }
+        const double lo = std::ceil(std::min(a, b));
+        const double hi = std::floor(std::max(a, b));
+        const int l = static_cast<int>(std::clamp(lo, 0.0, static_cast<double>(n)));
+        const int h = static_cast<int>(std::clamp(hi, 0.0, static_cast<double>(n)));
+        return std::pair<int, int>(l, std::max(h, l));
+    };
+    const auto [x0, x1] = span(layout.offset.x, layout.scale.x, width);
+    const auto [r0, r1] = span(layout.offset.y, layout.scale.y, height); // rows down
+    if (x1 == x0 || r1 == r0) {
+        return {0, 0, 0, 0};
+    }
+    return {x0, height - r1, x1 - x0, r1 - r0};
+}
+
 } // namespace replica::pipeline::render

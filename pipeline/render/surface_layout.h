@@ -23,6 +23,12 @@ struct SurfaceLayout {
 // (0, 0, 0), the black panel around the surface. The whole frame for a layout that does not scale.
 PixelRect surfaceRect(const SurfaceLayout& layout, int width, int height);
 
+// The pixels of a width x height frame that show the surface for certain: every pixel wholly
+// inside its edges (where the shader's bounds test, in float, cannot decide otherwise).
+// surfaceRect less its edge pixels: what lies between the two is decided pixel by pixel. Empty for
+// a layout that does not scale.
+PixelRect surfaceInterior(const SurfaceLayout& layout, int width, int height);
+
 // The surface at its physical size, centred on the panel's active area (the appliance's frame
 // covers the whole panel). The matching View's panel centre is the active area's centre.
 SurfaceLayout layoutOnPanel(const surface::SurfaceScene& scene, const scene::StandModel& stand);

@@ -195,6 +195,14 @@ void compose(vec3 p, vec3 nShade, vec2 uv, bool inside) {
 void main() {
     vec2 uv = surfaceUv();
     bool inside = uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0;
+#if BOOTH_MODE == 0 && BOOTH_SURROUND
+    // Mode 0 is two programs, each without the other's code, which llvmpipe would run for every
+    // pixel under a mask: this one, drawn after the surface's over the pixels that may lie around
+    // the surface (booth_diffuse_cache.cpp), leaves the surface's pixels as that one drew them.
+    if (inside) {
+        discard;
+    }
+#endif
     // On the panel plane also around the surface: the flare term needs E_geo on every pixel.
     vec3 p = uCentre + uRight * ((uv.x - 0.5) * uSizeM.x) + uUp * ((0.5 - uv.y) * uSizeM.y);
     vec2 tex = texelPosition(uv);
@@ -202,17 +210,21 @@ void main() {
     vec3 nShade = uNormal;
     // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
     bool facets = uMode == 0 || (kSpecular && (uMode == 2 || !kGrid));
+#if !(BOOTH_MODE == 0 && BOOTH_SURROUND)
     if (inside && uRelief && facets) {
         nShade = facetNormal(tex, tc);
     }
+#endif
     if (uMode == 2) {
         specularNode(p, nShade);
     } else if (uMode == 3) {
         diffuseNode(p);
-    } else if (uMode == 0 && !inside) {
-        flareOnly(p, uv);
     } else if (uMode == 0) {
+#if BOOTH_SURROUND
+        flareOnly(p, uv); // around the surface: only E_geo
+#else
         diffuseCache(p, nShade, uv, tc, inside);
+#endif
     } else {
         compose(p, nShade, uv, inside);
     }
