@@ -86,7 +86,6 @@ void BoothDiffuseCache::update(const BoothPrograms& programs,
                                int height)
 {
     const Key shown = keyOf(want.shown, layout, width, height);
-    interior_ = surfaceInterior(layout, width, height);
     if (!want.band) {
         if (front_ != shown) {
             drawWhole(programs, shown, want.shown, rect);
@@ -124,7 +123,7 @@ void BoothDiffuseCache::drawWhole(const BoothPrograms& programs,
     // A refresh's bands in the other buffer were drawn with the diffuse grid of its tilt, which
     // this draw replaces: they are of no use any more.
     back_.reset();
-    drawSlice(programs, shown_, pose, {0, 1, rect, key.width, key.height});
+    drawSlice(programs, shown_, pose, {0, 1, rect, interiorOf(key), key.width, key.height});
     front_ = key;
     ++refreshes_;
 }
@@ -135,7 +134,8 @@ void BoothDiffuseCache::drawBand(const BoothPrograms& programs,
                                  const PixelRect& rect)
 {
     const int back = 1 - shown_;
-    drawSlice(programs, back, band.toward, {band.band, band.bands, rect, key.width, key.height});
+    drawSlice(programs, back, band.toward,
+              {band.band, band.bands, rect, interiorOf(key), key.width, key.height});
     back_ = Partial{key, band.band + 1};
     if (band.band + 1 == band.bands) {
         // The last band: that buffer is the one composed from now on.
@@ -216,7 +216,7 @@ void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
         }
     };
     drawRows(BoothMode::Cache, rect.x, rect.y, rect.width, rect.y + rect.height);
-    const PixelRect& in = interior_;
+    const PixelRect& in = band.interior;
     const int regionTop = region.y + region.height;
     if (in.width <= 0 || in.height <= 0) {
         drawRows(BoothMode::CacheSurround, region.x, region.y, region.width, regionTop);

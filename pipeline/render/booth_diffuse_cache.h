@@ -105,17 +105,20 @@ private:
         return {pose.centre, pose.right, pose.up, pose.normal, w, h, layout.offset, layout.scale};
     }
     // Band 'slice' of 'slices' of a refresh (slice 0 also draws the diffuse grid and clears what
-    // needs clearing), for a frame of width x height whose surface is 'rect'.
-    // The pixels surely on the surface (surfaceInterior) of the layout update() draws now: what
-    // mode 0's surround program can leave out.
-    PixelRect interior_;
+    // needs clearing), for a frame of width x height whose surface is 'rect', of which 'interior'
+    // (surfaceInterior) is surely on the surface: what mode 0's surround program leaves out.
     struct Band {
         int slice = 0;
         int slices = 1;
         PixelRect rect;
+        PixelRect interior;
         int width = 0;
         int height = 0;
     };
+    static PixelRect interiorOf(const Key& k)
+    {
+        return surfaceInterior(SurfaceLayout{k.offset, k.scale}, k.width, k.height);
+    }
     // The term whole into the buffer composed; band 'band' into the other one.
     void drawWhole(const BoothPrograms& programs,
                    const Key& key,
