@@ -200,11 +200,12 @@ void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
         y0 = slice == 0 ? region.y : edge(slice);
         y1 = slice == slices - 1 ? region.y + region.height : edge(slice + 1);
     }
-    // Mode 0 is two programs (booth_main.glsl): the surface's pixels over its rectangle, and
-    // those around it over the rest of the region and the rectangle's margin (the pixels between
-    // the interior, surely on the surface, and the rectangle's edge); each discards the other's.
-    // Same pixels as one program over the region, without the surround's light loop on every
-    // pixel of the surface (llvmpipe ran it under a mask: 5.4 of the ColorChecker's 7.9 ms).
+    // Mode 0 is two programs (booth_main.glsl): the surface's over its rectangle, then the
+    // surround's over the rest of the region and the rectangle's margin (the pixels between the
+    // interior, surely on the surface, and the rectangle's edge), discarding the surface's pixels
+    // and overwriting the margin's others. Same pixels as one program over the region, without
+    // the surround's light loop on every pixel of the surface (llvmpipe ran it under a mask: 5.4
+    // of the ColorChecker's 7.9 ms).
     glEnable(GL_SCISSOR_TEST);
     const auto drawRows = [&](BoothMode mode, int x, int ya, int w, int yb) {
         const int lo = std::max(ya, y0);

@@ -51,9 +51,10 @@ void channelPlanes(const shading::PreparedScene& ps, std::vector<float>& a, std:
 // the files after it say what each does).
 struct BoothShaderConfig {
     int mode = 0; // 0 cache, 1 compose, 2 specular grid, 3 diffuse grid
-    // Mode 0's two programs: the surface's pixels (false) or those around it (true), each
-    // discarding the other's, so that neither carries the other's code (llvmpipe runs both sides
-    // of a branch under a mask: the surface's pixels paid for the surround's light loop).
+    // Mode 0's two programs: the surface's pixels (false), and those around it (true), drawn
+    // after it and discarding the surface's pixels, so that neither carries the other's code
+    // (llvmpipe runs both sides of a branch under a mask: the surface's pixels paid for the
+    // surround's light loop).
     bool surround = false;
     bool relief = false;
     bool specularGrid = false;
