@@ -213,10 +213,14 @@ int closeRecording(RunRecording& rec, const run_cli::RunOptions& o, nlohmann::js
             log->warn("session {} is incomplete; the next start recovers it",
                       rec.sessions->currentPath().string());
             code = kExitFailure;
-        } else {
+        } else if (!o.json) {
             fmt::print("recording: {} ({} rotations)\n", rec.sessions->currentPath().string(),
                        rec.sessions->rotations());
         }
+        // With --json standard output is the summary alone: the session file is in it.
+        summary["sessions"] = {{"file", rec.sessions->currentPath().string()},
+                               {"rotations", rec.sessions->rotations()},
+                               {"complete", code == kExitOk}};
     }
     if (rec.file) {
         if (auto closed = rec.file->close(); !closed) {
