@@ -427,6 +427,7 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
     r.string("run", "hal", c.hal, {"live", "sim", "replay"});
     r.string("run", "replay_file", c.replayFile);
     r.number("run", "rate_hz", c.rateHz, 1.0, 240.0);
+    r.number("run", "min_rate_hz", c.minRateHz, 1.0, 240.0);
     r.boolean("recording", "enabled", c.recordingEnabled);
     r.string("recording", "directory", c.recordingDirectory);
     r.integer("recording", "rotate_bytes", c.rotateBytes, 1 << 20, std::int64_t{1} << 50);
@@ -502,7 +503,11 @@ std::string SiteConfig::toJson() const
               {"accel_axes", accelAxes},
               {"lamp_gpio", lampGpio},
               {"spectrometer_serial", spectrometerSerial}}},
-            {"run", {{"hal", hal}, {"replay_file", replayFile}, {"rate_hz", rateHz}}},
+            {"run",
+             {{"hal", hal},
+              {"replay_file", replayFile},
+              {"rate_hz", rateHz},
+              {"min_rate_hz", minRateHz}}},
             {"recording",
              {{"enabled", recordingEnabled},
               {"directory", recordingDirectory},

@@ -93,6 +93,7 @@ struct SiteConfig {
     std::string hal = "live"; // live, sim or replay
     std::string replayFile;   // hal = "replay": the recording whose samples feed the display
     double rateHz = 60.0;
+    double minRateHz = 15.0; // the steady cadence's lowest rate (platform/loop/cadence.h)
     // [recording]
     bool recordingEnabled = true;
     std::string recordingDirectory = "/var/lib/replica/sessions";

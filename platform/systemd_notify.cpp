@@ -68,11 +68,16 @@ void SystemdNotifier::send(const std::string& message)
 #endif
 }
 
-void SystemdNotifier::frameShown(std::uint64_t frames, std::uint64_t skippedTicks)
+void SystemdNotifier::frameShown(std::uint64_t frames, std::uint64_t skippedTicks, int everyNthTick)
 {
     const auto now = std::chrono::steady_clock::now();
     const auto status = [&] {
-        return fmt::format("STATUS={} frames shown, {} late ticks skipped", frames, skippedTicks);
+        return fmt::format("STATUS={} frames shown, {} late ticks skipped{}", frames, skippedTicks,
+                           everyNthTick > 1
+                                   ? fmt::format(", drawing 1 tick in {} (frames longer than "
+                                                 "the period)",
+                                                 everyNthTick)
+                                   : std::string());
     };
     if (!ready_) {
         ready_ = true;

@@ -19,7 +19,9 @@ public:
     bool watchdogEnabled() const { return watchdogUs_ > 0; }
     // Call once per frame: the first call says READY=1, then a WATCHDOG=1 at most every quarter
     // of the watchdog interval (a 60 Hz loop would otherwise send 60 datagrams a second).
-    void frameShown(std::uint64_t frames, std::uint64_t skippedTicks);
+    // 'everyNthTick': the loop's steady cadence (platform/loop/cadence.h), said in the status
+    // when it is not every tick.
+    void frameShown(std::uint64_t frames, std::uint64_t skippedTicks, int everyNthTick = 1);
     void stopping();
 
 private:

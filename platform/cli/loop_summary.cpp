@@ -11,6 +11,19 @@ nlohmann::json loopSummaryJson(const LoopStats& stats, double periodMs)
     nlohmann::json j;
     j["frames"] = stats.frames;
     j["late_frames"] = stats.lateFrames;
+    j["skipped_ticks"] = stats.skippedTicks;
+    // The steady cadence (platform/loop/cadence.h): the frames drawn at each rate it ran at.
+    nlohmann::json atRate = nlohmann::json::object();
+    for (std::size_t n = 1; n < stats.framesAtDivisor.size(); ++n) {
+        if (stats.framesAtDivisor[n] > 0 && periodMs > 0.0) {
+            atRate[fmt::format("{:.4g}", 1000.0 / periodMs / static_cast<double>(n))] =
+                    stats.framesAtDivisor[n];
+        }
+    }
+    j["cadence"] = {{"every_nth_tick", stats.divisor},
+                    {"changes", stats.cadenceChanges},
+                    {"ticks_paced", stats.pacedTicks},
+                    {"frames_at_hz", atRate}};
     j["dropped"] = nlohmann::json::object();
     for (const auto* kind : recordings::deviceKinds()) {
         const auto it = stats.dropped.find(kind->name());
@@ -54,6 +67,19 @@ void logLoopSummary(const LoopStats& stats, double periodMs, bool digests)
               stats.frames, dropped.empty() ? std::string("none") : dropped, stats.lateFrames,
               stats.skippedTicks, stats.meanOutOfGamutFraction(), stats.maxOutOfGamutFraction,
               stats.meanOverPeakFraction(), stats.maxOverPeakFraction);
+    if (stats.cadenceChanges > 0) {
+        std::string rates;
+        for (std::size_t n = 1; n < stats.framesAtDivisor.size(); ++n) {
+            if (stats.framesAtDivisor[n] > 0) {
+                rates += fmt::format("{}{} at {:.4g} Hz", rates.empty() ? "" : ", ",
+                                     stats.framesAtDivisor[n],
+                                     1000.0 / periodMs / static_cast<double>(n));
+            }
+        }
+        log->info("cadence: frames {}; {} ticks passed over for an even cadence, {} changes "
+                  "(platform/loop/cadence.h)",
+                  rates, stats.pacedTicks, stats.cadenceChanges);
+    }
     const FrameTimes& t = stats.frameTimes;
     // --digests reads every frame back as float XYZ and hashes it (XXH3-64, digest format 2; about
     // 1 ms for the 11.5 MB of a 960x600 frame, docs/performance.md) inside each frame's time; the

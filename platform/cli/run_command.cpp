@@ -299,8 +299,9 @@ Expected<LoopStats> runLoop(const run_cli::RunOptions& o,
     LoopOptions loopOptions;
     loopOptions.skipLateTicks = true;
     loopOptions.periodNs = periodNs;
+    loopOptions.maxDivisor = CadenceGovernor::divisorLimit(o.rateHz, o.minRateHz);
     loopOptions.afterFrame = [&notifier, &warmUp](const LoopStats& s) {
-        notifier.frameShown(s.frames, s.skippedTicks);
+        notifier.frameShown(s.frames, s.skippedTicks, s.divisor);
         if (warmUp) {
             warmUp->afterFrame(s.frames);
         }

@@ -43,6 +43,7 @@ constexpr std::array kSiteDefaults = {
         SiteDefault{"--hal", fromSite<&S::hal, &O::hal>},
         SiteDefault{"--replay-file", fromSite<&S::replayFile, &O::replayFile>},
         SiteDefault{"--rate", fromSite<&S::rateHz, &O::rateHz>},
+        SiteDefault{"--min-rate", fromSite<&S::minRateHz, &O::minRateHz>},
         SiteDefault{"--output", fromSite<&S::output, &O::output>},
         SiteDefault{
                 "--kms-device",
@@ -149,6 +150,13 @@ void addOutputOptions(CLI::App& cmd, RunOptions& o)
                    "the panel's active area WIDTHxHEIGHT in millimetres, which the frame covers "
                    "(default: the display's EDID on kms, else 518x324, a 24-inch 16:10 panel)");
     cmd.add_option("--rate", o.rateHz, "frame rate (Hz)")
+            ->check(CLI::Range(1.0, 1000.0))
+            ->capture_default_str();
+    cmd.add_option("--min-rate", o.minRateHz,
+                   "when frames take longer than the period, draw every n-th tick (rate / n, the "
+                   "smallest whole n the frames fit) down to this rate, for even motion, instead "
+                   "of late ticks as they come; at or above --rate: never (Hz; realtime runs only, "
+                   "not --fast)")
             ->check(CLI::Range(1.0, 1000.0))
             ->capture_default_str();
     cmd.add_option("--record", o.record, "write every sensor sample and frame input to FILE");

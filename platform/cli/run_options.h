@@ -30,6 +30,7 @@ struct RunOptions {
     std::string size; // headless: 960x600 when not given; kms: the mode's size
     std::string panelSizeMm;
     double rateHz = 60.0;
+    double minRateHz = 15.0; // --min-rate: the steady cadence's lowest rate (loop/cadence.h)
     std::string record;
     bool force = false; // --force: overwrite an existing recording
     int recordFlushMs = 500;

@@ -129,6 +129,16 @@ static_assert(consumesEachKind(static_cast<const recordings::StateKinds*>(nullpt
               "state::SceneEstimator::update must take one sample of each of "
               "recordings::StateKinds, in order");
 
+// "tick", "2nd tick", "3rd tick", "4th tick" ... for the cadence's log lines.
+std::string tickOrdinal(int n)
+{
+    if (n <= 1) {
+        return "tick";
+    }
+    const char* suffix = n == 2 ? "nd" : n == 3 ? "rd" : "th";
+    return fmt::format("{}{} tick", n, suffix);
+}
+
 // When each frame starts: a realtime tick waits for its wall-clock time (skipping ticks a slow
 // frame missed, with skipLateTicks), a stepped one for a line on standard input.
 class Pacer
@@ -136,7 +146,9 @@ class Pacer
 public:
     Pacer(Pacing pacing, const LoopOptions& options)
         : pacing_(pacing), options_(options), stepping_(pacing == Pacing::Step),
-          wallStart_(std::chrono::steady_clock::now())
+          wallStart_(std::chrono::steady_clock::now()),
+          cadence_(options.periodNs,
+                   pacing == Pacing::Realtime && options.skipLateTicks ? options.maxDivisor : 1)
     {}
 
     // The next tick to draw, none at the end.
@@ -146,20 +158,60 @@ public:
         if (!tick || pacing_ != Pacing::Realtime || !options_.skipLateTicks) {
             return tick;
         }
-        const std::uint64_t skip = ticksToSkip(elapsedNs(), tick->tickNs, options_.periodNs);
-        // The plan's last tick is rendered even when late: a fixed run ends on its last frame.
-        for (std::uint64_t i = 0; i < skip; ++i) {
-            std::optional<TickPlan> later = ticks();
-            if (!later) {
-                break;
+        // The plan's last tick is rendered even when passed over or late: a fixed run ends on its
+        // last frame.
+        const auto advance = [&](std::uint64_t n, std::uint64_t& counter) {
+            for (std::uint64_t i = 0; i < n; ++i) {
+                std::optional<TickPlan> later = ticks();
+                if (!later) {
+                    return;
+                }
+                tick = std::move(later);
+                ++counter;
             }
-            tick = std::move(later);
-            ++stats.skippedTicks;
-        }
+        };
+        // A steady cadence: every n-th tick, the n - 1 between passed over (loop/cadence.h).
+        const auto n = static_cast<std::uint64_t>(cadence_.divisor());
+        advance(n - 1, stats.pacedTicks);
+        // Late by a whole cadence period or more: skipped in whole cadence steps, so that the
+        // ticks drawn stay n apart.
+        const std::uint64_t skip = ticksToSkip(elapsedNs(), tick->tickNs,
+                                               options_.periodNs * static_cast<std::int64_t>(n)) *
+                                   n;
+        advance(skip, stats.skippedTicks);
         if (skip > 0) {
             logger("loop")->debug("late: skipped {} ticks to frame {}", skip, tick->frameIndex);
         }
         return tick;
+    }
+
+    // A frame drawn, its work 'workMs' without the display's flip: the cadence's figures, and a
+    // new cadence when its frames no longer fit the one in force (or fit a faster one again).
+    void drawn(double workMs, LoopStats& stats)
+    {
+        ++stats.framesAtDivisor[static_cast<std::size_t>(cadence_.divisor())];
+        if (!cadence_.add(workMs)) {
+            return;
+        }
+        const int n = cadence_.divisor();
+        const bool slower = n > stats.divisor;
+        stats.divisor = n;
+        ++stats.cadenceChanges;
+        const double period = cadence_.periodMs();
+        const double rate = 1000.0 / period;
+        if (slower) {
+            logger("loop")->info("cadence: frames take {:.1f} ms (the median of the last {}), "
+                                 "longer than the {:.1f} ms period: every {} drawn, {:.4g} Hz, "
+                                 "so that motion stays even (the lowest allowed: {:.4g} Hz, [run] "
+                                 "min_rate_hz)",
+                                 cadence_.decidedOnMs(), cadence_.decidedOverFrames(), period,
+                                 tickOrdinal(n), rate / n, rate / cadence_.maxDivisor());
+        } else {
+            logger("loop")->info("cadence: frames fit a faster one again (95th percentile {:.1f} "
+                                 "ms of the last {}): every {} drawn, {:.4g} Hz",
+                                 cadence_.decidedOnMs(), cadence_.decidedOverFrames(),
+                                 tickOrdinal(n), rate / n);
+        }
     }
 
     void wait(const TickPlan& tick, LoopStats& stats)
@@ -206,6 +258,7 @@ private:
     bool stepping_;
     std::chrono::steady_clock::time_point wallStart_;
     bool afterWarmup_ = false;
+    CadenceGovernor cadence_;
 };
 
 using Slots = decltype(recordings::DeviceSlots(
@@ -335,9 +388,13 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         }
         countGamut(image, tick.frameIndex, stats);
         DisplayFrame frame{image.width, image.height, image.rgba, image.displayFramebuffer};
+        const auto presentStart = std::chrono::steady_clock::now();
         if (auto ok = appliance.output->present(frame); !ok) {
             log->warn("output {}: {}", appliance.output->name(), ok.error().message);
         }
+        // A display's present waits for its flip (kms): time the frame did not need, left out
+        // of what the cadence decides on.
+        const auto presentNs = std::chrono::steady_clock::now() - presentStart;
         recordings::FrameRecord record{tick.frameIndex, tick.tickNs, {}};
         for (const auto& slot : slots.all()) {
             record.setSequence(slot->kind(), slot->chosenSequence());
@@ -354,6 +411,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         stats.frameTimes.add(workMs);
         log->debug("frame {}: {:.1f} ms", tick.frameIndex, workMs);
         ++stats.frames;
+        pacer.drawn(workMs - std::chrono::duration<double, std::milli>(presentNs).count(), stats);
         if (options.afterFrame) {
             options.afterFrame(stats);
         }

@@ -3,6 +3,7 @@
 // the frame on, and record what was used.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -13,6 +14,7 @@
 #include <pipeline/base/expected.h>
 #include <pipeline/render/renderer.h>
 #include <platform/appliance.h>
+#include <platform/loop/cadence.h>
 #include <platform/loop/frame_times.h>
 #include <recordings/recording.h>
 
@@ -48,7 +50,14 @@ struct LoopStats {
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
     std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
     std::uint64_t skippedTicks = 0;     // LoopOptions::skipLateTicks: ticks never rendered
-    std::uint64_t estimatedOnly = 0;    // TickPlan::estimateOnly: ticks only estimated, never drawn
+    // LoopOptions::maxDivisor: the ticks passed over on purpose for a steady cadence (every n-th
+    // tick drawn, loop/cadence.h), how often n changed, the n of the last frame, and the frames
+    // drawn at each n (index n; 0 unused).
+    std::uint64_t pacedTicks = 0;
+    std::uint64_t cadenceChanges = 0;
+    int divisor = 1;
+    std::array<std::uint64_t, CadenceGovernor::kMaxDivisor + 1> framesAtDivisor{};
+    std::uint64_t estimatedOnly = 0; // TickPlan::estimateOnly: ticks only estimated, never drawn
     std::uint64_t recorderRotations = 0; // LoopOptions::nextRecorder returned a new recorder
     // Each frame's work on the wall clock, from polling the sources to handing the frame on
     // (not the wait for its tick): what says whether the machine keeps the rate.
@@ -104,6 +113,10 @@ struct LoopOptions {
     // replay renders every recorded frame and leaves it off.
     bool skipLateTicks = false;
     std::int64_t periodNs = 0;
+    // With skipLateTicks: the largest n the loop may draw every n-th tick at when its frames take
+    // longer than a period (loop/cadence.h; CadenceGovernor::divisorLimit of the rate and the
+    // site's min_rate_hz). 1: every tick, late ones skipped as they come.
+    int maxDivisor = 1;
     // After each frame: the systemd watchdog ping and readiness, and the shading passes' warm-up
     // after the first frame (platform/output/pass_warm_up.h); its time is not the frame's.
     std::function<void(const LoopStats&)> afterFrame;

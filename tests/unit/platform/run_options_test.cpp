@@ -80,6 +80,11 @@ TEST(RunOptions, TheSiteFileFillsOnlyWhatTheCommandLineLeavesOpen)
     ASSERT_TRUE(plan) << plan.error().lines.front();
     EXPECT_TRUE(plan->config.warmUp);
     EXPECT_TRUE(parseRun({"--no-warm-up"}, "").noWarmUp);
+
+    // The steady cadence's floor: the site's, the command line's over it, 15 Hz without either.
+    EXPECT_DOUBLE_EQ(plain.minRateHz, 15.0);
+    EXPECT_DOUBLE_EQ(parseRun({}, "[run]\nmin_rate_hz = 30.0\n").minRateHz, 30.0);
+    EXPECT_DOUBLE_EQ(parseRun({"--min-rate", "20"}, "[run]\nmin_rate_hz = 30.0\n").minRateHz, 20.0);
 }
 
 TEST(RunOptions, TheLightAndTheBoothComeFromTheSiteFileOrTheCommandLine)
