@@ -23,6 +23,7 @@ nlohmann::json loopSummaryJson(const LoopStats& stats, double periodMs)
     j["cadence"] = {{"every_nth_tick", stats.divisor},
                     {"changes", stats.cadenceChanges},
                     {"ticks_paced", stats.pacedTicks},
+                    {"frames_over_its_period", stats.framesOverCadence},
                     {"frames_at_hz", atRate}};
     j["dropped"] = nlohmann::json::object();
     for (const auto* kind : recordings::deviceKinds()) {
@@ -76,9 +77,9 @@ void logLoopSummary(const LoopStats& stats, double periodMs, bool digests)
                                      1000.0 / periodMs / static_cast<double>(n));
             }
         }
-        log->info("cadence: frames {}; {} ticks passed over for an even cadence, {} changes "
-                  "(platform/loop/cadence.h)",
-                  rates, stats.pacedTicks, stats.cadenceChanges);
+        log->info("cadence: frames {}; {} ticks passed over for an even cadence, {} changes, {} "
+                  "frames longer than the cadence's period (platform/loop/cadence.h)",
+                  rates, stats.pacedTicks, stats.cadenceChanges, stats.framesOverCadence);
     }
     const FrameTimes& t = stats.frameTimes;
     // --digests reads every frame back as float XYZ and hashes it (XXH3-64, digest format 2; about

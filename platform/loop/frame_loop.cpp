@@ -190,6 +190,9 @@ public:
     void drawn(double workMs, LoopStats& stats)
     {
         ++stats.framesAtDivisor[static_cast<std::size_t>(cadence_.divisor())];
+        if (paced() && workMs > cadence_.divisor() * cadence_.periodMs()) {
+            ++stats.framesOverCadence;
+        }
         if (!cadence_.add(workMs)) {
             return;
         }
@@ -246,6 +249,12 @@ public:
     }
 
 private:
+    // Live pacing at a known period: the loop that skips late ticks and may pace a cadence.
+    bool paced() const
+    {
+        return pacing_ == Pacing::Realtime && options_.skipLateTicks && options_.periodNs > 0;
+    }
+
     std::int64_t elapsedNs() const
     {
         return std::chrono::duration_cast<std::chrono::nanoseconds>(

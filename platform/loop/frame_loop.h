@@ -51,9 +51,12 @@ struct LoopStats {
     std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
     std::uint64_t skippedTicks = 0;     // LoopOptions::skipLateTicks: ticks never rendered
     // LoopOptions::maxDivisor: the ticks passed over on purpose for a steady cadence (every n-th
-    // tick drawn, loop/cadence.h), how often n changed, the n of the last frame, and the frames
-    // drawn at each n (index n; 0 unused).
+    // tick drawn, loop/cadence.h), how often n changed, the n of the last frame, the frames drawn
+    // at each n (index n; 0 unused), and the frames whose work (without the display's flip) took
+    // longer than the cadence's period they were drawn at, n periods: the frames that were late
+    // for the cadence, where frameTimes counts against the tick period.
     std::uint64_t pacedTicks = 0;
+    std::uint64_t framesOverCadence = 0;
     std::uint64_t cadenceChanges = 0;
     int divisor = 1;
     std::array<std::uint64_t, CadenceGovernor::kMaxDivisor + 1> framesAtDivisor{};

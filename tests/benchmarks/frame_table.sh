@@ -11,13 +11,15 @@
 # shader warm-up and the run's wall time (start-up included). The environment may set SCENES
 # ("colorchecker painting metamer", folders of data/scenes), SIZES ("960x600 1920x1200"), PACING
 # ("paced"; "fast" adds --fast, which skips the waits between frames), FRAMES (150), RATE (30),
-# SKIP (20: frames left out at the start), RUN_TIMEOUT (600 s a run).
+# SKIP (20: frames left out at the start), RUN_TIMEOUT (600 s a run), MIN_RATE (unset: replica's
+# default steady cadence, which draws every n-th tick where frames overrun the period; RATE: every
+# tick, late ones skipped, as before the cadence: docs/appliance.md, "Steady cadence").
 # The scenes are REPLICA_DATA_DIR/scenes/S when it is set, else data/scenes/S (run it from the
 # repository's root). Exit 1 when any run failed (its row says so and its log's tail is printed).
 set -uo pipefail
 
 if [ $# -ne 2 ] || [ "$1" = "-h" ] || [ "$1" = "--help" ]; then
-    sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'
     exit 2
 fi
 replica="$1"
@@ -63,6 +65,7 @@ for size in $sizes; do
             args=(--log-level loop=debug run --hal sim --output headless --scene "$scene_arg"
                 --rate "$rate" --frames "$frames" --size "$size")
             [ "$p" = "fast" ] && args+=(--fast)
+            [ -n "${MIN_RATE:-}" ] && args+=(--min-rate "$MIN_RATE")
             echo "frame_table: $replica ${args[*]}" >&2
             start=$EPOCHREALTIME
             timeout "$run_timeout" "$replica" "${args[@]}" > "$log" 2>&1
