@@ -1,9 +1,31 @@
 // What 'replica run' and 'replica replay' report of the frames a loop ran.
+#include <string>
+#include <utility>
+#include <vector>
+
 #include <platform/cli/loop_summary.h>
 #include <platform/logging.h>
 #include <recordings/device_kind.h>
 
 namespace replica::platform {
+namespace {
+
+// The steady cadence's rates (platform/loop/cadence.h): each rate the loop drew frames at, as
+// the summary writes it ("30"), and how many, fastest first.
+std::vector<std::pair<std::string, std::uint64_t>> framesByRate(const LoopStats& stats,
+                                                                double periodMs)
+{
+    std::vector<std::pair<std::string, std::uint64_t>> rates;
+    for (std::size_t n = 1; n < stats.framesAtDivisor.size() && periodMs > 0.0; ++n) {
+        if (stats.framesAtDivisor[n] > 0) {
+            rates.emplace_back(fmt::format("{:.4g}", 1000.0 / periodMs / static_cast<double>(n)),
+                               stats.framesAtDivisor[n]);
+        }
+    }
+    return rates;
+}
+
+} // namespace
 
 nlohmann::json loopSummaryJson(const LoopStats& stats, double periodMs)
 {
@@ -14,11 +36,8 @@ nlohmann::json loopSummaryJson(const LoopStats& stats, double periodMs)
     j["skipped_ticks"] = stats.skippedTicks;
     // The steady cadence (platform/loop/cadence.h): the frames drawn at each rate it ran at.
     nlohmann::json atRate = nlohmann::json::object();
-    for (std::size_t n = 1; n < stats.framesAtDivisor.size(); ++n) {
-        if (stats.framesAtDivisor[n] > 0 && periodMs > 0.0) {
-            atRate[fmt::format("{:.4g}", 1000.0 / periodMs / static_cast<double>(n))] =
-                    stats.framesAtDivisor[n];
-        }
+    for (const auto& [rate, frames] : framesByRate(stats, periodMs)) {
+        atRate[rate] = frames;
     }
     j["cadence"] = {{"every_nth_tick", stats.divisor},
                     {"changes", stats.cadenceChanges},
@@ -70,12 +89,8 @@ void logLoopSummary(const LoopStats& stats, double periodMs, bool digests)
               stats.meanOverPeakFraction(), stats.maxOverPeakFraction);
     if (stats.cadenceChanges > 0) {
         std::string rates;
-        for (std::size_t n = 1; n < stats.framesAtDivisor.size(); ++n) {
-            if (stats.framesAtDivisor[n] > 0) {
-                rates += fmt::format("{}{} at {:.4g} Hz", rates.empty() ? "" : ", ",
-                                     stats.framesAtDivisor[n],
-                                     1000.0 / periodMs / static_cast<double>(n));
-            }
+        for (const auto& [rate, frames] : framesByRate(stats, periodMs)) {
+            rates += fmt::format("{}{} at {} Hz", rates.empty() ? "" : ", ", frames, rate);
         }
         log->info("cadence: frames {}; {} ticks passed over for an even cadence, {} changes, {} "
                   "frames longer than the cadence's period (platform/loop/cadence.h)",

@@ -147,15 +147,14 @@ public:
     Pacer(Pacing pacing, const LoopOptions& options)
         : pacing_(pacing), options_(options), stepping_(pacing == Pacing::Step),
           wallStart_(std::chrono::steady_clock::now()),
-          cadence_(options.periodNs,
-                   pacing == Pacing::Realtime && options.skipLateTicks ? options.maxDivisor : 1)
+          cadence_(options.periodNs, paced() ? options.maxDivisor : 1)
     {}
 
     // The next tick to draw, none at the end.
     std::optional<TickPlan> next(const TickSource& ticks, LoopStats& stats)
     {
         std::optional<TickPlan> tick = ticks();
-        if (!tick || pacing_ != Pacing::Realtime || !options_.skipLateTicks) {
+        if (!tick || !paced()) {
             return tick;
         }
         // The plan's last tick is rendered even when passed over or late: a fixed run ends on its
