@@ -80,12 +80,12 @@ echo "version: $out"
 # As shipped the kiosk refuses the synthetic display profile (until the panel's is set), and the
 # check, resolving what the kiosk resolves with the package's own data, says exactly that.
 out=$(env -u REPLICA_DATA_DIR "$root/usr/bin/replica" config check "$root/etc/replica/replica.toml" 2>&1)
-echo "$out" | grep -q "display.allow_synthetic: the kiosk refuses a live run" ||
+grep -q "display.allow_synthetic: the kiosk refuses a live run" <<<"$out" ||
     fail "the shipped site file: $out"
 [ "$(echo "$out" | grep -c "replica.toml:")" -eq 1 ] || fail "the shipped site file: $out"
 log=$(env -u REPLICA_DATA_DIR "$root/usr/bin/replica" run --frames 2 --fast 2>&1) ||
     fail "the unpacked binary cannot run: $log"
-echo "$log" | grep -q "data $root/usr/share/replica\$" ||
+grep -q "data $root/usr/share/replica\$" <<<"$log" ||
     fail "the unpacked binary did not use its own data: $(echo "$log" | grep data)"
 
 # The copyright file names the licence of the top-level LICENSE (Apache-2.0).
@@ -104,9 +104,9 @@ for page in replica replica-kiosk "${commands[@]/#/replica-}"; do
     if command -v man >/dev/null; then
         text=$(MANWIDTH=80 man --warnings -l "$file" 2>"$work/man.err") || fail "man -l $page.1.gz failed"
         [ ! -s "$work/man.err" ] || fail "man warns on $page(1): $(head -3 "$work/man.err")"
-        echo "$text" | grep -q "^NAME" || fail "$page(1) has no NAME section"
+        grep -q "^NAME" <<<"$text" || fail "$page(1) has no NAME section"
         echo "$text" | grep -A1 "^NAME" | grep -Eq "^ +$page +- " || fail "$page(1)'s NAME is not '$page - ...'"
-        echo "$text" | grep -Eq -- "^ +-" || fail "$page(1) lists no options"
+        grep -Eq -- "^ +-" <<<"$text" || fail "$page(1) lists no options"
     fi
     pages=$((pages + 1))
 done

@@ -18,7 +18,7 @@ fail() {
 out=$("$replica" config check "$shipped" 2>&1)
 status=$?
 [ $status -eq 1 ] || fail "the shipped site file: exit $status, expected 1 (the synthetic profile)"
-echo "$out" | grep -q "^$shipped:[0-9]*: display.allow_synthetic: the kiosk refuses a live run" ||
+grep -q "^$shipped:[0-9]*: display.allow_synthetic: the kiosk refuses a live run" <<<"$out" ||
     fail "the shipped site file: $out"
 sed 's/^allow_synthetic = false/allow_synthetic = true/' "$shipped" >"$work/allowed.toml"
 "$replica" config check "$work/allowed.toml" || fail "the shipped site file allowing it does not check"
@@ -45,7 +45,7 @@ out=$("$replica" config check "$bad" 2>&1)
 status=$?
 [ $status -eq 1 ] || fail "exit $status for a bad file, expected 1"
 expect() {
-    echo "$out" | grep -qF -- "$1" || fail "no line '$1' in:
+    grep -qF -- "$1" <<<"$out" || fail "no line '$1' in:
 $out"
 }
 expect "$bad:2: display.size: expected a string, got an integer"
@@ -61,7 +61,7 @@ expect "$bad: 9 problems"
 
 printf '[display]\nsize = "1920x"\n[scene\n' >"$work/syntax.toml"
 out=$("$replica" config check "$work/syntax.toml" 2>&1) && fail "a syntax error passed"
-echo "$out" | grep -q "^$work/syntax.toml:3: not valid TOML" || fail "syntax error: $out"
+grep -q "^$work/syntax.toml:3: not valid TOML" <<<"$out" || fail "syntax error: $out"
 out=$("$replica" config check "$work/missing.toml" 2>&1) && fail "a missing file passed"
 
 "$replica" run --config "$bad" --frames 1 --fast >/dev/null 2>&1
@@ -73,8 +73,8 @@ status=$?
 out=$("$replica" run --kiosk --config "$shipped" --output headless --frames 1 2>&1)
 status=$?
 [ $status -eq 78 ] || fail "kiosk on the synthetic profile: exit $status, expected 78"
-echo "$out" | grep -q "LIVE RUN ON A SYNTHETIC DISPLAY PROFILE" || fail "no loud warning: $out"
-echo "$out" | grep -q "allow_synthetic = true" || fail "the refusal does not say how: $out"
+grep -q "LIVE RUN ON A SYNTHETIC DISPLAY PROFILE" <<<"$out" || fail "no loud warning: $out"
+grep -q "allow_synthetic = true" <<<"$out" || fail "the refusal does not say how: $out"
 
 # A good file: hal sim from the file, the frame count from the command line, and the resolved
 # configuration (with the site's geometry) recorded in the session.

@@ -24,14 +24,14 @@ out=$("$replica" probe --config "$site" --tracker-wait 0.2 --iio-root "$work/no-
 rc=$?
 echo "$out"
 [ $rc -eq 1 ] || fail "exit $rc with no devices attached, expected 1"
-echo "$out" | grep -q '^probed as ' || fail "no 'probed as' line"
+grep -q '^probed as ' <<<"$out" || fail "no 'probed as' line"
 if [ "$(id -u)" -ne 0 ] || ! getent passwd replica >/dev/null; then
-    echo "$out" | grep -Eq "^probed as +(no user 'replica'|probing as .*not as the service's user 'replica')" ||
+    grep -Eq "^probed as +(no user 'replica'|probing as .*not as the service's user 'replica')" <<<"$out" ||
         fail "the probe does not say it runs as someone other than the service's user"
 fi
-echo "$out" | grep -q "udp 127.0.0.1:4299\|UDP port 4299" || fail "the tracker was not probed on the site's port 4299"
+grep -q "udp 127.0.0.1:4299\|UDP port 4299" <<<"$out" || fail "the tracker was not probed on the site's port 4299"
 expect() {
-    echo "$out" | grep -q -- "^kiosk *$1" || fail "no kiosk line '$1'"
+    grep -q -- "^kiosk *$1" <<<"$out" || fail "no kiosk line '$1'"
 }
 expect "spectrometer: missing: the kiosk starts without it, tries it again every second and meanwhile shows the lamp 'd65-fluorescent' (defaults.lamp)"
 expect "tracker: missing: .*the view from defaults.eye_m"
@@ -53,7 +53,7 @@ PY
 # hal = "sim": the kiosk opens no sensor.
 sed -e 's|^hal = .*|hal = "sim"|' "$site" >"$work/sim.toml"
 sim=$("$replica" probe --config "$work/sim.toml" --tracker-wait 0.2 --iio-root "$work/no-iio" 2>/dev/null)
-echo "$sim" | grep -q '^kiosk *hal = "sim": the kiosk opens no sensor' || fail "hal = sim: no 'opens no sensor' line"
+grep -q '^kiosk *hal = "sim": the kiosk opens no sensor' <<<"$sim" || fail "hal = sim: no 'opens no sensor' line"
 
 # A missing site file: refused by name.
 if "$replica" probe --config "$work/absent.toml" >/dev/null 2>"$work/err"; then

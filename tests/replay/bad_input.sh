@@ -20,7 +20,7 @@ for cmd in replay inspect; do
         elif [ "$lines" -ne 1 ]; then
             echo "FAIL: replica $cmd $f printed $lines lines, expected one: $err" >&2
             status=1
-        elif ! printf '%s' "$err" | grep -q "$(basename "$f")"; then
+        elif ! grep -q "$(basename "$f")" <<<"$err"; then
             echo "FAIL: replica $cmd $f did not name the file: $err" >&2
             status=1
         else

@@ -49,7 +49,7 @@ expect() {
         fail "replica $* exited $got, expected $code: $err"
     elif [ "$lines" -ne 1 ]; then
         fail "replica $* printed $lines lines, expected one: $err"
-    elif ! printf '%s' "$err" | grep -qE -- "$pattern"; then
+    elif ! grep -qE -- "$pattern" <<<"$err"; then
         fail "replica $* did not say /$pattern/: $err"
     else
         pass=$((pass + 1))
@@ -287,7 +287,7 @@ bounded() {
         fail "replica $* exited $got, expected $code: $err"
     elif [ "$lines" -ne 1 ]; then
         fail "replica $* printed $lines lines, expected one: $err"
-    elif ! printf '%s' "$err" | grep -qE -- "$pattern"; then
+    elif ! grep -qE -- "$pattern" <<<"$err"; then
         fail "replica $* did not say /$pattern/: $err"
     elif [ "$limit_kb" != unlimited ] && [ -n "$kb" ] && [ "$kb" -gt $((max_mb * 1024)) ]; then
         fail "replica $* peaked at $kb KB, more than $max_mb MB"
@@ -350,7 +350,7 @@ for scale in 1e308 0; do
     want="249 accelerometer samples came out not finite.*accelerometer 'accelerometer \(simulated\) SIM-ACCEL-0001' sample 0: raw [^ ]+, scale $shown,"
     if [ $got -ne 0 ]; then
         fail "replay --reprocess with an accelerometer scale of $scale: exit $got: $out"
-    elif ! printf '%s' "$out" | grep -qE -- "$want"; then
+    elif ! grep -qE -- "$want" <<<"$out"; then
         fail "replay --reprocess with an accelerometer scale of $scale did not say /$want/: $out"
     else
         pass=$((pass + 1))
@@ -489,9 +489,9 @@ expect 1 "16384x16384 pixels; at most 16384 per side and 16777216 in all" -- "${
 
 # replay shows a recording's text with its control characters escaped, as inspect does.
 out=$("$replica" --log-level info replay "$rec/escapes.mcap" 2>&1)
-if printf '%s' "$out" | grep -q $'\x1b'; then
+if grep -q $'\x1b' <<<"$out"; then
     fail "replay printed a raw escape sequence from a recording"
-elif ! printf '%s' "$out" | grep -qF 'recorded by \x1b]0;owned\x07'; then
+elif ! grep -qF 'recorded by \x1b]0;owned\x07' <<<"$out"; then
     fail "replay did not show the escaped software string: $out"
 else
     pass=$((pass + 1))
@@ -500,9 +500,9 @@ fi
 
 # inspect shows a recording's text with its control characters escaped.
 out=$("$replica" inspect "$rec/escapes.mcap" 2>&1)
-if printf '%s' "$out" | grep -q $'\x1b'; then
+if grep -q $'\x1b' <<<"$out"; then
     fail "inspect printed a raw escape sequence from a recording"
-elif ! printf '%s' "$out" | grep -qF 'written by \x1b]0;owned\x07'; then
+elif ! grep -qF 'written by \x1b]0;owned\x07' <<<"$out"; then
     fail "inspect did not show the escaped software string: $out"
 else
     pass=$((pass + 1))

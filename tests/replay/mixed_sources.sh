@@ -42,7 +42,7 @@ expect() {
     err=$("$replica" run --output headless --size 32x20 --frames 1 "$@" 2>&1 >/dev/null)
     code=$?
     set -e
-    if [ "$code" -ne "$want" ] || ! printf '%s' "$err" | grep -q -- "$text"; then
+    if [ "$code" -ne "$want" ] || ! grep -q -- "$text" <<<"$err"; then
         echo "FAIL: replica run $* -> exit $code (want $want), '$err' (want '$text')" >&2
         exit 1
     fi
