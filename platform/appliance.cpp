@@ -40,6 +40,7 @@ pipeline::shading::RenderSettings boothRenderSettings(const RunConfig& config)
     s.horizonDirections = config.horizonDirections;
     s.areaLights = config.areaLights != 0;
     s.cacheSlices = config.cacheSlices;
+    s.tiltNodesRad = config.tiltNodesDeg * std::numbers::pi / 180.0;
     // The display pass subtracts the screen's flare when asked to (issue 6): then pass 1 must not.
     s.subtractFlare = !config.flareSubtraction;
     return s;
@@ -379,6 +380,7 @@ makeStateStage(const RunConfig& config,
     // The re-encode decision and the diffuse term's sliced refresh are state.
     setup.light.adaptive = encoding.adaptive;
     setup.tilt.cacheSlices = config.cacheSlices;
+    setup.tilt.tiltNodesRad = config.tiltNodesDeg * std::numbers::pi / 180.0;
     setup.eye.trackerInBooth = config.trackerInBooth;
     setup.eye.defaultEyeM = config.defaultEyeM;
     setup.tilt.defaultTiltRad = config.defaultTiltRad;

@@ -40,6 +40,10 @@ constexpr int kAutoAreaLights = -1;
 // configuration may ask for.
 constexpr int kDefaultCacheSlices = 3;
 constexpr int kMaxCacheSlices = 16;
+// RunConfig::tiltNodesDeg for new runs (docs/rendering.md, "Tilt nodes", measures the choice),
+// and the most a recording may ask for.
+constexpr double kDefaultTiltNodesDeg = 2.0;
+constexpr double kMaxTiltNodesDeg = 10.0;
 // Frame sizes a run takes and a recording may hold: each side 1..8192 pixels and at most 16:1
 // (a 16384x1 "frame" is no display).
 constexpr int kMaxFrameSide = 8192;
@@ -125,6 +129,10 @@ struct RunConfig {
     // bands over as many frames. Recordings made before it have none and replay with 1 (whole at
     // once), frame for frame.
     int cacheSlices = kDefaultCacheSlices;
+    // shading::RenderSettings::tiltNodesRad, in degrees: the diffuse term cached at tilt nodes
+    // this far apart and interpolated between them (0: the held tilt's term alone). Recordings
+    // made before it have none and replay with 0, frame for frame.
+    double tiltNodesDeg = kDefaultTiltNodesDeg;
     // The planner in the loop (platform/render_plan.h). planner asks buildAppliance for the
     // cached plan of the scene (computed once when missing; plannerCache empty: the default cache
     // folder); the per-lamp choice it takes is recorded as plannedLamps ("planned_lamps"), and a

@@ -64,6 +64,7 @@ std::string RunConfig::toJson() const
                      {"booth_dimmer", boothDimmer},
                      {"booth_dimmer_auto", boothDimmerAuto || boothDimmerChosenAuto},
                      {"cache_slices", cacheSlices},
+                     {"tilt_nodes_deg", tiltNodesDeg},
                      {"error_probe_s", errorProbeS},
                      {"render_profile", renderProfile},
                      {"horizon_directions", horizonDirections},
@@ -159,6 +160,8 @@ void readRendering(const nlohmann::json& j, RunConfig& c)
     c.boothDimmer = j.value("booth_dimmer", c.boothDimmer);
     c.boothDimmerChosenAuto = j.value("booth_dimmer_auto", false);
     c.cacheSlices = j.value("cache_slices", c.cacheSlices);
+    // Absent in recordings made before tilt nodes: the held tilt's term, as they were drawn.
+    c.tiltNodesDeg = j.value("tilt_nodes_deg", 0.0);
     c.errorProbeS = j.value("error_probe_s", c.errorProbeS);
     c.renderProfile = j.value("render_profile", 0);
     c.horizonDirections = j.value("horizon_directions", c.horizonDirections);
@@ -266,14 +269,16 @@ Expected<void> checkRanges(const RunConfig& c)
         c.specularSamples > 256 || c.horizonDirections < 0 || c.horizonDirections > 32 ||
         c.specularGrid < kAutoSpecularGrid || c.specularGrid > 256 ||
         c.diffuseGrid < kAutoDiffuseGrid || c.diffuseGrid > 256 || c.cacheSlices < 1 ||
-        c.cacheSlices > kMaxCacheSlices || c.areaLights < kAutoAreaLights || c.areaLights > 1 ||
+        c.cacheSlices > kMaxCacheSlices || !(c.tiltNodesDeg >= 0.0) ||
+        c.tiltNodesDeg > kMaxTiltNodesDeg || c.areaLights < kAutoAreaLights || c.areaLights > 1 ||
         !(c.boothDimmer > 0.0) || c.boothDimmer > 1.0 || !(c.directCdM2PerY >= 0.0) ||
         c.directCdM2PerY > 1e12) {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("run configuration: size {}x{} (each side 1-{}, at most "
                                      "{}:1), rate {} Hz (1-1000), display peak/black, specular "
                                      "samples, specular or diffuse grid, horizon directions, "
-                                     "cache slices, area lights, booth dimmer (0 to 1) or "
+                                     "cache slices, tilt nodes (0 to 10 degrees), area lights, "
+                                     "booth dimmer (0 to 1) or "
                                      "direct_cdm2_per_y out of range",
                                      c.width, c.height, kMaxFrameSide, kMaxFrameAspect, c.rateHz));
     }

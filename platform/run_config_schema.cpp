@@ -105,6 +105,7 @@ const JsonSchema& runConfigSchema()
                 {"diffuse_grid", integer(kAutoDiffuseGrid, 256).optional()},
                 {"area_lights", integer(kAutoAreaLights, 1).optional()},
                 {"cache_slices", integer(1, kMaxCacheSlices).optional()},
+                {"tilt_nodes_deg", number(0.0, kMaxTiltNodesDeg).optional()},
                 // Seconds between the running appliance's error probes (not replayed).
                 {"error_probe_s", number(0.0, 3600.0).optional()},
                 // A luminance scale on the booth's lights (0 excluded by fromJson).

@@ -39,12 +39,12 @@ double TiltEstimator::windowMean() const
     return count_ > 0 ? sum / static_cast<double>(count_) : held_;
 }
 
-double TiltEstimator::refreshTarget() const
+std::optional<double> TiltEstimator::trendSlope() const
 {
     // The least-squares slope of the trend's tilts against their frame numbers (0, 1, ...).
     const std::size_t n = trendCount_;
     if (n < trend_.size()) {
-        return held_; // too few tilts since the start for a slope its noise allows
+        return std::nullopt; // too few tilts since the start for a slope its noise allows
     }
     const double meanX = static_cast<double>(n - 1) / 2.0;
     double meanY = 0.0;
@@ -59,12 +59,27 @@ double TiltEstimator::refreshTarget() const
         sxy += dx * (trend_[i] - meanY);
         sxx += dx * dx;
     }
-    // sxx > 0: n >= 2 distinct frame numbers.
-    const double ahead = (sxy / sxx) * (3.0 * setup_.cacheSlices - 3.0) / 2.0;
+    return sxy / sxx; // sxx > 0: n >= 2 distinct frame numbers
+}
+
+double TiltEstimator::refreshTarget() const
+{
+    const double ahead = trendSlope().value_or(0.0) * (3.0 * setup_.cacheSlices - 3.0) / 2.0;
     if (!(std::abs(ahead) > kTiltMotionRad)) {
         return held_;
     }
     return held_ + std::clamp(ahead, -kDiffuseMaxLagRad, kDiffuseMaxLagRad);
+}
+
+int TiltEstimator::nodeDirection() const
+{
+    // Motion: the trend's travel over its own frames past the motion threshold (its noise is
+    // 0.17 degrees there, so a still panel seldom prefetches, and then a node it keeps).
+    const double travel = trendSlope().value_or(0.0) * static_cast<double>(kTiltTrend);
+    if (!(std::abs(travel) > kTiltMotionRad)) {
+        return 0;
+    }
+    return travel > 0.0 ? 1 : -1;
 }
 
 void TiltEstimator::write(pipeline::scene::SceneState& state)
@@ -94,15 +109,23 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
             heldValid_ = true;
         }
     }
-    // The diffuse term's tilt: one frame of the cache's refresh schedule, and what the frame
-    // draws of it (the band of a refresh under way).
-    const auto last = diffuse_;
-    diffuse_ = pipeline::scene::nextDiffuse(diffuse_, held_, state.lightChanged, setup_.cacheSlices,
-                                            kDiffuseMaxLagRad, refreshTarget());
     // The specular term follows the sensed tilt (a highlight moves twice as fast as the panel); a
     // non-finite one (set from elsewhere: sense()) shows the held tilt.
     state.tiltRad = std::isfinite(tilt_) ? tilt_ : held_;
     state.heldTiltRad = held_;
+    // The diffuse term's tilt: one frame of the cache's refresh schedule, and what the frame
+    // draws of it (the band of a refresh under way; with tilt nodes, the two it interpolates).
+    if (setup_.tiltNodesRad > 0.0) {
+        auto step = pipeline::scene::nextDiffuseNodes(nodes_, held_, state.lightChanged,
+                                                      setup_.cacheSlices, setup_.tiltNodesRad,
+                                                      kDiffuseMaxLagRad, nodeDirection());
+        nodes_ = std::move(step.nodes);
+        state.diffuse = step.draw;
+        return;
+    }
+    const auto last = diffuse_;
+    diffuse_ = pipeline::scene::nextDiffuse(diffuse_, held_, state.lightChanged, setup_.cacheSlices,
+                                            kDiffuseMaxLagRad, refreshTarget());
     state.diffuse =
             pipeline::scene::diffuseDraw(last, *diffuse_, state.lightChanged, setup_.cacheSlices);
 }
@@ -122,7 +145,10 @@ nlohmann::json TiltEstimator::save() const
              std::vector<double>(trend_.begin(), trend_.begin() + static_cast<long>(trendCount_))},
             {"shown_rad", diffuse_ ? nlohmann::json(diffuse_->shownRad) : nlohmann::json()},
             {"refresh_rad", optionalJson(diffuse_ ? diffuse_->refreshRad : std::nullopt)},
-            {"refresh_bands", diffuse_ ? diffuse_->refreshBands : 0}};
+            {"refresh_bands", diffuse_ ? diffuse_->refreshBands : 0},
+            {"nodes", nodes_ ? nlohmann::json(nodes_->nodes) : nlohmann::json()},
+            {"node_refresh_rad", optionalJson(nodes_ ? nodes_->refreshRad : std::nullopt)},
+            {"node_refresh_bands", nodes_ ? nodes_->refreshBands : 0}};
 }
 
 Expected<void> TiltEstimator::restore(const nlohmann::json& j)
@@ -174,6 +200,30 @@ Expected<void> TiltEstimator::restore(const nlohmann::json& j)
         } else {
             d.shownRad = finiteFromJson(shown);
             diffuse_ = d;
+        }
+        // Absent in states saved before tilt nodes, and null before the first frame.
+        nodes_.reset();
+        if (j.contains("nodes") && !j.at("nodes").is_null()) {
+            const auto& nodes = j.at("nodes");
+            pipeline::scene::DiffuseNodes n;
+            if (!nodes.is_array() || nodes.size() > pipeline::scene::kMaxDiffuseNodes) {
+                throw std::out_of_range(fmt::format("the diffuse term has at most {} tilt nodes",
+                                                    pipeline::scene::kMaxDiffuseNodes));
+            }
+            for (const auto& v : nodes) {
+                n.nodes.push_back(finiteFromJson(v));
+            }
+            const auto nodeRefresh = j.at("node_refresh_rad");
+            n.refreshRad = nodeRefresh.is_null()
+                                   ? std::nullopt
+                                   : std::optional<double>(finiteFromJson(nodeRefresh));
+            n.refreshBands = j.at("node_refresh_bands").get<int>();
+            if (n.refreshBands < 0 || n.refreshBands >= setup_.cacheSlices ||
+                (!n.refreshRad && n.refreshBands != 0)) {
+                throw std::out_of_range(fmt::format("{} bands drawn of a tilt node in {}",
+                                                    n.refreshBands, setup_.cacheSlices));
+            }
+            nodes_ = std::move(n);
         }
     } catch (const std::exception& e) {
         return makeError(ErrorCode::InvalidArgument, fmt::format("tilt: {}", e.what()));

@@ -55,6 +55,9 @@ struct TiltEstimatorSetup {
     double defaultTiltRad = 0.0; // shown until the first usable sample
     // RenderSettings::cacheSlices: a new held tilt is drawn in this many bands, one a frame.
     int cacheSlices = 1;
+    // RenderSettings::tiltNodesRad: above 0, the diffuse term is cached at tilt nodes this far
+    // apart and interpolated (scene::nextDiffuseNodes); 0, the sliced refresh of the held tilt.
+    double tiltNodesRad = 0.0;
 };
 
 class TiltEstimator
@@ -97,10 +100,16 @@ private:
     // The diffuse term of the last frame (none before the first):
     // pipeline/scene/diffuse_schedule.h.
     std::optional<pipeline::scene::DiffuseTilt> diffuse_;
+    // With tilt nodes, what the cache holds instead (none before the first frame).
+    std::optional<pipeline::scene::DiffuseNodes> nodes_;
 
     double windowMean() const;
+    // The sensed tilts' trend, radians a frame (none until kTiltTrend of them).
+    std::optional<double> trendSlope() const;
     // Where a refresh started this frame aims: the held tilt, or ahead of it on a moving panel.
     double refreshTarget() const;
+    // With tilt nodes: the way the panel moves (-1, 0 still, +1), where the next node is drawn.
+    int nodeDirection() const;
 };
 
 } // namespace replica::state

@@ -2,17 +2,50 @@
 #include <algorithm>
 #include <array>
 
+#include <glm/geometric.hpp>
+
 #include <pipeline/render/booth_diffuse_cache.h>
+#include <pipeline/render/gl_program.h>
 
 namespace replica::pipeline::render {
 
+namespace {
+
+// The tilt nodes' interpolation: (1 - uMix) a + uMix b, texel for texel.
+constexpr const char* kMixShader = R"(#version 310 es
+precision highp float;
+uniform highp sampler2D uA;
+uniform highp sampler2D uB;
+uniform float uMix;
+layout(location = 0) out vec4 outXyz;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    outXyz = mix(texelFetch(uA, p, 0), texelFetch(uB, p, 0), uMix);
+}
+)";
+
+} // namespace
+
 Expected<void> BoothDiffuseCache::init(int slices,
+                                       bool nodes,
                                        bool facetCache,
                                        shading::GridNodes diffuseGrid,
                                        const BoothPrograms& programs)
 {
     slices_ = std::max(slices, 1);
+    nodes_ = nodes;
     facetCache_ = facetCache;
+    if (nodes_) {
+        auto program = linkProgram(kFullscreenVertexShader, kMixShader, "tilt-node interpolation");
+        if (!program) {
+            return tl::unexpected(program.error());
+        }
+        mixProgram_ = std::move(*program);
+        const GLuint p = mixProgram_.get();
+        glProgramUniform1i(p, glGetUniformLocation(p, "uA"), kUnitCache);
+        glProgramUniform1i(p, glGetUniformLocation(p, "uB"), kUnitCacheMix);
+        mixLocation_ = glGetUniformLocation(p, "uMix");
+    }
     diffuseNodes_ = diffuseGrid;
     if (diffuseNodes_.x > 0) {
         if (auto ok = booth_upload::nodeTarget(diffuseNodes_, kUnitDiffGrid, "diffuse",
@@ -35,47 +68,64 @@ void BoothDiffuseCache::setSurroundIlluminance(bool on)
 
 Expected<void> BoothDiffuseCache::ensureTarget(int width, int height)
 {
-    if (buffers_[0].texture && width_ == width && height_ == height) {
+    const Buffer& first = nodes_ ? slots_[0].buffer : buffers_[0];
+    if (first.texture && width_ == width && height_ == height) {
         return {};
     }
     for (Buffer& c : buffers_) {
         c = Buffer{}; // a new texture holds nothing yet
     }
+    for (Slot& s : slots_) {
+        s = Slot{};
+    }
+    mixed_ = Buffer{};
+    frontBuffer_ = nullptr;
     facetTexture_.reset();
     shown_ = 0;
     invalidate();
+    width_ = width;
+    height_ = height;
     glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
     if (facetCache_) {
         facetTexture_ = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
     }
     // The back buffer only where refreshes are sliced: 9 MB at 960x600 that nothing else reads.
-    const int buffers = slices_ > 1 ? 2 : 1;
+    // With tilt nodes the slots' buffers are made as they are first used, and the first holds
+    // the first frame's term.
+    const int buffers = nodes_ ? 0 : (slices_ > 1 ? 2 : 1);
     bool complete = true;
     for (int b = 0; b < buffers; ++b) {
-        Buffer& c = buffers_[static_cast<std::size_t>(b)];
-        c.texture = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width, height, nullptr);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        c.fbo = GlFramebuffer::make();
-        glBindFramebuffer(GL_FRAMEBUFFER, c.fbo.get());
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, c.texture.get(),
-                               0);
-        if (facetCache_) {
-            // Mode 0 writes the facet normal beside the cached terms; the blit reads attachment 0.
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D,
-                                   facetTexture_.get(), 0);
-            const std::array<GLenum, 2> attachments{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-            glDrawBuffers(2, attachments.data());
-            glReadBuffer(GL_COLOR_ATTACHMENT0);
-        }
-        complete = complete && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+        complete = makeBuffer(buffers_[static_cast<std::size_t>(b)], facetCache_) && complete;
     }
-    width_ = width;
-    height_ = height;
+    if (nodes_) {
+        complete = makeBuffer(slots_[0].buffer, facetCache_) && complete;
+    }
     if (!complete) {
         return makeError(ErrorCode::Unsupported,
                          "render: the booth pass's RGBA32F cache is not renderable on this GL");
     }
     return booth_upload::glCheck("creating the booth pass's cache");
+}
+
+bool BoothDiffuseCache::makeBuffer(Buffer& c, bool facet)
+{
+    glActiveTexture(GL_TEXTURE0 + kUnitCache); // texture2d binds it: not over another input
+    c.texture = texture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, width_, height_, nullptr);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE0);
+    c.fbo = GlFramebuffer::make();
+    c.zeroAround.reset();
+    glBindFramebuffer(GL_FRAMEBUFFER, c.fbo.get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, c.texture.get(), 0);
+    if (facet) {
+        // Mode 0 writes the facet normal beside the cached terms; the blit reads attachment 0.
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D,
+                               facetTexture_.get(), 0);
+        const std::array<GLenum, 2> attachments{GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        glDrawBuffers(2, attachments.data());
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+    }
+    return glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
 }
 
 void BoothDiffuseCache::update(const BoothPrograms& programs,
@@ -85,6 +135,10 @@ void BoothDiffuseCache::update(const BoothPrograms& programs,
                                int width,
                                int height)
 {
+    if (nodes_) {
+        updateNodes(programs, want, layout, rect);
+        return;
+    }
     const Key shown = keyOf(want.shown, layout, width, height);
     if (!want.band) {
         if (front_ != shown) {
@@ -123,7 +177,8 @@ void BoothDiffuseCache::drawWhole(const BoothPrograms& programs,
     // A refresh's bands in the other buffer were drawn with the diffuse grid of its tilt, which
     // this draw replaces: they are of no use any more.
     back_.reset();
-    drawSlice(programs, shown_, pose, {0, 1, rect, interiorOf(key), key.width, key.height});
+    drawSlice(programs, buffers_[static_cast<std::size_t>(shown_)], pose,
+              {0, 1, rect, interiorOf(key), key.width, key.height});
     front_ = key;
     ++refreshes_;
 }
@@ -134,7 +189,7 @@ void BoothDiffuseCache::drawBand(const BoothPrograms& programs,
                                  const PixelRect& rect)
 {
     const int back = 1 - shown_;
-    drawSlice(programs, back, band.toward,
+    drawSlice(programs, buffers_[static_cast<std::size_t>(back)], band.toward,
               {band.band, band.bands, rect, interiorOf(key), key.width, key.height});
     back_ = Partial{key, band.band + 1};
     if (band.band + 1 == band.bands) {
@@ -147,7 +202,7 @@ void BoothDiffuseCache::drawBand(const BoothPrograms& programs,
 }
 
 void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
-                                  int buffer,
+                                  Buffer& c,
                                   const shading::PanelPose& pose,
                                   const Band& band)
 {
@@ -156,7 +211,6 @@ void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
     const PixelRect& rect = band.rect;
     const int width = band.width;
     const int height = band.height;
-    Buffer& c = buffers_[static_cast<std::size_t>(buffer)];
     if (slice == 0 && diffuseNodes_.x > 0) {
         // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface (it stays
         // for the refresh's later bands: nothing else draws into it).
@@ -235,6 +289,153 @@ void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
         glBindTexture(GL_TEXTURE_2D, 0); // not sampled while mode 3 draws into it
         glActiveTexture(GL_TEXTURE0);
     }
+}
+
+BoothDiffuseCache::Slot* BoothDiffuseCache::findSlot(const Key& key)
+{
+    for (Slot& s : slots_) {
+        if (s.key && *s.key == key) {
+            return &s;
+        }
+    }
+    return nullptr;
+}
+
+BoothDiffuseCache::Slot& BoothDiffuseCache::freeSlot(const shading::Vec3& normal)
+{
+    // An empty slot, else the one whose pose is farthest from the frame's (the state stage
+    // forgets the node farthest from the held tilt: scene::nextDiffuseNodes).
+    Slot* pick = nullptr;
+    double farthest = 2.0;
+    for (Slot& s : slots_) {
+        if (!s.key) {
+            pick = &s;
+            break;
+        }
+        const double facing = glm::dot(s.key->normal, normal);
+        if (s.used != updates_ && (pick == nullptr || facing < farthest)) {
+            pick = &s;
+            farthest = facing;
+        }
+    }
+    // A frame names at most three poses (shown, mixed with, drawn in bands), so of kNodeSlots
+    // one is always free or unused this update.
+    if (!pick->buffer.texture) {
+        makeBuffer(pick->buffer, facetCache_);
+    }
+    pick->key.reset();
+    pick->bands = 0;
+    return *pick;
+}
+
+void BoothDiffuseCache::drawNodeWhole(const BoothPrograms& programs,
+                                      Slot& slot,
+                                      const Key& key,
+                                      const shading::PanelPose& pose,
+                                      const PixelRect& rect)
+{
+    drawSlice(programs, slot.buffer, pose, {0, 1, rect, interiorOf(key), key.width, key.height});
+    slot.key = key;
+    slot.bands = slot.slices = 1;
+    slot.used = updates_;
+    ++refreshes_;
+    if (diffuseNodes_.x > 0) {
+        // The diffuse grid now holds this pose's: a refresh's bands drawn with another's are
+        // of no use (the next band asked for draws them again).
+        for (Slot& s : slots_) {
+            if (s.key && s.bands < s.slices) {
+                s.key.reset();
+            }
+        }
+    }
+}
+
+void BoothDiffuseCache::updateNodes(const BoothPrograms& programs,
+                                    const CacheWant& want,
+                                    const SurfaceLayout& layout,
+                                    const PixelRect& rect)
+{
+    ++updates_;
+    const auto whole = [](const Slot* s) { return s != nullptr && s->bands == s->slices; };
+    const auto held = [&](const shading::PanelPose& pose) -> Slot& {
+        const Key key = keyOf(pose, layout, width_, height_);
+        Slot* s = findSlot(key);
+        if (whole(s)) {
+            s->used = updates_;
+            return *s;
+        }
+        if (s != nullptr) {
+            s->key.reset(); // part of a refresh: drawn whole instead
+        }
+        Slot& slot = freeSlot(want.shown.normal);
+        drawNodeWhole(programs, slot, key, pose, rect);
+        return slot;
+    };
+    // The band of a node drawn in bands. A last band goes first, since the frame may show the
+    // node it completes; another after the terms shown, since a term drawn whole where a
+    // diffuse grid is drawn forgets the bands drawn with another pose's grid.
+    const auto drawBand = [&] {
+        if (!want.band) {
+            return;
+        }
+        const CacheBand& band = *want.band;
+        const Key toward = keyOf(band.toward, layout, width_, height_);
+        Slot* t = findSlot(toward);
+        if (t == nullptr || (!whole(t) && (t->slices != band.bands || t->bands != band.band))) {
+            // Not held, or not the bands before this one (a fresh cache, frame N drawn alone):
+            // those bands first. Band by band, the pixels a whole draw makes.
+            t = t != nullptr ? t : &freeSlot(want.shown.normal);
+            t->key = toward;
+            t->slices = band.bands;
+            for (int b = 0; b < band.band; ++b) {
+                drawSlice(programs, t->buffer, band.toward,
+                          {b, band.bands, rect, interiorOf(toward), width_, height_});
+            }
+            t->bands = band.band;
+        }
+        if (!whole(t)) {
+            drawSlice(programs, t->buffer, band.toward,
+                      {band.band, band.bands, rect, interiorOf(toward), width_, height_});
+            if (++t->bands == t->slices) {
+                ++refreshes_;
+            }
+        }
+        t->used = updates_;
+    };
+    const bool lastBand = want.band && want.band->band + 1 >= want.band->bands;
+    if (lastBand) {
+        drawBand();
+    }
+    Slot& a = held(want.shown);
+    Slot* const b = want.mixWith && want.mix > 0.0 ? &held(*want.mixWith) : nullptr;
+    if (!lastBand) {
+        drawBand();
+    }
+    if (b == nullptr) {
+        frontBuffer_ = &a.buffer;
+        return;
+    }
+    const MixKey mk{*a.key, *b->key, static_cast<float>(want.mix)};
+    if (!mixedFor_ || !(*mixedFor_ == mk)) {
+        if (!mixed_.texture) {
+            makeBuffer(mixed_, false);
+        }
+        // Every pixel: around the surface the interpolated E_geo (the surround's light) as well.
+        glBindFramebuffer(GL_FRAMEBUFFER, mixed_.fbo.get());
+        glUseProgram(mixProgram_.get());
+        glUniform1f(mixLocation_, mk.mix);
+        glActiveTexture(GL_TEXTURE0 + kUnitCache);
+        glBindTexture(GL_TEXTURE_2D, a.buffer.texture.get());
+        glActiveTexture(GL_TEXTURE0 + kUnitCacheMix);
+        glBindTexture(GL_TEXTURE_2D, b->buffer.texture.get());
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE0 + kUnitCache);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE0);
+        mixedFor_ = mk;
+    }
+    frontBuffer_ = &mixed_;
 }
 
 } // namespace replica::pipeline::render

@@ -6,6 +6,7 @@
 // which band a frame draws (pipeline/scene/diffuse_schedule.h).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <optional>
 
@@ -29,17 +30,24 @@ struct CacheBand {
     int band = 0;
     int bands = 1;
 };
+// With tilt nodes (init's 'nodes') the term composed is (1 - mix) times the term at 'shown' plus
+// mix times the term at 'mixWith' (scene::DiffuseDraw); 'band' then draws a node.
 struct CacheWant {
     shading::PanelPose shown;
     std::optional<CacheBand> band;
+    std::optional<shading::PanelPose> mixWith{};
+    double mix = 0.0;
 };
 
 class BoothDiffuseCache
 {
 public:
-    // 'slices' (settings.cacheSlices): bands a pose change is redrawn in; 'facetCache': keep the
-    // facet normals; 'diffuseGrid': the diffuse grid's nodes (none: per pixel).
+    // 'slices' (settings.cacheSlices): bands a pose change is redrawn in; 'nodes'
+    // (settings.tiltNodesRad > 0): keep the terms of several poses and compose two of them
+    // interpolated, as CacheWant names; 'facetCache': keep the facet normals; 'diffuseGrid': the
+    // diffuse grid's nodes (none: per pixel).
     Expected<void> init(int slices,
+                        bool nodes,
                         bool facetCache,
                         shading::GridNodes diffuseGrid,
                         const BoothPrograms& programs);
@@ -63,6 +71,10 @@ public:
     {
         front_.reset();
         back_.reset();
+        for (Slot& s : slots_) {
+            s.key.reset();
+        }
+        mixedFor_.reset();
     }
     // BoothShadingPass::setSurroundIlluminance.
     void setSurroundIlluminance(bool on);
@@ -70,12 +82,24 @@ public:
     long refreshes() const { return refreshes_; }
     // Whether a sliced refresh is under way (some of its bands drawn, the frame composed from the
     // other buffer).
-    bool refreshPending() const { return back_.has_value(); }
+    bool refreshPending() const
+    {
+        return back_.has_value() || std::any_of(slots_.begin(), slots_.end(), [](const Slot& s) {
+                   return s.key && s.bands < s.slices;
+               });
+    }
+    // With tilt nodes: the poses' terms held whole (at most kNodeSlots).
+    int nodesHeld() const
+    {
+        return static_cast<int>(std::count_if(slots_.begin(), slots_.end(), [](const Slot& s) {
+            return s.key && s.bands == s.slices;
+        }));
+    }
 
     // The complete cache the frame composes from: its framebuffer and texture, and the facet
     // normals (0 without).
-    GLuint frontFramebuffer() const { return buffers_[static_cast<std::size_t>(shown_)].fbo.get(); }
-    GLuint frontTexture() const { return buffers_[static_cast<std::size_t>(shown_)].texture.get(); }
+    GLuint frontFramebuffer() const { return front().fbo.get(); }
+    GLuint frontTexture() const { return front().texture.get(); }
     GLuint facetTexture() const { return facetTexture_.get(); }
 
 private:
@@ -100,6 +124,47 @@ private:
         Key key;
         int bands = 0;
     };
+    // With tilt nodes: a buffer holding a pose's term, whole (bands == slices) or the first
+    // 'bands' of its 'slices', and the update it was last used in.
+    struct Slot {
+        Buffer buffer;
+        std::optional<Key> key;
+        int bands = 0;
+        int slices = 1;
+        long used = 0;
+    };
+    // The nodes the state stage keeps (scene::kMaxDiffuseNodes), the one drawn in bands, and a
+    // spare: where the two forget different nodes, the one forgotten here can be one kept there.
+    static constexpr std::size_t kNodeSlots = 6;
+    // What the interpolated buffer holds.
+    struct MixKey {
+        Key a, b;
+        float mix = 0.0f;
+        bool operator==(const MixKey&) const = default;
+    };
+    const Buffer& front() const
+    {
+        return frontBuffer_ != nullptr ? *frontBuffer_ : buffers_[static_cast<std::size_t>(shown_)];
+    }
+    // The buffer's texture and framebuffer, width_ x height_ (the facet texture beside it).
+    bool makeBuffer(Buffer& c, bool facet);
+    // CacheWant with tilt nodes (update()).
+    void updateNodes(const BoothPrograms& programs,
+                     const CacheWant& want,
+                     const SurfaceLayout& layout,
+                     const PixelRect& rect);
+    // The node slot for 'key' (whole or not), or none.
+    Slot* findSlot(const Key& key);
+    // A slot for a new key: an empty one, else the one whose normal is farthest from 'normal'
+    // (the frame's), never one used in this update; its buffer made on first use.
+    Slot& freeSlot(const shading::Vec3& normal);
+    // The term at 'pose' whole into 'slot' (the refreshes' bands elsewhere forgotten where a
+    // diffuse grid is drawn: they were drawn with another pose's).
+    void drawNodeWhole(const BoothPrograms& programs,
+                       Slot& slot,
+                       const Key& key,
+                       const shading::PanelPose& pose,
+                       const PixelRect& rect);
     Key keyOf(const shading::PanelPose& pose, const SurfaceLayout& layout, int w, int h) const
     {
         return {pose.centre, pose.right, pose.up, pose.normal, w, h, layout.offset, layout.scale};
@@ -130,11 +195,12 @@ private:
                   const PixelRect& rect);
     // Draws the eye-independent part at 'pose' into buffers_[buffer], band 'band'.
     void drawSlice(const BoothPrograms& programs,
-                   int buffer,
+                   Buffer& c,
                    const shading::PanelPose& pose,
                    const Band& band);
 
     int slices_ = 1;
+    bool nodes_ = false;
     bool facetCache_ = false;
     bool surroundIlluminance_ = true;
     long refreshes_ = 0;
@@ -149,6 +215,15 @@ private:
     // what it already holds.
     GlTexture facetTexture_;
     int width_ = 0, height_ = 0;
+    // Tilt nodes: the slots, the interpolated term and what it holds, the program that draws it,
+    // and the buffer this update composes from (none: buffers_[shown_]).
+    std::array<Slot, kNodeSlots> slots_{};
+    long updates_ = 0;
+    Buffer mixed_;
+    std::optional<MixKey> mixedFor_;
+    GlProgram mixProgram_;
+    GLint mixLocation_ = -1;
+    const Buffer* frontBuffer_ = nullptr;
     // The diffuse grid (on a flat surface): E_geo at its nodes, drawn with the cache (mode 3).
     shading::GridNodes diffuseNodes_;
     GlTexture diffuseTexture_;

@@ -27,7 +27,8 @@ enum BoothTextureUnit : GLint {
     kUnitCache,
     kUnitSpecGrid,
     kUnitFacet,
-    kUnitDiffGrid
+    kUnitDiffGrid,
+    kUnitCacheMix // the second term a tilt-node interpolation reads (BoothDiffuseCache)
 };
 
 // The shader's modes (BOOTH_MODE), and mode 0's second program: the cache's pixels around the

@@ -2,6 +2,7 @@
 // others, then drawn.
 #include <algorithm>
 #include <chrono>
+#include <numbers>
 
 #include <GLES3/gl31.h>
 #include <fmt/format.h>
@@ -198,7 +199,10 @@ std::string BoothScenePass::description() const
             (flat && s.diffuseGrid > 0 ? fmt::format(", diffuse grid {} texels", s.diffuseGrid)
                                        : std::string()) +
             (s.cacheSlices > 1 ? fmt::format(", a tilt recomputed over {} frames", s.cacheSlices)
-                               : std::string());
+                               : std::string()) +
+            (s.tiltNodesRad > 0.0 ? fmt::format(", tilt nodes {:.3g} degrees apart",
+                                                s.tiltNodesRad * 180.0 / std::numbers::pi)
+                                  : std::string());
     return fmt::format("gles-booth (scene {}, {} median-cut lights, {} specular samples, {} "
                        "horizon directions{}, basis {}{})",
                        setup_.scene.name, s.lights, glossy ? s.specularSamples : 0,
@@ -277,11 +281,15 @@ Expected<void> BoothScenePass::draw(const scene::SceneState& state, int width, i
     view.eye = state.eyeBoothM;
     view.pixelsX = width;
     view.pixelsY = height;
-    CacheWant want{view.panel, std::nullopt};
+    CacheWant want{view.panel, std::nullopt, std::nullopt, 0.0};
     if (state.diffuse) {
         want.shown = pose(state.diffuse->shownRad);
         if (const auto& b = state.diffuse->band) {
             want.band = CacheBand{pose(b->towardRad), b->band, b->bands};
+        }
+        if (state.diffuse->mixRad) {
+            want.mixWith = pose(*state.diffuse->mixRad);
+            want.mix = state.diffuse->mix;
         }
     }
     const auto layout = layoutOnPanel(setup_.scene, setup_.stand);

@@ -133,7 +133,9 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
     if (auto ok = specularTerm_.init(s, samples, specularNodes, programs_); !ok) {
         return ok;
     }
-    if (auto ok = cache_.init(settings_.cacheSlices, facetCache, diffuseNodes, programs_); !ok) {
+    if (auto ok = cache_.init(settings_.cacheSlices, settings_.tiltNodesRad > 0.0, facetCache,
+                              diffuseNodes, programs_);
+        !ok) {
         return ok;
     }
 
@@ -247,7 +249,9 @@ Expected<void> BoothShadingPass::draw(const shading::View& view,
     // What the surface can light (the whole viewport for a layout that does not scale): what the
     // compose draws, and all the cache holds without the surround's illuminance.
     const PixelRect rect = surfaceRect(layout, width, height);
-    cache_.update(programs_, cache != nullptr ? *cache : CacheWant{view.panel, std::nullopt},
+    cache_.update(programs_,
+                  cache != nullptr ? *cache
+                                   : CacheWant{view.panel, std::nullopt, std::nullopt, 0.0},
                   layout, rect, width, height);
     specularTerm_.drawGrid(programs_, view.panel, width, height);
     // Without a specular term or flare to add the frame is the cache as it is.

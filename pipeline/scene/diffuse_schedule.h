@@ -39,4 +39,33 @@ DiffuseDraw diffuseDraw(const std::optional<DiffuseTilt>& last,
                         bool lightChanged,
                         int slices);
 
+// Tilt nodes (RenderSettings::tiltNodesRad = 'stepRad' > 0): the frame after 'last' (none: the
+// first frame) at held tilt 'heldRad'. The diffuse term is linear enough in the tilt that the
+// term interpolated between two tilts 2 degrees apart is within ΔE00 p95 0.07, max 0.12, of the
+// term itself (booth_cache_test.cpp, TiltNodes), so a panel that moves needs a new term every 2
+// degrees instead of every held tilt, and a panel that turns back within a step or two finds
+// its nodes cached:
+// - a new light (or the first frame) draws the term whole at the held tilt, the one node;
+// - the frame composes the two nodes that bracket the held tilt (at most a step apart; a node at
+//   the held tilt itself alone), interpolated linearly;
+// - while no two nodes at most a step apart bracket the held tilt, the ends of its step (the
+//   multiples of the step around it, the nearer first) are drawn in K = 'slices' bands, one a
+//   frame, and cached at the last; once they do, and the panel moves ('direction' -1 or +1: the
+//   sign of its trend), the first multiple of the step past them that way;
+// - while the bracket lacks a node the frame shows the nearest node alone, unless that is more
+//   than 'maxLagRad' from the held tilt: then the held tilt is drawn whole at once (a refresh
+//   under way is dropped), as nextDiffuse bounds its lag;
+// - past kMaxDiffuseNodes the node farthest from the held tilt is forgotten.
+struct DiffuseNodeStep {
+    DiffuseNodes nodes;
+    DiffuseDraw draw;
+};
+DiffuseNodeStep nextDiffuseNodes(const std::optional<DiffuseNodes>& last,
+                                 double heldRad,
+                                 bool lightChanged,
+                                 int slices,
+                                 double stepRad,
+                                 double maxLagRad,
+                                 int direction);
+
 } // namespace replica::pipeline::scene

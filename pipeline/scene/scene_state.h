@@ -5,9 +5,11 @@
 // "The state stage").
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -39,10 +41,26 @@ struct DiffuseBand {
 // What the frame's cached diffuse term is, as the state stage decided it
 // (pipeline/scene/diffuse_schedule.h): the term composed, and the band of a refresh drawn this
 // frame. The renderer holds buffers and draws what this names; it keeps no schedule.
+// With tilt nodes (DiffuseNodes) the term composed is (1 - mix) times the term at shownRad plus
+// mix times the term at mixRad, both of them cached whole.
 struct DiffuseDraw {
     double shownRad = 0.0;
     std::optional<DiffuseBand> band;
+    std::optional<double> mixRad{};
+    double mix = 0.0;
     bool operator==(const DiffuseDraw&) const = default;
+};
+
+// Tilt nodes (RenderSettings::tiltNodesRad > 0; pipeline/scene/diffuse_schedule.h): the diffuse
+// term cached whole at a few tilts, the multiples of the step and the held tilt at a new light,
+// and shown interpolated between the two that bracket the held tilt. This is what the tilt
+// estimator carries from frame to frame: the tilts cached whole, and a node being drawn in bands.
+constexpr std::size_t kMaxDiffuseNodes = 4;
+struct DiffuseNodes {
+    std::vector<double> nodes;        // at most kMaxDiffuseNodes, each drawn whole
+    std::optional<double> refreshRad; // a node drawn in bands...
+    int refreshBands = 0;             // ...with this many of its K bands drawn (this frame's too)
+    bool operator==(const DiffuseNodes&) const = default;
 };
 
 struct SceneState {

@@ -72,6 +72,12 @@ struct RenderSettings {
     // the frames are those of 1 (recompute whole at once), bit for bit. 1 for a one-off render;
     // the appliance sets its own (platform::RunConfig::cacheSlices).
     int cacheSlices = 1;
+    // The GL pass only, and only across frames: above 0, the cached diffuse term is drawn at tilt
+    // nodes this far apart (radians) and a frame interpolates the two that bracket its tilt
+    // (scene::nextDiffuseNodes); the cache then holds up to kMaxDiffuseNodes terms and a
+    // refresh's, and a frame whose tilt lies between two nodes one interpolated term more.
+    // 0: the held tilt's term alone (a one-off render; recordings made before tilt nodes).
+    double tiltNodesRad = 0.0;
     // Subtract the screen's front-surface flare here (the GL pass only: the CPU model always does).
     // The appliance turns it off when its display pass subtracts the flare instead, so that the
     // reflection is never subtracted twice.

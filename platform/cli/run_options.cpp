@@ -179,6 +179,12 @@ void addOutputOptions(CLI::App& cmd, RunOptions& o)
     cmd.add_option("--thumbnail-width", o.thumbnailWidth, "thumbnail width (pixels)")
             ->check(CLI::Range(16, 4096))
             ->capture_default_str();
+    cmd.add_option("--tilt-nodes", o.tiltNodesDeg,
+                   "cache the diffuse term at panel tilts this many degrees apart and show a "
+                   "moving panel's term interpolated between the two around its tilt (redrawn "
+                   "every node, not every tilt); 0: redraw the term at every held tilt (degrees)")
+            ->check(CLI::Range(0.0, kMaxTiltNodesDeg))
+            ->capture_default_str();
     cmd.add_option("--error-probe", o.errorProbeS,
                    "every SECONDS of session time, the exact reference at a few hundred random "
                    "pixels of the frame against the frame, at idle priority: ΔE00 p95/max into "

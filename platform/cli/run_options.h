@@ -56,6 +56,7 @@ struct RunOptions {
     bool recordDigests = true; // format 4: XXH3-64 of every displayed frame in the recording
     double thumbnailHz = 1.0;
     double errorProbeS = 0.0; // --error-probe: seconds between error probes, 0: none
+    double tiltNodesDeg = kDefaultTiltNodesDeg; // --tilt-nodes: RunConfig::tiltNodesDeg
     int thumbnailWidth = 320;
     bool json = false;
     LiveOptions live;

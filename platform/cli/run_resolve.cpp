@@ -284,6 +284,7 @@ void renderChoices(const RunOptions& o, RunConfig& config)
     config.warmUp = !o.noWarmUp;
     config.warmUpAfterFirstFrame = true; // the first frame first (platform/output/pass_warm_up.h)
     config.errorProbeS = o.errorProbeS;
+    config.tiltNodesDeg = o.tiltNodesDeg;
 }
 
 // A live run on a synthetic display profile: warned loudly, and refused by the kiosk unless the

@@ -41,6 +41,23 @@ TEST(RunConfigSchema, EveryKeyTheRunWritesIsKnown)
     EXPECT_EQ(c->trackerInBooth.translation.x, 0.01);
 }
 
+// A new run records its tilt nodes; a recording made before them replays without (0: the held
+// tilt's own term, as it was drawn).
+TEST(RunConfigSchema, TiltNodesAreRecordedAndAbsentMeansNone)
+{
+    RunConfig fresh;
+    EXPECT_EQ(fresh.tiltNodesDeg, kDefaultTiltNodesDeg);
+    fresh.tiltNodesDeg = 3.5;
+    auto back = RunConfig::fromJson(fresh.toJson());
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->tiltNodesDeg, 3.5);
+    auto j = nlohmann::json::parse(fresh.toJson());
+    j.erase("tilt_nodes_deg");
+    back = RunConfig::fromJson(j.dump());
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->tiltNodesDeg, 0.0);
+}
+
 TEST(RunConfigSchema, RefusedValuesNameTheirJsonPath)
 {
     struct Case {
@@ -57,6 +74,8 @@ TEST(RunConfigSchema, RefusedValuesNameTheirJsonPath)
             {"specular_lod_bias", nullptr, "/specular_lod_bias: expected a number in [-8, 8]"},
             {"display_black_cd_m2", -1.0, "/display_black_cd_m2: expected a number in [0, "},
             {"cache_slices", 0, "/cache_slices: expected an integer in [1, 16], found 0"},
+            {"tilt_nodes_deg", -1.0, "/tilt_nodes_deg: expected a number in [0, 10], found -1"},
+            {"tilt_nodes_deg", 90, "/tilt_nodes_deg: expected a number in [0, 10], found 90"},
             {"hardware_filter", 1, "/hardware_filter: expected true or false, found an integer"},
             {"default_eye_m", {0.0, "x", 0.6}, "/default_eye_m/1: expected a number"},
             {"tracker_rotation_deg",

@@ -19,8 +19,10 @@ namespace replica::tests {
 class StateSequence
 {
 public:
-    explicit StateSequence(int cacheSlices = 1, state::EncodingDecision encoding = {})
-        : tilt_({0.0, cacheSlices}), encoding_(std::move(encoding))
+    explicit StateSequence(int cacheSlices = 1,
+                           state::EncodingDecision encoding = {},
+                           double tiltNodesRad = 0.0)
+        : tilt_({0.0, cacheSlices, tiltNodesRad}), encoding_(std::move(encoding))
     {}
 
     // The next frame: 'st' with its lamp (or illuminant and luminance), eye and sensed tilt set.
