@@ -301,10 +301,11 @@ BoothDiffuseCache::Slot* BoothDiffuseCache::findSlot(const Key& key)
     return nullptr;
 }
 
-BoothDiffuseCache::Slot& BoothDiffuseCache::freeSlot(const shading::Vec3& normal)
+BoothDiffuseCache::Slot& BoothDiffuseCache::freeSlot(const Key& frame)
 {
-    // An empty slot, else the one whose pose is farthest from the frame's (the state stage
-    // forgets the node farthest from the held tilt: scene::nextDiffuseNodes).
+    // An empty slot, else one drawn for another size or layout (of no use again), else the one
+    // whose pose is farthest from the frame's (the state stage forgets the node farthest from the
+    // held tilt: scene::nextDiffuseNodes).
     Slot* pick = nullptr;
     double farthest = 2.0;
     for (Slot& s : slots_) {
@@ -312,8 +313,14 @@ BoothDiffuseCache::Slot& BoothDiffuseCache::freeSlot(const shading::Vec3& normal
             pick = &s;
             break;
         }
-        const double facing = glm::dot(s.key->normal, normal);
-        if (s.used != updates_ && (pick == nullptr || facing < farthest)) {
+        if (s.used == updates_) {
+            continue;
+        }
+        const Key& k = *s.key;
+        const bool stale = k.width != frame.width || k.height != frame.height ||
+                           k.offset != frame.offset || k.scale != frame.scale;
+        const double facing = stale ? -2.0 : glm::dot(k.normal, frame.normal);
+        if (pick == nullptr || facing < farthest) {
             pick = &s;
             farthest = facing;
         }
@@ -356,6 +363,7 @@ void BoothDiffuseCache::updateNodes(const BoothPrograms& programs,
                                     const PixelRect& rect)
 {
     ++updates_;
+    const Key frameKey = keyOf(want.shown, layout, width_, height_);
     const auto whole = [](const Slot* s) { return s != nullptr && s->bands == s->slices; };
     const auto held = [&](const shading::PanelPose& pose) -> Slot& {
         const Key key = keyOf(pose, layout, width_, height_);
@@ -367,7 +375,7 @@ void BoothDiffuseCache::updateNodes(const BoothPrograms& programs,
         if (s != nullptr) {
             s->key.reset(); // part of a refresh: drawn whole instead
         }
-        Slot& slot = freeSlot(want.shown.normal);
+        Slot& slot = freeSlot(frameKey);
         drawNodeWhole(programs, slot, key, pose, rect);
         return slot;
     };
@@ -384,7 +392,7 @@ void BoothDiffuseCache::updateNodes(const BoothPrograms& programs,
         if (t == nullptr || (!whole(t) && (t->slices != band.bands || t->bands != band.band))) {
             // Not held, or not the bands before this one (a fresh cache, frame N drawn alone):
             // those bands first. Band by band, the pixels a whole draw makes.
-            t = t != nullptr ? t : &freeSlot(want.shown.normal);
+            t = t != nullptr ? t : &freeSlot(frameKey);
             t->key = toward;
             t->slices = band.bands;
             for (int b = 0; b < band.band; ++b) {

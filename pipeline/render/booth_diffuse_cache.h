@@ -155,9 +155,10 @@ private:
                      const PixelRect& rect);
     // The node slot for 'key' (whole or not), or none.
     Slot* findSlot(const Key& key);
-    // A slot for a new key: an empty one, else the one whose normal is farthest from 'normal'
-    // (the frame's), never one used in this update; its buffer made on first use.
-    Slot& freeSlot(const shading::Vec3& normal);
+    // A slot for a new key: an empty one, else one of another size or layout than 'frame' (the
+    // frame's term shown), else the one whose pose is farthest from it; never one used in this
+    // update. Its buffer is made on first use.
+    Slot& freeSlot(const Key& frame);
     // The term at 'pose' whole into 'slot' (the refreshes' bands elsewhere forgotten where a
     // diffuse grid is drawn: they were drawn with another pose's).
     void drawNodeWhole(const BoothPrograms& programs,
