@@ -248,37 +248,51 @@ TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
 struct TiltOffsetCost {
     double p95 = 0.0, p95Upright = 0.0, max = 0.0;
 };
-TiltOffsetCost diffuseCostOfTiltOffset(double offsetDeg)
+// The diffuse term alone (CPU model, the default stand) of every shipped scene under every booth
+// light: fn(termAt) once each, where termAt(deg, width, height) renders it at that tilt.
+template <typename Fn>
+void forEveryDiffuseTerm(Fn fn)
 {
     const auto obs = *colour::loadCie1931(dataDir());
     const auto boothModel = *booth::loadBooth(dataDir() / "booth");
     const auto basis = *colour::loadDefaultChannelBasis(dataDir());
     shading::RenderSettings settings;
     settings.specularPass = false;
-    TiltOffsetCost cost;
     for (const char* name : {"colorchecker", "metamer", "painting"}) {
         const auto scene = *surface::loadScene(dataDir() / "scenes" / name);
         const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, basis);
         for (const auto& l : boothModel.lights) {
             const auto pl = shading::prepareLight(l, obs, settings.lights, basis);
-            for (const double tiltDeg : {5.0, 20.0, 35.0}) {
-                shading::View truth;
-                truth.pixelsX = 32;
-                truth.pixelsY = 20;
-                truth.panel = scene::panelPose(scene::degreesToRadians(tiltDeg));
-                shading::View held = truth;
-                held.panel = scene::panelPose(scene::degreesToRadians(tiltDeg + offsetDeg));
-                const auto a = shading::renderRealtime(ps, pl, truth, obs, settings);
-                const auto b = shading::renderRealtime(ps, pl, held, obs, settings);
-                const auto e = reference::compareFrames(a, b);
-                cost.p95 = std::max(cost.p95, e.p95);
-                cost.max = std::max(cost.max, e.max);
-                if (tiltDeg >= 20.0) {
-                    cost.p95Upright = std::max(cost.p95Upright, e.p95);
-                }
-            }
+            fn([&](double deg, int width, int height) {
+                shading::View v;
+                v.pixelsX = width;
+                v.pixelsY = height;
+                v.panel = scene::panelPose(scene::degreesToRadians(deg));
+                return shading::renderRealtime(ps, pl, v, obs, settings);
+            });
         }
     }
+}
+
+void addCost(TiltOffsetCost& cost, const reference::FrameError& e, bool upright)
+{
+    cost.p95 = std::max(cost.p95, e.p95);
+    cost.max = std::max(cost.max, e.max);
+    if (upright) {
+        cost.p95Upright = std::max(cost.p95Upright, e.p95);
+    }
+}
+
+TiltOffsetCost diffuseCostOfTiltOffset(double offsetDeg)
+{
+    TiltOffsetCost cost;
+    forEveryDiffuseTerm([&](const auto& termAt) {
+        for (const double tiltDeg : {5.0, 20.0, 35.0}) {
+            const auto e = reference::compareFrames(termAt(tiltDeg, 32, 20),
+                                                    termAt(tiltDeg + offsetDeg, 32, 20));
+            addCost(cost, e, tiltDeg >= 20.0);
+        }
+    });
     std::printf("diffuse term %.2f deg off the tilt: dE00 p95 <= %.3f (5-35 deg), <= %.3f "
                 "(20-35 deg); max %.3f\n",
                 offsetDeg, cost.p95, cost.p95Upright, cost.max);
@@ -317,41 +331,19 @@ TEST(TiltHold, ALaggingDiffuseTermCostsMoreTheFurtherItLags)
 // platform::kDefaultTiltNodesDeg) costs less than the hold's own 0.15 degrees.
 TiltOffsetCost diffuseCostOfTiltNodes(double stepDeg)
 {
-    const auto obs = *colour::loadCie1931(dataDir());
-    const auto boothModel = *booth::loadBooth(dataDir() / "booth");
-    const auto basis = *colour::loadDefaultChannelBasis(dataDir());
-    shading::RenderSettings settings;
-    settings.specularPass = false;
     TiltOffsetCost cost;
-    for (const char* name : {"colorchecker", "metamer", "painting"}) {
-        const auto scene = *surface::loadScene(dataDir() / "scenes" / name);
-        const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, basis);
-        for (const auto& l : boothModel.lights) {
-            const auto pl = shading::prepareLight(l, obs, settings.lights, basis);
-            for (const double loDeg : {4.0, 20.0, 34.0}) {
-                const auto at = [&](double deg) {
-                    shading::View v;
-                    v.pixelsX = 64;
-                    v.pixelsY = 40;
-                    v.panel = scene::panelPose(scene::degreesToRadians(deg));
-                    return shading::renderRealtime(ps, pl, v, obs, settings);
-                };
-                const auto a = at(loDeg);
-                const auto b = at(loDeg + stepDeg);
-                const auto truth = at(loDeg + 0.5 * stepDeg);
-                auto lerp = a;
-                for (std::size_t i = 0; i < lerp.xyz.size(); ++i) {
-                    lerp.xyz[i] = 0.5 * a.xyz[i] + 0.5 * b.xyz[i];
-                }
-                const auto e = reference::compareFrames(truth, lerp);
-                cost.p95 = std::max(cost.p95, e.p95);
-                cost.max = std::max(cost.max, e.max);
-                if (loDeg >= 20.0) {
-                    cost.p95Upright = std::max(cost.p95Upright, e.p95);
-                }
+    forEveryDiffuseTerm([&](const auto& termAt) {
+        for (const double loDeg : {4.0, 20.0, 34.0}) {
+            const auto a = termAt(loDeg, 64, 40);
+            const auto b = termAt(loDeg + stepDeg, 64, 40);
+            auto lerp = a;
+            for (std::size_t i = 0; i < lerp.xyz.size(); ++i) {
+                lerp.xyz[i] = 0.5 * a.xyz[i] + 0.5 * b.xyz[i];
             }
+            const auto e = reference::compareFrames(termAt(loDeg + 0.5 * stepDeg, 64, 40), lerp);
+            addCost(cost, e, loDeg >= 20.0);
         }
-    }
+    });
     std::printf("diffuse term between tilt nodes %.1f deg apart: dE00 p95 <= %.3f (4-38 deg), "
                 "<= %.3f (20-38 deg); max %.3f\n",
                 stepDeg, cost.p95, cost.p95Upright, cost.max);
