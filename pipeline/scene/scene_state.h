@@ -49,6 +49,8 @@ struct DiffuseDraw {
     std::optional<double> mixRad{};
     double mix = 0.0;
     bool operator==(const DiffuseDraw&) const = default;
+    // The tilt the term composed stands for: shownRad, or between it and mixRad by mix.
+    double tiltRad() const { return mixRad ? shownRad + mix * (*mixRad - shownRad) : shownRad; }
 };
 
 // Tilt nodes (RenderSettings::tiltNodesRad > 0; pipeline/scene/diffuse_schedule.h): the diffuse

@@ -278,7 +278,7 @@ bool ErrorProbe::complete(const Job& job, const std::atomic<bool>* cancel)
     logger("probe")->debug("frame {}: ΔE00 p95 {:.3f}, max {:.3f} over {} pixels ({:.0f} ms CPU); "
                            "lamp {}, encoding {}, tilt {:.4f} rad (diffuse shown at {:.4f})",
                            r.frameIndex, e->p95, e->max, e->n, cpuMs, st.lampIndex, st.encoding,
-                           st.tiltRad, st.diffuse ? st.diffuse->shownRad : st.tiltRad);
+                           st.tiltRad, st.diffuse ? st.diffuse->tiltRad() : st.tiltRad);
     std::lock_guard lock(mutex_);
     if (writer_ != nullptr) {
         writer_->write(r);

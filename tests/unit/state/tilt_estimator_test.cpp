@@ -265,12 +265,6 @@ TEST(TiltEstimator, AStillPanelsNoiseNeverAimsAhead)
     EXPECT_FALSE(b.restore(tooLong));
 }
 
-// The term a frame shows, as a tilt: the node shown, or the tilt its interpolation stands for.
-double shownTilt(const pipeline::scene::DiffuseDraw& d)
-{
-    return d.mixRad ? d.shownRad + d.mix * (*d.mixRad - d.shownRad) : d.shownRad;
-}
-
 // Tilt nodes 2 degrees apart on the simulator's sweep (as above): the term a frame shows stands
 // for the held tilt itself (interpolated) on nearly every frame, nearer the panel than the aimed
 // refresh's; a node is drawn for every 2 degrees the panel travels instead of a refresh every K
@@ -303,8 +297,8 @@ TEST(TiltEstimator, TiltNodesFollowTheSimulatorsSweepWithFewerDraws)
                                      std::fmod(n.heldTiltRad, 2.0 * kDeg) != 0.0
                              ? 1
                              : 0;
-            atHeld += std::abs(shownTilt(*n.diffuse) - n.heldTiltRad) < 1e-12 ? 1 : 0;
-            sumNodes += std::abs(shownTilt(*n.diffuse) - truth);
+            atHeld += std::abs(n.diffuse->tiltRad() - n.heldTiltRad) < 1e-12 ? 1 : 0;
+            sumNodes += std::abs(n.diffuse->tiltRad() - truth);
             sumAimed += std::abs(a.diffuse->shownRad - truth);
         }
         std::printf("%.0f Hz: %d node draws (%.1f degrees of travel), %d aimed refreshes; "
