@@ -22,7 +22,7 @@ namespace replica::state {
 // of two such means, so noise alone almost never recomputes the cache. Holding the diffuse term
 // 0.15 degrees off costs at most ΔE00 p95 0.25 at a 5-degree tilt (the ceiling light grazes the
 // panel there; the painting's relief) and 0.11 from 20 degrees up, on every shipped scene and
-// light (CPU model, booth_cache_test.cpp; docs/rendering.md): about what one sample's noise costs.
+// light (CPU model, tilt_cost_test.cpp; docs/rendering.md): about what one sample's noise costs.
 //
 // The mean lags a panel that is moving: by half the window (8 frames: 0.8 s at 10 Hz, where the
 // error probe saw the diffuse term 15 degrees behind under the simulator's sweep). So a sensed tilt

@@ -42,7 +42,7 @@ DiffuseDraw diffuseDraw(const std::optional<DiffuseTilt>& last,
 // Tilt nodes (RenderSettings::tiltNodesRad = 'stepRad' > 0): the frame after 'last' (none: the
 // first frame) at held tilt 'heldRad'. The diffuse term is linear enough in the tilt that the
 // term interpolated between two tilts 2 degrees apart is within ΔE00 p95 0.07, max 0.12, of the
-// term itself (booth_cache_test.cpp, TiltNodes), so a panel that moves needs a new term every 2
+// term itself (tilt_cost_test.cpp, TiltNodes), so a panel that moves needs a new term every 2
 // degrees instead of every held tilt, and a panel that turns back within a step or two finds
 // its nodes cached:
 // - a new light (or the first frame) draws the term whole at the held tilt, the one node;
