@@ -2,6 +2,7 @@
 // recomputes it, the cache follows light, pose and size, its bands and tilt nodes draw what the
 // state names, and pass 1's illuminance in alpha is E_geo on every pixel of the panel. What the
 // held tilt and the nodes cost in colour: tilt_cost_test.cpp.
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -49,6 +50,44 @@ protected:
 
     std::unique_ptr<XyzTarget> target_;
     BoothSceneSetup setup_;
+};
+
+// The cache's two ways of running, as the appliance runs them: the ColorChecker with a diffuse
+// grid (mode 3 drawn with the first band) and the surround's illuminance, and the painting
+// (relief, the facet cache) without it.
+struct CacheCase {
+    const char* scene;
+    int diffuseGrid;
+    bool surround;
+};
+constexpr std::array kCacheCases{CacheCase{"colorchecker", 4, true},
+                                 CacheCase{"painting", 0, false}};
+
+// A case's scene prepared with the fixture's settings and its diffuse grid, and the d65 light:
+// what its passes are made from. The prepared scene points at the scene and the passes at both,
+// so they are made in place and never copied or moved.
+struct CacheCaseInputs {
+    CacheCaseInputs(const BoothSceneSetup& setup, const CacheCase& c)
+        : scene(*surface::loadScene(dataDir() / "scenes" / c.scene)),
+          settings(withGrid(setup.settings, c.diffuseGrid)),
+          prepared(shading::prepareScene(scene, settings.horizonDirections, 0.01, setup.basis)),
+          d65(shading::prepareLight(*setup.booth.find("d65-fluorescent"),
+                                    setup.observer,
+                                    settings.lights,
+                                    setup.basis))
+    {}
+    CacheCaseInputs(const CacheCaseInputs&) = delete;
+    CacheCaseInputs& operator=(const CacheCaseInputs&) = delete;
+
+    static shading::RenderSettings withGrid(shading::RenderSettings s, int diffuseGrid)
+    {
+        s.diffuseGrid = diffuseGrid;
+        return s;
+    }
+    const surface::SurfaceScene scene;
+    const shading::RenderSettings settings;
+    const shading::PreparedScene prepared;
+    const shading::PreparedLight d65;
 };
 
 TEST_F(BoothCacheTest, AFrameFromTheCacheEqualsOneThatRecomputesIt)
@@ -248,20 +287,13 @@ TEST_F(BoothCacheTest, AlphaIsTheIlluminanceOnThePanelOnEveryPixel)
 // bands is the whole pass's, and a fresh pass asked for a frame in the middle of one draws it.
 TEST_F(BoothCacheTest, ANodeFrameIsItsTwoNodesFramesInterpolated)
 {
-    struct Case {
-        const char* scene;
-        int diffuseGrid;
-        bool surround;
-    };
-    for (const Case& c : {Case{"colorchecker", 4, true}, Case{"painting", 0, false}}) {
+    for (const CacheCase& c : kCacheCases) {
         SCOPED_TRACE(c.scene);
-        const auto scene = *surface::loadScene(dataDir() / "scenes" / c.scene);
-        shading::RenderSettings settings = setup_.settings;
-        settings.diffuseGrid = c.diffuseGrid;
-        const auto ps =
-                shading::prepareScene(scene, settings.horizonDirections, 0.01, setup_.basis);
-        const auto d65 = shading::prepareLight(*setup_.booth.find("d65-fluorescent"),
-                                               setup_.observer, settings.lights, setup_.basis);
+        const CacheCaseInputs in(setup_, c);
+        const auto& scene = in.scene;
+        const auto& ps = in.prepared;
+        const auto& d65 = in.d65;
+        shading::RenderSettings settings = in.settings;
         auto whole = BoothShadingPass::create(ps, settings, setup_.observer);
         settings.cacheSlices = 3;
         settings.tiltNodesRad = scene::degreesToRadians(2.0);
@@ -342,24 +374,16 @@ TEST_F(BoothCacheTest, ANodeFrameIsItsTwoNodesFramesInterpolated)
 // cache, the one a pass that recomputes at once draws for the tilt shown; the last band's frame
 // is the unsliced pass's at the new tilt, bit for bit; a band asked for without the earlier ones
 // (frame N drawn alone) draws them first; a new light or layout draws the term shown whole. On
-// the ColorChecker with a diffuse grid (mode 3 drawn with the first band) and the surround's
-// illuminance, and on the painting (relief, the facet cache) without it, as the appliance runs.
+// both kCacheCases.
 TEST_F(BoothCacheTest, TheBandTheFrameNamesIsDrawnAndTheLastShowsTheUnslicedFrame)
 {
-    struct Case {
-        const char* scene;
-        int diffuseGrid;
-        bool surround;
-    };
-    for (const Case& c : {Case{"colorchecker", 4, true}, Case{"painting", 0, false}}) {
+    for (const CacheCase& c : kCacheCases) {
         SCOPED_TRACE(c.scene);
-        const auto scene = *surface::loadScene(dataDir() / "scenes" / c.scene);
-        shading::RenderSettings settings = setup_.settings;
-        settings.diffuseGrid = c.diffuseGrid;
-        const auto ps =
-                shading::prepareScene(scene, settings.horizonDirections, 0.01, setup_.basis);
-        const auto d65 = shading::prepareLight(*setup_.booth.find("d65-fluorescent"),
-                                               setup_.observer, settings.lights, setup_.basis);
+        const CacheCaseInputs in(setup_, c);
+        const auto& scene = in.scene;
+        const auto& ps = in.prepared;
+        const auto& d65 = in.d65;
+        shading::RenderSettings settings = in.settings;
         const auto tungsten = shading::prepareLight(*setup_.booth.find("tungsten"), setup_.observer,
                                                     settings.lights, setup_.basis);
         auto whole = BoothShadingPass::create(ps, settings, setup_.observer);
