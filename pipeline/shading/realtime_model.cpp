@@ -398,7 +398,18 @@ GridNodes gridNodes(const surface::SurfaceScene& scene, int spacingTexels)
 
 int defaultSpecularGrid(const surface::SurfaceScene& scene)
 {
-    return scene.flat() ? kFlatSpecularGrid : 0;
+    if (scene.flat()) {
+        return kFlatSpecularGrid;
+    }
+    // Compared as products, so that a plane's zero turn (a tilted plane is relief too) divides
+    // nothing: it gets the flat surface's grid.
+    const double turn = surface::largestNormalTurn(scene.relief);
+    const double reach = kReliefGridLobeFraction * scene.alpha;
+    int grid = 0;
+    for (int g = 1; g <= kFlatSpecularGrid && 2.0 * turn * g <= reach; g *= 2) {
+        grid = g;
+    }
+    return grid;
 }
 
 int defaultDiffuseGrid(const surface::SurfaceScene& scene)

@@ -53,6 +53,34 @@ std::vector<Vec3> normalMap(const HeightField& h)
     return n;
 }
 
+double largestNormalTurn(const HeightField& h)
+{
+    const std::vector<Vec3> n = normalMap(h);
+    const auto at = [&](int x, int y) {
+        return n[static_cast<std::size_t>(y) * static_cast<std::size_t>(h.width) +
+                 static_cast<std::size_t>(x)];
+    };
+    // atan2(|a x b|, a.b), not acos(a.b): exact for the small angles a smooth surface turns by,
+    // where acos loses half its digits.
+    const auto angle = [](const Vec3& a, const Vec3& b) {
+        const Vec3 c(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+        return std::atan2(std::sqrt(c.x * c.x + c.y * c.y + c.z * c.z),
+                          a.x * b.x + a.y * b.y + a.z * b.z);
+    };
+    double largest = 0.0;
+    for (int y = 0; y < h.height; ++y) {
+        for (int x = 0; x < h.width; ++x) {
+            if (x + 1 < h.width) {
+                largest = std::max(largest, angle(at(x, y), at(x + 1, y)));
+            }
+            if (y + 1 < h.height) {
+                largest = std::max(largest, angle(at(x, y), at(x, y + 1)));
+            }
+        }
+    }
+    return largest;
+}
+
 double exactSinHorizon(const HeightField& h, double x, double y, double phi, double maxDistanceM)
 {
     const double h0 = h.sample(x, y);

@@ -30,6 +30,11 @@ struct HeightField {
 // a finite, nearly horizontal normal and never normalises a zero vector.
 std::vector<Vec3> normalMap(const HeightField& h);
 
+// The largest angle (radians) between the normals of two texels side by side or one above the
+// other in normalMap(h): how fast the surface turns per texel where it turns fastest. 0 on a
+// plane, flat or tilted.
+double largestNormalTurn(const HeightField& h);
+
 // A horizon table of n entries at azimuths 2 pi k / n (k = 0 along +x, n/4 along +y), linear in
 // azimuth, at the direction whose components along x and y are (lx, ly): the one rule the horizon
 // map and the exact reference's horizon tests read a table by.

@@ -377,8 +377,9 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
             ->check(CLI::Range(kAutoSpecularSamples, 1024) & !CLI::IsMember({0}));
     cmd->add_option("--specular-grid", args->specularGrid,
                     "texels between the nodes the specular term is shaded at, then interpolated; "
-                    "0: per pixel; -1: as the appliance chooses (8 on a flat surface, per pixel "
-                    "on relief)")
+                    "0: per pixel; -1: as the appliance chooses (8 on a flat surface; on relief "
+                    "the most the surface's turn per texel allows against its gloss lobe, per "
+                    "pixel where it turns fast)")
             ->capture_default_str()
             ->check(CLI::Range(kAutoSpecularGrid, 256));
     cmd->add_option("--diffuse-grid", args->diffuseGrid,

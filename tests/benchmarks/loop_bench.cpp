@@ -27,7 +27,7 @@ namespace {
 
 using namespace replica;
 
-const char* const kScenes[] = {"colorchecker", "metamer", "painting"};
+const char* const kScenes[] = {"colorchecker", "metamer", "painting", "glossy-cylinder"};
 
 // One appliance per scene, specular sample count and cache slices, built once (the GL context
 // lives in it).
@@ -46,6 +46,11 @@ platform::Appliance* appliance(int scene, int specularSamples, int cacheSlices)
     c.sceneDir = std::string("scenes/") + kScenes[scene];
     c.specularSamples = specularSamples;
     c.cacheSlices = cacheSlices;
+    // REPLICA_BENCH_SPECULAR_GRID=T: the specular term every T texels (0: per pixel) instead of
+    // the scene's default spacing (shading::defaultSpecularGrid), for an A/B of spacings.
+    if (const char* grid = std::getenv("REPLICA_BENCH_SPECULAR_GRID")) {
+        c.specularGrid = std::atoi(grid);
+    }
     // REPLICA_BENCH_POINT_LIGHTS or REPLICA_BENCH_AREA_LIGHTS set: eq. (1) from point lights or
     // from areas on every scene (for an A/B of the two in one build: tests/benchmarks/ab_loop.sh
     // with wrappers that set them); neither: as the appliance chooses for the scene.
@@ -121,7 +126,7 @@ void BM_ApplianceFrame(benchmark::State& st)
             benchmark::Counter(static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ApplianceFrame)
-        ->ArgsProduct({{0, 1, 2},
+        ->ArgsProduct({{0, 1, 2, 3},
                        {0, 1},
                        {platform::kAutoSpecularSamples},
                        {platform::kDefaultCacheSlices}}) // the defaults
@@ -136,6 +141,7 @@ BENCHMARK(BM_ApplianceFrame)
         ->Args({0, 0, 48, platform::kDefaultCacheSlices}) // the default before the lod bias was 0
         ->Args({2, 0, 48, platform::kDefaultCacheSlices})
         ->Args({2, 0, 16, platform::kDefaultCacheSlices})
+        ->Args({3, 0, 48, platform::kDefaultCacheSlices}) // the cylinder's d65 plan: 48 samples
         ->Args({2, 0, 12, platform::kDefaultCacheSlices}) // the painting's default before 8
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();

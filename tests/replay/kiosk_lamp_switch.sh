@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The kiosk from a site file on a cold shader cache, the sensors simulated (the booth's lamps in
 # turn, 2 s each), for the ColorChecker (its plan: 24, 48 and 32 specular samples, looped at the
-# specular grid's nodes) and the glossy cylinder (16 / 32 / 128 lights, 16 / 24 / 48 samples per
-# pixel): lamps that differ only in counts share one pass, so every lamp draws with the pass the
+# specular grid's nodes) and the glossy cylinder (16 / 32 / 128 lights, 16 / 24 / 48 samples at
+# its grid's nodes, every 2 texels): lamps that differ only in counts share one pass, so every lamp draws with the pass the
 # first frame compiled. Checked from what field staff see: the log names one shading pass and one
 # frame that compiled it (the first), the recording holds the lamp switches, and its replay draws
 set -uo pipefail

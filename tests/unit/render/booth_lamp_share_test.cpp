@@ -169,6 +169,7 @@ TEST_F(BoothLampShareTest, CountsOutOfRangeAreRefused)
     shading::RenderSettings reliefSettings = relief.settings;
     reliefSettings.specularSamples = 24;
     reliefSettings.horizonDirections = 4;
+    reliefSettings.specularGrid = 0; // per pixel, as the painting draws (the cylinder's is 2)
     auto perPixel = BoothShadingPass::create(rs, reliefSettings, relief.observer);
     ASSERT_TRUE(perPixel) << perPixel.error().message;
     EXPECT_EQ((*perPixel)->writtenOutSamples(), 24); // per pixel on relief: all 24 written out

@@ -63,7 +63,7 @@ protected:
         obs_ = new colour::Observer(*colour::loadCie1931(dataDir()));
         booth_ = new booth::Booth(*booth::loadBooth(dataDir() / "booth"));
         basis_ = new colour::ChannelBasis(*colour::loadDefaultChannelBasis(dataDir()));
-        for (const char* name : {"colorchecker", "metamer", "painting"}) {
+        for (const char* name : {"colorchecker", "metamer", "painting", "glossy-cylinder"}) {
             auto s = surface::loadScene(dataDir() / "scenes" / name);
             ASSERT_TRUE(s) << s.error().message;
             scenes_[name] = *s;
@@ -215,14 +215,16 @@ TEST_F(BoothPassTest, SpecularGridMatchesTheCpuModel)
 {
     // The grid pass (mode 2) and the compose's interpolation against the model's: the flat
     // ColorChecker at the appliance's spacing, the painting's relief (facets and horizons at the
-    // nodes) at 1 and 3 texels.
+    // nodes) at 1 and 3 texels, the glossy cylinder at the spacing its smooth relief gets (2).
     const shading::View v = view(64, 40);
     struct Case {
         const char* scene;
         int grid;
     };
-    for (const Case c : {Case{"colorchecker", shading::kFlatSpecularGrid}, Case{"painting", 1},
-                         Case{"painting", 3}}) {
+    for (const Case c :
+         {Case{"colorchecker", shading::kFlatSpecularGrid}, Case{"painting", 1},
+          Case{"painting", 3},
+          Case{"glossy-cylinder", shading::defaultSpecularGrid(scenes_.at("glossy-cylinder"))}}) {
         shading::RenderSettings settings;
         settings.specularGrid = c.grid;
         expectMatchesTheCpuModel(scenes_.at(c.scene), settings, v,

@@ -1,12 +1,21 @@
 // The specular grid of the CPU model (shading::gridNodes, gridValue): node layout,
-// interpolation that is exact for bilinear functions, and what the grid costs the ColorChecker
-// against shading the specular term per pixel.
+// interpolation that is exact for bilinear functions, what the grid costs the ColorChecker
+// against shading the specular term per pixel, the spacing chosen for relief from how fast it
+// turns, and what that costs the glossy cylinder against the exact reference.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <random>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/booth/booth_model.h>
+#include <pipeline/colour/ciede2000.h>
+#include <pipeline/colour/cielab.h>
 #include <pipeline/reference/frame_error.h>
+#include <pipeline/reference/reference_integrator.h>
+#include <pipeline/scene/stand.h>
 #include <pipeline/shading/realtime_model.h>
+#include <pipeline/spectral/adaptive_encoding.h>
 
 #include <gtest/gtest.h>
 
@@ -81,6 +90,151 @@ TEST(SpecularGrid, CostsTheFlatColorCheckerLittleAgainstPerPixelShading)
     EXPECT_LE(e.max, 1.0);
     RecordProperty("grid_vs_per_pixel_p95", std::to_string(e.p95));
     RecordProperty("grid_vs_per_pixel_max", std::to_string(e.max));
+}
+
+// A glossy cylinder of radius R across the rows of a 24 x 16 cm surface at 1 mm texels, as the
+// shipped one is made.
+surface::SurfaceScene cylinderScene(double radiusM, double alpha)
+{
+    surface::SurfaceScene s;
+    s.width = 240;
+    s.height = 160;
+    s.widthM = 0.24;
+    s.heightM = 0.16;
+    s.alpha = alpha;
+    s.rhoS = colour::Spectrum::constant(0.05);
+    s.relief.width = s.width;
+    s.relief.height = s.height;
+    s.relief.pitchM = 0.001;
+    s.relief.m.resize(static_cast<std::size_t>(s.width) * s.height);
+    for (int y = 0; y < s.height; ++y) {
+        const double v = (y + 0.5 - 0.5 * s.height) * 0.001;
+        for (int x = 0; x < s.width; ++x) {
+            s.relief.m[static_cast<std::size_t>(y) * s.width + x] =
+                    std::sqrt(radiusM * radiusM - v * v);
+        }
+    }
+    return s;
+}
+
+TEST(ReliefSpecularGrid, SpacingFollowsHowFastTheSurfaceTurnsAgainstTheLobe)
+{
+    // The cylinder's normal turns fastest at its outer rows, 78 mm from the crest:
+    // turn = 1 mm / sqrt(R^2 - (78 mm)^2) (tests/unit/surface/relief_test.cpp checks that). The
+    // grid is the largest power of two g <= 8 with 2 turn g <= 0.75 alpha.
+    struct Case {
+        double radius, alpha;
+        int grid;
+    };
+    for (const Case c : {
+                 Case{0.15, 0.05, 2}, // turn 0.00781: g <= 2.40
+                 Case{0.30, 0.05, 4}, // turn 0.00345: g <= 5.43
+                 Case{0.50, 0.05, 8}, // turn 0.00202: g <= 9.27, and 8 at most
+                 Case{0.09, 0.05, 0}, // turn 0.0223: even one texel is 0.84 of the reach
+                 Case{0.15, 0.20, 8}, // a wider lobe: g <= 9.6
+                 Case{0.15, 0.01, 0}, // a mirror-like one: g <= 0.48
+         }) {
+        EXPECT_EQ(defaultSpecularGrid(cylinderScene(c.radius, c.alpha)), c.grid)
+                << "radius " << c.radius << " alpha " << c.alpha;
+    }
+    // A plane is the flat case whatever its tilt.
+    surface::SurfaceScene tilted = cylinderScene(0.15, 0.05);
+    for (int y = 0; y < tilted.height; ++y) {
+        for (int x = 0; x < tilted.width; ++x) {
+            tilted.relief.m[static_cast<std::size_t>(y) * tilted.width + x] = 2e-4 * x + 1e-4 * y;
+        }
+    }
+    ASSERT_FALSE(tilted.flat());
+    EXPECT_EQ(defaultSpecularGrid(tilted), kFlatSpecularGrid);
+    // The shipped scenes: the ColorChecker flat, the painting's texel-sized relief per pixel, the
+    // glossy cylinder (radius 15 cm, alpha 0.05) every 2 texels.
+    for (const auto& [name, grid] : {std::pair<const char*, int>{"colorchecker", kFlatSpecularGrid},
+                                     {"painting", 0},
+                                     {"glossy-cylinder", 2}}) {
+        auto scene = surface::loadScene(dataDir() / "scenes" / name);
+        ASSERT_TRUE(scene) << name;
+        EXPECT_EQ(defaultSpecularGrid(*scene), grid) << name;
+    }
+}
+
+// What the glossy cylinder's grid costs where it counts: against the exact reference, at the
+// panel's own density (the appliance shows its 240 x 160 texels on about 445 x 296 pixels), with
+// the plan's D65 setting (128 lights, 48 samples). The interpolation's error is a property of
+// each point, so a few hundred pixels at random, evaluated by the reference one by one, measure
+// it as the whole frame would.
+TEST(ReliefSpecularGrid, TheGlossyCylindersGridStaysNearPerPixelAgainstTheReference)
+{
+    auto obs = colour::loadCie1931(dataDir());
+    auto booth = booth::loadBooth(dataDir() / "booth");
+    auto scene = surface::loadScene(dataDir() / "scenes" / "glossy-cylinder");
+    ASSERT_TRUE(obs && booth && scene);
+    const booth::BoothLight& light = booth->lights[2]; // d65-fluorescent
+    ASSERT_EQ(light.name, "d65-fluorescent");
+    RenderSettings perPixel;
+    perPixel.lights = 128;
+    perPixel.specularSamples = 48;
+    perPixel.specularGrid = 0;
+    RenderSettings grid = perPixel;
+    grid.specularGrid = defaultSpecularGrid(*scene);
+    ASSERT_EQ(grid.specularGrid, 2);
+    // The appliance's basis, made for the light: what is left is the geometry's error.
+    auto encoder = spectral::AdaptiveEncoder::createDefault(dataDir());
+    ASSERT_TRUE(encoder) << encoder.error().message;
+    auto basis = encoder->basisFor(light.spd);
+    ASSERT_TRUE(basis) << basis.error().message;
+    const PreparedScene ps = prepareScene(*scene, perPixel.horizonDirections, 0.01, *basis);
+    const PreparedLight pl = prepareLight(light, *obs, perPixel.lights, *basis);
+    struct Pose {
+        Vec3 eye;
+        double tiltDeg;
+    };
+    for (const Pose pose : {Pose{{0.0, 0.45, 0.60}, 30.0}, Pose{{0.25, 0.40, 0.55}, 10.0}}) {
+        View view;
+        view.panel = scene::panelPose(scene::degreesToRadians(pose.tiltDeg));
+        view.eye = pose.eye;
+        view.pixelsX = 444;
+        view.pixelsY = 296;
+        const XyzFrame a = renderRealtime(ps, pl, view, *obs, perPixel);
+        const XyzFrame b = renderRealtime(ps, pl, view, *obs, grid);
+        std::mt19937 rng(7);
+        std::vector<std::pair<int, int>> pixels;
+        std::vector<reference::SurfaceSample> points;
+        for (int i = 0; i < 300; ++i) {
+            const int px = std::uniform_int_distribution<int>(0, view.pixelsX - 1)(rng);
+            const int py = std::uniform_int_distribution<int>(0, view.pixelsY - 1)(rng);
+            pixels.emplace_back(px, py);
+            points.push_back({(px + 0.5) / view.pixelsX, (py + 0.5) / view.pixelsY,
+                              glm::dvec2((px + 0.5) * scene->width / view.pixelsX,
+                                         (py + 0.5) * scene->height / view.pixelsY)});
+        }
+        const auto ref = reference::referenceAt(*scene, light, view, *obs, points);
+        ASSERT_EQ(ref.xyz.size(), points.size());
+        const auto errors = [&](const XyzFrame& f) {
+            std::vector<double> e;
+            for (std::size_t i = 0; i < points.size(); ++i) {
+                const auto& px = f.xyz[static_cast<std::size_t>(pixels[i].second) * f.width +
+                                       pixels[i].first];
+                e.push_back(colour::ciede2000(colour::xyzToLab(ref.xyz[i], ref.whiteXyz),
+                                              colour::xyzToLab(px, ref.whiteXyz)));
+            }
+            std::sort(e.begin(), e.end());
+            return std::pair{e[static_cast<std::size_t>(0.95 * static_cast<double>(e.size() - 1))],
+                             e.back()};
+        };
+        const auto [p95PerPixel, maxPerPixel] = errors(a);
+        const auto [p95Grid, maxGrid] = errors(b);
+        // The grid changes the frame (the specular term is there and interpolated) ...
+        EXPECT_GT(reference::compareFrames(a, b).max, 0.05);
+        // ... and stays near per-pixel shading, inside the budget.
+        EXPECT_LE(p95Grid, p95PerPixel + 0.15) << "tilt " << pose.tiltDeg;
+        EXPECT_LE(maxGrid, maxPerPixel + 0.5) << "tilt " << pose.tiltDeg;
+        EXPECT_LE(p95Grid, 1.0);
+        RecordProperty("tilt_" + std::to_string(static_cast<int>(pose.tiltDeg)) + "_p95",
+                       std::to_string(p95PerPixel) + " per pixel, " + std::to_string(p95Grid) +
+                               " grid");
+        std::printf("tilt %.0f: p95 / max per pixel %.3f / %.3f, grid %d %.3f / %.3f\n",
+                    pose.tiltDeg, p95PerPixel, maxPerPixel, grid.specularGrid, p95Grid, maxGrid);
+    }
 }
 
 } // namespace

@@ -58,6 +58,66 @@ TEST(NormalMap, VerticalCliffStaysFinite)
     }
 }
 
+// A cylinder of radius R across the rows: its normal turns by d(theta)/dv = 1 / sqrt(R^2 - v^2)
+// radians per metre of height v from its crest, fastest at the rows furthest out.
+HeightField cylinder(double radiusM, int w, int h, double pitch)
+{
+    HeightField f = field(w, h, pitch);
+    for (int y = 0; y < h; ++y) {
+        const double v = (y + 0.5 - 0.5 * h) * pitch;
+        for (int x = 0; x < w; ++x) {
+            f.m[static_cast<std::size_t>(y) * w + x] = std::sqrt(radiusM * radiusM - v * v);
+        }
+    }
+    return f;
+}
+
+TEST(NormalTurn, APlaneFlatOrTiltedTurnsNowhere)
+{
+    HeightField f = field(20, 10, 0.001);
+    EXPECT_EQ(largestNormalTurn(f), 0.0);
+    for (int y = 0; y < 10; ++y) {
+        for (int x = 0; x < 20; ++x) {
+            f.m[static_cast<std::size_t>(y) * 20 + x] = 0.3 * x * 0.001 - 0.7 * y * 0.001;
+        }
+    }
+    EXPECT_LT(largestNormalTurn(f), 1e-12);
+}
+
+TEST(NormalTurn, ACylinderTurnsAsItsCurvatureSays)
+{
+    for (const double radius : {0.15, 0.5, 0.09}) {
+        const double pitch = 0.001;
+        const int rows = 160;
+        // The fastest turn is between the two outermost interior rows, whose central differences
+        // stand for heights v = (rows / 2 - 1.5) pitch and (rows / 2 - 2.5) pitch from the crest.
+        const double v = (rows / 2 - 2.0) * pitch;
+        const double expected = pitch / std::sqrt(radius * radius - v * v);
+        const double turn = largestNormalTurn(cylinder(radius, 24, rows, pitch));
+        EXPECT_NEAR(turn, expected, 0.02 * expected) << "radius " << radius;
+    }
+    // Turned by 90 degrees (its rows become columns) it turns as fast; along its axis not at
+    // all, so a one-row strip of it does not turn.
+    const HeightField rows = cylinder(0.15, 24, 160, 0.001);
+    HeightField columns = field(160, 24, 0.001);
+    for (int y = 0; y < 24; ++y) {
+        for (int x = 0; x < 160; ++x) {
+            columns.m[static_cast<std::size_t>(y) * 160 + x] =
+                    rows.m[static_cast<std::size_t>(x) * 24 + y];
+        }
+    }
+    EXPECT_NEAR(largestNormalTurn(columns), largestNormalTurn(rows), 1e-15);
+    EXPECT_LT(largestNormalTurn(cylinder(0.15, 24, 1, 0.001)), 1e-12);
+}
+
+TEST(NormalTurn, OneRaisedTexelTurnsItsNeighboursSharply)
+{
+    HeightField f = field(9, 9, 0.001);
+    f.m[4 * 9 + 4] = 0.001; // one pitch high: its neighbours' central slopes are 1/2
+    // A normal (0, 0, 1) beside one of slope 1/2: atan(1/2).
+    EXPECT_NEAR(largestNormalTurn(f), std::atan(0.5), 1e-12);
+}
+
 TEST(HorizonMap, FlatFieldHasZeroHorizonsEverywhere)
 {
     const HorizonMap m = horizonMap(field(10, 10, 0.001), 8, 0.01);
