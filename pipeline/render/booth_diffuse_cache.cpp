@@ -30,6 +30,7 @@ Expected<void> BoothDiffuseCache::init(int slices,
                                        bool nodes,
                                        bool facetCache,
                                        shading::GridNodes diffuseGrid,
+                                       bool relief,
                                        const BoothPrograms& programs)
 {
     slices_ = std::max(slices, 1);
@@ -49,7 +50,7 @@ Expected<void> BoothDiffuseCache::init(int slices,
     diffuseNodes_ = diffuseGrid;
     if (diffuseNodes_.x > 0) {
         if (auto ok = booth_upload::nodeTarget(diffuseNodes_, kUnitDiffGrid, "diffuse",
-                                               diffuseTexture_, diffuseFbo_);
+                                               diffuseTexture_, diffuseFbo_, relief);
             !ok) {
             return ok;
         }
@@ -212,8 +213,9 @@ void BoothDiffuseCache::drawSlice(const BoothPrograms& programs,
     const int width = band.width;
     const int height = band.height;
     if (slice == 0 && diffuseNodes_.x > 0) {
-        // E_geo at the diffuse grid's nodes, for mode 0 to interpolate on the surface (it stays
-        // for the refresh's later bands: nothing else draws into it).
+        // E_geo at the diffuse grid's nodes (and on relief eq. (1) with the facets), for mode 0
+        // to interpolate on the surface (it stays for the refresh's later bands: nothing else
+        // draws into it).
         glBindFramebuffer(GL_FRAMEBUFFER, diffuseFbo_.get());
         glViewport(0, 0, diffuseNodes_.x, diffuseNodes_.y);
         programs.usePose(BoothMode::DiffuseGrid, pose);

@@ -45,11 +45,12 @@ public:
     // 'slices' (settings.cacheSlices): bands a pose change is redrawn in; 'nodes'
     // (settings.tiltNodesRad > 0): keep the terms of several poses and compose two of them
     // interpolated, as CacheWant names; 'facetCache': keep the facet normals; 'diffuseGrid': the
-    // diffuse grid's nodes (none: per pixel).
+    // diffuse grid's nodes (none: per pixel), holding eq. (1) with the facets too on 'relief'.
     Expected<void> init(int slices,
                         bool nodes,
                         bool facetCache,
                         shading::GridNodes diffuseGrid,
+                        bool relief,
                         const BoothPrograms& programs);
 
     // Makes the cache's targets width x height (new ones, holding nothing, on a size change).

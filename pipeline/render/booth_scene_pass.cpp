@@ -196,8 +196,8 @@ std::string BoothScenePass::description() const
     const std::string grids =
             (glossy && s.specularGrid > 0 ? fmt::format(", specular grid {} texels", s.specularGrid)
                                           : std::string()) +
-            (flat && s.diffuseGrid > 0 ? fmt::format(", diffuse grid {} texels", s.diffuseGrid)
-                                       : std::string()) +
+            (s.diffuseGrid > 0 ? fmt::format(", diffuse grid {} texels", s.diffuseGrid)
+                               : std::string()) +
             (s.cacheSlices > 1 ? fmt::format(", a tilt recomputed over {} frames", s.cacheSlices)
                                : std::string()) +
             (s.tiltNodesRad > 0.0 ? fmt::format(", tilt nodes {:.3g} degrees apart",

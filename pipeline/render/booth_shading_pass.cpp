@@ -100,8 +100,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
     const shading::GridNodes specularNodes =
             specular_ ? shading::gridNodes(s, settings_.specularGrid) : shading::GridNodes{};
     const bool facetCache = relief && specular_ && specularNodes.x == 0;
-    const shading::GridNodes diffuseNodes =
-            relief ? shading::GridNodes{} : shading::gridNodes(s, settings_.diffuseGrid);
+    const shading::GridNodes diffuseNodes = shading::gridNodes(s, settings_.diffuseGrid);
     const int samples = specular_ ? settings_.specularSamples : 0;
     if (samples > kBoothMaxSpecularSamples) {
         return makeError(ErrorCode::InvalidArgument,
@@ -134,7 +133,7 @@ Expected<void> BoothShadingPass::init(const shading::PreparedScene& ps, BoothUnr
         return ok;
     }
     if (auto ok = cache_.init(settings_.cacheSlices, settings_.tiltNodesRad > 0.0, facetCache,
-                              diffuseNodes, programs_);
+                              diffuseNodes, relief, programs_);
         !ok) {
         return ok;
     }

@@ -28,10 +28,12 @@ Expected<void> nodeTarget(shading::GridNodes nodes,
                           GLint unit,
                           const char* grid,
                           GlTexture& texture,
-                          GlFramebuffer& fbo)
+                          GlFramebuffer& fbo,
+                          bool twoValues)
 {
     glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
-    texture = texture2d(GL_R32F, GL_RED, GL_FLOAT, nodes.x, nodes.y, nullptr);
+    texture = twoValues ? texture2d(GL_RG32F, GL_RG, GL_FLOAT, nodes.x, nodes.y, nullptr)
+                        : texture2d(GL_R32F, GL_RED, GL_FLOAT, nodes.x, nodes.y, nullptr);
     glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE0);
     fbo = GlFramebuffer::make();
@@ -41,9 +43,9 @@ Expected<void> nodeTarget(shading::GridNodes nodes,
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (!complete) {
         return makeError(ErrorCode::Unsupported,
-                         fmt::format("render: the booth pass's R32F {0} grid is not renderable on "
-                                     "this GL; run with a {0} grid of 0 (per pixel)",
-                                     grid));
+                         fmt::format("render: the booth pass's {1} {0} grid is not renderable "
+                                     "on this GL; run with a {0} grid of 0 (per pixel)",
+                                     grid, twoValues ? "RG32F" : "R32F"));
     }
     return {};
 }

@@ -19,13 +19,15 @@ namespace replica::pipeline::render::booth_upload {
 // Nearest sampling, clamped to the edge, on the texture bound to 'target'.
 void nearest(GLenum target);
 
-// A grid's target: one R32F texel per node (made on 'unit', so that creating it binds over no
-// other input) and a framebuffer that draws into it; an error naming 'grid' if not renderable.
+// A grid's target: one R32F texel per node, RG32F with 'twoValues' (made on 'unit', so that
+// creating it binds over no other input) and a framebuffer that draws into it; an error naming
+// 'grid' if not renderable.
 Expected<void> nodeTarget(shading::GridNodes nodes,
                           GLint unit,
                           const char* grid,
                           GlTexture& texture,
-                          GlFramebuffer& fbo);
+                          GlFramebuffer& fbo,
+                          bool twoValues = false);
 
 // The horizon map as a 2-D array texture: directions [8j, 8j + 8) as half floats in layer j of
 // an RGBA32UI array (packHalf2x16's layout). 'dirs' 0: one empty texel.

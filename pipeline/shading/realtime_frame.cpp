@@ -65,11 +65,20 @@ public:
             const Vec3 toEye = towardEye(sp);
             return glm::dot(toEye, sp.nGeo) > 0.0 ? specularAt(sp, toEye) : 0.0;
         });
-        diffuseNodes_ = relief_ ? GridNodes{} : gridNodes(scene_, settings_.diffuseGrid);
+        diffuseNodes_ = gridNodes(scene_, settings_.diffuseGrid);
         diffuseGrid_ = gridValues(diffuseNodes_, [&](const ShadingPoint& sp) {
             return diffuse_(light_.points, nl_, texelArea_, withMacroNormal(sp), nullptr, 0.0,
                             false);
         });
+        // On relief the grid also holds eq. (1) with the node's facet and horizons (the GL's
+        // mode 3 writes both into one RG32F texel).
+        diffuseReliefGrid_ =
+                relief_ ? gridValues(diffuseNodes_,
+                                     [&](const ShadingPoint& sp) {
+                                         return diffuse_(light_.points, nl_, texelArea_, sp,
+                                                         horizon_, settings_.horizonSoftness, true);
+                                     })
+                        : std::vector<double>{};
         if (settings_.walls && light_.walls != nullptr) {
             walls_ = wallField(*light_.walls, view_.panel, scene_);
         }
@@ -154,9 +163,11 @@ private:
                                                      withMacroNormal(sp), nullptr, 0.0, false);
         double e = eGeo;
         if (relief_) {
-            // Eq. (1)'s horizons bilinear at the pixel's point on the surface.
-            e = diffuse_(light_.points, nl_, texelArea_, sp, horizon_, settings_.horizonSoftness,
-                         true);
+            // Eq. (1)'s horizons bilinear at the pixel's point on the surface, or between the
+            // grid's nodes, where they were taken at each node's point.
+            e = diffuseNodes_.x > 0 ? gridValue(diffuseReliefGrid_, diffuseNodes_, u, v)
+                                    : diffuse_(light_.points, nl_, texelArea_, sp, horizon_,
+                                               settings_.horizonSoftness, true);
         }
         if (walls_) {
             const double wallGeo = wallFieldAt(*walls_, u, v, sp.nGeo, sp.nGeo);
@@ -208,7 +219,7 @@ private:
     const colour::Xyz specXyz_;
     const int threads_;
     GridNodes specularNodes_, diffuseNodes_;
-    std::vector<double> specularGrid_, diffuseGrid_;
+    std::vector<double> specularGrid_, diffuseGrid_, diffuseReliefGrid_;
     std::optional<WallField> walls_;
 };
 

@@ -396,25 +396,41 @@ GridNodes gridNodes(const surface::SurfaceScene& scene, int spacingTexels)
             (scene.height + spacingTexels - 1) / spacingTexels + 1};
 }
 
-int defaultSpecularGrid(const surface::SurfaceScene& scene)
+namespace {
+
+// The largest power of two g <= most whose g texels turn the surface by at most 'reach'
+// radians, where it turns by 'turn' a texel at most; 0 when one texel already turns further.
+// Compared as products, so that a plane's zero turn (a tilted plane is relief too) divides
+// nothing: it gets 'most'.
+int gridWithin(double turn, double reach, int most)
 {
-    if (scene.flat()) {
-        return kFlatSpecularGrid;
-    }
-    // Compared as products, so that a plane's zero turn (a tilted plane is relief too) divides
-    // nothing: it gets the flat surface's grid.
-    const double turn = surface::largestNormalTurn(scene.relief);
-    const double reach = kReliefGridLobeFraction * scene.alpha;
     int grid = 0;
-    for (int g = 1; g <= kFlatSpecularGrid && 2.0 * turn * g <= reach; g *= 2) {
+    for (int g = 1; g <= most && turn * g <= reach; g *= 2) {
         grid = g;
     }
     return grid;
 }
 
+} // namespace
+
+int defaultSpecularGrid(const surface::SurfaceScene& scene)
+{
+    if (scene.flat()) {
+        return kFlatSpecularGrid;
+    }
+    // The mirror direction turns twice as fast as the normal.
+    return gridWithin(surface::largestNormalTurn(scene.relief),
+                      0.5 * kReliefGridLobeFraction * scene.alpha, kFlatSpecularGrid);
+}
+
 int defaultDiffuseGrid(const surface::SurfaceScene& scene)
 {
-    return scene.flat() ? kFlatDiffuseGrid : 0;
+    if (scene.flat()) {
+        return kFlatDiffuseGrid;
+    }
+    return gridWithin(surface::largestNormalTurn(scene.relief),
+                      kReliefDiffuseGridSoftnesses * RenderSettings{}.horizonSoftness,
+                      kFlatDiffuseGrid);
 }
 
 bool defaultAreaLights(const surface::SurfaceScene& scene)

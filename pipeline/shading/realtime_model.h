@@ -87,8 +87,9 @@ struct RenderSettings {
     // smoothly over the surface, and shading it at grid nodes and interpolating costs a fraction
     // of shading it per pixel (gridNodes; the planner measures the error it adds).
     int specularGrid = 0;
-    // Texels between the nodes of the diffuse grid; 0: eq. (1) per pixel. Ignored on relief,
-    // whose facets and horizons change from texel to texel. On a flat surface the illuminance from
+    // Texels between the nodes of the diffuse grid; 0: eq. (1) per pixel. On relief the nodes
+    // hold eq. (1) with their own facets and horizons as well (defaultDiffuseGrid says where that
+    // holds: where the relief turns slowly). On a flat surface the illuminance from
     // the booth's lights varies over centimetres, not texels: summed at the grid's nodes
     // (gridNodes' layout) and interpolated, it costs a frame that recomputes the cache
     // (the panel being tilted) a few hundred sums instead of one per pixel.
@@ -143,10 +144,19 @@ int defaultSpecularGrid(const surface::SurfaceScene& scene);
 
 // On a flat surface the diffuse term (eq. 1 with the macro normal) is summed every 8 texels and
 // interpolated: the shipped flat scenes move by ΔE00 0.01 at most against per pixel (docs/
-// rendering.md). 0 (per pixel) on relief.
+// rendering.md).
 constexpr int kFlatDiffuseGrid = 8;
+// Relief: eq. (1) with each node's facet and horizons. Its cosines are wide; what varies fastest
+// is each light's horizon test, a smoothstep 2 horizonSoftness wide in the sine of the light's
+// elevation, which the horizon sweeps about as fast as the surface turns. The grid is the largest
+// power of two (at most kFlatDiffuseGrid) whose span turns the surface by at most this many
+// softnesses, and per pixel where one texel turns further (the painting). Measured on the glossy
+// cylinder (0.45 degrees a texel: a grid of 4) under D65 with its plan's 128 lights at the
+// appliance's density, against per pixel: p95 0.005 / max 0.10 at tilt 30, 0.042 / 0.29 at tilt
+// 10 from the side; at 8 texels 0.061 / 0.13 and 0.125 / 0.37 (docs/rendering.md).
+constexpr double kReliefDiffuseGridSoftnesses = 2.0;
 // The spacing the appliance and 'replica render' use unless told: kFlatDiffuseGrid on a flat
-// surface, 0 on relief.
+// surface, the rule above on relief.
 int defaultDiffuseGrid(const surface::SurfaceScene& scene);
 
 // Whether the appliance lights eq. (1) from areas unless told (RenderSettings::areaLights): on a

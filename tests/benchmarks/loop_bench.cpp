@@ -51,6 +51,15 @@ platform::Appliance* appliance(int scene, int specularSamples, int cacheSlices)
     if (const char* grid = std::getenv("REPLICA_BENCH_SPECULAR_GRID")) {
         c.specularGrid = std::atoi(grid);
     }
+    // REPLICA_BENCH_LIGHTS=N: N median-cut lights instead of 32 (the glossy cylinder's d65 plan
+    // takes 128).
+    if (const char* lights = std::getenv("REPLICA_BENCH_LIGHTS")) {
+        c.boothLights = std::atoi(lights);
+    }
+    // REPLICA_BENCH_DIFFUSE_GRID=T: likewise for the diffuse grid (shading::defaultDiffuseGrid).
+    if (const char* grid = std::getenv("REPLICA_BENCH_DIFFUSE_GRID")) {
+        c.diffuseGrid = std::atoi(grid);
+    }
     // REPLICA_BENCH_POINT_LIGHTS or REPLICA_BENCH_AREA_LIGHTS set: eq. (1) from point lights or
     // from areas on every scene (for an A/B of the two in one build: tests/benchmarks/ab_loop.sh
     // with wrappers that set them); neither: as the appliance chooses for the scene.
@@ -142,6 +151,7 @@ BENCHMARK(BM_ApplianceFrame)
         ->Args({2, 0, 48, platform::kDefaultCacheSlices})
         ->Args({2, 0, 16, platform::kDefaultCacheSlices})
         ->Args({3, 0, 48, platform::kDefaultCacheSlices}) // the cylinder's d65 plan: 48 samples
+        ->Args({3, 1, 48, platform::kDefaultCacheSlices})
         ->Args({2, 0, 12, platform::kDefaultCacheSlices}) // the painting's default before 8
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();

@@ -41,7 +41,7 @@ vec3 facetNormal(vec2 tex, ivec2 tc) {
 #if BOOTH_FACET_CACHE && BOOTH_MODE == 0
     outFacet = vec4(nl, 0.0);
 #endif
-#if BOOTH_MODE == 0
+#if BOOTH_MODE == 0 || BOOTH_MODE == 3
     bilinearHorizons(tex.x, tex.y);
 #else
     for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {
@@ -72,17 +72,19 @@ void specularNode(vec3 p, vec3 nShade) {
     outXyz = vec4(finiteOrZero(spec), 0.0, 0.0, 0.0);
 }
 
-// Mode 3: realtime_model.cpp's diffuse grid: eq. (1) with the macro normal at this node.
-void diffuseNode(vec3 p) {
+// Mode 3: realtime_model.cpp's diffuse grid: eq. (1) with the macro normal at this node, and on
+// relief with the node's facet and horizons too (green; the texture is RG32F there).
+void diffuseNode(vec3 p, vec3 nShade) {
     float eg = 0.0;
-    float unused = 0.0;
-#define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, uNormal, false, eg, unused); }
+    float e = 0.0;
+    bool relief = uRelief;
+#define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, nShade, relief, eg, e); }
     BOOTH_LIGHT_CALLS
 #undef LIGHT_AT
     for (int i = BOOTH_UNROLLED_LIGHTS; i < uLightCount; ++i) {
-        diffuseLight(i, p, uNormal, false, eg, unused);
+        diffuseLight(i, p, nShade, relief, eg, e);
     }
-    outXyz = vec4(finiteOrZero(eg), 0.0, 0.0, 0.0);
+    outXyz = vec4(finiteOrZero(eg), finiteOrZero(e), 0.0, 0.0);
 }
 
 // Mode 0 around the surface: only E_geo (pass 2's flare): eq. (1) with the macro normal, the
@@ -123,8 +125,12 @@ void diffuseCache(vec3 p, vec3 nShade, vec2 uv, ivec2 tc, bool inside) {
     // uniform array at a loop counter as a gather per pixel, at a constant index as one load), then
     // any beyond them in a loop. Same lights in the same order.
 #if BOOTH_DIFFUSE_GRID
-    // Flat, and inside the surface here: E_geo between the diffuse grid's nodes.
+    // Inside the surface here: E_geo between the diffuse grid's nodes, and on relief eq. (1) with
+    // facets and horizons too, taken at each node.
     eGeo = gridValue(uDiffGrid, uDiffNodes, uv.x, uv.y);
+    if (relief) {
+        e = gridValueGreen(uDiffGrid, uDiffNodes, uv.x, uv.y);
+    }
 #else
 #define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, nShade, relief, eGeo, e); }
     BOOTH_LIGHT_CALLS
@@ -209,7 +215,7 @@ void main() {
     ivec2 tc = clamp(ivec2(floor(tex)), ivec2(0), uTexels - 1);
     vec3 nShade = uNormal;
     // Facets and horizons where this mode shades with them (the compose reads a grid's specular).
-    bool facets = uMode == 0 || (kSpecular && (uMode == 2 || !kGrid));
+    bool facets = uMode == 0 || uMode == 3 || (kSpecular && (uMode == 2 || !kGrid));
 #if !(BOOTH_MODE == 0 && BOOTH_SURROUND)
     if (inside && uRelief && facets) {
         nShade = facetNormal(tex, tc);
@@ -218,7 +224,7 @@ void main() {
     if (uMode == 2) {
         specularNode(p, nShade);
     } else if (uMode == 3) {
-        diffuseNode(p);
+        diffuseNode(p, nShade);
     } else if (uMode == 0) {
 #if BOOTH_SURROUND
         flareOnly(p, uv); // around the surface: only E_geo

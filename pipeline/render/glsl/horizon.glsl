@@ -15,7 +15,7 @@ vec2 bilinearTexel(float x, float y, out ivec2 c) {
     return vec2(fx - x0, fy - y0);
 }
 
-#if BOOTH_MODE == 0
+#if BOOTH_MODE == 0 || BOOTH_MODE == 3
 // Adds w times texel t's horizon sines to hz (horizonTexture's layout).
 void addHorizons(ivec2 t, float w) {
     for (int j = 0; j < (uHorizonDirs + 7) / 8; ++j) {

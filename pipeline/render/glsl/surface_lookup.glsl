@@ -17,16 +17,33 @@ vec3 sampleNormal(float x, float y) {
     return len > 1e-12 ? n / len : vec3(0.0, 0.0, 1.0);
 }
 
-// realtime_model.cpp gridValue: bilinear between the four nodes around (u, v).
-float gridValue(sampler2D grid, ivec2 nodes, float u, float v) {
+// realtime_model.cpp gridValue: bilinear between the four nodes around (u, v). gridCell finds
+// them (c the one below and left) and the weights towards the others.
+ivec2 gridCell(ivec2 nodes, float u, float v, out vec2 a) {
     vec2 last = vec2(nodes - 1);
     vec2 f = clamp(vec2(u, v), 0.0, 1.0) * last;
     vec2 f0 = min(floor(f), last - 1.0);
-    vec2 a = f - f0;
-    ivec2 c = ivec2(f0);
-    float s00 = texelFetch(grid, c, 0).r;
-    float s10 = texelFetch(grid, c + ivec2(1, 0), 0).r;
-    float s01 = texelFetch(grid, c + ivec2(0, 1), 0).r;
-    float s11 = texelFetch(grid, c + ivec2(1, 1), 0).r;
+    a = f - f0;
+    return ivec2(f0);
+}
+
+float gridBilinear(float s00, float s10, float s01, float s11, vec2 a) {
     return (1.0 - a.y) * ((1.0 - a.x) * s00 + a.x * s10) + a.y * ((1.0 - a.x) * s01 + a.x * s11);
+}
+
+float gridValue(sampler2D grid, ivec2 nodes, float u, float v) {
+    vec2 a;
+    ivec2 c = gridCell(nodes, u, v, a);
+    return gridBilinear(texelFetch(grid, c, 0).r, texelFetch(grid, c + ivec2(1, 0), 0).r,
+                        texelFetch(grid, c + ivec2(0, 1), 0).r,
+                        texelFetch(grid, c + ivec2(1, 1), 0).r, a);
+}
+
+// The same from the grid's second channel (the diffuse grid's eq. (1) on relief).
+float gridValueGreen(sampler2D grid, ivec2 nodes, float u, float v) {
+    vec2 a;
+    ivec2 c = gridCell(nodes, u, v, a);
+    return gridBilinear(texelFetch(grid, c, 0).g, texelFetch(grid, c + ivec2(1, 0), 0).g,
+                        texelFetch(grid, c + ivec2(0, 1), 0).g,
+                        texelFetch(grid, c + ivec2(1, 1), 0).g, a);
 }

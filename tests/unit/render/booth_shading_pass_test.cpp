@@ -235,16 +235,19 @@ TEST_F(BoothPassTest, SpecularGridMatchesTheCpuModel)
 TEST_F(BoothPassTest, DiffuseGridMatchesTheCpuModel)
 {
     // The diffuse grid's nodes (mode 3) and the cache's interpolation (mode 0) against the
-    // model's, on both flat scenes at the appliance's spacing and at 3 texels; on relief the grid
-    // is ignored by both, so the painting's frame is the per-pixel one.
+    // model's, on both flat scenes at the appliance's spacing and at 3 texels; on relief (eq. (1)
+    // with each node's facet and horizons as well) the painting at 8 texels, which its rule never
+    // picks but which the pass must draw as the model does, and the glossy cylinder at its own.
     const shading::View v = view(64, 40, 20.0);
     struct Case {
         const char* scene;
         int grid;
     };
-    for (const Case c : {Case{"colorchecker", shading::kFlatDiffuseGrid},
-                         Case{"metamer", shading::kFlatDiffuseGrid}, Case{"metamer", 3},
-                         Case{"painting", shading::kFlatDiffuseGrid}}) {
+    for (const Case c :
+         {Case{"colorchecker", shading::kFlatDiffuseGrid},
+          Case{"metamer", shading::kFlatDiffuseGrid}, Case{"metamer", 3},
+          Case{"painting", shading::kFlatDiffuseGrid},
+          Case{"glossy-cylinder", shading::defaultDiffuseGrid(scenes_.at("glossy-cylinder"))}}) {
         shading::RenderSettings settings;
         settings.diffuseGrid = c.grid;
         settings.specularGrid = shading::defaultSpecularGrid(scenes_.at(c.scene));

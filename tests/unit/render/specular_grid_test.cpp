@@ -121,20 +121,26 @@ TEST(ReliefSpecularGrid, SpacingFollowsHowFastTheSurfaceTurnsAgainstTheLobe)
 {
     // The cylinder's normal turns fastest at its outer rows, 78 mm from the crest:
     // turn = 1 mm / sqrt(R^2 - (78 mm)^2) (tests/unit/surface/relief_test.cpp checks that). The
-    // grid is the largest power of two g <= 8 with 2 turn g <= 0.75 alpha.
+    // specular grid is the largest power of two g <= 8 with 2 turn g <= 0.75 alpha.
+    // The diffuse grid: the largest power of two g <= 8 with turn g <= 2 x 0.02 (two horizon
+    // softnesses), whatever the gloss.
     struct Case {
         double radius, alpha;
-        int grid;
+        int grid, diffuseGrid;
     };
     for (const Case c : {
-                 Case{0.15, 0.05, 2}, // turn 0.00781: g <= 2.40
-                 Case{0.30, 0.05, 4}, // turn 0.00345: g <= 5.43
-                 Case{0.50, 0.05, 8}, // turn 0.00202: g <= 9.27, and 8 at most
-                 Case{0.09, 0.05, 0}, // turn 0.0223: even one texel is 0.84 of the reach
-                 Case{0.15, 0.20, 8}, // a wider lobe: g <= 9.6
-                 Case{0.15, 0.01, 0}, // a mirror-like one: g <= 0.48
+                 Case{0.15, 0.05, 2, 4}, // turn 0.00781: g <= 2.40; diffuse g <= 5.12
+                 Case{0.30, 0.05, 4, 8}, // turn 0.00345: g <= 5.43; diffuse g <= 11.6
+                 Case{0.50, 0.05, 8, 8}, // turn 0.00202: g <= 9.27, and 8 at most
+                 Case{0.09, 0.05, 0, 1}, // turn 0.0223: even one texel is 0.84 of the reach;
+                                         // diffuse g <= 1.79
+                 Case{0.15, 0.20, 8, 4}, // a wider lobe: g <= 9.6
+                 Case{0.15, 0.01, 0, 4}, // a mirror-like one: g <= 0.48
          }) {
-        EXPECT_EQ(defaultSpecularGrid(cylinderScene(c.radius, c.alpha)), c.grid)
+        const surface::SurfaceScene scene = cylinderScene(c.radius, c.alpha);
+        EXPECT_EQ(defaultSpecularGrid(scene), c.grid)
+                << "radius " << c.radius << " alpha " << c.alpha;
+        EXPECT_EQ(defaultDiffuseGrid(scene), c.diffuseGrid)
                 << "radius " << c.radius << " alpha " << c.alpha;
     }
     // A plane is the flat case whatever its tilt.
@@ -146,23 +152,28 @@ TEST(ReliefSpecularGrid, SpacingFollowsHowFastTheSurfaceTurnsAgainstTheLobe)
     }
     ASSERT_FALSE(tilted.flat());
     EXPECT_EQ(defaultSpecularGrid(tilted), kFlatSpecularGrid);
+    EXPECT_EQ(defaultDiffuseGrid(tilted), kFlatDiffuseGrid);
     // The shipped scenes: the ColorChecker flat, the painting's texel-sized relief per pixel, the
-    // glossy cylinder (radius 15 cm, alpha 0.05) every 2 texels.
-    for (const auto& [name, grid] : {std::pair<const char*, int>{"colorchecker", kFlatSpecularGrid},
-                                     {"painting", 0},
-                                     {"glossy-cylinder", 2}}) {
-        auto scene = surface::loadScene(dataDir() / "scenes" / name);
-        ASSERT_TRUE(scene) << name;
-        EXPECT_EQ(defaultSpecularGrid(*scene), grid) << name;
+    // glossy cylinder (radius 15 cm, alpha 0.05) every 2 texels, its diffuse term every 4.
+    struct Shipped {
+        const char* name;
+        int grid, diffuseGrid;
+    };
+    for (const Shipped c : {Shipped{"colorchecker", kFlatSpecularGrid, kFlatDiffuseGrid},
+                            Shipped{"painting", 0, 0}, Shipped{"glossy-cylinder", 2, 4}}) {
+        auto scene = surface::loadScene(dataDir() / "scenes" / c.name);
+        ASSERT_TRUE(scene) << c.name;
+        EXPECT_EQ(defaultSpecularGrid(*scene), c.grid) << c.name;
+        EXPECT_EQ(defaultDiffuseGrid(*scene), c.diffuseGrid) << c.name;
     }
 }
 
-// What the glossy cylinder's grid costs where it counts: against the exact reference, at the
-// panel's own density (the appliance shows its 240 x 160 texels on about 445 x 296 pixels), with
-// the plan's D65 setting (128 lights, 48 samples). The interpolation's error is a property of
-// each point, so a few hundred pixels at random, evaluated by the reference one by one, measure
-// it as the whole frame would.
-TEST(ReliefSpecularGrid, TheGlossyCylindersGridStaysNearPerPixelAgainstTheReference)
+// What the glossy cylinder's grids (specular every 2 texels, diffuse every 4) cost where it
+// counts: against the exact reference, at the panel's own density (the appliance shows its
+// 240 x 160 texels on about 445 x 296 pixels), with the plan's D65 setting (128 point lights, 48
+// samples). The interpolation's error is a property of each point, so a few hundred pixels at
+// random, evaluated by the reference one by one, measure it as the whole frame would.
+TEST(ReliefSpecularGrid, TheGlossyCylindersGridsStayNearPerPixelAgainstTheReference)
 {
     auto obs = colour::loadCie1931(dataDir());
     auto booth = booth::loadBooth(dataDir() / "booth");
@@ -174,9 +185,14 @@ TEST(ReliefSpecularGrid, TheGlossyCylindersGridStaysNearPerPixelAgainstTheRefere
     perPixel.lights = 128;
     perPixel.specularSamples = 48;
     perPixel.specularGrid = 0;
+    perPixel.diffuseGrid = 0;
+    perPixel.areaLights = defaultAreaLights(*scene);
+    ASSERT_FALSE(perPixel.areaLights);
     RenderSettings grid = perPixel;
     grid.specularGrid = defaultSpecularGrid(*scene);
+    grid.diffuseGrid = defaultDiffuseGrid(*scene);
     ASSERT_EQ(grid.specularGrid, 2);
+    ASSERT_EQ(grid.diffuseGrid, 4);
     // The appliance's basis, made for the light: what is left is the geometry's error.
     auto encoder = spectral::AdaptiveEncoder::createDefault(dataDir());
     ASSERT_TRUE(encoder) << encoder.error().message;
@@ -232,8 +248,9 @@ TEST(ReliefSpecularGrid, TheGlossyCylindersGridStaysNearPerPixelAgainstTheRefere
         RecordProperty("tilt_" + std::to_string(static_cast<int>(pose.tiltDeg)) + "_p95",
                        std::to_string(p95PerPixel) + " per pixel, " + std::to_string(p95Grid) +
                                " grid");
-        std::printf("tilt %.0f: p95 / max per pixel %.3f / %.3f, grid %d %.3f / %.3f\n",
-                    pose.tiltDeg, p95PerPixel, maxPerPixel, grid.specularGrid, p95Grid, maxGrid);
+        std::printf("tilt %.0f: p95 / max per pixel %.3f / %.3f, grids %d and %d %.3f / %.3f\n",
+                    pose.tiltDeg, p95PerPixel, maxPerPixel, grid.specularGrid, grid.diffuseGrid,
+                    p95Grid, maxGrid);
     }
 }
 
