@@ -383,9 +383,11 @@ void registerRenderCommand(CLI::App& app, int& exitCode)
             ->capture_default_str()
             ->check(CLI::Range(kAutoSpecularGrid, 256));
     cmd->add_option("--diffuse-grid", args->diffuseGrid,
-                    "texels between the nodes eq. (1) is summed at on a flat surface, then "
-                    "interpolated; 0: per pixel; -1: as the appliance chooses (8 on a flat "
-                    "surface; relief is always per pixel)")
+                    "texels between the nodes eq. (1) is summed at (on relief with each node's "
+                    "facet and horizons), then interpolated; 0: per pixel; -1: as the appliance "
+                    "chooses (8 on a flat surface; on relief the most the surface's turn per "
+                    "texel allows against the horizon test's softness, per pixel where it turns "
+                    "fast)")
             ->capture_default_str()
             ->check(CLI::Range(kAutoDiffuseGrid, 256));
     cmd->add_flag("--specular-trilinear", args->trilinear,
