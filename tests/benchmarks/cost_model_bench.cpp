@@ -181,6 +181,8 @@ bool timeWalls(const std::string& scene,
 bool timeGrid(const std::string& scene,
               bool glossy,
               bool relief,
+              int specularGrid,
+              int diffuseGrid,
               int frames,
               int w,
               int h,
@@ -199,6 +201,9 @@ bool timeGrid(const std::string& scene,
                 rs.lights = l;
                 rs.specularSamples = s;
                 rs.horizonDirections = d;
+                // The appliance's grids for the scene, which the frame timed draws with.
+                rs.specularGrid = specularGrid;
+                rs.diffuseGrid = diffuseGrid;
                 r.modelCost = shading::settingCost(rs, glossy, relief);
                 if (!timeSetting(scene, r, frames, w, h)) {
                     return false;
@@ -288,7 +293,7 @@ int main(int argc, char** argv)
     if (!writeWalledBooth(walled)) {
         return 1;
     }
-    for (const char* sceneName : {"metamer", "colorchecker", "painting"}) {
+    for (const char* sceneName : {"metamer", "colorchecker", "painting", "glossy-cylinder"}) {
         if (!args.scene.empty() && args.scene != sceneName) {
             continue;
         }
@@ -300,7 +305,9 @@ int main(int argc, char** argv)
         const bool glossy = scene->glossy();
         const bool relief = !scene->flat();
         std::vector<Row> rows;
-        if (!timeGrid(sceneName, glossy, relief, args.frames, args.width, args.height, rows) ||
+        if (!timeGrid(sceneName, glossy, relief, shading::defaultSpecularGrid(*scene),
+                      shading::defaultDiffuseGrid(*scene), args.frames, args.width, args.height,
+                      rows) ||
             !printFit(sceneName, rows, glossy, relief)) {
             return 1;
         }
