@@ -129,7 +129,7 @@ void diffuseCache(vec3 p, vec3 nShade, vec2 uv, ivec2 tc, bool inside) {
     // facets and horizons too, taken at each node.
     eGeo = gridValue(uDiffGrid, uDiffNodes, uv.x, uv.y);
     if (relief) {
-        e = gridValueGreen(uDiffGrid, uDiffNodes, uv.x, uv.y);
+        e = gridChannel(uDiffGrid, uDiffNodes, uv.x, uv.y, 1);
     }
 #else
 #define LIGHT_AT(k) if (k < uLightCount) { diffuseLight(k, p, nShade, relief, eGeo, e); }

@@ -31,19 +31,16 @@ float gridBilinear(float s00, float s10, float s01, float s11, vec2 a) {
     return (1.0 - a.y) * ((1.0 - a.x) * s00 + a.x * s10) + a.y * ((1.0 - a.x) * s01 + a.x * s11);
 }
 
-float gridValue(sampler2D grid, ivec2 nodes, float u, float v) {
+// Channel 'k' of the grid (0 for both grids; 1: the diffuse grid's eq. (1) on relief); every
+// caller passes a constant, which the compiler folds into a plain component read.
+float gridChannel(sampler2D grid, ivec2 nodes, float u, float v, int k) {
     vec2 a;
     ivec2 c = gridCell(nodes, u, v, a);
-    return gridBilinear(texelFetch(grid, c, 0).r, texelFetch(grid, c + ivec2(1, 0), 0).r,
-                        texelFetch(grid, c + ivec2(0, 1), 0).r,
-                        texelFetch(grid, c + ivec2(1, 1), 0).r, a);
+    return gridBilinear(texelFetch(grid, c, 0)[k], texelFetch(grid, c + ivec2(1, 0), 0)[k],
+                        texelFetch(grid, c + ivec2(0, 1), 0)[k],
+                        texelFetch(grid, c + ivec2(1, 1), 0)[k], a);
 }
 
-// The same from the grid's second channel (the diffuse grid's eq. (1) on relief).
-float gridValueGreen(sampler2D grid, ivec2 nodes, float u, float v) {
-    vec2 a;
-    ivec2 c = gridCell(nodes, u, v, a);
-    return gridBilinear(texelFetch(grid, c, 0).g, texelFetch(grid, c + ivec2(1, 0), 0).g,
-                        texelFetch(grid, c + ivec2(0, 1), 0).g,
-                        texelFetch(grid, c + ivec2(1, 1), 0).g, a);
+float gridValue(sampler2D grid, ivec2 nodes, float u, float v) {
+    return gridChannel(grid, nodes, u, v, 0);
 }
