@@ -629,15 +629,18 @@ TEST_F(BoothPassTest, HardCasesOnShippedScenesMatchTheCpuModelAndTheReference)
     }
     double worstP95 = 0.0, worstMax = 0.0, worstStrip = 0.0, worstStripMatte = 0.0;
     for (const auto& [name, scene] : scenes_) {
-        if (name == "glossy-cylinder") {
-            // In the suite for the GL-against-CPU tests; not held to these bounds against the
-            // reference: at 32 lights its tilt of 80 degrees reaches p95 1.04 and the one-texel
-            // lamp p95 18 (a curved mirror of the strip), measured when it joined the suite.
-            continue;
-        }
         shading::RenderSettings settings;
         settings.specularSamples = shading::defaultSpecularSamples(scene);
         settings.areaLights = shading::defaultAreaLights(scene);
+        if (name == "glossy-cylinder") {
+            // Its plan's setting under d65-fluorescent, the light of these cases, and its grids:
+            // what the appliance draws it with. The relief's fixed 8 samples are too few for its
+            // sharp lobe (tilt 80: p95 1.04 at 8, 0.47 at 16, 0.15 at 48).
+            settings.lights = 128;
+            settings.specularSamples = 48;
+            settings.specularGrid = shading::defaultSpecularGrid(scene);
+            settings.diffuseGrid = shading::defaultDiffuseGrid(scene);
+        }
         const auto ps = shading::prepareScene(scene, settings.horizonDirections, 0.01, basis);
         auto pass = BoothShadingPass::create(ps, settings, *obs_);
         ASSERT_TRUE(pass) << pass.error().message;
@@ -688,8 +691,12 @@ TEST_F(BoothPassTest, HardCasesOnShippedScenesMatchTheCpuModelAndTheReference)
             // Matte: the budget. Glossy: the specular samples find the strip's mirror image in the
             // mip chain, blurred over the level's texels, so the highlight is spread wrong
             // (measured p95 4.6 on the ColorChecker, 8.1 on the painting at 30 degrees, where
-            // the strip's reflection is in view): a stated limit, held to 1.25 times that.
-            const double limit = scene.glossy() ? (name == "painting" ? 10.2 : 5.8) : 0.05;
+            // the strip's reflection is in view; 7.4 on the glossy cylinder, whose curved mirror
+            // still shows it at 85 degrees, p95 2.1): a stated limit, held to 1.25 times that.
+            const double limit = !scene.glossy()             ? 0.05
+                                 : name == "painting"        ? 10.2
+                                 : name == "glossy-cylinder" ? 9.2
+                                                             : 5.8;
             EXPECT_LE(e.p95, limit) << label;
             (scene.glossy() ? worstStrip : worstStripMatte) =
                     std::max(scene.glossy() ? worstStrip : worstStripMatte, e.p95);
