@@ -125,7 +125,7 @@ Expected<std::vector<double>> SpectralTable::values(const std::string& column) c
     return out;
 }
 
-Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
+Expected<Spectrum> SpectralTable::spectrum(const std::string& column, GridSampling sampling) const
 {
     auto v = values(column);
     if (!v) {
@@ -145,14 +145,14 @@ Expected<Spectrum> SpectralTable::spectrum(const std::string& column) const
                                      kFirstNm, kLastNm));
     }
     return resampleToWorkingGrid(SampledSpectrum{wavelengthNm, std::move(*v)},
-                                 fmt::format("{}: column '{}'", source, column));
+                                 fmt::format("{}: column '{}'", source, column), sampling);
 }
 
-Expected<std::vector<Spectrum>> SpectralTable::allSpectra() const
+Expected<std::vector<Spectrum>> SpectralTable::allSpectra(GridSampling sampling) const
 {
     std::vector<Spectrum> out;
     for (const auto& name : columns) {
-        auto s = spectrum(name);
+        auto s = spectrum(name, sampling);
         if (!s) {
             return tl::unexpected(s.error());
         }

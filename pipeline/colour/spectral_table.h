@@ -21,10 +21,11 @@ struct SpectralTable {
 
     // The named column at the table's own wavelengths, or an error naming the file and column.
     Expected<std::vector<double>> values(const std::string& column) const;
-    // The named column resampled to the working grid, or an error naming the file and column.
-    Expected<Spectrum> spectrum(const std::string& column) const;
+    // The named column resampled to the working grid ('sampling': a light's band average or a
+    // reflectance's value at the band centre), or an error naming the file and column.
+    Expected<Spectrum> spectrum(const std::string& column, GridSampling sampling) const;
     // Every column resampled to the working grid, in header order.
-    Expected<std::vector<Spectrum>> allSpectra() const;
+    Expected<std::vector<Spectrum>> allSpectra(GridSampling sampling) const;
 };
 
 // Parses CSV text. 'source' names the file in messages ("file:line: problem").

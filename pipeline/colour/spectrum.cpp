@@ -56,7 +56,34 @@ double Spectrum::max() const
     return *std::max_element(v.begin(), v.end());
 }
 
-Expected<Spectrum> resampleToWorkingGrid(const SampledSpectrum& s, const std::string& what)
+namespace {
+
+// The samples (covering 380..730 nm, increasing) linear between the two around each band centre.
+Spectrum valuesAtBandCentres(const SampledSpectrum& s)
+{
+    const auto& wl = s.wavelengthNm;
+    Spectrum out;
+    std::size_t i = 0;
+    for (std::size_t b = 0; b < kBands; ++b) {
+        const double centre = bandCentreNm(b);
+        while (i + 1 < wl.size() && wl[i + 1] <= centre) {
+            ++i;
+        }
+        if (wl[i] == centre || i + 1 == wl.size()) {
+            out.v[b] = s.value[i];
+            continue;
+        }
+        // wl[i] < centre < wl[i + 1]: strictly increasing, so the span is positive.
+        const double t = (centre - wl[i]) / (wl[i + 1] - wl[i]);
+        out.v[b] = s.value[i] + t * (s.value[i + 1] - s.value[i]);
+    }
+    return out;
+}
+
+} // namespace
+
+Expected<Spectrum>
+resampleToWorkingGrid(const SampledSpectrum& s, const std::string& what, GridSampling sampling)
 {
     const auto& wl = s.wavelengthNm;
     const std::size_t n = wl.size();
@@ -81,6 +108,9 @@ Expected<Spectrum> resampleToWorkingGrid(const SampledSpectrum& s, const std::st
                                      wl.front(), wl.back(), kFirstNm, kLastNm));
     }
 
+    if (sampling == GridSampling::AtBandCentre) {
+        return valuesAtBandCentres(s);
+    }
     constexpr double kHalfBaseNm = 10.0;
     Spectrum out;
     for (std::size_t b = 0; b < kBands; ++b) {

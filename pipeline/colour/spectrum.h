@@ -42,12 +42,23 @@ struct SampledSpectrum {
     std::vector<double> value;
 };
 
-// Reduces a spectrum on any grid to the working grid with a triangular bandpass of 10 nm half-base
-// centred on each band: band value = sum_i tri(lambda_i) * dlambda_i * S_i / 10. On a 5 nm grid
-// this is exactly the 1/4, 1/2, 1/4 filter of the CIE triangular tables; it keeps the energy of
-// narrow mercury lines that point picking would drop (../docs: a picked F11 white moves by 0.025 in
-// x). Where the triangle reaches past the data (at 380 or 730 nm), the edge value is repeated.
+// How a spectrum on another grid goes onto the working grid.
+// - BandAverage, for light (an SPD, a spectrometer's counts): a triangular bandpass of 10 nm
+//   half-base centred on each band, band value = sum_i tri(lambda_i) * dlambda_i * S_i / 10. On a
+//   5 nm grid this is exactly the 1/4, 1/2, 1/4 filter of the CIE triangular tables; it keeps the
+//   energy of narrow mercury lines that point picking would drop (a picked F11 white moves by
+//   0.025 in x). Where the triangle reaches past the data (at 380 or 730 nm), the edge value is
+//   repeated.
+// - AtBandCentre, for a reflectance or transmittance factor: the value at each band centre,
+//   linear between the two samples around it (a sample on the centre is taken as it is). A factor
+//   multiplies the light wavelength by wavelength, so its band value is its value there; averaged
+//   like a light, a 5 nm reflectance set's colours moved 3 times further from their 5 nm sums
+//   (TCS01-14 under D65: dE00 mean 0.078, max 0.220, against 0.033 / 0.117 at the centres).
+// On data already on the working grid both give the data.
+enum class GridSampling { BandAverage, AtBandCentre };
+
 // Fails when the samples do not cover 380..730 nm, are not strictly increasing, or are not finite.
-Expected<Spectrum> resampleToWorkingGrid(const SampledSpectrum& s, const std::string& what);
+Expected<Spectrum>
+resampleToWorkingGrid(const SampledSpectrum& s, const std::string& what, GridSampling sampling);
 
 } // namespace replica::pipeline::colour

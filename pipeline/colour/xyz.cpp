@@ -11,9 +11,11 @@ Expected<Observer> loadCie1931(const std::filesystem::path& dataDir)
         return tl::unexpected(table.error());
     }
     Observer obs;
-    auto x = table->spectrum("xbar");
-    auto y = table->spectrum("ybar");
-    auto z = table->spectrum("zbar");
+    // The 10 nm table is on the working grid already; a colour-matching function, like a
+    // reflectance, is sampled at the band centres, never averaged over them.
+    auto x = table->spectrum("xbar", GridSampling::AtBandCentre);
+    auto y = table->spectrum("ybar", GridSampling::AtBandCentre);
+    auto z = table->spectrum("zbar", GridSampling::AtBandCentre);
     if (!x || !y || !z) {
         return tl::unexpected(!x ? x.error() : (!y ? y.error() : z.error()));
     }

@@ -64,7 +64,7 @@ Expected<booth::Booth> loadApplianceBooth(const std::filesystem::path& boothDir,
         if (!table) {
             return tl::unexpected(table.error());
         }
-        auto s = table->spectrum(light.referenceColumn);
+        auto s = table->spectrum(light.referenceColumn, colour::GridSampling::BandAverage);
         if (!s) {
             return tl::unexpected(s.error());
         }

@@ -34,13 +34,14 @@ void NamedSpectra::append(const NamedSpectra& other)
     spectra.insert(spectra.end(), other.spectra.begin(), other.spectra.end());
 }
 
-Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path)
+Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path,
+                                        colour::GridSampling sampling)
 {
     auto table = colour::loadSpectralCsv(path);
     if (!table) {
         return tl::unexpected(table.error());
     }
-    auto spectra = table->allSpectra();
+    auto spectra = table->allSpectra(sampling);
     if (!spectra) {
         return tl::unexpected(spectra.error());
     }
@@ -61,7 +62,8 @@ Expected<NamedSpectra> loadReflectanceSet(const std::filesystem::path& dataDir,
 {
     for (const auto& s : kReflectanceSets) {
         if (name == s.name) {
-            return loadNamedSpectra(dataDir / "spectra" / s.file);
+            return loadNamedSpectra(dataDir / "spectra" / s.file,
+                                    colour::GridSampling::AtBandCentre);
         }
     }
     return makeError(ErrorCode::NotFound,
@@ -74,7 +76,7 @@ Expected<NamedSpectra> loadAllCieIlluminants(const std::filesystem::path& dataDi
     NamedSpectra all;
     all.source = (dataDir / "spectra").string();
     for (const char* file : kIlluminantFiles) {
-        auto set = loadNamedSpectra(dataDir / "spectra" / file);
+        auto set = loadNamedSpectra(dataDir / "spectra" / file, colour::GridSampling::BandAverage);
         if (!set) {
             return tl::unexpected(set.error());
         }
@@ -92,7 +94,7 @@ Expected<Spectrum> loadCieIlluminant(const std::filesystem::path& dataDir, const
         }
         for (const auto& column : table->columns) {
             if (column == name) {
-                return table->spectrum(name);
+                return table->spectrum(name, colour::GridSampling::BandAverage);
             }
         }
     }

@@ -23,11 +23,14 @@ struct NamedSpectra {
     void append(const NamedSpectra& other);
 };
 
-// Every value column of a spectral CSV, resampled to the working grid.
-Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path);
+// Every value column of a spectral CSV, resampled to the working grid: lights averaged over each
+// band, reflectances taken at the band centres (colour::GridSampling).
+Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path,
+                                        colour::GridSampling sampling);
 
 // Reflectance sets by name: "colorchecker" (BabelColor average, 24 patches), "colorchecker-ohta",
-// "ces99" (CIE 224:2017 / TM-30 evaluation samples), "tcs14" (CIE 13.3 test colour samples).
+// "ces99" (CIE 224:2017 / TM-30 evaluation samples), "tcs14" (CIE 13.3 test colour samples); the
+// 5 nm sets taken at the band centres.
 Expected<NamedSpectra> loadReflectanceSet(const std::filesystem::path& dataDir,
                                           const std::string& name);
 std::vector<std::string> reflectanceSetNames();

@@ -123,7 +123,7 @@ Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,
                                            Outside::Zero);
         s.value[i] = r > 1e-9 ? s.value[i] / (seconds * r) : 0.0;
     }
-    return colour::resampleToWorkingGrid(s, "spectrometer");
+    return colour::resampleToWorkingGrid(s, "spectrometer", colour::GridSampling::BandAverage);
 }
 
 std::optional<double> estimateWavelengthOffset(const RawSpectrum& raw,

@@ -171,7 +171,8 @@ Expected<pipeline::booth::BoothLight> buildLight(const nlohmann::json& lj,
     l.edgeU = v3("edge_u");
     l.edgeV = v3("edge_v");
     if (lj.contains("spd_column")) {
-        auto s = table.spectrum(lj["spd_column"].get<std::string>());
+        auto s = table.spectrum(lj["spd_column"].get<std::string>(),
+                                colour::GridSampling::BandAverage);
         if (!s) {
             return makeError(ErrorCode::InvalidArgument, where + ": " + s.error().message);
         }

@@ -154,7 +154,7 @@ int runEval(const EvalOptions& o)
     if (!lightTable) {
         return fail(lightTable.error().message);
     }
-    auto light = lightTable->spectrum("value");
+    auto light = lightTable->spectrum("value", colour::GridSampling::BandAverage);
     if (!light) {
         return fail(light.error().message);
     }
@@ -162,7 +162,7 @@ int runEval(const EvalOptions& o)
         return fail(fmt::format("{}: the light has no luminance over 380-730 nm (Y <= 0)",
                                 o.illuminant));
     }
-    auto set = spectral::loadNamedSpectra(o.reflectances);
+    auto set = spectral::loadNamedSpectra(o.reflectances, colour::GridSampling::AtBandCentre);
     if (!set) {
         return fail(set.error().message);
     }
@@ -181,7 +181,7 @@ int runEval(const EvalOptions& o)
         if (!forTable) {
             return fail(forTable.error().message);
         }
-        auto forLight = forTable->spectrum("value");
+        auto forLight = forTable->spectrum("value", colour::GridSampling::BandAverage);
         if (!forLight) {
             return fail(forLight.error().message);
         }
@@ -267,7 +267,7 @@ Expected<spectral::NamedSpectra> loadTraining(const std::filesystem::path& data,
                                          name));
         }
         auto set = name.find(".csv") != std::string::npos
-                           ? spectral::loadNamedSpectra(name)
+                           ? spectral::loadNamedSpectra(name, colour::GridSampling::AtBandCentre)
                            : spectral::loadReflectanceSet(data, name);
         if (!set) {
             return tl::unexpected(set.error());

@@ -81,7 +81,7 @@ Expected<Booth> generateShippedBooth(const std::filesystem::path& dataDir, const
     Booth booth;
     // One light per lamp kind, named and as bright as scene::loadDefaultBooth says the lamp is.
     for (const LampKind& s : kLampKinds) {
-        auto spd = table->spectrum(s.column);
+        auto spd = table->spectrum(s.column, colour::GridSampling::BandAverage);
         if (!spd) {
             return tl::unexpected(spd.error());
         }

@@ -266,7 +266,7 @@ colorCheckerStudy(const DisplayInverse& inverse,
         if (!table) {
             return tl::unexpected(table.error());
         }
-        auto spd = table->spectrum(light.column);
+        auto spd = table->spectrum(light.column, colour::GridSampling::BandAverage);
         if (!spd) {
             return tl::unexpected(spd.error());
         }
@@ -292,7 +292,7 @@ Expected<SensedSamples> colorCheckerSamples(const std::filesystem::path& dataDir
     if (!chart) {
         return tl::unexpected(chart.error());
     }
-    auto patches = chart->allSpectra();
+    auto patches = chart->allSpectra(colour::GridSampling::AtBandCentre);
     if (!patches) {
         return tl::unexpected(patches.error());
     }

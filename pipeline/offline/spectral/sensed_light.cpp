@@ -107,7 +107,7 @@ Expected<colour::Spectrum> fineLightToWorkingGrid(const FineLight& light)
         s.value.push_back(
                 interpolateLinear(light.wavelengthNm, light.continuum, nm, Outside::Clamp));
     }
-    auto out = colour::resampleToWorkingGrid(s, light.name);
+    auto out = colour::resampleToWorkingGrid(s, light.name, colour::GridSampling::BandAverage);
     if (!out) {
         return out;
     }

@@ -52,7 +52,7 @@ Expected<SurfaceScene> colorChecker(const std::filesystem::path& dataDir)
     if (!t) {
         return tl::unexpected(t.error());
     }
-    auto spectra = t->allSpectra();
+    auto spectra = t->allSpectra(colour::GridSampling::AtBandCentre);
     if (!spectra) {
         return tl::unexpected(spectra.error());
     }
@@ -155,7 +155,7 @@ Expected<SurfaceScene> metamerTarget(const std::filesystem::path& dataDir)
     if (!cc || !pairs) {
         return tl::unexpected(!cc ? cc.error() : pairs.error());
     }
-    auto spectra = pairs->allSpectra();
+    auto spectra = pairs->allSpectra(colour::GridSampling::AtBandCentre);
     if (!spectra) {
         return tl::unexpected(spectra.error());
     }
@@ -164,7 +164,7 @@ Expected<SurfaceScene> metamerTarget(const std::filesystem::path& dataDir)
                          "metamers_A_D65.csv: expected 1 to 6 pairs of columns (_a, _b)");
     }
     SurfaceScene s = blank("metamer", 240, 160, 0.001);
-    s.palette.push_back(*cc->spectrum("neutral_6.5") * 0.9);
+    s.palette.push_back(*cc->spectrum("neutral_6.5", colour::GridSampling::AtBandCentre) * 0.9);
     s.paletteNames.push_back("surround");
     for (std::size_t i = 0; i < spectra->size(); ++i) {
         s.palette.push_back((*spectra)[i]);
@@ -187,19 +187,19 @@ Expected<SurfaceScene> metamerD65Target(const std::filesystem::path& dataDir)
     if (!cc || !ill || !obs) {
         return tl::unexpected(!cc ? cc.error() : (!ill ? ill.error() : obs.error()));
     }
-    const colour::Spectrum f7 = *ill->spectrum("F7");
+    const colour::Spectrum f7 = *ill->spectrum("F7", colour::GridSampling::BandAverage);
     // Three pairs, matched under the booth's D65 simulator (F7): a grey, a skin tone, a foliage
     // green.
     SurfaceScene s = blank("metamer-d65", 240, 160, 0.001);
     const char* bases[3] = {"neutral_5", "light_skin", "foliage"};
-    s.palette.push_back(*cc->spectrum("neutral_6.5") * 0.9);
+    s.palette.push_back(*cc->spectrum("neutral_6.5", colour::GridSampling::AtBandCentre) * 0.9);
     s.paletteNames.push_back("surround");
     for (int p = 0; p < 3; ++p) {
-        const colour::Spectrum r1 = *cc->spectrum(bases[p]);
+        const colour::Spectrum r1 = *cc->spectrum(bases[p], colour::GridSampling::AtBandCentre);
         // Among smooth candidate shapes, keep the metameric black that separates the pair most
         // under tungsten (CIE A): the target should show a visible mismatch when the light is
         // switched.
-        const colour::Spectrum a = *ill->spectrum("A");
+        const colour::Spectrum a = *ill->spectrum("A", colour::GridSampling::BandAverage);
         const colour::Xyz whiteA =
                 colour::reflectanceToXyz(*obs, a, colour::Spectrum::constant(1.0));
         colour::Spectrum bestR2 = r1;
@@ -255,8 +255,12 @@ Expected<SurfaceScene> painting(const std::filesystem::path& dataDir)
             {"blue", true},      {"purplish_blue", true}, {"green", true},  {"foliage", true},
             {"dark_skin", true}, {"TCS09", false},        {"TCS10", false}, {"TCS11", false},
             {"TCS12", false}};
+    // The TCS pigments are averaged over each band, as when the painting first shipped: they stand
+    // in for paints, so the smoothing is part of the pigment, and the shipped scene (and its plan,
+    // keyed by the scene's digest) stays what this makes.
     for (const auto& [name, fromChecker] : names) {
-        auto sp = fromChecker ? cc->spectrum(name) : tcs->spectrum(name);
+        auto sp = fromChecker ? cc->spectrum(name, colour::GridSampling::AtBandCentre)
+                              : tcs->spectrum(name, colour::GridSampling::BandAverage);
         if (!sp) {
             return tl::unexpected(sp.error());
         }
@@ -339,7 +343,7 @@ Expected<SurfaceScene> glossyCylinder(const std::filesystem::path& dataDir)
         return tl::unexpected(cc.error());
     }
     SurfaceScene s = blank("glossy-cylinder", 240, 160, 0.001);
-    s.palette.push_back(*cc->spectrum("blue"));
+    s.palette.push_back(*cc->spectrum("blue", colour::GridSampling::AtBandCentre));
     s.paletteNames.emplace_back("blue");
     const double radius = 0.15, half = 0.5 * s.heightM;
     const double rim = std::sqrt(radius * radius - half * half);

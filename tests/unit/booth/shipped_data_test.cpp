@@ -81,6 +81,13 @@ TEST(ShippedScenes, LoadAndMatchTheGenerators)
         ASSERT_TRUE(fresh) << fresh.error().message;
         EXPECT_EQ(shipped->width, fresh->width) << kind;
         EXPECT_EQ(shipped->pigmentA, fresh->pigmentA) << kind;
+        ASSERT_EQ(shipped->palette.size(), fresh->palette.size()) << kind;
+        for (std::size_t p = 0; p < shipped->palette.size(); ++p) {
+            for (std::size_t b = 0; b < colour::kBands; ++b) {
+                EXPECT_NEAR(shipped->palette[p][b], fresh->palette[p][b], 1e-12)
+                        << kind << " palette entry " << p << " band " << b;
+            }
+        }
         for (std::size_t k = 0; k < shipped->relief.m.size(); k += 101) {
             EXPECT_FLOAT_EQ(static_cast<float>(shipped->relief.m[k]),
                             static_cast<float>(fresh->relief.m[k]))
@@ -110,7 +117,7 @@ std::vector<double> pairDe00(const surface::SurfaceScene& s, const std::string& 
     auto table = *colour::loadSpectralCsv(dataDir() / "spectra" /
                                           "cie_illuminants_10nm_380_730_triangular.csv");
     const auto& obs = test::observer();
-    const auto spd = *table.spectrum(light);
+    const auto spd = *table.spectrum(light, colour::GridSampling::BandAverage);
     const auto white = colour::reflectanceToXyz(obs, spd, colour::Spectrum::constant(1.0));
     std::vector<double> out;
     for (std::size_t p = 0; 2 + 2 * p < s.palette.size(); ++p) {

@@ -13,7 +13,7 @@ TEST(ChannelBasis, ExactForReflectanceInTheSpanUnderSpikyLight)
     auto obs = loadCie1931(dataDir());
     auto t = loadSpectralCsv(dataDir() / "spectra" / "cie_illuminants_F1_F12_5nm_380_780.csv");
     ASSERT_TRUE(obs && t);
-    const Spectrum light = *t->spectrum("F11");
+    const Spectrum light = *t->spectrum("F11", GridSampling::BandAverage);
     const ChannelBasis basis = boxBasis();
     // A reflectance that is constant in each box band lies in the box basis' span.
     Spectrum r;

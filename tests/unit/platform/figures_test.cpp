@@ -83,7 +83,7 @@ Spectrum illuminant(const std::string& lamp)
             dataDir() / "spectra" / "cie_illuminants_10nm_380_730_triangular.csv");
     const std::map<std::string, std::string> cie = {
             {"tungsten", "A"}, {"d50-fluorescent", "F8"}, {"d65-fluorescent", "F7"}};
-    return *table.spectrum(cie.at(lamp));
+    return *table.spectrum(cie.at(lamp), pipeline::colour::GridSampling::BandAverage);
 }
 
 Lab lab(const std::string& lamp, const Spectrum& r)
@@ -143,7 +143,9 @@ void checkFig6ReferenceColoursAndRenderedMatch(const fs::path& out)
     ASSERT_EQ(rows.size(), 72u);
     for (const auto& r : rows) {
         const std::string what = r.at("lamp") + " " + r.at("patch");
-        const Lab want = lab(r.at("lamp"), *cc.spectrum(r.at("patch")));
+        const Lab want =
+                lab(r.at("lamp"),
+                    *cc.spectrum(r.at("patch"), pipeline::colour::GridSampling::AtBandCentre));
         EXPECT_NEAR(num(r, "ref_L"), want.L, 1e-3) << what;
         EXPECT_NEAR(num(r, "ref_a"), want.a, 1e-3) << what;
         EXPECT_NEAR(num(r, "ref_b"), want.b, 1e-3) << what;
@@ -163,8 +165,11 @@ void checkFig7PairsMatchUnderTungstenAndDifferUnderD65(const fs::path& out)
     ASSERT_EQ(rows.size(), 18u); // six pairs, three lamps
     for (const auto& r : rows) {
         const std::string lamp = r.at("lamp"), pair = r.at("pair");
-        const double want = pipeline::colour::ciede2000(lab(lamp, *pairs.spectrum(pair + "_a")),
-                                                        lab(lamp, *pairs.spectrum(pair + "_b")));
+        const double want = pipeline::colour::ciede2000(
+                lab(lamp,
+                    *pairs.spectrum(pair + "_a", pipeline::colour::GridSampling::AtBandCentre)),
+                lab(lamp,
+                    *pairs.spectrum(pair + "_b", pipeline::colour::GridSampling::AtBandCentre)));
         EXPECT_NEAR(num(r, "de00_reflectances"), want, 1e-3) << lamp << " " << pair;
         if (lamp == "tungsten") {
             EXPECT_LT(want, 0.5) << pair;

@@ -29,7 +29,8 @@ TEST(Metamers, ShippedTargetSurvivesTheShippedRepresentations)
     auto obs = colour::loadCie1931(dataDir());
     auto a = loadCieIlluminant(dataDir(), "A");
     auto d65 = loadCieIlluminant(dataDir(), "D65");
-    auto set = loadNamedSpectra(dataDir() / "scenes" / "metamers" / "metamers_A_D65.csv");
+    auto set = loadNamedSpectra(dataDir() / "scenes" / "metamers" / "metamers_A_D65.csv",
+                                colour::GridSampling::AtBandCentre);
     ASSERT_TRUE(obs && a && d65);
     ASSERT_TRUE(set) << set.error().message;
     ASSERT_GE(set->size(), 8u);
@@ -62,7 +63,8 @@ TEST(Metamers, NaiveRgbCannotShowTheMismatch)
     auto obs = colour::loadCie1931(dataDir());
     auto a = loadCieIlluminant(dataDir(), "A");
     auto d65 = loadCieIlluminant(dataDir(), "D65");
-    auto set = loadNamedSpectra(dataDir() / "scenes" / "metamers" / "metamers_A_D65.csv");
+    auto set = loadNamedSpectra(dataDir() / "scenes" / "metamers" / "metamers_A_D65.csv",
+                                colour::GridSampling::AtBandCentre);
     ASSERT_TRUE(obs && a && d65 && set);
     auto rgb = makeNaiveRgb(*obs, *d65);
     // Under A the RGB pipeline already shows them as different (it sees their D65 colours): it
