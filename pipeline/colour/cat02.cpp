@@ -17,19 +17,41 @@ const Matrix3& cat02Inverse()
     return m;
 }
 
+namespace {
+
+bool allPositive(const Xyz& v)
+{
+    return v.x > 0.0 && v.y > 0.0 && v.z > 0.0;
+}
+
+// diag(D * d / s + 1 - D), the von Kries gains; s is positive in every component.
+Matrix3 vonKriesGains(const Xyz& s, const Xyz& d, double degree)
+{
+    Matrix3 gains{};
+    gains[0][0] = degree * d.x / s.x + 1.0 - degree;
+    gains[1][1] = degree * d.y / s.y + 1.0 - degree;
+    gains[2][2] = degree * d.z / s.z + 1.0 - degree;
+    return gains;
+}
+
+} // namespace
+
+bool cat02Defined(const Xyz& white)
+{
+    return allPositive(applyMatrix(cat02Forward(), white));
+}
+
 Matrix3 cat02AdaptationMatrix(const Xyz& sourceWhite, const Xyz& destinationWhite, double degree)
 {
     const Xyz rs = applyMatrix(cat02Forward(), sourceWhite);
     const Xyz rd = applyMatrix(cat02Forward(), destinationWhite);
-    Matrix3 identity{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}};
-    if (!(rs.x > 0.0 && rs.y > 0.0 && rs.z > 0.0 && rd.x > 0.0 && rd.y > 0.0 && rd.z > 0.0)) {
-        return identity;
+    if (allPositive(rs) && allPositive(rd)) {
+        return multiply(cat02Inverse(), multiply(vonKriesGains(rs, rd, degree), cat02Forward()));
     }
-    Matrix3 scale{};
-    scale[0][0] = degree * rd.x / rs.x + 1.0 - degree;
-    scale[1][1] = degree * rd.y / rs.y + 1.0 - degree;
-    scale[2][2] = degree * rd.z / rs.z + 1.0 - degree;
-    return multiply(cat02Inverse(), multiply(scale, cat02Forward()));
+    if (allPositive(sourceWhite) && allPositive(destinationWhite)) {
+        return vonKriesGains(sourceWhite, destinationWhite, degree);
+    }
+    return Matrix3{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}};
 }
 
 Xyz cat02Adapt(const Xyz& xyz, const Xyz& sourceWhite, const Xyz& destinationWhite, double degree)

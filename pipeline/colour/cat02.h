@@ -11,9 +11,16 @@ namespace replica::pipeline::colour {
 const Matrix3& cat02Forward();
 const Matrix3& cat02Inverse();
 
+// Whether CAT02 can adapt from this white: its three sharpened (CAT02 RGB) responses are positive.
+// A narrow-band light's are not (a 450 nm line has R < 0: the sharpened primaries are not
+// colours), and the von Kries ratio would flip or blow up.
+bool cat02Defined(const Xyz& white);
+
 // The matrix adapting colours seen under sourceWhite to destinationWhite: M^-1 diag(D * rw_d / rw_s
 // + 1 - D) M, the von Kries scaling in CAT02 space. Whites on any common scale (Y = 1 or 100); D =
-// 1 is full adaptation. Whites with a non-positive sharpened component give the identity.
+// 1 is full adaptation. Where CAT02 is undefined for either white (cat02Defined), the same scaling
+// in XYZ (the source white still lands on the destination's, so a neutral stays neutral), and the
+// identity only where even an XYZ component is not positive.
 Matrix3
 cat02AdaptationMatrix(const Xyz& sourceWhite, const Xyz& destinationWhite, double degree = 1.0);
 

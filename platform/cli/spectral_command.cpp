@@ -106,6 +106,7 @@ int printEvalReport(const EvalOptions& o,
         out["reflectances"] = o.reflectances;
         out["white"] = set.names[report.whiteIndex];
         out["grid"] = "380-730 nm, 10 nm (36 bands)";
+        out["adaptation"] = report.cat02 ? "CAT02 to D65" : "XYZ scaling to D65";
         out["samples"] = nlohmann::json::array();
         for (const auto& s : report.samples) {
             out["samples"].push_back({{"name", s.name},
@@ -121,8 +122,14 @@ int printEvalReport(const EvalOptions& o,
         return kExitOk;
     }
     std::cout << fmt::format("representation {}, white sample '{}', CIEDE2000 against spectral36 "
-                             "(CAT02 to D65, white Y = 1/1.13)\n",
-                             report.representation, set.names[report.whiteIndex]);
+                             "({} to D65, white Y = 1/1.13)\n",
+                             report.representation, set.names[report.whiteIndex],
+                             report.cat02 ? "CAT02" : "XYZ scaling");
+    if (!report.cat02) {
+        std::cout
+                << "(CAT02 cannot adapt this light: its white has a sharpened response <= 0, as a "
+                   "narrow-band light's does; its white is scaled onto D65's in XYZ instead)\n";
+    }
     std::cout << fmt::format("{:<24} {:>26} {:>26} {:>8}\n", "sample", "Lab reference",
                              "Lab approx", "de00");
     for (const auto& s : report.samples) {

@@ -38,6 +38,9 @@ struct AccuracyReport {
     std::vector<SampleAccuracy> samples;
     ErrorStats stats;
     std::size_t whiteIndex = 0; // the sample used as white (named "white", else the highest Y)
+    // How the light's colours were adapted to D65: CAT02, or, for a light whose white CAT02 cannot
+    // adapt (colour::cat02Defined: a narrow-band light), the same von Kries scaling in XYZ.
+    bool cat02 = true;
 };
 
 // Index of the white sample: the one named exactly "white", else the one with the highest Y under

@@ -177,6 +177,27 @@ TEST(Cat02, MapsSourceWhiteToDestinationAndNoAdaptationIsIdentity)
     EXPECT_NEAR(round.y, 0.5, 1e-14);
 }
 
+TEST(Cat02, WhereItIsUndefinedTheWhiteStillLandsOnTheDestinationsInXyz)
+{
+    // A 450 nm line's white (CIE 1931 at 450 nm, x-bar 0.3362, y-bar 0.0380, z-bar 1.7721): its
+    // CAT02 R is 0.7328 * 0.3362 + 0.4296 * 0.0380 - 0.1624 * 1.7721 = -0.0176, so CAT02's von
+    // Kries ratio is undefined there.
+    const Xyz blue{0.3362, 0.0380, 1.7721};
+    EXPECT_FALSE(cat02Defined(blue));
+    EXPECT_TRUE(cat02Defined(kD65));
+    // The light's own white is then scaled onto D65 in XYZ, so a neutral surface stays neutral.
+    const Xyz w = cat02Adapt(blue, blue, kD65);
+    EXPECT_NEAR(w.x, kD65.x, 1e-12);
+    EXPECT_NEAR(w.y, kD65.y, 1e-12);
+    EXPECT_NEAR(w.z, kD65.z, 1e-12);
+    const Xyz half = cat02Adapt(blue * 0.5, blue, kD65);
+    EXPECT_NEAR(half.y, 0.5 * kD65.y, 1e-12);
+    // Without a positive XYZ white there is no scale to take: the colours pass unchanged.
+    const Xyz same = cat02Adapt(Xyz{0.3, 0.2, 0.1}, Xyz{0.5, 0.0, 0.4}, kD65);
+    EXPECT_EQ(same.x, 0.3);
+    EXPECT_EQ(same.y, 0.2);
+}
+
 class CctTest : public ::testing::Test
 {
 protected:
