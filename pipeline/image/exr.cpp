@@ -18,6 +18,7 @@
 #include <pipeline/base/input_file.h>
 #include <pipeline/base/output_file.h>
 #include <pipeline/image/exr.h>
+#include <pipeline/image/exr_chunks.h>
 
 namespace replica::pipeline::image {
 
@@ -113,6 +114,9 @@ Expected<ChannelImage> readExr(const std::filesystem::path& path,
     } catch (const std::exception& e) {
         return makeError(ErrorCode::Corrupt, fmt::format("{}: not a readable OpenEXR file ({})",
                                                          path.string(), e.what()));
+    }
+    if (auto chunks = checkExrChunks(*bytes, path.string()); !chunks) {
+        return tl::unexpected(chunks.error());
     }
     for (std::size_t c = 0; c < names.size(); ++c) {
         const auto& p = img.planes[c];
