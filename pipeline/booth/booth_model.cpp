@@ -1,5 +1,7 @@
 // booth.json reading and writing; nlohmann exceptions are caught here and become Error values.
 
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -116,6 +118,20 @@ Expected<Booth> loadBooth(const std::filesystem::path& dir)
                              where + ": needs string fields 'name' and 'luminance'");
         }
         l.name = lj["name"].get<std::string>();
+        // A lamp is chosen by name (the site file's default lamp, --light, the plan's keys, the
+        // recording's lamp labels): an empty name or a second lamp of the same name could never be
+        // chosen, or would silently be the first.
+        if (l.name.empty()) {
+            return makeError(ErrorCode::Corrupt,
+                             where + ".name: is empty; name the lamp (tungsten, d50, ...)");
+        }
+        if (std::any_of(booth.lights.begin(), booth.lights.end(),
+                        [&](const BoothLight& o) { return o.name == l.name; })) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}.name: '{}' names another lamp of this booth too; "
+                                         "each lamp needs a name of its own",
+                                         where, l.name));
+        }
         // The luminance map is a file next to booth.json, named, never a path elsewhere.
         if (auto ok = checkPlainName(lj["luminance"].get<std::string>(), where + ".luminance");
             !ok) {

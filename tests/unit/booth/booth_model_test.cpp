@@ -79,6 +79,35 @@ TEST(BoothModel, WallsAreDeclaredOrNotModelled)
     EXPECT_EQ(n7->walls->reflectance[0], kMunsellN7Reflectance);
 }
 
+TEST(BoothModel, RefusesAnEmptyOrRepeatedLampName)
+{
+    Booth b;
+    b.lights.push_back(test::ceilingLight(8, 4, 500.0));
+    b.lights.push_back(test::ceilingLight(8, 4, 700.0));
+    b.lights[0].name = "tungsten";
+    b.lights[1].name = "d65";
+    const auto dir = freshDir("names");
+    ASSERT_TRUE(saveBooth(dir, b));
+    std::ifstream in(dir / "booth.json");
+    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    ASSERT_TRUE(loadBooth(dir));
+    // The second lamp renamed to the first's (its map still d65.exr), then to nothing.
+    for (const auto& [name, expected] :
+         {std::pair<std::string, std::string>{"tungsten",
+                                              "lights[1].name: 'tungsten' names another "
+                                              "lamp of this booth too"},
+          {"", "lights[1].name: is empty"}}) {
+        std::string edited = text;
+        const auto at = edited.find("\"d65\"");
+        ASSERT_NE(at, std::string::npos);
+        edited.replace(at, 5, "\"" + name + "\"");
+        std::ofstream(dir / "booth.json", std::ios::trunc) << edited;
+        auto r = loadBooth(dir);
+        ASSERT_FALSE(r) << name;
+        EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+    }
+}
+
 TEST(BoothModel, ReportsMissingFolderAndBadFields)
 {
     auto r = loadBooth(freshDir("missing"));
