@@ -1,6 +1,12 @@
 // 'replica config check FILE': the site file resolved as the kiosk resolves it (run_resolve.h),
 // every problem with its file, line and key.
+#include <filesystem>
+#include <string>
+
 #include <fmt/format.h>
+#include <linux/magic.h>
+#include <sys/statfs.h>
+#include <sys/statvfs.h>
 
 #include <platform/cli/commands.h>
 #include <platform/cli/run_resolve.h>
@@ -15,6 +21,40 @@ struct ConfigOptions {
     bool print = false;
 };
 
+// Why the kiosk could not keep its sessions in 'dir', or empty. The kiosk creates a missing folder
+// at start and runs without recording where it cannot (a fault it survives and reports), so the
+// resolve it shares with config check lets that pass; config check says it before it bites. A
+// missing folder is judged by the nearest folder above it that exists, which must be a folder on a
+// writable filesystem that holds folders (root may 'write' to /proc and /sys; mkdir fails there).
+std::string sessionsFolderProblem(const std::filesystem::path& dir)
+{
+    std::error_code ec;
+    std::filesystem::path at = std::filesystem::absolute(dir, ec);
+    if (ec) {
+        return ec.message();
+    }
+    while (!std::filesystem::exists(at, ec) && at.has_parent_path() && at != at.parent_path()) {
+        at = at.parent_path();
+    }
+    if (!std::filesystem::is_directory(at, ec)) {
+        return fmt::format("'{}' is not a folder", at.string());
+    }
+    struct statfs fs {
+    };
+    if (statfs(at.c_str(), &fs) == 0 &&
+        (fs.f_type == PROC_SUPER_MAGIC || fs.f_type == SYSFS_MAGIC)) {
+        return fmt::format("'{}' is on a kernel filesystem (/proc, /sys)", at.string());
+    }
+    // Not access(): the kiosk runs as its own user (the unit's StateDirectory makes its folder),
+    // so whether the user checking the file may write there says nothing; a read-only mount does.
+    struct statvfs vfs {
+    };
+    if (statvfs(at.c_str(), &vfs) == 0 && (vfs.f_flag & ST_RDONLY) != 0) {
+        return fmt::format("'{}' is on a read-only filesystem", at.string());
+    }
+    return {};
+}
+
 int checkMain(const ConfigOptions& o)
 {
     // What 'replica run --kiosk --config FILE' resolves, opening no device.
@@ -27,6 +67,19 @@ int checkMain(const ConfigOptions& o)
             fmt::print(stderr, "{}\n", line);
         }
         return kExitFailure;
+    }
+    const auto& site = *plan->options.site;
+    if (site.recordingEnabled) {
+        if (const std::string why = sessionsFolderProblem(site.recordingDirectory); !why.empty()) {
+            const SiteProblem p{
+                    "recording.directory", site.lineOf("recording.directory"),
+                    fmt::format("'{}' cannot hold the sessions ({}): the kiosk would run without "
+                                "recording; name a folder it can write, or set "
+                                "recording.enabled = false",
+                                site.recordingDirectory, why)};
+            fmt::print(stderr, "{}\n", formatProblem(o.file, p));
+            return kExitFailure;
+        }
     }
     if (o.print) {
         fmt::print("{}\n", plan->options.site->toJson());

@@ -93,6 +93,13 @@ panel_width_m = 0.6
 lamp = "tungsten"
 TOML
 "$replica" config check "$good" || fail "good file refused"
+# A sessions folder the kiosk could never make (it would run without recording) fails the check,
+# naming the line and the key; the kiosk itself runs on, as it does with a full disk.
+cp "$good" "$work/proc.toml"
+printf '[recording]\ndirectory = "/proc/replica-sessions"\n' >>"$work/proc.toml"
+out=$("$replica" config check "$work/proc.toml" 2>&1) && fail "a sessions folder under /proc passed"
+grep -q "^$work/proc.toml:13: recording.directory: '/proc/replica-sessions' cannot hold the sessions" <<<"$out" ||
+    fail "sessions folder under /proc: $out"
 "$replica" run --config "$good" --frames 3 --fast --size 48x30 --record "$work/s.mcap" \
     >"$work/run.log" 2>&1 || fail "run --config failed: $(tail -3 "$work/run.log")"
 "$replica" inspect "$work/s.mcap" --json >"$work/inspect.json" || fail "inspect failed"
