@@ -107,6 +107,21 @@ Expected<void> MessageDecoder::decodeSessionMessage(const std::string& topic,
     return {};
 }
 
+// Frames are written in the order the loop ticks: one whose tick is before the frame ahead of it
+// (or before the session start) was not written by Replica, and replay could not pace it.
+void MessageDecoder::decodeFrameMessage(const nlohmann::json& j)
+{
+    FrameRecord f = decodeFrame(j, kinds_);
+    if (f.tickNs < lastTickNs_) {
+        throw std::out_of_range(fmt::format("frame {} has tick_ns {}, before {} (the session start "
+                                            "or the frame ahead of it): the frame channel is "
+                                            "corrupt",
+                                            f.frameIndex, f.tickNs, lastTickNs_));
+    }
+    lastTickNs_ = f.tickNs;
+    rec_.frames.push_back(std::move(f));
+}
+
 Expected<void> MessageDecoder::decodeJson(const std::string& topic, const nlohmann::json& j)
 {
     if (topic == kSessionTopic) {
@@ -119,7 +134,7 @@ Expected<void> MessageDecoder::decodeJson(const std::string& topic, const nlohma
             ++unusableRaw_;
         }
     } else if (topic == kFrameTopic) {
-        rec_.frames.push_back(decodeFrame(j, kinds_));
+        decodeFrameMessage(j);
     } else if (topic == kDisplayDigestTopic) { // format 4
         rec_.displayDigests.push_back(decodeDisplayDigest(j));
     } else if (topic == kLightTopic) { // format 4

@@ -33,13 +33,14 @@ public:
     void attachRaw();
 
     // Drops what was decoded so far (samples, frames, raw inputs) and keeps what later messages
-    // are checked against (the session, HID descriptors): recover checks
+    // are checked against (the session, the last frame's tick, HID descriptors): recover checks
     // every message of a file of any size in bounded memory.
     void forget();
 
 private:
     Expected<void> decodeSessionMessage(const std::string& topic, const nlohmann::json& j);
     Expected<void> decodeJson(const std::string& topic, const nlohmann::json& j);
+    void decodeFrameMessage(const nlohmann::json& j);
 
     Recording& rec_;
     const DeviceKinds& kinds_;
@@ -47,6 +48,7 @@ private:
     std::map<std::string, std::size_t> sampleTopics_, rawTopics_;
     std::vector<AnyReaderState> rawState_; // in the kinds' order, as rec_.devices
     std::uint64_t unusableRaw_ = 0;
+    std::int64_t lastTickNs_ = 0; // the last frame's tick: frames never go back (nor before 0)
     bool haveSession_ = false;
 };
 

@@ -248,6 +248,33 @@ TEST(RecoverChecks, AMessageTheReaderRefusesIsDroppedCountedAndNamed)
     }
 }
 
+// Frames going backwards: replay refused them, and now the reader does (inspect says damaged);
+// recover drops the frames that go back.
+TEST(RecoverChecks, FramesOutOfTickOrderAreDamage)
+{
+    const auto backwards =
+            withMessage(kFrameTopic, 6, replaced(R"("tick_ns":\d+)", R"("tick_ns":5)"));
+    const auto direct = read(backwards);
+    ASSERT_FALSE(direct);
+    EXPECT_NE(direct.error().message.find("frame 6 has tick_ns 5, before 83333335"),
+              std::string::npos)
+            << direct.error().message;
+    const auto r = recover(backwards);
+    ASSERT_TRUE(r.report) << r.report.error().message;
+    EXPECT_TRUE(r.report->lossy());
+    EXPECT_EQ(r.report->messagesDropped, 1u);
+    ASSERT_TRUE(r.output) << r.output.error().message;
+    EXPECT_EQ(r.output->frames.size(), 11u);
+    // A tick far ahead: every later frame goes back from it.
+    const auto huge = withMessage(kFrameTopic, 9,
+                                  replaced(R"("tick_ns":\d+)", R"("tick_ns":9223372036854775807)"));
+    ASSERT_FALSE(read(huge));
+    const auto h = recover(huge);
+    ASSERT_TRUE(h.report) << h.report.error().message;
+    EXPECT_TRUE(h.report->lossy());
+    ASSERT_TRUE(h.output) << h.output.error().message;
+}
+
 // The session's chunk lost and the copy in the metadata unusable: recover says the session could
 // not be rebuilt and writes nothing (it used to write a file inspect refused, and exit 0).
 TEST(RecoverChecks, ASessionThatCannotBeRebuiltIsNothingRecoverable)
