@@ -307,5 +307,30 @@ TEST(RecoverChecks, ASessionThatCannotBeRebuiltIsNothingRecoverable)
     ASSERT_TRUE(ok.output) << ok.output.error().message;
 }
 
+// A chunk nested inside another (uncompressed, CRC intact): MCAP chunks do not nest, so what the
+// inner one holds is not read; that is said and counted, not silently lost.
+TEST(RecoverChecks, AChunkInsideAChunkIsCountedAsDropped)
+{
+    const std::string& bytes = soundRecording();
+    const auto chunks = mcap::scan(bytes).chunks;
+    ASSERT_GT(chunks.size(), 2u);
+    const auto& c = chunks[1];
+    const std::string inner = bytes.substr(c.offset, c.length);
+    auto u64 = [](std::uint64_t v) { return std::string(reinterpret_cast<const char*>(&v), 8); };
+    auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    const std::string body = u64(0) + u64(0) + u64(inner.size()) + u32(mcap::crc32(0, inner)) +
+                             u32(0) + u64(inner.size()) + inner;
+    const std::string nested = bytes.substr(0, c.offset) + std::string(1, '\x06') +
+                               u64(body.size()) + body + bytes.substr(c.offset + c.length);
+    const auto s = mcap::scan(nested);
+    EXPECT_TRUE(mentions(s.damage, "chunks do not nest"));
+    const auto r = recover(nested);
+    ASSERT_TRUE(r.report) << r.report.error().message;
+    EXPECT_TRUE(r.report->lossy()) << "recover said nothing lost";
+    EXPECT_GE(r.report->chunksDamaged, 1u);
+    EXPECT_TRUE(mentions(r.report->problems, "chunks do not nest"));
+    ASSERT_TRUE(r.output) << r.output.error().message;
+}
+
 } // namespace
 } // namespace replica::recordings::recover_checks
