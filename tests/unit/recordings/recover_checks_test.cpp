@@ -307,6 +307,42 @@ TEST(RecoverChecks, ASessionThatCannotBeRebuiltIsNothingRecoverable)
     ASSERT_TRUE(ok.output) << ok.output.error().message;
 }
 
+// Values no Replica build writes, that the reader used to take after a cast (3.5 as frame 3, a pose
+// time of 2^64-1 as -1) or pass on unused (lamp 99 of a three-lamp switch): damage, naming the
+// field, and dropped by recover.
+TEST(RecoverChecks, IntegersThatDoNotFitAndImpossibleLampsAreDamage)
+{
+    const struct {
+        const char* what;
+        std::string topic;
+        std::function<std::string(const std::string&)> change;
+        const char* says;
+    } cases[] = {
+            {"frame 3.5", std::string(kFrameTopic), replaced(R"("frame":\d+)", R"("frame":3.5)"),
+             "frame: expected an integer, found number 3.5"},
+            {"frame 10^29", std::string(kFrameTopic),
+             replaced(R"("frame":\d+)", R"("frame":123456789012345678901234567890)"),
+             "frame: expected an integer"},
+            {"pose t 2^64-1", std::string(kTrackerTopic),
+             replaced(R"("t":\d+)", R"("t":18446744073709551615)"),
+             "t: 18446744073709551615 is out of range"},
+            {"lamp 99", std::string(kLampSelectorTopic), replaced(R"("lamp":1)", R"("lamp":99)"),
+             "lamp 99"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.what);
+        const auto bytes = withMessage(c.topic, 2, c.change);
+        const auto direct = read(bytes);
+        ASSERT_FALSE(direct) << "the reader accepts it";
+        EXPECT_NE(direct.error().message.find(c.says), std::string::npos) << direct.error().message;
+        const auto r = recover(bytes);
+        ASSERT_TRUE(r.report) << r.report.error().message;
+        EXPECT_TRUE(r.report->lossy());
+        EXPECT_EQ(r.report->messagesDropped, 1u);
+        ASSERT_TRUE(r.output) << r.output.error().message;
+    }
+}
+
 // A chunk nested inside another (uncompressed, CRC intact): MCAP chunks do not nest, so what the
 // inner one holds is not read; that is said and counted, not silently lost.
 TEST(RecoverChecks, AChunkInsideAChunkIsCountedAsDropped)
