@@ -15,8 +15,8 @@ std::optional<std::string> encodeAccel(const hal::AccelSample& s)
 hal::AccelSample decodeAccel(const json& j)
 {
     hal::AccelSample s;
-    s.timestampNs = j.at("t");
-    s.sequence = j.at("seq");
+    s.timestampNs = integerField<std::int64_t>(j, "t");
+    s.sequence = integerField<std::uint32_t>(j, "seq");
     s.gravity = vec3From(j.at("gravity"));
     return s;
 }

@@ -6,11 +6,15 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <recordings/sample_codec.h>
@@ -33,6 +37,32 @@ bool finite(const std::array<double, N>& a)
         }
     }
     return true;
+}
+
+// Field `key` of `j`, an integer as Replica writes it: a JSON integer that fits T. (get<T>() would
+// take 3.5 as 3, 1e29 as whatever the cast makes of it, and 18446744073709551615 as -1 for an
+// int64_t: values no Replica build wrote, that the reader would otherwise use.)
+template <typename T>
+T integerField(const json& j, const char* key)
+{
+    const json& v = j.at(key);
+    if (v.is_number_unsigned()) {
+        const auto u = v.get<std::uint64_t>();
+        if (std::in_range<T>(u)) {
+            return static_cast<T>(u);
+        }
+    } else if (v.is_number_integer()) {
+        const auto i = v.get<std::int64_t>();
+        if (std::in_range<T>(i)) {
+            return static_cast<T>(i);
+        }
+    } else {
+        throw std::out_of_range(fmt::format("{}: expected an integer, found {} {}", key,
+                                            v.type_name(), v.dump().substr(0, 40)));
+    }
+    throw std::out_of_range(fmt::format("{}: {} is out of range [{}, {}]", key, v.dump(),
+                                        std::numeric_limits<T>::min(),
+                                        std::numeric_limits<T>::max()));
 }
 
 inline json vec3(const glm::dvec3& v)

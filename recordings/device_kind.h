@@ -177,6 +177,9 @@ public:
     virtual bool decodeRaw(const nlohmann::json& j, AnyReaderState& state) const = 0;
     // Gives each sample its raw input; returns how many raw inputs found no sample.
     virtual std::uint64_t attachRaw(AnySamples& samples, AnyReaderState& state) const = 0;
+    // Drops the raw inputs read so far and keeps what later raw messages refer to (the HID
+    // descriptors): recover checks a file's messages one at a time and holds none of them.
+    virtual void forgetRawInputs(AnyReaderState& state) const = 0;
     // How many samples carry a raw input (inspect).
     virtual std::uint64_t countWithRaw(const AnySamples& samples) const = 0;
     // Each sample's time, in the recording's order.
@@ -336,6 +339,13 @@ public:
     std::uint64_t attachRaw(AnySamples& samples, AnyReaderState& state) const override
     {
         return codec_.attachRaw ? codec_.attachRaw(of(samples), std::get<ReaderState>(state)) : 0;
+    }
+    void forgetRawInputs(AnyReaderState& state) const override
+    {
+        auto& st = std::get<ReaderState>(state);
+        if constexpr (requires { st.raw.clear(); }) {
+            st.raw.clear();
+        }
     }
     std::uint64_t countWithRaw(const AnySamples& samples) const override
     {

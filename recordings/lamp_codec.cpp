@@ -5,6 +5,11 @@
 #include <recordings/codec_json.h>
 
 namespace replica::recordings {
+namespace {
+
+constexpr std::size_t kMaxSelectorLines = 32; // GPIO lines a lamp selector may have
+
+} // namespace
 
 std::string encodeLamp(const hal::LampSample& s)
 {
@@ -23,12 +28,18 @@ std::string encodeLamp(const hal::LampSample& s)
 hal::LampSample decodeLamp(const json& j)
 {
     hal::LampSample s;
-    s.timestampNs = j.at("t");
-    s.sequence = j.at("seq");
-    s.lamp = j.at("lamp");
+    s.timestampNs = integerField<std::int64_t>(j, "t");
+    s.sequence = integerField<std::uint32_t>(j, "seq");
+    s.lamp = integerField<int>(j, "lamp");
     const auto levels = j.at("levels").get<std::vector<int>>();
-    if (levels.size() > 32 || s.lamp < hal::kLampLost) {
-        throw std::out_of_range("lamp selector sample: more than 32 lines or an unknown lamp code");
+    // A selector has at most 32 lines and lamp i is line i alone: an index of 32 or more (or below
+    // the codes -1..-3) is not one any Replica build wrote.
+    if (levels.size() > kMaxSelectorLines || s.lamp < hal::kLampLost ||
+        s.lamp >= static_cast<int>(kMaxSelectorLines)) {
+        throw std::out_of_range(fmt::format("lamp selector sample: {} lines, lamp {}; a selector "
+                                            "has at most {} lines, lamp codes are -3..{}",
+                                            levels.size(), s.lamp, kMaxSelectorLines,
+                                            kMaxSelectorLines - 1));
     }
     s.lineCount = static_cast<std::uint32_t>(levels.size());
     for (std::size_t i = 0; i < levels.size(); ++i) {

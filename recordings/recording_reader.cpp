@@ -9,11 +9,10 @@
 #include <fmt/format.h>
 
 #include <pipeline/base/input_file.h>
-#include <pipeline/base/json_limits.h>
 #include <recordings/mcap/reader.h>
+#include <recordings/message_decoder.h>
 #include <recordings/recording.h>
 #include <recordings/sample_codec.h>
-#include <recordings/session_schema.h>
 
 namespace replica::recordings {
 namespace {
@@ -77,17 +76,6 @@ Expected<void> checkOneSession(const mcap::Scan& s, const std::string& name)
     return {};
 }
 
-// A thumbnail message (foxglove.CompressedImage): its PNG, tNs its Unix time until
-// placeThumbnails.
-ThumbnailRecord decodeThumbnailMessage(const nlohmann::json& j)
-{
-    ThumbnailRecord t;
-    t.tNs = j.at("timestamp").at("sec").get<std::int64_t>() * 1'000'000'000 +
-            j.at("timestamp").at("nsec").get<std::int64_t>();
-    t.png = base64Decode(j.at("data").get<std::string>());
-    return t;
-}
-
 // A thumbnail's time is its frame's tick after the session's wall-clock start.
 void placeThumbnails(Recording& rec)
 {
@@ -122,116 +110,6 @@ Expected<void> checkScan(const mcap::Scan& s, const std::string& name)
     return checkOneSession(s, name);
 }
 
-// Decodes a recording's messages into 'rec' by topic: the session, each device kind's samples by
-// its topic and (format 5) its raw inputs by its raw topic, attached to their samples by sequence
-// number once all are read.
-class MessageDecoder
-{
-public:
-    MessageDecoder(Recording& rec, const DeviceKinds& kinds, std::string name)
-        : rec_(rec), kinds_(kinds), name_(std::move(name))
-    {
-        rec.devices.clear();
-        for (std::size_t i = 0; i < kinds.size(); ++i) {
-            const auto& n = kinds[i]->names();
-            rec.devices.push_back({kinds[i], kinds[i]->emptySamples()});
-            rawState_.push_back(kinds[i]->readerState());
-            sampleTopics_[n.channel.topic] = i;
-            if (n.rawChannel) {
-                rawTopics_[n.rawChannel->topic] = i;
-            }
-        }
-    }
-
-    Expected<void> decode(const std::string& topic, const mcap::Message& m)
-    {
-        if (m.data.size() > kMaxMessageBytes) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: {} message (sequence {}) of {} bytes; Replica's are "
-                                         "at most {} KiB: not a recording Replica wrote",
-                                         name_, topic, m.sequence, m.data.size(),
-                                         kMaxMessageBytes >> 10));
-        }
-        if (auto ok = checkJsonLimits(
-                    m.data, fmt::format("{}: {} message (sequence {})", name_, topic, m.sequence));
-            !ok) {
-            return ok;
-        }
-        try {
-            return decodeJson(topic, nlohmann::json::parse(m.data));
-        } catch (const std::exception& e) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}: damaged {} message (sequence {}): {}", name_, topic,
-                                         m.sequence, e.what()));
-        }
-    }
-
-    bool haveSession() const { return haveSession_; }
-
-    // The raw inputs attached to their samples; those that matched none are counted.
-    void attachRaw()
-    {
-        rec_.unmatchedRaw = unusableRaw_;
-        for (std::size_t i = 0; i < kinds_.size(); ++i) {
-            rec_.unmatchedRaw += kinds_[i]->attachRaw(rec_.devices[i].samples, rawState_[i]);
-        }
-    }
-
-private:
-    Expected<void> decodeSessionMessage(const std::string& topic, const nlohmann::json& j)
-    {
-        if (auto ok = validateJson(j, sessionSchema(), fmt::format("{}: {} message", name_, topic));
-            !ok) {
-            return ok;
-        }
-        rec_.session = decodeSession(j, rec_.formatVersion, kinds_);
-        // The run configuration is JSON inside the session's JSON: held to the same limits
-        // before anything (replay, inspect --json) parses it.
-        if (auto ok = checkJsonLimits(rec_.session.configJson,
-                                      fmt::format("{}: run configuration", name_));
-            !ok) {
-            return ok;
-        }
-        haveSession_ = true;
-        return {};
-    }
-
-    Expected<void> decodeJson(const std::string& topic, const nlohmann::json& j)
-    {
-        if (topic == kSessionTopic) {
-            return decodeSessionMessage(topic, j);
-        }
-        if (auto k = sampleTopics_.find(topic); k != sampleTopics_.end()) {
-            kinds_[k->second]->decode(j, rec_.devices[k->second].samples);
-        } else if (auto rk = rawTopics_.find(topic); rk != rawTopics_.end()) { // format 5
-            if (!kinds_[rk->second]->decodeRaw(j, rawState_[rk->second])) {
-                ++unusableRaw_;
-            }
-        } else if (topic == kFrameTopic) {
-            rec_.frames.push_back(decodeFrame(j, kinds_));
-        } else if (topic == kDisplayDigestTopic) { // format 4
-            rec_.displayDigests.push_back(decodeDisplayDigest(j));
-        } else if (topic == kLightTopic) { // format 4
-            rec_.lights.push_back(decodeLight(j));
-        } else if (topic == kThumbnailTopic) { // format 4
-            rec_.thumbnails.push_back(decodeThumbnailMessage(j));
-        } else if (topic == kRecorderTopic) {
-            const auto r = decodeRecorderStatus(j, kinds_);
-            rec_.droppedMessages = r.droppedTotal();
-            rec_.rejectedNonFinite = r.rejectedNonFinite;
-        }
-        return {};
-    }
-
-    Recording& rec_;
-    const DeviceKinds& kinds_;
-    std::string name_;
-    std::map<std::string, std::size_t> sampleTopics_, rawTopics_;
-    std::vector<AnyReaderState> rawState_; // in the kinds' order, as rec_.devices
-    std::uint64_t unusableRaw_ = 0;
-    bool haveSession_ = false;
-};
-
 } // namespace
 
 Expected<Recording> readRecording(const std::filesystem::path& path, const DeviceKinds& kinds)
@@ -246,7 +124,7 @@ Expected<Recording> readRecording(const std::filesystem::path& path, const Devic
         return tl::unexpected(ok.error());
     }
     Recording rec;
-    MessageDecoder decoder(rec, kinds, name);
+    detail::MessageDecoder decoder(rec, kinds, name);
     for (const auto& m : s.messages) {
         if (auto ok = decoder.decode(s.channels.at(m.channelId).topic, m); !ok) {
             return tl::unexpected(ok.error());

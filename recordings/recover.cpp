@@ -18,6 +18,7 @@
 #include <pipeline/base/json_limits.h>
 #include <recordings/mcap/reader.h>
 #include <recordings/mcap/writer.h>
+#include <recordings/message_decoder.h>
 #include <recordings/recover.h>
 #include <recordings/sample_codec.h>
 
@@ -143,11 +144,76 @@ struct Plan {
     std::optional<mcap::Message> session; // restored from the metadata, written first
 };
 
+// The reader's checks of each message (the decoder readRecording uses): what fails them is dropped
+// and counted, so that recover never keeps what inspect and replay would refuse.
+class MessageChecks
+{
+public:
+    MessageChecks(const mcap::Scan& scan, std::string name)
+        : scan_(scan), decoder_(scratch_, deviceKinds(), std::move(name))
+    {}
+
+    // Whether `m` passes; a message that does not is counted, the first few named.
+    bool accept(const mcap::Message& m)
+    {
+        auto ok = decoder_.decode(scan_.channels.at(m.channelId).topic, m);
+        decoder_.forget(); // checked, not held: memory does not grow with the file
+        if (ok) {
+            return true;
+        }
+        ++dropped_;
+        if (problems_.size() < kMaxProblems) {
+            problems_.push_back(ok.error().message + "; dropped");
+        }
+        return false;
+    }
+
+    std::uint64_t dropped() const { return dropped_; }
+    bool haveSession() const { return decoder_.haveSession(); }
+    const std::vector<std::string>& problems() const { return problems_; }
+
+private:
+    static constexpr std::size_t kMaxProblems = 20;
+    const mcap::Scan& scan_;
+    Recording scratch_;
+    detail::MessageDecoder decoder_;
+    std::uint64_t dropped_ = 0;
+    std::vector<std::string> problems_;
+};
+
+// What the second pass dropped because the reader's checks refused it.
+struct Checked {
+    std::uint64_t dropped = 0;
+    std::vector<std::string> problems;
+};
+
+// A recording the reader accepts needs its session: without it, one line that says why it is
+// missing.
+Expected<void> checkRecoverable(const MessageChecks& checks, const fs::path& in)
+{
+    if (!checks.haveSession()) {
+        std::string why = "its /replica/session message is lost and the copy in its metadata is "
+                          "missing or unusable";
+        for (const auto& p : checks.problems()) {
+            if (p.find(std::string(kSessionTopic)) != std::string::npos) {
+                why = p;
+                break;
+            }
+        }
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: nothing recoverable: the session could not be rebuilt "
+                                     "({}), and a recording without one does not replay",
+                                     in.string(), why));
+    }
+    return {};
+}
+
 // Every kept message into a fresh, complete recording at `path` (finish() syncs it): the metadata,
 // schemas and channels the first pass found, then a second pass over `in` giving its messages to
-// the writer as they come, so that nothing grows with the file. The second pass must find what
-// the first did.
-Expected<void> writeRecovered(const Plan& plan, mcap::Source& in, const fs::path& path)
+// the writer as they come, so that nothing grows with the file; those the reader's checks refuse
+// are dropped. The second pass must find what the first did.
+Expected<Checked>
+writeRecovered(const Plan& plan, mcap::Source& in, const fs::path& path, const fs::path& inPath)
 {
     const auto& s = plan.scan;
     auto w = mcap::FileWriter::create(path, s.library.empty() ? "replica recover" : s.library,
@@ -174,7 +240,11 @@ Expected<void> writeRecovered(const Plan& plan, mcap::Source& in, const fs::path
     }
     constexpr std::size_t kChunkBytes = 256 * 1024;
     std::optional<Error> failed;
+    MessageChecks checks(s, inPath.string());
     auto add = [&](mcap::Message&& m) {
+        if (!checks.accept(m)) {
+            return true;
+        }
         (*w)->addMessage(m);
         if ((*w)->pendingBytes() >= kChunkBytes) {
             if (auto ok = (*w)->closeChunk(false); !ok) {
@@ -199,10 +269,13 @@ Expected<void> writeRecovered(const Plan& plan, mcap::Source& in, const fs::path
         return makeError(ErrorCode::Io, "the recording changed while it was being recovered "
                                         "(is something still writing it?)");
     }
+    if (auto ok = checkRecoverable(checks, inPath); !ok) {
+        return tl::unexpected(ok.error());
+    }
     if (auto ok = (*w)->finish(); !ok) {
         return tl::unexpected(ok.error());
     }
-    return {};
+    return Checked{checks.dropped(), checks.problems()};
 }
 
 // How recover scans: resynchronising, chunked records only, and (for a file whose first chunk,
@@ -271,22 +344,27 @@ bool restoreSession(Plan& plan)
     return false;
 }
 
-RecoverReport reportOf(const mcap::Scan& s, bool sessionRestored)
+RecoverReport reportOf(const mcap::Scan& s, bool sessionRestored, const Checked& checked)
 {
-    const std::uint64_t kept = s.messageCount + (sessionRestored ? 1 : 0);
+    const std::uint64_t scanned = s.messageCount + (sessionRestored ? 1 : 0);
     RecoverReport r;
     r.problems = s.damage;
     if (s.damageCount > s.damage.size()) {
         r.problems.push_back(
                 fmt::format("... and {} more problems", s.damageCount - s.damage.size()));
     }
-    r.messagesKept = kept;
+    r.problems.insert(r.problems.end(), checked.problems.begin(), checked.problems.end());
+    if (checked.dropped > checked.problems.size()) {
+        r.problems.push_back(fmt::format("... and {} more messages the reader refuses",
+                                         checked.dropped - checked.problems.size()));
+    }
+    r.messagesKept = scanned - checked.dropped;
     r.chunksKept = s.chunks.size();
     r.chunksDamaged = s.chunksDamaged;
     r.bytesDropped = s.bytesSkipped;
-    r.messagesDropped = s.messagesDropped;
-    if (s.summaryMessageCount && *s.summaryMessageCount > kept) {
-        r.messagesDropped += *s.summaryMessageCount - kept;
+    r.messagesDropped = s.messagesDropped + checked.dropped;
+    if (s.summaryMessageCount && *s.summaryMessageCount > scanned) {
+        r.messagesDropped += *s.summaryMessageCount - scanned;
     }
     r.channelsAssumed = s.channelsAssumed;
     r.sessionRestored = sessionRestored;
@@ -295,20 +373,23 @@ RecoverReport reportOf(const mcap::Scan& s, bool sessionRestored)
 
 // Writes the kept messages to a new file beside `out` and puts it in place; whatever goes wrong,
 // the temporary file goes and `out` stays as it was.
-Expected<void>
-writeInPlace(const Plan& plan, mcap::Source& in, const fs::path& out, ExistingOutput existing)
+Expected<Checked> writeInPlace(const Plan& plan,
+                               mcap::Source& in,
+                               const fs::path& inPath,
+                               const fs::path& out,
+                               ExistingOutput existing)
 {
     auto tmp = createTemporaryBeside(out);
     if (!tmp) {
         return tl::unexpected(tmp.error());
     }
-    auto written = writeRecovered(plan, in, *tmp);
+    auto written = writeRecovered(plan, in, *tmp, inPath);
     if (!written) {
         written =
                 makeError(written.error().code, fmt::format("{}: not written (left as it was): {}",
                                                             out.string(), written.error().message));
-    } else {
-        written = moveIntoPlace(*tmp, out, existing);
+    } else if (auto moved = moveIntoPlace(*tmp, out, existing); !moved) {
+        written = tl::unexpected(moved.error());
     }
     if (!written) {
         std::error_code ec;
@@ -356,10 +437,11 @@ Expected<RecoverReport> recoverRecording(const std::filesystem::path& in,
                 fmt::format("{}: nothing recoverable: {}", in.string(),
                             s.damage.empty() ? "the file holds no messages" : s.damage.front()));
     }
-    if (auto ok = writeInPlace(plan, **source, out, existing); !ok) {
-        return tl::unexpected(ok.error());
+    auto checked = writeInPlace(plan, **source, in, out, existing);
+    if (!checked) {
+        return tl::unexpected(checked.error());
     }
-    return reportOf(s, sessionRestored);
+    return reportOf(s, sessionRestored, *checked);
 }
 
 } // namespace replica::recordings

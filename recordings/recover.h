@@ -19,7 +19,12 @@ struct RecoverReport {
     std::vector<std::string> problems; // what was wrong, one sentence each
     std::vector<std::uint16_t> channelsAssumed; // channel definitions re-created from the format
     bool sessionRestored = false; // the session message came from the replica.session metadata
-    bool lossy() const { return bytesDropped > 0 || messagesDropped > 0 || chunksDamaged > 0; }
+    // Something was dropped. A restored session means the first chunk, which held it (and the
+    // first samples), is gone, even when it was cut out so cleanly that nothing else shows it.
+    bool lossy() const
+    {
+        return bytesDropped > 0 || messagesDropped > 0 || chunksDamaged > 0 || sessionRestored;
+    }
 };
 
 // What recover does when its output already exists ('replica recover --force': Replace).

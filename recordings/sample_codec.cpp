@@ -192,11 +192,11 @@ std::string encodeFrame(const FrameRecord& f, const DeviceKinds& kinds)
 FrameRecord decodeFrame(const json& j, const DeviceKinds& kinds)
 {
     FrameRecord f;
-    f.frameIndex = j.at("frame");
-    f.tickNs = j.at("tick_ns");
+    f.frameIndex = integerField<std::uint64_t>(j, "frame");
+    f.tickNs = integerField<std::int64_t>(j, "tick_ns");
     for (const auto* k : kinds) {
         if (j.contains(k->names().frameKey)) {
-            f.sequences[k] = j.at(k->names().frameKey).get<std::uint32_t>();
+            f.sequences[k] = integerField<std::uint32_t>(j, k->names().frameKey.c_str());
         }
     }
     return f;

@@ -145,8 +145,8 @@ std::string encodeDisplayDigest(const DisplayDigestRecord& d)
 DisplayDigestRecord decodeDisplayDigest(const json& j)
 {
     DisplayDigestRecord d;
-    d.frameIndex = j.at("frame");
-    d.tickNs = j.at("tick_ns");
+    d.frameIndex = integerField<std::uint64_t>(j, "frame");
+    d.tickNs = integerField<std::int64_t>(j, "tick_ns");
     if (j.at("hash").get<std::string>() != "xxh3_64") {
         throw std::out_of_range("display digest: unknown hash " + j.at("hash").get<std::string>());
     }
@@ -215,8 +215,8 @@ std::string encodeLight(const LightRecord& l)
 LightRecord decodeLight(const json& j)
 {
     LightRecord l;
-    l.tNs = j.at("t");
-    l.frameIndex = j.at("frame");
+    l.tNs = integerField<std::int64_t>(j, "t");
+    l.frameIndex = integerField<std::uint64_t>(j, "frame");
     l.mode = j.at("mode");
     l.lamp = j.at("lamp");
     l.name = j.at("name");

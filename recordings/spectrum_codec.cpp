@@ -23,9 +23,9 @@ std::optional<std::string> encodeSpectrum(const hal::SpectrumSample& s)
 hal::SpectrumSample decodeSpectrum(const json& j)
 {
     hal::SpectrumSample s;
-    s.timestampNs = j.at("t");
-    s.sequence = j.at("seq");
-    s.integrationTimeUs = j.at("integration_time_us");
+    s.timestampNs = integerField<std::int64_t>(j, "t");
+    s.sequence = integerField<std::uint32_t>(j, "seq");
+    s.integrationTimeUs = integerField<std::uint32_t>(j, "integration_time_us");
     if (j.at("counts").size() > kMaxSpectrumCounts) {
         throw std::out_of_range(fmt::format("{} counts; a spectrometer has at most {} pixels",
                                             j.at("counts").size(), kMaxSpectrumCounts));

@@ -39,8 +39,8 @@ std::optional<std::string> encodePose(const hal::PoseSample& s)
 hal::PoseSample decodePose(const json& j)
 {
     hal::PoseSample s;
-    s.timestampNs = j.at("t");
-    s.sequence = j.at("seq");
+    s.timestampNs = integerField<std::int64_t>(j, "t");
+    s.sequence = integerField<std::uint32_t>(j, "seq");
     s.tracked = j.at("tracked");
     s.eyeTrackerM = vec3From(j.at("eye"));
     return s;

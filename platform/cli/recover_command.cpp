@@ -46,6 +46,10 @@ int recoverMain(const RecoverOptions& o)
     for (const auto& p : r->problems) {
         fmt::print("found: {}\n", p);
     }
+    if (r->sessionRestored) {
+        fmt::print("found: the session message was missing (its chunk lost): restored from the "
+                   "copy in the metadata\n");
+    }
     fmt::print("{}: kept {} messages from {} intact chunks; dropped {} damaged chunks, {} bytes, "
                "{} messages{}\n",
                o.out, r->messagesKept, r->chunksKept, r->chunksDamaged, r->bytesDropped,

@@ -362,6 +362,9 @@ private:
             }
             const auto body = records.substr(p + kRecordPrefix, len);
             const auto kind = static_cast<Op>(op);
+            if (kind == Op::Chunk) {
+                nestedChunk(at, p, len);
+            }
             if ((kind == Op::Schema || kind == Op::Channel || kind == Op::Message) &&
                 !inner(kind, body, at)) {
                 return "-";
@@ -369,6 +372,17 @@ private:
             p += kRecordPrefix + static_cast<std::size_t>(len);
         }
         return {};
+    }
+
+    // MCAP chunks do not nest and Replica's writer never nests them: a Chunk record inside the
+    // chunk at `at` (at offset `p` of its records) is not unpacked, and what it holds is lost:
+    // reported and counted as a dropped chunk, so that recover says so (exit 3).
+    void nestedChunk(std::size_t at, std::size_t p, std::uint64_t len)
+    {
+        problem(fmt::format("chunk at byte {} holds a Chunk record ({} bytes at offset {} of its "
+                            "records); chunks do not nest: its messages are not read",
+                            at, len, p));
+        ++s_.chunksDamaged;
     }
 
     // A message kept: to the sink, or into the Scan.
