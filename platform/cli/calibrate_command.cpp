@@ -20,7 +20,6 @@
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
-#include <platform/site_config.h>
 #include <platform/site_file.h>
 #include <recordings/device_kind.h>
 #include <recordings/recording.h>
@@ -355,12 +354,7 @@ int calibrateSpectrometer(const CalibrateOptions& o)
             return kExitFailure;
         }
         body += *level;
-    } else if (auto site = loadSiteConfig(o.site);
-               site && site->config.spectrometerDirectCdM2PerY) {
-        // The section is written whole: a level calibrated before is kept, not dropped.
-        body += fmt::format("direct_cdm2_per_y = {:.6g}\n",
-                            *site->config.spectrometerDirectCdM2PerY);
-    }
+    } // else a level calibrated before stays in the site file as it is (writeSiteSection)
     return finish(o, "spectrometer", body);
 }
 
