@@ -389,10 +389,8 @@ parseTi3(const std::string& text, const std::string& source, int bitDepth, doubl
             }
             m.xyz[k] = v * scale;
         }
-        if (m.xyz.y < -1e-3) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}:{}: negative luminance Y = {} cd/m^2", source, m.line,
-                                         m.xyz.y));
+        if (auto ok = checkMeasuredXyz(m.xyz, source, m.line); !ok) {
+            return tl::unexpected(ok.error());
         }
         set.rows.push_back(m);
     }
