@@ -14,6 +14,7 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/base/input_file.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/csv/csv_cells.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/spectral/direct_level.h>
 #include <pipeline/spectral/live_chain.h>
@@ -93,7 +94,7 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
         if (!numeric || row.size() != columns) {
             const auto e = Error{ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: expected {} numbers, got '{}'", name, lineNo,
-                                             columns, line)};
+                                             columns, pipeline::csv::shownCell(line))};
             if (prompt) {
                 fmt::print(stderr, "{}; type it again\n", e.message);
                 continue;

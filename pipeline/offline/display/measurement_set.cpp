@@ -51,7 +51,7 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: header must be R,G,B,X,Y,Z (counts, then "
                                              "XYZ in cd/m^2); found '{}'",
-                                             source, lineNo, line));
+                                             source, lineNo, csv::shownCell(line)));
             }
             header = true;
             continue;
@@ -67,7 +67,8 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
             if (!csv::parseFiniteNumber(cells[static_cast<std::size_t>(i)], v)) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: '{}' in column {} is not a finite number",
-                                             source, lineNo, cells[static_cast<std::size_t>(i)],
+                                             source, lineNo,
+                                             csv::shownCell(cells[static_cast<std::size_t>(i)]),
                                              "RGBXYZ"[i]));
             }
             if (i < 3) {
@@ -75,7 +76,8 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
                     return makeError(ErrorCode::Corrupt,
                                      fmt::format("{}:{}: count {} in column {} must be a "
                                                  "non-negative integer",
-                                                 source, lineNo, cells[static_cast<std::size_t>(i)],
+                                                 source, lineNo,
+                                                 csv::shownCell(cells[static_cast<std::size_t>(i)]),
                                                  "RGB"[i]));
                 }
                 m.counts[i] = v;
