@@ -262,6 +262,11 @@ TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
              ":3: data start at 400 nm but must cover 380-730 nm"},
             {"narrow2.csv", "wavelength_nm,value\n380,1\n700,1\n", ":3: data end at 700 nm"},
             {"dark.csv", "wavelength_nm,value\n380,0\n730,0\n", ": the light has no luminance"},
+            // Values at the ends of a double's range were blamed on the reflectance file.
+            {"huge.csv", "wavelength_nm,value\n380,1e308\n730,1e308\n",
+             ": the light's values overflow"},
+            {"tiny.csv", "wavelength_nm,value\n380,1e-320\n730,1e-320\n",
+             ": the light's values underflow"},
     };
     for (const auto& c : cases) {
         const auto light = write(c.file, c.text);
@@ -269,8 +274,27 @@ TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
                 runReplica("spectral eval --illuminant " + light + " --reflectances " + set, dir_);
         EXPECT_EQ(r.exitCode, 1) << c.file;
         EXPECT_NE(r.err.find(light + c.expect), std::string::npos) << c.file << ": " << r.err;
+        const auto rgb = runReplica("spectral eval --representation rgb3 --illuminant " + light +
+                                            " --reflectances " + set,
+                                    dir_);
+        EXPECT_EQ(rgb.exitCode, 1) << c.file;
+        EXPECT_NE(rgb.err.find(light + c.expect), std::string::npos) << c.file << ": " << rgb.err;
     }
     const auto light = write("ok.csv", lightCsv("F2"));
+    // A reflectance below -0.05 is no measurement noise (-0.1 printed L* = -88.8).
+    const auto negative =
+            write("negative.csv", "wavelength_nm,a,b\n380,0.5,0.5\n550,0.5,-0.1\n730,0.5,0.5\n");
+    auto neg =
+            runReplica("spectral eval --illuminant " + light + " --reflectances " + negative, dir_);
+    EXPECT_EQ(neg.exitCode, 1);
+    EXPECT_NE(neg.err.find(negative + ":3: column 'b' value -0.1 is no reflectance"),
+              std::string::npos)
+            << neg.err;
+    const auto noise =
+            write("noise.csv", "wavelength_nm,a,b\n380,0.5,0.5\n550,0.5,-0.01\n730,0.5,0.5\n");
+    EXPECT_EQ(runReplica("spectral eval --illuminant " + light + " --reflectances " + noise, dir_)
+                      .exitCode,
+              0);
     const auto badSet = write("set.csv", "wavelength_nm,a,b\n380,0.5,0.5\n730,0.5\n");
     auto r = runReplica("spectral eval --illuminant " + light + " --reflectances " + badSet, dir_);
     EXPECT_EQ(r.exitCode, 1);
