@@ -7,6 +7,7 @@
 #include <toml++/toml.h>
 
 #include <pipeline/base/input_file.h>
+#include <platform/output/display_geometry.h>
 #include <platform/site_config.h>
 
 namespace replica::platform {
@@ -318,12 +319,10 @@ private:
 
 bool validSize(const std::string& s)
 {
-    int w = 0;
-    int h = 0;
-    char x = 0;
-    char extra = 0;
-    return std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) == 3 && (x == 'x' || x == 'X') &&
-           w > 0 && h > 0 && w <= 16384 && h <= 16384;
+    // Each side read whole: "4294967297x1" is out of range, not 1x1.
+    const auto size = parsePixelSize(s);
+    return size && size->first > 0 && size->second > 0 && size->first <= 16384 &&
+           size->second <= 16384;
 }
 
 nlohmann::json vec(const glm::dvec3& v)

@@ -1,9 +1,11 @@
 // Site file sections: text replacement checked with toml++.
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -53,43 +55,206 @@ std::string today()
     return buf;
 }
 
+std::vector<std::string> splitLines(const std::string& text)
+{
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        const auto nl = text.find('\n', start);
+        if (nl == std::string::npos) {
+            lines.push_back(text.substr(start));
+            break;
+        }
+        lines.push_back(text.substr(start, nl - start));
+        start = nl + 1;
+    }
+    return lines;
+}
+
+// Marks the lines that continue a multi-line value (an array, a string), whose text may look like
+// a table header: only the lines left unmarked can open a section.
+void markValueLines(const toml::node& node, std::vector<bool>& inValue)
+{
+    if (const auto* t = node.as_table(); t != nullptr && !t->is_inline()) {
+        for (auto&& [k, v] : *t) {
+            markValueLines(v, inValue);
+        }
+        return;
+    }
+    if (const auto* a = node.as_array(); a != nullptr && !a->empty() && a->front().is_table() &&
+                                         !a->front().as_table()->is_inline()) {
+        for (auto&& v : *a) { // [[array.of.tables]]: headers, each with its own keys
+            markValueLines(v, inValue);
+        }
+        return;
+    }
+    const auto& s = node.source();
+    for (auto l = s.begin.line + 1; l <= s.end.line && l <= inValue.size(); ++l) {
+        inValue[l - 1] = true;
+    }
+}
+
+// "[ tracker ]  # comment" -> "[tracker]": a header line as its table's name.
+std::string headerName(const std::string& line)
+{
+    std::string name;
+    for (const char c : line.substr(0, line.find('#'))) {
+        if (c != ' ' && c != '\t' && c != '\r') {
+            name += c;
+        }
+    }
+    return name;
+}
+
+// The comment lines a calibration writes above its keys, from an earlier run (replaced with the
+// keys, so that they do not pile up): "# 'replica calibrate tracker' on ...", or the same text as
+// one of the new section's comments.
+bool isCalibrationComment(const std::string& line, const std::vector<std::string>& bodyLines)
+{
+    const std::string t = trim(line);
+    if (t.rfind("# 'replica calibrate ", 0) == 0 ||
+        t.rfind("# direct-sensor level from ", 0) == 0) {
+        return true;
+    }
+    return t.rfind('#', 0) == 0 &&
+           std::find(bodyLines.begin(), bodyLines.end(), t) != bodyLines.end();
+}
+
+// The first line of [section]'s block and the one after its last (0-based), or nullopt when the
+// file has no [section] header.
+std::optional<std::pair<std::size_t, std::size_t>> sectionBlock(
+        const std::vector<std::string>& lines, const toml::table& table, const std::string& section)
+{
+    std::vector<bool> inValue(lines.size(), false);
+    markValueLines(table, inValue);
+    std::optional<std::size_t> first;
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+        if (inValue[i] || trim(lines[i]).rfind('[', 0) != 0) {
+            continue;
+        }
+        if (first) {
+            return std::make_pair(*first, i);
+        }
+        if (headerName(lines[i]) == "[" + section + "]") {
+            first = i;
+        }
+    }
+    return first ? std::optional(std::make_pair(*first, lines.size())) : std::nullopt;
+}
+
+// The file with [section]'s keys that 'body' sets replaced by it: each old key's lines (and the
+// comments an earlier calibration wrote above it) dropped, the new lines where the first of them
+// was, or at the end of the section. Every other line stays byte for byte: the site's other
+// settings (the tracker's port and bind address) and the technician's comments.
+Expected<std::string> replaceSiteKeys(const std::string& old,
+                                      const toml::table& table,
+                                      const std::filesystem::path& file,
+                                      const std::string& section,
+                                      const std::string& body)
+{
+    const std::vector<std::string> lines = splitLines(old);
+    const auto block = sectionBlock(lines, table, section);
+    if (!block) {
+        std::string kept = old;
+        if (!kept.empty() && kept.back() != '\n') {
+            kept += '\n';
+        }
+        return kept + (kept.empty() ? "" : "\n") + "[" + section + "]\n" + body;
+    }
+    std::vector<std::string> bodyLines;
+    for (const auto& l : splitLines(body)) {
+        bodyLines.push_back(trim(l));
+    }
+    const auto* sec = table[section].as_table();
+    auto newKeys = parse(body, "(the new [" + section + "])");
+    if (!newKeys || sec == nullptr) {
+        return newKeys ? makeError(ErrorCode::InvalidArgument,
+                                   fmt::format("{}: [{}] is not a table", file.string(), section))
+                       : tl::unexpected(newKeys.error());
+    }
+    std::vector<bool> drop(lines.size(), false);
+    std::size_t insertAt = block->second;
+    while (insertAt > block->first + 1 && trim(lines[insertAt - 1]).empty()) {
+        --insertAt; // after the section's last line, before the blank lines that end it
+    }
+    std::size_t firstDropped = lines.size();
+    for (auto&& [key, value] : *newKeys) {
+        const auto it = sec->find(key.str());
+        if (it == sec->end()) {
+            continue;
+        }
+        const std::size_t from = it->first.source().begin.line;
+        const std::size_t to = it->second.source().end.line;
+        const auto* sub = it->second.as_table();
+        if ((sub != nullptr && !sub->is_inline()) || from <= block->first + 1 ||
+            to > block->second) {
+            return makeError(
+                    ErrorCode::InvalidArgument,
+                    fmt::format("{}:{}: {}.{} is not one 'key = value' under [{}]; make it "
+                                "one (or remove it) and run the calibration again",
+                                file.string(), from, section, key.str(), section));
+        }
+        std::size_t top = from - 1;
+        while (top > block->first + 1 && isCalibrationComment(lines[top - 1], bodyLines)) {
+            --top;
+        }
+        std::fill(drop.begin() + static_cast<std::ptrdiff_t>(top),
+                  drop.begin() + static_cast<std::ptrdiff_t>(to), true);
+        firstDropped = std::min(firstDropped, top);
+    }
+    if (firstDropped < lines.size()) {
+        insertAt = firstDropped;
+    }
+    const bool finalNewline = old.back() == '\n';
+    std::string out;
+    for (std::size_t i = 0; i <= lines.size(); ++i) {
+        if (i == insertAt) {
+            out += body;
+        }
+        if (i < lines.size() && !drop[i]) {
+            out += lines[i] +
+                   (i + 1 < lines.size() || finalNewline || insertAt == lines.size() ? "\n" : "");
+        }
+    }
+    return out;
+}
+
 } // namespace
 
 Expected<void> writeSiteSection(const std::filesystem::path& file,
                                 const std::string& section,
                                 const std::string& body)
 {
-    std::string old;
+    // The site file goes where the package installed it (/etc/replica): a folder that is not
+    // there is a mistyped --site, never one to create.
+    const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
     std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec)) {
+        return makeError(ErrorCode::NotFound,
+                         fmt::format("{}: there is no folder {}; give --site a file in an existing "
+                                     "folder (the site file is {})",
+                                     file.string(), folder.string(), kDefaultSiteFile));
+    }
+    std::string old;
+    std::optional<toml::table> oldTable;
     if (std::filesystem::exists(file, ec)) {
         auto text = readText(file);
         if (!text) {
             return tl::unexpected(text.error());
         }
-        if (auto t = parse(*text, file); !t) {
+        auto t = parse(*text, file);
+        if (!t) {
             return tl::unexpected(t.error());
         }
         old = std::move(*text);
+        oldTable = std::move(*t);
     }
-    // Keep every line outside [section] and [section.*].
-    std::istringstream in(old);
-    std::string line;
-    std::string kept;
-    bool inside = false;
-    while (std::getline(in, line)) {
-        const std::string t = trim(line);
-        if (!t.empty() && t[0] == '[') {
-            inside = t == "[" + section + "]" || t.rfind("[" + section + ".", 0) == 0;
-        }
-        if (!inside) {
-            kept += line + "\n";
-        }
+    auto result = oldTable ? replaceSiteKeys(old, *oldTable, file, section, body)
+                           : Expected<std::string>("[" + section + "]\n" + body);
+    if (!result) {
+        return tl::unexpected(result.error());
     }
-    while (kept.size() >= 2 && kept.substr(kept.size() - 2) == "\n\n") {
-        kept.pop_back();
-    }
-    const std::string result = kept + (kept.empty() ? "" : "\n") + "[" + section + "]\n" + body;
-    auto check = parse(result, file);
+    auto check = parse(*result, file);
     if (!check) {
         return tl::unexpected(check.error());
     }
@@ -99,10 +264,7 @@ Expected<void> writeSiteSection(const std::filesystem::path& file,
                                      "the top of the file?)",
                                      file.string(), section, section));
     }
-    if (file.has_parent_path()) {
-        std::filesystem::create_directories(file.parent_path(), ec);
-    }
-    auto written = writeOutputFile(file, result, "site file");
+    auto written = writeOutputFile(file, *result, "site file");
     if (!written) {
         const std::string& why = written.error().message;
         const bool denied = why.find(std::strerror(EACCES)) != std::string::npos ||

@@ -1,6 +1,7 @@
 // The site configuration file (TOML, /etc/replica/replica.toml on an appliance): what the
-// calibration steps write into it. A section is replaced as text, so the technician's comments
-// and every other section stay as they were; the file is checked to parse before and after.
+// calibration steps write into it. Only the keys a calibration writes are replaced, as text: the
+// technician's comments and every other key and section stay byte for byte; the file is checked
+// to parse before and after.
 #pragma once
 
 #include <filesystem>
@@ -14,10 +15,15 @@ namespace replica::platform {
 
 constexpr const char* kDefaultSiteFile = "/etc/replica/replica.toml";
 
-// Replaces table [section] (and its [section.*] subtables) in 'file' by 'body' (key = value
-// lines), creating the file if it does not exist; written by writeOutputFile (a temporary file,
-// fsynced, renamed; never through a symbolic link: a linked site file is refused, name its target).
-// Fails, naming the file and line, when the existing file is not valid TOML.
+// Sets the keys of 'body' (key = value lines, with comments) in table [section] of 'file': each
+// key already there is replaced where it stands, with the comments an earlier calibration wrote
+// above it; a new one goes at the end of the section; [section] is added at the end of the file
+// when it has none. Every other line is kept: a calibration never drops a site's port, bind
+// address or comments. The file is created when it does not exist, in a folder that does (a
+// missing folder is a mistyped --site). Written by writeOutputFile (a temporary file, fsynced,
+// renamed; never through a symbolic link: a linked site file is refused, name its target). Fails,
+// naming the file and line, when the existing file is not valid TOML or holds one of the keys in a
+// form other than one 'key = value' under [section] (a [section.key] table, a dotted key).
 Expected<void> writeSiteSection(const std::filesystem::path& file,
                                 const std::string& section,
                                 const std::string& body);

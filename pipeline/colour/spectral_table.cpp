@@ -62,7 +62,7 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
         if (!csv::parseFiniteNumber(cells[0], wl)) {
             return makeError(ErrorCode::InvalidArgument,
                              fmt::format("{}:{}: wavelength '{}' is not a number", source, lineNo,
-                                         cells[0]));
+                                         csv::shownCell(cells[0])));
         }
         if (!table.wavelengthNm.empty() && !(wl > table.wavelengthNm.back())) {
             return makeError(
@@ -75,7 +75,8 @@ Expected<SpectralTable> parseSpectralCsv(const std::string& text, const std::str
             if (!csv::parseFiniteNumber(cells[c + 1], row[c])) {
                 return makeError(ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: column '{}' value '{}' is not a finite number",
-                                             source, lineNo, table.columns[c], cells[c + 1]));
+                                             source, lineNo, csv::shownCell(table.columns[c]),
+                                             csv::shownCell(cells[c + 1])));
             }
         }
         table.wavelengthNm.push_back(wl);

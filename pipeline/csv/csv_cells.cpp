@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include <pipeline/base/printable.h>
 #include <pipeline/csv/csv_cells.h>
 
 namespace replica::pipeline::csv {
@@ -104,6 +105,11 @@ bool parseFiniteNumber(std::string_view cell, double& v)
     }
     v = parsed;
     return true;
+}
+
+std::string shownCell(std::string_view cell)
+{
+    return printable(cell, kShownCellChars);
 }
 
 std::vector<CsvLine> csvLines(const std::string& text)

@@ -26,6 +26,13 @@ std::vector<std::string> splitCsvRow(std::string_view line);
 // same files), and hexadecimal, "inf" and "nan" are refused. 'v' is written only on success.
 bool parseFiniteNumber(std::string_view cell, double& v);
 
+// A cell, or a line, of a file as an error message quotes it: control characters as \xNN (a
+// terminal escape in a hostile file is shown, never run; a NUL does not cut the message short) and
+// at most kShownCellChars characters, then "..." (a 10 MB cell is not a 10 MB message). Every
+// reader quotes what it read through it.
+constexpr std::size_t kShownCellChars = 40;
+std::string shownCell(std::string_view cell);
+
 // One data line of a CSV text: its 1-based line number, the line trimmed (trimCell) and its
 // cells (splitCsvRow).
 struct CsvLine {

@@ -1,5 +1,7 @@
 // Display profile JSON.
+#include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -66,9 +68,45 @@ const JsonSchema& profileSchema()
     return s;
 }
 
-} // namespace
+// The key of the first number in 'j' that is not finite ("fit.additivity_luminance_percent"), or
+// of a null (what a NaN or an infinity becomes when written): no reader takes either.
+std::optional<std::string> nonFiniteKey(const nlohmann::json& j, const std::string& at)
+{
+    if (j.is_null() || (j.is_number_float() && !std::isfinite(j.get<double>()))) {
+        return at;
+    }
+    if (j.is_object()) {
+        for (const auto& [key, value] : j.items()) {
+            if (auto bad = nonFiniteKey(value, at.empty() ? key : at + "." + key)) {
+                return bad;
+            }
+        }
+    } else if (j.is_array()) {
+        for (std::size_t i = 0; i < j.size(); ++i) {
+            if (auto bad = nonFiniteKey(j[i], fmt::format("{}[{}]", at, i))) {
+                return bad;
+            }
+        }
+    }
+    return std::nullopt;
+}
 
-std::string profileToJson(const DisplayModel& m)
+// A primary's X, Y and Z are amounts of light: Y above 0, and X and Z no more negative than a
+// measurement's noise (1 % of Y). [-1, -1, -1] inverts to nonsense and renders wrong colours.
+Expected<void> checkPrimary(const glm::dvec3& xyz, const char* key, const std::string& source)
+{
+    if (!(xyz.y > 0.0) || xyz.x < -0.01 * xyz.y || xyz.z < -0.01 * xyz.y) {
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: primaries_xyz_cd_m2.{} = [{:g}, {:g}, {:g}]: a "
+                                     "primary's light cannot be negative (Y above 0, X and Z at "
+                                     "least -1 % of Y); fit the profile again ('replica display "
+                                     "fit')",
+                                     source, key, xyz.x, xyz.y, xyz.z));
+    }
+    return {};
+}
+
+nlohmann::json profileJson(const DisplayModel& m)
 {
     nlohmann::json j;
     j["format"] = "replica-display-profile";
@@ -132,7 +170,14 @@ std::string profileToJson(const DisplayModel& m)
             jf["crosstalk_gain_de00"] = f.crosstalkGainDe00;
         }
     }
-    return j.dump(2) + "\n";
+    return j;
+}
+
+} // namespace
+
+std::string profileToJson(const DisplayModel& m)
+{
+    return profileJson(m).dump(2) + "\n";
 }
 
 namespace {
@@ -218,6 +263,11 @@ Expected<DisplayModel> profileFromJson(const std::string& text, const std::strin
                     glm::dmat3(vec3From(x.at("rg")), vec3From(x.at("gb")), vec3From(x.at("br")));
         }
         const auto& p = j.at("primaries_xyz_cd_m2");
+        for (const char* key : kChannelKeys) {
+            if (auto ok = checkPrimary(vec3From(p.at(key)), key, source); !ok) {
+                return tl::unexpected(ok.error());
+            }
+        }
         m.matrix = glm::dmat3(vec3From(p.at("r")), vec3From(p.at("g")), vec3From(p.at("b")));
         for (std::size_t c = 0; c < 3; ++c) {
             const auto& t = j.at("tone_curves").at(kChannelKeys[c]);
@@ -269,7 +319,20 @@ Expected<DisplayModel> loadProfile(const std::filesystem::path& path)
 
 Expected<void> saveProfile(const DisplayModel& model, const std::filesystem::path& path)
 {
-    return writeOutputFile(path, profileToJson(model), "display profile");
+    // Never a profile that nothing can load: a number that is not finite (written as null), or
+    // anything else the reader refuses, is an error here and nothing is written.
+    const nlohmann::json j = profileJson(model);
+    if (auto bad = nonFiniteKey(j, "")) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: the profile's {} is not a finite number; nothing "
+                                     "written: check the measurements for a value out of range",
+                                     path.string(), *bad));
+    }
+    const std::string text = j.dump(2) + "\n";
+    if (auto back = profileFromJson(text, path.string()); !back) {
+        return makeError(back.error().code, back.error().message + "; nothing written");
+    }
+    return writeOutputFile(path, text, "display profile");
 }
 
 } // namespace replica::pipeline::display

@@ -1,7 +1,10 @@
 // Loading the shipped reflectance sets and CIE illuminants.
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include <pipeline/colour/spectral_table.h>
+#include <pipeline/csv/csv_cells.h>
 #include <pipeline/spectral/reference_sets.h>
 
 namespace replica::pipeline::spectral {
@@ -48,6 +51,61 @@ Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path,
     return NamedSpectra{path.string(), table->columns, std::move(*spectra)};
 }
 
+Expected<NamedSpectra> loadReflectances(const std::filesystem::path& path)
+{
+    auto table = colour::loadSpectralCsv(path);
+    if (!table) {
+        return tl::unexpected(table.error());
+    }
+    for (std::size_t i = 0; i < table->rows.size(); ++i) {
+        for (std::size_t c = 0; c < table->columns.size(); ++c) {
+            const double v = table->rows[i][c];
+            if (v >= kMinReflectance && v <= kMaxReflectance) {
+                continue;
+            }
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}:{}: column '{}' value {:g} is no reflectance (a "
+                                         "fraction of the light, {} to {}: a little below 0 is "
+                                         "noise, above 1 a fluorescent sample); fix the value",
+                                         path.string(), table->rowLines[i],
+                                         csv::shownCell(table->columns[c]), v, kMinReflectance,
+                                         kMaxReflectance));
+        }
+    }
+    auto spectra = table->allSpectra(colour::GridSampling::AtBandCentre);
+    if (!spectra) {
+        return tl::unexpected(spectra.error());
+    }
+    return NamedSpectra{path.string(), table->columns, std::move(*spectra)};
+}
+
+Expected<void>
+checkLightScale(const colour::Observer& obs, const Spectrum& light, const std::string& file)
+{
+    const colour::Xyz xyz = colour::spectrumToXyz(obs, light);
+    if (!std::isfinite(xyz.x) || !std::isfinite(xyz.y) || !std::isfinite(xyz.z) ||
+        xyz.y > kMaxLightY) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: the light's values overflow: its XYZ is not finite or "
+                                     "beyond {:g}; give the spectrum in smaller units (e.g. 100 at "
+                                     "560 nm)",
+                                     file, kMaxLightY));
+    }
+    if (light.max() > 0.0 && xyz.y < kMinLightY) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: the light's values underflow: its Y is {:g}, zero or "
+                                     "next to it; give the spectrum in larger units (e.g. 100 at "
+                                     "560 nm)",
+                                     file, xyz.y));
+    }
+    if (!(xyz.y > 0.0)) {
+        return makeError(
+                ErrorCode::InvalidArgument,
+                fmt::format("{}: the light has no luminance over 380-730 nm (Y <= 0)", file));
+    }
+    return {};
+}
+
 std::vector<std::string> reflectanceSetNames()
 {
     std::vector<std::string> names;
@@ -62,8 +120,7 @@ Expected<NamedSpectra> loadReflectanceSet(const std::filesystem::path& dataDir,
 {
     for (const auto& s : kReflectanceSets) {
         if (name == s.name) {
-            return loadNamedSpectra(dataDir / "spectra" / s.file,
-                                    colour::GridSampling::AtBandCentre);
+            return loadReflectances(dataDir / "spectra" / s.file);
         }
     }
     return makeError(ErrorCode::NotFound,

@@ -8,6 +8,7 @@
 
 #include <pipeline/base/expected.h>
 #include <pipeline/colour/spectrum.h>
+#include <pipeline/colour/xyz.h>
 
 namespace replica::pipeline::spectral {
 
@@ -27,6 +28,24 @@ struct NamedSpectra {
 // band, reflectances taken at the band centres (colour::GridSampling).
 Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path,
                                         colour::GridSampling sampling);
+
+// A reflectance set from a spectral CSV, taken at the band centres, every value checked to be a
+// reflectance: from kMinReflectance (a small negative is measurement noise; -0.1 gave L* = -88.8)
+// to kMaxReflectance (a fluorescent sample reflects a little more than 1, never 10 times the
+// light). A value outside is an error naming the file, line and column.
+constexpr double kMinReflectance = -0.05;
+constexpr double kMaxReflectance = 10.0;
+Expected<NamedSpectra> loadReflectances(const std::filesystem::path& path);
+
+// A light's scale does not matter to a colour evaluation (its white is normalised), but values near
+// either end of a double's range overflow or underflow once multiplied out, and were then blamed
+// on the reflectances: an error naming 'source' (the light's file) when its XYZ is not finite or
+// its Y beyond kMaxLightY (overflow), its Y below kMinLightY while it has light (underflow), or Y
+// is not above 0 (no light).
+constexpr double kMaxLightY = 1e30;
+constexpr double kMinLightY = 1e-30;
+Expected<void>
+checkLightScale(const colour::Observer& obs, const Spectrum& light, const std::string& source);
 
 // Reflectance sets by name: "colorchecker" (BabelColor average, 24 patches), "colorchecker-ohta",
 // "ces99" (CIE 224:2017 / TM-30 evaluation samples), "tcs14" (CIE 13.3 test colour samples); the

@@ -406,7 +406,7 @@ Expected<SixChannelModel> loadSixChannelModel(const std::filesystem::path& csvPa
             if (!csv::parseFiniteNumber(cells[i], v[i])) {
                 return makeError(ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: '{}' is not a finite number", xyzPath.string(),
-                                             lineNo, cells[i]));
+                                             lineNo, csv::shownCell(cells[i])));
             }
         }
         if (v[0] != static_cast<double>(rows + 1) || rows >= kK) {

@@ -14,13 +14,13 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/base/input_file.h>
 #include <pipeline/colour/xyz.h>
+#include <pipeline/csv/csv_cells.h>
 #include <pipeline/scene/calibration.h>
 #include <pipeline/spectral/direct_level.h>
 #include <pipeline/spectral/live_chain.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
-#include <platform/site_config.h>
 #include <platform/site_file.h>
 #include <recordings/device_kind.h>
 #include <recordings/recording.h>
@@ -94,7 +94,7 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
         if (!numeric || row.size() != columns) {
             const auto e = Error{ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: expected {} numbers, got '{}'", name, lineNo,
-                                             columns, line)};
+                                             columns, pipeline::csv::shownCell(line))};
             if (prompt) {
                 fmt::print(stderr, "{}; type it again\n", e.message);
                 continue;
@@ -355,12 +355,7 @@ int calibrateSpectrometer(const CalibrateOptions& o)
             return kExitFailure;
         }
         body += *level;
-    } else if (auto site = loadSiteConfig(o.site);
-               site && site->config.spectrometerDirectCdM2PerY) {
-        // The section is written whole: a level calibrated before is kept, not dropped.
-        body += fmt::format("direct_cdm2_per_y = {:.6g}\n",
-                            *site->config.spectrometerDirectCdM2PerY);
-    }
+    } // else a level calibrated before stays in the site file as it is (writeSiteSection)
     return finish(o, "spectrometer", body);
 }
 

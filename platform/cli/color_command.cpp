@@ -34,6 +34,27 @@ struct PairFile {
     std::vector<PairRow> rows;
 };
 
+// CIELAB as a colour can have it, widely: L* from 0 (black) to 1000 (100 is the white point, and a
+// highlight may be a little above it), a* and b* within +-1000 (the spectrum locus reaches about
+// +-500). Beyond that the formula's powers overflow: L* = 1e200 gave a dE00 of NaN.
+constexpr double kMaxLightness = 1000.0;
+constexpr double kMaxChroma = 1000.0;
+
+Expected<void> checkLabRange(double v, bool lightness, const std::string& cell, const char* column)
+{
+    const double lo = lightness ? 0.0 : -kMaxChroma;
+    const double hi = lightness ? kMaxLightness : kMaxChroma;
+    if (v >= lo && v <= hi) {
+        return {};
+    }
+    return makeError(ErrorCode::InvalidArgument,
+                     fmt::format("column '{}' value '{}' is outside [{:g}, {:g}] ({}); fix or "
+                                 "remove the row",
+                                 column, pipeline::csv::shownCell(cell), lo, hi,
+                                 lightness ? "L*: 0 is black, 100 the white point"
+                                           : "a*, b*: the spectrum locus is within +-500"));
+}
+
 Expected<PairFile> readPairs(const std::string& path)
 {
     // Regular files only, opened once and read whole within the CSV limits: a directory would
@@ -90,10 +111,16 @@ Expected<PairFile> readPairs(const std::string& path)
         }
         double v[6] = {};
         for (std::size_t c = 0; c < 6; ++c) {
-            if (!pipeline::csv::parseFiniteNumber(cells[columnIndex[c]], v[c])) {
+            const std::string& cell = cells[columnIndex[c]];
+            if (!pipeline::csv::parseFiniteNumber(cell, v[c])) {
                 return makeError(ErrorCode::InvalidArgument,
                                  fmt::format("{}:{}: column '{}' value '{}' is not a finite number",
-                                             path, lineNo, kColumns[c], cells[columnIndex[c]]));
+                                             path, lineNo, kColumns[c],
+                                             pipeline::csv::shownCell(cell)));
+            }
+            if (auto ok = checkLabRange(v[c], c % 3 == 0, cell, kColumns[c]); !ok) {
+                return makeError(ErrorCode::InvalidArgument,
+                                 fmt::format("{}:{}: {}", path, lineNo, ok.error().message));
             }
         }
         out.rows.push_back(PairRow{lineNo, line, Lab{v[0], v[1], v[2]}, Lab{v[3], v[4], v[5]}});

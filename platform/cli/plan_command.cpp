@@ -10,6 +10,7 @@
 #include <pipeline/booth/booth_model.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
+#include <platform/output/display_geometry.h>
 #include <platform/render_plan.h>
 
 namespace replica::platform {
@@ -72,13 +73,15 @@ int runPlan(const PlanArgs& a)
                     p.probeMax, p.met ? "" : " (the budget is not met)");
     }
     if (!a.check.empty()) {
-        int w = 0, h = 0;
-        if (std::sscanf(a.check.c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 1024 ||
-            h > 1024) {
+        const auto size = parsePixelSize(a.check); // the one WxH parser, checked before narrowing
+        if (!size || size->first < 2 || size->second < 2 || size->first > 1024 ||
+            size->second > 1024) {
             std::fprintf(stderr, "replica plan: --check %s: expected WIDTHxHEIGHT, 2-1024 each\n",
                          a.check.c_str());
             return kExitUsage;
         }
+        const int w = static_cast<int>(size->first);
+        const int h = static_cast<int>(size->second);
         auto checked = checkRenderPlan(scene, booth, *plan, w, h, a.eyes);
         if (!checked) {
             std::fprintf(stderr, "replica plan: %s\n", checked.error().message.c_str());

@@ -22,6 +22,7 @@
 #include <pipeline/tuning/planner.h>
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
+#include <platform/output/display_geometry.h>
 #include <platform/output/output.h>
 
 namespace replica::platform {
@@ -93,11 +94,14 @@ bool parseTriple(const std::string& s, glm::dvec3& v)
 
 bool parseSize(const std::string& s, int& w, int& h)
 {
-    char x = 0;
-    std::istringstream in(s);
-    in >> w >> x >> h;
-    return in && (x == 'x' || x == 'X') && w > 0 && h > 0 && w <= 8192 && h <= 8192 &&
-           in.peek() == std::char_traits<char>::eof();
+    const auto size = parsePixelSize(s); // the one WxH parser, each side checked before narrowing
+    if (!size || size->first <= 0 || size->second <= 0 || size->first > 8192 ||
+        size->second > 8192) {
+        return false;
+    }
+    w = static_cast<int>(size->first);
+    h = static_cast<int>(size->second);
+    return true;
 }
 
 int fail(int code, const std::string& msg)

@@ -326,15 +326,12 @@ void applySite(const SiteConfig& s, RunOptions& o)
 
 std::optional<std::pair<int, int>> parseSize(const std::string& s)
 {
-    int w = 0;
-    int h = 0;
-    char x = 0;
-    char extra = 0;
-    if (std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
-        !frameSizeOk(w, h)) {
+    // Checked whole before it is narrowed to int: 4294967392x60 is out of range, not 96x60.
+    const auto size = parsePixelSize(s);
+    if (!size || !frameSizeOk(size->first, size->second)) {
         return std::nullopt;
     }
-    return std::make_pair(w, h);
+    return std::make_pair(static_cast<int>(size->first), static_cast<int>(size->second));
 }
 
 } // namespace replica::platform::run_cli

@@ -165,11 +165,10 @@ int runEval(const EvalOptions& o)
     if (!light) {
         return fail(light.error().message);
     }
-    if (!(colour::spectrumToXyz(*obs, *light).y > 0.0)) {
-        return fail(fmt::format("{}: the light has no luminance over 380-730 nm (Y <= 0)",
-                                o.illuminant));
+    if (auto ok = spectral::checkLightScale(*obs, *light, o.illuminant); !ok) {
+        return fail(ok.error().message);
     }
-    auto set = spectral::loadNamedSpectra(o.reflectances, colour::GridSampling::AtBandCentre);
+    auto set = spectral::loadReflectances(o.reflectances);
     if (!set) {
         return fail(set.error().message);
     }
@@ -191,6 +190,11 @@ int runEval(const EvalOptions& o)
         auto forLight = forTable->spectrum("value", colour::GridSampling::BandAverage);
         if (!forLight) {
             return fail(forLight.error().message);
+        }
+        // A dark light is the encoder's to refuse (it says what the appliance then does).
+        if (auto ok = spectral::checkLightScale(*obs, *forLight, o.encodedFor);
+            !ok && forLight->max() > 0.0) {
+            return fail(ok.error().message);
         }
         auto adapted = (*rep)->adaptedTo(*forLight);
         if (!adapted) {
@@ -274,7 +278,7 @@ Expected<spectral::NamedSpectra> loadTraining(const std::filesystem::path& data,
                                          name));
         }
         auto set = name.find(".csv") != std::string::npos
-                           ? spectral::loadNamedSpectra(name, colour::GridSampling::AtBandCentre)
+                           ? spectral::loadReflectances(name)
                            : spectral::loadReflectanceSet(data, name);
         if (!set) {
             return tl::unexpected(set.error());

@@ -1,4 +1,5 @@
 // Mode choice, EDID physical size and the panel-size rule (display_geometry.h).
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -8,29 +9,60 @@
 
 namespace replica::platform {
 
+namespace {
+
+// A whole number of digits only (no sign, no spaces), read whole: nullopt when it is not one or
+// does not fit 64 bits.
+std::optional<long long> wholeNumber(std::string_view text)
+{
+    long long v = 0;
+    const char* end = text.data() + text.size();
+    if (text.empty() || text.front() < '0' || text.front() > '9') {
+        return std::nullopt;
+    }
+    const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+    if (ec != std::errc() || ptr != end) {
+        return std::nullopt;
+    }
+    return v;
+}
+
+} // namespace
+
+std::optional<std::pair<long long, long long>> parsePixelSize(std::string_view text)
+{
+    const auto x = text.find_first_of("xX");
+    if (x == std::string_view::npos) {
+        return std::nullopt;
+    }
+    const auto w = wholeNumber(text.substr(0, x));
+    const auto h = wholeNumber(text.substr(x + 1));
+    if (!w || !h) {
+        return std::nullopt;
+    }
+    return std::make_pair(*w, *h);
+}
+
 Expected<ModeRequest> parseModeRequest(const std::string& text)
 {
     ModeRequest r;
     if (text.empty()) {
         return r;
     }
-    char x = 0;
-    char at = 0;
-    char extra = 0;
-    const int n = std::sscanf(text.c_str(), "%d%c%d%c%d%c", &r.width, &x, &r.height, &at,
-                              &r.refreshHz, &extra);
-    const bool sizeOnly = n == 3;
-    const bool withRate = n == 5 && at == '@';
-    if ((!sizeOnly && !withRate) || (x != 'x' && x != 'X') || r.width <= 0 || r.height <= 0 ||
-        r.width > 16384 || r.height > 16384 || r.refreshHz < 0 || r.refreshHz > 1000) {
+    const auto at = text.find('@');
+    const auto size = parsePixelSize(std::string_view(text).substr(0, at));
+    const auto hz = at == std::string::npos ? std::optional<long long>(0)
+                                            : wholeNumber(std::string_view(text).substr(at + 1));
+    if (!size || !hz || size->first <= 0 || size->second <= 0 || size->first > 16384 ||
+        size->second > 16384 || *hz > 1000) {
         return makeError(ErrorCode::InvalidArgument,
                          fmt::format("mode '{}': expected WIDTHxHEIGHT or WIDTHxHEIGHT@HZ, e.g. "
                                      "1920x1200 or 1920x1200@60",
                                      text));
     }
-    if (sizeOnly) {
-        r.refreshHz = 0;
-    }
+    r.width = static_cast<int>(size->first);
+    r.height = static_cast<int>(size->second);
+    r.refreshHz = static_cast<int>(*hz);
     return r;
 }
 

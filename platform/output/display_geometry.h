@@ -8,6 +8,8 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <pipeline/base/expected.h>
@@ -21,6 +23,13 @@ struct DisplayMode {
     int refreshHz = 0;
     bool preferred = false;
 };
+
+// "WIDTHxHEIGHT" in pixels: two whole numbers (digits only) joined by 'x' or 'X', nothing
+// around them; nullopt otherwise. The one parser of a pixel size (run --size, the site file's
+// display.size, render --size, plan --check, the KMS mode): each side is read whole as a 64-bit
+// number before any range check or narrowing, so that 4294967392 is a side far out of range, not
+// 96 (a side past 18 digits is refused as not a number). The caller checks its own range.
+std::optional<std::pair<long long, long long>> parsePixelSize(std::string_view text);
 
 // A mode request: "WIDTHxHEIGHT" or "WIDTHxHEIGHT@HZ"; empty: the preferred mode.
 struct ModeRequest {

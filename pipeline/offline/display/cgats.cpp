@@ -98,7 +98,7 @@ countsOf(const CgatsTable& t, const std::string& source, int bitDepth)
                                              t.rowLines[r],
                                              t.fields[static_cast<std::size_t>(
                                                      col[static_cast<std::size_t>(c)])],
-                                             cell));
+                                             csv::shownCell(cell)));
             }
             counts[c] = std::round(v / 100.0 * maxCount);
         }
@@ -158,7 +158,7 @@ public:
             if (!isIdentifier(tok)) {
                 return fail(lineNo, fmt::format("not a CGATS file: the first line must be its type "
                                                 "(CTI1, CTI3), found '{}'",
-                                                csv::trimCell(text)));
+                                                csv::shownCell(csv::trimCell(text))));
             }
             at_ = At::Header;
         } else if (at_ == At::Header) {
@@ -360,7 +360,7 @@ parseTi3(const std::string& text, const std::string& source, int bitDepth, doubl
     if (const auto* rep = t->keyword("COLOR_REP"); rep != nullptr && *rep != "RGB_XYZ") {
         return makeError(ErrorCode::Corrupt,
                          fmt::format("{}: COLOR_REP is '{}', a display's readings are RGB_XYZ",
-                                     source, *rep));
+                                     source, csv::shownCell(*rep)));
     }
     // Display readings are normalised to white Y = 100 unless the file says NO (Argyll's rule).
     auto scaleOr = ti3Scale(*t, source, whiteCdM2);
@@ -385,14 +385,13 @@ parseTi3(const std::string& text, const std::string& source, int bitDepth, doubl
             if (!parseNumber(t->rows[r][col], v)) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: {} '{}' is not a finite number", source,
-                                             m.line, t->fields[col], t->rows[r][col]));
+                                             m.line, csv::shownCell(t->fields[col]),
+                                             csv::shownCell(t->rows[r][col])));
             }
             m.xyz[k] = v * scale;
         }
-        if (m.xyz.y < -1e-3) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}:{}: negative luminance Y = {} cd/m^2", source, m.line,
-                                         m.xyz.y));
+        if (auto ok = checkMeasuredXyz(m.xyz, source, m.line); !ok) {
+            return tl::unexpected(ok.error());
         }
         set.rows.push_back(m);
     }
@@ -444,9 +443,9 @@ parseTi1(const std::string& text, const std::string& source, int bitDepth)
         return tl::unexpected(t.error());
     }
     if (const auto* rep = t->keyword("COLOR_REP"); rep != nullptr && rep->rfind("RGB", 0) != 0) {
-        return makeError(
-                ErrorCode::Corrupt,
-                fmt::format("{}: COLOR_REP is '{}', a display patch set is RGB", source, *rep));
+        return makeError(ErrorCode::Corrupt,
+                         fmt::format("{}: COLOR_REP is '{}', a display patch set is RGB", source,
+                                     csv::shownCell(*rep)));
     }
     auto counts = countsOf(*t, source, bitDepth);
     if (counts && counts->empty()) {

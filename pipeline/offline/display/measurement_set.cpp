@@ -12,6 +12,28 @@
 
 namespace replica::pipeline::display {
 
+// No panel is this bright (the brightest HDR panels reach about 10 000 cd/m^2; a profile holds at
+// most 1e5, json_schema's bound in display_profile.cpp): a larger X, Y or Z is a typo or a unit
+// mistake, and one as large as 1e308 overflows the fit into a profile of NaNs.
+constexpr double kMaxMeasuredCdM2 = 1e5;
+
+Expected<void> checkMeasuredXyz(const glm::dvec3& xyz, const std::string& source, int line)
+{
+    if (xyz.y < -1e-3) {
+        return makeError(ErrorCode::Corrupt, fmt::format("{}:{}: negative luminance Y = {} cd/m^2",
+                                                         source, line, xyz.y));
+    }
+    for (int i = 0; i < 3; ++i) {
+        if (std::abs(xyz[i]) > kMaxMeasuredCdM2) {
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}:{}: {} = {:g} cd/m^2 is beyond any display (at most "
+                                         "{:g}): fix the row (a unit mistake?) or remove it",
+                                         source, line, "XYZ"[i], xyz[i], kMaxMeasuredCdM2));
+        }
+    }
+    return {};
+}
+
 Expected<MeasurementSet>
 parseMeasurementCsv(const std::string& text, const std::string& source, int bitDepth)
 {
@@ -29,7 +51,7 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: header must be R,G,B,X,Y,Z (counts, then "
                                              "XYZ in cd/m^2); found '{}'",
-                                             source, lineNo, line));
+                                             source, lineNo, csv::shownCell(line)));
             }
             header = true;
             continue;
@@ -45,7 +67,8 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
             if (!csv::parseFiniteNumber(cells[static_cast<std::size_t>(i)], v)) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: '{}' in column {} is not a finite number",
-                                             source, lineNo, cells[static_cast<std::size_t>(i)],
+                                             source, lineNo,
+                                             csv::shownCell(cells[static_cast<std::size_t>(i)]),
                                              "RGBXYZ"[i]));
             }
             if (i < 3) {
@@ -53,7 +76,8 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
                     return makeError(ErrorCode::Corrupt,
                                      fmt::format("{}:{}: count {} in column {} must be a "
                                                  "non-negative integer",
-                                                 source, lineNo, cells[static_cast<std::size_t>(i)],
+                                                 source, lineNo,
+                                                 csv::shownCell(cells[static_cast<std::size_t>(i)]),
                                                  "RGB"[i]));
                 }
                 m.counts[i] = v;
@@ -62,10 +86,8 @@ parseMeasurementCsv(const std::string& text, const std::string& source, int bitD
                 m.xyz[i - 3] = v;
             }
         }
-        if (m.xyz.y < -1e-3) {
-            return makeError(ErrorCode::Corrupt,
-                             fmt::format("{}:{}: negative luminance Y = {} cd/m^2", source, lineNo,
-                                         m.xyz.y));
+        if (auto ok = checkMeasuredXyz(m.xyz, source, lineNo); !ok) {
+            return tl::unexpected(ok.error());
         }
         set.rows.push_back(m);
     }

@@ -31,6 +31,11 @@ Expected<MeasurementSet>
 parseMeasurementCsv(const std::string& text, const std::string& source, int bitDepth = 0);
 Expected<MeasurementSet> loadMeasurementCsv(const std::filesystem::path& path, int bitDepth = 0);
 
+// A reading's XYZ (cd/m^2) as a display's light can be: Y not below -1e-3 (noise about black), and
+// X, Y and Z within 1e5 (ten times the brightest HDR panel: a larger one is a typo or a unit
+// mistake, and one near 1e308 overflows the fit). The error names source:line.
+Expected<void> checkMeasuredXyz(const glm::dvec3& xyz, const std::string& source, int line);
+
 // CSV text of a measurement set (the header, then one row per measurement), as read back above.
 std::string measurementCsv(const std::vector<Measurement>& rows, const std::string& comment);
 

@@ -28,7 +28,7 @@ Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const 
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: header must be angle_deg,X,Y,Z (full white "
                                              "measured off axis, cd/m^2); found '{}'",
-                                             source, lineNo, line));
+                                             source, lineNo, csv::shownCell(line)));
             }
             header = true;
             continue;
@@ -42,7 +42,7 @@ Expected<ViewingAngleTable> parseViewingAngleCsv(const std::string& text, const 
             if (!csv::parseFiniteNumber(cells[i], v[i])) {
                 return makeError(ErrorCode::Corrupt,
                                  fmt::format("{}:{}: '{}' is not a finite number", source, lineNo,
-                                             cells[i]));
+                                             csv::shownCell(cells[i])));
             }
         }
         const double sum = v[1] + v[2] + v[3];

@@ -79,5 +79,17 @@ TEST(CsvCells, RefusesAnythingButOneWholeFiniteDecimalNumber)
     EXPECT_EQ(v, 42.0) << "a refused cell must leave the value alone";
 }
 
+TEST(CsvCells, AQuotedCellIsEscapedAndCut)
+{
+    EXPECT_EQ(shownCell("abc"), "abc");
+    EXPECT_EQ(shownCell("\x1b[2J"), "\\x1b[2J");
+    EXPECT_EQ(shownCell(std::string_view("5\0"
+                                         "0",
+                                         3)),
+              "5\\x000");
+    const std::string big(10'000'000, 'x');
+    EXPECT_EQ(shownCell(big), std::string(kShownCellChars, 'x') + "...");
+}
+
 } // namespace
 } // namespace replica::pipeline::csv

@@ -168,6 +168,24 @@ TEST_F(DisplayCli, FitFailsClearlyOnDegenerateSets)
             << header.err;
 }
 
+// A reading no display can give (1e308 cd/m^2 overflowed the fit into a profile of nulls, exit 0)
+// is refused naming its line, like a NaN or a negative Y, and nothing is written.
+TEST_F(DisplayCli, FitRefusesAReadingBeyondAnyDisplayNamingItsLine)
+{
+    std::ifstream in(shippedMeasurements());
+    std::string csv;
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) {
+        csv += (n == 9 ? std::string("255,255,255,1e308,1e308,1e308") : line) + "\n";
+    }
+    const auto file = write("m.csv", csv);
+    const auto r = run("display fit " + file + " --out " + (dir_ / "p.json").string());
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find(file + ":9: X = 1e+308 cd/m^2 is beyond any display"), std::string::npos)
+            << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "p.json"));
+}
+
 TEST_F(DisplayCli, FitsArgyllReadingsAndWritesAnIccProfile)
 {
     // The shipped set as dispread would have written it: the same fit as from the CSV.

@@ -2,6 +2,10 @@
 // is synthetic, and is exactly what the shipped tool and measurement set produce.
 #include <filesystem>
 #include <fstream>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <pipeline/base/data_dir.h>
 #include <pipeline/display/display_profile.h>
@@ -109,6 +113,40 @@ TEST(DisplayProfile, BadProfilesAreRejectedWithTheReason)
               "(r = 0) to count 1023 (r = 1)");
     EXPECT_EQ(loadProfile("/nonexistent/p.json").error().message,
               "/nonexistent/p.json: cannot open the display profile");
+}
+
+// A primary's XYZ is light: [-1, -1, -1] was accepted and inverted to nonsense.
+TEST(DisplayProfile, APrimaryWithNegativeLightIsRefusedNamingItsKey)
+{
+    auto j = nlohmann::json::parse(profileToJson(test::fittedSyntheticIps()));
+    j["primaries_xyz_cd_m2"]["r"] = {-1.0, -1.0, -1.0};
+    auto p = profileFromJson(j.dump(), "p.json");
+    ASSERT_FALSE(p);
+    EXPECT_NE(p.error().message.find("p.json: primaries_xyz_cd_m2.r = [-1, -1, -1]"),
+              std::string::npos)
+            << p.error().message;
+    // A measured primary's noise about zero in X or Z stays accepted.
+    auto g = nlohmann::json::parse(profileToJson(test::fittedSyntheticIps()));
+    const double y = g["primaries_xyz_cd_m2"]["b"][1].get<double>();
+    g["primaries_xyz_cd_m2"]["b"][0] = -0.001 * y;
+    EXPECT_TRUE(profileFromJson(g.dump(), "p.json"));
+}
+
+// A number that is not finite is written as null, which no reader takes: saveProfile refuses it,
+// naming the key, and writes nothing (display fit wrote such a profile from a 1e308 reading).
+TEST(DisplayProfile, AProfileWithANonFiniteNumberIsNeverWritten)
+{
+    DisplayModel m = test::fittedSyntheticIps();
+    m.fit.additivityLuminancePercent = std::numeric_limits<double>::quiet_NaN();
+    const auto file = std::filesystem::temp_directory_path() /
+                      ("replica-nan-profile-" + std::to_string(::getpid()) + ".json");
+    std::filesystem::remove(file);
+    auto saved = saveProfile(m, file);
+    ASSERT_FALSE(saved);
+    EXPECT_NE(saved.error().message.find("fit.additivity_luminance_percent is not a finite number"),
+              std::string::npos)
+            << saved.error().message;
+    EXPECT_FALSE(std::filesystem::exists(file));
 }
 
 TEST(DisplayProfile, ShippedSyntheticProfileIsReproducible)

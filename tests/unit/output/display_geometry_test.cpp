@@ -43,6 +43,21 @@ TEST(ModeRequest, ParsesSizeAndRateAndRejectsTheRest)
     }
 }
 
+// The one WxH parser reads each side whole: a side past 2^32 is a large number, never wrapped to a
+// small one (sscanf's %d turned 4294967392 into 96).
+TEST(ModeRequest, SidesAndRatesPast32BitsAreRefusedNotWrapped)
+{
+    const auto big = platform::parsePixelSize("4294967392x60");
+    ASSERT_TRUE(big);
+    EXPECT_EQ(big->first, 4294967392LL);
+    EXPECT_EQ(big->second, 60);
+    EXPECT_FALSE(platform::parsePixelSize("99999999999999999999x60"));
+    for (const char* bad : {"4294967392x60", "1920x4294968496", "1920x1200@4294967356"}) {
+        auto r = parseModeRequest(bad);
+        EXPECT_FALSE(r) << bad;
+    }
+}
+
 TEST(ModeChoice, PreferredElseFirstAndTheRequestedSizeAtItsHighestRate)
 {
     const std::vector<DisplayMode> modes{{1920, 1080, 60, false},

@@ -192,6 +192,9 @@ TEST(RunResolve, WhatTheKioskWouldRefuseIsTheSiteFilesProblemWithItsLineAndKey)
             {"[devices]\nlamp_gpio = \"gpiochip0:17\"\n", "devices.lamp_gpio"},
             {"[tracker]\nbind = \"localhost:80\"\n", "tracker.bind"},
             {"[display]\noutput = \"headless\"\nsize = \"16384x16\"\n", "display.size"},
+            // Sides past 2^32 wrapped to 1 and 600 once: each is read whole before narrowing.
+            {"[display]\noutput = \"headless\"\nsize = \"4294967297x1\"\n", "display.size"},
+            {"[display]\noutput = \"headless\"\nsize = \"960x4294967896\"\n", "display.size"},
             {"[scene]\ndir = \"/nonexistent-replica-scene\"\n", "scene.dir"},
             {"[display]\nprofile = \"/nonexistent-replica-profile.json\"\n", "display.profile"},
             {"[log]\nlevel = \"loud\"\n", "log.level"},
@@ -216,6 +219,19 @@ TEST(RunResolve, WhatTheKioskWouldRefuseIsTheSiteFilesProblemWithItsLineAndKey)
     EXPECT_EQ(cli.error().code, kExitFailure);
     EXPECT_EQ(cli.error().lines.front().rfind("--accel-axes x,x,q: ", 0), 0u)
             << cli.error().lines.front();
+}
+
+// --size and the site file's display.size share one WxH parser that reads each side whole before
+// narrowing it: 4294967392x60 once became a 96x60 frame (while 4294967296x60 was refused).
+TEST(RunOptions, AFrameSizePast32BitsIsOutOfRangeNotWrapped)
+{
+    ASSERT_TRUE(parseSize("960x600"));
+    EXPECT_EQ(*parseSize("96X60"), std::make_pair(96, 60));
+    for (const char* bad : {"4294967392x60", "4294967296x60", "96x4294967356",
+                            "18446744073709551712x60", "99999999999999999999999x60", "-96x60",
+                            "+96x60", " 96x60", "96x60 ", "96x60x2", "0x60", "96x"}) {
+        EXPECT_FALSE(parseSize(bad)) << bad;
+    }
 }
 
 // One renderer: "flat" is refused by name with a line that says so, from the site file (exit 78,

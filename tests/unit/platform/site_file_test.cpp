@@ -1,5 +1,6 @@
-// The site file: a calibration section replaces only itself (comments and other sections stay),
-// reads back to the transform written, and a broken file is refused naming its line.
+// The site file: a calibration replaces only its own keys (every other key, comment and section
+// stays byte for byte), reads back to the transform written, and a broken file or a missing
+// folder is refused naming it.
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -32,35 +33,77 @@ protected:
     std::filesystem::path dir_;
 };
 
-TEST_F(CalibrationSiteFile, TrackerSectionReplacesOnlyItselfAndReadsBack)
+pipeline::scene::RigidFit quarterTurn(double x)
 {
-    const auto file = dir_ / "replica.toml";
-    std::ofstream(file) << "# site of booth 7\n[display]\nprofile = \"panel.json\" # measured\n\n"
-                           "[tracker]\nold = 1\n\n[tracker.extra]\nx = 2\n\n[sources]\n"
-                           "tracker = \"hid\"\n";
     pipeline::scene::RigidFit fit;
     // A quarter turn about y and a translation.
     fit.T_booth_tracker.rotation = glm::dmat3(glm::dvec3{0.0, 0.0, -1.0}, glm::dvec3{0.0, 1.0, 0.0},
                                               glm::dvec3{1.0, 0.0, 0.0});
-    fit.T_booth_tracker.translation = {0.1, 0.42, -0.05};
+    fit.T_booth_tracker.translation = {x, 0.42, -0.05};
     fit.residualsM = {0.001, 0.002, 0.0015};
     fit.rmsM = 0.0016;
     fit.worst = 1;
-    ASSERT_TRUE(writeSiteSection(file, "tracker", trackerSection(fit, 3)));
-    const std::string text = slurp(file);
-    EXPECT_NE(text.find("# site of booth 7"), std::string::npos);
-    EXPECT_NE(text.find("profile = \"panel.json\" # measured"), std::string::npos);
-    EXPECT_NE(text.find("[sources]\ntracker = \"hid\""), std::string::npos);
-    EXPECT_EQ(text.find("old = 1"), std::string::npos);
-    EXPECT_EQ(text.find("[tracker.extra]"), std::string::npos);
+    return fit;
+}
+
+TEST_F(CalibrationSiteFile, TrackerCalibrationReplacesOnlyItsKeysAndReadsBack)
+{
+    const auto file = dir_ / "replica.toml";
+    // The kiosk's tracker settings (a port and bind address that are not the defaults, a
+    // multi-line array whose line starts like a header) must survive the calibration byte for
+    // byte: a lost port is a kiosk listening where opentrack does not send.
+    const std::string head = "# site of booth 7\n[display]\nprofile = \"panel.json\" # measured\n\n"
+                             "[tracker]\n# opentrack on the booth's PC\nold = 1\n"
+                             "port = 5555                         # opentrack's UDP output\n"
+                             "bind = \"0.0.0.0\"\nlist = [\n[1, 2],\n]\n";
+    const std::string tail = "\n[tracker.extra]\nx = 2\n\n[sources]\ntracker = \"hid\"\n";
+    spit(file, head + tail);
+    const auto fit = quarterTurn(0.1);
+    const std::string body = trackerSection(fit, 3);
+    ASSERT_TRUE(writeSiteSection(file, "tracker", body));
+    EXPECT_EQ(slurp(file), head + body + tail);
     auto t = readTrackerTransform(file);
     ASSERT_TRUE(t) << t.error().message;
     const glm::dvec3 p{0.3, -0.2, 0.7};
     EXPECT_LT(glm::length(t->apply(p) - fit.T_booth_tracker.apply(p)), 1e-8);
-    // Written twice: still one [tracker] table.
-    ASSERT_TRUE(writeSiteSection(file, "tracker", trackerSection(fit, 3)));
-    const std::string again = slurp(file);
-    EXPECT_EQ(again.find("[tracker]"), again.rfind("[tracker]"));
+    // Calibrated again: the keys and the comments the first calibration wrote are replaced where
+    // they stand, not added again.
+    const std::string again = trackerSection(quarterTurn(0.2), 4);
+    ASSERT_TRUE(writeSiteSection(file, "tracker", again));
+    EXPECT_EQ(slurp(file), head + again + tail);
+}
+
+TEST_F(CalibrationSiteFile, SpectrometerCalibrationKeepsTheLevelAndTheNotes)
+{
+    const auto file = dir_ / "replica.toml";
+    const std::string head = "[spectrometer]\n# metered 2024-05-01\ndirect_cdm2_per_y = 7.1e-05\n";
+    spit(file, head + "stray_light_fraction = 0.0004 # from the maker\n\n[log]\nlevel = \"info\"");
+    const std::string body = "# 'replica calibrate spectrometer' from lamp.mcap\n"
+                             "stray_light_fraction = 0.0005\nwavelength_offset_nm = 0.1000\n";
+    ASSERT_TRUE(writeSiteSection(file, "spectrometer", body));
+    // The file's last line had no newline: it still has none.
+    EXPECT_EQ(slurp(file), head + body + "\n[log]\nlevel = \"info\"");
+}
+
+TEST_F(CalibrationSiteFile, AKeyItCannotReplaceInPlaceAndAMissingFolderAreRefused)
+{
+    const auto file = dir_ / "dotted.toml";
+    const std::string dotted = "[tracker]\nport = 5555\nT_booth_tracker.translation = [0, 0, 0]\n";
+    spit(file, dotted);
+    auto w = writeSiteSection(file, "tracker", trackerSection(quarterTurn(0.1), 3));
+    ASSERT_FALSE(w);
+    EXPECT_NE(w.error().message.find("dotted.toml:3: tracker.T_booth_tracker"), std::string::npos)
+            << w.error().message;
+    EXPECT_EQ(slurp(file), dotted);
+    // A mistyped --site: no folder is made, nothing is written.
+    const auto nowhere = dir_ / "no-such-folder" / "replica.toml";
+    w = writeSiteSection(nowhere, "tracker", "a = 1\n");
+    ASSERT_FALSE(w);
+    EXPECT_NE(w.error().message.find("there is no folder"), std::string::npos) << w.error().message;
+    EXPECT_FALSE(std::filesystem::exists(nowhere.parent_path()));
+    // A new file in a folder that exists is the documented first calibration.
+    ASSERT_TRUE(writeSiteSection(dir_ / "new.toml", "tracker", "a = 1\n"));
+    EXPECT_EQ(slurp(dir_ / "new.toml"), "[tracker]\na = 1\n");
 }
 
 TEST_F(CalibrationSiteFile, SourcesAreReadWhenPresent)

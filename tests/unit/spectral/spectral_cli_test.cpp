@@ -64,6 +64,58 @@ TEST_F(CliFiles, De2000BadFilesNameFileLineAndProblem)
     EXPECT_NE(r.err.find("missing.csv: cannot open"), std::string::npos) << r.err;
 }
 
+// Values the formula cannot take (L* = 1e200 printed -nan, exit 0) are refused naming the file,
+// line and column; L* a little above 100 is a highlight, not an error.
+TEST_F(CliFiles, De2000RefusesValuesOutOfRangeNamingLineAndColumn)
+{
+    const std::string head = "L1,a1,b1,L2,a2,b2\n50,1,1,50,1,1\n";
+    const auto ok = write("ok.csv", "L1,a1,b1,L2,a2,b2\n100.5,0,0,0,-999,999\n");
+    EXPECT_EQ(runReplica("color de2000 " + ok, dir_).exitCode, 0);
+    struct Case {
+        const char* row;
+        const char* expect;
+    };
+    for (const auto& c :
+         {Case{"1e200,0,0,50,0,0", ":3: column 'L1' value '1e200' is outside [0, 1000]"},
+          Case{"50,0,0,-1,0,0", ":3: column 'L2' value '-1' is outside [0, 1000]"},
+          Case{"50,0,1001,50,0,0", ":3: column 'b1' value '1001' is outside [-1000, 1000]"}}) {
+        const auto f = write("range.csv", head + c.row + "\n");
+        for (const char* json : {"", "--json "}) {
+            const auto r = runReplica(std::string("color de2000 ") + json + f, dir_);
+            EXPECT_EQ(r.exitCode, 1) << c.row;
+            EXPECT_NE(r.err.find(f + c.expect), std::string::npos) << r.err;
+            EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+        }
+    }
+}
+
+// A cell quoted in an error message is escaped and cut (pipeline/csv/csv_cells.h, shownCell):
+// a terminal escape in the file is shown, never run; a NUL does not cut the message short; a
+// 1 MB cell is not a 1 MB message.
+TEST_F(CliFiles, De2000QuotesABadCellEscapedAndCut)
+{
+    const std::string head = "L1,a1,b1,L2,a2,b2\n";
+    auto f = write("esc.csv", head + "\x1b[2J\x1b]0;pwned\x07,0,0,50,0,0\n");
+    auto r = runReplica("color de2000 " + f, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(":2: column 'L1' value '\\x1b[2J\\x1b]0;pwned\\x07' is not a finite"),
+              std::string::npos)
+            << r.err;
+    static const char kNul[] = "5\0"
+                               "0,0,0,50,0,0\n";
+    f = write("nul.csv", head + std::string(kNul, sizeof kNul - 1));
+    r = runReplica("color de2000 " + f, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("value '5\\x000' is not a finite number\n"), std::string::npos) << r.err;
+    f = write("long.csv", head + std::string(1 << 20, '7') + "x,0,0,50,0,0\n");
+    r = runReplica("color de2000 " + f, dir_);
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_LT(r.err.size(), 400u) << r.err.size();
+    EXPECT_NE(r.err.find("7777...' is not a finite number"), std::string::npos)
+            << r.err.substr(0, 400);
+}
+
 std::string lightCsv(const std::string& name)
 {
     // The CIE table's column as 'wavelength_nm,value' on its own 5 nm grid.
@@ -210,6 +262,11 @@ TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
              ":3: data start at 400 nm but must cover 380-730 nm"},
             {"narrow2.csv", "wavelength_nm,value\n380,1\n700,1\n", ":3: data end at 700 nm"},
             {"dark.csv", "wavelength_nm,value\n380,0\n730,0\n", ": the light has no luminance"},
+            // Values at the ends of a double's range were blamed on the reflectance file.
+            {"huge.csv", "wavelength_nm,value\n380,1e308\n730,1e308\n",
+             ": the light's values overflow"},
+            {"tiny.csv", "wavelength_nm,value\n380,1e-320\n730,1e-320\n",
+             ": the light's values underflow"},
     };
     for (const auto& c : cases) {
         const auto light = write(c.file, c.text);
@@ -217,8 +274,27 @@ TEST_F(CliFiles, EvalBadFilesNameFileLineAndProblem)
                 runReplica("spectral eval --illuminant " + light + " --reflectances " + set, dir_);
         EXPECT_EQ(r.exitCode, 1) << c.file;
         EXPECT_NE(r.err.find(light + c.expect), std::string::npos) << c.file << ": " << r.err;
+        const auto rgb = runReplica("spectral eval --representation rgb3 --illuminant " + light +
+                                            " --reflectances " + set,
+                                    dir_);
+        EXPECT_EQ(rgb.exitCode, 1) << c.file;
+        EXPECT_NE(rgb.err.find(light + c.expect), std::string::npos) << c.file << ": " << rgb.err;
     }
     const auto light = write("ok.csv", lightCsv("F2"));
+    // A reflectance below -0.05 is no measurement noise (-0.1 printed L* = -88.8).
+    const auto negative =
+            write("negative.csv", "wavelength_nm,a,b\n380,0.5,0.5\n550,0.5,-0.1\n730,0.5,0.5\n");
+    auto neg =
+            runReplica("spectral eval --illuminant " + light + " --reflectances " + negative, dir_);
+    EXPECT_EQ(neg.exitCode, 1);
+    EXPECT_NE(neg.err.find(negative + ":3: column 'b' value -0.1 is no reflectance"),
+              std::string::npos)
+            << neg.err;
+    const auto noise =
+            write("noise.csv", "wavelength_nm,a,b\n380,0.5,0.5\n550,0.5,-0.01\n730,0.5,0.5\n");
+    EXPECT_EQ(runReplica("spectral eval --illuminant " + light + " --reflectances " + noise, dir_)
+                      .exitCode,
+              0);
     const auto badSet = write("set.csv", "wavelength_nm,a,b\n380,0.5,0.5\n730,0.5\n");
     auto r = runReplica("spectral eval --illuminant " + light + " --reflectances " + badSet, dir_);
     EXPECT_EQ(r.exitCode, 1);
