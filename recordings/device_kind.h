@@ -168,7 +168,8 @@ public:
     virtual bool
     encode(const AnySample& sample, AnyWriterState& state, const DeviceEmitter& emit) const = 0;
 
-    // Reader. decode throws nlohmann::json exceptions on a missing or mistyped field.
+    // Reader. decode throws a std::exception (nlohmann::json's on a missing or mistyped field,
+    // std::out_of_range on an integer that does not fit: codec_json.h's integerField).
     virtual AnySamples emptySamples() const = 0;
     virtual std::size_t count(const AnySamples& samples) const = 0;
     virtual void decode(const nlohmann::json& j, AnySamples& samples) const = 0;

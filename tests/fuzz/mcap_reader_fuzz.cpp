@@ -5,6 +5,7 @@
 // compiler).
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
@@ -39,8 +40,9 @@ void decodeAll(const replica::recordings::mcap::Scan& s)
             } else if (topic == kRecorderTopic) {
                 (void)decodeRecorderStatus(j);
             }
-        } catch (const nlohmann::json::exception&) {
-            // A malformed payload is reported by the reader as damage; it must only not crash.
+        } catch (const std::exception&) {
+            // A malformed payload (a JSON error, or an integer that does not fit: integerField's
+            // std::out_of_range) is reported by the reader as damage; it must only not crash.
         }
     }
 }
