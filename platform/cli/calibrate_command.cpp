@@ -3,6 +3,7 @@
 // result is checked (residual, degenerate points) and written into the site TOML file.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <vector>
@@ -361,6 +362,22 @@ int calibrateSpectrometer(const CalibrateOptions& o)
 
 } // namespace
 
+// --site checked when the command line is read, before a fit the technician would otherwise sit
+// through and then lose: the file's folder must exist (writeSiteSection refuses it again, for
+// the library's other callers).
+const CLI::Validator siteInExistingFolder(
+        [](const std::string& site) -> std::string {
+            const std::filesystem::path file(site);
+            const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+            std::error_code ec;
+            if (std::filesystem::is_directory(folder, ec)) {
+                return {};
+            }
+            return fmt::format("there is no folder {}; give --site a file in an existing folder",
+                               folder.string());
+        },
+        "FILE in an existing folder");
+
 void registerCalibrateCommand(CLI::App& app, int& exitCode)
 {
     auto* cmd = app.add_subcommand(
@@ -372,6 +389,7 @@ void registerCalibrateCommand(CLI::App& app, int& exitCode)
         sub->add_option("--points", o->points,
                         fmt::format("CSV of the {} (without it, typed in at the terminal)", what));
         sub->add_option("--site", o->site, "site configuration file to write the result into")
+                ->check(siteInExistingFolder)
                 ->capture_default_str();
         sub->add_option("--max-rms-mm", o->maxRmsMm,
                         "refuse a fit whose RMS residual is larger (mm)")
@@ -424,6 +442,7 @@ void registerCalibrateCommand(CLI::App& app, int& exitCode)
                              "a recording of the metered lamp alone, steady for some seconds "
                              "(default: --recording)");
     spectrometer->add_option("--site", o->site, "site configuration file to write the result into")
+            ->check(siteInExistingFolder)
             ->capture_default_str();
     spectrometer->add_flag("--dry-run", o->dryRun, "print the section instead of writing the file");
     spectrometer->callback([o, &exitCode] {

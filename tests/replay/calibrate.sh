@@ -65,7 +65,17 @@ swapped=$?
 "$replica" calibrate tracker --points "$work/line.csv" --site "$work/site.toml" \
     > /dev/null 2> "$work/line.log"
 line=$?
+# A --site in a folder that does not exist is refused when the command line is read, before the
+# fit runs or prints anything, and no folder is made.
+"$replica" calibrate tracker --points "$work/marker.csv" --site "$work/no-such-folder/site.toml" \
+    > "$work/nofolder.out" 2> "$work/nofolder.log"
+nofolder=$?
 set -e
+[ "$nofolder" -ne 0 ] || { echo "FAIL: --site in a missing folder exited 0" >&2; exit 1; }
+grep -q "there is no folder $work/no-such-folder" "$work/nofolder.log" ||
+    { echo "FAIL: --site in a missing folder: $(cat "$work/nofolder.log")" >&2; exit 1; }
+[ ! -s "$work/nofolder.out" ] && [ ! -e "$work/no-such-folder" ] ||
+    { echo "FAIL: --site in a missing folder still fitted or made the folder" >&2; exit 1; }
 "$replica" calibrate stand --points "$work/tilts.csv" --site "$work/site.toml" \
     --panel-width 0.518 --panel-height 0.324 > "$work/stand.out" 2> "$work/stand.log"
 python3 - "$work" "$swapped" "$line" <<'PY'
