@@ -37,6 +37,22 @@ void NamedSpectra::append(const NamedSpectra& other)
     spectra.insert(spectra.end(), other.spectra.begin(), other.spectra.end());
 }
 
+namespace {
+
+// Every column of a read table on the working grid, with its name.
+Expected<NamedSpectra> namedSpectra(const colour::SpectralTable& table,
+                                    const std::filesystem::path& path,
+                                    colour::GridSampling sampling)
+{
+    auto spectra = table.allSpectra(sampling);
+    if (!spectra) {
+        return tl::unexpected(spectra.error());
+    }
+    return NamedSpectra{path.string(), table.columns, std::move(*spectra)};
+}
+
+} // namespace
+
 Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path,
                                         colour::GridSampling sampling)
 {
@@ -44,11 +60,7 @@ Expected<NamedSpectra> loadNamedSpectra(const std::filesystem::path& path,
     if (!table) {
         return tl::unexpected(table.error());
     }
-    auto spectra = table->allSpectra(sampling);
-    if (!spectra) {
-        return tl::unexpected(spectra.error());
-    }
-    return NamedSpectra{path.string(), table->columns, std::move(*spectra)};
+    return namedSpectra(*table, path, sampling);
 }
 
 Expected<NamedSpectra> loadReflectances(const std::filesystem::path& path)
@@ -72,11 +84,7 @@ Expected<NamedSpectra> loadReflectances(const std::filesystem::path& path)
                                          kMaxReflectance));
         }
     }
-    auto spectra = table->allSpectra(colour::GridSampling::AtBandCentre);
-    if (!spectra) {
-        return tl::unexpected(spectra.error());
-    }
-    return NamedSpectra{path.string(), table->columns, std::move(*spectra)};
+    return namedSpectra(*table, path, colour::GridSampling::AtBandCentre);
 }
 
 Expected<void>
