@@ -390,10 +390,20 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
     }
     r.string("display", "kms_device", c.kmsDevice);
     r.string("display", "kms_connector", c.kmsConnector);
-    r.vec3("stand", "hinge_m", c.stand.hingeM, -5.0, 5.0);
-    r.number("stand", "hinge_to_panel_m", c.stand.hingeToPanelM, -1.0, 1.0);
+    r.vec3("stand", "hinge_m", c.stand.hingeM, -kStandHingeLimitM, kStandHingeLimitM);
+    r.number("stand", "hinge_to_panel_m", c.stand.hingeToPanelM, -kStandHingeToPanelLimitM,
+             kStandHingeToPanelLimitM);
     r.number("stand", "panel_width_m", c.stand.panelWidthM, 0.01, 10.0);
     r.number("stand", "panel_height_m", c.stand.panelHeightM, 0.01, 10.0);
+    {
+        // 'replica calibrate stand' writes its figures beside the stand, for people: the hinge
+        // axis as the accelerometer saw it (a unit vector in the panel's frame) and the tape's
+        // RMS residual. The stand model takes the hinge along the panel's x axis.
+        glm::dvec3 axis{0.0};
+        double rms = 0.0;
+        r.vec3("stand", "hinge_axis_panel", axis, -1.0, 1.0);
+        r.number("stand", "calibration_rms_m", rms, 0.0, 1.0);
+    }
     r.vec3("tracker", "rotation_deg", c.trackerRotationDeg, -360.0, 360.0);
     r.vec3("tracker", "translation_m", c.trackerTranslationM, -10.0, 10.0);
     r.rigid("tracker", "T_booth_tracker", c.trackerCalibrated);

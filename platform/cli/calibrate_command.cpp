@@ -22,6 +22,7 @@
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
+#include <platform/site_config.h>
 #include <platform/site_file.h>
 #include <recordings/device_kind.h>
 #include <recordings/recording.h>
@@ -226,6 +227,18 @@ int calibrateStand(const CalibrateOptions& o)
                "hinge axis {:.2f} deg off the panel's x axis\n",
                fit->stand.hingeM.y, fit->stand.hingeM.z, fit->stand.hingeToPanelM, fit->rmsM * 1e3,
                fit->axisAngleRad * kDeg);
+    // A tape read in centimetres fits as well as one in metres (a stand scaled up has the same
+    // residual), so the scale is checked against what a booth's stand can be.
+    const glm::dvec3& h = fit->stand.hingeM;
+    if (std::abs(h.y) > kStandHingeLimitM || std::abs(h.z) > kStandHingeLimitM ||
+        std::abs(fit->stand.hingeToPanelM) > kStandHingeToPanelLimitM) {
+        log->error("{}: the fit puts the hinge {:.3f} m up and {:.3f} m out and the panel {:.3f} m "
+                   "above it, not a stand in a booth (within {} m; the panel within {} m of the "
+                   "hinge): give top_y and top_z in metres; nothing written",
+                   o.points.empty() ? "stdin" : o.points, h.y, h.z, fit->stand.hingeToPanelM,
+                   kStandHingeLimitM, kStandHingeToPanelLimitM);
+        return kExitFailure;
+    }
     if (fit->axisAngleRad * kDeg > 3.0) {
         log->warn("the hinge axis is {:.1f} degrees off the panel's x axis as the accelerometer "
                   "sees it: check --accel-axes and how the sensor is mounted",
