@@ -75,11 +75,14 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
         std::vector<double> row;
         std::string word;
         bool numeric = true;
+        std::string bad; // a field that is not a finite number: named in the error
         while (s >> word) {
             char* end = nullptr;
             const double v = std::strtod(word.c_str(), &end);
             if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
                 numeric = false;
+                bad = fmt::format("field {} ('{}') is not a finite number", row.size() + 1,
+                                  pipeline::csv::shownCell(word));
                 break;
             }
             row.push_back(v);
@@ -95,8 +98,12 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
         }
         if (!numeric || row.size() != columns) {
             const auto e = Error{ErrorCode::InvalidArgument,
-                                 fmt::format("{}:{}: expected {} numbers, got '{}'", name, lineNo,
-                                             columns, pipeline::csv::shownCell(line))};
+                                 !bad.empty()
+                                         ? fmt::format("{}:{}: {}; expected {} numbers", name,
+                                                       lineNo, bad, columns)
+                                         : fmt::format("{}:{}: expected {} numbers, got '{}'",
+                                                       name, lineNo, columns,
+                                                       pipeline::csv::shownCell(line))};
             if (prompt) {
                 fmt::print(stderr, "{}; type it again\n", e.message);
                 continue;
