@@ -338,8 +338,12 @@ int calibrateSpectrometer(const CalibrateOptions& o)
     const auto shift = pipeline::spectral::calibrateWavelengthShift(rawSpectra(*lamp), cal);
     if (!shift) {
         log->error("{}: no run of 10 steady spectra shows two mercury lines (404.66, 435.83, "
-                   "546.07 nm); record a fluorescent booth lamp, not tungsten or an LED",
-                   o.recording);
+                   "546.07 nm) within {} nm of where the instrument's wavelength polynomial puts "
+                   "them; record a fluorescent booth lamp, not tungsten or an LED. If this is a "
+                   "fluorescent lamp, the polynomial is off by more than that: check the EEPROM's "
+                   "wavelength coefficients ('replica probe' prints them) or have the instrument "
+                   "recalibrated",
+                   o.recording, pipeline::spectral::LineSearchOptions{}.searchNm);
         return kExitFailure;
     }
     double stray = o.strayLight >= 0.0
