@@ -34,8 +34,8 @@ hal::SpectrumSample decodeSpectrum(const json& j)
     // and -1 to 65535, a light the instrument never saw.
     const json& counts = j.at("counts");
     if (!counts.is_array()) {
-        throw std::out_of_range(fmt::format("counts: expected an array, found {}",
-                                            counts.type_name()));
+        throw std::out_of_range(
+                fmt::format("counts: expected an array, found {}", counts.type_name()));
     }
     s.counts.reserve(counts.size());
     for (std::size_t i = 0; i < counts.size(); ++i) {

@@ -4,7 +4,6 @@
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
-
 #include <state/eye_estimator.h>
 #include <state/json_state.h>
 
@@ -53,9 +52,9 @@ std::string EyeEstimator::refusal(const hal::PoseSample& pose) const
         // Samples out of order count by the time between them either way, and never as less
         // than kEyeMinIntervalS apart (two poses of one batch share a time stamp): a step of
         // up to 10 cm is always a head's.
-        const double dt = std::max(
-                std::abs(static_cast<double>(pose.timestampNs - *lastGoodNs_)) * 1e-9,
-                kEyeMinIntervalS);
+        const double dt =
+                std::max(std::abs(static_cast<double>(pose.timestampNs - *lastGoodNs_)) * 1e-9,
+                         kEyeMinIntervalS);
         const double moved = glm::length(booth - eye_);
         if (moved > kMaxEyeSpeedMPerS * dt) {
             return fmt::format("an eye that moved {:.3f} m in {:.0f} ms ({:.0f} m/s; a head moves "

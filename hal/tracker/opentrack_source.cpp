@@ -229,7 +229,7 @@ private:
     std::atomic<std::int64_t> lastGoodNs_{-1};
     std::atomic<long> rejected_{0};
     std::atomic<long> coalesced_{0};
-    LogLimiter rejectedLog_{options_.logIntervalNs};  // receiver thread only
+    LogLimiter rejectedLog_{options_.logIntervalNs}; // receiver thread only
     long lastRejectedBytes_ = 0; // the size of the last datagram dropped (receiver thread only)
     LogLimiter coalescedLog_{options_.logIntervalNs}; // receiver thread only
     std::mutex mutex_;

@@ -98,12 +98,11 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
         }
         if (!numeric || row.size() != columns) {
             const auto e = Error{ErrorCode::InvalidArgument,
-                                 !bad.empty()
-                                         ? fmt::format("{}:{}: {}; expected {} numbers", name,
-                                                       lineNo, bad, columns)
-                                         : fmt::format("{}:{}: expected {} numbers, got '{}'",
-                                                       name, lineNo, columns,
-                                                       pipeline::csv::shownCell(line))};
+                                 !bad.empty() ? fmt::format("{}:{}: {}; expected {} numbers", name,
+                                                            lineNo, bad, columns)
+                                              : fmt::format("{}:{}: expected {} numbers, got '{}'",
+                                                            name, lineNo, columns,
+                                                            pipeline::csv::shownCell(line))};
             if (prompt) {
                 fmt::print(stderr, "{}; type it again\n", e.message);
                 continue;

@@ -2,12 +2,12 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <state/scene_estimator.h>
 
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 #include <platform/loop/refusal_log.h>
 #include <recordings/device_kind.h>
-#include <state/scene_estimator.h>
 
 namespace replica::platform {
 

@@ -5,10 +5,11 @@
 #include <string>
 #include <vector>
 
+#include <state/scene_estimator.h>
+
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
 #include <platform/loop/refusal_log.h>
-#include <state/scene_estimator.h>
 
 #include <gtest/gtest.h>
 
@@ -36,10 +37,11 @@ TEST(RefusalLog, RefusedSamplesAreSaidOnceAnIntervalWithWhyTheLast)
     auto estimator = state::SceneEstimator::create(tests::shippedEstimatorSetup());
     ASSERT_TRUE(estimator) << estimator.error().message;
     Lines seen;
-    auto tap = tapLogs(spdlog::level::info, [&](auto, const std::string& area, const std::string& m) {
-        std::lock_guard lock(seen.mutex);
-        seen.lines.push_back(area + ": " + m);
-    });
+    auto tap =
+            tapLogs(spdlog::level::info, [&](auto, const std::string& area, const std::string& m) {
+                std::lock_guard lock(seen.mutex);
+                seen.lines.push_back(area + ": " + m);
+            });
     RefusalLog log;
     LoopStats stats;
     pipeline::scene::SceneState st;

@@ -361,8 +361,7 @@ TEST_F(SceneEstimatorTest, RefusedSamplesHoldTheLastGoodValueAndSayWhy)
     weak.gravity *= 0.8; // a scale 20 % off: the direction is right, the reading is not 1 g
     u.update(st, nullptr, nullptr, &weak);
     EXPECT_NEAR(st.tiltRad, 0.5, 1e-12);
-    EXPECT_NE(u.tilt().lastRefusal().find("(0.80 g)"), std::string::npos)
-            << u.tilt().lastRefusal();
+    EXPECT_NE(u.tilt().lastRefusal().find("(0.80 g)"), std::string::npos) << u.tilt().lastRefusal();
 
     hal::PoseSample p;
     p.sequence = 10;
