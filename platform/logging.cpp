@@ -26,8 +26,9 @@ namespace replica::platform {
 namespace {
 
 const char* const kAreas[] = {
-        "hal.spectrometer", "hal.tracker", "hal.accel", "hal.lamp", "pipeline", "render",
-        "output",           "rec",         "loop",      "replica",  "planner",  "booth"};
+        "hal.spectrometer", "hal.tracker", "hal.accel", "hal.lamp", "pipeline",
+        "render",           "output",      "rec",       "loop",     "replica",
+        "planner",          "booth",       "state"};
 
 // The message of a log line with its control characters escaped (pipeline/base/printable.h):
 // a log line may carry text from a recording or a device, and a terminal must not obey it.

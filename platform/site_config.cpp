@@ -330,6 +330,50 @@ nlohmann::json vec(const glm::dvec3& v)
     return nlohmann::json::array({v.x, v.y, v.z});
 }
 
+// The sections the calibrations write ('replica calibrate stand|tracker|spectrometer',
+// platform/site_file.h), their figures for people among them.
+void readCalibrated(Reader& r, SiteConfig& c)
+{
+    r.vec3("stand", "hinge_m", c.stand.hingeM, -kStandHingeLimitM, kStandHingeLimitM);
+    r.number("stand", "hinge_to_panel_m", c.stand.hingeToPanelM, -kStandHingeToPanelLimitM,
+             kStandHingeToPanelLimitM);
+    r.number("stand", "panel_width_m", c.stand.panelWidthM, 0.01, 10.0);
+    r.number("stand", "panel_height_m", c.stand.panelHeightM, 0.01, 10.0);
+    {
+        // 'replica calibrate stand' writes its figures beside the stand, for people: the hinge
+        // axis as the accelerometer saw it (a unit vector in the panel's frame) and the tape's
+        // RMS residual. The stand model takes the hinge along the panel's x axis.
+        glm::dvec3 axis{0.0};
+        double rms = 0.0;
+        r.vec3("stand", "hinge_axis_panel", axis, -1.0, 1.0);
+        r.number("stand", "calibration_rms_m", rms, 0.0, 1.0);
+    }
+    r.vec3("tracker", "rotation_deg", c.trackerRotationDeg, -360.0, 360.0);
+    r.vec3("tracker", "translation_m", c.trackerTranslationM, -10.0, 10.0);
+    r.rigid("tracker", "T_booth_tracker", c.trackerCalibrated);
+    {
+        double unused = 0.0; // the calibration's figures, for people
+        r.number("tracker", "calibration_rms_m", unused, 0.0, 1.0);
+        r.number("tracker", "calibration_points", unused, 0.0, 1e6);
+    }
+    r.integer("tracker", "port", c.trackerPort, 1, 65535);
+    r.string("tracker", "bind", c.trackerBind);
+    r.number("spectrometer", "stray_light_fraction", c.spectrometerStrayLight, 0.0, 0.05);
+    r.number("spectrometer", "wavelength_offset_nm", c.spectrometerWavelengthOffsetNm, -5.0, 5.0);
+    {
+        double perY = 0.0;
+        r.number("spectrometer", "direct_cdm2_per_y", perY, 1e-12, 1e12);
+        if (perY > 0.0) { // given and good
+            c.spectrometerDirectCdM2PerY = perY;
+        }
+    }
+    {
+        double unused = 0.0; // the calibration's figures, for people
+        r.number("spectrometer", "calibration_spectra", unused, 0.0, 1e9);
+        r.number("spectrometer", "calibration_spread_nm", unused, 0.0, 100.0);
+    }
+}
+
 } // namespace
 
 std::filesystem::path defaultSiteConfigPath()
@@ -390,39 +434,12 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
     }
     r.string("display", "kms_device", c.kmsDevice);
     r.string("display", "kms_connector", c.kmsConnector);
-    r.vec3("stand", "hinge_m", c.stand.hingeM, -5.0, 5.0);
-    r.number("stand", "hinge_to_panel_m", c.stand.hingeToPanelM, -1.0, 1.0);
-    r.number("stand", "panel_width_m", c.stand.panelWidthM, 0.01, 10.0);
-    r.number("stand", "panel_height_m", c.stand.panelHeightM, 0.01, 10.0);
-    r.vec3("tracker", "rotation_deg", c.trackerRotationDeg, -360.0, 360.0);
-    r.vec3("tracker", "translation_m", c.trackerTranslationM, -10.0, 10.0);
-    r.rigid("tracker", "T_booth_tracker", c.trackerCalibrated);
-    {
-        double unused = 0.0; // the calibration's figures, for people
-        r.number("tracker", "calibration_rms_m", unused, 0.0, 1.0);
-        r.number("tracker", "calibration_points", unused, 0.0, 1e6);
-    }
-    r.integer("tracker", "port", c.trackerPort, 1, 65535);
-    r.string("tracker", "bind", c.trackerBind);
+    readCalibrated(r, c);
     r.string("devices", "iio_root", c.iioRoot);
     r.string("devices", "accel_name", c.accelName);
     r.string("devices", "accel_axes", c.accelAxes);
     r.string("devices", "lamp_gpio", c.lampGpio);
     r.string("devices", "spectrometer_serial", c.spectrometerSerial);
-    r.number("spectrometer", "stray_light_fraction", c.spectrometerStrayLight, 0.0, 0.05);
-    r.number("spectrometer", "wavelength_offset_nm", c.spectrometerWavelengthOffsetNm, -5.0, 5.0);
-    {
-        double perY = 0.0;
-        r.number("spectrometer", "direct_cdm2_per_y", perY, 1e-12, 1e12);
-        if (perY > 0.0) { // given and good
-            c.spectrometerDirectCdM2PerY = perY;
-        }
-    }
-    {
-        double unused = 0.0; // the calibration's figures, for people
-        r.number("spectrometer", "calibration_spectra", unused, 0.0, 1e9);
-        r.number("spectrometer", "calibration_spread_nm", unused, 0.0, 100.0);
-    }
     r.string("run", "hal", c.hal, {"live", "sim", "replay"});
     r.string("run", "replay_file", c.replayFile);
     r.number("run", "rate_hz", c.rateHz, 1.0, 240.0);

@@ -22,6 +22,11 @@ namespace replica::platform {
 // The compiled-in default of the site file: REPLICA_SITE_CONFIG (/etc/replica/replica.toml).
 std::filesystem::path defaultSiteConfigPath();
 
+// The stand a site file takes: the hinge within this of the booth's origin on each axis, the
+// panel's bottom edge within this of the hinge (metres; a booth is about a metre across).
+constexpr double kStandHingeLimitM = 5.0;
+constexpr double kStandHingeToPanelLimitM = 1.0;
+
 // Every value has the default a run without a site file has, so that a file holding only some
 // keys changes only those (and recordings made without one are unchanged).
 struct SiteConfig {

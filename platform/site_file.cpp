@@ -264,12 +264,34 @@ Expected<void> writeSiteSection(const std::filesystem::path& file,
                                      "the top of the file?)",
                                      file.string(), section, section));
     }
-    auto written = writeOutputFile(file, *result, "site file");
-    if (!written) {
-        const std::string& why = written.error().message;
+    // What the appliance would say of the keys written: a calibration never writes a value the
+    // site reader refuses (a stand measured in centimetres, a key it does not know), since the
+    // next start would stop on it (exit 78). The file stays as it was.
+    auto load = parseSiteConfig(*result, file);
+    if (!load) {
+        return tl::unexpected(load.error());
+    }
+    auto keys = parse(body, file); // the keys this calibration writes
+    if (!keys) {
+        return tl::unexpected(keys.error());
+    }
+    for (const SiteProblem& p : load->problems) {
+        const std::string rest = p.key.rfind(section + ".", 0) == 0
+                                         ? p.key.substr(section.size() + 1)
+                                         : std::string();
+        const bool ours = !rest.empty() && keys->contains(rest.substr(0, rest.find('.')));
+        if (ours) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}; the calibration is not written and {} is unchanged",
+                                         formatProblem(file, p), file.string()));
+        }
+    }
+    auto saved = writeOutputFile(file, *result, "site file");
+    if (!saved) {
+        const std::string& why = saved.error().message;
         const bool denied = why.find(std::strerror(EACCES)) != std::string::npos ||
                             why.find(std::strerror(EROFS)) != std::string::npos;
-        return makeError(written.error().code,
+        return makeError(saved.error().code,
                          why + (denied ? " (run as root, or give --site a writable path)" : ""));
     }
     return {};

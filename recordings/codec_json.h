@@ -11,6 +11,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -43,9 +44,8 @@ bool finite(const std::array<double, N>& a)
 // take 3.5 as 3, 1e29 as whatever the cast makes of it, and 18446744073709551615 as -1 for an
 // int64_t: values no Replica build wrote, that the reader would otherwise use.)
 template <typename T>
-T integerField(const json& j, const char* key)
+T integerValue(const json& v, std::string_view what)
 {
-    const json& v = j.at(key);
     if (v.is_number_unsigned()) {
         const auto u = v.get<std::uint64_t>();
         if (std::in_range<T>(u)) {
@@ -57,12 +57,17 @@ T integerField(const json& j, const char* key)
             return static_cast<T>(i);
         }
     } else {
-        throw std::out_of_range(fmt::format("{}: expected an integer, found {} {}", key,
+        throw std::out_of_range(fmt::format("{}: expected an integer, found {} {}", what,
                                             v.type_name(), v.dump().substr(0, 40)));
     }
-    throw std::out_of_range(fmt::format("{}: {} is out of range [{}, {}]", key, v.dump(),
+    throw std::out_of_range(fmt::format("{}: {} is out of range [{}, {}]", what, v.dump(),
                                         std::numeric_limits<T>::min(),
                                         std::numeric_limits<T>::max()));
+}
+template <typename T>
+T integerField(const json& j, const char* key)
+{
+    return integerValue<T>(j.at(key), key);
 }
 
 inline json vec3(const glm::dvec3& v)

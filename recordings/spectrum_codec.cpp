@@ -30,7 +30,17 @@ hal::SpectrumSample decodeSpectrum(const json& j)
         throw std::out_of_range(fmt::format("{} counts; a spectrometer has at most {} pixels",
                                             j.at("counts").size(), kMaxSpectrumCounts));
     }
-    s.counts = j.at("counts").get<std::vector<std::uint16_t>>();
+    // Each count as the detector gives it, 0..65535: get<uint16_t>() would wrap 70000 to 4464
+    // and -1 to 65535, a light the instrument never saw.
+    const json& counts = j.at("counts");
+    if (!counts.is_array()) {
+        throw std::out_of_range(
+                fmt::format("counts: expected an array, found {}", counts.type_name()));
+    }
+    s.counts.reserve(counts.size());
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+        s.counts.push_back(integerValue<std::uint16_t>(counts[i], fmt::format("counts[{}]", i)));
+    }
     s.wavelengthCoeffs = j.at("wavelength_coeffs");
     s.nonlinearityCoeffs = j.at("nonlinearity_coeffs");
     s.saturated = j.at("saturated");

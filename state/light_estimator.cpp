@@ -5,8 +5,27 @@
 #include <state/json_state.h>
 #include <state/light_estimator.h>
 
+#include <hal/spectrometer/usb2000_protocol.h>
+
 namespace replica::state {
 namespace {
+
+namespace usb2000 = hal::spectrometer::usb2000;
+
+// Why a spectrum is not converted at all ("" when it is).
+std::string unusable(const hal::SpectrumSample& s)
+{
+    if (s.saturated) {
+        return "saturated (a pixel at full scale): shorten the integration time or dim the light";
+    }
+    if (s.integrationTimeUs < usb2000::kMinIntegrationUs ||
+        s.integrationTimeUs > usb2000::kMaxIntegrationUs) {
+        return fmt::format("an integration time of {} us, outside the USB2000+'s {}..{} us",
+                           s.integrationTimeUs, usb2000::kMinIntegrationUs,
+                           usb2000::kMaxIntegrationUs);
+    }
+    return "";
+}
 
 std::vector<pipeline::spectral::StoredLight> lampLights(const pipeline::booth::Booth& booth)
 {
@@ -109,9 +128,12 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
                                             spectrum->wavelengthCoeffs,
                                             spectrum->nonlinearityCoeffs};
         // A saturated spectrum has lost its peaks: its shape cannot be trusted, keep the last
-        // light (and leave it out of the average).
-        auto spd = spectrum->saturated ? makeError(ErrorCode::InvalidArgument, "saturated")
-                                       : chain_.add(raw);
+        // light (and leave it out of the average). So is one whose integration time no USB2000+
+        // takes: the level divides by it (1 us would read a lamp a thousand times too bright).
+        const std::string refused = unusable(*spectrum);
+        auto spd = refused.empty() ? chain_.add(raw)
+                                   : Expected<pipeline::colour::Spectrum>(
+                                             makeError(ErrorCode::InvalidArgument, refused));
         if (spd) {
             const int lamp =
                     setup_.forceDirect
@@ -129,6 +151,7 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
             }
         } else {
             ++rejected_;
+            lastRefusal_ = spd.error().message;
         }
     }
 }

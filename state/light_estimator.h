@@ -107,6 +107,8 @@ public:
 
     bool sensed() const { return haveSpectrum_; }
     std::uint64_t rejectedSpectra() const { return rejected_; }
+    // Why the last refused spectrum was refused ("" before the first).
+    const std::string& lastRefusal() const { return lastRefusal_; }
     pipeline::spectral::Classification classification() const;
     const LampArbiter& lampArbiter() const { return arbiter_; }
     // A warning to log (the arbiter's), once.
@@ -134,6 +136,7 @@ private:
     std::optional<std::uint32_t> lastSelector_;
     bool haveSpectrum_ = false;
     std::uint64_t rejected_ = 0;
+    std::string lastRefusal_;
     // The light now, and the one the previous frame rendered (none before the first frame).
     int lamp_ = -1;
     pipeline::colour::Spectrum spd_{};

@@ -26,6 +26,7 @@ void TiltEstimator::update(const hal::AccelSample* accel)
         sense(*tilt);
     } else {
         ++rejected_;
+        lastRefusal_ = pipeline::scene::whyNoTilt(accel->gravity);
     }
 }
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -78,6 +79,8 @@ public:
 
     bool sensed() const { return haveTilt_; }
     std::uint64_t rejectedTilts() const { return rejected_; }
+    // Why the last refused reading was refused ("" before the first).
+    const std::string& lastRefusal() const { return lastRefusal_; }
 
     nlohmann::json save() const;
     Expected<void> restore(const nlohmann::json& j);
@@ -88,6 +91,7 @@ private:
     std::optional<std::uint32_t> lastAccel_;
     bool haveTilt_ = false;
     std::uint64_t rejected_ = 0;
+    std::string lastRefusal_;
     // The hold filter.
     std::array<double, kTiltWindow> window_{};
     std::size_t next_ = 0;

@@ -399,28 +399,35 @@ private:
         s.gravity = gravityFromRaw(*raw, options_.mounting);
         const bool finite = std::isfinite(s.gravity.x) && std::isfinite(s.gravity.y) &&
                             std::isfinite(s.gravity.z);
+        // A line may come with a later reading (the limiter's interval passed): it names the
+        // last bad one, kept here, not the reading at hand.
+        const auto readingText = [&] {
+            return fmt::format("raw {} scale {} offset {}", fmt::join(reading, ","),
+                               fmt::join(dev.scale(), ","), fmt::join(dev.offset(), ","));
+        };
+        if (!finite) {
+            lastNonFinite_ = readingText();
+        }
         if (const auto n = nonFinite_.add(finite ? 0 : 1, nowNs); n > 0) {
             deviceLog("hal.accel")
-                    ->warn("'{}' at {}: {} reading{} not finite (the last: raw {} scale {} offset "
-                           "{}), {} in all: not used, the display keeps its last tilt (at most "
-                           "one line per {:g} s)",
-                           dev.name(), dev.dir().string(), n, n == 1 ? "" : "s",
-                           fmt::join(reading, ","), fmt::join(dev.scale(), ","),
-                           fmt::join(dev.offset(), ","), nonFinite_.total(),
-                           static_cast<double>(options_.logIntervalNs) * 1e-9);
+                    ->warn("'{}' at {}: {} reading{} not finite (the last: {}), {} in all: not "
+                           "used, the display keeps its last tilt (at most one line per {:g} s)",
+                           dev.name(), dev.dir().string(), n, n == 1 ? "" : "s", lastNonFinite_,
+                           nonFinite_.total(), static_cast<double>(options_.logIntervalNs) * 1e-9);
         }
         const double g = finite ? glm::length(s.gravity) : 0.0;
         const bool inRange = !finite || (g >= kMinGravityMs2 && g <= kMaxGravityMs2);
+        if (!inRange) {
+            lastOutOfRange_ = fmt::format("{:.4g} m/s^2 from {}", g, readingText());
+        }
         if (const auto n = outOfRange_.add(inRange ? 0 : 1, nowNs); n > 0) {
             deviceLog("hal.accel")
-                    ->warn("'{}' at {}: {} reading{} out of range (the last: {:.4g} m/s^2 from raw "
-                           "{} scale {} offset {}; a panel reads 9.81, {:.4g}..{:.4g} is used), {} "
-                           "in all: not used, the display keeps its last tilt (at most one line "
-                           "per {:g} s)",
-                           dev.name(), dev.dir().string(), n, n == 1 ? "" : "s", g,
-                           fmt::join(reading, ","), fmt::join(dev.scale(), ","),
-                           fmt::join(dev.offset(), ","), kMinGravityMs2, kMaxGravityMs2,
-                           outOfRange_.total(), static_cast<double>(options_.logIntervalNs) * 1e-9);
+                    ->warn("'{}' at {}: {} reading{} out of range (the last: {}; a panel reads "
+                           "9.81, {:.4g}..{:.4g} is used), {} in all: not used, the display keeps "
+                           "its last tilt (at most one line per {:g} s)",
+                           dev.name(), dev.dir().string(), n, n == 1 ? "" : "s", lastOutOfRange_,
+                           kMinGravityMs2, kMaxGravityMs2, outOfRange_.total(),
+                           static_cast<double>(options_.logIntervalNs) * 1e-9);
         }
         if (!finite || !inRange) {
             return std::nullopt;
@@ -437,6 +444,7 @@ private:
     // The source's thread only:
     std::string lastError_;  // the error the device is lost on (empty: reading)
     std::string lastLogged_; // the last error logged: a repeated one is not logged again
+    std::string lastNonFinite_, lastOutOfRange_; // the last bad reading of each kind, as logged
     bool announced_ = false;
     LogLimiter nonFinite_{options_.logIntervalNs};
     LogLimiter outOfRange_{options_.logIntervalNs};

@@ -38,7 +38,7 @@ struct SimSpectrometerParams {
 };
 
 // Simulated Ocean Optics USB2000+: 2048 pixels, a realistic wavelength polynomial, dark
-// pixels 6..21 (masked on the detector), shot and read noise, detector non-linearity with its
+// pixels 6..20 (masked on the detector), shot and read noise, detector non-linearity with its
 // EEPROM correction coefficients, 16-bit saturation.
 std::unique_ptr<SpectrometerSource> makeSimSpectrometer(ScenarioParams scenario,
                                                         SimSpectrometerParams params);
@@ -84,6 +84,6 @@ std::unique_ptr<LampSelectorSource> makeSimLampSelector(ScenarioParams scenario,
 constexpr double kSimWavelengthCoeffs[4] = {339.2, 0.3797, -1.62e-5, -1.3e-10};
 constexpr int kSimPixels = 2048;
 constexpr int kSimDarkPixelFirst = 6;
-constexpr int kSimDarkPixelLast = 21;
+constexpr int kSimDarkPixelLast = 20;
 
 } // namespace replica::hal::sim

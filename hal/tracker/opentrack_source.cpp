@@ -102,7 +102,7 @@ private:
         while (!stop_) {
             pollfd p{fd_, POLLIN, 0};
             if (::poll(&p, 1, 50) <= 0) {
-                report(0);
+                report();
                 continue;
             }
             Drained d = drain(buf);
@@ -121,13 +121,16 @@ private:
             lastErrno = 0;
             rejected_ += d.rejected;
             rejectedLog_.count(static_cast<std::uint64_t>(d.rejected));
+            if (d.rejected > 0) {
+                lastRejectedBytes_ = d.lastRejectedBytes;
+            }
             if (!d.latest.empty()) {
                 push(d.latest, d.pose);
                 const long coalesced = d.good - 1;
                 coalesced_ += coalesced;
                 coalescedLog_.count(static_cast<std::uint64_t>(coalesced));
             }
-            report(d.lastRejectedBytes);
+            report();
             if (!d.latest.empty() && options_.minIntervalNs > 0) {
                 // A flood waits in the socket's buffer (the kernel drops what does not fit) and
                 // is read as one batch, its latest pose kept: the receiver costs at most one
@@ -193,8 +196,9 @@ private:
     }
 
     // The rate-limited lines: the first rejected or coalesced datagram at once, then at most one
-    // line per logIntervalNs for each, with the count since the last line.
-    void report(long lastRejectedBytes)
+    // line per logIntervalNs for each, with the count since the last line (and the size of the
+    // last datagram dropped, which may have come before the wake-up that says so).
+    void report()
     {
         const std::int64_t now = clock_.nowNs();
         const double seconds = static_cast<double>(options_.logIntervalNs) * 1e-9;
@@ -203,7 +207,7 @@ private:
                     ->warn("dropped {} datagram{} on port {} (the last {} bytes; opentrack sends "
                            "48 finite bytes), {} in all; is another program sending here? (at "
                            "most one line per {:g} s)",
-                           n, n == 1 ? "" : "s", port_, lastRejectedBytes, rejected_.load(),
+                           n, n == 1 ? "" : "s", port_, lastRejectedBytes_, rejected_.load(),
                            seconds);
         }
         if (const auto n = coalescedLog_.flush(now); n > 0) {
@@ -225,7 +229,8 @@ private:
     std::atomic<std::int64_t> lastGoodNs_{-1};
     std::atomic<long> rejected_{0};
     std::atomic<long> coalesced_{0};
-    LogLimiter rejectedLog_{options_.logIntervalNs};  // receiver thread only
+    LogLimiter rejectedLog_{options_.logIntervalNs}; // receiver thread only
+    long lastRejectedBytes_ = 0; // the size of the last datagram dropped (receiver thread only)
     LogLimiter coalescedLog_{options_.logIntervalNs}; // receiver thread only
     std::mutex mutex_;
     std::deque<PoseSample> queue_;

@@ -1,6 +1,7 @@
 // Stand hinge model and tilt from the accelerometer.
 #include <cmath>
 
+#include <fmt/format.h>
 #include <glm/geometric.hpp>
 
 #include <pipeline/scene/stand.h>
@@ -30,20 +31,37 @@ PanelPose panelPose(double tiltRad)
     return panelPose(StandModel{}, tiltRad);
 }
 
-std::optional<double> tiltFromGravity(const glm::dvec3& g)
+namespace {
+
+constexpr double kStandardGravity = 9.80665;
+
+} // namespace
+
+std::string whyNoTilt(const glm::dvec3& g)
 {
     if (!std::isfinite(g.x) || !std::isfinite(g.y) || !std::isfinite(g.z)) {
-        return std::nullopt;
+        return "a reading that is not finite";
     }
-    constexpr double kStandardGravity = 9.80665;
     const double magnitude = glm::length(g);
     // Gate implausible readings (knocks, free fall): |g| must be within 10 % of 1 g.
     if (std::abs(magnitude - kStandardGravity) > 0.1 * kStandardGravity) {
-        return std::nullopt;
+        return fmt::format("|g| {:.3f} m/s^2 ({:.2f} g), outside 0.9-1.1 g: a knock, the panel "
+                           "moved, or the sensor's scale is off",
+                           magnitude, magnitude / kStandardGravity);
     }
     // With gravity nearly along the hinge (x) axis the rotation about x is undefined.
     const double inPlane = std::hypot(g.y, g.z);
     if (inPlane < 0.2 * kStandardGravity) {
+        return fmt::format("gravity along the hinge ({:.2f} g of it across the hinge, under "
+                           "0.2 g): check the accelerometer's axes",
+                           inPlane / kStandardGravity);
+    }
+    return "";
+}
+
+std::optional<double> tiltFromGravity(const glm::dvec3& g)
+{
+    if (!whyNoTilt(g).empty()) {
         return std::nullopt;
     }
     return std::atan2(-g.z, -g.y);

@@ -3,6 +3,7 @@
 
 #include <numbers>
 #include <optional>
+#include <string>
 
 #include <glm/vec3.hpp>
 
@@ -45,5 +46,8 @@ constexpr double degreesToRadians(double deg)
 // or nullopt when it is undefined: gravity (nearly) along the hinge axis, implausible magnitude, or
 // NaN.
 std::optional<double> tiltFromGravity(const glm::dvec3& gravityPanel);
+// Why tiltFromGravity gives none for this reading ("" when it gives a tilt): for the log line that
+// says what the frame held on to.
+std::string whyNoTilt(const glm::dvec3& gravityPanel);
 
 } // namespace replica::pipeline::scene

@@ -29,8 +29,11 @@ struct RawSpectrum {
 struct SpectrometerCalibration {
     std::vector<double> wavelengthNm;
     std::vector<double> responsivity;
-    int darkPixelFirst = 6; // optically masked pixels, read for the electrical dark level
-    int darkPixelLast = 21;
+    // The electrically dark (optically masked) pixels, read for the dark level: 6..20 on the
+    // USB2000+ (its protocol notes; hal/spectrometer/usb2000_protocol.h, SeaBreeze). Pixel 21
+    // sees light.
+    int darkPixelFirst = 6;
+    int darkPixelLast = 20;
 };
 
 // Reads a calibration CSV with columns wavelength_nm,responsivity.

@@ -22,6 +22,7 @@
 #include <platform/appliance.h>
 #include <platform/cli/commands.h>
 #include <platform/logging.h>
+#include <platform/site_config.h>
 #include <platform/site_file.h>
 #include <recordings/device_kind.h>
 #include <recordings/recording.h>
@@ -74,11 +75,14 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
         std::vector<double> row;
         std::string word;
         bool numeric = true;
+        std::string bad; // a field that is not a finite number: named in the error
         while (s >> word) {
             char* end = nullptr;
             const double v = std::strtod(word.c_str(), &end);
             if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
                 numeric = false;
+                bad = fmt::format("field {} ('{}') is not a finite number", row.size() + 1,
+                                  pipeline::csv::shownCell(word));
                 break;
             }
             row.push_back(v);
@@ -94,8 +98,11 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
         }
         if (!numeric || row.size() != columns) {
             const auto e = Error{ErrorCode::InvalidArgument,
-                                 fmt::format("{}:{}: expected {} numbers, got '{}'", name, lineNo,
-                                             columns, pipeline::csv::shownCell(line))};
+                                 !bad.empty() ? fmt::format("{}:{}: {}; expected {} numbers", name,
+                                                            lineNo, bad, columns)
+                                              : fmt::format("{}:{}: expected {} numbers, got '{}'",
+                                                            name, lineNo, columns,
+                                                            pipeline::csv::shownCell(line))};
             if (prompt) {
                 fmt::print(stderr, "{}; type it again\n", e.message);
                 continue;
@@ -226,6 +233,18 @@ int calibrateStand(const CalibrateOptions& o)
                "hinge axis {:.2f} deg off the panel's x axis\n",
                fit->stand.hingeM.y, fit->stand.hingeM.z, fit->stand.hingeToPanelM, fit->rmsM * 1e3,
                fit->axisAngleRad * kDeg);
+    // A tape read in centimetres fits as well as one in metres (a stand scaled up has the same
+    // residual), so the scale is checked against what a booth's stand can be.
+    const glm::dvec3& h = fit->stand.hingeM;
+    if (std::abs(h.y) > kStandHingeLimitM || std::abs(h.z) > kStandHingeLimitM ||
+        std::abs(fit->stand.hingeToPanelM) > kStandHingeToPanelLimitM) {
+        log->error("{}: the fit puts the hinge {:.3f} m up and {:.3f} m out and the panel {:.3f} m "
+                   "above it, not a stand in a booth (within {} m; the panel within {} m of the "
+                   "hinge): give top_y and top_z in metres; nothing written",
+                   o.points.empty() ? "stdin" : o.points, h.y, h.z, fit->stand.hingeToPanelM,
+                   kStandHingeLimitM, kStandHingeToPanelLimitM);
+        return kExitFailure;
+    }
     if (fit->axisAngleRad * kDeg > 3.0) {
         log->warn("the hinge axis is {:.1f} degrees off the panel's x axis as the accelerometer "
                   "sees it: check --accel-axes and how the sensor is mounted",
@@ -318,8 +337,12 @@ int calibrateSpectrometer(const CalibrateOptions& o)
     const auto shift = pipeline::spectral::calibrateWavelengthShift(rawSpectra(*lamp), cal);
     if (!shift) {
         log->error("{}: no run of 10 steady spectra shows two mercury lines (404.66, 435.83, "
-                   "546.07 nm); record a fluorescent booth lamp, not tungsten or an LED",
-                   o.recording);
+                   "546.07 nm) within {} nm of where the instrument's wavelength polynomial puts "
+                   "them; record a fluorescent booth lamp, not tungsten or an LED. If this is a "
+                   "fluorescent lamp, the polynomial is off by more than that: check the EEPROM's "
+                   "wavelength coefficients ('replica probe' prints them) or have the instrument "
+                   "recalibrated",
+                   o.recording, pipeline::spectral::LineSearchOptions{}.searchNm);
         return kExitFailure;
     }
     double stray = o.strayLight >= 0.0

@@ -49,6 +49,10 @@ nlohmann::json loopSummaryJson(const LoopStats& stats, double periodMs)
         const auto it = stats.dropped.find(kind->name());
         j["dropped"][kind->name()] = it != stats.dropped.end() ? it->second : 0;
     }
+    j["refused"] = nlohmann::json::object();
+    for (const auto& [kind, n] : stats.refused) {
+        j["refused"][kind] = n;
+    }
     j["frame_time_ms"] = {{"mean", t.meanMs()},
                           {"p50", t.percentileMs(0.50)},
                           {"p95", t.percentileMs(0.95)},
@@ -87,6 +91,15 @@ void logLoopSummary(const LoopStats& stats, double periodMs, bool digests)
               stats.frames, dropped.empty() ? std::string("none") : dropped, stats.lateFrames,
               stats.skippedTicks, stats.meanOutOfGamutFraction(), stats.maxOutOfGamutFraction,
               stats.meanOverPeakFraction(), stats.maxOverPeakFraction);
+    if (!stats.refused.empty()) {
+        std::string refused;
+        for (const auto& [kind, n] : stats.refused) {
+            refused += fmt::format("{}{} {}", refused.empty() ? "" : ", ", kind, n);
+        }
+        log->warn("samples the state stage did not use (each kept the last good value; the log "
+                  "says why): {}",
+                  refused);
+    }
     if (stats.cadenceChanges > 0) {
         std::string rates;
         for (const auto& [rate, frames] : framesByRate(stats, periodMs)) {

@@ -15,6 +15,7 @@
 #include <hal/log_limiter.h>
 #include <platform/logging.h>
 #include <platform/loop/frame_loop.h>
+#include <platform/loop/refusal_log.h>
 #include <recordings/device_kind.h>
 
 namespace replica::platform {
@@ -371,6 +372,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
     pipeline::render::RenderedFrame image;
     Pacer pacer(pacing, options);
     std::map<std::string, hal::LogLimiter> droppedLog;
+    RefusalLog refusals;
     while (!stopRequested()) {
         const std::optional<TickPlan> next = pacer.next(ticks, stats);
         if (!next) {
@@ -385,6 +387,7 @@ Expected<LoopStats> runFrames(Appliance& appliance,
         std::apply(
                 [&](const auto*... sample) { appliance.sceneEstimator->update(state, sample...); },
                 slots.chosen());
+        refusals.after(*appliance.sceneEstimator, tick.tickNs, stats);
         if (tick.estimateOnly) {
             // Before a replayed slice: the state stage alone. A frame is a function of its
             // SceneState (the renderer keeps no history), so nothing before the slice is drawn.

@@ -47,6 +47,9 @@ struct LoopStats {
     std::uint64_t frames = 0;
     // Device kind name -> samples lost (sequence gaps seen), for every device the run has.
     std::map<std::string, std::uint64_t> dropped;
+    // Device kind name -> samples the state stage refused (loop/refusal_log.h): saturated
+    // spectra, tilt readings far from 1 g, poses no head can take. Only the kinds that had any.
+    std::map<std::string, std::uint64_t> refused;
     std::uint64_t lateFrames = 0; // realtime pacing only: frames that started after their tick
     std::uint64_t replayMismatches = 0; // replay: a recorded sample was not found (latest used)
     std::uint64_t skippedTicks = 0;     // LoopOptions::skipLateTicks: ticks never rendered

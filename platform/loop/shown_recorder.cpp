@@ -198,8 +198,13 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
         l.mode = "direct-sensor";
         l.lamp = -1;
         l.name = "unknown";
+        const auto& light = appliance_.sceneEstimator->light();
         l.why = !frame.sequence(recordings::spectrometerKind())
                         ? std::string("no spectrum yet: the starting light")
+                : !light.sensed()
+                        ? fmt::format("no usable spectrum yet ({} refused, the last: {}): the "
+                                      "starting light",
+                                      light.rejectedSpectra(), light.lastRefusal())
                 : appliance_.config.light == kLightDirect
                         ? fmt::format("direct-sensor mode forced (light = \"direct\"): "
                                       "rendering the sensed light at {:.0f} cd/m^2",

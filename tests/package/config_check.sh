@@ -23,6 +23,39 @@ grep -q "^$shipped:[0-9]*: display.allow_synthetic: the kiosk refuses a live run
 sed 's/^allow_synthetic = false/allow_synthetic = true/' "$shipped" >"$work/allowed.toml"
 "$replica" config check "$work/allowed.toml" || fail "the shipped site file allowing it does not check"
 
+# The calibrations write into the shipped file what it then takes: the stand's and the tracker's
+# sections (with their figures for people) still check, and a stand taped in centimetres is
+# refused with the file unchanged, as is a section whose key the reader would refuse.
+python3 - "$work" <<'PY'
+import math, sys
+work = sys.argv[1]
+g, L = 9.80665, 0.035 + 0.324
+with open(f"{work}/tilts.csv", "w") as f, open(f"{work}/tilts_cm.csv", "w") as cm:
+    for deg in (0.0, 20.0, 40.0):
+        a = math.radians(deg)
+        y, z = 0.18 + L * math.cos(a), -0.07 - L * math.sin(a)
+        f.write(f"0.0,{g*math.cos(a):.6f},{g*math.sin(a):.6f},{y:.6f},{z:.6f}\n")
+        cm.write(f"0.0,{g*math.cos(a):.6f},{g*math.sin(a):.6f},{100*y:.4f},{100*z:.4f}\n")
+with open(f"{work}/marker.csv", "w") as f:
+    for q in ([0.0, 0.3, 0.5], [0.2, 0.5, 0.6], [-0.2, 0.6, 0.7], [0.1, 0.2, 0.9]):
+        t = [q[0] - 0.1, q[1] - 0.42, q[2] + 0.05]  # the tracker 0.1 m along x, no rotation
+        f.write(",".join(f"{v:.6f}" for v in q + t) + "\n")
+PY
+calibrated="$work/calibrated.toml"
+cp "$work/allowed.toml" "$calibrated"
+"$replica" calibrate stand --points "$work/tilts.csv" --site "$calibrated" --panel-width 0.518 \
+    --panel-height 0.324 >/dev/null 2>"$work/stand.log" || fail "calibrate stand: $(cat "$work/stand.log")"
+"$replica" calibrate tracker --points "$work/marker.csv" --site "$calibrated" \
+    >/dev/null 2>"$work/tracker.log" || fail "calibrate tracker: $(cat "$work/tracker.log")"
+grep -q "^hinge_axis_panel = " "$calibrated" && grep -q "^T_booth_tracker = " "$calibrated" ||
+    fail "the calibrations did not write their sections"
+out=$("$replica" config check "$calibrated" 2>&1) || fail "the calibrated site file: $out"
+cp "$calibrated" "$work/before_cm.toml"
+out=$("$replica" calibrate stand --points "$work/tilts_cm.csv" --site "$calibrated" \
+    --panel-width 0.518 --panel-height 0.324 2>&1) && fail "a stand taped in centimetres was written"
+grep -q "give top_y and top_z in metres" <<<"$out" || fail "the centimetre stand: $out"
+cmp -s "$calibrated" "$work/before_cm.toml" || fail "the centimetre stand changed the site file"
+
 bad="$work/bad.toml"
 cat >"$bad" <<'TOML'
 [display]

@@ -70,7 +70,13 @@ line=$?
 "$replica" calibrate tracker --points "$work/marker.csv" --site "$work/no-such-folder/site.toml" \
     > "$work/nofolder.out" 2> "$work/nofolder.log"
 nofolder=$?
+# A row with a field that is not a number says which field, not only that six were expected.
+sed '3s/^\([^,]*\),\([^,]*\),[^,]*,/\1,\2,nan,/' "$work/marker.csv" > "$work/nan.csv"
+"$replica" calibrate tracker --points "$work/nan.csv" --dry-run > /dev/null 2> "$work/nan.log"
+nan=$?
 set -e
+[ "$nan" -eq 2 ] && grep -q "nan.csv:3: field 3 ('nan') is not a finite number" "$work/nan.log" ||
+    { echo "FAIL: a nan field: exit $nan, $(cat "$work/nan.log")" >&2; exit 1; }
 [ "$nofolder" -ne 0 ] || { echo "FAIL: --site in a missing folder exited 0" >&2; exit 1; }
 grep -q "there is no folder $work/no-such-folder" "$work/nofolder.log" ||
     { echo "FAIL: --site in a missing folder: $(cat "$work/nofolder.log")" >&2; exit 1; }

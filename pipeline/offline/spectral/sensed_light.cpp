@@ -17,11 +17,11 @@ namespace replica::pipeline::spectral {
 namespace {
 
 // The instrument. The wavelength polynomial is a typical USB2000+ one (the simulated device in
-// hal/sim uses the same); pixels 6..21 are optically masked.
+// hal/sim uses the same); pixels 6..20 are optically masked.
 constexpr std::array<double, 4> kCoeffs{339.2, 0.3797, -1.62e-5, -1.3e-10};
 constexpr int kPixels = 2048;
 constexpr int kDarkFirst = 6;
-constexpr int kDarkLast = 21;
+constexpr int kDarkLast = 20;
 constexpr double kDarkOffsetCounts = 1500.0;
 constexpr double kDarkCurrentCountsPerS = 200.0;
 constexpr double kReadNoiseCounts = 50.0;     // data sheet: dark noise 50 counts rms

@@ -265,6 +265,8 @@ TEST_F(FakeIio, NonFiniteReadingsAreCountedAndLoggedAtABoundedRate)
     EXPECT_NE(text.find("1 reading not finite (the last: raw -12,nan,40"), std::string::npos)
             << text;
     EXPECT_NE(text.find(" readings not finite"), std::string::npos) << "no count > 1: " << text;
+    // The line that comes with the good reading names the last bad one, not the good one.
+    EXPECT_EQ(text.find("raw -12,1000,40"), std::string::npos) << text;
 }
 
 // A reading out of range (a sensor stuck at zero: 0.04 g; a knock or a wrong scale: 10 g) is
@@ -302,6 +304,7 @@ TEST_F(FakeIio, OutOfRangeReadingsAreCountedAndLoggedAtABoundedRate)
         EXPECT_NE(text.find("1 reading out of range (the last: "), std::string::npos) << text;
         EXPECT_NE(text.find("raw -12," + y + ",40"), std::string::npos) << text;
         EXPECT_NE(text.find(" readings out of range"), std::string::npos) << "no count: " << text;
+        EXPECT_EQ(text.find("raw -12,1000,40"), std::string::npos) << text;
     }
 }
 

@@ -336,8 +336,9 @@ TEST_F(SiteUpdater, TrackerRotationIsXThenYThenZ)
     EXPECT_NEAR(st.eyeBoothM.x, 2.0, 1e-12);
     EXPECT_NEAR(st.eyeBoothM.y, 2.0, 1e-12);
     EXPECT_NEAR(st.eyeBoothM.z, 3.0, 1e-12);
-    // A rotation keeps lengths: |R e| = |e|.
+    // A rotation keeps lengths: |R e| = |e| (a second later: a step a head can take).
     p.sequence = 2;
+    p.timestampNs = 1'000'000'000;
     p.eyeTrackerM = {0.3, -0.4, 1.2};
     u->update(st, nullptr, &p, nullptr);
     const glm::dvec3 d = st.eyeBoothM - setup_.eye.trackerInBooth.translation;

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <unistd.h>
 
+#include <platform/site_config.h>
 #include <platform/site_file.h>
 
 #include <gtest/gtest.h>
@@ -102,8 +103,49 @@ TEST_F(CalibrationSiteFile, AKeyItCannotReplaceInPlaceAndAMissingFolderAreRefuse
     EXPECT_NE(w.error().message.find("there is no folder"), std::string::npos) << w.error().message;
     EXPECT_FALSE(std::filesystem::exists(nowhere.parent_path()));
     // A new file in a folder that exists is the documented first calibration.
-    ASSERT_TRUE(writeSiteSection(dir_ / "new.toml", "tracker", "a = 1\n"));
-    EXPECT_EQ(slurp(dir_ / "new.toml"), "[tracker]\na = 1\n");
+    ASSERT_TRUE(writeSiteSection(dir_ / "new.toml", "tracker", "port = 5555\n"));
+    EXPECT_EQ(slurp(dir_ / "new.toml"), "[tracker]\nport = 5555\n");
+}
+
+// What a calibration writes, the site reader takes: the stand's section with its figures for
+// people checks as written, and a key the reader would refuse (unknown, out of range) is not
+// written, the file left as it was, so that the next start does not stop on it (exit 78).
+TEST_F(CalibrationSiteFile, WhatACalibrationWritesTheSiteReaderTakes)
+{
+    const auto file = dir_ / "replica.toml";
+    // A technician's own mistake elsewhere in the section is not the calibration's to refuse.
+    const std::string head = "[stand]\nmy_note = 1\n[tracker]\nport = 5555\n";
+    spit(file, head);
+    pipeline::scene::StandFit fit;
+    fit.stand.hingeM = {0.0, 0.18, -0.07};
+    fit.stand.hingeToPanelM = 0.035;
+    fit.hingeAxisPanel = {0.999, 0.03, -0.02};
+    fit.axisAngleRad = 0.036;
+    fit.tiltsRad = {0.0, 0.35, 0.7};
+    fit.rmsM = 0.0004;
+    ASSERT_TRUE(writeSiteSection(file, "stand", standSection(fit)));
+    auto load = loadSiteConfig(file);
+    ASSERT_TRUE(load) << load.error().message;
+    for (const auto& p : load->problems) {
+        EXPECT_EQ(p.key, "stand.my_note") << formatProblem(file, p);
+    }
+    EXPECT_NEAR(load->config.stand.hingeM.y, 0.18, 1e-9);
+    EXPECT_NEAR(load->config.stand.hingeToPanelM, 0.035, 1e-9);
+
+    const std::string before = slurp(file);
+    for (const char* body : {"port = 70000\n", "porrt = 5556\n"}) {
+        auto w = writeSiteSection(file, "tracker", body);
+        ASSERT_FALSE(w) << body;
+        EXPECT_NE(w.error().message.find("replica.toml:"), std::string::npos) << w.error().message;
+        EXPECT_NE(w.error().message.find(": tracker.por"), std::string::npos) << w.error().message;
+        EXPECT_NE(w.error().message.find("is unchanged"), std::string::npos) << w.error().message;
+        EXPECT_EQ(slurp(file), before);
+    }
+    fit.stand.hingeM.y = 18.0; // a tape read in centimetres
+    auto w = writeSiteSection(file, "stand", standSection(fit));
+    ASSERT_FALSE(w);
+    EXPECT_NE(w.error().message.find("stand.hinge_m"), std::string::npos) << w.error().message;
+    EXPECT_EQ(slurp(file), before);
 }
 
 TEST_F(CalibrationSiteFile, SourcesAreReadWhenPresent)

@@ -328,6 +328,16 @@ TEST(RecoverChecks, IntegersThatDoNotFitAndImpossibleLampsAreDamage)
              "t: 18446744073709551615 is out of range"},
             {"lamp 99", std::string(kLampSelectorTopic), replaced(R"("lamp":1)", R"("lamp":99)"),
              "lamp 99"},
+            // A detector count past 16 bits would wrap (70000 read as 4464, -1 as 65535): a light
+            // the instrument never saw.
+            {"count 70000", std::string(kSpectrometerTopic),
+             replaced(R"("counts":\[\d+)", R"("counts":[70000)"),
+             "counts[0]: 70000 is out of range [0, 65535]"},
+            {"count -1", std::string(kSpectrometerTopic),
+             replaced(R"("counts":\[\d+)", R"("counts":[-1)"), "counts[0]: -1 is out of range"},
+            {"count 12.5", std::string(kSpectrometerTopic),
+             replaced(R"("counts":\[\d+)", R"("counts":[12.5)"),
+             "counts[0]: expected an integer, found number 12.5"},
     };
     for (const auto& c : cases) {
         SCOPED_TRACE(c.what);

@@ -107,7 +107,7 @@ protected:
         s.sequence = sequence;
         s.nonlinearityCoeffs = {1.0, 0, 0, 0, 0, 0, 0, 0};
         for (std::size_t p = 0; p < s.counts.size(); ++p) {
-            const bool darkPixel = p >= 6 && p <= 21;
+            const bool darkPixel = p >= 6 && p <= 20;
             const int signal = darkPixel ? 0 : std::max(int(s.counts[p]) - dark, 0) / 2;
             s.counts[p] = static_cast<std::uint16_t>(dark + factor * signal);
         }

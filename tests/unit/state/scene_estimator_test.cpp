@@ -328,3 +328,74 @@ TEST_F(SceneEstimatorTest, ARestoreOfAnotherVersionOrBoothIsRefusedWithOneLine)
 
 } // namespace
 } // namespace replica::state
+
+namespace replica::state {
+namespace {
+
+// What the estimators refuse, they say why (loop/refusal_log.h puts it in the log): a spectrum
+// with an integration time no USB2000+ takes (1 us would read a lamp a thousand times too
+// bright), a tilt reading far from 1 g, and poses no head can take (1e298 m away, a 0.5 m jump in
+// 10 ms), each holding the last good value; a head that really moved is followed.
+TEST_F(SceneEstimatorTest, RefusedSamplesHoldTheLastGoodValueAndSayWhy)
+{
+    SceneEstimator u = make();
+    pipeline::scene::SceneState st;
+    for (int i = 0; i < 3; ++i) {
+        u.update(st, &f7_[static_cast<std::size_t>(i)], nullptr, nullptr);
+    }
+    ASSERT_EQ(st.lampIndex, 2);
+    hal::SpectrumSample quick = tungsten_[3];
+    quick.integrationTimeUs = 1;
+    u.update(st, &quick, nullptr, nullptr);
+    EXPECT_EQ(st.lampIndex, 2);
+    EXPECT_EQ(u.rejectedSpectra(), 1u);
+    EXPECT_NE(u.light().lastRefusal().find("integration time of 1 us"), std::string::npos)
+            << u.light().lastRefusal();
+
+    hal::AccelSample a;
+    a.sequence = 1;
+    a.gravity = {0.0, -9.80665 * std::cos(0.5), -9.80665 * std::sin(0.5)};
+    u.update(st, nullptr, nullptr, &a);
+    hal::AccelSample weak = a;
+    weak.sequence = 2;
+    weak.gravity *= 0.8; // a scale 20 % off: the direction is right, the reading is not 1 g
+    u.update(st, nullptr, nullptr, &weak);
+    EXPECT_NEAR(st.tiltRad, 0.5, 1e-12);
+    EXPECT_NE(u.tilt().lastRefusal().find("(0.80 g)"), std::string::npos) << u.tilt().lastRefusal();
+
+    hal::PoseSample p;
+    p.sequence = 10;
+    p.timestampNs = 1'000'000'000;
+    p.tracked = true;
+    p.eyeTrackerM = {0.0, 0.05, 0.5};
+    u.update(st, nullptr, &p, nullptr);
+    const glm::dvec3 good = st.eyeBoothM;
+    const auto pose = [&](std::int64_t dtMs, glm::dvec3 e) {
+        p.sequence++;
+        p.timestampNs += dtMs * 1'000'000;
+        p.eyeTrackerM = e;
+        u.update(st, nullptr, &p, nullptr);
+        return st.eyeBoothM;
+    };
+    EXPECT_EQ(pose(10, {1e298, 0.05, 0.5}), good);
+    EXPECT_NE(u.eye().lastRefusal().find("from the booth's origin"), std::string::npos);
+    EXPECT_EQ(pose(10, {0.5, 0.05, 0.5}), good); // 0.5 m in 20 ms: 25 m/s
+    EXPECT_NE(u.eye().lastRefusal().find("moved 0.500 m in 20 ms"), std::string::npos)
+            << u.eye().lastRefusal();
+    EXPECT_EQ(u.eye().refusedPoses(), 2u);
+    // Walking pace is followed; so is a jump once enough time has passed for a head to make it
+    // (the tracker re-centred, another viewer).
+    EXPECT_NE(pose(10, {0.01, 0.05, 0.5}), good);
+    EXPECT_EQ(pose(10, {0.5, 0.05, 0.5}).x, 0.01); // 0.49 m in 10 ms: refused
+    EXPECT_EQ(pose(200, {0.5, 0.05, 0.5}).x, 0.5); // in 210 ms: 2.3 m/s
+    EXPECT_EQ(u.eye().refusedPoses(), 3u);
+    hal::PoseSample lost = p;
+    lost.sequence++;
+    lost.tracked = false;
+    u.update(st, nullptr, &lost, nullptr);
+    EXPECT_FALSE(u.eye().viewerInView());
+    EXPECT_EQ(u.eye().refusedPoses(), 3u) << "a viewer out of view is no refusal";
+}
+
+} // namespace
+} // namespace replica::state
