@@ -1,5 +1,7 @@
 // Spectrum -> classified (or sensed) light -> encoding decision.
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 
 #include <nlohmann/json.hpp>
 #include <state/json_state.h>
@@ -134,7 +136,10 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
         auto spd = refused.empty() ? chain_.add(raw)
                                    : Expected<pipeline::colour::Spectrum>(
                                              makeError(ErrorCode::InvalidArgument, refused));
-        if (spd) {
+        if (spd && weak(*spectrum)) {
+            showWeak(*spd);
+        } else if (spd) {
+            showingWeak_ = false;
             const int lamp =
                     setup_.forceDirect
                             ? -1
@@ -154,6 +159,45 @@ void LightEstimator::update(const hal::SpectrumSample* spectrum, const hal::Lamp
             lastRefusal_ = spd.error().message;
         }
     }
+}
+
+bool LightEstimator::weak(const hal::SpectrumSample& s) const
+{
+    const auto level = pipeline::spectral::signalLevel(s.counts, setup_.calibration);
+    return level.peakAboveDark <
+           pipeline::spectral::kMinPeakOverDarkNoise * std::max(level.darkNoise, 1.0);
+}
+
+void LightEstimator::showWeak(const pipeline::colour::Spectrum& reading)
+{
+    // Too little light to tell its colour, enough to say how much: the colour shown stays (the
+    // lamp's spectrum, or the sensed one), at the reading's level in direct-sensor mode, and the
+    // classifier is not asked (its noise would pass for a light of its own). A dark room shows
+    // the surface dark in the light it last had, not lit, and not in a colour that changes with
+    // every spectrum. With nothing shown before, the reading is all there is.
+    // The level by Y (the band sum where the setup has no observer: a level is all it is for).
+    const bool haveObserver =
+            std::any_of(setup_.observer.ybar.v.begin(), setup_.observer.ybar.v.end(),
+                        [](double v) { return v > 0.0; });
+    const auto level = [&](const pipeline::colour::Spectrum& s) {
+        return haveObserver ? pipeline::colour::spectrumToXyz(setup_.observer, s).y
+                            : std::accumulate(s.v.begin(), s.v.end(), 0.0);
+    };
+    const double read = level(reading);
+    const double shown = level(spd_);
+    pipeline::colour::Spectrum shape = reading;
+    if (shown > 0.0 && std::isfinite(read)) {
+        shape = spd_;
+        for (double& v : shape.v) {
+            v *= std::max(read, 0.0) / shown;
+        }
+    }
+    haveSpectrum_ = true;
+    ++weak_;
+    showingWeak_ = true;
+    lamp_ = -1;
+    spd_ = shape;
+    luminance_ = directLuminance(setup_, shape);
 }
 
 std::vector<pipeline::colour::Spectrum> LightEstimator::encodeSpectra(const LightEstimatorSetup& s)

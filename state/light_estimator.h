@@ -109,6 +109,10 @@ public:
     std::uint64_t rejectedSpectra() const { return rejected_; }
     // Why the last refused spectrum was refused ("" before the first).
     const std::string& lastRefusal() const { return lastRefusal_; }
+    // Spectra too weak to tell a colour by (shown at their level in the colour there was).
+    std::uint64_t weakSpectra() const { return weak_; }
+    // Whether the light shown comes from such a reading.
+    bool showingWeak() const { return showingWeak_; }
     pipeline::spectral::Classification classification() const;
     const LampArbiter& lampArbiter() const { return arbiter_; }
     // A warning to log (the arbiter's), once.
@@ -127,6 +131,10 @@ private:
     {}
     static std::vector<pipeline::colour::Spectrum> encodeSpectra(const LightEstimatorSetup& s);
     void showLamp(int lamp);
+    // Whether the spectrum's brightest pixel is too close to the detector's noise to tell its
+    // colour (pipeline::spectral::kMinPeakOverDarkNoise), and what is shown for such a reading.
+    bool weak(const hal::SpectrumSample& s) const;
+    void showWeak(const pipeline::colour::Spectrum& reading);
 
     LightEstimatorSetup setup_;
     std::optional<pipeline::spectral::LightClassifier> classifier_; // none: no lamps
@@ -137,6 +145,8 @@ private:
     bool haveSpectrum_ = false;
     std::uint64_t rejected_ = 0;
     std::string lastRefusal_;
+    std::uint64_t weak_ = 0;
+    bool showingWeak_ = false;
     // The light now, and the one the previous frame rendered (none before the first frame).
     int lamp_ = -1;
     pipeline::colour::Spectrum spd_{};

@@ -1,6 +1,7 @@
 // Raw spectrometer counts to a working-grid relative SPD.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -32,6 +33,32 @@ Expected<SpectrometerCalibration> loadSpectrometerCalibration(const std::filesys
         cal.responsivity.push_back(row[0]);
     }
     return cal;
+}
+
+SignalLevel signalLevel(std::span<const std::uint16_t> counts, const SpectrometerCalibration& cal)
+{
+    const auto n = static_cast<int>(counts.size());
+    if (n <= cal.darkPixelLast + 1 || cal.darkPixelFirst < 0 ||
+        cal.darkPixelLast < cal.darkPixelFirst) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        return {nan, nan};
+    }
+    const auto dark =
+            counts.subspan(static_cast<std::size_t>(cal.darkPixelFirst),
+                           static_cast<std::size_t>(cal.darkPixelLast - cal.darkPixelFirst + 1));
+    double mean = 0.0;
+    for (const std::uint16_t c : dark) {
+        mean += c;
+    }
+    mean /= static_cast<double>(dark.size());
+    double var = 0.0;
+    for (const std::uint16_t c : dark) {
+        var += (c - mean) * (c - mean);
+    }
+    var /= static_cast<double>(std::max<std::size_t>(dark.size() - 1, 1));
+    const auto light = counts.subspan(static_cast<std::size_t>(cal.darkPixelLast + 1));
+    return {static_cast<double>(*std::max_element(light.begin(), light.end())) - mean,
+            std::sqrt(var)};
 }
 
 Expected<colour::Spectrum> countsToSpectrum(const RawSpectrum& raw,

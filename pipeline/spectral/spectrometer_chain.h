@@ -36,6 +36,19 @@ struct SpectrometerCalibration {
     int darkPixelLast = 20;
 };
 
+// How far a spectrum's brightest pixel stands above the dark level, against the detector's noise:
+// the largest count after the dark pixels less the dark pixels' mean, and the dark pixels'
+// standard deviation (their read noise and fixed pattern). Both NaN when the counts are too few.
+struct SignalLevel {
+    double peakAboveDark = 0.0;
+    double darkNoise = 0.0;
+};
+SignalLevel signalLevel(std::span<const std::uint16_t> counts, const SpectrometerCalibration& cal);
+// Below this many times the dark noise (at least 1 count) the brightest pixel is too close to the
+// noise to tell a light's colour: its shape is noise (the probe's SNR 3 read CIE A anywhere from
+// 2727 to 3121 K), though its level still says how much light there is.
+inline constexpr double kMinPeakOverDarkNoise = 10.0;
+
 // Reads a calibration CSV with columns wavelength_nm,responsivity.
 Expected<SpectrometerCalibration> loadSpectrometerCalibration(const std::filesystem::path& path);
 

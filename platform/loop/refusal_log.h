@@ -34,15 +34,18 @@ private:
         std::uint64_t seen = 0; // the estimator's count at the last call
         hal::LogLimiter limiter;
     };
+    // 'one' and 'many': the sample's name in the singular and the plural.
     void report(Device& d,
                 std::uint64_t count,
                 const std::string& kind,
-                const std::string& what,
+                const char* one,
+                const char* many,
                 const std::string& why,
                 const std::string& held,
                 std::int64_t tickNs,
                 LoopStats& stats);
     std::map<std::string, Device> devices_;
+    Device weak_; // spectra too weak to tell a colour by: said at info
     std::optional<bool> inView_;
     std::int64_t outOfViewSinceNs_ = 0;
 };

@@ -6,6 +6,7 @@
 #include <pipeline/base/data_dir.h>
 #include <pipeline/colour/cct.h>
 #include <pipeline/display/icc_profile.h>
+#include <pipeline/spectral/spectrometer_chain.h>
 #include <platform/image/png_metadata.h>
 #include <platform/image/thumbnail.h>
 #include <platform/logging.h>
@@ -205,6 +206,12 @@ void ShownRecorder::recordLight(const recordings::FrameRecord& frame,
                         ? fmt::format("no usable spectrum yet ({} refused, the last: {}): the "
                                       "starting light",
                                       light.rejectedSpectra(), light.lastRefusal())
+                : light.showingWeak()
+                        ? fmt::format("too little light to tell its colour (the brightest pixel "
+                                      "under {:g} times the detector's noise above dark): the "
+                                      "colour there was, at the reading's level, {:.1f} cd/m^2",
+                                      pipeline::spectral::kMinPeakOverDarkNoise,
+                                      s.emitterLuminanceCdM2)
                 : appliance_.config.light == kLightDirect
                         ? fmt::format("direct-sensor mode forced (light = \"direct\"): "
                                       "rendering the sensed light at {:.0f} cd/m^2",

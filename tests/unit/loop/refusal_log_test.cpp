@@ -64,12 +64,12 @@ TEST(RefusalLog, RefusedSamplesAreSaidOnceAnIntervalWithWhyTheLast)
     }
     // 250 readings refused: said at once, then every 10 s (t = 10, 20 s: 100 each), the last 49
     // still pending (the run's summary counts them).
-    EXPECT_EQ(seen.count("state: accel: 1 tilt readings not used (the last: |g| 7.845 m/s^2 "
+    EXPECT_EQ(seen.count("state: accel: 1 tilt reading not used (the last: |g| 7.845 m/s^2 "
                          "(0.80 g), outside 0.9-1.1 g"),
               1u);
     EXPECT_EQ(seen.count("state: accel: 100 tilt readings not used"), 2u);
     EXPECT_EQ(stats.refused["accel"], 250u);
-    EXPECT_EQ(seen.count("state: tracker: 1 poses not used (the last: an eye 1e+300 m"), 1u);
+    EXPECT_EQ(seen.count("state: tracker: 1 pose not used (the last: an eye 1e+300 m"), 1u);
     EXPECT_EQ(stats.refused["tracker"], 1u);
     EXPECT_EQ(seen.count("the viewer is out of view; the frame keeps the eye at (0.119, 0.470, "
                          "0.550) m"),

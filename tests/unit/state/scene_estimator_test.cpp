@@ -399,3 +399,70 @@ TEST_F(SceneEstimatorTest, RefusedSamplesHoldTheLastGoodValueAndSayWhy)
 
 } // namespace
 } // namespace replica::state
+
+namespace replica::state {
+namespace {
+
+// A spectrum whose brightest pixel stands within ten times the detector's noise of the dark level
+// (a dark room) says how much light there is, not its colour: the frame shows the colour it had
+// (here the D65 lamp's spectrum), at the reading's level in direct-sensor mode, and the classifier
+// is not asked; light again shows the lamp at once (the classifier still holds it).
+TEST_F(SceneEstimatorTest, AReadingTooWeakForItsColourKeepsTheColourAtItsLevel)
+{
+    // The simulated instrument's direct-sensor level (platform::kDefaultDirectCdM2PerY): its
+    // readings render at their lamp's luminance (direct_sensor_test.cpp).
+    setup_.light.directCdM2PerY = 7.3451e-5;
+    auto observer = pipeline::colour::loadCie1931(dataDir());
+    ASSERT_TRUE(observer);
+    setup_.light.observer = *observer;
+    SceneEstimator u = make();
+    pipeline::scene::SceneState st;
+    for (int i = 0; i < 3; ++i) {
+        u.update(st, &f7_[static_cast<std::size_t>(i)], nullptr, nullptr);
+    }
+    ASSERT_EQ(st.lampIndex, 2);
+    const pipeline::colour::Spectrum lampSpd = st.illuminant;
+    const double nominal = st.emitterLuminanceCdM2;
+    // The same light at 1/400 of it (100 counts above dark at the peak) on a detector whose dark
+    // pixels scatter by 20 counts (a fixed pattern of +-20 about the same mean): the peak within
+    // ten times the noise.
+    hal::SpectrumSample dim = f7_[3];
+    const auto& cal = setup_.light.calibration;
+    double dark = 0.0;
+    for (int p = cal.darkPixelFirst; p <= cal.darkPixelLast; ++p) {
+        dark += dim.counts[static_cast<std::size_t>(p)];
+    }
+    dark /= cal.darkPixelLast - cal.darkPixelFirst + 1;
+    for (int p = cal.darkPixelFirst; p + 1 <= cal.darkPixelLast; p += 2) {
+        dim.counts[static_cast<std::size_t>(p)] += 20;
+        dim.counts[static_cast<std::size_t>(p + 1)] -= 20;
+    }
+    for (std::size_t p = static_cast<std::size_t>(cal.darkPixelLast) + 1; p < dim.counts.size();
+         ++p) {
+        dim.counts[p] =
+                static_cast<std::uint16_t>(std::lround(dark + (dim.counts[p] - dark) / 400.0));
+    }
+    const auto level = pipeline::spectral::signalLevel(dim.counts, cal);
+    ASSERT_LT(level.peakAboveDark, 120.0);
+    ASSERT_GT(level.darkNoise, 15.0);
+    u.update(st, &dim, nullptr, nullptr);
+    EXPECT_EQ(st.lampIndex, -1);
+    EXPECT_EQ(u.light().weakSpectra(), 1u);
+    EXPECT_TRUE(u.light().showingWeak());
+    // The lamp's colour: the same shape band for band.
+    const double k = st.illuminant[20] / lampSpd[20];
+    EXPECT_GT(k, 0.0);
+    for (std::size_t i = 0; i < pipeline::colour::kBands; ++i) {
+        EXPECT_NEAR(st.illuminant[i], k * lampSpd[i], 1e-12 * (1.0 + lampSpd[i])) << i;
+    }
+    // At the reading's level: about 1/400 of the lamp's (the rounding of the counts and
+    // direct-sensor mode's own scale move it a little), neither the lamp's nor none.
+    EXPECT_GT(st.emitterLuminanceCdM2, nominal / 1600.0);
+    EXPECT_LT(st.emitterLuminanceCdM2, nominal / 100.0);
+    u.update(st, &f7_[4], nullptr, nullptr);
+    EXPECT_EQ(st.lampIndex, 2);
+    EXPECT_FALSE(u.light().showingWeak());
+}
+
+} // namespace
+} // namespace replica::state
