@@ -1,5 +1,5 @@
 // The state stage's refusals in the log (refusal_log.h).
-#include <cmath>
+#include <algorithm>
 
 #include <fmt/format.h>
 #include <state/scene_estimator.h>
