@@ -30,6 +30,24 @@ void TiltEstimator::update(const hal::AccelSample* accel)
     }
 }
 
+double TiltEstimator::motionThresholdRad() const
+{
+    const double sigma = noise_.sigmaRad();
+    if (!(sigma > kTiltNoiseFitRad)) {
+        return kTiltMotionRad;
+    }
+    return std::max(kTiltMotionRad, kTiltMotionSigmas * sigma * std::sqrt(17.0 / 16.0));
+}
+
+double TiltEstimator::holdThresholdRad() const
+{
+    const double sigma = noise_.sigmaRad();
+    if (!(sigma > kTiltNoiseFitRad)) {
+        return kTiltHoldRad;
+    }
+    return std::max(kTiltHoldRad, kTiltHoldSigmas * sigma * std::sqrt(2.0 / 16.0));
+}
+
 double TiltEstimator::windowMean() const
 {
     // The window fills from slot 0 after a start (count_ < size: slots 0..count_-1 hold it).
@@ -66,7 +84,7 @@ std::optional<double> TiltEstimator::trendSlope() const
 double TiltEstimator::refreshTarget() const
 {
     const double ahead = trendSlope().value_or(0.0) * (3.0 * setup_.cacheSlices - 3.0) / 2.0;
-    if (!(std::abs(ahead) > kTiltMotionRad)) {
+    if (!(std::abs(ahead) > motionThresholdRad())) {
         return held_;
     }
     return held_ + std::clamp(ahead, -kDiffuseMaxLagRad, kDiffuseMaxLagRad);
@@ -77,7 +95,7 @@ int TiltEstimator::nodeDirection() const
     // Motion: the trend's travel over its own frames past the motion threshold (its noise is
     // 0.17 degrees there, so a still panel seldom prefetches, and then a node it keeps).
     const double travel = trendSlope().value_or(0.0) * static_cast<double>(kTiltTrend);
-    if (!(std::abs(travel) > kTiltMotionRad)) {
+    if (!(std::abs(travel) > motionThresholdRad())) {
         return 0;
     }
     return travel > 0.0 ? 1 : -1;
@@ -86,16 +104,16 @@ int TiltEstimator::nodeDirection() const
 void TiltEstimator::write(pipeline::scene::SceneState& state)
 {
     // The held tilt: the mean of the last kTiltWindow frames' tilts, taken when the light changes
-    // (the cache is drawn whole anyway) or when that mean has moved more than kTiltHoldRad from
-    // the held tilt; a tilt kTiltMotionRad from the mean starts the window again (motion: the
-    // mean would lag it). Non-finite tilts are left out.
+    // (the cache is drawn whole anyway) or when that mean has moved more than the hold threshold
+    // from the held tilt; a tilt past the motion threshold from the mean starts the window again
+    // (motion: the mean would lag it). Non-finite tilts are left out.
     if (std::isfinite(tilt_)) {
         if (trendCount_ == trend_.size()) {
             std::rotate(trend_.begin(), trend_.begin() + 1, trend_.end());
         }
         trend_[std::min(trendCount_, trend_.size() - 1)] = tilt_;
         trendCount_ = std::min(trendCount_ + 1, trend_.size());
-        if (count_ > 0 && std::abs(tilt_ - windowMean()) > kTiltMotionRad) {
+        if (count_ > 0 && std::abs(tilt_ - windowMean()) > motionThresholdRad()) {
             count_ = 0;
             next_ = 0;
         }
@@ -105,7 +123,14 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
     }
     if (count_ > 0) {
         const double mean = windowMean();
-        if (state.lightChanged || !heldValid_ || std::abs(mean - held_) > kTiltHoldRad) {
+        // On a sensor noisier than the design's, the held tilt follows the window's mean while it
+        // fills (after a start or motion): re-taken at its first samples, it kept their error (up
+        // to a sample's noise) for as long as the full mean stayed within the hold of it, where
+        // the full mean's error is a quarter of that (held scatter 0.57 sigma, now 0.25). The
+        // design's sensor keeps its schedule (its hold is about one sample's noise).
+        const bool filling = count_ < window_.size() && noise_.sigmaRad() > kTiltNoiseFitRad;
+        if (state.lightChanged || !heldValid_ || filling ||
+            std::abs(mean - held_) > holdThresholdRad()) {
             held_ = mean;
             heldValid_ = true;
         }
@@ -149,7 +174,8 @@ nlohmann::json TiltEstimator::save() const
             {"refresh_bands", diffuse_ ? diffuse_->refreshBands : 0},
             {"nodes", nodes_ ? nlohmann::json(nodes_->nodes) : nlohmann::json()},
             {"node_refresh_rad", optionalJson(nodes_ ? nodes_->refreshRad : std::nullopt)},
-            {"node_refresh_bands", nodes_ ? nodes_->refreshBands : 0}};
+            {"node_refresh_bands", nodes_ ? nodes_->refreshBands : 0},
+            {"noise", noise_.save()}};
 }
 
 Expected<void> TiltEstimator::restore(const nlohmann::json& j)
@@ -225,6 +251,13 @@ Expected<void> TiltEstimator::restore(const nlohmann::json& j)
                                                     n.refreshBands, setup_.cacheSlices));
             }
             nodes_ = std::move(n);
+        }
+        // Absent in states saved before the thresholds followed the noise: none measured yet.
+        noise_ = TiltNoise{};
+        if (j.contains("noise")) {
+            if (auto r = noise_.restore(j.at("noise")); !r) {
+                throw std::out_of_range(r.error().message);
+            }
         }
     } catch (const std::exception& e) {
         return makeError(ErrorCode::InvalidArgument, fmt::format("tilt: {}", e.what()));

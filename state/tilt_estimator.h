@@ -10,6 +10,7 @@
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
+#include <state/tilt_noise.h>
 
 #include <hal/samples.h>
 #include <pipeline/base/expected.h>
@@ -51,6 +52,18 @@ constexpr double kDiffuseMaxLagRad = 2.0 * 3.14159265358979323846 / 180.0;
 // threshold (six times its noise: a still panel never extrapolates), and never further than the
 // lag bound.
 constexpr std::size_t kTiltTrend = 6;
+// The figures above are for the design's 0.12-degree sensor. A noisier one (a cheaper part, a
+// stand that hums) crossed the fixed thresholds on noise alone, restarted the window at single
+// samples and re-took the held tilt at one of them: at 0.5 degrees a sample the held tilt was no
+// steadier than a sample (it moved on 749 of 1200 frames). So once the noise measured (TiltNoise)
+// passes kTiltNoiseFitRad the thresholds are as many standard deviations of it as the fixed ones
+// are of the design's: the motion threshold 4 of a sample about the window's mean (sigma
+// sqrt(17/16)), the hold 3.5 of the difference of two means (sigma sqrt(2/16)). Up to it the fixed
+// ones stay: the estimate of a design sensor scatters up to 1.3 times its noise, and 0.18 degrees
+// (1.5 times the design's) keeps its thresholds, and the simulator's frames, as they were.
+constexpr double kTiltNoiseFitRad = 0.18 * 3.14159265358979323846 / 180.0;
+constexpr double kTiltMotionSigmas = 4.0;
+constexpr double kTiltHoldSigmas = 3.5;
 
 struct TiltEstimatorSetup {
     double defaultTiltRad = 0.0; // shown until the first usable sample
@@ -72,6 +85,7 @@ public:
     {
         tilt_ = tiltRad;
         haveTilt_ = true;
+        noise_.add(tiltRad);
     }
     // The frame's tilts: the sensed one, the held one (re-taken when the light changed, since
     // the renderer then draws the diffuse term whole anyway) and the diffuse term's.
@@ -79,6 +93,11 @@ public:
 
     bool sensed() const { return haveTilt_; }
     std::uint64_t rejectedTilts() const { return rejected_; }
+    // The sensor's tilt noise measured so far (radians a sample; 0 before 256 samples), and the
+    // motion and hold thresholds it sets.
+    double noiseRad() const { return noise_.sigmaRad(); }
+    double motionThresholdRad() const;
+    double holdThresholdRad() const;
     // Why the last refused reading was refused ("" before the first).
     const std::string& lastRefusal() const { return lastRefusal_; }
 
@@ -92,6 +111,7 @@ private:
     bool haveTilt_ = false;
     std::uint64_t rejected_ = 0;
     std::string lastRefusal_;
+    TiltNoise noise_;
     // The hold filter.
     std::array<double, kTiltWindow> window_{};
     std::size_t next_ = 0;
