@@ -1,5 +1,6 @@
 // Tests for working-grid resampling and CSV parsing.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <numeric>
 #include <vector>
@@ -44,6 +45,67 @@ TEST(Resample, TenNanometreGridIsIdentity)
     ASSERT_TRUE(r);
     for (std::size_t i = 0; i < kBands; ++i) {
         EXPECT_DOUBLE_EQ((*r)[i], static_cast<double>(i * i));
+    }
+}
+
+// The band's triangle (10 nm half base) over the samples' linear interpolant, constant beyond the
+// ends, by a fine midpoint sum: independent of the resampler's breakpoints and Simpson's rule.
+double triangleByMidpoints(const SampledSpectrum& s, double centre)
+{
+    constexpr int kSteps = 200000;
+    const double h = 20.0 / kSteps;
+    double sum = 0.0;
+    for (int k = 0; k < kSteps; ++k) {
+        const double lambda = centre - 10.0 + (k + 0.5) * h;
+        double v = s.value.front();
+        if (lambda >= s.wavelengthNm.back()) {
+            v = s.value.back();
+        } else if (lambda > s.wavelengthNm.front()) {
+            std::size_t i = 0;
+            while (s.wavelengthNm[i + 1] <= lambda) {
+                ++i;
+            }
+            const double t =
+                    (lambda - s.wavelengthNm[i]) / (s.wavelengthNm[i + 1] - s.wavelengthNm[i]);
+            v = s.value[i] + t * (s.value[i + 1] - s.value[i]);
+        }
+        sum += (1.0 - std::abs(lambda - centre) / 10.0) * v * h;
+    }
+    return sum / 10.0;
+}
+
+TEST(Resample, CoarseGridsAverageTheirInterpolantNotTheirEnds)
+{
+    // Grids coarser than the 10 nm bands: 20 nm offset by 5, 25 nm, and irregular 12-31 nm steps,
+    // each from below 380 to past 730 nm, values of a smooth light with a line in it. Before, a
+    // band with no sample within 10 nm of its centre took an end's value (300 or 780 nm).
+    std::vector<std::vector<double>> grids(3);
+    for (double w = 305.0; w <= 785.0; w += 20.0) {
+        grids[0].push_back(w);
+    }
+    for (double w = 355.0; w <= 755.0; w += 25.0) {
+        grids[1].push_back(w);
+    }
+    double w = 366.0;
+    for (int k = 0; w <= 760.0; ++k) {
+        grids[2].push_back(w);
+        w += 12.0 + static_cast<double>((k * 7) % 20);
+    }
+    for (const auto& grid : grids) {
+        SampledSpectrum s;
+        for (double l : grid) {
+            s.wavelengthNm.push_back(l);
+            s.value.push_back(60.0 + 40.0 * std::sin(l / 37.0) +
+                              (std::abs(l - 545.0) < 8.0 ? 300.0 : 0.0));
+        }
+        s.value.front() = 0.01; // the ends far from the rest: any leak of them shows
+        s.value.back() = 900.0;
+        auto r = resampleToWorkingGrid(s, "coarse", GridSampling::BandAverage);
+        ASSERT_TRUE(r) << r.error().message;
+        for (std::size_t b = 0; b < kBands; ++b) {
+            EXPECT_NEAR((*r)[b], triangleByMidpoints(s, bandCentreNm(b)), 1e-6)
+                    << "grid from " << grid.front() << " nm, band " << bandCentreNm(b) << " nm";
+        }
     }
 }
 
