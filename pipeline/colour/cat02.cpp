@@ -41,15 +41,30 @@ bool cat02Defined(const Xyz& white)
     return allPositive(applyMatrix(cat02Forward(), white));
 }
 
-Matrix3 cat02AdaptationMatrix(const Xyz& sourceWhite, const Xyz& destinationWhite, double degree)
+Adaptation adaptationBetween(const Xyz& sourceWhite, const Xyz& destinationWhite)
 {
-    const Xyz rs = applyMatrix(cat02Forward(), sourceWhite);
-    const Xyz rd = applyMatrix(cat02Forward(), destinationWhite);
-    if (allPositive(rs) && allPositive(rd)) {
-        return multiply(cat02Inverse(), multiply(vonKriesGains(rs, rd, degree), cat02Forward()));
+    if (cat02Defined(sourceWhite) && cat02Defined(destinationWhite)) {
+        return Adaptation::Cat02;
     }
     if (allPositive(sourceWhite) && allPositive(destinationWhite)) {
+        return Adaptation::XyzScaling;
+    }
+    return Adaptation::None;
+}
+
+Matrix3 cat02AdaptationMatrix(const Xyz& sourceWhite, const Xyz& destinationWhite, double degree)
+{
+    switch (adaptationBetween(sourceWhite, destinationWhite)) {
+    case Adaptation::Cat02:
+        return multiply(
+                cat02Inverse(),
+                multiply(vonKriesGains(applyMatrix(cat02Forward(), sourceWhite),
+                                       applyMatrix(cat02Forward(), destinationWhite), degree),
+                         cat02Forward()));
+    case Adaptation::XyzScaling:
         return vonKriesGains(sourceWhite, destinationWhite, degree);
+    case Adaptation::None:
+        break;
     }
     return Matrix3{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}};
 }

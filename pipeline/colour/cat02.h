@@ -16,6 +16,12 @@ const Matrix3& cat02Inverse();
 // colours), and the von Kries ratio would flip or blow up.
 bool cat02Defined(const Xyz& white);
 
+// How cat02AdaptationMatrix adapts from one white to another: CAT02; where CAT02 is undefined for
+// either, von Kries scaling in XYZ; and where even an XYZ component is not positive (a light at
+// 650-730 nm, where the observer's z-bar is 0, excites no Z), nothing: the identity.
+enum class Adaptation { Cat02, XyzScaling, None };
+Adaptation adaptationBetween(const Xyz& sourceWhite, const Xyz& destinationWhite);
+
 // The matrix adapting colours seen under sourceWhite to destinationWhite: M^-1 diag(D * rw_d / rw_s
 // + 1 - D) M, the von Kries scaling in CAT02 space. Whites on any common scale (Y = 1 or 100); D =
 // 1 is full adaptation. Where CAT02 is undefined for either white (cat02Defined), the same scaling

@@ -46,6 +46,19 @@ struct EvalOptions {
     std::string profile; // --sensed: the display profile (default: the shipped synthetic one)
 };
 
+const char* adaptationName(colour::Adaptation a)
+{
+    switch (a) {
+    case colour::Adaptation::Cat02:
+        return "CAT02 to D65";
+    case colour::Adaptation::XyzScaling:
+        return "XYZ scaling to D65";
+    case colour::Adaptation::None:
+        break;
+    }
+    return "none (the light has no Z)";
+}
+
 nlohmann::json labJson(const colour::Lab& lab)
 {
     return nlohmann::json::array({lab.L, lab.a, lab.b});
@@ -107,7 +120,7 @@ int printEvalReport(const EvalOptions& o,
         out["reflectances"] = o.reflectances;
         out["white"] = set.names[report.whiteIndex];
         out["grid"] = "380-730 nm, 10 nm (36 bands)";
-        out["adaptation"] = report.cat02 ? "CAT02 to D65" : "XYZ scaling to D65";
+        out["adaptation"] = adaptationName(report.adaptation);
         out["samples"] = nlohmann::json::array();
         for (const auto& s : report.samples) {
             out["samples"].push_back({{"name", s.name},
@@ -123,13 +136,18 @@ int printEvalReport(const EvalOptions& o,
         return kExitOk;
     }
     std::cout << fmt::format("representation {}, white sample '{}', CIEDE2000 against spectral36 "
-                             "({} to D65, white Y = 1/1.13)\n",
+                             "({}, white Y = 1/1.13)\n",
                              report.representation, set.names[report.whiteIndex],
-                             report.cat02 ? "CAT02" : "XYZ scaling");
-    if (!report.cat02) {
+                             adaptationName(report.adaptation));
+    if (report.adaptation == colour::Adaptation::XyzScaling) {
         std::cout
                 << "(CAT02 cannot adapt this light: its white has a sharpened response <= 0, as a "
                    "narrow-band light's does; its white is scaled onto D65's in XYZ instead)\n";
+    } else if (report.adaptation == colour::Adaptation::None) {
+        std::cout << "(this light cannot be adapted to D65: its white has no Z (the observer's "
+                     "z-bar is 0 over all of its power, as at 650-730 nm), and no scaling makes "
+                     "0 into D65's Z; Lab is against D65's white unadapted, so its a* and b* "
+                     "show the light's own colour)\n";
     }
     std::cout << fmt::format("{:<24} {:>26} {:>26} {:>8}\n", "sample", "Lab reference",
                              "Lab approx", "de00");

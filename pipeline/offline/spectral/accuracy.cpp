@@ -119,7 +119,7 @@ Expected<AccuracyReport> evaluateRepresentation(const Observer& obs,
     AccuracyReport report;
     report.representation = approx.name();
     report.whiteIndex = whiteSampleIndex(obs, light, samples);
-    report.cat02 = colour::cat02Defined(lightXyz);
+    report.adaptation = colour::adaptationBetween(lightXyz, d65Xyz);
     auto labRef = normalisedLab(reference, report.whiteIndex, lightXyz, d65Xyz);
     if (!labRef) {
         return tl::unexpected(labRef.error());

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <pipeline/base/expected.h>
+#include <pipeline/colour/cat02.h>
 #include <pipeline/colour/cielab.h>
 #include <pipeline/spectral/reference_sets.h>
 #include <pipeline/spectral/representation.h>
@@ -38,9 +39,10 @@ struct AccuracyReport {
     std::vector<SampleAccuracy> samples;
     ErrorStats stats;
     std::size_t whiteIndex = 0; // the sample used as white (named "white", else the highest Y)
-    // How the light's colours were adapted to D65: CAT02, or, for a light whose white CAT02 cannot
-    // adapt (colour::cat02Defined: a narrow-band light), the same von Kries scaling in XYZ.
-    bool cat02 = true;
+    // How the light's colours were adapted to D65 (colour::adaptationBetween): CAT02; for a light
+    // whose white CAT02 cannot adapt (a narrow-band light), von Kries scaling in XYZ; for a light
+    // with no Z at all (650-730 nm alone), not at all.
+    colour::Adaptation adaptation = colour::Adaptation::Cat02;
 };
 
 // Index of the white sample: the one named exactly "white", else the one with the highest Y under

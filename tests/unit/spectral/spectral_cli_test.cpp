@@ -5,6 +5,7 @@
 #include <fstream>
 #include <string>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/data_dir.h>
@@ -160,6 +161,51 @@ TEST_F(CliFiles, EvalJsonMatchesTheLibrary)
     EXPECT_NEAR(doc["stats"]["mean"].get<double>(), lib->stats.mean, 1e-12);
     EXPECT_NEAR(doc["stats"]["max"].get<double>(), lib->stats.max, 1e-12);
     EXPECT_NEAR(doc["samples"][14]["de00"].get<double>(), lib->samples[14].de00, 1e-12);
+}
+
+TEST_F(CliFiles, EvalSaysHowEachLightWasAdapted)
+{
+    // A light of one 10 nm band: at 450 nm CAT02 cannot adapt it but XYZ scaling can; at 700 nm
+    // z-bar is 0, the white has no Z and nothing adapts it (it was reported as scaled onto D65
+    // while its white came out at a* 206, b* 164).
+    const auto set =
+            (dataDir() / "spectra" / "colorchecker24_babelcolor_avg_10nm_380_730.csv").string();
+    auto band = [](int nm) {
+        std::string text = "wavelength_nm,value\n";
+        for (int w = 380; w <= 730; w += 10) {
+            text += fmt::format("{},{}\n", w, w == nm ? 1.0 : 0.0);
+        }
+        return text;
+    };
+    const std::pair<int, std::string> cases[] = {{450, "XYZ scaling to D65"},
+                                                 {700, "none (the light has no Z)"}};
+    for (const auto& [nm, adaptation] : cases) {
+        const auto light = write(fmt::format("band{}.csv", nm), band(nm));
+        const auto r = runReplica(
+                "spectral eval --illuminant " + light + " --reflectances " + set + " --json", dir_);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        const auto doc = nlohmann::json::parse(r.out);
+        EXPECT_EQ(doc["adaptation"], adaptation) << nm;
+        const auto& white = doc["samples"][18]["lab_reference"];
+        ASSERT_EQ(doc["samples"][18]["name"], "white_9.5");
+        if (nm == 450) {
+            EXPECT_NEAR(white[1].get<double>(), 0.0, 1e-6); // scaled onto D65: neutral
+            EXPECT_NEAR(white[2].get<double>(), 0.0, 1e-6);
+        } else {
+            EXPECT_GT(white[1].get<double>(), 100.0); // unadapted: the light's own red
+        }
+        const auto text =
+                runReplica("spectral eval --illuminant " + light + " --reflectances " + set, dir_);
+        ASSERT_EQ(text.exitCode, 0) << text.err;
+        EXPECT_NE(text.out.find(nm == 450 ? "scaled onto D65's in XYZ" : "cannot be adapted"),
+                  std::string::npos)
+                << text.out;
+    }
+    const auto f11 = write("f11.csv", lightCsv("F11"));
+    const auto r = runReplica(
+            "spectral eval --illuminant " + f11 + " --reflectances " + set + " --json", dir_);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["adaptation"], "CAT02 to D65");
 }
 
 TEST_F(CliFiles, EvalSensedAblatesEachImpairmentAndIsReproducible)
