@@ -51,6 +51,12 @@ Uv xyzToUv1960(const Xyz& xyz)
 
 Expected<Cct> correlatedColourTemperature(const Observer& obs, const Xyz& xyz)
 {
+    if (!std::isfinite(xyz.x) || !std::isfinite(xyz.y) || !std::isfinite(xyz.z)) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("correlated colour temperature: XYZ ({}, {}, {}) is not "
+                                     "finite",
+                                     xyz.x, xyz.y, xyz.z));
+    }
     if (!(xyz.y > 0.0) || !(xyz.x + 15.0 * xyz.y + 3.0 * xyz.z > 0.0)) {
         return makeError(ErrorCode::InvalidArgument,
                          "correlated colour temperature: the light has no luminance (Y <= 0)");
@@ -97,7 +103,11 @@ Expected<Cct> correlatedColourTemperature(const Observer& obs, const Xyz& xyz)
     const double kelvin = 1e6 / mired;
     const Uv onLocus = locusUv(obs, kelvin);
     const double dist = distance(target, onLocus);
-    if (mired <= mLo + 1e-6 || mired >= mHi - 1e-6) {
+    // At an end of the search the nearest point may lie beyond it: refused, unless the end itself
+    // is nearer than just past it (a 1000 K radiator is at the end, and within the range).
+    const bool atEnd = mired <= mLo + 1e-6 || mired >= mHi - 1e-6;
+    const double beyondMired = mired <= mLo + 1e-6 ? mLo - 1e-3 : mHi + 1e-3;
+    if (atEnd && distance(target, locusUv(obs, 1e6 / beyondMired)) < dist) {
         return makeError(
                 ErrorCode::InvalidArgument,
                 fmt::format("correlated colour temperature: chromaticity (u={:.4f}, v={:.4f}) lies "

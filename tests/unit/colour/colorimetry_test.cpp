@@ -196,6 +196,11 @@ TEST(Cat02, WhereItIsUndefinedTheWhiteStillLandsOnTheDestinationsInXyz)
     const Xyz same = cat02Adapt(Xyz{0.3, 0.2, 0.1}, Xyz{0.5, 0.0, 0.4}, kD65);
     EXPECT_EQ(same.x, 0.3);
     EXPECT_EQ(same.y, 0.2);
+    // Which of the three was taken, for a report to say: a 700 nm line's white (x-bar 0.01136,
+    // y-bar 0.004102, z-bar 0) has no Z.
+    EXPECT_EQ(adaptationBetween(kD65, kD65), Adaptation::Cat02);
+    EXPECT_EQ(adaptationBetween(blue, kD65), Adaptation::XyzScaling);
+    EXPECT_EQ(adaptationBetween(Xyz{0.01136, 0.004102, 0.0}, kD65), Adaptation::None);
 }
 
 class CctTest : public ::testing::Test
@@ -260,6 +265,29 @@ TEST_F(CctTest, DuvSignAndUndefinedCases)
     auto green = correlatedColourTemperature(obs_, Xyz{0.3, 0.6, 0.1});
     ASSERT_FALSE(green);
     EXPECT_NE(green.error().message.find("undefined"), std::string::npos);
+    // Not finite: refused, saying so (an infinite X gave 66890 K with a Duv of NaN).
+    for (const Xyz& bad : {Xyz{INFINITY, 1.0, 1.0}, Xyz{NAN, 1.0, 1.0}, Xyz{1.0, 1.0, -INFINITY}}) {
+        auto c = correlatedColourTemperature(obs_, bad);
+        ASSERT_FALSE(c);
+        EXPECT_NE(c.error().message.find("not finite"), std::string::npos) << c.error().message;
+    }
+}
+
+TEST_F(CctTest, TheEndsOfTheRangeAreInIt)
+{
+    // 1000 K and 100000 K are the search's ends: a radiator there is its own temperature (1000 K
+    // was refused as beyond the range); just past them is refused.
+    for (const double t : {1000.0, 100000.0}) {
+        auto c = correlatedColourTemperature(obs_, spectrumToXyz(obs_, planckianSpectrum(t)));
+        ASSERT_TRUE(c) << t << ": " << c.error().message;
+        EXPECT_NEAR(c->kelvin, t, 1e-4 * t);
+        EXPECT_NEAR(c->duv, 0.0, 1e-6);
+    }
+    for (const double t : {990.0, 120000.0}) {
+        auto c = correlatedColourTemperature(obs_, spectrumToXyz(obs_, planckianSpectrum(t)));
+        ASSERT_FALSE(c) << t;
+        EXPECT_NE(c.error().message.find("beyond"), std::string::npos) << c.error().message;
+    }
 }
 
 } // namespace
