@@ -1,14 +1,17 @@
 // 'replica calibrate tracker|stand': the site calibration a technician can do with a marker and a
 // tape measure. Readings come from a CSV file (or are typed in when stdin is a terminal); the
 // result is checked (residual, degenerate points) and written into the site TOML file.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <numeric>
 #include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <hal/accel/iio_accel.h>
@@ -47,14 +50,55 @@ struct CalibrateOptions {
     std::string levelRecording; // its readings (default: --recording)
 };
 
-// Rows of 'columns' numbers, comma- or space-separated; '#' starts a comment; a first row that is
-// not numeric is a header. Errors name the file and line.
-Expected<std::vector<std::vector<double>>>
-readRows(std::istream& in, const std::string& name, std::size_t columns, bool prompt)
+// A header row's columns in the order 'names' gives them: header[order[k]] is names[k]. Names are
+// matched without regard to case; an unknown, missing or repeated one is refused, naming the file
+// and line (a header was skipped unread, so a file with its tracker columns first fitted the
+// inverse transform with the same RMS and wrote it to the site file).
+Expected<std::vector<std::size_t>> columnOrder(const std::string& line,
+                                               const std::vector<std::string>& names,
+                                               const std::string& where)
 {
+    std::istringstream s(line);
+    std::vector<std::string> header;
+    std::string word;
+    while (s >> word) {
+        std::transform(word.begin(), word.end(), word.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        header.push_back(word);
+    }
+    std::vector<std::size_t> order;
+    for (const auto& n : names) {
+        const auto it = std::find(header.begin(), header.end(), n);
+        if (it == header.end() || std::count(header.begin(), header.end(), n) != 1) {
+            break;
+        }
+        order.push_back(static_cast<std::size_t>(it - header.begin()));
+    }
+    if (order.size() != names.size() || header.size() != names.size()) {
+        return makeError(ErrorCode::InvalidArgument,
+                         fmt::format("{}: the header '{}' is not the columns {} (in any order, "
+                                     "each once); name them so, or leave the header out and give "
+                                     "them in that order",
+                                     where, pipeline::csv::shownCell(line), fmt::join(names, ",")));
+    }
+    return order;
+}
+
+// Rows of names.size() numbers, comma- or space-separated; '#' starts a comment; a first row that
+// is not numeric is a header naming the columns (columnOrder), which may come in any order. Errors
+// name the file and line.
+Expected<std::vector<std::vector<double>>> readRows(std::istream& in,
+                                                    const std::string& name,
+                                                    const std::vector<std::string>& names,
+                                                    bool prompt)
+{
+    const std::size_t columns = names.size();
+    std::vector<std::size_t> order(columns);
+    std::iota(order.begin(), order.end(), std::size_t{0});
     std::vector<std::vector<double>> rows;
     std::string line;
     int lineNo = 0;
+    bool headerSeen = false;
     while (true) {
         if (prompt) {
             fmt::print(stderr, "point {} ({} numbers, empty line to finish): ", rows.size() + 1,
@@ -93,8 +137,14 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
             }
             continue;
         }
-        if (!numeric && rows.empty() && !prompt) {
-            continue; // header
+        if (!numeric && rows.empty() && !prompt && !headerSeen) {
+            auto o = columnOrder(line, names, fmt::format("{}:{}", name, lineNo));
+            if (!o) {
+                return tl::unexpected(o.error());
+            }
+            order = *o;
+            headerSeen = true;
+            continue;
         }
         if (!numeric || row.size() != columns) {
             const auto e = Error{ErrorCode::InvalidArgument,
@@ -109,13 +159,17 @@ readRows(std::istream& in, const std::string& name, std::size_t columns, bool pr
             }
             return tl::unexpected(e);
         }
-        rows.push_back(std::move(row));
+        std::vector<double> ordered(columns);
+        for (std::size_t k = 0; k < columns; ++k) {
+            ordered[k] = row[order[k]];
+        }
+        rows.push_back(std::move(ordered));
     }
     return rows;
 }
 
 Expected<std::vector<std::vector<double>>>
-readingsFrom(const std::string& file, std::size_t columns, const char* what)
+readingsFrom(const std::string& file, const std::vector<std::string>& names, const char* what)
 {
     if (file.empty()) {
         if (::isatty(STDIN_FILENO) == 0) {
@@ -125,7 +179,7 @@ readingsFrom(const std::string& file, std::size_t columns, const char* what)
                                          what));
         }
         fmt::print(stderr, "Type the {}, one per line.\n", what);
-        return readRows(std::cin, "stdin", columns, true);
+        return readRows(std::cin, "stdin", names, true);
     }
     // The bounded reader: a regular file of at most kMaxCsvBytes and a table within its limits (a
     // FIFO, /dev/zero or a directory is refused in one line, never a hang or bad_alloc).
@@ -137,7 +191,7 @@ readingsFrom(const std::string& file, std::size_t columns, const char* what)
         return tl::unexpected(ok.error());
     }
     std::istringstream in(*text);
-    return readRows(in, file, columns, false);
+    return readRows(in, file, names, false);
 }
 
 int finish(const CalibrateOptions& o, const char* section, const std::string& body)
@@ -157,10 +211,11 @@ int finish(const CalibrateOptions& o, const char* section, const std::string& bo
 int calibrateTracker(const CalibrateOptions& o)
 {
     auto log = logger("replica");
-    auto rows = readingsFrom(o.points, 6,
-                             "points as booth_x booth_y booth_z tracker_x tracker_y tracker_z "
-                             "(metres; the booth point measured with the tape, the tracker's "
-                             "reading of the marker held there)");
+    auto rows = readingsFrom(
+            o.points, {"booth_x", "booth_y", "booth_z", "tracker_x", "tracker_y", "tracker_z"},
+            "points as booth_x booth_y booth_z tracker_x tracker_y tracker_z "
+            "(metres; the booth point measured with the tape, the tracker's "
+            "reading of the marker held there)");
     if (!rows) {
         log->error("{}", rows.error().message);
         return kExitUsage;
@@ -196,7 +251,7 @@ int calibrateStand(const CalibrateOptions& o)
         log->error("--accel-axes {}: {}", o.accelAxes, mapping.error().message);
         return kExitUsage;
     }
-    auto rows = readingsFrom(o.points, 5,
+    auto rows = readingsFrom(o.points, {"ax", "ay", "az", "top_y", "top_z"},
                              "readings as ax ay az top_y top_z (the accelerometer in m/s^2 as "
                              "'replica probe' prints it; the tape: height of the middle of the "
                              "panel's top edge above the booth floor and its distance towards the "

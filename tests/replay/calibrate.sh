@@ -74,7 +74,33 @@ nofolder=$?
 sed '3s/^\([^,]*\),\([^,]*\),[^,]*,/\1,\2,nan,/' "$work/marker.csv" > "$work/nan.csv"
 "$replica" calibrate tracker --points "$work/nan.csv" --dry-run > /dev/null 2> "$work/nan.log"
 nan=$?
+# The header names the columns: the same points with the tracker's columns first fit the same
+# transform (a header was skipped unread, and such a file fitted the inverse with the same RMS);
+# a header that is not the six names is refused, naming the line.
+python3 - "$work" <<'PY'
+import sys
+work = sys.argv[1]
+rows = open(f"{work}/marker.csv").read().splitlines()
+with open(f"{work}/reordered.csv", "w") as f:
+    f.write("Tracker_X,tracker_y,tracker_z,booth_x,booth_y,booth_z\n")
+    for r in rows[1:]:
+        v = r.split(",")
+        f.write(",".join(v[3:] + v[:3]) + "\n")
+with open(f"{work}/badheader.csv", "w") as f:
+    f.write("tracker_x,tracker_y,tracker_z,booth_x,booth_y,booth_y\n" + "\n".join(rows[1:]) + "\n")
+PY
+"$replica" calibrate tracker --points "$work/reordered.csv" --dry-run > "$work/reordered.out" \
+    2> "$work/reordered.log"
+reordered=$?
+"$replica" calibrate tracker --points "$work/badheader.csv" --dry-run > /dev/null \
+    2> "$work/badheader.log"
+badheader=$?
 set -e
+[ "$reordered" -eq 0 ] && [ "$(grep '^T_booth_tracker:' "$work/reordered.out")" = \
+    "$(grep '^T_booth_tracker:' "$work/tracker.out")" ] ||
+    { echo "FAIL: reordered columns: exit $reordered, $(cat "$work/reordered.out" "$work/reordered.log")" >&2; exit 1; }
+[ "$badheader" -eq 2 ] && grep -q "badheader.csv:1: the header" "$work/badheader.log" ||
+    { echo "FAIL: a bad header: exit $badheader, $(cat "$work/badheader.log")" >&2; exit 1; }
 [ "$nan" -eq 2 ] && grep -q "nan.csv:3: field 3 ('nan') is not a finite number" "$work/nan.log" ||
     { echo "FAIL: a nan field: exit $nan, $(cat "$work/nan.log")" >&2; exit 1; }
 [ "$nofolder" -ne 0 ] || { echo "FAIL: --site in a missing folder exited 0" >&2; exit 1; }
