@@ -38,6 +38,13 @@ constexpr std::uint32_t usage(std::uint16_t page, std::uint16_t id)
     return (static_cast<std::uint32_t>(page) << 16) | id;
 }
 
+// A 4-bit two's-complement nibble (the low four bits of v) as -8..7.
+constexpr int signedNibble(std::uint32_t v)
+{
+    const int n = static_cast<int>(v & 0xF);
+    return n >= 8 ? n - 16 : n;
+}
+
 // HID unit systems (the low nibble of Unit).
 enum class UnitSystem { None, SiLinear, SiRotation, EnglishLinear, EnglishRotation, Vendor };
 
