@@ -174,6 +174,7 @@ public:
 
 private:
     Expected<void> global(const Item& item);
+    Expected<void> unitExponent(const Item& item);
     void local(const Item& item);
     Expected<MainUsages> takeUsages(const Item& item);
     Expected<void> main(const Item& item);
@@ -247,10 +248,7 @@ Expected<void> DescriptorParser::global(const Item& item)
     case kPhysicalMax:
         break; // physical ranges only rescale; the trackers' units come with logical values
     case kUnitExponent:
-        // HID 1.11 codes it as a signed nibble; some descriptors write a signed byte.
-        g_.unit.exponent = (v.size == 1 && v.raw <= 0xF) ? signedNibble(v.raw)
-                                                         : static_cast<int>(v.asSigned());
-        break;
+        return unitExponent(item);
     case kUnit:
         g_.unit.raw = v.raw;
         break;
@@ -286,6 +284,24 @@ Expected<void> DescriptorParser::global(const Item& item)
         return tl::unexpected(
                 errorAt(item.at, fmt::format("reserved global item tag 0x{:x}", item.tag)));
     }
+    return {};
+}
+
+// HID 1.11 codes the Unit Exponent as a 4-bit two's-complement nibble whatever the item's size
+// (`56 0D 00` is -3, not 13); some descriptors write a signed byte instead (0xFD). As Linux's
+// hid-core reads it: a value with no bits above the low four is a nibble, any other a signed
+// value. What is then outside -8..7 is no unit a device can mean (400 made a position of inf m,
+// 127 one of 5e129 m, -400 a unit of 0 m): the descriptor is refused.
+Expected<void> DescriptorParser::unitExponent(const Item& item)
+{
+    const ItemValue& v = item.value;
+    const std::int64_t e = (v.raw >> 4) == 0 ? signedNibble(v.raw) : v.asSigned();
+    if (e < -8 || e > 7) {
+        return tl::unexpected(errorAt(
+                item.at, fmt::format("Unit Exponent {} (0x{:x} in {} byte{}) is outside -8..7", e,
+                                     v.raw, v.size, v.size == 1 ? "" : "s")));
+    }
+    g_.unit.exponent = static_cast<int>(e);
     return {};
 }
 

@@ -50,7 +50,7 @@ enum class UnitSystem { None, SiLinear, SiRotation, EnglishLinear, EnglishRotati
 
 struct HidUnit {
     std::uint32_t raw = 0; // as in the descriptor
-    int exponent = 0;      // Unit Exponent, power of ten
+    int exponent = 0;      // Unit Exponent, power of ten: -8..7 (the parser refuses others)
 
     UnitSystem system() const;
     // The power of one base dimension (nibble 1 length, 2 mass, 3 time, 4 temperature, 5 current,
