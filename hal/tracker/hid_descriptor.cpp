@@ -58,6 +58,8 @@ struct GlobalState {
     std::uint16_t usagePage = 0;
     ItemValue logicalMin;
     ItemValue logicalMax;
+    ItemValue physicalMin;
+    ItemValue physicalMax;
     HidUnit unit;
     std::uint32_t reportSize = 0;
     std::uint32_t reportCount = 0;
@@ -74,15 +76,16 @@ std::uint32_t resolve(const LocalUsage& u, std::uint16_t page)
     return u.size == 4 ? u.value : usage(page, static_cast<std::uint16_t>(u.value & 0xFFFF));
 }
 
-// Logical limits as the descriptor means them: signed two's complement in the item's size, except
-// that a maximum which reads below a non-negative minimum was meant unsigned (a common way to
-// write 0..255 in one byte, which Linux and Windows accept).
-std::pair<std::int64_t, std::int64_t> logicalRange(const GlobalState& g)
+// Limits as the descriptor means them (logical or physical): signed two's complement in the
+// item's size, except that a maximum which reads below a non-negative minimum was meant unsigned
+// (a common way to write 0..255 in one byte, which Linux and Windows accept). A minimum that is
+// still above the maximum is a broken descriptor, which the users of the field refuse.
+std::pair<std::int64_t, std::int64_t> rangeOf(const ItemValue& min, const ItemValue& max)
 {
-    const std::int64_t lo = g.logicalMin.asSigned();
-    std::int64_t hi = g.logicalMax.asSigned();
+    const std::int64_t lo = min.asSigned();
+    std::int64_t hi = max.asSigned();
     if (lo >= 0 && hi < lo) {
-        hi = static_cast<std::int64_t>(g.logicalMax.raw);
+        hi = static_cast<std::int64_t>(max.raw);
     }
     return {lo, hi};
 }
@@ -245,8 +248,11 @@ Expected<void> DescriptorParser::global(const Item& item)
         g_.logicalMax = v;
         break;
     case kPhysicalMin:
+        g_.physicalMin = v;
+        break;
     case kPhysicalMax:
-        break; // physical ranges only rescale; the trackers' units come with logical values
+        g_.physicalMax = v;
+        break;
     case kUnitExponent:
         return unitExponent(item);
     case kUnit:
@@ -433,7 +439,8 @@ Expected<void> DescriptorParser::data(const Item& item, const MainUsages& usages
         return tl::unexpected(errorAt(
                 item.at, fmt::format("more than {} fields in all (the limit)", kMaxFields)));
     }
-    const auto logical = logicalRange(g_);
+    const auto logical = rangeOf(g_.logicalMin, g_.logicalMax);
+    const auto physical = rangeOf(g_.physicalMin, g_.physicalMax);
     std::vector<std::uint32_t> path;
     for (const auto& c : open_) {
         path.push_back(c.usage);
@@ -452,7 +459,10 @@ Expected<void> DescriptorParser::data(const Item& item, const MainUsages& usages
         f.nullState = (v.raw & 0x40) != 0;
         f.logicalMin = logical.first;
         f.logicalMax = logical.second;
+        f.physicalMin = physical.first;
+        f.physicalMax = physical.second;
         f.unit = g_.unit;
+        f.itemAt = item.at;
         f.collections = path;
         d_.fields.push_back(std::move(f));
     }

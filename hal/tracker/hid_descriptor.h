@@ -75,7 +75,11 @@ struct HidField {
     bool nullState = false;      // values outside the logical range mean "no value"
     std::int64_t logicalMin = 0; // signed when logicalMin < 0
     std::int64_t logicalMax = 0;
+    // Physical Minimum and Maximum: both 0 means the physical value is the logical one.
+    std::int64_t physicalMin = 0;
+    std::int64_t physicalMax = 0;
     HidUnit unit;
+    std::size_t itemAt = 0; // byte offset of the main item that declared it (for errors)
     // Usages of the enclosing collections, outermost first.
     std::vector<std::uint32_t> collections;
 
@@ -111,5 +115,11 @@ std::optional<std::int64_t> extractField(const HidField& f, std::span<const std:
 
 // Writes a field's value into a report's data bytes (which must be long enough).
 void insertField(const HidField& f, std::span<std::uint8_t> data, std::int64_t value);
+
+// A logical value in the field's physical range (HID 1.11 6.2.2.7): (logical - LogMin) *
+// (PhysMax - PhysMin) / (LogMax - LogMin) + PhysMin, in the field's unit times 10^exponent; the
+// logical value itself when the physical range is 0..0. Nullopt when a physical range is given
+// over an empty logical range (LogMin == LogMax): nothing can be scaled then.
+std::optional<double> physicalValue(const HidField& f, std::int64_t logical);
 
 } // namespace replica::hal::hid

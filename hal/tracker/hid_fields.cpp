@@ -123,4 +123,22 @@ void insertField(const HidField& f, std::span<std::uint8_t> data, std::int64_t v
     }
 }
 
+std::optional<double> physicalValue(const HidField& f, std::int64_t logical)
+{
+    const auto x = static_cast<double>(logical);
+    if (f.physicalMin == 0 && f.physicalMax == 0) {
+        return x;
+    }
+    if (f.logicalMax == f.logicalMin) {
+        return std::nullopt;
+    }
+    // In doubles: the differences of 64-bit limits may not fit an int64.
+    const double logicalSpan =
+            static_cast<double>(f.logicalMax) - static_cast<double>(f.logicalMin);
+    const double physicalSpan =
+            static_cast<double>(f.physicalMax) - static_cast<double>(f.physicalMin);
+    return (x - static_cast<double>(f.logicalMin)) * physicalSpan / logicalSpan +
+           static_cast<double>(f.physicalMin);
+}
+
 } // namespace replica::hal::hid

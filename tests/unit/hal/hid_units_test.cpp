@@ -1,8 +1,10 @@
 // The HID eye/head tracker's reading of what a descriptor says about its values (HID 1.11
-// 6.2.2.7; the Eye and Head Trackers page 0x12 of the HID Usage Tables): the Unit Exponent
-// nibble in items of any size and exponents no device can mean. Each descriptor is written here
-// byte by byte; the expected values follow from the spec's formulas applied by hand to those
-// bytes. The cases are those of an independent probe of this path (F3-F5 of its report).
+// 6.2.2.7; the Eye and Head Trackers page 0x12 of the HID Usage Tables): physical ranges, each
+// axis's own unit, the Unit Exponent nibble in items of any size, exponents no device can mean,
+// Logical Minimum above Maximum, Relative positions and units that are no length. Each descriptor
+// is written here byte by byte; the expected values follow from the spec's formulas applied by hand
+// to those bytes. The cases are those of an independent probe of this path (F1-F6 and F10 of its
+// report).
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -72,6 +74,99 @@ glm::dvec3 headOf(const eht::Layout& layout, const Bytes& report)
     return r.headM ? *r.headM : glm::dvec3(-99.0);
 }
 
+void expectRefused(const Bytes& descriptor, const std::string& what)
+{
+    auto layout = hal::tracker::trackerLayout(descriptor);
+    ASSERT_FALSE(layout) << "taken as a tracker: " << layout->summary() << "; wanted " << what;
+    EXPECT_NE(layout.error().message.find(what), std::string::npos) << layout.error().message;
+}
+
+// F1: logical 0..4095 over physical -2000..2000, in cm x 10^-1 (mm). The spec's physical value is
+// (logical - 0) * (2000 - -2000) / (4095 - 0) + -2000 mm; the product read the logical value as
+// millimetres (2.06 m off, finite, inside every plausibility limit).
+TEST(HidUnits, PhysicalRangeRescalesTheLogicalValue)
+{
+    const Bytes d = headTracker({
+            0x15, 0x00,                         // Logical Minimum (0)
+            0x26, 0xFF, 0x0F,                   // Logical Maximum (4095)
+            0x36, 0x30, 0xF8,                   // Physical Minimum (-2000)
+            0x46, 0xD0, 0x07,                   // Physical Maximum (2000)
+            0x65, 0x11,                         // Unit (SI linear: cm)
+            0x55, 0x0F,                         // Unit Exponent (-1)
+            0x09, 0x21, 0x09, 0x22, 0x09, 0x23, // Usage (Position X, Y, Z)
+            0x75, 0x10, 0x95, 0x03, 0x81, 0x02, // Report Size 16, Count 3, Input (Data, Var, Abs)
+    });
+    const auto layout = layoutOf(d);
+    const glm::dvec3 m = headOf(layout, report16(0, 4095, 2048));
+    EXPECT_NEAR(m.x, -2.0, 1e-12);
+    EXPECT_NEAR(m.y, 2.0, 1e-12);
+    EXPECT_NEAR(m.z, (2048.0 * 4000.0 / 4095.0 - 2000.0) * 1e-3, 1e-12); // 0.000488 m
+    const glm::dvec3 mid = headOf(layout, report16(1000, 3000, 4000));
+    EXPECT_NEAR(mid.x, (1000.0 * 4000.0 / 4095.0 - 2000.0) * 1e-3, 1e-12);
+    EXPECT_NEAR(mid.z, (4000.0 * 4000.0 / 4095.0 - 2000.0) * 1e-3, 1e-12);
+
+    // Physical Minimum and Maximum both 0: physical = logical (the spec's default).
+    const Bytes plain = headTracker({0x15, 0x00, 0x26, 0xFF, 0x0F, 0x35, 0x00, 0x45, 0x00,
+                                     0x65, 0x11, 0x55, 0x0F, 0x09, 0x21, 0x09, 0x22, 0x09,
+                                     0x23, 0x75, 0x10, 0x95, 0x03, 0x81, 0x02});
+    EXPECT_NEAR(headOf(layoutOf(plain), report16(0, 4095, 600)).z, 0.6, 1e-12);
+
+    // A physical range over an empty logical range (0..0) cannot be scaled: refused, naming the
+    // Input item (byte 18 of the body).
+    expectRefused(headTracker({0x36, 0x30, 0xF8, 0x46, 0xD0, 0x07, 0x65, 0x11, 0x09, 0x21,
+                               0x09, 0x22, 0x09, 0x23, 0x75, 0x10, 0x95, 0x03, 0x81, 0x02}),
+                  "byte " + std::to_string(kBodyAt + 18) +
+                          ": Head Position X has physical range -2000..2000 over the empty "
+                          "logical range 0..0");
+}
+
+// F2: X and Y in cm x 10^-1 (mm), Z in cm x 10^0: each axis its own unit. The product scaled
+// Z by X's unit (0.082 m for 0.82 m).
+TEST(HidUnits, EachAxisHasItsOwnUnit)
+{
+    const Bytes d = headTracker({
+            0x16, 0x00, 0x80, 0x26, 0xFF, 0x7F, // Logical -32768..32767
+            0x65, 0x11, 0x55, 0x0F,             // Unit (cm), Unit Exponent (-1): mm
+            0x75, 0x10, 0x95, 0x02,             // Report Size 16, Report Count 2
+            0x09, 0x21, 0x09, 0x22, 0x81, 0x02, // Usage (X), Usage (Y), Input
+            0x55, 0x00,                         // Unit Exponent (0): cm
+            0x95, 0x01, 0x09, 0x23, 0x81, 0x02, // Report Count 1, Usage (Z), Input
+    });
+    const auto layout = layoutOf(d);
+    const glm::dvec3 m = headOf(layout, report16(100, -50, 82));
+    EXPECT_NEAR(m.x, 0.1, 1e-12);
+    EXPECT_NEAR(m.y, -0.05, 1e-12);
+    EXPECT_NEAR(m.z, 0.82, 1e-12);
+    EXPECT_NE(layout.summary().find("head in mm (x, y), cm (z)"), std::string::npos)
+            << layout.summary();
+}
+
+// Both eyes, each in its own unit: left in mm, right in inch x 10^-2. The eye midpoint is of the
+// two in metres.
+TEST(HidUnits, EachEyeHasItsOwnUnit)
+{
+    Bytes d = {0x05, 0x12, 0x09, 0x01, 0xA1, 0x01, 0x85, 0x01, // Eye Tracker, report 1
+               0x16, 0x00, 0x80, 0x26, 0xFF, 0x7F, 0x75, 0x10, // int16
+               0x09, 0x25, 0xA1, 0x00,                         // Left Eye Position
+               0x65, 0x11, 0x55, 0x0F,                         //   mm
+               0x09, 0x21, 0x09, 0x22, 0x09, 0x23, 0x95, 0x03, 0x81, 0x02,
+               0xC0, 0x09, 0x26, 0xA1, 0x00, //   Right Eye Position
+               0x65, 0x13, 0x55, 0x0E,       //   Unit (English linear: inch), Unit Exponent (-2)
+               0x09, 0x21, 0x09, 0x22, 0x09, 0x23, 0x81, 0x02, 0xC0, 0xC0};
+    const auto layout = layoutOf(d);
+    Bytes r = report16(-32, 10, 600);            // left: mm
+    const Bytes right = report16(126, 39, 2362); // right: 0.01 inch
+    r.insert(r.end(), right.begin() + 1, right.end());
+    eht::TrackingReport t;
+    ASSERT_EQ(eht::decodeTracking(layout, r, t), eht::DecodeResult::Ok);
+    ASSERT_TRUE(t.leftEyeM && t.rightEyeM);
+    EXPECT_NEAR(t.leftEyeM->z, 0.6, 1e-12);
+    EXPECT_NEAR(t.rightEyeM->x, 1.26 * 0.0254, 1e-12);
+    EXPECT_NEAR(t.rightEyeM->z, 23.62 * 0.0254, 1e-12);
+    EXPECT_NE(layout.summary().find("left eye in mm, right eye in 0.000254 m"), std::string::npos)
+            << layout.summary();
+}
+
 // F3: the Unit Exponent is a 4-bit two's-complement nibble whatever the item's size: `56 0D 00`
 // and `57 0D 00 00 00` are -3, as `55 0D` is; a value with bits above the nibble is a signed
 // value (`55 FD`, `56 FD FF`: -3). The product read the 2-byte form as +13 (a head 8e15 m away).
@@ -130,6 +225,32 @@ TEST(HidUnits, UnitExponentOutsideTheNibbleRangeIsRefusedNamingTheByte)
         const double want = 3.0 * 0.01 * std::pow(10.0, e);
         EXPECT_NEAR(m.z, want, 1e-12 * want) << "exponent " << e;
     }
+}
+
+// F6: Logical Minimum above Logical Maximum (HID 1.11 6.2.2.7 asks min <= max). Min 100, max 50
+// was read unsigned (-31500 as 4294935796: an eye 2147 m away); min -50, max -100 made every
+// value "in range". F10: a Relative position decoded as absolute. A unit that is not a length
+// (cm^2) read as "um (assumed)". Each refused naming its Input item (byte 18 of the body).
+TEST(HidUnits, PositionFieldsThatCannotBeReadAreRefusedNamingTheByte)
+{
+    const std::string at = "byte " + std::to_string(kBodyAt + 18) + ": Head Position X ";
+    auto body = [](std::initializer_list<std::uint8_t> globals, std::uint8_t flags) {
+        Bytes b(globals);
+        b.insert(b.end(),
+                 {0x09, 0x21, 0x09, 0x22, 0x09, 0x23, 0x75, 0x10, 0x95, 0x03, 0x81, flags});
+        return headTracker(b);
+    };
+    expectRefused(body({0x15, 0x64, 0x25, 0x32, 0x65, 0x11, 0x55, 0x0F}, 0x02),
+                  at + "has Logical Minimum 100 above its Logical Maximum 50");
+    expectRefused(body({0x15, 0xCE, 0x25, 0x9C, 0x65, 0x11, 0x55, 0x0F}, 0x02),
+                  at + "has Logical Minimum -50 above its Logical Maximum -100");
+    expectRefused(body({0x15, 0x81, 0x25, 0x7F, 0x65, 0x11, 0x55, 0x0F}, 0x06),
+                  at + "is Relative (Input item bit 2)");
+    expectRefused(body({0x15, 0x81, 0x25, 0x7F, 0x65, 0x21, 0x55, 0x0F}, 0x02),
+                  at + "has Unit 0x21, which is not a length");
+    // The same with a valid range, absolute, in cm: taken.
+    EXPECT_TRUE(hal::tracker::trackerLayout(
+            body({0x15, 0x81, 0x25, 0x7F, 0x65, 0x11, 0x55, 0x0F}, 0x02)));
 }
 
 } // namespace hid_units
