@@ -122,4 +122,13 @@ void insertField(const HidField& f, std::span<std::uint8_t> data, std::int64_t v
 // over an empty logical range (LogMin == LogMax): nothing can be scaled then.
 std::optional<double> physicalValue(const HidField& f, std::int64_t logical);
 
+// The field 'first' joined with the fields right after it that repeat its usage, as one
+// little-endian integer of up to 64 bits: a descriptor that declares one usage over several
+// 8-bit fields (Microsoft's reference eye tracker: Sensor Timestamp, Report Size 8, Report Count
+// 8, a uint64 microsecond counter) means one value in those bytes, not eight values of which the
+// first would do. The joined field is unsigned and has no logical or physical range (those of a
+// byte say nothing about the whole). 'first' must be one of d.fields; it is returned as it is
+// when no byte field of its usage follows it.
+HidField joinedBytes(const ReportDescriptor& d, const HidField& first);
+
 } // namespace replica::hal::hid

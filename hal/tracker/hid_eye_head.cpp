@@ -211,7 +211,8 @@ std::string Layout::summary() const
     return fmt::format("{}, input report {} ({} bytes): {}; {}",
                        application == u(kHeadTracker) ? "head tracker" : "eye tracker",
                        inputReportId, inputReportBytes, what,
-                       timestamp ? fmt::format("timestamp every {:g} s{}", secondsPerTick,
+                       timestamp ? fmt::format("{}-bit timestamp every {:g} s{}",
+                                               timestamp->bitSize, secondsPerTick,
                                                timestampUnitAssumed ? " (assumed)" : "")
                                  : std::string("no timestamp (host time used)"));
 }
@@ -262,7 +263,7 @@ Expected<Layout> findLayout(const ReportDescriptor& d)
     l.inputReportBytes = d.reportBytes(ReportType::Input, l.inputReportId);
     if (const HidField* t = d.find(ReportType::Input, u(kSensorTimestamp));
         t != nullptr && t->reportId == l.inputReportId) {
-        l.timestamp = *t;
+        l.timestamp = joinedBytes(d, *t);
         l.secondsPerTick = t->unit.secondsPerUnit();
         if (l.secondsPerTick <= 0.0) {
             l.secondsPerTick = 1e-6; // microseconds, as the reference implementations use

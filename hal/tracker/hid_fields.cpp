@@ -2,6 +2,7 @@
 // report bytes (HID 1.11, 5.8 and 6.2.2.7).
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include <hal/tracker/hid_descriptor.h>
 
@@ -139,6 +140,30 @@ std::optional<double> physicalValue(const HidField& f, std::int64_t logical)
             static_cast<double>(f.physicalMax) - static_cast<double>(f.physicalMin);
     return (x - static_cast<double>(f.logicalMin)) * physicalSpan / logicalSpan +
            static_cast<double>(f.physicalMin);
+}
+
+HidField joinedBytes(const ReportDescriptor& d, const HidField& first)
+{
+    const auto at = std::find_if(d.fields.begin(), d.fields.end(),
+                                 [&](const HidField& f) { return &f == &first; });
+    if (at == d.fields.end() || first.bitSize != 8) {
+        return first;
+    }
+    HidField joined = first;
+    for (auto it = std::next(at); it != d.fields.end() && joined.bitSize < 64; ++it) {
+        if (it->type != first.type || it->reportId != first.reportId || it->usage != first.usage ||
+            it->constant || it->bitSize != 8 || it->bitOffset != first.bitOffset + joined.bitSize) {
+            break;
+        }
+        joined.bitSize += 8;
+    }
+    if (joined.bitSize > 8) {
+        joined.logicalMin = 0;
+        joined.logicalMax = 0;
+        joined.physicalMin = 0;
+        joined.physicalMax = 0;
+    }
+    return joined;
 }
 
 } // namespace replica::hal::hid

@@ -1,10 +1,10 @@
 // The HID eye/head tracker's reading of what a descriptor says about its values (HID 1.11
 // 6.2.2.7; the Eye and Head Trackers page 0x12 of the HID Usage Tables): physical ranges, each
 // axis's own unit, the Unit Exponent nibble in items of any size, exponents no device can mean,
-// Logical Minimum above Maximum, Relative positions and units that are no length. Each descriptor
-// is written here byte by byte; the expected values follow from the spec's formulas applied by hand
-// to those bytes. The cases are those of an independent probe of this path (F1-F6 and F10 of its
-// report).
+// Logical Minimum above Maximum, Relative positions, and one usage spread over byte fields (the
+// timestamp of Microsoft's reference tracker). Each descriptor is written here byte by byte; the
+// expected values follow from the spec's formulas applied by hand to those bytes. The cases are
+// those of an independent probe of this path (F1-F7 and F10 of its report).
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -251,6 +251,63 @@ TEST(HidUnits, PositionFieldsThatCannotBeReadAreRefusedNamingTheByte)
     // The same with a valid range, absolute, in cm: taken.
     EXPECT_TRUE(hal::tracker::trackerLayout(
             body({0x15, 0x81, 0x25, 0x7F, 0x65, 0x11, 0x55, 0x0F}, 0x02)));
+}
+
+// F7: Microsoft's reference eye tracker (GazeHid) declares its Sensor Timestamp as one usage over
+// Report Size 8 x Report Count 8: the bytes of a uint64 microsecond counter, little-endian. The
+// product read the first byte only: device times of 64 us, 205 us ... for 5 000 000 000 us, and
+// session-time steps of 141 us to 16.5 ms for reports 8.333 ms apart.
+TEST(HidUnits, OneUsageOverByteFieldsIsOneLittleEndianInteger)
+{
+    const Bytes d = {
+            0x05, 0x12, 0x09, 0x01, 0xA1, 0x01, // Usage Page (0x12), Usage (Eye Tracker), App
+            0xA1, 0x02,                         //   Collection (Logical)
+            0x85, 0x10,                         //   Report ID (16)
+            0x15, 0x00, 0x25, 0xFF,             //   Logical 0..255 (one unsigned byte)
+            0x75, 0x08, 0x95, 0x03, 0x81, 0x01, //   3 bytes of padding (Input, Constant)
+            0x09, 0x20, 0x95, 0x08, 0x81, 0x02, //   Usage (Sensor Timestamp), Count 8, Input
+            0x95, 0x01, 0x75, 0x20,             //   Report Count 1, Report Size 32
+            0x17, 0x00, 0x00, 0x00, 0x80,       //   Logical Minimum (-2^31)
+            0x27, 0xFF, 0xFF, 0xFF, 0x7F,       //   Logical Maximum (2^31 - 1)
+            0x09, 0x25, 0xA1, 0x00,             //   Left Eye Position, no unit (um)
+            0x95, 0x03, 0x09, 0x21, 0x09, 0x22, 0x09, 0x23, 0x81, 0x02, 0xC0,
+            0x09, 0x26, 0xA1, 0x00, //   Right Eye Position
+            0x09, 0x21, 0x09, 0x22, 0x09, 0x23, 0x81, 0x02, 0xC0, 0xC0, 0xC0};
+    const auto layout = layoutOf(d);
+    EXPECT_NE(layout.summary().find("64-bit timestamp every 1e-06 s (assumed)"), std::string::npos)
+            << layout.summary();
+    auto report = [](std::uint64_t us) {
+        Bytes r = {0x10, 0xAA, 0xBB, 0xCC}; // ID, padding
+        for (int i = 0; i < 8; ++i) {
+            r.push_back(static_cast<std::uint8_t>(us >> (8 * i)));
+        }
+        for (const std::int32_t v : {-31500, 50000, 600000, 31500, 50000, 600000}) {
+            for (int i = 0; i < 4; ++i) {
+                r.push_back(static_cast<std::uint8_t>(static_cast<std::uint32_t>(v) >> (8 * i)));
+            }
+        }
+        return r;
+    };
+    eht::TrackingReport t;
+    ASSERT_EQ(eht::decodeTracking(layout, report(5'000'000'000), t), eht::DecodeResult::Ok);
+    ASSERT_TRUE(t.deviceTimeNs);
+    EXPECT_EQ(*t.deviceTimeNs, 5'000'000'000'000);
+    ASSERT_TRUE(t.leftEyeM);
+    EXPECT_NEAR(t.leftEyeM->z, 0.6, 1e-12);
+
+    // Reports 8.333 ms apart by the device clock, arriving 8.333333 ms apart: each is stamped
+    // 8.333 ms after the one before.
+    hal::tracker::HidReportProcessor p(layout, {}, 50'000'000);
+    std::int64_t last = 0;
+    for (int i = 0; i < 10; ++i) {
+        hal::PoseSample s;
+        const auto us = 5'000'000'000ull + static_cast<std::uint64_t>(i) * 8333;
+        ASSERT_EQ(p.process(report(us), 1'000'000'000 + i * 8'333'333, s), eht::DecodeResult::Ok);
+        if (i > 0) {
+            EXPECT_EQ(s.timestampNs - last, 8'333'000) << "report " << i;
+        }
+        last = s.timestampNs;
+    }
 }
 
 } // namespace hid_units
