@@ -1,6 +1,5 @@
 // HID report-descriptor parsing (HID 1.11, 6.2.2 "Report Descriptor").
 #include <algorithm>
-#include <cmath>
 
 #include <fmt/format.h>
 
@@ -59,6 +58,8 @@ struct GlobalState {
     std::uint16_t usagePage = 0;
     ItemValue logicalMin;
     ItemValue logicalMax;
+    ItemValue physicalMin;
+    ItemValue physicalMax;
     HidUnit unit;
     std::uint32_t reportSize = 0;
     std::uint32_t reportCount = 0;
@@ -75,23 +76,18 @@ std::uint32_t resolve(const LocalUsage& u, std::uint16_t page)
     return u.size == 4 ? u.value : usage(page, static_cast<std::uint16_t>(u.value & 0xFFFF));
 }
 
-// Logical limits as the descriptor means them: signed two's complement in the item's size, except
-// that a maximum which reads below a non-negative minimum was meant unsigned (a common way to
-// write 0..255 in one byte, which Linux and Windows accept).
-std::pair<std::int64_t, std::int64_t> logicalRange(const GlobalState& g)
+// Limits as the descriptor means them (logical or physical): signed two's complement in the
+// item's size, except that a maximum which reads below a non-negative minimum was meant unsigned
+// (a common way to write 0..255 in one byte, which Linux and Windows accept). A minimum that is
+// still above the maximum is a broken descriptor, which the users of the field refuse.
+std::pair<std::int64_t, std::int64_t> rangeOf(const ItemValue& min, const ItemValue& max)
 {
-    const std::int64_t lo = g.logicalMin.asSigned();
-    std::int64_t hi = g.logicalMax.asSigned();
+    const std::int64_t lo = min.asSigned();
+    std::int64_t hi = max.asSigned();
     if (lo >= 0 && hi < lo) {
-        hi = static_cast<std::int64_t>(g.logicalMax.raw);
+        hi = static_cast<std::int64_t>(max.raw);
     }
     return {lo, hi};
-}
-
-int signedNibble(std::uint32_t v)
-{
-    const int n = static_cast<int>(v & 0xF);
-    return n >= 8 ? n - 16 : n;
 }
 
 Error errorAt(std::size_t offset, const std::string& what)
@@ -99,91 +95,6 @@ Error errorAt(std::size_t offset, const std::string& what)
     return Error{ErrorCode::Corrupt,
                  fmt::format("HID report descriptor byte {}: {}", offset, what)};
 }
-
-} // namespace
-
-const char* toString(ReportType t)
-{
-    switch (t) {
-    case ReportType::Input:
-        return "input";
-    case ReportType::Output:
-        return "output";
-    case ReportType::Feature:
-        return "feature";
-    }
-    return "unknown";
-}
-
-UnitSystem HidUnit::system() const
-{
-    switch (raw & 0xF) {
-    case 0:
-        return UnitSystem::None;
-    case 1:
-        return UnitSystem::SiLinear;
-    case 2:
-        return UnitSystem::SiRotation;
-    case 3:
-        return UnitSystem::EnglishLinear;
-    case 4:
-        return UnitSystem::EnglishRotation;
-    default:
-        return UnitSystem::Vendor;
-    }
-}
-
-int HidUnit::power(int nibble) const
-{
-    return signedNibble(raw >> (4 * nibble));
-}
-
-double HidUnit::metresPerUnit() const
-{
-    // Length to the first power and nothing else.
-    if ((raw & 0xFFFFFFF0u) != 0x10u) {
-        return 0.0;
-    }
-    const double base = system() == UnitSystem::SiLinear        ? 0.01   // centimetre
-                        : system() == UnitSystem::EnglishLinear ? 0.0254 // inch
-                                                                : 0.0;
-    return base * std::pow(10.0, exponent);
-}
-
-double HidUnit::secondsPerUnit() const
-{
-    if ((raw & 0xFFFFF0F0u) != 0x1000u || system() == UnitSystem::None ||
-        system() == UnitSystem::Vendor) {
-        return 0.0;
-    }
-    return std::pow(10.0, exponent); // the second in every system
-}
-
-bool HidField::within(std::uint32_t collectionUsage) const
-{
-    return std::find(collections.begin(), collections.end(), collectionUsage) != collections.end();
-}
-
-std::size_t ReportDescriptor::reportBytes(ReportType type, std::uint8_t id) const
-{
-    const auto it = reportBits.find({type, id});
-    const std::size_t bits = it == reportBits.end() ? 0 : it->second;
-    return (bits + 7) / 8 + (numberedReports ? 1 : 0);
-}
-
-const HidField*
-ReportDescriptor::find(ReportType type, std::uint32_t u, std::uint32_t withinCollection) const
-{
-    for (const auto& f : fields) {
-        if (f.type == type && f.usage == u && !f.constant &&
-            (withinCollection == 0 || f.within(withinCollection))) {
-            return &f;
-        }
-    }
-    return nullptr;
-}
-
-namespace {
 
 // One short item as read from the descriptor (long items are skipped by readItem).
 struct Item {
@@ -266,6 +177,7 @@ public:
 
 private:
     Expected<void> global(const Item& item);
+    Expected<void> unitExponent(const Item& item);
     void local(const Item& item);
     Expected<MainUsages> takeUsages(const Item& item);
     Expected<void> main(const Item& item);
@@ -336,13 +248,13 @@ Expected<void> DescriptorParser::global(const Item& item)
         g_.logicalMax = v;
         break;
     case kPhysicalMin:
-    case kPhysicalMax:
-        break; // physical ranges only rescale; the trackers' units come with logical values
-    case kUnitExponent:
-        // HID 1.11 codes it as a signed nibble; some descriptors write a signed byte.
-        g_.unit.exponent = (v.size == 1 && v.raw <= 0xF) ? signedNibble(v.raw)
-                                                         : static_cast<int>(v.asSigned());
+        g_.physicalMin = v;
         break;
+    case kPhysicalMax:
+        g_.physicalMax = v;
+        break;
+    case kUnitExponent:
+        return unitExponent(item);
     case kUnit:
         g_.unit.raw = v.raw;
         break;
@@ -378,6 +290,24 @@ Expected<void> DescriptorParser::global(const Item& item)
         return tl::unexpected(
                 errorAt(item.at, fmt::format("reserved global item tag 0x{:x}", item.tag)));
     }
+    return {};
+}
+
+// HID 1.11 codes the Unit Exponent as a 4-bit two's-complement nibble whatever the item's size
+// (`56 0D 00` is -3, not 13); some descriptors write a signed byte instead (0xFD). As Linux's
+// hid-core reads it: a value with no bits above the low four is a nibble, any other a signed
+// value. What is then outside -8..7 is no unit a device can mean (400 made a position of inf m,
+// 127 one of 5e129 m, -400 a unit of 0 m): the descriptor is refused.
+Expected<void> DescriptorParser::unitExponent(const Item& item)
+{
+    const ItemValue& v = item.value;
+    const std::int64_t e = (v.raw >> 4) == 0 ? signedNibble(v.raw) : v.asSigned();
+    if (e < -8 || e > 7) {
+        return tl::unexpected(errorAt(
+                item.at, fmt::format("Unit Exponent {} (0x{:x} in {} byte{}) is outside -8..7", e,
+                                     v.raw, v.size, v.size == 1 ? "" : "s")));
+    }
+    g_.unit.exponent = static_cast<int>(e);
     return {};
 }
 
@@ -509,7 +439,8 @@ Expected<void> DescriptorParser::data(const Item& item, const MainUsages& usages
         return tl::unexpected(errorAt(
                 item.at, fmt::format("more than {} fields in all (the limit)", kMaxFields)));
     }
-    const auto logical = logicalRange(g_);
+    const auto logical = rangeOf(g_.logicalMin, g_.logicalMax);
+    const auto physical = rangeOf(g_.physicalMin, g_.physicalMax);
     std::vector<std::uint32_t> path;
     for (const auto& c : open_) {
         path.push_back(c.usage);
@@ -528,7 +459,10 @@ Expected<void> DescriptorParser::data(const Item& item, const MainUsages& usages
         f.nullState = (v.raw & 0x40) != 0;
         f.logicalMin = logical.first;
         f.logicalMax = logical.second;
+        f.physicalMin = physical.first;
+        f.physicalMax = physical.second;
         f.unit = g_.unit;
+        f.itemAt = item.at;
         f.collections = path;
         d_.fields.push_back(std::move(f));
     }
@@ -559,41 +493,6 @@ Expected<void> DescriptorParser::finish(std::size_t end)
 Expected<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> bytes)
 {
     return DescriptorParser().run(bytes);
-}
-
-std::optional<std::int64_t> extractField(const HidField& f, std::span<const std::uint8_t> data)
-{
-    if (f.bitSize == 0 || f.bitSize > 64 || (f.bitOffset + f.bitSize + 7) / 8 > data.size()) {
-        return std::nullopt;
-    }
-    std::uint64_t v = 0;
-    for (std::uint32_t k = 0; k < f.bitSize; ++k) {
-        const std::uint32_t bit = f.bitOffset + k;
-        if ((data[bit / 8] >> (bit % 8)) & 1u) {
-            v |= std::uint64_t{1} << k;
-        }
-    }
-    if (f.isSigned() && f.bitSize < 64 && (v >> (f.bitSize - 1)) & 1u) {
-        v |= ~std::uint64_t{0} << f.bitSize;
-    }
-    return static_cast<std::int64_t>(v);
-}
-
-void insertField(const HidField& f, std::span<std::uint8_t> data, std::int64_t value)
-{
-    const auto v = static_cast<std::uint64_t>(value);
-    for (std::uint32_t k = 0; k < f.bitSize && k < 64; ++k) {
-        const std::uint32_t bit = f.bitOffset + k;
-        if (bit / 8 >= data.size()) {
-            return;
-        }
-        const auto mask = static_cast<std::uint8_t>(1u << (bit % 8));
-        if ((v >> k) & 1u) {
-            data[bit / 8] = static_cast<std::uint8_t>(data[bit / 8] | mask);
-        } else {
-            data[bit / 8] = static_cast<std::uint8_t>(data[bit / 8] & ~mask);
-        }
-    }
 }
 
 } // namespace replica::hal::hid

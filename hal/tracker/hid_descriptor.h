@@ -38,12 +38,19 @@ constexpr std::uint32_t usage(std::uint16_t page, std::uint16_t id)
     return (static_cast<std::uint32_t>(page) << 16) | id;
 }
 
+// A 4-bit two's-complement nibble (the low four bits of v) as -8..7.
+constexpr int signedNibble(std::uint32_t v)
+{
+    const int n = static_cast<int>(v & 0xF);
+    return n >= 8 ? n - 16 : n;
+}
+
 // HID unit systems (the low nibble of Unit).
 enum class UnitSystem { None, SiLinear, SiRotation, EnglishLinear, EnglishRotation, Vendor };
 
 struct HidUnit {
     std::uint32_t raw = 0; // as in the descriptor
-    int exponent = 0;      // Unit Exponent, power of ten
+    int exponent = 0;      // Unit Exponent, power of ten: -8..7 (the parser refuses others)
 
     UnitSystem system() const;
     // The power of one base dimension (nibble 1 length, 2 mass, 3 time, 4 temperature, 5 current,
@@ -68,7 +75,11 @@ struct HidField {
     bool nullState = false;      // values outside the logical range mean "no value"
     std::int64_t logicalMin = 0; // signed when logicalMin < 0
     std::int64_t logicalMax = 0;
+    // Physical Minimum and Maximum: both 0 means the physical value is the logical one.
+    std::int64_t physicalMin = 0;
+    std::int64_t physicalMax = 0;
     HidUnit unit;
+    std::size_t itemAt = 0; // byte offset of the main item that declared it (for errors)
     // Usages of the enclosing collections, outermost first.
     std::vector<std::uint32_t> collections;
 
@@ -104,5 +115,20 @@ std::optional<std::int64_t> extractField(const HidField& f, std::span<const std:
 
 // Writes a field's value into a report's data bytes (which must be long enough).
 void insertField(const HidField& f, std::span<std::uint8_t> data, std::int64_t value);
+
+// A logical value in the field's physical range (HID 1.11 6.2.2.7): (logical - LogMin) *
+// (PhysMax - PhysMin) / (LogMax - LogMin) + PhysMin, in the field's unit times 10^exponent; the
+// logical value itself when the physical range is 0..0. Nullopt when a physical range is given
+// over an empty logical range (LogMin == LogMax): nothing can be scaled then.
+std::optional<double> physicalValue(const HidField& f, std::int64_t logical);
+
+// The field 'first' joined with the fields right after it that repeat its usage, as one
+// little-endian integer of up to 64 bits: a descriptor that declares one usage over several
+// 8-bit fields (Microsoft's reference eye tracker: Sensor Timestamp, Report Size 8, Report Count
+// 8, a uint64 microsecond counter) means one value in those bytes, not eight values of which the
+// first would do. The joined field is unsigned and has no logical or physical range (those of a
+// byte say nothing about the whole). 'first' must be one of d.fields; it is returned as it is
+// when no byte field of its usage follows it.
+HidField joinedBytes(const ReportDescriptor& d, const HidField& first);
 
 } // namespace replica::hal::hid

@@ -5,6 +5,7 @@
 // request sit, with their units; and the decoding of input reports into positions in metres.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -58,12 +59,18 @@ constexpr int kModeGazePoint = 1;
 constexpr int kModeEyePosition = 2;
 constexpr int kModeHeadPosition = 4;
 
+// X, Y and Z of one position, each with its own unit: a descriptor may give each axis (and each
+// eye) its own unit, exponent and physical range.
 struct PositionFields {
     HidField x;
     HidField y;
     HidField z;
-    double metresPerUnit = 0.0;
-    bool unitAssumed = false; // the descriptor gave no length unit: micrometres assumed
+    // Metres per physical unit of x, y and z (the unit times 10^exponent).
+    std::array<double, 3> metresPerUnit{};
+    // Per axis: the descriptor gave no unit (Unit 0): micrometres assumed.
+    std::array<bool, 3> unitAssumed{};
+    // "um", "mm (x, y), cm (z)", "um (assumed)": the units, for the layout's summary.
+    std::string units() const;
 };
 
 // Where everything this driver uses sits in the device's reports.
@@ -93,7 +100,10 @@ struct Layout {
 };
 
 // Finds the tracker in a descriptor. Fails, saying what is missing, for a device that is not an
-// eye/head tracker or that reports neither a head nor both eye positions.
+// eye/head tracker or that reports neither a head nor both eye positions; and, naming the byte
+// offset of the field's Input item, for a position field that is Relative, whose Logical
+// Minimum exceeds its Maximum, whose unit is not a length, or that has a physical range over an
+// empty logical range.
 Expected<Layout> findLayout(const ReportDescriptor& descriptor);
 
 // One decoded tracking-data report. Positions are in the tracker's own frame, metres, as the
@@ -113,8 +123,9 @@ enum class DecodeResult { Ok, OtherReport, Short };
 DecodeResult
 decodeTracking(const Layout& layout, std::span<const std::uint8_t> report, TrackingReport& out);
 
-// A feature value in physical units (metres for lengths, Hz for the sampling frequency, the raw
-// logical value otherwise) from a feature report as read (ID byte first, 0 when not numbered).
+// A feature value in physical units (metres for lengths, Hz for the sampling frequency, the
+// physical value otherwise; HID 1.11 6.2.2.7) from a feature report as read (ID byte first, 0
+// when not numbered). Nullopt when the report is too short or the value cannot be scaled.
 std::optional<double> featureValue(const HidField& field, std::span<const std::uint8_t> report);
 
 } // namespace replica::hal::hid::eht

@@ -1,5 +1,7 @@
 // The HID eye/head tracker: configuration on open, report decoding, and the reader thread.
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -14,8 +16,6 @@ namespace replica::hal::tracker {
 namespace {
 
 namespace eht = hid::eht;
-
-constexpr std::size_t kFeatureBytes = 256;
 
 Error deviceError(hid::HidStatus s, const std::string& where, const std::string& doing)
 {
@@ -85,23 +85,63 @@ Expected<void> HidTrackerReader::configure()
     for (const auto& f : descriptor->fields) {
         knownIds_[f.reportId] = true;
     }
+    if (auto ok = readFeatures(*descriptor); !ok) {
+        return ok;
+    }
+    return requestMode(*descriptor);
+}
 
-    // Read one feature value; a device that refuses a feature request is still usable.
-    std::vector<std::uint8_t> feature(kFeatureBytes);
-    auto readFeature =
-            [&](const std::optional<hid::HidField>& f) -> Expected<std::optional<double>> {
+// A feature report as hidapi reads it, sized as the descriptor declares it (ID byte first, 0 when
+// not numbered): a fixed 256-byte buffer cut longer reports short, and the mode request then
+// wrote zeros over the rest of the control report.
+Expected<std::vector<std::uint8_t>>
+HidTrackerReader::getFeature(const hid::ReportDescriptor& d, std::uint8_t id, const char* doing)
+{
+    const std::size_t n = d.reportBytes(hid::ReportType::Feature, id) + (d.numberedReports ? 0 : 1);
+    std::vector<std::uint8_t> report(std::max<std::size_t>(n, 2), 0);
+    const auto got = device_->getFeature(id, report);
+    if (got.status == hid::HidStatus::Gone) {
+        return tl::unexpected(deviceError(got.status, description_.where, doing));
+    }
+    if (got.status != hid::HidStatus::Ok) {
+        return std::vector<std::uint8_t>();
+    }
+    report.resize(std::min(got.bytes, report.size()));
+    return report;
+}
+
+// A feature value that is a whole number (status, quality). An infinite or huge value (a unit
+// exponent of 400 made one; casting it to int is undefined) is taken as not reported, and said.
+std::optional<int> HidTrackerReader::wholeFeature(std::optional<double> v, const char* what) const
+{
+    if (!v) {
+        return std::nullopt;
+    }
+    if (!std::isfinite(*v) || *v < static_cast<double>(std::numeric_limits<int>::min()) ||
+        *v > static_cast<double>(std::numeric_limits<int>::max())) {
+        deviceLog("hal.tracker")
+                ->warn("HID tracker {}: {} reads {:g}, which is no value it can have; taken as "
+                       "not reported",
+                       description_.where, what, *v);
+        return std::nullopt;
+    }
+    return static_cast<int>(*v);
+}
+
+// Status, quality, calibrated screen and rate; a device that refuses a feature request is still
+// usable.
+Expected<void> HidTrackerReader::readFeatures(const hid::ReportDescriptor& d)
+{
+    const eht::Layout& layout = description_.layout;
+    auto read = [&](const std::optional<hid::HidField>& f) -> Expected<std::optional<double>> {
         if (!f) {
             return std::optional<double>();
         }
-        std::fill(feature.begin(), feature.end(), std::uint8_t{0});
-        const auto got = device_->getFeature(f->reportId, feature);
-        if (got.status == hid::HidStatus::Gone) {
-            return tl::unexpected(deviceError(got.status, where, "a get-feature request"));
+        auto report = getFeature(d, f->reportId, "a get-feature request");
+        if (!report) {
+            return tl::unexpected(report.error());
         }
-        if (got.status != hid::HidStatus::Ok || got.bytes == 0) {
-            return std::optional<double>();
-        }
-        return eht::featureValue(*f, {feature.data(), got.bytes});
+        return report->empty() ? std::nullopt : eht::featureValue(*f, *report);
     };
     auto asLength = [](const std::optional<hid::HidField>& f, std::optional<double> v) {
         // Without a length unit the page's convention, micrometres, applies.
@@ -110,50 +150,59 @@ Expected<void> HidTrackerReader::configure()
         }
         return v;
     };
-    auto status = readFeature(layout->configurationStatus);
-    auto quality = readFeature(layout->quality);
-    auto width = readFeature(layout->calibratedWidth);
-    auto height = readFeature(layout->calibratedHeight);
-    auto rate = readFeature(layout->samplingFrequency);
+    auto status = read(layout.configurationStatus);
+    auto quality = read(layout.quality);
+    auto width = read(layout.calibratedWidth);
+    auto height = read(layout.calibratedHeight);
+    auto rate = read(layout.samplingFrequency);
     for (const auto* e : {&status, &quality, &width, &height, &rate}) {
         if (!*e) {
             return tl::unexpected(e->error());
         }
     }
-    if (const std::optional<double> v = *status) {
-        description_.status = static_cast<int>(*v);
-    }
-    if (const std::optional<double> v = *quality) {
-        description_.quality = static_cast<int>(*v);
-    }
-    description_.screenWidthM = asLength(layout->calibratedWidth, *width);
-    description_.screenHeightM = asLength(layout->calibratedHeight, *height);
+    description_.status = wholeFeature(*status, "Configuration Status");
+    description_.quality = wholeFeature(*quality, "Tracker Quality");
+    description_.screenWidthM = asLength(layout.calibratedWidth, *width);
+    description_.screenHeightM = asLength(layout.calibratedHeight, *height);
     description_.samplingHz = *rate;
+    return {};
+}
 
-    // Device Mode Request: read the control report (other values in it stay as they are), set the
-    // streams wanted, write it back.
-    if (layout->modeRequest) {
-        const hid::HidField& f = *layout->modeRequest;
-        const std::size_t n = descriptor->reportBytes(hid::ReportType::Feature, f.reportId) +
-                              (descriptor->numberedReports ? 0 : 1);
-        std::vector<std::uint8_t> report(std::max<std::size_t>(n, 2), 0);
-        std::fill(feature.begin(), feature.end(), std::uint8_t{0});
-        const auto got = device_->getFeature(f.reportId, feature);
-        if (got.status == hid::HidStatus::Gone) {
-            return tl::unexpected(deviceError(got.status, where, "reading the control report"));
-        }
-        if (got.status == hid::HidStatus::Ok) {
-            std::copy_n(feature.begin(), std::min(got.bytes, report.size()), report.begin());
-        }
-        report[0] = f.reportId;
-        const int mode = layout->wantedMode();
-        hid::insertField(f, std::span<std::uint8_t>(report).subspan(1), mode);
-        if (const auto s = device_->sendFeature(report); s != hid::HidStatus::Ok) {
-            return tl::unexpected(
-                    deviceError(s, where, fmt::format("the device mode request ({})", mode)));
-        }
-        description_.modeSent = mode;
+// Device Mode Request: read the control report (other values in it stay as they are), set the
+// streams wanted, write it back.
+Expected<void> HidTrackerReader::requestMode(const hid::ReportDescriptor& d)
+{
+    const eht::Layout& layout = description_.layout;
+    if (!layout.modeRequest) {
+        return {};
     }
+    const hid::HidField& f = *layout.modeRequest;
+    const std::size_t n =
+            d.reportBytes(hid::ReportType::Feature, f.reportId) + (d.numberedReports ? 0 : 1);
+    auto got = getFeature(d, f.reportId, "reading the control report");
+    if (!got) {
+        return tl::unexpected(got.error());
+    }
+    std::vector<std::uint8_t> report(std::max<std::size_t>(n, 2), 0);
+    std::copy_n(got->begin(), std::min(got->size(), report.size()), report.begin());
+    report[0] = f.reportId;
+    const int mode = layout.wantedMode();
+    if (f.logicalMin < f.logicalMax && (mode < f.logicalMin || mode > f.logicalMax)) {
+        // Microsoft's reference descriptor declares 0..1 and its driver expects 2 (eye
+        // position, as the usage page defines it): no value in such a range asks for the
+        // positions, so the value is sent as it is, and the log says so.
+        deviceLog("hal.tracker")
+                ->warn("HID tracker {}: device mode request {} is outside the field's logical "
+                       "range {}..{}; sent as it is, since no value in the range asks for the "
+                       "positions",
+                       description_.where, mode, f.logicalMin, f.logicalMax);
+    }
+    hid::insertField(f, std::span<std::uint8_t>(report).subspan(1), mode);
+    if (const auto s = device_->sendFeature(report); s != hid::HidStatus::Ok) {
+        return tl::unexpected(deviceError(s, description_.where,
+                                          fmt::format("the device mode request ({})", mode)));
+    }
+    description_.modeSent = mode;
     return {};
 }
 

@@ -102,6 +102,11 @@ private:
         : device_(std::move(device)), clock_(&clock), options_(std::move(options))
     {}
     Expected<void> configure();
+    Expected<std::vector<std::uint8_t>>
+    getFeature(const hid::ReportDescriptor& d, std::uint8_t id, const char* doing);
+    std::optional<int> wholeFeature(std::optional<double> v, const char* what) const;
+    Expected<void> readFeatures(const hid::ReportDescriptor& d);
+    Expected<void> requestMode(const hid::ReportDescriptor& d);
 
     std::unique_ptr<hid::HidDevice> device_;
     const Clock* clock_;
