@@ -7,6 +7,7 @@
 #include <toml++/toml.h>
 
 #include <pipeline/base/input_file.h>
+#include <pipeline/base/printable.h>
 #include <platform/output/display_geometry.h>
 #include <platform/site_config.h>
 
@@ -469,10 +470,12 @@ Expected<SiteLoad> parseSiteConfig(const std::string& text, const std::filesyste
 
 std::string formatProblem(const std::filesystem::path& file, const SiteProblem& p)
 {
+    // The key and the value quoted in 'what' come from the file: a terminal escape in them is
+    // shown (\x1b), never run, as in the log.
     if (p.line > 0) {
-        return fmt::format("{}:{}: {}: {}", file.string(), p.line, p.key, p.what);
+        return printable(fmt::format("{}:{}: {}: {}", file.string(), p.line, p.key, p.what));
     }
-    return fmt::format("{}: {}: {}", file.string(), p.key, p.what);
+    return printable(fmt::format("{}: {}: {}", file.string(), p.key, p.what));
 }
 
 std::string SiteConfig::toJson() const

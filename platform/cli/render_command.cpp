@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <pipeline/base/data_dir.h>
+#include <pipeline/base/printable.h>
 #include <pipeline/booth/booth_model.h>
 #include <pipeline/image/exr.h>
 #include <pipeline/reference/reference_integrator.h>
@@ -106,7 +107,8 @@ bool parseSize(const std::string& s, int& w, int& h)
 
 int fail(int code, const std::string& msg)
 {
-    std::fprintf(stderr, "replica render: %s\n", msg.c_str());
+    // Messages quote names from the booth's and scene's files: escapes shown, never run.
+    std::fprintf(stderr, "replica render: %s\n", printable(msg, std::string::npos, true).c_str());
     return code;
 }
 

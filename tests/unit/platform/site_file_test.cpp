@@ -180,3 +180,19 @@ TEST_F(CalibrationSiteFile, BrokenFilesAreRefusedWithTheirLineAndMissingTablesSa
 
 } // namespace
 } // namespace replica::tests
+
+namespace replica::tests {
+namespace {
+
+TEST(SiteProblemText, ATerminalEscapeFromTheFileIsShownNotRun)
+{
+    // The hostile-files probe: booth.id = "\x1b[31mRED\x1b[0m" reached the terminal raw from
+    // 'config check' (the run log escaped it).
+    const platform::SiteProblem p{"booth.id", 9, "\"\x1b[31mRED\x1b[0m\": unknown booth"};
+    const auto text = platform::formatProblem("site.toml", p);
+    EXPECT_EQ(text.find('\x1b'), std::string::npos) << text;
+    EXPECT_EQ(text, "site.toml:9: booth.id: \"\\x1b[31mRED\\x1b[0m\": unknown booth");
+}
+
+} // namespace
+} // namespace replica::tests
