@@ -54,6 +54,16 @@ Expected<void> checkLuminance(const LuminanceImage& img, const std::string& what
                                          what, k % static_cast<std::size_t>(img.width),
                                          k / static_cast<std::size_t>(img.width), v));
         }
+        if (v > kMaxLuminanceCdM2) {
+            // A float's 3e38 passed, and the auto dimmer then drew the lamp black (gain 4e-36).
+            return makeError(ErrorCode::Corrupt,
+                             fmt::format("{}: texel ({}, {}) has luminance {:g} cd/m^2, brighter "
+                                         "than the sun's disc ({:g}); is the map in cd/m^2 (not "
+                                         "raw counts or another unit)?",
+                                         what, k % static_cast<std::size_t>(img.width),
+                                         k / static_cast<std::size_t>(img.width), v,
+                                         kMaxLuminanceCdM2));
+        }
     }
     return {};
 }

@@ -22,8 +22,12 @@ struct LuminanceImage {
     double max() const;
 };
 
-// Fails naming the first texel that is negative, NaN or Inf (hard cases 7 and 18); 'what' names the
-// source (file or light) in the message.
+// The brightest luminance a booth light's map may hold: the sun's disc at noon, about 1.6e9 cd/m^2.
+// Nothing in a booth is brighter; a map that is comes in another unit or is damaged.
+constexpr double kMaxLuminanceCdM2 = 1.6e9;
+
+// Fails naming the first texel that is negative, NaN, Inf or brighter than kMaxLuminanceCdM2 (hard
+// cases 7 and 18); 'what' names the source (file or light) in the message.
 Expected<void> checkLuminance(const LuminanceImage& img, const std::string& what);
 
 // Mip chain over the image padded with zeros to power-of-two sides (level 0 is padded too), so

@@ -230,6 +230,15 @@ TEST(LuminanceCheck, NamesTheFirstBadTexel)
             << r.error().message;
     img.at(3, 2) = -1.0;
     EXPECT_FALSE(checkLuminance(img, "light.exr"));
+    // A float's largest value (a damaged or mis-scaled map) is refused, naming the texel; a
+    // halogen filament's 2e7 cd/m^2 is not.
+    img.at(3, 2) = 3e38;
+    r = checkLuminance(img, "light.exr");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("light.exr: texel (3, 2)"), std::string::npos);
+    EXPECT_NE(r.error().message.find("brighter than the sun"), std::string::npos);
+    img.at(3, 2) = 2e7;
+    EXPECT_TRUE(checkLuminance(img, "light.exr"));
 }
 
 } // namespace
