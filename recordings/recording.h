@@ -273,6 +273,9 @@ public:
     virtual std::int64_t wallClockStartNs() const = 0;
 };
 
+// A format this build reads, or one line naming the recording saying it is newer (update replica).
+Expected<void> checkFormatVersion(const std::string& name, int formatVersion);
+
 // Reads a whole recording. Fails with a one-line reason (missing, empty, not a recording, damaged).
 // 'kinds': the device kinds to read (the registry; a channel of no kind there is skipped).
 Expected<Recording> readRecording(const std::filesystem::path& path,

@@ -36,18 +36,6 @@ Expected<std::string> slurp(const std::filesystem::path& path)
     return bytes;
 }
 
-// A format this build reads, or one line saying it is newer.
-Expected<void> checkFormatVersion(const std::string& name, int formatVersion)
-{
-    if (formatVersion < 1 || formatVersion > kFormatVersion) {
-        return makeError(ErrorCode::Unsupported,
-                         fmt::format("{}: recording format {} is newer than this replica reads "
-                                     "(up to {}); update replica",
-                                     name, formatVersion, kFormatVersion));
-    }
-    return {};
-}
-
 // One session per recording: a second /replica/session channel or message would change the
 // configuration (the frame size, the scene) part way through the file, whichever came last.
 Expected<void> checkOneSession(const mcap::Scan& s, const std::string& name)
@@ -181,6 +169,17 @@ Expected<FileReport> inspectRecording(const std::filesystem::path& path)
         r.channels.push_back(std::move(cr));
     }
     return r;
+}
+
+Expected<void> checkFormatVersion(const std::string& name, int formatVersion)
+{
+    if (formatVersion < 1 || formatVersion > kFormatVersion) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("{}: recording format {} is newer than this replica reads "
+                                     "(up to {}); update replica",
+                                     name, formatVersion, kFormatVersion));
+    }
+    return {};
 }
 
 } // namespace replica::recordings

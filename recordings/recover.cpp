@@ -170,6 +170,7 @@ public:
 
     std::uint64_t dropped() const { return dropped_; }
     bool haveSession() const { return decoder_.haveSession(); }
+    int formatVersion() const { return scratch_.formatVersion; } // the session's, once decoded
     const std::vector<std::string>& problems() const { return problems_; }
 
 private:
@@ -204,6 +205,12 @@ Expected<void> checkRecoverable(const MessageChecks& checks, const fs::path& in)
                          fmt::format("{}: nothing recoverable: the session could not be rebuilt "
                                      "({}), and a recording without one does not replay",
                                      in.string(), why));
+    }
+    // A newer format's messages were checked by this build's rules, which may not be its rules:
+    // "nothing lost" would be a guess, and inspect and replay refuse the file anyway.
+    if (auto ok = checkFormatVersion(in.string(), checks.formatVersion()); !ok) {
+        return makeError(ErrorCode::Unsupported,
+                         fmt::format("{}; nothing was written", ok.error().message));
     }
     return {};
 }

@@ -307,6 +307,30 @@ TEST(RecoverChecks, ASessionThatCannotBeRebuiltIsNothingRecoverable)
     ASSERT_TRUE(ok.output) << ok.output.error().message;
 }
 
+// A session of a format newer than this build reads: recover refuses and writes nothing (it said
+// "nothing lost", exit 0, and wrote a file inspect then refused as newer than it reads).
+TEST(RecoverChecks, ANewerFormatIsRefusedNotCalledWhole)
+{
+    const auto newer = withMessage(kSessionTopic, 0,
+                                   replaced(R"("format_version":\d+)", R"("format_version":99)"));
+    const auto direct = read(newer);
+    ASSERT_FALSE(direct);
+    EXPECT_NE(direct.error().message.find("newer than this replica reads"), std::string::npos);
+    const auto in = tempPath("newer-in");
+    const auto out = tempPath("newer-out");
+    spit(in, newer);
+    std::error_code ec;
+    std::filesystem::remove(out, ec);
+    const auto r = recoverRecording(in, out, ExistingOutput::Replace);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("recording format 99 is newer than this replica reads"),
+              std::string::npos)
+            << r.error().message;
+    EXPECT_NE(r.error().message.find("nothing was written"), std::string::npos);
+    EXPECT_FALSE(std::filesystem::exists(out));
+    std::filesystem::remove(in, ec);
+}
+
 // Values no Replica build writes, that the reader used to take after a cast (3.5 as frame 3, a pose
 // time of 2^64-1 as -1) or pass on unused (lamp 99 of a three-lamp switch): damage, naming the
 // field, and dropped by recover.
