@@ -111,6 +111,19 @@ checkLightScale(const colour::Observer& obs, const Spectrum& light, const std::s
                 ErrorCode::InvalidArgument,
                 fmt::format("{}: the light has no luminance over 380-730 nm (Y <= 0)", file));
     }
+    // Power is not negative; a measured spectrum's dark-subtracted noise dips a little below 0.
+    const double peak = light.max();
+    for (std::size_t b = 0; b < colour::kBands; ++b) {
+        if (light[b] < -kMaxNegativeLightFraction * peak) {
+            return makeError(ErrorCode::InvalidArgument,
+                             fmt::format("{}: the light's band at {:g} nm is {:g}, {:.1f} % of its "
+                                         "peak below 0; a light's power cannot be negative (more "
+                                         "than {:g} % is not noise): check the file",
+                                         file, colour::bandCentreNm(b), light[b],
+                                         -100.0 * light[b] / peak,
+                                         100.0 * kMaxNegativeLightFraction));
+        }
+    }
     return {};
 }
 

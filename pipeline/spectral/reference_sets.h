@@ -44,6 +44,9 @@ Expected<NamedSpectra> loadReflectances(const std::filesystem::path& path);
 // is not above 0 (no light).
 constexpr double kMaxLightY = 1e30;
 constexpr double kMinLightY = 1e-30;
+// A band below -kMaxNegativeLightFraction of the peak is refused too: noise about a measured
+// spectrum's dark level dips below 0 by a fraction of a percent, a wrong file by more.
+constexpr double kMaxNegativeLightFraction = 0.01;
 Expected<void>
 checkLightScale(const colour::Observer& obs, const Spectrum& light, const std::string& source);
 

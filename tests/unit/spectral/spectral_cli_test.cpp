@@ -208,6 +208,31 @@ TEST_F(CliFiles, EvalSaysHowEachLightWasAdapted)
     EXPECT_EQ(nlohmann::json::parse(r.out)["adaptation"], "CAT02 to D65");
 }
 
+TEST_F(CliFiles, EvalRefusesANegativeLightButNotItsNoise)
+{
+    // The colour probe's light: D65-like, -5 at 430 nm, evaluated with no word. A dip of 0.3 % of
+    // the peak (a dark-subtracted measurement's noise) still evaluates.
+    const auto set =
+            (dataDir() / "spectra" / "colorchecker24_babelcolor_avg_10nm_380_730.csv").string();
+    auto light = [](double at430) {
+        std::string text = "wavelength_nm,value\n";
+        for (int w = 380; w <= 730; w += 10) {
+            text += fmt::format("{},{}\n", w, w == 430 ? at430 : 100.0);
+        }
+        return text;
+    };
+    const auto bad = write("negative.csv", light(-5.0));
+    const auto r = runReplica("spectral eval --illuminant " + bad + " --reflectances " + set, dir_);
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find("negative.csv: the light's band at 430 nm is -5"), std::string::npos)
+            << r.err;
+    EXPECT_NE(r.err.find("cannot be negative"), std::string::npos) << r.err;
+    const auto noise = write("noise.csv", light(-0.3));
+    const auto ok =
+            runReplica("spectral eval --illuminant " + noise + " --reflectances " + set, dir_);
+    EXPECT_EQ(ok.exitCode, 0) << ok.err;
+}
+
 TEST_F(CliFiles, EvalSensedAblatesEachImpairmentAndIsReproducible)
 {
     const auto light = write("f7.csv", lightCsv("F7"));
