@@ -30,22 +30,25 @@ void TiltEstimator::update(const hal::AccelSample* accel)
     }
 }
 
+bool TiltEstimator::noisierThanDesign() const
+{
+    return noise_.sigmaRad() > kTiltNoiseFitRad;
+}
+
 double TiltEstimator::motionThresholdRad() const
 {
-    const double sigma = noise_.sigmaRad();
-    if (!(sigma > kTiltNoiseFitRad)) {
+    if (!noisierThanDesign()) {
         return kTiltMotionRad;
     }
-    return std::max(kTiltMotionRad, kTiltMotionSigmas * sigma * std::sqrt(17.0 / 16.0));
+    return std::max(kTiltMotionRad, kTiltMotionSigmas * noise_.sigmaRad() * std::sqrt(17.0 / 16.0));
 }
 
 double TiltEstimator::holdThresholdRad() const
 {
-    const double sigma = noise_.sigmaRad();
-    if (!(sigma > kTiltNoiseFitRad)) {
+    if (!noisierThanDesign()) {
         return kTiltHoldRad;
     }
-    return std::max(kTiltHoldRad, kTiltHoldSigmas * sigma * std::sqrt(2.0 / 16.0));
+    return std::max(kTiltHoldRad, kTiltHoldSigmas * noise_.sigmaRad() * std::sqrt(2.0 / 16.0));
 }
 
 double TiltEstimator::windowMean() const
@@ -126,9 +129,9 @@ void TiltEstimator::write(pipeline::scene::SceneState& state)
         // On a sensor noisier than the design's, the held tilt follows the window's mean while it
         // fills (after a start or motion): re-taken at its first samples, it kept their error (up
         // to a sample's noise) for as long as the full mean stayed within the hold of it, where
-        // the full mean's error is a quarter of that (held scatter 0.57 sigma, now 0.25). The
-        // design's sensor keeps its schedule (its hold is about one sample's noise).
-        const bool filling = count_ < window_.size() && noise_.sigmaRad() > kTiltNoiseFitRad;
+        // the full mean's error is a quarter of that (held error RMS 0.57 sigma; now 0.2-0.33).
+        // The design's sensor keeps its schedule (its hold is about one sample's noise).
+        const bool filling = count_ < window_.size() && noisierThanDesign();
         if (state.lightChanged || !heldValid_ || filling ||
             std::abs(mean - held_) > holdThresholdRad()) {
             held_ = mean;

@@ -97,6 +97,8 @@ public:
     // motion and hold thresholds it sets.
     double noiseRad() const { return noise_.sigmaRad(); }
     double motionThresholdRad() const;
+    // Whether the noise measured is past kTiltNoiseFitRad (the thresholds then follow it).
+    bool noisierThanDesign() const;
     double holdThresholdRad() const;
     // Why the last refused reading was refused ("" before the first).
     const std::string& lastRefusal() const { return lastRefusal_; }
