@@ -1,5 +1,8 @@
 // Eye and Head Trackers usage page: layout discovery and report decoding.
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -173,19 +176,20 @@ std::string PositionFields::units() const
     if (names[0] == names[1] && names[1] == names[2]) {
         return names[0];
     }
-    // Each unit once, with the axes in it: "mm (x, y), cm (z)".
-    std::string text;
+    // Each unit once, with the axes in it, in the order first named: "mm (x, y), cm (z)".
+    std::vector<std::pair<std::string, std::string>> groups; // unit, its axes
     for (std::size_t i = 0; i < 3; ++i) {
-        if ((i >= 1 && names[0] == names[i]) || (i == 2 && names[1] == names[2])) {
-            continue; // named with an earlier axis
+        const auto g = std::find_if(groups.begin(), groups.end(),
+                                    [&](const auto& e) { return e.first == names[i]; });
+        if (g == groups.end()) {
+            groups.emplace_back(names[i], std::string(1, "xyz"[i]));
+        } else {
+            g->second += fmt::format(", {}", "xyz"[i]);
         }
-        std::string axes(1, "xyz"[i]);
-        for (std::size_t k = i + 1; k < 3; ++k) {
-            if (names[k] == names[i]) {
-                axes += fmt::format(", {}", "xyz"[k]);
-            }
-        }
-        text += fmt::format("{}{} ({})", text.empty() ? "" : ", ", names[i], axes);
+    }
+    std::string text;
+    for (const auto& [unit, axes] : groups) {
+        text += fmt::format("{}{} ({})", text.empty() ? "" : ", ", unit, axes);
     }
     return text;
 }

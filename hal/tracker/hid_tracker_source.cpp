@@ -17,6 +17,14 @@ namespace {
 
 namespace eht = hid::eht;
 
+// A feature report's buffer as hidapi takes it: the ID byte first (0 when reports are not
+// numbered), then the report as the descriptor declares it; at least 2 bytes.
+std::size_t featureBufferBytes(const hid::ReportDescriptor& d, std::uint8_t id)
+{
+    const std::size_t n = d.reportBytes(hid::ReportType::Feature, id) + (d.numberedReports ? 0 : 1);
+    return std::max<std::size_t>(n, 2);
+}
+
 Error deviceError(hid::HidStatus s, const std::string& where, const std::string& doing)
 {
     return Error{s == hid::HidStatus::Gone ? ErrorCode::NotFound : ErrorCode::DeviceFailure,
@@ -97,8 +105,7 @@ Expected<void> HidTrackerReader::configure()
 Expected<std::vector<std::uint8_t>>
 HidTrackerReader::getFeature(const hid::ReportDescriptor& d, std::uint8_t id, const char* doing)
 {
-    const std::size_t n = d.reportBytes(hid::ReportType::Feature, id) + (d.numberedReports ? 0 : 1);
-    std::vector<std::uint8_t> report(std::max<std::size_t>(n, 2), 0);
+    std::vector<std::uint8_t> report(featureBufferBytes(d, id), 0);
     const auto got = device_->getFeature(id, report);
     if (got.status == hid::HidStatus::Gone) {
         return tl::unexpected(deviceError(got.status, description_.where, doing));
@@ -177,15 +184,13 @@ Expected<void> HidTrackerReader::requestMode(const hid::ReportDescriptor& d)
         return {};
     }
     const hid::HidField& f = *layout.modeRequest;
-    const std::size_t n =
-            d.reportBytes(hid::ReportType::Feature, f.reportId) + (d.numberedReports ? 0 : 1);
-    auto got = getFeature(d, f.reportId, "reading the control report");
-    if (!got) {
-        return tl::unexpected(got.error());
+    auto report = getFeature(d, f.reportId, "reading the control report");
+    if (!report) {
+        return tl::unexpected(report.error());
     }
-    std::vector<std::uint8_t> report(std::max<std::size_t>(n, 2), 0);
-    std::copy_n(got->begin(), std::min(got->size(), report.size()), report.begin());
-    report[0] = f.reportId;
+    // What the device did not return (all of it, if it refused the request) is written as 0.
+    report->resize(featureBufferBytes(d, f.reportId), 0);
+    (*report)[0] = f.reportId;
     const int mode = layout.wantedMode();
     if (f.logicalMin < f.logicalMax && (mode < f.logicalMin || mode > f.logicalMax)) {
         // Microsoft's reference descriptor declares 0..1 and its driver expects 2 (eye
@@ -197,8 +202,8 @@ Expected<void> HidTrackerReader::requestMode(const hid::ReportDescriptor& d)
                        "positions",
                        description_.where, mode, f.logicalMin, f.logicalMax);
     }
-    hid::insertField(f, std::span<std::uint8_t>(report).subspan(1), mode);
-    if (const auto s = device_->sendFeature(report); s != hid::HidStatus::Ok) {
+    hid::insertField(f, std::span<std::uint8_t>(*report).subspan(1), mode);
+    if (const auto s = device_->sendFeature(*report); s != hid::HidStatus::Ok) {
         return tl::unexpected(deviceError(s, description_.where,
                                           fmt::format("the device mode request ({})", mode)));
     }
